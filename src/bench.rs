@@ -1,0 +1,102 @@
+//! Benchmark scenes and timing: synthetic occluder clouds of a chosen size, and the example office.
+//!
+//! Owns what `sunlit bench` measures, so the figures in the README come from one place.
+
+use glam::{DMat4, DVec3};
+
+use crate::count::ViewRequest;
+use crate::count::gpu::{Counter, GpuScene};
+use crate::error::Result;
+use crate::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
+
+/// A 10 m × 10 m horizontal receiver at z = 0 under a cloud of `triangles` random small
+/// triangles (0.05–0.5 m) between 0.5 m and 10 m up, spread over 20 m × 20 m.
+pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
+    let mut rng = SplitMix64(seed);
+    let mut b = SceneBuilder::new();
+    let floor = b.add_mesh(
+        "floor",
+        SourceMesh { positions: vec![[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]], indices: vec![0, 1, 2, 0, 2, 3] },
+    );
+    b.add_node(SourceNode { name: "FLOOR".into(), origin: "bench: node 'FLOOR'".into(), mesh: floor, transform: DMat4::IDENTITY, receiver: true });
+    let mut cloud = SourceMesh::default();
+    for t in 0..triangles {
+        let centre = DVec3::new(rng.range(-5.0, 15.0), rng.range(-5.0, 15.0), rng.range(0.5, 10.0));
+        let size = rng.range(0.05, 0.5);
+        for _ in 0..3 {
+            let d = DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * size;
+            let p = centre + d;
+            cloud.positions.push([p.x as f32, p.y as f32, p.z as f32]);
+        }
+        cloud.indices.extend([3 * t as u32, 3 * t as u32 + 1, 3 * t as u32 + 2]);
+    }
+    let mesh = b.add_mesh("cloud", cloud);
+    b.add_node(SourceNode { name: "cloud".into(), origin: "bench: node 'cloud'".into(), mesh, transform: DMat4::IDENTITY, receiver: false });
+    b.build()
+}
+
+/// `count` sun directions spread over the sky above 10° altitude (deterministic).
+pub fn suns(count: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = SplitMix64(seed);
+    (0..count)
+        .map(|_| {
+            let az = rng.range(0.0, std::f64::consts::TAU);
+            let alt = rng.range(10f64.to_radians(), 85f64.to_radians());
+            DVec3::new(az.sin() * alt.cos(), az.cos() * alt.cos(), alt.sin())
+        })
+        .collect()
+}
+
+/// Timing of one benchmark case.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Timing {
+    /// Case name.
+    pub case: String,
+    /// Triangles drawn per view.
+    pub triangles: usize,
+    /// Views requested.
+    pub views: usize,
+    /// Views rendered (not dark).
+    pub rendered: usize,
+    /// Seconds for all views (after one warm-up call).
+    pub seconds: f64,
+    /// Rendered views per second.
+    pub views_per_second: f64,
+}
+
+/// Times `Counter::fractions` over every receiver × sun of a scene; one warm-up call first.
+pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DVec3], now: impl Fn() -> f64) -> Result<Timing> {
+    let gpu: GpuScene = counter.upload(scene)?;
+    let requests: Vec<ViewRequest> =
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+    counter.fractions(&gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
+    let start = now();
+    let counted = counter.fractions(&gpu, &requests).await?;
+    let seconds = now() - start;
+    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    Ok(Timing {
+        case: case.to_string(),
+        triangles: scene.triangle_count(),
+        views: requests.len(),
+        rendered,
+        seconds,
+        views_per_second: rendered as f64 / seconds.max(1e-9),
+    })
+}
+
+/// A small deterministic generator: benchmarks must not depend on a random crate's versions.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -1,0 +1,651 @@
+//! The GPU pixel counter (wgpu; Vulkan/lavapipe natively, WebGPU in the browser).
+//!
+//! Owns the device, the pipelines and the atlas. For each (receiver, sun) view it renders, into
+//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the whole
+//! scene (depth-tested receiver ids); a compute pass counts per tile the pixels where the receiver
+//! is visible and where it is covered. The sunlit fraction is visible / covered: the covered
+//! count is the pixel estimate of the projected area A·cosθ/Ap of the paper's formula, measured
+//! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
+//! surface gives exactly 1. Many views share one submission (tiles of the atlas).
+
+use std::ops::Range;
+use std::sync::{Arc, Mutex};
+
+use glam::{DMat4, DVec3};
+
+use super::view::{self, SunView};
+use super::{ViewRequest, cos_incidence, is_dark};
+use crate::error::{Error, Result};
+use crate::platform;
+use crate::scene::Scene;
+
+const SUN_VIEW_WGSL: &str = include_str!("../../shaders/sun_view.wgsl");
+const COUNT_PIXELS_WGSL: &str = include_str!("../../shaders/count_pixels.wgsl");
+/// Rows of a tile per compute workgroup (the shader's `ROWS_PER_GROUP`).
+const ROWS_PER_GROUP: u32 = 64;
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Batches read back per map: bounds latency and memory while keeping the GPU fed.
+const BATCHES_PER_READBACK: usize = 32;
+
+/// Settings of a [`Counter`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CounterOptions {
+    /// Tile size in pixels (square); 512 gives about three decimals.
+    pub resolution: u32,
+    /// Largest atlas side in pixels; tiles per submission = (atlas / resolution)².
+    pub max_atlas: u32,
+}
+
+impl Default for CounterOptions {
+    fn default() -> Self {
+        Self { resolution: 512, max_atlas: 2048 }
+    }
+}
+
+/// One counted view.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Counted {
+    /// Sunlit fraction in [0, 1].
+    pub fraction: f64,
+    /// Cosine of incidence (normal · sun).
+    pub cos_incidence: f64,
+    /// Pixels where the receiver is visible from the sun (0 when not rendered).
+    pub visible: u32,
+    /// Pixels the receiver covers in its tile (0 when not rendered).
+    pub covered: u32,
+    /// Area per pixel on the view plane (m²; 0 when not rendered).
+    pub pixel_area: f64,
+}
+
+/// The device, pipelines and atlas; reusable across scenes.
+pub struct Counter {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    options: CounterOptions,
+    tiles_per_side: u32,
+    render_layout: wgpu::BindGroupLayout,
+    count_layout: wgpu::BindGroupLayout,
+    scene_pipeline: wgpu::RenderPipeline,
+    mask_pipeline: wgpu::RenderPipeline,
+    count_pipeline: wgpu::ComputePipeline,
+    atlas: Atlas,
+    views: wgpu::Buffer,
+    counts: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+struct Atlas {
+    ids: wgpu::TextureView,
+    mask: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+/// A scene uploaded to a [`Counter`]'s device.
+pub struct GpuScene {
+    meshes: Vec<GpuMesh>,
+    /// Instance slots grouped by mesh: (mesh, slot range).
+    groups: Vec<(usize, Range<u32>)>,
+    instance_count: u32,
+    receivers: Vec<ReceiverView>,
+    bounds: (DVec3, DVec3),
+    origin: DVec3,
+    render_bind: wgpu::BindGroup,
+    count_bind: wgpu::BindGroup,
+}
+
+struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+/// What a view of one receiver needs: where to draw it alone, and how to fit the camera.
+struct ReceiverView {
+    mesh: usize,
+    indices: Range<u32>,
+    slot: u32,
+    points: Vec<DVec3>,
+    normal: DVec3,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuInstance {
+    transform: [[f32; 4]; 4],
+    receiver_base: u32,
+    _pad: [u32; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuView {
+    view_proj: [[f32; 4]; 4],
+    tile: [u32; 2],
+    target_id: u32,
+    _pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuParams {
+    instance_count: u32,
+    resolution: u32,
+    _pad: [u32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuVertex {
+    position: [f32; 3],
+    surface: u32,
+}
+
+impl Counter {
+    /// Opens a device and builds the pipelines and atlas.
+    pub async fn new(options: CounterOptions) -> Result<Self> {
+        let instance = platform::instance();
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions::default())
+            .await
+            .map_err(|e| Error::Gpu(format!("{} ({e})", platform::no_adapter_hint())))?;
+        let limits = adapter.limits();
+        let resolution = options.resolution;
+        if !(16..=limits.max_texture_dimension_2d).contains(&resolution) {
+            return Err(Error::argument(
+                "--resolution",
+                format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
+            ));
+        }
+        let atlas_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d);
+        let tiles_per_side = atlas_side / resolution;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("sunlit"),
+                required_limits: limits,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::Gpu(format!("could not open the GPU device: {e}")))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut list) = sink.lock() {
+                list.push(e.to_string());
+            }
+        }));
+        let render_layout = render_bind_layout(&device);
+        let count_layout = count_bind_layout(&device);
+        let (scene_pipeline, mask_pipeline) = render_pipelines(&device, &render_layout);
+        let count_pipeline = count_pipeline(&device, &count_layout);
+        let side = tiles_per_side * resolution;
+        let atlas = Atlas {
+            ids: attachment(&device, "ids", side, ID_FORMAT, true),
+            mask: attachment(&device, "mask", side, MASK_FORMAT, true),
+            depth: attachment(&device, "depth", side, DEPTH_FORMAT, false),
+        };
+        let tiles = (tiles_per_side * tiles_per_side) as u64;
+        let views = buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let counts = buffer(&device, "counts", tiles * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
+        let readback = buffer(&device, "readback", tiles * 8 * BATCHES_PER_READBACK as u64, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let counter = Self {
+            device,
+            queue,
+            info: adapter.get_info(),
+            options,
+            tiles_per_side,
+            render_layout,
+            count_layout,
+            scene_pipeline,
+            mask_pipeline,
+            count_pipeline,
+            atlas,
+            views,
+            counts,
+            readback,
+            errors,
+        };
+        counter.check_errors("setting up the GPU")?;
+        Ok(counter)
+    }
+
+    /// The adapter in use (name, backend, device type).
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// Tile resolution in pixels.
+    pub fn resolution(&self) -> u32 {
+        self.options.resolution
+    }
+
+    /// Views rendered per submission.
+    pub fn tiles_per_batch(&self) -> usize {
+        (self.tiles_per_side * self.tiles_per_side) as usize
+    }
+
+    fn check_errors(&self, doing: &str) -> Result<()> {
+        let mut list = self.errors.lock().map_err(|_| Error::Gpu("error log poisoned".into()))?;
+        if list.is_empty() {
+            return Ok(());
+        }
+        let all = list.join("; ");
+        list.clear();
+        Err(Error::Gpu(format!("{doing}: {all}")))
+    }
+
+    /// Uploads a scene's geometry once; views of it then cost only draws.
+    pub fn upload(&self, scene: &Scene) -> Result<GpuScene> {
+        use wgpu::util::DeviceExt as _;
+        let meshes: Vec<GpuMesh> = scene
+            .meshes
+            .iter()
+            .map(|m| {
+                let vertices: Vec<GpuVertex> =
+                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect();
+                GpuMesh {
+                    vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.label),
+                        contents: non_empty(bytemuck::cast_slice(&vertices)),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    indices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(&m.label),
+                        contents: non_empty(bytemuck::cast_slice(&m.indices)),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    index_count: m.indices.len() as u32,
+                }
+            })
+            .collect();
+        // Slots: instances sorted by mesh, so each mesh's placements are one instance range.
+        let mut order: Vec<usize> = (0..scene.instances.len()).collect();
+        order.sort_by_key(|&i| scene.instances[i].mesh);
+        let mut slot_of = vec![0u32; order.len()];
+        let mut groups: Vec<(usize, Range<u32>)> = Vec::new();
+        for (slot, &i) in order.iter().enumerate() {
+            slot_of[i] = slot as u32;
+            let mesh = scene.instances[i].mesh;
+            match groups.last_mut() {
+                Some((m, r)) if *m == mesh => r.end = slot as u32 + 1,
+                _ => groups.push((mesh, slot as u32..slot as u32 + 1)),
+            }
+        }
+        groups.retain(|(m, _)| meshes[*m].index_count > 0);
+        let to_scene = DMat4::from_translation(-scene.origin);
+        let instances: Vec<GpuInstance> = order
+            .iter()
+            .map(|&i| {
+                let inst = &scene.instances[i];
+                GpuInstance {
+                    transform: (to_scene * inst.transform).as_mat4().to_cols_array_2d(),
+                    receiver_base: inst.receiver_base,
+                    _pad: [0; 3],
+                }
+            })
+            .collect();
+        let instance_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("instances"),
+            contents: non_empty(bytemuck::cast_slice(&instances)),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let params = GpuParams { instance_count: instances.len().max(1) as u32, resolution: self.options.resolution, _pad: [0; 2] };
+        let params_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let receivers = scene
+            .receivers
+            .iter()
+            .map(|r| ReceiverView {
+                mesh: scene.instances[r.draw.instance].mesh,
+                indices: r.draw.indices.clone(),
+                slot: slot_of[r.draw.instance],
+                points: r.triangles.iter().flatten().copied().collect(),
+                normal: r.normal,
+            })
+            .collect();
+        let render_bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("render"),
+            layout: &self.render_layout,
+            entries: &[
+                entry(0, instance_buffer.as_entire_binding()),
+                entry(1, self.views.as_entire_binding()),
+                entry(2, params_buffer.as_entire_binding()),
+            ],
+        });
+        let count_bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("count"),
+            layout: &self.count_layout,
+            entries: &[
+                entry(0, wgpu::BindingResource::TextureView(&self.atlas.ids)),
+                entry(1, wgpu::BindingResource::TextureView(&self.atlas.mask)),
+                entry(2, self.views.as_entire_binding()),
+                entry(3, params_buffer.as_entire_binding()),
+                entry(4, self.counts.as_entire_binding()),
+            ],
+        });
+        self.check_errors("uploading the scene")?;
+        Ok(GpuScene {
+            meshes,
+            groups,
+            instance_count: params.instance_count,
+            receivers,
+            bounds: scene.bounds,
+            origin: scene.origin,
+            render_bind,
+            count_bind,
+        })
+    }
+
+    /// Sunlit fractions for many (receiver, sun) pairs; dark views (sun down, facing away) cost
+    /// nothing, the others are rendered in batches of atlas tiles.
+    pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
+        let mut out = vec![Counted::default(); requests.len()];
+        let mut lit: Vec<(usize, SunView)> = Vec::new();
+        for (i, req) in requests.iter().enumerate() {
+            let r = scene.receivers.get(req.receiver as usize).ok_or_else(|| {
+                Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
+            })?;
+            out[i].cos_incidence = cos_incidence(r.normal, req.sun);
+            if !is_dark(r.normal, req.sun) {
+                lit.push((i, view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution)));
+            }
+        }
+        let per_batch = self.tiles_per_batch();
+        for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {
+            for (b, batch) in chunk.chunks(per_batch).enumerate() {
+                self.submit_batch(scene, requests, batch, b)?;
+            }
+            let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await?;
+            self.check_errors("counting pixels")?;
+            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
+            for (k, (i, view)) in chunk.iter().enumerate() {
+                let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
+                let o = &mut out[*i];
+                o.visible = visible;
+                o.covered = covered;
+                o.pixel_area = view.pixel_area;
+                o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
+            }
+        }
+        Ok(out)
+    }
+
+    fn tile_origin(&self, slot: usize) -> [u32; 2] {
+        let t = slot as u32;
+        [(t % self.tiles_per_side) * self.options.resolution, (t / self.tiles_per_side) * self.options.resolution]
+    }
+
+    /// Renders and counts one batch of views; results land in `readback` at batch `index`.
+    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)], index: usize) -> Result<()> {
+        let views: Vec<GpuView> = batch
+            .iter()
+            .enumerate()
+            .map(|(slot, (i, view))| GpuView {
+                view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
+                tile: self.tile_origin(slot),
+                target_id: requests[*i].receiver,
+                _pad: 0,
+            })
+            .collect();
+        self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
+        encoder.clear_buffer(&self.counts, 0, None);
+        self.render_tiles(&mut encoder, scene, requests, batch);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("count"), timestamp_writes: None });
+            pass.set_pipeline(&self.count_pipeline);
+            pass.set_bind_group(0, &scene.count_bind, &[]);
+            pass.dispatch_workgroups(self.options.resolution.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
+        }
+        let bytes = (batch.len() * 8) as u64;
+        let offset = (index * self.tiles_per_batch() * 8) as u64;
+        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.readback, offset, bytes);
+        self.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)]) {
+        let clear_id = wgpu::Color { r: crate::scene::NO_RECEIVER as f64, g: 0.0, b: 0.0, a: 0.0 };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("sun views"),
+            color_attachments: &[color(&self.atlas.ids, clear_id), color(&self.atlas.mask, wgpu::Color::TRANSPARENT)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.atlas.depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_bind_group(0, &scene.render_bind, &[]);
+        let res = self.options.resolution;
+        for (slot, (i, _)) in batch.iter().enumerate() {
+            let [x, y] = self.tile_origin(slot);
+            pass.set_viewport(x as f32, y as f32, res as f32, res as f32, 0.0, 1.0);
+            pass.set_scissor_rect(x, y, res, res);
+            let first = slot as u32 * scene.instance_count;
+            // The receiver alone: its coverage, the denominator.
+            let r = &scene.receivers[requests[*i].receiver as usize];
+            let mesh = &scene.meshes[r.mesh];
+            pass.set_pipeline(&self.mask_pipeline);
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+            // Everything, depth-tested: where the receiver's id survives, it is sunlit.
+            pass.set_pipeline(&self.scene_pipeline);
+            for (m, slots) in &scene.groups {
+                let mesh = &scene.meshes[*m];
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..mesh.index_count, 0, first + slots.start..first + slots.end);
+            }
+        }
+    }
+
+    /// Reads back the id atlas (for tests comparing the compute count with a CPU count).
+    pub async fn read_ids(&self) -> Result<(u32, Vec<u32>)> {
+        let side = self.tiles_per_side * self.options.resolution;
+        let bytes_per_row = side * 4;
+        let size = (bytes_per_row * side) as u64;
+        let target = buffer(&self.device, "ids readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read ids") });
+        let texture = self.atlas.ids.texture();
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &target,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(bytes_per_row), rows_per_image: None },
+            },
+            texture.size(),
+        );
+        self.queue.submit([encoder.finish()]);
+        let bytes = platform::read_buffer(&self.device, &target, size).await?;
+        self.check_errors("reading the id atlas")?;
+        Ok((side, bytemuck::cast_slice(&bytes).to_vec()))
+    }
+
+    /// Where view `slot` of the last batch was drawn (top-left pixel).
+    pub fn tile_of(&self, slot: usize) -> [u32; 2] {
+        self.tile_origin(slot)
+    }
+}
+
+impl GpuScene {
+    /// World origin the GPU coordinates are relative to.
+    pub fn origin(&self) -> DVec3 {
+        self.origin
+    }
+}
+
+fn color(view: &wgpu::TextureView, clear: wgpu::Color) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+    })
+}
+
+/// wgpu refuses zero-sized buffer initialisation in some paths; an empty mesh gets 16 bytes.
+fn non_empty(bytes: &[u8]) -> &[u8] {
+    if bytes.is_empty() { &[0u8; 16] } else { bytes }
+}
+
+fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource }
+}
+
+fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+}
+
+fn attachment(device: &wgpu::Device, label: &str, side: u32, format: wgpu::TextureFormat, sampled: bool) -> wgpu::TextureView {
+    let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if sampled {
+        usage |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    }
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+fn uint_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn render_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vs = wgpu::ShaderStages::VERTEX;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("render"),
+        entries: &[storage_entry(0, vs, true), storage_entry(1, vs, true), uniform_entry(2, vs)],
+    })
+}
+
+fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let cs = wgpu::ShaderStages::COMPUTE;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("count"),
+        entries: &[uint_texture_entry(0), uint_texture_entry(1), storage_entry(2, cs, true), uniform_entry(3, cs), storage_entry(4, cs, false)],
+    })
+}
+
+/// The scene pipeline (depth-tested ids) and the mask pipeline (the receiver alone, always
+/// passing, no depth write); they differ only in depth state and colour write masks.
+fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgpu::RenderPipeline, wgpu::RenderPipeline) {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("sun_view.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("sun view"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32];
+    let make = |label: &str, depth_write: bool, compare: wgpu::CompareFunction, ids: wgpu::ColorWrites, mask: wgpu::ColorWrites| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: size_of::<GpuVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(depth_write),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[
+                    Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: ids }),
+                    Some(wgpu::ColorTargetState { format: MASK_FORMAT, blend: None, write_mask: mask }),
+                ],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let none = wgpu::ColorWrites::empty();
+    let all = wgpu::ColorWrites::ALL;
+    (
+        make("scene", true, wgpu::CompareFunction::Less, all, none),
+        make("mask", false, wgpu::CompareFunction::Always, none, all),
+    )
+}
+
+fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("count_pixels.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(COUNT_PIXELS_WGSL.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("count"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("count"),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("count_main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// WGSL sources, for validation in tests.
+pub const SHADERS: [(&str, &str); 2] = [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL)];

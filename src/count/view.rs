@@ -1,0 +1,194 @@
+//! Fitting an orthographic sun view to one receiver: the camera looks along the sun's rays.
+//!
+//! Owns the view geometry shared by every counting backend:
+//! - the side planes are parallel to the rays and enclose the receiver's projection with the
+//!   smallest-area rectangle (rotating calipers on its convex hull), so long thin or steeply
+//!   inclined surfaces still fill the tile; pixels may be non-square, which counting does not mind;
+//! - a margin of at least one pixel on every side, so no receiver pixel touches the tile edge;
+//! - depth runs from the scene's bound towards the sun (near) to just behind the receiver (far):
+//!   nothing outside the scene can shade, and geometry behind the receiver is clipped away.
+
+use glam::{DMat4, DVec2, DVec3, DVec4};
+
+/// An orthographic view of one receiver along one sun direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SunView {
+    /// Scene coordinates *relative to the scene origin* → clip space (x, y in [−1, 1], z in [0, 1]).
+    pub view_proj: DMat4,
+    /// Area on the view plane covered by one pixel (m²).
+    pub pixel_area: f64,
+}
+
+/// Fits the view. `points` are the receiver's vertices and `bounds` the scene's, both in world
+/// coordinates; `sun` points towards the sun (unit); `resolution` is the tile size in pixels.
+pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, resolution: u32) -> SunView {
+    let (u0, v0) = perpendicular_basis(sun);
+    let rel: Vec<DVec3> = points.iter().map(|p| *p - origin).collect();
+    let flat: Vec<DVec2> = rel.iter().map(|p| DVec2::new(p.dot(u0), p.dot(v0))).collect();
+    let (angle, lo, hi) = min_area_rectangle(&flat);
+    let (c, s) = (angle.cos(), angle.sin());
+    let u = u0 * c + v0 * s;
+    let v = v0 * c - u0 * s;
+
+    let res = resolution.max(4) as f64;
+    let extent = (bounds.1 - bounds.0).length().max(1e-3);
+    // At least one pixel of margin on each side: the shape spans at most res − 2 pixels.
+    let grow = |a: f64, b: f64| {
+        let span = (b - a).max(extent * 1e-9);
+        let half = 0.5 * span * res / (res - 2.0);
+        (0.5 * (a + b), half)
+    };
+    let (uc, uh) = grow(lo.x, hi.x);
+    let (vc, vh) = grow(lo.y, hi.y);
+
+    let near = corners(bounds).iter().map(|p| (*p - origin).dot(sun)).fold(f64::NEG_INFINITY, f64::max);
+    let far = rel.iter().map(|p| p.dot(sun)).fold(f64::INFINITY, f64::min);
+    // Pads keep the scene's nearest point and the receiver's farthest point strictly inside [0, 1].
+    let pad = extent * 1e-4;
+    let (near, far) = (near + pad, far - pad);
+    let depth = (near - far).max(pad);
+
+    let rows = [
+        (u / uh).extend(-uc / uh),
+        (v / vh).extend(-vc / vh),
+        (-sun / depth).extend(near / depth),
+        DVec4::W,
+    ];
+    let view_proj = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
+    SunView { view_proj, pixel_area: (2.0 * uh) * (2.0 * vh) / (res * res) }
+}
+
+/// Two unit vectors completing `w` to a right-handed orthonormal basis.
+fn perpendicular_basis(w: DVec3) -> (DVec3, DVec3) {
+    let helper = if w.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
+    let u = helper.cross(w).normalize();
+    (u, w.cross(u))
+}
+
+fn corners((lo, hi): (DVec3, DVec3)) -> [DVec3; 8] {
+    std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
+/// Smallest-area enclosing rectangle: its rotation angle and its extents in the rotated frame.
+/// One side of the optimum lies along a hull edge, so trying every hull edge finds it.
+fn min_area_rectangle(points: &[DVec2]) -> (f64, DVec2, DVec2) {
+    let hull = convex_hull(points);
+    let mut best = (f64::INFINITY, 0.0, DVec2::ZERO, DVec2::ZERO);
+    let mut candidates: Vec<f64> = vec![0.0];
+    for i in 0..hull.len() {
+        let e = hull[(i + 1) % hull.len()] - hull[i];
+        if e.length_squared() > 0.0 {
+            candidates.push(e.y.atan2(e.x));
+        }
+    }
+    for angle in candidates {
+        let (lo, hi) = rotated_extents(points, angle);
+        let area = (hi.x - lo.x) * (hi.y - lo.y);
+        // Prefer strictly smaller areas so near-ties keep the first (axis-aligned) frame.
+        if area < best.0 * (1.0 - 1e-12) {
+            best = (area, angle, lo, hi);
+        }
+    }
+    (best.1, best.2, best.3)
+}
+
+fn rotated_extents(points: &[DVec2], angle: f64) -> (DVec2, DVec2) {
+    let (c, s) = (angle.cos(), angle.sin());
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for p in points {
+        let q = DVec2::new(c * p.x + s * p.y, -s * p.x + c * p.y);
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    (lo, hi)
+}
+
+/// Andrew's monotone chain; returns the hull counter-clockwise without repeating the first point.
+fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
+    let mut p: Vec<DVec2> = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
+        for &q in iter {
+            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn clip(view: &SunView, p: DVec3) -> DVec3 {
+        view.view_proj.transform_point3(p)
+    }
+
+    #[test]
+    fn receiver_fills_the_tile_with_a_pixel_margin() {
+        // A 4 m × 1 m south wall, sun from the south-west, low.
+        let pts = [DVec3::new(0., 0., 0.), DVec3::new(4., 0., 0.), DVec3::new(4., 0., 1.), DVec3::new(0., 0., 1.)];
+        let sun = DVec3::new(-0.5, -0.7, 0.3).normalize();
+        let bounds = (DVec3::new(-5., -5., 0.), DVec3::new(5., 5., 3.));
+        let origin = DVec3::new(1.0, 2.0, 0.5);
+        let view = fit(&pts, sun, bounds, origin, 512);
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for p in pts {
+            let c = clip(&view, p - origin);
+            lo = lo.min(c);
+            hi = hi.max(c);
+        }
+        let margin = 2.0 / 512.0;
+        assert!((lo.x + 1.0 - margin).abs() < 1e-9 && (hi.x - 1.0 + margin).abs() < 1e-9, "{lo} {hi}");
+        assert!((lo.y + 1.0 - margin).abs() < 1e-9 && (hi.y - 1.0 + margin).abs() < 1e-9, "{lo} {hi}");
+        assert!(lo.z > 0.0 && hi.z < 1.0);
+        // Projected area = A·cosθ; the rectangle here is the projected parallelogram's box,
+        // so pixel count of the full tile interior ≥ projected area.
+        let cos = DVec3::new(0., -1., 0.).dot(sun);
+        assert!(view.pixel_area * 510.0 * 510.0 >= 4.0 * cos - 1e-9);
+    }
+
+    #[test]
+    fn every_scene_point_lies_in_front_of_the_near_plane() {
+        let pts = [DVec3::new(0., 0., 0.), DVec3::new(1., 0., 0.), DVec3::new(0., 0., 1.)];
+        let sun = DVec3::new(0.2, -0.9, 0.4).normalize();
+        let bounds = (DVec3::new(-10., -10., 0.), DVec3::new(10., 10., 30.));
+        let view = fit(&pts, sun, bounds, DVec3::ZERO, 256);
+        for c in corners(bounds) {
+            assert!(clip(&view, c).z > 0.0);
+        }
+        // Closer to the sun means smaller depth.
+        assert!(clip(&view, sun).z < clip(&view, DVec3::ZERO).z);
+    }
+
+    #[test]
+    fn hull_and_rectangle_of_a_rotated_square() {
+        let a = 0.3f64;
+        let pts: Vec<DVec2> = [(0., 0.), (1., 0.), (1., 1.), (0., 1.), (0.5, 0.5)]
+            .iter()
+            .map(|&(x, y)| DVec2::new(x * a.cos() - y * a.sin(), x * a.sin() + y * a.cos()))
+            .collect();
+        assert_eq!(convex_hull(&pts).len(), 4);
+        let (_, lo, hi) = min_area_rectangle(&pts);
+        assert!(((hi.x - lo.x) * (hi.y - lo.y) - 1.0).abs() < 1e-9);
+    }
+}

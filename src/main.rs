@@ -1,0 +1,227 @@
+//! `sunlit`, the command line: a thin edge over the library.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::{Args, Parser, Subcommand};
+use serde_json::json;
+
+use sunlit::count::gpu::{Counted, Counter, CounterOptions};
+use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::model::{self, LoadOptions};
+use sunlit::scene::Scene;
+use sunlit::sun::SunPosition;
+use sunlit::{Error, Result, bench};
+
+#[derive(Parser)]
+#[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces by GPU pixel counting")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Sunlit fraction of every receiver for one sun position.
+    Fraction(FractionArgs),
+    /// List receivers (name, area, normal) and occluder counts.
+    Info(InfoArgs),
+    /// Views per second on synthetic occluder clouds and the example office.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct ModelArgs {
+    /// glTF/glb model files; all cast shadows.
+    #[arg(required = true, value_name = "MODEL")]
+    models: Vec<PathBuf>,
+    /// Receivers: glob over node names (case-insensitive); repeatable.
+    #[arg(long = "receivers", value_name = "GLOB")]
+    receivers: Vec<String>,
+    /// Degrees clockwise from true north of the model's north (glTF −Z).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    north: f64,
+}
+
+impl ModelArgs {
+    fn load(&self) -> Result<Scene> {
+        model::load(&self.models, &LoadOptions { receivers: self.receivers.clone(), north: self.north })
+    }
+}
+
+#[derive(Args)]
+struct FractionArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Sun position: azimuth (degrees clockwise from north), altitude (degrees above the horizon).
+    #[arg(long, value_name = "AZ,ALT", allow_hyphen_values = true)]
+    sun: String,
+    /// Tile size in pixels.
+    #[arg(long, default_value_t = 512)]
+    resolution: u32,
+    /// Use the exact CPU polygon-clipping reference instead of the GPU.
+    #[arg(long)]
+    exact: bool,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Occluder triangle counts for the synthetic cases.
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
+    triangles: Vec<usize>,
+    /// Sun directions per case.
+    #[arg(long, default_value_t = 64)]
+    suns: usize,
+    /// Tile size in pixels.
+    #[arg(long, default_value_t = 512)]
+    resolution: u32,
+    /// Extra models to time (every receiver × every sun).
+    models: Vec<PathBuf>,
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Fraction(a) => fraction(a),
+        Command::Info(a) => info(a),
+        Command::Bench(a) => run_bench(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn counter(resolution: u32) -> Result<Counter> {
+    pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))
+}
+
+fn fraction(args: FractionArgs) -> Result<()> {
+    let sun = SunPosition::parse(&args.sun)?;
+    let scene = args.model.load()?;
+    let dir = sun.direction();
+    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
+    let counted: Vec<Counted> = if args.exact {
+        exact::sunlit_fractions(&scene, &requests)
+            .into_iter()
+            .zip(&scene.receivers)
+            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
+            .collect()
+    } else {
+        let counter = counter(args.resolution)?;
+        let gpu = counter.upload(&scene)?;
+        pollster::block_on(counter.fractions(&gpu, &requests))?
+    };
+    if args.json {
+        let surfaces: Vec<_> = scene
+            .receivers
+            .iter()
+            .zip(&counted)
+            .map(|(r, c)| json!({"name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6), "cos_incidence": round(c.cos_incidence, 6)}))
+            .collect();
+        let out = json!({
+            "sun": {"azimuth": sun.azimuth, "altitude": sun.altitude},
+            "resolution": args.resolution,
+            "method": if args.exact { "exact" } else { "gpu" },
+            "surfaces": surfaces,
+        });
+        println!("{out:#}");
+        return Ok(());
+    }
+    let method = if args.exact { "exact polygon clipping".to_string() } else { format!("GPU pixel counting, {0}×{0}", args.resolution) };
+    println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
+    let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
+    println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
+    for (r, c) in scene.receivers.iter().zip(&counted) {
+        println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
+    }
+    Ok(())
+}
+
+fn round(x: f64, digits: i32) -> f64 {
+    let k = 10f64.powi(digits);
+    (x * k).round() / k
+}
+
+fn info(args: InfoArgs) -> Result<()> {
+    let scene = args.model.load()?;
+    let receivers: Vec<_> = scene
+        .receivers
+        .iter()
+        .map(|r| json!({"name": r.name, "area": round(r.area, 6), "normal": [round(r.normal.x, 6), round(r.normal.y, 6), round(r.normal.z, 6)], "source": r.origin}))
+        .collect();
+    let (lo, hi) = scene.bounds;
+    if args.json {
+        let out = json!({
+            "receivers": receivers,
+            "triangles": scene.triangle_count(),
+            "meshes": scene.meshes.len(),
+            "instances": scene.instances.len(),
+            "bounds": {"min": [lo.x, lo.y, lo.z], "max": [hi.x, hi.y, hi.z]},
+        });
+        println!("{out:#}");
+        return Ok(());
+    }
+    println!(
+        "{} receivers; {} triangles cast shadows ({} shared meshes, {} placements); bounds ({:.2}, {:.2}, {:.2}) – ({:.2}, {:.2}, {:.2}) m",
+        scene.receivers.len(),
+        scene.triangle_count(),
+        scene.meshes.len() - 1,
+        scene.instances.len() - 1,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z
+    );
+    let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
+    println!("{:<width$}  {:>10}  normal (x east, y north, z up)", "surface", "area m²");
+    for r in &scene.receivers {
+        println!("{:<width$}  {:>10.3}  ({:+.3}, {:+.3}, {:+.3})", r.name, r.area, r.normal.x, r.normal.y, r.normal.z);
+    }
+    Ok(())
+}
+
+fn run_bench(args: BenchArgs) -> Result<()> {
+    if args.suns == 0 {
+        return Err(Error::argument("--suns", "must be at least 1"));
+    }
+    let counter = counter(args.resolution)?;
+    let info = counter.adapter_info();
+    eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
+    let start = Instant::now();
+    let now = move || start.elapsed().as_secs_f64();
+    let suns = bench::suns(args.suns, 7);
+    let mut cases: Vec<(String, Scene)> = Vec::new();
+    for &n in &args.triangles {
+        cases.push((format!("cloud {n}"), bench::occluder_cloud(n, 42)?));
+    }
+    let office = sunlit::model::office::office(6).to_glb();
+    cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
+    for path in &args.models {
+        cases.push((path.display().to_string(), model::load(std::slice::from_ref(path), &LoadOptions::default())?));
+    }
+    for (name, scene) in &cases {
+        let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+    }
+    Ok(())
+}

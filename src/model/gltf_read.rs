@@ -1,0 +1,314 @@
+//! glTF 2.0 reader (.gltf and .glb, from a path or from bytes) into [`SourceNode`]s and meshes.
+//!
+//! Owns: resolving buffers (GLB chunk, `data:` URIs, files beside a `.gltf`), reading positions
+//! and indices with explicit bounds checks (a hostile file must give an error, never a panic),
+//! node transforms, the glTF → sunlit axis change (x, y, z) = (gx, −gz, gy) and the north rotation.
+
+use std::path::Path;
+
+use base64::Engine as _;
+use glam::{DMat4, DVec4};
+
+use crate::error::{Error, Result};
+use crate::scene::{SourceMesh, SourceNode};
+
+/// One glTF file, read: its meshes (one per glTF mesh, primitives merged) and mesh nodes.
+#[derive(Debug, Clone)]
+pub struct GltfModel {
+    /// File label used in messages.
+    pub file: String,
+    /// Meshes in glTF mesh order.
+    pub meshes: Vec<SourceMesh>,
+    /// Nodes that place a mesh, with world transforms; `receiver` is the extras mark.
+    pub nodes: Vec<GltfNode>,
+}
+
+/// A mesh node of a glTF file.
+#[derive(Debug, Clone)]
+pub struct GltfNode {
+    /// The node's name, or `node<index>` when it has none.
+    pub name: String,
+    /// Whether the file named it (default receivers are the named nodes).
+    pub named: bool,
+    /// Marked `{"sunlit": {"receiver": true}}` in its extras.
+    pub marked: bool,
+    /// Index into [`GltfModel::meshes`].
+    pub mesh: usize,
+    /// Mesh → world (sunlit axes).
+    pub transform: DMat4,
+}
+
+impl GltfNode {
+    /// `file: node 'name'`.
+    pub fn origin(&self, file: &str) -> String {
+        format!("{file}: node '{}'", self.name)
+    }
+}
+
+/// glTF axes → sunlit axes: (x, y, z) = (gx, −gz, gy).
+pub fn gltf_to_world() -> DMat4 {
+    DMat4::from_cols(DVec4::X, DVec4::Z, -DVec4::Y, DVec4::W)
+}
+
+/// Reads a .gltf or .glb file; external buffers are looked up beside it.
+pub fn read_path(path: &Path, north_deg: f64) -> Result<GltfModel> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let dir = path.parent().map(Path::to_path_buf);
+    let file = path.display().to_string();
+    read_with(&file, &bytes, north_deg, |uri| match &dir {
+        Some(d) => std::fs::read(d.join(uri)).map_err(|e| format!("external buffer '{uri}' could not be read: {e}")),
+        None => Err(format!("external buffer '{uri}' could not be read")),
+    })
+}
+
+/// Reads glTF from bytes (the web path): external buffers are not available and give an error.
+pub fn read_bytes(file: &str, bytes: &[u8], north_deg: f64) -> Result<GltfModel> {
+    read_with(file, bytes, north_deg, |uri| Err(format!("external buffer '{uri}' was not given (use a .glb, or embed buffers as data: URIs)")))
+}
+
+fn read_with(file: &str, bytes: &[u8], north_deg: f64, external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>) -> Result<GltfModel> {
+    check_magic(file, bytes)?;
+    let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
+    let buffers = load_buffers(file, &gltf, external)?;
+    let meshes = gltf
+        .document
+        .meshes()
+        .map(|m| read_mesh(file, &m, &buffers))
+        .collect::<Result<Vec<_>>>()?;
+    let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
+    let mut nodes = Vec::new();
+    for root in scene_roots(&gltf.document) {
+        collect_nodes(file, &root, world, &mut nodes, 0)?;
+    }
+    Ok(GltfModel { file: file.to_string(), meshes, nodes })
+}
+
+fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
+    let first = bytes.iter().find(|b| !b.is_ascii_whitespace()).copied();
+    if bytes.starts_with(b"glTF") || first == Some(b'{') {
+        return Ok(());
+    }
+    if bytes.is_empty() {
+        return Err(Error::model(file, "the file is empty"));
+    }
+    Err(Error::model(file, "not a glTF file: expected the binary magic 'glTF' or a JSON object"))
+}
+
+fn load_buffers(file: &str, gltf: &::gltf::Gltf, external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>) -> Result<Vec<Vec<u8>>> {
+    let mut out = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let data = match buffer.source() {
+            ::gltf::buffer::Source::Bin => gltf
+                .blob
+                .clone()
+                .ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?,
+            ::gltf::buffer::Source::Uri(uri) => match uri.strip_prefix("data:") {
+                Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {}: {r}", buffer.index())))?,
+                None => external(uri).map_err(|r| Error::model(file, r))?,
+            },
+        };
+        if data.len() < buffer.length() {
+            return Err(Error::model(
+                file,
+                format!("buffer {} is truncated: {} bytes present, {} declared", buffer.index(), data.len(), buffer.length()),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn decode_data_uri(rest: &str) -> std::result::Result<Vec<u8>, String> {
+    let (_, payload) = rest.split_once(";base64,").ok_or("data: URI is not base64")?;
+    base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64 data: {e}"))
+}
+
+/// The nodes to walk: the default scene's, else the first scene's, else every parentless node.
+fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
+    if let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) {
+        return scene.nodes().collect();
+    }
+    let mut has_parent = vec![false; doc.nodes().len()];
+    for n in doc.nodes() {
+        for c in n.children() {
+            has_parent[c.index()] = true;
+        }
+    }
+    doc.nodes().filter(|n| !has_parent[n.index()]).collect()
+}
+
+/// glTF forbids cycles, but a hostile file may contain one: stop well before the stack does.
+const MAX_DEPTH: usize = 256;
+
+fn collect_nodes(file: &str, node: &::gltf::Node, parent: DMat4, out: &mut Vec<GltfNode>, depth: usize) -> Result<()> {
+    let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
+    if depth > MAX_DEPTH {
+        return Err(Error::object(file, format!("node '{name}'"), "node hierarchy is deeper than 256 levels (a cycle?)"));
+    }
+    let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+    let world = parent * local;
+    if let Some(mesh) = node.mesh() {
+        out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(node), mesh: mesh.index(), transform: world });
+    }
+    for child in node.children() {
+        collect_nodes(file, &child, world, out, depth + 1)?;
+    }
+    Ok(())
+}
+
+fn is_marked(node: &::gltf::Node) -> bool {
+    let Some(raw) = node.extras() else { return false };
+    let value: serde_json::Value = serde_json::from_str(raw.get()).unwrap_or_default();
+    value.pointer("/sunlit/receiver").and_then(serde_json::Value::as_bool).unwrap_or(false)
+}
+
+fn read_mesh(file: &str, mesh: &::gltf::Mesh, buffers: &[Vec<u8>]) -> Result<SourceMesh> {
+    let object = format!("mesh {} '{}'", mesh.index(), mesh.name().unwrap_or(""));
+    let err = |reason: String| Error::object(file, object.clone(), reason);
+    let mut out = SourceMesh::default();
+    for prim in mesh.primitives() {
+        let Some(pos) = prim.get(&::gltf::Semantic::Positions) else {
+            return Err(err(format!("primitive {} has no POSITION attribute", prim.index())));
+        };
+        let positions = read_positions(&pos, buffers).map_err(&err)?;
+        let indices = match prim.indices() {
+            Some(acc) => read_indices(&acc, buffers).map_err(&err)?,
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(err(format!("index {bad} out of range ({} vertices)", positions.len())));
+        }
+        let base = out.positions.len() as u32;
+        let tris = triangles(prim.mode(), &indices).map_err(&err)?;
+        out.indices.extend(tris.iter().map(|i| i + base));
+        out.positions.extend(positions);
+    }
+    Ok(out)
+}
+
+/// Triangle list from a primitive's index stream; points and lines cast no shadow.
+fn triangles(mode: ::gltf::mesh::Mode, idx: &[u32]) -> std::result::Result<Vec<u32>, String> {
+    use ::gltf::mesh::Mode;
+    Ok(match mode {
+        Mode::Triangles => idx[..idx.len() - idx.len() % 3].to_vec(),
+        Mode::TriangleStrip => (2..idx.len())
+            .flat_map(|i| if i % 2 == 0 { [idx[i - 2], idx[i - 1], idx[i]] } else { [idx[i - 1], idx[i - 2], idx[i]] })
+            .collect(),
+        Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
+        Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
+    })
+}
+
+/// The bytes of an accessor's elements, bounds-checked against its view and buffer.
+fn accessor_bytes<'a>(acc: &::gltf::Accessor, buffers: &'a [Vec<u8>], elem: usize) -> std::result::Result<(&'a [u8], usize), String> {
+    if acc.sparse().is_some() {
+        return Err(format!("accessor {} is sparse, which is not supported", acc.index()));
+    }
+    let view = acc.view().ok_or_else(|| format!("accessor {} has no buffer view", acc.index()))?;
+    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| format!("buffer {} is missing", view.buffer().index()))?;
+    let stride = view.stride().unwrap_or(elem);
+    let start = view.offset().checked_add(acc.offset()).ok_or("offset overflow")?;
+    let view_end = view.offset().checked_add(view.length()).ok_or("offset overflow")?;
+    let need = match acc.count() {
+        0 => 0,
+        n => stride.checked_mul(n - 1).and_then(|x| x.checked_add(elem)).ok_or("size overflow")?,
+    };
+    let end = start.checked_add(need).ok_or("size overflow")?;
+    if end > view_end || view_end > buffer.len() {
+        return Err(format!(
+            "accessor {} reads bytes {start}..{end} beyond its buffer view (ends at {view_end}) or buffer ({} bytes)",
+            acc.index(),
+            buffer.len()
+        ));
+    }
+    Ok((&buffer[start..end], stride))
+}
+
+fn read_positions(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<[f32; 3]>, String> {
+    use ::gltf::accessor::{DataType, Dimensions};
+    if acc.data_type() != DataType::F32 || acc.dimensions() != Dimensions::Vec3 {
+        return Err(format!("POSITION accessor {} must be float VEC3 (quantized positions are not supported)", acc.index()));
+    }
+    let (bytes, stride) = accessor_bytes(acc, buffers, 12)?;
+    Ok((0..acc.count())
+        .map(|i| {
+            let f = |k: usize| {
+                let o = i * stride + 4 * k;
+                f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]])
+            };
+            [f(0), f(1), f(2)]
+        })
+        .collect())
+}
+
+fn read_indices(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<u32>, String> {
+    use ::gltf::accessor::{DataType, Dimensions};
+    let size = match acc.data_type() {
+        DataType::U8 => 1,
+        DataType::U16 => 2,
+        DataType::U32 => 4,
+        other => return Err(format!("index accessor {} has type {other:?}; expected an unsigned integer", acc.index())),
+    };
+    if acc.dimensions() != Dimensions::Scalar {
+        return Err(format!("index accessor {} is not SCALAR", acc.index()));
+    }
+    let (bytes, stride) = accessor_bytes(acc, buffers, size)?;
+    Ok((0..acc.count())
+        .map(|i| {
+            let o = i * stride;
+            match size {
+                1 => bytes[o] as u32,
+                2 => u16::from_le_bytes([bytes[o], bytes[o + 1]]) as u32,
+                _ => u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]),
+            }
+        })
+        .collect())
+}
+
+impl GltfModel {
+    /// Adds this model's meshes and nodes to a scene builder, choosing receivers with `is_receiver`.
+    pub fn add_to(self, builder: &mut crate::scene::SceneBuilder, mut is_receiver: impl FnMut(&GltfNode) -> bool) {
+        let file = self.file;
+        let base: Vec<usize> = self
+            .meshes
+            .into_iter()
+            .enumerate()
+            .map(|(i, m)| builder.add_mesh(format!("{file}: mesh {i}"), m))
+            .collect();
+        for node in self.nodes {
+            let receiver = is_receiver(&node);
+            builder.add_node(SourceNode {
+                origin: node.origin(&file),
+                mesh: base[node.mesh],
+                transform: node.transform,
+                receiver,
+                name: node.name,
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn axes_map_gltf_up_and_north() {
+        let m = gltf_to_world();
+        // glTF +Y (up) → z; glTF −Z (north) → +y; glTF +X (east) → +x.
+        assert_eq!(m.transform_point3(DVec3::Y), DVec3::Z);
+        assert_eq!(m.transform_point3(-DVec3::Z), DVec3::Y);
+        assert_eq!(m.transform_point3(DVec3::X), DVec3::X);
+        // A determinant of +1: a rotation, so triangle winding (outward normals) is kept.
+        assert!((m.determinant() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn garbage_is_refused_with_the_file_named() {
+        for (bytes, needle) in [(&b""[..], "empty"), (b"PK\x03\x04", "not a glTF"), (b"glTF\x02\x00\x00\x00", "not a valid glTF")] {
+            let e = read_bytes("x.glb", bytes, 0.0).unwrap_err().to_string();
+            assert!(e.starts_with("x.glb: ") && e.contains(needle), "{e}");
+        }
+    }
+}

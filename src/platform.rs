@@ -1,0 +1,59 @@
+//! The one place where native and web differ: instance set-up and waiting for GPU → CPU reads.
+//!
+//! Natively the thread blocks in `Device::poll` until the map completes; on the web `poll` is a
+//! no-op and blocking would freeze the page, so the map's callback completes a future instead.
+
+use crate::error::{Error, Result};
+
+/// The wgpu instance for this platform: the browser's WebGPU on the web; natively Vulkan, Metal
+/// or DX12, overridable with `WGPU_BACKEND` (e.g. `vulkan`).
+pub(crate) fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    if cfg!(target_arch = "wasm32") {
+        desc.backends = wgpu::Backends::BROWSER_WEBGPU;
+    } else if wgpu::Backends::from_env().is_none() {
+        desc.backends = wgpu::Backends::PRIMARY;
+    }
+    wgpu::Instance::new(desc)
+}
+
+/// What to tell a user who has no adapter at all.
+pub(crate) fn no_adapter_hint() -> &'static str {
+    if cfg!(target_arch = "wasm32") {
+        "this browser offers no WebGPU adapter (try a current Chrome or Edge, or enable WebGPU)"
+    } else {
+        "no GPU adapter found; on Debian install a software Vulkan driver with `apt-get install mesa-vulkan-drivers`"
+    }
+}
+
+/// Maps `buffer` (MAP_READ) and copies out its first `size` bytes.
+pub(crate) async fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+    let slice = buffer.slice(..size);
+    let (sender, receiver) = futures_channel::oneshot::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        // The receiver only goes away if the caller was dropped; nothing to report then.
+        let _ = sender.send(result);
+    });
+    wait_for_maps(device)?;
+    receiver
+        .await
+        .map_err(|_| Error::Gpu("the GPU device went away while reading results".into()))?
+        .map_err(|e| Error::Gpu(format!("reading results back failed: {e}")))?;
+    let bytes = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping results failed: {e}")))?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+fn wait_for_maps(device: &wgpu::Device) -> Result<()> {
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))
+}
+
+#[cfg(target_arch = "wasm32")]
+fn wait_for_maps(_device: &wgpu::Device) -> Result<()> {
+    // The browser resolves the map on its own event loop; the future above is awaited instead.
+    Ok(())
+}

@@ -1,0 +1,526 @@
+//! The scene: the triangles that cast shadows and the planar surfaces that receive sun.
+//!
+//! Owns the step from "nodes read from model files" to a render-ready layout:
+//! - world axes are EnergyPlus's: x east, y north, z up, metres;
+//! - a mesh used by one node is baked into world coordinates and merged with the others into
+//!   one static mesh (one draw per view); a mesh used by several nodes stays shared and is drawn
+//!   instanced, so instanced geometry is never copied per instance;
+//! - every receiving node is split into planar parts (one receiver each), because a sunlit
+//!   fraction is only defined for a plane; every receiver also casts shadows.
+//!
+//! GPU surface ids: a vertex carries a `surface` value, an instance a `receiver_base`; the id a
+//! triangle writes is `receiver_base + surface`, or [`NO_RECEIVER`] when either is [`NO_RECEIVER`].
+//! The merged static mesh has base 0 and absolute receiver ids in its vertices.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::{DMat4, DVec3};
+
+use crate::error::{Error, Result};
+
+/// Surface id of geometry that only casts shadows.
+pub const NO_RECEIVER: u32 = u32::MAX;
+
+/// Two triangles are coplanar when their normals are within this angle (radians)…
+const COPLANAR_ANGLE: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// …and every vertex lies within this distance (metres) of the part's plane.
+const COPLANAR_DISTANCE: f64 = 1e-3;
+/// Triangles with less area than this (m²) are ignored when building receivers.
+const DEGENERATE_AREA: f64 = 1e-10;
+
+/// Triangle geometry in one coordinate frame, with a per-vertex surface value.
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    /// For messages: where the mesh came from.
+    pub label: String,
+    /// Vertex positions (world, relative to nothing, for the static mesh; local for shared ones).
+    pub positions: Vec<[f32; 3]>,
+    /// Per vertex: receiver part or absolute receiver id (see the module doc), or [`NO_RECEIVER`].
+    pub surfaces: Vec<u32>,
+    /// Triangle list.
+    pub indices: Vec<u32>,
+}
+
+/// One placement of a mesh in the world.
+#[derive(Debug, Clone)]
+pub struct Instance {
+    /// Index into [`Scene::meshes`].
+    pub mesh: usize,
+    /// Mesh coordinates → world coordinates.
+    pub transform: DMat4,
+    /// Added to the mesh's per-vertex surface values, or [`NO_RECEIVER`].
+    pub receiver_base: u32,
+}
+
+/// A planar receiving surface.
+#[derive(Debug, Clone)]
+pub struct Receiver {
+    /// Unique name (an output column).
+    pub name: String,
+    /// Where it came from, for messages: `file: node 'name'`.
+    pub origin: String,
+    /// Its triangles in world coordinates (few: receivers are building surfaces).
+    pub triangles: Vec<[DVec3; 3]>,
+    /// Outward unit normal (from the triangles' counter-clockwise winding).
+    pub normal: DVec3,
+    /// Area in m² (sum of its triangles; overlapping triangles are not expected).
+    pub area: f64,
+    /// Which instance draws it and which index range of that instance's mesh holds it.
+    pub draw: ReceiverDraw,
+}
+
+/// Where a receiver's triangles sit in the GPU layout, so a view can draw it alone.
+#[derive(Debug, Clone)]
+pub struct ReceiverDraw {
+    /// Index into [`Scene::instances`].
+    pub instance: usize,
+    /// Index range (into the instance mesh's `indices`).
+    pub indices: Range<u32>,
+}
+
+/// A render-ready scene. Build one with [`SceneBuilder`].
+#[derive(Debug, Clone, Default)]
+pub struct Scene {
+    /// Geometry; index 0 is the merged static mesh (possibly empty).
+    pub meshes: Vec<Mesh>,
+    /// Placements; index 0 places the static mesh with the identity.
+    pub instances: Vec<Instance>,
+    /// Receiving surfaces; a receiver's id is its index here.
+    pub receivers: Vec<Receiver>,
+    /// World-space bounds of everything (min, max).
+    pub bounds: (DVec3, DVec3),
+    /// Centre of the input's bounds. The static mesh is stored relative to it (instance 0 adds it
+    /// back) so f32 vertices keep millimetres even in georeferenced coordinates.
+    pub origin: DVec3,
+}
+
+impl Scene {
+
+    /// Total triangles drawn per full view (instances counted).
+    pub fn triangle_count(&self) -> usize {
+        self.instances.iter().map(|i| self.meshes[i.mesh].indices.len() / 3).sum()
+    }
+
+    /// Every triangle in world coordinates with the receiver it belongs to (if any).
+    pub fn world_triangles(&self) -> impl Iterator<Item = ([DVec3; 3], Option<u32>)> + '_ {
+        self.instances.iter().flat_map(move |inst| {
+            let mesh = &self.meshes[inst.mesh];
+            mesh.indices.chunks_exact(3).map(move |tri| {
+                let p = |i: u32| inst.transform.transform_point3(to_dvec(mesh.positions[i as usize]));
+                let surface = mesh.surfaces[tri[0] as usize];
+                let id = (surface != NO_RECEIVER && inst.receiver_base != NO_RECEIVER)
+                    .then(|| inst.receiver_base + surface);
+                ([p(tri[0]), p(tri[1]), p(tri[2])], id)
+            })
+        })
+    }
+
+    /// Looks a receiver up by name.
+    pub fn receiver(&self, name: &str) -> Option<(u32, &Receiver)> {
+        self.receivers.iter().enumerate().find(|(_, r)| r.name == name).map(|(i, r)| (i as u32, r))
+    }
+}
+
+fn to_dvec(p: [f32; 3]) -> DVec3 {
+    DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+}
+
+/// Mesh data as read from a model file, in the mesh's own coordinates.
+#[derive(Debug, Clone, Default)]
+pub struct SourceMesh {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Triangle list.
+    pub indices: Vec<u32>,
+}
+
+/// One node as read from a model file.
+#[derive(Debug, Clone)]
+pub struct SourceNode {
+    /// Node name used for receiver names (already made unique-ish by the reader if unnamed).
+    pub name: String,
+    /// `file: node 'name'`, for messages.
+    pub origin: String,
+    /// Index into the model's meshes.
+    pub mesh: usize,
+    /// Mesh → world transform (world axes as in the module doc).
+    pub transform: DMat4,
+    /// Whether this node receives (and so gets sunlit fractions).
+    pub receiver: bool,
+}
+
+/// Collects meshes and nodes from one or more model files, then lays them out ([`Self::build`]).
+#[derive(Debug, Default)]
+pub struct SceneBuilder {
+    meshes: Vec<(String, SourceMesh)>,
+    nodes: Vec<SourceNode>,
+}
+
+impl SceneBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a mesh; returns its index for [`SourceNode::mesh`].
+    pub fn add_mesh(&mut self, label: impl Into<String>, mesh: SourceMesh) -> usize {
+        self.meshes.push((label.into(), mesh));
+        self.meshes.len() - 1
+    }
+
+    /// Adds a node placing a mesh added earlier.
+    pub fn add_node(&mut self, node: SourceNode) {
+        self.nodes.push(node);
+    }
+
+    /// Number of nodes added so far.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Lays the scene out: bakes single-use meshes, splits receivers into planar parts, checks names.
+    pub fn build(self) -> Result<Scene> {
+        let mut uses = vec![0usize; self.meshes.len()];
+        for node in &self.nodes {
+            uses[node.mesh] += 1;
+        }
+        for node in &self.nodes {
+            check_finite(node, &self.meshes[node.mesh].1)?;
+        }
+        let origin = input_centre(&self.nodes, &self.meshes);
+        let mut scene = Scene {
+            meshes: vec![Mesh { label: "static".into(), ..Default::default() }],
+            instances: vec![Instance { mesh: 0, transform: DMat4::from_translation(origin), receiver_base: 0 }],
+            origin,
+            ..Default::default()
+        };
+        // Shared meshes are copied once into the scene; parts are found per (mesh, receiving node).
+        let mut shared: HashMap<usize, usize> = HashMap::new();
+        let mut names: HashMap<String, String> = HashMap::new();
+        for node in &self.nodes {
+            let (label, source) = &self.meshes[node.mesh];
+            if uses[node.mesh] == 1 {
+                bake_node(&mut scene, node, source)?;
+            } else {
+                let mesh_index = *shared.entry(node.mesh).or_insert_with(|| {
+                    scene.meshes.push(shared_mesh(label, source));
+                    scene.meshes.len() - 1
+                });
+                instance_node(&mut scene, node, mesh_index)?;
+            }
+        }
+        for r in &scene.receivers {
+            if let Some(first) = names.insert(r.name.clone(), r.origin.clone()) {
+                return Err(Error::DuplicateReceiver { name: r.name.clone(), first, second: r.origin.clone() });
+            }
+        }
+        scene.bounds = bounds(&scene);
+        Ok(scene)
+    }
+}
+
+fn input_centre(nodes: &[SourceNode], meshes: &[(String, SourceMesh)]) -> DVec3 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for node in nodes {
+        for p in &meshes[node.mesh].1.positions {
+            let w = node.transform.transform_point3(to_dvec(*p));
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    if lo.x > hi.x { DVec3::ZERO } else { (lo + hi) * 0.5 }
+}
+
+fn check_finite(node: &SourceNode, mesh: &SourceMesh) -> Result<()> {
+    let bad_transform = !node.transform.is_finite();
+    let bad_vertex = mesh.positions.iter().position(|p| p.iter().any(|c| !c.is_finite() || c.abs() > 1e7));
+    if bad_transform || bad_vertex.is_some() {
+        let (file, object) = split_origin(&node.origin);
+        let what = match bad_vertex {
+            Some(i) => format!("vertex {i} has a non-finite or absurd coordinate {:?} (limit ±1e7 m)", mesh.positions[i]),
+            None => "its transform is not finite".to_string(),
+        };
+        return Err(Error::object(file, object, what));
+    }
+    let n = mesh.positions.len() as u32;
+    if let Some(i) = mesh.indices.iter().find(|&&i| i >= n) {
+        let (file, object) = split_origin(&node.origin);
+        return Err(Error::object(file, object, format!("index {i} out of range ({n} vertices)")));
+    }
+    if mesh.indices.len() % 3 != 0 {
+        let (file, object) = split_origin(&node.origin);
+        return Err(Error::object(file, object, "index count is not a multiple of 3"));
+    }
+    Ok(())
+}
+
+/// `origin` reads `file: object`; errors want the two apart.
+fn split_origin(origin: &str) -> (String, String) {
+    match origin.rsplit_once(": ") {
+        Some((f, o)) => (f.to_string(), o.to_string()),
+        None => (String::new(), origin.to_string()),
+    }
+}
+
+fn world_tris(node: &SourceNode, mesh: &SourceMesh) -> Vec<[DVec3; 3]> {
+    let p = |i: u32| node.transform.transform_point3(to_dvec(mesh.positions[i as usize]));
+    mesh.indices.chunks_exact(3).map(|t| [p(t[0]), p(t[1]), p(t[2])]).collect()
+}
+
+/// A planar group of a receiving node's triangles (indices into its triangle list).
+struct Part {
+    normal: DVec3,
+    offset: f64,
+    triangles: Vec<usize>,
+}
+
+/// Groups triangles by plane, largest triangles first so each part's plane is a large triangle's.
+fn planar_parts(tris: &[[DVec3; 3]]) -> Vec<Part> {
+    let mut order: Vec<usize> = (0..tris.len()).filter(|&i| tri_area(&tris[i]) > DEGENERATE_AREA).collect();
+    order.sort_by(|&a, &b| tri_area(&tris[b]).total_cmp(&tri_area(&tris[a])));
+    let cos_tol = COPLANAR_ANGLE.cos();
+    let mut parts: Vec<Part> = Vec::new();
+    for i in order {
+        let t = &tris[i];
+        let n = tri_normal(t);
+        let fits = |p: &Part| n.dot(p.normal) >= cos_tol && t.iter().all(|v| (v.dot(p.normal) - p.offset).abs() <= COPLANAR_DISTANCE);
+        match parts.iter_mut().find(|p| fits(p)) {
+            Some(p) => p.triangles.push(i),
+            None => parts.push(Part { normal: n, offset: n.dot(t[0]), triangles: vec![i] }),
+        }
+    }
+    // Deterministic numbering: by first triangle's position in the source.
+    for p in &mut parts {
+        p.triangles.sort_unstable();
+    }
+    parts.sort_by_key(|p| p.triangles[0]);
+    parts
+}
+
+fn tri_area(t: &[DVec3; 3]) -> f64 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+fn tri_normal(t: &[DVec3; 3]) -> DVec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
+}
+
+fn part_name(node: &str, k: usize, count: usize) -> String {
+    if count == 1 { node.to_string() } else { format!("{node}#{}", k + 1) }
+}
+
+fn no_area_error(node: &SourceNode) -> Error {
+    let (file, object) = split_origin(&node.origin);
+    Error::object(file, object, "receiver has zero area (all its triangles are degenerate)")
+}
+
+/// Appends a single-use node to the static mesh, in world coordinates.
+fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Result<()> {
+    let tris = world_tris(node, source);
+    let scene_origin = scene.origin;
+    if !node.receiver {
+        let mesh = &mut scene.meshes[0];
+        for t in &tris {
+            push_tri(mesh, t, scene_origin, NO_RECEIVER);
+        }
+        return Ok(());
+    }
+    let parts = planar_parts(&tris);
+    if parts.is_empty() {
+        return Err(no_area_error(node));
+    }
+    let mut in_part = vec![false; tris.len()];
+    for (k, part) in parts.iter().enumerate() {
+        let id = scene.receivers.len() as u32;
+        let start = scene.meshes[0].indices.len() as u32;
+        for &i in &part.triangles {
+            push_tri(&mut scene.meshes[0], &tris[i], scene_origin, id);
+            in_part[i] = true;
+        }
+        let end = scene.meshes[0].indices.len() as u32;
+        scene.receivers.push(receiver(node, part, k, parts.len(), &tris, ReceiverDraw { instance: 0, indices: start..end }));
+    }
+    // Degenerate leftovers still go in (harmless), as shadow casters only.
+    for (i, t) in tris.iter().enumerate() {
+        if !in_part[i] {
+            push_tri(&mut scene.meshes[0], t, scene_origin, NO_RECEIVER);
+        }
+    }
+    Ok(())
+}
+
+fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVec3; 3]], draw: ReceiverDraw) -> Receiver {
+    let triangles: Vec<[DVec3; 3]> = part.triangles.iter().map(|&i| tris[i]).collect();
+    Receiver {
+        name: part_name(&node.name, k, count),
+        origin: node.origin.clone(),
+        area: triangles.iter().map(tri_area).sum(),
+        triangles,
+        normal: part.normal,
+        draw,
+    }
+}
+
+fn push_tri(mesh: &mut Mesh, t: &[DVec3; 3], origin: DVec3, surface: u32) {
+    for v in t {
+        let v = *v - origin;
+        mesh.indices.push(mesh.positions.len() as u32);
+        mesh.positions.push([v.x as f32, v.y as f32, v.z as f32]);
+        mesh.surfaces.push(surface);
+    }
+}
+
+fn shared_mesh(label: &str, source: &SourceMesh) -> Mesh {
+    Mesh {
+        label: label.to_string(),
+        positions: source.positions.clone(),
+        surfaces: vec![NO_RECEIVER; source.positions.len()],
+        indices: source.indices.clone(),
+    }
+}
+
+/// Places a shared mesh. A receiving instance needs per-vertex part values in the mesh; since an
+/// affine transform keeps coplanar triangles coplanar, the parts are a property of the mesh and
+/// are assigned once, on the first receiving instance.
+fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize) -> Result<()> {
+    let instance = scene.instances.len();
+    if !node.receiver {
+        scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: NO_RECEIVER });
+        return Ok(());
+    }
+    let local = SourceMesh { positions: scene.meshes[mesh_index].positions.clone(), indices: scene.meshes[mesh_index].indices.clone() };
+    let tris = world_tris(node, &local);
+    let parts = planar_parts(&tris);
+    if parts.is_empty() {
+        return Err(no_area_error(node));
+    }
+    let ranges = assign_parts(&mut scene.meshes[mesh_index], &parts);
+    let base = scene.receivers.len() as u32;
+    for (k, part) in parts.iter().enumerate() {
+        let draw = ReceiverDraw { instance, indices: ranges[k].clone() };
+        scene.receivers.push(receiver(node, part, k, parts.len(), &tris, draw));
+    }
+    scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: base });
+    Ok(())
+}
+
+/// Rewrites a shared mesh so each part's triangles are contiguous with their own vertices
+/// carrying the part number; returns each part's index range. Idempotent for the same parts.
+fn assign_parts(mesh: &mut Mesh, parts: &[Part]) -> Vec<Range<u32>> {
+    let old = std::mem::take(mesh);
+    let mut new = Mesh { label: old.label.clone(), ..Default::default() };
+    let mut ranges = Vec::with_capacity(parts.len());
+    let mut used = vec![false; old.indices.len() / 3];
+    let copy_tri = |new: &mut Mesh, t: usize, surface: u32| {
+        for c in 0..3 {
+            let v = old.indices[3 * t + c] as usize;
+            new.indices.push(new.positions.len() as u32);
+            new.positions.push(old.positions[v]);
+            new.surfaces.push(surface);
+        }
+    };
+    for (k, part) in parts.iter().enumerate() {
+        let start = new.indices.len() as u32;
+        for &t in &part.triangles {
+            copy_tri(&mut new, t, k as u32);
+            used[t] = true;
+        }
+        ranges.push(start..new.indices.len() as u32);
+    }
+    for (t, &u) in used.iter().enumerate() {
+        if !u {
+            copy_tri(&mut new, t, NO_RECEIVER);
+        }
+    }
+    *mesh = new;
+    ranges
+}
+
+fn bounds(scene: &Scene) -> (DVec3, DVec3) {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for inst in &scene.instances {
+        for p in &scene.meshes[inst.mesh].positions {
+            let w = inst.transform.transform_point3(to_dvec(*p));
+            lo = lo.min(w);
+            hi = hi.max(w);
+        }
+    }
+    if lo.x > hi.x { (DVec3::ZERO, DVec3::ZERO) } else { (lo, hi) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad(z: f32) -> SourceMesh {
+        SourceMesh { positions: vec![[0., 0., z], [1., 0., z], [1., 1., z], [0., 1., z]], indices: vec![0, 1, 2, 0, 2, 3] }
+    }
+
+    fn node(name: &str, mesh: usize, receiver: bool, t: DMat4) -> SourceNode {
+        SourceNode { name: name.into(), origin: format!("test.glb: node '{name}'"), mesh, transform: t, receiver }
+    }
+
+    #[test]
+    fn shared_mesh_is_instanced_not_copied() {
+        let mut b = SceneBuilder::new();
+        let m = b.add_mesh("quad", quad(0.0));
+        for i in 0..3 {
+            b.add_node(node(&format!("q{i}"), m, i == 1, DMat4::from_translation(DVec3::new(i as f64 * 2.0, 0.0, 0.0))));
+        }
+        let s = b.build().unwrap();
+        assert_eq!(s.meshes.len(), 2, "static mesh + one shared mesh");
+        assert_eq!(s.instances.len(), 4);
+        assert_eq!(s.receivers.len(), 1);
+        assert_eq!(s.receivers[0].name, "q1");
+        assert!((s.receivers[0].area - 1.0).abs() < 1e-9);
+        assert_eq!(s.triangle_count(), 6);
+        let ids: Vec<_> = s.world_triangles().map(|(_, id)| id).collect();
+        assert_eq!(ids.iter().filter(|i| i.is_some()).count(), 2);
+    }
+
+    #[test]
+    fn non_planar_receiver_is_split_into_named_parts() {
+        let mut b = SceneBuilder::new();
+        // Two faces of a box corner: z = 0 plane and x = 0 plane.
+        let m = b.add_mesh(
+            "corner",
+            SourceMesh {
+                positions: vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 0., 1.], [0., 1., 1.], [0., 1., 0.]],
+                indices: vec![0, 1, 2, 0, 4, 3, 0, 5, 4],
+            },
+        );
+        b.add_node(node("Box", m, true, DMat4::IDENTITY));
+        let s = b.build().unwrap();
+        let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, ["Box#1", "Box#2"]);
+        assert!((s.receivers[1].area - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn bad_inputs_are_named() {
+        let mut b = SceneBuilder::new();
+        let mut q = quad(0.0);
+        q.positions[2][1] = f32::NAN;
+        let m = b.add_mesh("quad", q);
+        b.add_node(node("Bad", m, false, DMat4::IDENTITY));
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("test.glb") && e.contains("node 'Bad'") && e.contains("non-finite"), "{e}");
+
+        let mut b = SceneBuilder::new();
+        let m = b.add_mesh("line", SourceMesh { positions: vec![[0., 0., 0.], [1., 0., 0.], [2., 0., 0.]], indices: vec![0, 1, 2] });
+        b.add_node(node("Flat", m, true, DMat4::IDENTITY));
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("node 'Flat'") && e.contains("zero area"), "{e}");
+
+        let mut b = SceneBuilder::new();
+        let m1 = b.add_mesh("a", quad(0.0));
+        let m2 = b.add_mesh("b", quad(1.0));
+        b.add_node(node("Same", m1, true, DMat4::IDENTITY));
+        b.add_node(node("Same", m2, true, DMat4::IDENTITY));
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("duplicate receiver name 'Same'"), "{e}");
+    }
+}
