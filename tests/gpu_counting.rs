@@ -1,0 +1,248 @@
+//! The GPU pixel counter against analytic truths and the exact polygon-clipping reference.
+//! These need a GPU adapter (lavapipe in CI) and never skip.
+
+mod common;
+
+use common::*;
+use glam::DVec3;
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+use sunlit::count::{ViewRequest, exact};
+use sunlit::scene::{Scene, SourceMesh};
+
+/// Pixel counting at 512² is good to about three decimals.
+const TOL: f64 = 0.005;
+
+fn check(scene: &Scene, cases: &[(&str, DVec3, f64)]) {
+    let counter = counter(512);
+    let requests: Vec<ViewRequest> = cases.iter().map(|(n, s, _)| ViewRequest { receiver: receiver_id(scene, n), sun: *s }).collect();
+    let gpu = gpu_fractions(&counter, scene, &requests);
+    for ((name, sun, want), got) in cases.iter().zip(&gpu) {
+        let exact = exact::sunlit_fraction(scene, ViewRequest { receiver: receiver_id(scene, name), sun: *sun });
+        // Scene vertices are f32: the exact reference agrees with the analytic value to ~1e-8.
+        assert!((exact - want).abs() < 1e-6, "{name} sun {sun}: exact {exact} vs analytic {want}");
+        assert!((got.fraction - want).abs() < TOL, "{name} sun {sun}: gpu {} vs analytic {want} ({got:?})", got.fraction);
+    }
+}
+
+/// 2 m × 1 m south window (z 1..2) with an overhang of depth d at its top, wider than the window.
+fn overhang_scene(depth: f64) -> Scene {
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 2.0, 1.0, 2.0, 0.0), true);
+    s.polygon("OVERHANG", &flat_rect(-5.0, 7.0, -depth, 0.0, 2.0), false);
+    s.build()
+}
+
+#[test]
+fn overhang_due_south() {
+    // Shadow depth on the wall = d·tanα below the top edge.
+    let d = 0.5;
+    let scene = overhang_scene(d);
+    let cases: Vec<(&str, DVec3, f64)> = [10.0f64, 30.0, 45.0, 60.0, 63.0, 70.0]
+        .iter()
+        .map(|&alt| ("WIN", sun(180.0, alt), 1.0 - (d * alt.to_radians().tan()).min(1.0)))
+        .collect();
+    check(&scene, &cases);
+}
+
+#[test]
+fn overhang_oblique_sun() {
+    // A long overhang: shadow depth on the wall = d·tanα / cosγ, γ the azimuth off the normal.
+    let d = 0.4;
+    let scene = overhang_scene(d);
+    let cases: Vec<(&str, DVec3, f64)> = [(200.0f64, 40.0f64), (150.0, 50.0), (240.0, 25.0)]
+        .iter()
+        .map(|&(az, alt)| {
+            let gamma = (az - 180.0f64).to_radians();
+            ("WIN", sun(az, alt), 1.0 - (d * alt.to_radians().tan() / gamma.cos()).min(1.0))
+        })
+        .collect();
+    check(&scene, &cases);
+}
+
+#[test]
+fn side_fin() {
+    // 1 m × 2 m window (x 0..1, z 0..2) with a fin at x = 1.0 sticking out 0.5 m to the south,
+    // full height. Sun from the south-east at azimuth 180 − γ: the fin's shadow is a vertical
+    // band of width 0.5·tanγ from x = 1 westwards.
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 1.0, 0.0, 2.0, 0.0), true);
+    s.polygon("FIN", &[DVec3::new(1.0, -0.5, -1.0), DVec3::new(1.0, 0.0, -1.0), DVec3::new(1.0, 0.0, 5.0), DVec3::new(1.0, -0.5, 5.0)], false);
+    let scene = s.build();
+    let cases: Vec<(&str, DVec3, f64)> = [20.0f64, 45.0, 60.0]
+        .iter()
+        .map(|&g| ("WIN", sun(180.0 - g, 30.0), 1.0 - (0.5 * g.to_radians().tan()).min(1.0)))
+        .collect();
+    check(&scene, &cases);
+}
+
+#[test]
+fn concave_l_shaped_receiver_and_wall_with_window_hole() {
+    // L-shaped roof: the 2×2 square minus its north-east quarter, z = 0, as three unit squares.
+    let mut s = TestScene::new();
+    let l = SourceMesh {
+        positions: vec![[0., 0., 0.], [1., 0., 0.], [2., 0., 0.], [0., 1., 0.], [1., 1., 0.], [2., 1., 0.], [0., 2., 0.], [1., 2., 0.]],
+        indices: vec![0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4, 3, 4, 7, 3, 7, 6],
+    };
+    s.mesh("ROOF_L", l, true);
+    // A plate over the western half (x 0..1) at 1 m: with the sun overhead it hides 2 of 3 m².
+    s.polygon("PLATE", &flat_rect(0.0, 1.0, 0.0, 2.0, 1.0), false);
+    // A 4 × 3 wall (x 10..14, z 0..3) at y = 0 with a 2 × 1 hole (x 11..13, z 1..2) holding a window.
+    let wall = SourceMesh {
+        positions: [(10., 0.), (14., 0.), (14., 3.), (10., 3.), (11., 1.), (13., 1.), (13., 2.), (11., 2.)]
+            .iter()
+            .map(|&(x, z)| [x as f32, 0.0, z as f32])
+            .collect(),
+        // Four trapezoids around the hole, counter-clockwise seen from the south (−y).
+        indices: vec![0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7],
+    };
+    s.mesh("WALL", wall, true);
+    s.polygon("WIN", &south_rect(11.0, 13.0, 1.0, 2.0, 0.0), true);
+    // Overhang 1 m deep at z = 3 over the whole wall; sun due south at 45°: shadow 1 m deep.
+    s.polygon("OVERHANG", &flat_rect(9.0, 15.0, -1.0, 0.0, 3.0), false);
+    let scene = s.build();
+    check(
+        &scene,
+        &[
+            ("ROOF_L", DVec3::Z, 1.0 / 3.0),
+            // Wall: 12 − 2 = 10 m²; shaded z 2..3 = 4 m² → 0.6. Window (z 1..2) just clear → 1.
+            ("WALL", sun(180.0, 45.0), 0.6),
+            ("WIN", sun(180.0, 45.0), 1.0),
+            // At atan(1.5): shadow 1.5 m deep: wall loses 4 + 0.5·4 − 0.5·2 = 5 m² → 0.5; window half.
+            ("WALL", sun(180.0, 1.5f64.atan().to_degrees()), 0.5),
+            ("WIN", sun(180.0, 1.5f64.atan().to_degrees()), 0.5),
+        ],
+    );
+}
+
+#[test]
+fn back_facing_sun_down_and_geometry_behind() {
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 2.0, 0.0, 2.0, 0.0), true);
+    // A big box north of (behind) the window, taller than it: it must not shade.
+    s.cuboid("BEHIND", DVec3::new(-3.0, 0.5, -1.0), DVec3::new(5.0, 4.0, 6.0));
+    let scene = s.build();
+    check(
+        &scene,
+        &[("WIN", sun(0.0, 30.0), 0.0), ("WIN", sun(180.0, -5.0), 0.0), ("WIN", sun(180.0, 30.0), 1.0), ("WIN", sun(120.0, 10.0), 1.0)],
+    );
+}
+
+#[test]
+fn instanced_and_baked_occluders_shade_alike() {
+    use glam::DMat4;
+    use sunlit::scene::{SceneBuilder, SourceNode};
+    // Two identical slats placed by one shared mesh vs the same slats as separate meshes.
+    let slat = |y: f32| SourceMesh {
+        positions: vec![[-5., y - 0.3, 1.5], [7., y - 0.3, 1.5], [7., y, 1.5], [-5., y, 1.5]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    let window = SourceMesh { positions: vec![[0., 0., 0.], [2., 0., 0.], [2., 0., 2.], [0., 0., 2.]], indices: vec![0, 1, 2, 0, 2, 3] };
+    let node = |name: &str, mesh, dz: f64, receiver| SourceNode {
+        name: name.into(),
+        origin: format!("test: node '{name}'"),
+        mesh,
+        transform: DMat4::from_translation(DVec3::new(0.0, 0.0, dz)),
+        receiver,
+    };
+    let mut shared = SceneBuilder::new();
+    let w = shared.add_mesh("w", window.clone());
+    let m = shared.add_mesh("slat", slat(0.0));
+    shared.add_node(node("WIN", w, 0.0, true));
+    shared.add_node(node("S0", m, 0.0, false));
+    shared.add_node(node("S1", m, -1.0, false));
+    let shared = shared.build().unwrap();
+    assert!(shared.meshes.len() == 2 && shared.instances.len() == 3, "slats stay instanced");
+    let mut baked = SceneBuilder::new();
+    let w = baked.add_mesh("w", window);
+    let a = baked.add_mesh("a", slat(0.0));
+    let b = baked.add_mesh("b", slat(0.0));
+    baked.add_node(node("WIN", w, 0.0, true));
+    baked.add_node(node("S0", a, 0.0, false));
+    baked.add_node(node("S1", b, -1.0, false));
+    let baked = baked.build().unwrap();
+    let counter = counter(512);
+    let requests: Vec<ViewRequest> = [(180.0, 30.0), (200.0, 50.0), (150.0, 20.0)].iter().map(|&(az, alt)| ViewRequest { receiver: 0, sun: sun(az, alt) }).collect();
+    let a = gpu_fractions(&counter, &shared, &requests);
+    let b = gpu_fractions(&counter, &baked, &requests);
+    let e = exact::sunlit_fractions(&shared, &requests);
+    for i in 0..requests.len() {
+        assert_eq!(a[i].visible, b[i].visible, "same pixels either way");
+        assert!((a[i].fraction - e[i]).abs() < TOL, "{} vs exact {}", a[i].fraction, e[i]);
+        assert!(e[i] > 0.05 && e[i] < 0.95, "the case shades partly: {}", e[i]);
+    }
+}
+
+/// A random planar quad: a parallelogram with random centre, orientation and sides.
+fn random_quad(rng: &mut SmallRng, centre_box: f64, size: (f64, f64)) -> Vec<DVec3> {
+    let c = DVec3::new(rng.random_range(-centre_box..centre_box), rng.random_range(-centre_box..centre_box), rng.random_range(0.0..centre_box));
+    let a = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize() * rng.random_range(size.0..size.1);
+    let b0 = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+    let b = (b0 - a * (b0.dot(a) / a.length_squared())).normalize() * rng.random_range(size.0..size.1);
+    vec![c - a - b, c + a - b, c + a + b, c - a + b]
+}
+
+#[test]
+fn random_scenes_match_the_exact_reference() {
+    let counter = counter(512);
+    let mut errors: Vec<f64> = Vec::new();
+    let mut partial = 0;
+    for seed in 0..12u64 {
+        let mut rng = SmallRng::seed_from_u64(seed);
+        let mut s = TestScene::new();
+        for r in 0..4 {
+            s.polygon(&format!("R{r}"), &random_quad(&mut rng, 3.0, (0.5, 2.5)), true);
+        }
+        for o in 0..30 {
+            let q = random_quad(&mut rng, 4.0, (0.1, 1.0));
+            // Mix triangles and quads.
+            let corners = if o % 2 == 0 { q[..3].to_vec() } else { q };
+            s.polygon(&format!("O{o}"), &corners, false);
+        }
+        let scene = s.build();
+        let suns: Vec<DVec3> = (0..6)
+            .map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(5.0..85.0)))
+            .collect();
+        let requests: Vec<ViewRequest> =
+            suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+        let gpu = gpu_fractions(&counter, &scene, &requests);
+        let exact = exact::sunlit_fractions(&scene, &requests);
+        for (g, e) in gpu.iter().zip(&exact) {
+            errors.push((g.fraction - e).abs());
+            partial += (*e > 0.01 && *e < 0.99) as usize;
+        }
+    }
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let max = errors.iter().cloned().fold(0.0, f64::max);
+    println!("GPU vs exact at 512²: {} views ({partial} partly shaded), mean |error| {mean:.5}, max {max:.5}", errors.len());
+    assert!(partial > 50, "the random cases must exercise partial shading, got {partial}");
+    assert!(mean <= 0.002, "mean |error| {mean}");
+    assert!(max <= 0.005, "max |error| {max}");
+}
+
+#[test]
+fn compute_count_equals_a_cpu_count_of_the_id_atlas() {
+    // CPU reference of count_pixels.wgsl: count target ids in each tile of the read-back atlas.
+    let scene = overhang_scene(0.6);
+    let counter = counter(128);
+    let requests: Vec<ViewRequest> = (0..10).map(|i| ViewRequest { receiver: 0, sun: sun(150.0 + 6.0 * i as f64, 20.0 + 5.0 * i as f64) }).collect();
+    let gpu = counter.upload(&scene).unwrap();
+    let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    let (side, ids) = pollster::block_on(counter.read_ids()).unwrap();
+    let res = counter.resolution();
+    for (slot, c) in counted.iter().enumerate() {
+        let [x0, y0] = counter.tile_of(slot);
+        let mut n = 0;
+        for y in y0..y0 + res {
+            for x in x0..x0 + res {
+                n += (ids[(y * side + x) as usize] == 0) as u32;
+            }
+        }
+        assert_eq!(c.visible, n, "view {slot}");
+        assert!(c.covered >= c.visible && c.covered > 0);
+        // Covered pixels estimate the projected area A·cosθ / Ap (the paper's denominator).
+        let projected = c.covered as f64 * c.pixel_area;
+        let expect = 2.0 * c.cos_incidence;
+        assert!((projected / expect - 1.0).abs() < 0.02, "covered·Ap {projected} vs A·cosθ {expect}");
+    }
+}
