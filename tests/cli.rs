@@ -1,0 +1,192 @@
+//! The `sunlit` command line: output shapes, and a clear error (file, object, reason; exit 1, no
+//! panic) for every class of bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sunlit::model::glb_write::GlbWriter;
+use sunlit::model::office::office;
+
+fn sunlit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("run sunlit")
+}
+
+fn runtime_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join("sunlit-test-runtime");
+    std::fs::create_dir_all(&dir).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    dir
+}
+
+/// A fresh folder per test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path.display().to_string()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts a clean failure: exit code 1, an `error:` line containing every needle, no panic.
+fn fails_with(out: &Output, needles: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "expected '{n}' in: {err}");
+    }
+}
+
+fn office_file(dir: &Path) -> String {
+    write(dir, "office.glb", &office(6).to_glb())
+}
+
+#[test]
+fn fraction_json_matches_exact_and_has_the_documented_shape() {
+    let dir = scratch("json");
+    let model = office_file(&dir);
+    let run = |extra: &[&str]| {
+        let mut args = vec!["fraction", model.as_str(), "--sun", "200,35", "--json"];
+        args.extend_from_slice(extra);
+        let out = sunlit(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let gpu = run(&[]);
+    let exact = run(&["--exact"]);
+    assert_eq!(gpu["sun"]["azimuth"], 200.0);
+    assert_eq!(gpu["sun"]["altitude"], 35.0);
+    assert_eq!(gpu["resolution"], 512);
+    let (g, e) = (gpu["surfaces"].as_array().unwrap(), exact["surfaces"].as_array().unwrap());
+    assert_eq!(g.len(), 10);
+    let mut partly = 0;
+    for (a, b) in g.iter().zip(e) {
+        assert_eq!(a["name"], b["name"]);
+        let (fa, fb) = (a["fraction"].as_f64().unwrap(), b["fraction"].as_f64().unwrap());
+        assert!((fa - fb).abs() <= 0.005, "{}: gpu {fa} exact {fb}", a["name"]);
+        assert!(a["area"].as_f64().unwrap() > 0.0 && a["cos_incidence"].is_number());
+        partly += (fb > 0.01 && fb < 0.99) as usize;
+    }
+    assert!(partly >= 2, "the louvres and overhang shade the south facade partly");
+}
+
+#[test]
+fn table_and_info_list_the_receivers() {
+    let dir = scratch("table");
+    let model = office_file(&dir);
+    let out = sunlit(&["fraction", &model, "--sun", "180,40", "--receivers", "WIN_*"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("WIN_S1") && !text.contains("WALL_S"), "{text}");
+    let out = sunlit(&["info", &model]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("10 receivers"), "{text}");
+    assert!(text.contains("ROOF") && text.contains("+1.000)"), "{text}");
+}
+
+#[test]
+fn unreadable_truncated_and_foreign_files() {
+    let dir = scratch("files");
+    let missing = dir.join("nope.glb").display().to_string();
+    fails_with(&sunlit(&["info", &missing]), &["nope.glb", "No such file"]);
+    let glb = office(1).to_glb();
+    let cut = write(&dir, "cut.glb", &glb[..glb.len() / 2]);
+    fails_with(&sunlit(&["info", &cut]), &["cut.glb: ", "not a valid glTF"]);
+    let text = write(&dir, "notes.glb", b"hello, I am not a model");
+    fails_with(&sunlit(&["info", &text]), &["notes.glb: not a glTF file"]);
+    let empty = write(&dir, "empty.gltf", b"");
+    fails_with(&sunlit(&["info", &empty]), &["empty.gltf: the file is empty"]);
+}
+
+#[test]
+fn gltf_with_missing_external_buffer() {
+    let dir = scratch("external");
+    let gltf = r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"geometry.bin","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"name":"A","mesh":0}],"scenes":[{"nodes":[0]}]}"#;
+    let path = write(&dir, "model.gltf", gltf.as_bytes());
+    fails_with(&sunlit(&["info", &path]), &["model.gltf: ", "external buffer 'geometry.bin'"]);
+    // With the buffer present but too short: truncated.
+    write(&dir, "geometry.bin", &[0u8; 20]);
+    fails_with(&sunlit(&["info", &path]), &["model.gltf: buffer 0 is truncated"]);
+    // Present and complete, but an accessor reads past its view.
+    let bad = gltf.replace(r#""count":3"#, r#""count":30"#);
+    write(&dir, "geometry.bin", &[0u8; 36]);
+    let path = write(&dir, "model.gltf", bad.as_bytes());
+    fails_with(&sunlit(&["info", &path]), &["model.gltf: mesh 0", "beyond its buffer view"]);
+}
+
+/// Replaces the first occurrence of an f32 in the binary with another value.
+fn patch_f32(bytes: &mut [u8], from: f32, to: f32) {
+    let needle = from.to_le_bytes();
+    let at = bytes.windows(4).position(|w| w == needle).expect("value present");
+    bytes[at..at + 4].copy_from_slice(&to.to_le_bytes());
+}
+
+#[test]
+fn bad_geometry_is_named() {
+    let dir = scratch("geometry");
+    let square = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let quad = [0u32, 1, 2, 0, 2, 3];
+    let receiver = Some(serde_json::json!({"sunlit": {"receiver": true}}));
+
+    for (value, label) in [(f32::NAN, "nan"), (f32::INFINITY, "inf")] {
+        let mut w = GlbWriter::new();
+        let m = w.add_mesh("m", &[[0.0, 0.0, 0.0], [1234.5, 0.0, 0.0], [1.0, 1.0, 0.0]], &[0, 1, 2]);
+        w.add_node("Broken", m, [0.0; 3], None);
+        let mut bytes = w.to_glb();
+        patch_f32(&mut bytes, 1234.5, value);
+        let path = write(&dir, &format!("{label}.glb"), &bytes);
+        fails_with(&sunlit(&["info", &path]), &[&format!("{label}.glb: node 'Broken'"), "non-finite"]);
+    }
+
+    let mut w = GlbWriter::new();
+    let m = w.add_mesh("line", &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]], &[0, 1, 2]);
+    w.add_node("Sliver", m, [0.0; 3], receiver.clone());
+    let path = write(&dir, "sliver.glb", &w.to_glb());
+    fails_with(&sunlit(&["info", &path]), &["sliver.glb: node 'Sliver'", "zero area"]);
+
+    let mut w = GlbWriter::new();
+    let m = w.add_mesh("sq", &square, &quad);
+    w.add_node("Twin", m, [0.0; 3], None);
+    w.add_node("Twin", m, [0.0, 0.0, 3.0], None);
+    let path = write(&dir, "twins.glb", &w.to_glb());
+    fails_with(&sunlit(&["info", &path]), &["duplicate receiver name 'Twin'", "twins.glb: node 'Twin'"]);
+
+    let mut w = GlbWriter::new();
+    let m = w.add_mesh("sq", &square, &quad);
+    w.add_node("Roof", m, [0.0; 3], None);
+    let path = write(&dir, "roof.glb", &w.to_glb());
+    fails_with(&sunlit(&["info", &path, "--receivers", "Wall*"]), &["no receiving surface", "--receivers Wall*"]);
+    let out = sunlit(&["info", &path, "--receivers", "ROO?"]);
+    assert!(out.status.success(), "globs are case-insensitive: {}", stderr(&out));
+}
+
+#[test]
+fn malformed_sun_and_options() {
+    let dir = scratch("sun");
+    let model = office_file(&dir);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "180"]), &["--sun", "AZ,ALT"]);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "south,40"]), &["--sun"]);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "180,120"]), &["--sun", "altitude 120"]);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "180,40", "--resolution", "1000000"]), &["--resolution", "texture size limit"]);
+    // A negative altitude is a valid request: every fraction is 0.
+    let out = sunlit(&["fraction", &model, "--sun", "180,-10", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["surfaces"].as_array().unwrap().iter().all(|s| s["fraction"] == 0.0));
+}
