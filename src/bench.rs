@@ -18,7 +18,13 @@ pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
         "floor",
         SourceMesh { positions: vec![[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]], indices: vec![0, 1, 2, 0, 2, 3] },
     );
-    b.add_node(SourceNode { name: "FLOOR".into(), origin: "bench: node 'FLOOR'".into(), mesh: floor, transform: DMat4::IDENTITY, receiver: true });
+    b.add_node(SourceNode {
+        name: "FLOOR".into(),
+        origin: "bench: node 'FLOOR'".into(),
+        mesh: floor,
+        transform: DMat4::IDENTITY,
+        receiver: true,
+    });
     let mut cloud = SourceMesh::default();
     for t in 0..triangles {
         let centre = DVec3::new(rng.range(-5.0, 15.0), rng.range(-5.0, 15.0), rng.range(0.5, 10.0));
@@ -31,7 +37,13 @@ pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
         cloud.indices.extend([3 * t as u32, 3 * t as u32 + 1, 3 * t as u32 + 2]);
     }
     let mesh = b.add_mesh("cloud", cloud);
-    b.add_node(SourceNode { name: "cloud".into(), origin: "bench: node 'cloud'".into(), mesh, transform: DMat4::IDENTITY, receiver: false });
+    b.add_node(SourceNode {
+        name: "cloud".into(),
+        origin: "bench: node 'cloud'".into(),
+        mesh,
+        transform: DMat4::IDENTITY,
+        receiver: false,
+    });
     b.build()
 }
 

@@ -93,6 +93,7 @@ struct BenchArgs {
 }
 
 fn main() -> ExitCode {
+    quiet_mesa_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
@@ -106,6 +107,28 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Mesa's Vulkan drivers print "XDG_RUNTIME_DIR is invalid" on every start when it is unset,
+/// which reads like a sunlit error; point it at a private folder instead.
+fn quiet_mesa_runtime_dir() {
+    if !cfg!(target_os = "linux") || std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+    let dir = std::env::temp_dir().join(format!("sunlit-runtime-{user}"));
+    #[cfg(unix)]
+    let made = {
+        use std::os::unix::fs::DirBuilderExt;
+        let created = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+        created.is_ok() || dir.is_dir()
+    };
+    #[cfg(not(unix))]
+    let made = false;
+    if made {
+        // SAFETY: called first thing in main, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
     }
 }
 

@@ -46,10 +46,7 @@ pub(crate) async fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer, si
 
 #[cfg(not(target_arch = "wasm32"))]
 fn wait_for_maps(device: &wgpu::Device) -> Result<()> {
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map(|_| ())
-        .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))
+    device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))
 }
 
 #[cfg(target_arch = "wasm32")]

@@ -96,7 +96,6 @@ pub struct Scene {
 }
 
 impl Scene {
-
     /// Total triangles drawn per full view (instances counted).
     pub fn triangle_count(&self) -> usize {
         self.instances.iter().map(|i| self.meshes[i.mesh].indices.len() / 3).sum()
@@ -109,8 +108,7 @@ impl Scene {
             mesh.indices.chunks_exact(3).map(move |tri| {
                 let p = |i: u32| inst.transform.transform_point3(to_dvec(mesh.positions[i as usize]));
                 let surface = mesh.surfaces[tri[0] as usize];
-                let id = (surface != NO_RECEIVER && inst.receiver_base != NO_RECEIVER)
-                    .then(|| inst.receiver_base + surface);
+                let id = (surface != NO_RECEIVER && inst.receiver_base != NO_RECEIVER).then(|| inst.receiver_base + surface);
                 ([p(tri[0]), p(tri[1]), p(tri[2])], id)
             })
         })

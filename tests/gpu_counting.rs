@@ -1,6 +1,8 @@
 //! The GPU pixel counter against analytic truths and the exact polygon-clipping reference.
 //! These need a GPU adapter (lavapipe in CI) and never skip.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
 mod common;
 
 use common::*;
@@ -67,12 +69,14 @@ fn side_fin() {
     // band of width 0.5·tanγ from x = 1 westwards.
     let mut s = TestScene::new();
     s.polygon("WIN", &south_rect(0.0, 1.0, 0.0, 2.0, 0.0), true);
-    s.polygon("FIN", &[DVec3::new(1.0, -0.5, -1.0), DVec3::new(1.0, 0.0, -1.0), DVec3::new(1.0, 0.0, 5.0), DVec3::new(1.0, -0.5, 5.0)], false);
+    s.polygon(
+        "FIN",
+        &[DVec3::new(1.0, -0.5, -1.0), DVec3::new(1.0, 0.0, -1.0), DVec3::new(1.0, 0.0, 5.0), DVec3::new(1.0, -0.5, 5.0)],
+        false,
+    );
     let scene = s.build();
-    let cases: Vec<(&str, DVec3, f64)> = [20.0f64, 45.0, 60.0]
-        .iter()
-        .map(|&g| ("WIN", sun(180.0 - g, 30.0), 1.0 - (0.5 * g.to_radians().tan()).min(1.0)))
-        .collect();
+    let cases: Vec<(&str, DVec3, f64)> =
+        [20.0f64, 45.0, 60.0].iter().map(|&g| ("WIN", sun(180.0 - g, 30.0), 1.0 - (0.5 * g.to_radians().tan()).min(1.0))).collect();
     check(&scene, &cases);
 }
 
@@ -162,7 +166,8 @@ fn instanced_and_baked_occluders_shade_alike() {
     baked.add_node(node("S1", b, -1.0, false));
     let baked = baked.build().unwrap();
     let counter = counter(512);
-    let requests: Vec<ViewRequest> = [(180.0, 30.0), (200.0, 50.0), (150.0, 20.0)].iter().map(|&(az, alt)| ViewRequest { receiver: 0, sun: sun(az, alt) }).collect();
+    let requests: Vec<ViewRequest> =
+        [(180.0, 30.0), (200.0, 50.0), (150.0, 20.0)].iter().map(|&(az, alt)| ViewRequest { receiver: 0, sun: sun(az, alt) }).collect();
     let a = gpu_fractions(&counter, &shared, &requests);
     let b = gpu_fractions(&counter, &baked, &requests);
     let e = exact::sunlit_fractions(&shared, &requests);
@@ -175,8 +180,10 @@ fn instanced_and_baked_occluders_shade_alike() {
 
 /// A random planar quad: a parallelogram with random centre, orientation and sides.
 fn random_quad(rng: &mut SmallRng, centre_box: f64, size: (f64, f64)) -> Vec<DVec3> {
-    let c = DVec3::new(rng.random_range(-centre_box..centre_box), rng.random_range(-centre_box..centre_box), rng.random_range(0.0..centre_box));
-    let a = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize() * rng.random_range(size.0..size.1);
+    let c =
+        DVec3::new(rng.random_range(-centre_box..centre_box), rng.random_range(-centre_box..centre_box), rng.random_range(0.0..centre_box));
+    let a = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize()
+        * rng.random_range(size.0..size.1);
     let b0 = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
     let b = (b0 - a * (b0.dot(a) / a.length_squared())).normalize() * rng.random_range(size.0..size.1);
     vec![c - a - b, c + a - b, c + a + b, c - a + b]
@@ -200,9 +207,7 @@ fn random_scenes_match_the_exact_reference() {
             s.polygon(&format!("O{o}"), &corners, false);
         }
         let scene = s.build();
-        let suns: Vec<DVec3> = (0..6)
-            .map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(5.0..85.0)))
-            .collect();
+        let suns: Vec<DVec3> = (0..6).map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(5.0..85.0))).collect();
         let requests: Vec<ViewRequest> =
             suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
         let gpu = gpu_fractions(&counter, &scene, &requests);
@@ -225,7 +230,8 @@ fn compute_count_equals_a_cpu_count_of_the_id_atlas() {
     // CPU reference of count_pixels.wgsl: count target ids in each tile of the read-back atlas.
     let scene = overhang_scene(0.6);
     let counter = counter(128);
-    let requests: Vec<ViewRequest> = (0..10).map(|i| ViewRequest { receiver: 0, sun: sun(150.0 + 6.0 * i as f64, 20.0 + 5.0 * i as f64) }).collect();
+    let requests: Vec<ViewRequest> =
+        (0..10).map(|i| ViewRequest { receiver: 0, sun: sun(150.0 + 6.0 * i as f64, 20.0 + 5.0 * i as f64) }).collect();
     let gpu = counter.upload(&scene).unwrap();
     let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     let (side, ids) = pollster::block_on(counter.read_ids()).unwrap();

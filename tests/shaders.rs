@@ -1,6 +1,8 @@
 //! Every WGSL file in shaders/ parses and validates with naga (the same front end wgpu uses), and
 //! the library embeds exactly those files.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
 use std::fs;
 
 #[test]

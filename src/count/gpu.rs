@@ -163,11 +163,7 @@ impl Counter {
         let atlas_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d);
         let tiles_per_side = atlas_side / resolution;
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("sunlit"),
-                required_limits: limits,
-                ..Default::default()
-            })
+            .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: limits, ..Default::default() })
             .await
             .map_err(|e| Error::Gpu(format!("could not open the GPU device: {e}")))?;
         let errors = Arc::new(Mutex::new(Vec::new()));
@@ -188,9 +184,16 @@ impl Counter {
             depth: attachment(&device, "depth", side, DEPTH_FORMAT, false),
         };
         let tiles = (tiles_per_side * tiles_per_side) as u64;
-        let views = buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
-        let counts = buffer(&device, "counts", tiles * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
-        let readback = buffer(&device, "readback", tiles * 8 * BATCHES_PER_READBACK as u64, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let views =
+            buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let counts =
+            buffer(&device, "counts", tiles * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
+        let readback = buffer(
+            &device,
+            "readback",
+            tiles * 8 * BATCHES_PER_READBACK as u64,
+            wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        );
         let counter = Self {
             device,
             queue,
@@ -527,7 +530,11 @@ fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) 
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
@@ -566,7 +573,13 @@ fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let cs = wgpu::ShaderStages::COMPUTE;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("count"),
-        entries: &[uint_texture_entry(0), uint_texture_entry(1), storage_entry(2, cs, true), uniform_entry(3, cs), storage_entry(4, cs, false)],
+        entries: &[
+            uint_texture_entry(0),
+            uint_texture_entry(1),
+            storage_entry(2, cs, true),
+            uniform_entry(3, cs),
+            storage_entry(4, cs, false),
+        ],
     })
 }
 
@@ -621,10 +634,7 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
     };
     let none = wgpu::ColorWrites::empty();
     let all = wgpu::ColorWrites::ALL;
-    (
-        make("scene", true, wgpu::CompareFunction::Less, all, none),
-        make("mask", false, wgpu::CompareFunction::Always, none, all),
-    )
+    (make("scene", true, wgpu::CompareFunction::Less, all, none), make("mask", false, wgpu::CompareFunction::Always, none, all))
 }
 
 fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {

@@ -5,8 +5,8 @@
 //! polygon-clipping reference ([`exact`]) that tests hold the GPU to.
 
 pub mod exact;
-pub mod view;
 pub mod gpu;
+pub mod view;
 
 use glam::DVec3;
 

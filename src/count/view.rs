@@ -73,11 +73,7 @@ fn perpendicular_basis(w: DVec3) -> (DVec3, DVec3) {
 
 fn corners((lo, hi): (DVec3, DVec3)) -> [DVec3; 8] {
     std::array::from_fn(|i| {
-        DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
+        DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z })
     })
 }
 

@@ -78,10 +78,7 @@ impl GlbWriter {
     /// Returns the mesh index. `indices` is a triangle list into `positions`.
     pub fn add_mesh(&mut self, name: &str, positions: &[[f32; 3]], indices: &[u32]) -> usize {
         debug_assert!(indices.len() % 3 == 0, "mesh '{name}': index count not a multiple of 3");
-        debug_assert!(
-            indices.iter().all(|&i| (i as usize) < positions.len()),
-            "mesh '{name}': index out of range"
-        );
+        debug_assert!(indices.iter().all(|&i| (i as usize) < positions.len()), "mesh '{name}': index out of range");
         self.meshes.push(MeshData {
             name: name.to_owned(),
             positions: positions.iter().copied().map(to_gltf).collect(),
@@ -251,11 +248,7 @@ mod tests {
     /// A unit square in the sunlit ground plane (normal +z) and a triangle standing on it.
     fn sample() -> GlbWriter {
         let mut w = GlbWriter::new();
-        let square = w.add_mesh(
-            "square",
-            &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
-            &[0, 1, 2, 0, 2, 3],
-        );
+        let square = w.add_mesh("square", &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], &[0, 1, 2, 0, 2, 3]);
         let tri = w.add_mesh("tri", &[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 0.0, 3.0]], &[0, 1, 2]);
         w.add_node("Floor", square, [0.0; 3], Some(json!({"sunlit": {"receiver": true}})));
         w.add_node("Fin", tri, [1.0, 2.0, 3.0], None);

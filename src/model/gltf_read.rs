@@ -63,18 +63,21 @@ pub fn read_path(path: &Path, north_deg: f64) -> Result<GltfModel> {
 
 /// Reads glTF from bytes (the web path): external buffers are not available and give an error.
 pub fn read_bytes(file: &str, bytes: &[u8], north_deg: f64) -> Result<GltfModel> {
-    read_with(file, bytes, north_deg, |uri| Err(format!("external buffer '{uri}' was not given (use a .glb, or embed buffers as data: URIs)")))
+    read_with(file, bytes, north_deg, |uri| {
+        Err(format!("external buffer '{uri}' was not given (use a .glb, or embed buffers as data: URIs)"))
+    })
 }
 
-fn read_with(file: &str, bytes: &[u8], north_deg: f64, external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>) -> Result<GltfModel> {
+fn read_with(
+    file: &str,
+    bytes: &[u8],
+    north_deg: f64,
+    external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>,
+) -> Result<GltfModel> {
     check_magic(file, bytes)?;
     let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(file, &gltf, external)?;
-    let meshes = gltf
-        .document
-        .meshes()
-        .map(|m| read_mesh(file, &m, &buffers))
-        .collect::<Result<Vec<_>>>()?;
+    let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
     for root in scene_roots(&gltf.document) {
@@ -98,10 +101,9 @@ fn load_buffers(file: &str, gltf: &::gltf::Gltf, external: impl Fn(&str) -> std:
     let mut out = Vec::new();
     for buffer in gltf.document.buffers() {
         let data = match buffer.source() {
-            ::gltf::buffer::Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?,
+            ::gltf::buffer::Source::Bin => {
+                gltf.blob.clone().ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?
+            }
             ::gltf::buffer::Source::Uri(uri) => match uri.strip_prefix("data:") {
                 Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {}: {r}", buffer.index())))?,
                 None => external(uri).map_err(|r| Error::model(file, r))?,
@@ -269,12 +271,7 @@ impl GltfModel {
     /// Adds this model's meshes and nodes to a scene builder, choosing receivers with `is_receiver`.
     pub fn add_to(self, builder: &mut crate::scene::SceneBuilder, mut is_receiver: impl FnMut(&GltfNode) -> bool) {
         let file = self.file;
-        let base: Vec<usize> = self
-            .meshes
-            .into_iter()
-            .enumerate()
-            .map(|(i, m)| builder.add_mesh(format!("{file}: mesh {i}"), m))
-            .collect();
+        let base: Vec<usize> = self.meshes.into_iter().enumerate().map(|(i, m)| builder.add_mesh(format!("{file}: mesh {i}"), m)).collect();
         for node in self.nodes {
             let receiver = is_receiver(&node);
             builder.add_node(SourceNode {

@@ -121,8 +121,7 @@ impl Facade {
             let (t0, t1) = (band[0], band[1]);
             let mid = 0.5 * (t0 + t1);
             // Holes crossing this band, left to right.
-            let mut cuts: Vec<(f32, f32)> =
-                holes.iter().filter(|h| h.2 < mid && mid < h.3).map(|h| (h.0, h.1)).collect();
+            let mut cuts: Vec<(f32, f32)> = holes.iter().filter(|h| h.2 < mid && mid < h.3).map(|h| (h.0, h.1)).collect();
             cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut s = 0.0;
             for (h0, h1) in cuts.into_iter().chain([(self.width, self.width)]) {
@@ -195,10 +194,7 @@ pub fn office(louvres: usize) -> GlbWriter {
     // translation at the centres of equal bands over the window height.
     if louvres > 0 {
         let mut slat = MeshBuilder::default();
-        slat.cuboid(
-            Vec3::new(0.0, -LOUVRE_DEPTH, 0.0),
-            Vec3::new(LOUVRE_X.1 - LOUVRE_X.0, LOUVRE_DEPTH, LOUVRE_THICKNESS),
-        );
+        slat.cuboid(Vec3::new(0.0, -LOUVRE_DEPTH, 0.0), Vec3::new(LOUVRE_X.1 - LOUVRE_X.0, LOUVRE_DEPTH, LOUVRE_THICKNESS));
         let mesh = slat.add_to(&mut w, "LOUVER");
         let pitch = (HEAD - SILL) / louvres as f32;
         for i in 0..louvres {
@@ -336,7 +332,8 @@ mod tests {
         assert!((area_of(&["ROOF"]) - WIDTH * DEPTH).abs() < 1e-4);
 
         // No wall triangle's interior point lies inside a window's bounding box.
-        for (wall, wins) in [("WALL_S", &["WIN_S1", "WIN_S2"][..]), ("WALL_E", &["WIN_E"]), ("WALL_N", &["WIN_N"]), ("WALL_W", &["WIN_W"])] {
+        for (wall, wins) in [("WALL_S", &["WIN_S1", "WIN_S2"][..]), ("WALL_E", &["WIN_E"]), ("WALL_N", &["WIN_N"]), ("WALL_W", &["WIN_W"])]
+        {
             let wall = nodes.iter().find(|n| n.name == wall).unwrap();
             for win in wins {
                 let win = nodes.iter().find(|n| n.name == *win).unwrap();

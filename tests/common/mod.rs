@@ -39,8 +39,15 @@ impl TestScene {
 
     /// An axis-aligned closed box (shadow caster only).
     pub fn cuboid(&mut self, name: &str, lo: DVec3, hi: DVec3) -> &mut Self {
-        let c = |i: usize| DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
-        let positions = (0..8).map(|i| { let p = c(i); [p.x as f32, p.y as f32, p.z as f32] }).collect();
+        let c = |i: usize| {
+            DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z })
+        };
+        let positions = (0..8)
+            .map(|i| {
+                let p = c(i);
+                [p.x as f32, p.y as f32, p.z as f32]
+            })
+            .collect();
         let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         let indices = quads.iter().flat_map(|q: &[u32; 4]| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
         self.mesh(name, SourceMesh { positions, indices }, false)

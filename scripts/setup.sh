@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs what sunlit needs that cargo does not fetch, idempotently, then sets the environment.
+# Source it: `. scripts/setup.sh`.
+set -euo pipefail
+
+say() { printf '\033[1msunlit setup:\033[0m %s\n' "$*" >&2; }
+
+as_root() {
+  if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else
+    say "need root to run: $*"; return 1; fi
+}
+
+apt_install() {
+  say "installing $* (apt-get)"
+  as_root apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "$@" >/dev/null
+}
+
+if ! command -v cargo >/dev/null; then
+  say "cargo not found: install Rust 1.85 or newer (https://rustup.rs), then run this again"
+  exit 1
+fi
+
+# A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.
+if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
+  apt_install mesa-vulkan-drivers
+fi
+
+# Mesa warns on every start without a private runtime dir; give it one.
+if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
+  export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/sunlit-runtime-$(id -u)"
+  mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
+fi

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Every test: formatting, lints (no unwrap/expect in library code), then all cargo tests on the
+# GPU (lavapipe here). GPU tests never skip: without an adapter they fail.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+. scripts/setup.sh
+
+cargo fmt --check
+cargo clippy --all-targets --quiet -- -D warnings
+cargo test --no-fail-fast 2>&1 | tee target/test.log
