@@ -1,5 +1,5 @@
-// Counts, per view tile, the pixels where the target receiver is visible (id target) and the
-// pixels it covers at all (mask target). One invocation per tile row keeps a private count
+// Counts, per view tile, the pixels where the target receiver is visible (red = its id) and the
+// pixels it covers at all (green = 1). One invocation per tile row keeps a private count
 // (cheap on CPU rasterisers); a workgroup tree reduction then does one atomicAdd per workgroup.
 // Occlusion queries are not used: WebGPU only promises them as booleans.
 
@@ -19,12 +19,12 @@ struct Params {
     _pad1: u32,
 }
 
+// Red: visible surface id; green: 1 where the target receiver covers the pixel.
 @group(0) @binding(0) var ids: texture_2d<u32>;
-@group(0) @binding(1) var mask: texture_2d<u32>;
-@group(0) @binding(2) var<storage, read> views: array<View>;
-@group(0) @binding(3) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> views: array<View>;
+@group(0) @binding(2) var<uniform> params: Params;
 // counts[2 * view] = visible pixels, counts[2 * view + 1] = covered pixels.
-@group(0) @binding(4) var<storage, read_write> counts: array<atomic<u32>>;
+@group(0) @binding(3) var<storage, read_write> counts: array<atomic<u32>>;
 
 var<workgroup> visible_part: array<u32, ROWS_PER_GROUP>;
 var<workgroup> covered_part: array<u32, ROWS_PER_GROUP>;
@@ -39,8 +39,9 @@ fn count_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
     if row < params.resolution {
         for (var x = 0u; x < params.resolution; x++) {
             let p = vec2<i32>(view.tile + vec2<u32>(x, row));
-            visible += select(0u, 1u, textureLoad(ids, p, 0).r == view.target_id);
-            covered += select(0u, 1u, textureLoad(mask, p, 0).r != 0u);
+            let texel = textureLoad(ids, p, 0);
+            visible += select(0u, 1u, texel.r == view.target_id);
+            covered += texel.g;
         }
     }
     visible_part[lane] = visible;

@@ -1,7 +1,7 @@
 // Sun-view render: draws the scene into an atlas tile with an orthographic camera that looks
-// along the sun's rays, writing each fragment's receiver id (or NO_RECEIVER) to an r32uint
-// target. A second entry writes the receiver's own coverage mask (drawn alone, no depth test),
-// which is the denominator of the sunlit fraction.
+// along the sun's rays, writing each fragment's receiver id (or NO_RECEIVER) to the red channel
+// of an rg32uint target. The mask pipeline draws the target receiver alone (no depth test) into
+// the green channel: its coverage, the denominator of the sunlit fraction.
 //
 // Instances: a draw covers instance_index = view * instance_count + instance, so one
 // draw_indexed per mesh renders every placement of it for one view.
@@ -58,13 +58,8 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) surface: u32, @builtin
     return out;
 }
 
-struct FragmentOut {
-    @location(0) id: u32,
-    @location(1) mask: u32,
-}
-
-// Both pipelines share this: the scene pipeline masks out target 1, the mask pipeline target 0.
+// Both pipelines share this: the scene pipeline writes only red, the mask pipeline only green.
 @fragment
-fn fs_main(in: VertexOut) -> FragmentOut {
-    return FragmentOut(in.id, 1u);
+fn fs_main(in: VertexOut) -> @location(0) vec2<u32> {
+    return vec2<u32>(in.id, 1u);
 }

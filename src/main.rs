@@ -88,6 +88,9 @@ struct BenchArgs {
     /// Tile size in pixels.
     #[arg(long, default_value_t = 512)]
     resolution: u32,
+    /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
+    #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
+    atlas: u32,
     /// Extra models to time (every receiver × every sun).
     models: Vec<PathBuf>,
 }
@@ -134,6 +137,10 @@ fn quiet_mesa_runtime_dir() {
 
 fn counter(resolution: u32) -> Result<Counter> {
     pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))
+}
+
+fn counter_with(options: CounterOptions) -> Result<Counter> {
+    pollster::block_on(Counter::new(options))
 }
 
 fn fraction(args: FractionArgs) -> Result<()> {
@@ -227,7 +234,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
-    let counter = counter(args.resolution)?;
+    let counter = counter_with(CounterOptions { resolution: args.resolution, max_atlas: args.atlas })?;
     let info = counter.adapter_info();
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
     let start = Instant::now();

@@ -23,8 +23,10 @@ const SUN_VIEW_WGSL: &str = include_str!("../../shaders/sun_view.wgsl");
 const COUNT_PIXELS_WGSL: &str = include_str!("../../shaders/count_pixels.wgsl");
 /// Rows of a tile per compute workgroup (the shader's `ROWS_PER_GROUP`).
 const ROWS_PER_GROUP: u32 = 64;
-const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Uint;
+/// One target, two channels: red = the visible surface's id (scene pass), green = the target
+/// receiver's own coverage (mask pass). Per-channel write masks keep the passes apart, and the
+/// count reads one texel per pixel.
+const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 const BATCHES_PER_READBACK: usize = 32;
@@ -80,7 +82,6 @@ pub struct Counter {
 
 struct Atlas {
     ids: wgpu::TextureView,
-    mask: wgpu::TextureView,
     depth: wgpu::TextureView,
 }
 
@@ -180,7 +181,6 @@ impl Counter {
         let side = tiles_per_side * resolution;
         let atlas = Atlas {
             ids: attachment(&device, "ids", side, ID_FORMAT, true),
-            mask: attachment(&device, "mask", side, MASK_FORMAT, true),
             depth: attachment(&device, "depth", side, DEPTH_FORMAT, false),
         };
         let tiles = (tiles_per_side * tiles_per_side) as u64;
@@ -326,10 +326,9 @@ impl Counter {
             layout: &self.count_layout,
             entries: &[
                 entry(0, wgpu::BindingResource::TextureView(&self.atlas.ids)),
-                entry(1, wgpu::BindingResource::TextureView(&self.atlas.mask)),
-                entry(2, self.views.as_entire_binding()),
-                entry(3, params_buffer.as_entire_binding()),
-                entry(4, self.counts.as_entire_binding()),
+                entry(1, self.views.as_entire_binding()),
+                entry(2, params_buffer.as_entire_binding()),
+                entry(3, self.counts.as_entire_binding()),
             ],
         });
         self.check_errors("uploading the scene")?;
@@ -417,7 +416,7 @@ impl Counter {
         let clear_id = wgpu::Color { r: crate::scene::NO_RECEIVER as f64, g: 0.0, b: 0.0, a: 0.0 };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun views"),
-            color_attachments: &[color(&self.atlas.ids, clear_id), color(&self.atlas.mask, wgpu::Color::TRANSPARENT)],
+            color_attachments: &[color(&self.atlas.ids, clear_id)],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &self.atlas.depth,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
@@ -453,7 +452,7 @@ impl Counter {
     /// Reads back the id atlas (for tests comparing the compute count with a CPU count).
     pub async fn read_ids(&self) -> Result<(u32, Vec<u32>)> {
         let side = self.tiles_per_side * self.options.resolution;
-        let bytes_per_row = side * 4;
+        let bytes_per_row = side * 8;
         let size = (bytes_per_row * side) as u64;
         let target = buffer(&self.device, "ids readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read ids") });
@@ -469,7 +468,9 @@ impl Counter {
         self.queue.submit([encoder.finish()]);
         let bytes = platform::read_buffer(&self.device, &target, size).await?;
         self.check_errors("reading the id atlas")?;
-        Ok((side, bytemuck::cast_slice(&bytes).to_vec()))
+        // Keep the red channel: the visible surface ids.
+        let texels: &[[u32; 2]] = bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
+        Ok((side, texels.iter().map(|t| t[0]).collect()))
     }
 
     /// Where view `slot` of the last batch was drawn (top-left pixel).
@@ -573,18 +574,12 @@ fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let cs = wgpu::ShaderStages::COMPUTE;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("count"),
-        entries: &[
-            uint_texture_entry(0),
-            uint_texture_entry(1),
-            storage_entry(2, cs, true),
-            uniform_entry(3, cs),
-            storage_entry(4, cs, false),
-        ],
+        entries: &[uint_texture_entry(0), storage_entry(1, cs, true), uniform_entry(2, cs), storage_entry(3, cs, false)],
     })
 }
 
 /// The scene pipeline (depth-tested ids) and the mask pipeline (the receiver alone, always
-/// passing, no depth write); they differ only in depth state and colour write masks.
+/// passing, no depth write); they differ only in depth state and the channel they write.
 fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgpu::RenderPipeline, wgpu::RenderPipeline) {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("sun_view.wgsl"),
@@ -596,7 +591,7 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
         immediate_size: 0,
     });
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32];
-    let make = |label: &str, depth_write: bool, compare: wgpu::CompareFunction, ids: wgpu::ColorWrites, mask: wgpu::ColorWrites| {
+    let make = |label: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
@@ -623,18 +618,16 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[
-                    Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: ids }),
-                    Some(wgpu::ColorTargetState { format: MASK_FORMAT, blend: None, write_mask: mask }),
-                ],
+                targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: channels })],
             }),
             multiview_mask: None,
             cache: None,
         })
     };
-    let none = wgpu::ColorWrites::empty();
-    let all = wgpu::ColorWrites::ALL;
-    (make("scene", true, wgpu::CompareFunction::Less, all, none), make("mask", false, wgpu::CompareFunction::Always, none, all))
+    (
+        make("scene", true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED),
+        make("mask", false, wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN),
+    )
 }
 
 fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
