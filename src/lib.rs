@@ -22,12 +22,16 @@
 //! # Ok(()) }
 //! ```
 
+pub mod annual;
 pub mod bench;
 pub mod count;
 pub mod error;
+pub mod export;
 pub mod model;
 mod platform;
+pub mod samples;
 pub mod scene;
+pub mod spline;
 pub mod sun;
 
 pub use error::{Error, Result};

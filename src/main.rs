@@ -7,11 +7,14 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
+use sunlit::annual::{AnnualOptions, Method, Progress};
 use sunlit::count::gpu::{Counted, Counter, CounterOptions};
 use sunlit::count::{ViewRequest, cos_incidence, exact};
 use sunlit::model::{self, LoadOptions};
+use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
+use sunlit::sun::location::Location;
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -27,8 +30,44 @@ enum Command {
     Fraction(FractionArgs),
     /// List receivers (name, area, normal) and occluder counts.
     Info(InfoArgs),
+    /// Annual schedule at every EnergyPlus timestep, written as the CSV EnergyPlus reads.
+    Annual(AnnualArgs),
     /// Views per second on synthetic occluder clouds and the example office.
     Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct AnnualArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Weather file whose LOCATION line gives latitude, longitude and time zone.
+    #[arg(long, value_name = "FILE", conflicts_with = "location", required_unless_present = "location")]
+    epw: Option<PathBuf>,
+    /// Latitude (° north), longitude (° east), time zone (hours from UTC).
+    #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true)]
+    location: Option<String>,
+    /// Timesteps per hour (one EnergyPlus accepts: 1 2 3 4 5 6 10 12 15 20 30 60).
+    #[arg(long, default_value_t = 4)]
+    timesteps_per_hour: u32,
+    /// Sampled days, evenly over the year.
+    #[arg(long, default_value_t = SamplingPlan::default().days)]
+    days_per_year: usize,
+    /// Samples per day, evenly over daylight.
+    #[arg(long, default_value_t = SamplingPlan::default().per_day)]
+    samples_per_day: usize,
+    /// Tile size in pixels.
+    #[arg(long, default_value_t = 512)]
+    resolution: u32,
+    /// Count every sun-up timestep directly instead of interpolating (the reference; slow).
+    #[arg(long)]
+    dense: bool,
+    /// Count a timestep directly where the samples around it differ by more than this (a shadow
+    /// edge sweeping through); 1 interpolates everywhere.
+    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    refine: f64,
+    /// Output CSV (written atomically).
+    #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
+    output: PathBuf,
 }
 
 #[derive(Args)]
@@ -102,6 +141,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Fraction(a) => fraction(a),
         Command::Info(a) => info(a),
+        Command::Annual(a) => annual(a),
         Command::Bench(a) => run_bench(a),
     };
     match result {
@@ -181,6 +221,63 @@ fn fraction(args: FractionArgs) -> Result<()> {
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
     for (r, c) in scene.receivers.iter().zip(&counted) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
+    }
+    Ok(())
+}
+
+fn annual(args: AnnualArgs) -> Result<()> {
+    // Everything that can be refused is refused before minutes of counting.
+    let timesteps = Timesteps::new(args.timesteps_per_hour)?;
+    if !(0.0..=1.0).contains(&args.refine) {
+        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
+    }
+    let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
+    let location = match (&args.epw, &args.location) {
+        (Some(epw), _) => Location::from_epw(epw)?,
+        (None, Some(text)) => Location::parse(text)?,
+        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+    };
+    check_writable(&args.output)?;
+    let scene = args.model.load()?;
+    let counter = counter(args.resolution)?;
+    let gpu = counter.upload(&scene)?;
+    let start = Instant::now();
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
+            .map_err(|e| Error::argument("progress", e.to_string()))?,
+    );
+    bar.set_message(if args.dense { "dense" } else { "sampling" });
+    let mut report = |p: Progress| {
+        bar.set_length(p.total as u64);
+        bar.set_position(p.done as u64);
+    };
+    let options = AnnualOptions { timesteps, method, refine: args.refine };
+    let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;
+    bar.finish_and_clear();
+    let bytes = schedule.csv_bytes()?;
+    sunlit::export::write_atomic(&args.output, &bytes)?;
+    eprintln!(
+        "wrote {} ({} rows × {} surfaces) in {:.1} s; {} views counted",
+        args.output.display(),
+        timesteps.rows(),
+        schedule.names.len(),
+        start.elapsed().as_secs_f64(),
+        bar.length().unwrap_or(0)
+    );
+    Ok(())
+}
+
+/// Fails early, before any counting, when the output folder cannot take the file.
+fn check_writable(path: &std::path::Path) -> Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let probe = dir.join(format!(".sunlit-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let _ = std::fs::remove_file(&probe);
+    if path.is_dir() {
+        return Err(Error::argument("--output", format!("{} is a folder", path.display())));
     }
     Ok(())
 }

@@ -1,6 +1,12 @@
 //! Sun directions: azimuth/altitude in degrees to a unit vector in world axes (x east, y north, z up).
 //!
 //! Owns the convention every other stage uses: the vector points *towards* the sun.
+//! Where the sun is at a given place and time lives in the submodules:
+//! - [`location`]: the site (latitude, longitude, time zone), from the command line or an EPW weather file;
+//! - [`position`]: solar declination, equation of time, sun directions and daylight hours as EnergyPlus computes them.
+
+pub mod location;
+pub mod position;
 
 use glam::DVec3;
 
