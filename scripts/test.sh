@@ -3,7 +3,7 @@
 # GPU (lavapipe here). GPU tests never skip: without an adapter they fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-. scripts/setup.sh
+SUNLIT_ENERGYPLUS=1 . scripts/setup.sh
 
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings

@@ -10,6 +10,7 @@ use serde_json::json;
 use sunlit::annual::{AnnualOptions, Method, Progress};
 use sunlit::count::gpu::{Counted, Counter, CounterOptions};
 use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::export::hook::{Hook, HookPlan, patch_epjson, patch_idf};
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
@@ -46,9 +47,10 @@ struct AnnualArgs {
     /// Latitude (° north), longitude (° east), time zone (hours from UTC).
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true)]
     location: Option<String>,
-    /// Timesteps per hour (one EnergyPlus accepts: 1 2 3 4 5 6 10 12 15 20 30 60).
-    #[arg(long, default_value_t = 4)]
-    timesteps_per_hour: u32,
+    /// Timesteps per hour (one EnergyPlus accepts: 1 2 3 4 5 6 10 12 15 20 30 60); default: the
+    /// EnergyPlus model's Timestep, else 4.
+    #[arg(long)]
+    timesteps_per_hour: Option<u32>,
     /// Sampled days, evenly over the year.
     #[arg(long, default_value_t = SamplingPlan::default().days)]
     days_per_year: usize,
@@ -68,6 +70,13 @@ struct AnnualArgs {
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
+    /// Also write a copy of the EnergyPlus model (IDF or epJSON, as given) that uses the CSV.
+    #[arg(long, value_name = "FILE")]
+    idf_out: Option<PathBuf>,
+    /// How the copy hooks the CSV in: scheduled (per-surface Schedule:File, works with 25.2) or
+    /// imported (Schedule:File:Shading, ignored by 25.2); default by the model's Version.
+    #[arg(long, value_name = "FORM")]
+    hook: Option<String>,
 }
 
 #[derive(Args)]
@@ -84,8 +93,16 @@ struct ModelArgs {
 }
 
 impl ModelArgs {
+    fn options(&self) -> LoadOptions {
+        LoadOptions { receivers: self.receivers.clone(), north: self.north }
+    }
+
     fn load(&self) -> Result<Scene> {
-        model::load(&self.models, &LoadOptions { receivers: self.receivers.clone(), north: self.north })
+        model::load(&self.models, &self.options())
+    }
+
+    fn load_all(&self) -> Result<model::Loaded> {
+        model::load_all(&self.models, &self.options())
     }
 }
 
@@ -227,7 +244,6 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
-    let timesteps = Timesteps::new(args.timesteps_per_hour)?;
     if !(0.0..=1.0).contains(&args.refine) {
         return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
     }
@@ -237,8 +253,19 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (None, Some(text)) => Location::parse(text)?,
         (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
     };
+    let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
     check_writable(&args.output)?;
-    let scene = args.model.load()?;
+    if let Some(out) = &args.idf_out {
+        check_writable(out)?;
+    }
+    let loaded = args.model.load_all()?;
+    let (scene, energyplus) = (loaded.scene, loaded.energyplus);
+    let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let hooked = match (&args.idf_out, &energyplus) {
+        (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
+        (Some(_), Some(ep)) => Some(hook_check(ep, &scene, hook)?),
+        (None, _) => None,
+    };
     let counter = counter(args.resolution)?;
     let gpu = counter.upload(&scene)?;
     let start = Instant::now();
@@ -255,7 +282,16 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
+    // The hooked model is made before anything is written, so a refusal leaves no files.
+    let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
+        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, out, &args.output, &schedule.names, timesteps, form)?)),
+        _ => None,
+    };
     sunlit::export::write_atomic(&args.output, &bytes)?;
+    if let Some((out, form, text)) = patched {
+        sunlit::export::write_atomic(out, text.as_bytes())?;
+        eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
+    }
     eprintln!(
         "wrote {} ({} rows × {} surfaces) in {:.1} s; {} views counted",
         args.output.display(),
@@ -265,6 +301,43 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.length().unwrap_or(0)
     );
     Ok(())
+}
+
+/// The hook form for a model, and a check that every receiver is one of its surfaces.
+fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>) -> Result<Hook> {
+    let form = match hook {
+        Some(h) => h,
+        None => Hook::for_version(&ep.file, sunlit::model::idf::version(&ep.objects).as_deref())?,
+    };
+    if let Some(r) = scene.receivers.iter().find(|r| ep.building.surface(&r.name).is_none()) {
+        return Err(Error::argument(
+            "--idf-out",
+            format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
+        ));
+    }
+    Ok(form)
+}
+
+/// The model's text with the CSV hooked in. The CSV is named by file name when it sits beside the
+/// patched model (EnergyPlus looks there), by absolute path otherwise.
+fn patch_model(
+    ep: &model::EnergyPlusInput,
+    out: &std::path::Path,
+    csv: &std::path::Path,
+    columns: &[String],
+    timesteps: Timesteps,
+    hook: Hook,
+) -> Result<String> {
+    let folder = |p: &std::path::Path| {
+        std::fs::canonicalize(p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."))).ok()
+    };
+    let csv_text = match (folder(out), folder(csv), csv.file_name()) {
+        (Some(a), Some(b), Some(name)) if a == b => name.to_string_lossy().into_owned(),
+        (_, Some(b), Some(name)) => b.join(name).display().to_string(),
+        _ => csv.display().to_string(),
+    };
+    let plan = HookPlan { csv: &csv_text, columns, timesteps, hook };
+    if ep.epjson { patch_epjson(&ep.file, &ep.text, &plan) } else { patch_idf(&ep.file, &ep.text, &ep.objects, &plan) }
 }
 
 /// Fails early, before any counting, when the output folder cannot take the file.

@@ -6,8 +6,11 @@
 //!   time), with N = 1 at mid-hour, t = h − 0.5 (EnergyPlus's own convention). Each row is
 //!   stamped ` MM/DD HH:MM` at the end of its timestep, as in EnergyPlus's eplusshading.csv.
 //! - [`SamplingPlan`]: D days evenly over the (periodic) year at day-of-year 1 + (d + ½)·365/D,
-//!   and S times per day evenly over daylight at normalised time τ_j = (j + ½)/S, where τ = 0 is
-//!   sunrise and τ = 1 sunset of that day. Midpoints keep samples off the horizon, where every
+//!   and S normalised times per lit piece of a day at the Chebyshev nodes
+//!   τ_j = ½ − ½·cos(π(j + ½)/S), where τ = 0 is where the surface's lit piece begins (sunrise, or
+//!   the sun coming round in front of it) and τ = 1 where it ends. The nodes crowd towards both
+//!   ends, where shadows move fastest (low sun, grazing incidence): on the example office this
+//!   halves the RMS error of uniform times. They never touch the ends themselves, where every
 //!   fraction is 0 by definition and the spline would see a jump.
 
 use crate::error::{Error, Result};
@@ -125,7 +128,7 @@ impl SamplingPlan {
         (0..self.days).map(|d| self.first_day() + d as f64 * DAYS as f64 / self.days as f64).collect()
     }
 
-    /// Normalised daylight times τ of the samples of each day.
+    /// Normalised times τ of the samples within each lit piece (Chebyshev nodes on (0, 1)).
     pub fn taus(&self) -> Vec<f64> {
         (0..self.per_day).map(|j| 0.5 - 0.5 * (std::f64::consts::PI * (j as f64 + 0.5) / self.per_day as f64).cos()).collect()
     }

@@ -53,11 +53,14 @@ pub fn gltf_to_world() -> DMat4 {
 /// Reads a .gltf or .glb file; external buffers are looked up beside it.
 pub fn read_path(path: &Path, north_deg: f64) -> Result<GltfModel> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
-    let dir = path.parent().map(Path::to_path_buf);
-    let file = path.display().to_string();
-    read_with(&file, &bytes, north_deg, |uri| match &dir {
-        Some(d) => std::fs::read(d.join(uri)).map_err(|e| format!("external buffer '{uri}' could not be read: {e}")),
-        None => Err(format!("external buffer '{uri}' could not be read")),
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    read_bytes_beside(&path.display().to_string(), &bytes, &dir, north_deg)
+}
+
+/// Reads glTF bytes whose external buffers are files in `dir`.
+pub fn read_bytes_beside(file: &str, bytes: &[u8], dir: &Path, north_deg: f64) -> Result<GltfModel> {
+    read_with(file, bytes, north_deg, |uri| {
+        std::fs::read(dir.join(uri)).map_err(|e| format!("external buffer '{uri}' could not be read: {e}"))
     })
 }
 

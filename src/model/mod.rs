@@ -1,11 +1,18 @@
-//! Model readers and writers: glTF/glb in, glb out (examples, benchmarks, tests).
+//! Model readers and writers: glTF/glb and EnergyPlus IDF/epJSON in, glb and IDF out.
 //!
-//! Owns the choice of receivers across all input files: `--receivers GLOB` (node names,
-//! case-insensitive) when given; otherwise the nodes marked `{"sunlit": {"receiver": true}}` in
-//! their extras, if any file marks one; otherwise every named node with a mesh.
+//! Owns the choice of receivers across all input files. With an EnergyPlus model among the
+//! inputs, it gives the receivers (its outdoor surfaces and fenestration, by their EnergyPlus
+//! names) and glTF files are context that only casts shadows, unless `--receivers` picks glTF
+//! nodes too. Without one: `--receivers GLOB` (node names, case-insensitive) when given;
+//! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
+//! one; otherwise every named node with a mesh.
+pub mod building;
+pub mod epjson;
 pub mod glb_write;
 pub mod gltf_read;
+pub mod idf;
 pub mod office;
+pub mod office_idf;
 
 use std::path::PathBuf;
 
@@ -23,18 +30,102 @@ pub struct LoadOptions {
     pub north: f64,
 }
 
+/// The EnergyPlus model among the inputs, kept for `--idf-out`.
+#[derive(Debug, Clone)]
+pub struct EnergyPlusInput {
+    /// File label.
+    pub file: String,
+    /// Its text as read.
+    pub text: String,
+    /// Its objects.
+    pub objects: Vec<idf::IdfObject>,
+    /// epJSON rather than IDF.
+    pub epjson: bool,
+    /// Its geometry.
+    pub building: building::Building,
+}
+
+impl EnergyPlusInput {
+    /// The model's `Timestep` (timesteps per hour), if it has one.
+    pub fn timesteps(&self) -> Option<u32> {
+        self.objects.iter().find(|o| o.is("Timestep")).and_then(|o| o.field(0).trim().parse().ok())
+    }
+}
+
+/// A scene and, when one of the inputs was an EnergyPlus model, that model.
+#[derive(Debug)]
+pub struct Loaded {
+    /// What is counted.
+    pub scene: Scene,
+    /// The EnergyPlus model, if any.
+    pub energyplus: Option<EnergyPlusInput>,
+}
+
 /// Reads model files into one scene.
 pub fn load(paths: &[PathBuf], options: &LoadOptions) -> Result<Scene> {
-    check_options(options)?;
-    let models = paths.iter().map(|p| gltf_read::read_path(p, options.north)).collect::<Result<Vec<_>>>()?;
-    build(models, options)
+    Ok(load_all(paths, options)?.scene)
+}
+
+/// Reads model files into one scene, keeping an EnergyPlus input for patching.
+pub fn load_all(paths: &[PathBuf], options: &LoadOptions) -> Result<Loaded> {
+    let files = paths
+        .iter()
+        .map(|p| std::fs::read(p).map(|b| (p.display().to_string(), b)).map_err(|source| Error::Io { path: p.clone(), source }))
+        .collect::<Result<Vec<_>>>()?;
+    let dirs: Vec<Option<PathBuf>> = paths.iter().map(|p| p.parent().map(PathBuf::from)).collect();
+    read_inputs(&files, &dirs, options)
 }
 
 /// Reads in-memory model files (name, bytes) into one scene (the web path).
 pub fn load_bytes(files: &[(String, Vec<u8>)], options: &LoadOptions) -> Result<Scene> {
+    Ok(read_inputs(files, &vec![None; files.len()], options)?.scene)
+}
+
+/// Whether a file name is an EnergyPlus model (by extension).
+fn energyplus_kind(name: &str) -> Option<bool> {
+    let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".idf") {
+        Some(false)
+    } else if lower.ends_with(".epjson") || lower.ends_with(".json") {
+        Some(true)
+    } else {
+        None
+    }
+}
+
+fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &LoadOptions) -> Result<Loaded> {
     check_options(options)?;
-    let models = files.iter().map(|(n, b)| gltf_read::read_bytes(n, b, options.north)).collect::<Result<Vec<_>>>()?;
-    build(models, options)
+    let mut models = Vec::new();
+    let mut energyplus: Option<EnergyPlusInput> = None;
+    for ((name, bytes), dir) in files.iter().zip(dirs) {
+        match energyplus_kind(name) {
+            Some(epjson) => {
+                if let Some(first) = &energyplus {
+                    return Err(Error::model(name, format!("only one EnergyPlus model at a time ({} was given first)", first.file)));
+                }
+                energyplus = Some(read_energyplus(name, bytes, epjson)?);
+            }
+            None => models.push(match dir {
+                Some(d) => gltf_read::read_bytes_beside(name, bytes, d, options.north)?,
+                None => gltf_read::read_bytes(name, bytes, options.north)?,
+            }),
+        }
+    }
+    let scene = build(models, energyplus.as_ref().map(|e| &e.building), options)?;
+    Ok(Loaded { scene, energyplus })
+}
+
+fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusInput> {
+    let text = String::from_utf8(bytes.to_vec()).map_err(|e| Error::model(name, format!("not UTF-8 text: {e}")))?;
+    let objects = if epjson { epjson::parse_epjson(name, &text)? } else { idf::parse_idf(name, &text)? };
+    let building = building::read_building(name, &objects)?;
+    for warning in &building.warnings {
+        log::warn!("{name}: {warning}");
+    }
+    if !building.skipped.is_empty() {
+        log::info!("{name}: objects without geometry ignored: {}", building.skipped.join(", "));
+    }
+    Ok(EnergyPlusInput { file: name.to_string(), text, objects, epjson, building })
 }
 
 fn check_options(options: &LoadOptions) -> Result<()> {
@@ -44,10 +135,17 @@ fn check_options(options: &LoadOptions) -> Result<()> {
     Ok(())
 }
 
-fn build(models: Vec<GltfModel>, options: &LoadOptions) -> Result<Scene> {
-    let select = Selection::new(&models, options)?;
+fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, options: &LoadOptions) -> Result<Scene> {
+    let select = match energyplus {
+        Some(_) if options.receivers.is_empty() => Selection::Context,
+        _ => Selection::new(&models, options)?,
+    };
     let mut builder = SceneBuilder::new();
     let mut matched = 0usize;
+    if let Some(b) = energyplus {
+        b.add_to(&mut builder)?;
+        matched += b.receiver_names().len();
+    }
     for model in models {
         model.add_to(&mut builder, |n| {
             let hit = select.is_receiver(n);
@@ -66,6 +164,8 @@ enum Selection {
     Globs(globset::GlobSet, Vec<String>),
     Marked,
     Named,
+    /// glTF files beside an EnergyPlus model: context only.
+    Context,
 }
 
 impl Selection {
@@ -91,6 +191,7 @@ impl Selection {
             Selection::Globs(set, _) => set.is_match(&node.name),
             Selection::Marked => node.marked,
             Selection::Named => node.named,
+            Selection::Context => false,
         }
     }
 
@@ -99,6 +200,7 @@ impl Selection {
             Selection::Globs(_, p) => format!("no node name matches --receivers {}", p.join(", ")),
             Selection::Marked => "no node is marked as a receiver".into(),
             Selection::Named => "the models have no named node with a mesh (name nodes, mark them in extras, or use --receivers)".into(),
+            Selection::Context => "the EnergyPlus model has no outdoor surface or window".into(),
         }
     }
 }

@@ -12,6 +12,8 @@ use std::path::{Path, PathBuf};
 use crate::error::{Error, Result};
 use crate::samples::Timesteps;
 
+pub mod hook;
+
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Schedule {

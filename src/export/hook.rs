@@ -1,0 +1,389 @@
+//! Hooking a sunlit CSV into an EnergyPlus model, so that stock EnergyPlus really uses it.
+//!
+//! Owns the two forms EnergyPlus offers and the choice between them:
+//! - [`Hook::Scheduled`] (the default): `ShadowCalculation` method `Scheduled`, and per surface a
+//!   `Schedule:File` reading its column of the CSV plus a `SurfaceProperty:LocalEnvironment`
+//!   naming that schedule as the surface's sunlit fraction schedule. Measured with EnergyPlus
+//!   25.2 (tests/energyplus.rs): the fractions are used exactly.
+//! - [`Hook::Imported`]: `ShadowCalculation` method `Imported` and one `Schedule:File:Shading`.
+//!   EnergyPlus 25.2 silently ignores it (every surface "not found … set to 1.0", a name-lookup
+//!   bug fixed upstream later), so it is only written when asked for.
+//!
+//! Both exist from EnergyPlus 9.0 on; older models are refused. Either way the shading
+//! calculation is updated every timestep (in Periodic mode a schedule is read only on the first
+//! day of each period), the schedules are not shifted for daylight saving (the CSV is in standard
+//! time, as EnergyPlus's own), and the model's Timestep must match the CSV's.
+
+use std::fmt::Write as _;
+
+use crate::error::{Error, Result};
+use crate::model::idf::IdfObject;
+use crate::samples::Timesteps;
+
+/// How EnergyPlus is told to use the CSV.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hook {
+    /// Per-surface `Schedule:File` + `SurfaceProperty:LocalEnvironment` (works in 25.2).
+    Scheduled,
+    /// One `Schedule:File:Shading` (ignored by 25.2).
+    Imported,
+}
+
+impl Hook {
+    /// Parses `scheduled` / `imported`.
+    pub fn parse(text: &str) -> Result<Self> {
+        match text.to_ascii_lowercase().as_str() {
+            "scheduled" => Ok(Hook::Scheduled),
+            "imported" => Ok(Hook::Imported),
+            _ => Err(Error::argument("--hook", format!("'{text}': expected scheduled or imported"))),
+        }
+    }
+
+    /// The form for a model's `Version`: Scheduled from 9.0 on; before 9.0 EnergyPlus cannot take
+    /// external sunlit fractions at all.
+    pub fn for_version(file: &str, version: Option<&str>) -> Result<Self> {
+        let major = version.and_then(|v| v.split('.').next()).and_then(|m| m.trim().parse::<u32>().ok());
+        match major {
+            Some(m) if m < 9 => Err(Error::model(
+                file,
+                format!(
+                    "EnergyPlus {} cannot read external sunlit fractions (ShadowCalculation Scheduled/Imported need 9.0 or later)",
+                    version.unwrap_or("")
+                ),
+            )),
+            _ => Ok(Hook::Scheduled),
+        }
+    }
+}
+
+/// What to hook in: the CSV as the model will find it and its columns.
+#[derive(Debug, Clone)]
+pub struct HookPlan<'a> {
+    /// The CSV's path as written into the model (a bare file name when it sits beside the model).
+    pub csv: &'a str,
+    /// Surface names, in CSV column order (the CSV's first column is the time stamp).
+    pub columns: &'a [String],
+    /// The CSV's timesteps per hour.
+    pub timesteps: Timesteps,
+    /// The form.
+    pub hook: Hook,
+}
+
+/// Schedule type limits of the fraction schedules, so EnergyPlus validates them (0..1).
+const LIMITS: &str = "SUNLIT FRACTION";
+/// Objects that the hook replaces.
+const REPLACED: [&str; 2] = ["ShadowCalculation", "Schedule:File:Shading"];
+/// ShadowCalculation fields written when the model has none (IDD order, 25.2).
+const DEFAULT_SHADOW_CALCULATION: [&str; 8] =
+    ["Scheduled", "Timestep", "1", "15000", "SutherlandHodgman", "512", "SimpleSkyDiffuseModeling", "No"];
+
+/// The IDF text with the hook: the old ShadowCalculation (and any Schedule:File:Shading) removed,
+/// the new objects appended. Everything else, comments included, is kept as written.
+pub fn patch_idf(file: &str, text: &str, objects: &[IdfObject], plan: &HookPlan) -> Result<String> {
+    check_model(file, objects, plan)?;
+    let lines: Vec<&str> = text.lines().collect();
+    let mut drop = vec![false; lines.len() + 1];
+    for o in objects.iter().filter(|o| REPLACED.iter().any(|c| o.is(c))) {
+        if shares_lines(o, objects) {
+            return Err(Error::object(file, o.label(), "shares a line with another object; put it on lines of its own to be replaced"));
+        }
+        for l in o.line..=o.end_line {
+            drop[l] = true;
+        }
+    }
+    // Non-convex shading surfaces: EnergyPlus's own (sky diffuse) shading pass still reads every
+    // caster and calls a non-convex one a severe error, so they go in as convex triangles.
+    let mut replace: Vec<(usize, String)> = Vec::new();
+    for o in objects.iter().filter(|o| SHADING_VERTICES.iter().any(|(c, _)| o.is(c))) {
+        if let Some(text) = convex_split(file, o)? {
+            for l in o.line..=o.end_line {
+                drop[l] = true;
+            }
+            replace.push((o.line, text));
+        }
+    }
+    let mut out = String::with_capacity(text.len() + 512 * plan.columns.len());
+    for (i, line) in lines.iter().enumerate() {
+        if let Some((_, text)) = replace.iter().find(|(l, _)| *l == i + 1) {
+            out.push_str(text);
+        }
+        if !drop[i + 1] {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    let existing = objects.iter().find(|o| o.is("ShadowCalculation"));
+    out.push_str(&hook_objects(existing, plan));
+    let has_limits = objects.iter().any(|o| o.is("ScheduleTypeLimits") && o.field(0).eq_ignore_ascii_case(LIMITS));
+    if plan.hook == Hook::Scheduled && !has_limits {
+        object(&mut out, "ScheduleTypeLimits", &[LIMITS, "0", "1", "Continuous"]);
+    }
+    Ok(out)
+}
+
+/// Shading classes with a vertex list: the index of their "Number of Vertices" field.
+const SHADING_VERTICES: [(&str, usize); 3] = [("Shading:Site:Detailed", 2), ("Shading:Building:Detailed", 2), ("Shading:Zone:Detailed", 3)];
+
+/// A non-convex shading object rewritten as triangles `NAME_1`, `NAME_2`, … (same class and
+/// leading fields, vertices as written, so relative coordinates stay relative); None if convex.
+fn convex_split(file: &str, o: &IdfObject) -> Result<Option<String>> {
+    let Some(&(_, count_at)) = SHADING_VERTICES.iter().find(|(c, _)| o.is(c)) else { return Ok(None) };
+    let number = |i: usize| {
+        o.field(i)
+            .trim()
+            .parse::<f64>()
+            .map_err(|_| Error::object(file, o.label(), format!("field {} '{}' is not a number", i + 1, o.field(i))))
+    };
+    let coords = o.fields.len().saturating_sub(count_at + 1) / 3;
+    let vertices = (0..coords)
+        .map(|k| Ok(glam::DVec3::new(number(count_at + 1 + 3 * k)?, number(count_at + 2 + 3 * k)?, number(count_at + 3 + 3 * k)?)))
+        .collect::<Result<Vec<_>>>()?;
+    if vertices.len() < 4 || is_convex(&vertices) {
+        return Ok(None);
+    }
+    let name = o.name().unwrap_or("SHADING");
+    let mut out = format!("! sunlit: non-convex {} split into convex triangles\n", o.label());
+    for (k, t) in triangles(&vertices).iter().enumerate() {
+        let mut fields: Vec<String> = o.fields[..count_at].to_vec();
+        fields[0] = format!("{name}_{}", k + 1);
+        fields.push("3".into());
+        for &i in t {
+            fields
+                .extend([o.field(count_at + 1 + 3 * i), o.field(count_at + 2 + 3 * i), o.field(count_at + 3 + 3 * i)].map(str::to_string));
+        }
+        object(&mut out, &o.class, &fields.iter().map(String::as_str).collect::<Vec<_>>());
+    }
+    Ok(Some(out))
+}
+
+/// A polygon's normal × area (Newell), for its orientation.
+fn newell(v: &[glam::DVec3]) -> glam::DVec3 {
+    (0..v.len()).map(|i| v[i].cross(v[(i + 1) % v.len()])).sum::<glam::DVec3>() * 0.5
+}
+
+/// Whether every turn of the polygon goes the same way as its normal.
+fn is_convex(v: &[glam::DVec3]) -> bool {
+    let n = newell(v);
+    (0..v.len()).all(|i| {
+        let (a, b, c) = (v[i], v[(i + 1) % v.len()], v[(i + 2) % v.len()]);
+        (b - a).cross(c - b).dot(n) >= -1e-12 * n.length()
+    })
+}
+
+/// Ear-clipped triangles of a planar polygon, as vertex indices keeping its winding.
+fn triangles(v: &[glam::DVec3]) -> Vec<[usize; 3]> {
+    let n = newell(v).normalize_or_zero();
+    let helper = if n.x.abs() < 0.9 { glam::DVec3::X } else { glam::DVec3::Y };
+    let u = (helper - n * helper.dot(n)).normalize_or_zero();
+    let w = n.cross(u);
+    let flat: Vec<[f64; 2]> = v.iter().map(|p| [p.dot(u), p.dot(w)]).collect();
+    let mut indices: Vec<usize> = Vec::new();
+    earcut::Earcut::new().earcut(flat.iter().copied(), &[], &mut indices);
+    indices
+        .chunks_exact(3)
+        .map(|t| {
+            let facing = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).dot(n);
+            if facing < 0.0 { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] }
+        })
+        .collect()
+}
+
+/// Whether another object starts or ends on one of `o`'s lines.
+fn shares_lines(o: &IdfObject, objects: &[IdfObject]) -> bool {
+    objects.iter().any(|p| !std::ptr::eq(p, o) && p.end_line >= o.line && p.line <= o.end_line)
+}
+
+/// Refuses models the hook would break: an old version, a Timestep that differs from the CSV's,
+/// a surface that already has a local environment (EnergyPlus allows one).
+fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result<()> {
+    Hook::for_version(file, crate::model::idf::version(objects).as_deref())?;
+    if let Some(ts) = objects.iter().find(|o| o.is("Timestep")) {
+        let n: u32 = ts.field(0).trim().parse().unwrap_or(1);
+        if n != plan.timesteps.per_hour() {
+            return Err(Error::object(
+                file,
+                ts.label(),
+                format!(
+                    "the model runs {n} timesteps per hour but the CSV has {}: use --timesteps-per-hour {n}",
+                    plan.timesteps.per_hour()
+                ),
+            ));
+        }
+    }
+    if plan.hook == Hook::Scheduled {
+        for o in objects.iter().filter(|o| o.is("SurfaceProperty:LocalEnvironment")) {
+            if plan.columns.iter().any(|c| c.eq_ignore_ascii_case(o.field(1))) {
+                return Err(Error::object(
+                    file,
+                    o.label(),
+                    "this surface already has a local environment; sunlit would need to add its own",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The objects the hook adds, as IDF text.
+fn hook_objects(existing: Option<&IdfObject>, plan: &HookPlan) -> String {
+    let mut fields: Vec<String> = match existing {
+        Some(o) => o.fields.clone(),
+        None => DEFAULT_SHADOW_CALCULATION.iter().map(|s| s.to_string()).collect(),
+    };
+    fields.resize(fields.len().max(8), String::new());
+    fields[0] = if plan.hook == Hook::Scheduled { "Scheduled" } else { "Imported" }.into();
+    fields[1] = "Timestep".into();
+    fields[2] = "1".into();
+    fields[7] = "No".into();
+    let mut out = format!("\n! ---- Added by sunlit: EnergyPlus takes its sunlit fractions from {} ----\n", plan.csv);
+    object(&mut out, "ShadowCalculation", &fields.iter().map(String::as_str).collect::<Vec<_>>());
+    match plan.hook {
+        Hook::Imported => object(&mut out, "Schedule:File:Shading", &[plan.csv]),
+        Hook::Scheduled => {
+            let minutes = (60 / plan.timesteps.per_hour()).to_string();
+            for (k, surface) in plan.columns.iter().enumerate() {
+                let schedule = schedule_name(surface);
+                let column = (k + 2).to_string();
+                object(&mut out, "Schedule:File", &[&schedule, LIMITS, plan.csv, &column, "1", "8760", "Comma", "No", &minutes, "No"]);
+                let env = format!("SUNLIT ENV {surface}");
+                object(&mut out, "SurfaceProperty:LocalEnvironment", &[&env, surface, &schedule]);
+            }
+        }
+    }
+    out
+}
+
+/// The schedule that carries `surface`'s column.
+pub fn schedule_name(surface: &str) -> String {
+    format!("SUNLIT {surface}")
+}
+
+fn object(out: &mut String, class: &str, fields: &[&str]) {
+    let _ = write!(out, "{class},");
+    for (i, f) in fields.iter().enumerate() {
+        let end = if i + 1 == fields.len() { ';' } else { ',' };
+        let _ = write!(out, "\n  {f}{end}");
+    }
+    out.push_str("\n\n");
+}
+
+/// The epJSON text with the hook (the JSON is re-serialised; key order becomes alphabetical).
+pub fn patch_epjson(file: &str, text: &str, plan: &HookPlan) -> Result<String> {
+    use serde_json::{Map, Value, json};
+    let mut root: Value = serde_json::from_str(text).map_err(|e| Error::model(file, format!("not valid JSON: {e}")))?;
+    let version = root
+        .pointer("/Version")
+        .and_then(Value::as_object)
+        .and_then(|m| m.values().next())
+        .and_then(|v| v["version_identifier"].as_str())
+        .map(str::to_string);
+    Hook::for_version(file, version.as_deref())?;
+    let Some(model) = root.as_object_mut() else { return Err(Error::model(file, "the top level is not a JSON object")) };
+    let mut calc = model.get("ShadowCalculation").and_then(Value::as_object).and_then(|m| m.values().next()).cloned().unwrap_or(json!({}));
+    calc["shading_calculation_method"] = json!(if plan.hook == Hook::Scheduled { "Scheduled" } else { "Imported" });
+    calc["shading_calculation_update_frequency_method"] = json!("Timestep");
+    calc["shading_calculation_update_frequency"] = json!(1);
+    calc["output_external_shading_calculation_results"] = json!("No");
+    model.insert("ShadowCalculation".into(), json!({ "ShadowCalculation 1": calc }));
+    model.remove("Schedule:File:Shading");
+    match plan.hook {
+        Hook::Imported => {
+            model.insert("Schedule:File:Shading".into(), json!({ "Schedule:File:Shading 1": { "file_name": plan.csv } }));
+        }
+        Hook::Scheduled => {
+            let minutes = 60 / plan.timesteps.per_hour();
+            let mut schedules = model.get("Schedule:File").and_then(Value::as_object).cloned().unwrap_or_else(Map::new);
+            let mut envs = model.get("SurfaceProperty:LocalEnvironment").and_then(Value::as_object).cloned().unwrap_or_else(Map::new);
+            for (k, surface) in plan.columns.iter().enumerate() {
+                let schedule = schedule_name(surface);
+                schedules.insert(
+                    schedule.clone(),
+                    json!({"schedule_type_limits_name": LIMITS, "file_name": plan.csv, "column_number": k + 2, "rows_to_skip_at_top": 1, "number_of_hours_of_data": 8760,
+                           "column_separator": "Comma", "interpolate_to_timestep": "No", "minutes_per_item": minutes,
+                           "adjust_schedule_for_daylight_savings": "No"}),
+                );
+                envs.insert(
+                    format!("SUNLIT ENV {surface}"),
+                    json!({"exterior_surface_name": surface, "sunlit_fraction_schedule_name": schedule}),
+                );
+            }
+            model.insert("Schedule:File".into(), Value::Object(schedules));
+            let mut limits = model.get("ScheduleTypeLimits").and_then(Value::as_object).cloned().unwrap_or_else(Map::new);
+            limits.entry(LIMITS).or_insert(json!({"lower_limit_value": 0, "upper_limit_value": 1, "numeric_type": "Continuous"}));
+            model.insert("ScheduleTypeLimits".into(), Value::Object(limits));
+            model.insert("SurfaceProperty:LocalEnvironment".into(), Value::Object(envs));
+        }
+    }
+    serde_json::to_string_pretty(&root).map_err(|e| Error::model(file, e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::idf::parse_idf;
+
+    const MODEL: &str = "Version, 25.2;\n! keep me\nTimestep, 4;\nShadowCalculation,\n  PolygonClipping, Periodic, 20, 15000,\n  SutherlandHodgman, 512, DetailedSkyDiffuseModeling, Yes;\nZone, Z;\n";
+
+    fn plan(columns: &[String]) -> HookPlan<'_> {
+        HookPlan { csv: "shading.csv", columns, timesteps: Timesteps::new(4).unwrap(), hook: Hook::Scheduled }
+    }
+
+    #[test]
+    fn scheduled_hook_replaces_shadow_calculation_and_adds_schedules() {
+        let columns = vec!["WALL_S".to_string(), "WIN_S".to_string()];
+        let objects = parse_idf("m.idf", MODEL).unwrap();
+        let out = patch_idf("m.idf", MODEL, &objects, &plan(&columns)).unwrap();
+        let patched = parse_idf("out.idf", &out).unwrap();
+        let calc: Vec<_> = patched.iter().filter(|o| o.is("ShadowCalculation")).collect();
+        assert_eq!(calc.len(), 1);
+        assert_eq!(&calc[0].fields[..3], ["Scheduled", "Timestep", "1"]);
+        assert_eq!(calc[0].fields[6], "DetailedSkyDiffuseModeling", "the model's other settings are kept");
+        let files: Vec<_> = patched.iter().filter(|o| o.is("Schedule:File")).collect();
+        assert_eq!(files[1].fields, ["SUNLIT WIN_S", "SUNLIT FRACTION", "shading.csv", "3", "1", "8760", "Comma", "No", "15", "No"]);
+        assert_eq!(patched.iter().filter(|o| o.is("ScheduleTypeLimits")).count(), 1);
+        let envs: Vec<_> = patched.iter().filter(|o| o.is("SurfaceProperty:LocalEnvironment")).collect();
+        assert_eq!(envs[0].fields, ["SUNLIT ENV WALL_S", "WALL_S", "SUNLIT WALL_S"]);
+        assert!(out.contains("! keep me") && out.contains("Zone, Z;"));
+    }
+
+    #[test]
+    fn models_the_hook_would_break_are_refused() {
+        let columns = vec!["WIN_S".to_string()];
+        let objects = parse_idf("m.idf", "Version, 25.2;\nTimestep, 6;\n").unwrap();
+        let e = patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string();
+        assert!(e.contains("Timestep") && e.contains("--timesteps-per-hour 6"), "{e}");
+        let objects = parse_idf("m.idf", "Version, 8.9;\n").unwrap();
+        assert!(patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string().contains("9.0"));
+        let objects = parse_idf("m.idf", "Version, 25.2;\nSurfaceProperty:LocalEnvironment, E, win_s, S;\n").unwrap();
+        assert!(patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string().contains("local environment"));
+        let text = "Version, 25.2; ShadowCalculation, PolygonClipping;\n";
+        let objects = parse_idf("m.idf", text).unwrap();
+        assert!(patch_idf("m.idf", text, &objects, &plan(&columns)).unwrap_err().to_string().contains("own"));
+        assert_eq!(Hook::for_version("m", Some("25.2")).unwrap(), Hook::Scheduled);
+        assert!(Hook::parse("sometimes").is_err());
+    }
+
+    #[test]
+    fn non_convex_shading_becomes_triangles() {
+        let text = "Version, 25.2;\nShading:Building:Detailed, L, ,\n 6, 0,0,3, 2,0,3, 2,2,3, 1,2,3, 1,1,3, 0,1,3;\nShading:Building:Detailed, SQ, , 4, 0,0,4, 1,0,4, 1,1,4, 0,1,4;\n";
+        let objects = parse_idf("m.idf", text).unwrap();
+        let columns = vec!["WIN_S".to_string()];
+        let out = patch_idf("m.idf", text, &objects, &plan(&columns)).unwrap();
+        let patched = parse_idf("out.idf", &out).unwrap();
+        let shades: Vec<_> = patched.iter().filter(|o| o.is("Shading:Building:Detailed")).collect();
+        assert_eq!(shades.iter().filter(|o| o.field(0).starts_with("L_")).count(), 4, "an L of six vertices is four triangles");
+        assert!(shades.iter().any(|o| o.field(0) == "SQ"), "convex ones stay");
+        assert!(shades.iter().filter(|o| o.field(0).starts_with("L_")).all(|o| o.field(2) == "3"));
+    }
+
+    #[test]
+    fn epjson_hook() {
+        let columns = vec!["WIN_S".to_string()];
+        let text = r#"{"Version": {"Version 1": {"version_identifier": "25.2"}}, "ShadowCalculation": {"ShadowCalculation 1": {"shading_calculation_method": "PolygonClipping", "sky_diffuse_modeling_algorithm": "DetailedSkyDiffuseModeling"}}}"#;
+        let out: serde_json::Value = serde_json::from_str(&patch_epjson("m.epJSON", text, &plan(&columns)).unwrap()).unwrap();
+        assert_eq!(out["ShadowCalculation"]["ShadowCalculation 1"]["shading_calculation_method"], "Scheduled");
+        assert_eq!(out["ShadowCalculation"]["ShadowCalculation 1"]["sky_diffuse_modeling_algorithm"], "DetailedSkyDiffuseModeling");
+        assert_eq!(out["Schedule:File"]["SUNLIT WIN_S"]["column_number"], 2);
+        assert_eq!(out["SurfaceProperty:LocalEnvironment"]["SUNLIT ENV WIN_S"]["exterior_surface_name"], "WIN_S");
+    }
+}

