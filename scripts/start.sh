@@ -8,3 +8,6 @@ cargo build --release --quiet --bin sunlit --example make_office
 ./target/release/examples/make_office examples/office.glb >/dev/null
 ./target/release/sunlit info examples/office.glb
 ./target/release/sunlit fraction examples/office.glb --sun "${SUN:-200,35}"
+mkdir -p out
+./target/release/sunlit annual examples/office.glb --location 39.74,-105.18,-7 -o out/office-shading.csv
+echo "EnergyPlus CSV (Schedule:File:Shading layout): out/office-shading.csv"

@@ -2,29 +2,20 @@
 //!
 //! Owns what `sunlit bench` measures, so the figures in the README come from one place.
 
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 
 use crate::count::ViewRequest;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::error::Result;
-use crate::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
+use crate::scene::{Scene, SceneBuilder, SourceMesh};
 
 /// A 10 m × 10 m horizontal receiver at z = 0 under a cloud of `triangles` random small
 /// triangles (0.05–0.5 m) between 0.5 m and 10 m up, spread over 20 m × 20 m.
 pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
     let mut rng = SplitMix64(seed);
     let mut b = SceneBuilder::new();
-    let floor = b.add_mesh(
-        "floor",
-        SourceMesh { positions: vec![[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]], indices: vec![0, 1, 2, 0, 2, 3] },
-    );
-    b.add_node(SourceNode {
-        name: "FLOOR".into(),
-        origin: "bench: node 'FLOOR'".into(),
-        mesh: floor,
-        transform: DMat4::IDENTITY,
-        receiver: true,
-    });
+    let floor = SourceMesh { positions: vec![[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]], indices: vec![0, 1, 2, 0, 2, 3] };
+    b.add_object("bench", "FLOOR", floor, true);
     let mut cloud = SourceMesh::default();
     for t in 0..triangles {
         let centre = DVec3::new(rng.range(-5.0, 15.0), rng.range(-5.0, 15.0), rng.range(0.5, 10.0));
@@ -36,14 +27,7 @@ pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
         }
         cloud.indices.extend([3 * t as u32, 3 * t as u32 + 1, 3 * t as u32 + 2]);
     }
-    let mesh = b.add_mesh("cloud", cloud);
-    b.add_node(SourceNode {
-        name: "cloud".into(),
-        origin: "bench: node 'cloud'".into(),
-        mesh,
-        transform: DMat4::IDENTITY,
-        receiver: false,
-    });
+    b.add_object("bench", "cloud", cloud, false);
     b.build()
 }
 

@@ -172,6 +172,19 @@ impl SceneBuilder {
         self.nodes.push(node);
     }
 
+    /// Adds a mesh placed once, as it is (identity transform), labelled `source: node 'name'`
+    /// in messages: the common case for generated geometry (benchmarks, tests).
+    pub fn add_object(&mut self, source: &str, name: &str, mesh: SourceMesh, receiver: bool) {
+        let mesh = self.add_mesh(name, mesh);
+        self.add_node(SourceNode {
+            name: name.into(),
+            origin: format!("{source}: node '{name}'"),
+            mesh,
+            transform: DMat4::IDENTITY,
+            receiver,
+        });
+    }
+
     /// Number of nodes added so far.
     pub fn node_count(&self) -> usize {
         self.nodes.len()

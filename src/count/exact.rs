@@ -326,14 +326,7 @@ mod tests {
 
     impl TestScene {
         fn add(mut self, name: &str, mesh: SourceMesh, receiver: bool) -> Self {
-            let m = self.builder.add_mesh(name, mesh);
-            self.builder.add_node(SourceNode {
-                name: name.into(),
-                origin: format!("test: node '{name}'"),
-                mesh: m,
-                transform: DMat4::IDENTITY,
-                receiver,
-            });
+            self.builder.add_object("test", name, mesh, receiver);
             self
         }
 

@@ -1,10 +1,10 @@
 //! Scene-building helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use glam::{DMat4, DVec3};
+use glam::DVec3;
 use sunlit::count::ViewRequest;
 use sunlit::count::gpu::{Counted, Counter, CounterOptions};
-use sunlit::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
+use sunlit::scene::{Scene, SceneBuilder, SourceMesh};
 
 /// Builds scenes from named polygons (fans of triangles) and boxes.
 #[derive(Default)]
@@ -26,14 +26,7 @@ impl TestScene {
 
     /// Any triangle mesh as one node.
     pub fn mesh(&mut self, name: &str, mesh: SourceMesh, receiver: bool) -> &mut Self {
-        let m = self.builder.add_mesh(name, mesh);
-        self.builder.add_node(SourceNode {
-            name: name.into(),
-            origin: format!("test: node '{name}'"),
-            mesh: m,
-            transform: DMat4::IDENTITY,
-            receiver,
-        });
+        self.builder.add_object("test", name, mesh, receiver);
         self
     }
 
