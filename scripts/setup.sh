@@ -21,6 +21,12 @@ if ! command -v cargo >/dev/null; then
   exit 1
 fi
 
+# The browser build's target (the library is checked for it in the tests).
+if command -v rustup >/dev/null && ! rustup target list --installed | grep -q wasm32-unknown-unknown; then
+  say "adding the wasm32-unknown-unknown target (rustup)"
+  rustup target add wasm32-unknown-unknown >/dev/null
+fi
+
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.
 if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   apt_install mesa-vulkan-drivers

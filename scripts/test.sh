@@ -7,4 +7,6 @@ SUNLIT_ENERGYPLUS=1 . scripts/setup.sh
 
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings
+# The same core builds for the browser (wgpu's WebGPU backend): keep it compiling.
+cargo check --lib --quiet --target wasm32-unknown-unknown
 cargo test --no-fail-fast 2>&1 | tee target/test.log

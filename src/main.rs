@@ -263,7 +263,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
-        (Some(_), Some(ep)) => Some(hook_check(ep, &scene, hook)?),
+        (Some(_), Some(ep)) => Some(hook_check(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
     let counter = counter(args.resolution)?;
@@ -304,7 +304,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
 }
 
 /// The hook form for a model, and a check that every receiver is one of its surfaces.
-fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>) -> Result<Hook> {
+fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timesteps: Timesteps) -> Result<Hook> {
     let form = match hook {
         Some(h) => h,
         None => Hook::for_version(&ep.file, sunlit::model::idf::version(&ep.objects).as_deref())?,
@@ -315,6 +315,9 @@ fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>) ->
             format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
         ));
     }
+    // The model checks (version, Timestep, existing local environments) before any counting.
+    let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
+    sunlit::export::hook::check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form })?;
     Ok(form)
 }
 

@@ -199,3 +199,46 @@ fn committed_example_is_what_the_code_generates() {
     let committed = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb")).unwrap();
     assert!(committed == office(6).to_glb(), "regenerate with: cargo run --example make_office");
 }
+
+#[test]
+fn bad_energyplus_models_are_named_with_object_and_line() {
+    let dir = scratch("idf");
+    let good = sunlit::model::office_idf::office_idf(2, false, sunlit::model::office_idf::Shading::None);
+    let unterminated = write(&dir, "open.idf", format!("{good}\nBuildingSurface:Detailed,\n  LOOSE_END,\n  Wall,\n").as_bytes());
+    fails_with(&sunlit(&["info", &unterminated]), &["open.idf: ", "LOOSE_END", "not terminated"]);
+    let bad_number = good.replacen("  10,0,3.5,", "  10,zero,3.5,", 1);
+    assert_ne!(bad_number, good);
+    let path = write(&dir, "number.idf", bad_number.as_bytes());
+    fails_with(&sunlit(&["info", &path]), &["number.idf: ", "BuildingSurface:Detailed 'WALL_E' (line ", "'zero' is not a number"]);
+    let json = write(&dir, "broken.epJSON", b"{\"Version\": {\"Version 1\": ");
+    fails_with(&sunlit(&["info", &json]), &["broken.epJSON: "]);
+    // --idf-out needs an EnergyPlus model; nothing is written when it is refused.
+    let glb = office_file(&dir);
+    let csv = dir.join("out.csv");
+    let idf_out = dir.join("hooked.idf");
+    let out = sunlit(&["annual", &glb, "--location", "40,-105,-7", "-o", csv.to_str().unwrap(), "--idf-out", idf_out.to_str().unwrap()]);
+    fails_with(&out, &["--idf-out", "EnergyPlus model"]);
+    assert!(!csv.exists() && !idf_out.exists());
+    // A model whose Timestep differs from the CSV's is refused before anything is written.
+    let model = write(&dir, "model.idf", good.as_bytes());
+    let out = sunlit(&[
+        "annual",
+        &model,
+        "--location",
+        "40,-105,-7",
+        "--timesteps-per-hour",
+        "6",
+        "--days-per-year",
+        "3",
+        "--samples-per-day",
+        "3",
+        "--resolution",
+        "64",
+        "-o",
+        csv.to_str().unwrap(),
+        "--idf-out",
+        idf_out.to_str().unwrap(),
+    ]);
+    fails_with(&out, &["Timestep", "--timesteps-per-hour 4"]);
+    assert!(!csv.exists() && !idf_out.exists());
+}

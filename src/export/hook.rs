@@ -194,8 +194,9 @@ fn shares_lines(o: &IdfObject, objects: &[IdfObject]) -> bool {
 }
 
 /// Refuses models the hook would break: an old version, a Timestep that differs from the CSV's,
-/// a surface that already has a local environment (EnergyPlus allows one).
-fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result<()> {
+/// a surface that already has a local environment (EnergyPlus allows one). [`patch_idf`] checks
+/// too; callers run it first to refuse before any counting.
+pub fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result<()> {
     Hook::for_version(file, crate::model::idf::version(objects).as_deref())?;
     if let Some(ts) = objects.iter().find(|o| o.is("Timestep")) {
         let n: u32 = ts.field(0).trim().parse().unwrap_or(1);
