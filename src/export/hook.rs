@@ -87,8 +87,8 @@ pub fn patch_idf(file: &str, text: &str, objects: &[IdfObject], plan: &HookPlan)
         if shares_lines(o, objects) {
             return Err(Error::object(file, o.label(), "shares a line with another object; put it on lines of its own to be replaced"));
         }
-        for l in o.line..=o.end_line {
-            drop[l] = true;
+        if let Some(lines) = drop.get_mut(o.line..=o.end_line) {
+            lines.fill(true);
         }
     }
     // Non-convex shading surfaces: EnergyPlus's own (sky diffuse) shading pass still reads every
@@ -96,8 +96,8 @@ pub fn patch_idf(file: &str, text: &str, objects: &[IdfObject], plan: &HookPlan)
     let mut replace: Vec<(usize, String)> = Vec::new();
     for o in objects.iter().filter(|o| SHADING_VERTICES.iter().any(|(c, _)| o.is(c))) {
         if let Some(text) = convex_split(file, o)? {
-            for l in o.line..=o.end_line {
-                drop[l] = true;
+            if let Some(lines) = drop.get_mut(o.line..=o.end_line) {
+                lines.fill(true);
             }
             replace.push((o.line, text));
         }
