@@ -94,15 +94,15 @@ struct ModelArgs {
 
 impl ModelArgs {
     fn options(&self) -> LoadOptions {
-        LoadOptions { receivers: self.receivers.clone(), north: self.north }
+        LoadOptions { receivers: self.receivers.clone(), north: self.north, ..Default::default() }
     }
 
     fn load(&self) -> Result<Scene> {
         model::load(&self.models, &self.options())
     }
 
-    fn load_all(&self) -> Result<model::Loaded> {
-        model::load_all(&self.models, &self.options())
+    fn load_all(&self, all_energyplus_surfaces: bool) -> Result<model::Loaded> {
+        model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
     }
 }
 
@@ -258,7 +258,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
     }
-    let loaded = args.model.load_all()?;
+    // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
+    let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
     let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
     let hooked = match (&args.idf_out, &energyplus) {
@@ -309,7 +310,8 @@ fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>, ti
         Some(h) => h,
         None => Hook::for_version(&ep.file, sunlit::model::idf::version(&ep.objects).as_deref())?,
     };
-    if let Some(r) = scene.receivers.iter().find(|r| ep.building.surface(&r.name).is_none()) {
+    let known = |name: &str| ep.building.surface(name.strip_prefix("Mir-").unwrap_or(name)).is_some();
+    if let Some(r) = scene.receivers.iter().find(|r| !known(&r.name)) {
         return Err(Error::argument(
             "--idf-out",
             format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),

@@ -68,6 +68,9 @@ pub struct Receiver {
     pub area: f64,
     /// Which instance draws it and which index range of that instance's mesh holds it.
     pub draw: ReceiverDraw,
+    /// The id its triangles carry on the GPU and in [`Scene::world_triangles`]: its own index,
+    /// or, for a mirror (the back face of a shading surface), the index of the surface it mirrors.
+    pub gpu_id: u32,
 }
 
 /// Where a receiver's triangles sit in the GPU layout, so a view can draw it alone.
@@ -153,6 +156,8 @@ pub struct SourceNode {
 pub struct SceneBuilder {
     meshes: Vec<(String, SourceMesh)>,
     nodes: Vec<SourceNode>,
+    /// (receiver name, mirror name) pairs: see [`SceneBuilder::add_mirror`].
+    mirrors: Vec<(String, String)>,
 }
 
 impl SceneBuilder {
@@ -183,6 +188,13 @@ impl SceneBuilder {
             transform: DMat4::IDENTITY,
             receiver,
         });
+    }
+
+    /// Adds a receiver that is the back face of receiver `of`: same triangles, opposite normal.
+    /// EnergyPlus keeps such `Mir-` copies of shading surfaces; the geometry is drawn once and
+    /// the mirror counts the original's pixels whenever the sun is behind the original.
+    pub fn add_mirror(&mut self, of: &str, name: &str) {
+        self.mirrors.push((of.to_string(), name.to_string()));
     }
 
     /// Number of nodes added so far.
@@ -220,6 +232,17 @@ impl SceneBuilder {
                 });
                 instance_node(&mut scene, node, mesh_index)?;
             }
+        }
+        for (of, name) in &self.mirrors {
+            let Some(original) = scene.receivers.iter().find(|r| r.name == *of).cloned() else {
+                return Err(Error::NoReceivers(format!("'{name}' mirrors '{of}', which is not a receiver")));
+            };
+            scene.receivers.push(Receiver {
+                name: name.clone(),
+                origin: format!("{} (mirrored)", original.origin),
+                normal: -original.normal,
+                ..original
+            });
         }
         for r in &scene.receivers {
             if let Some(first) = names.insert(r.name.clone(), r.origin.clone()) {
@@ -351,7 +374,8 @@ fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Resul
             in_part[i] = true;
         }
         let end = scene.meshes[0].indices.len() as u32;
-        scene.receivers.push(receiver(node, part, k, parts.len(), &tris, ReceiverDraw { instance: 0, indices: start..end }));
+        let r = receiver(node, part, k, parts.len(), &tris, ReceiverDraw { instance: 0, indices: start..end }, scene.receivers.len());
+        scene.receivers.push(r);
     }
     // Degenerate leftovers still go in (harmless), as shadow casters only.
     for (i, t) in tris.iter().enumerate() {
@@ -362,7 +386,7 @@ fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Resul
     Ok(())
 }
 
-fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVec3; 3]], draw: ReceiverDraw) -> Receiver {
+fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVec3; 3]], draw: ReceiverDraw, id: usize) -> Receiver {
     let triangles: Vec<[DVec3; 3]> = part.triangles.iter().map(|&i| tris[i]).collect();
     Receiver {
         name: part_name(&node.name, k, count),
@@ -371,6 +395,7 @@ fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVe
         triangles,
         normal: part.normal,
         draw,
+        gpu_id: id as u32,
     }
 }
 
@@ -411,7 +436,8 @@ fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize) -> Res
     let base = scene.receivers.len() as u32;
     for (k, part) in parts.iter().enumerate() {
         let draw = ReceiverDraw { instance, indices: ranges[k].clone() };
-        scene.receivers.push(receiver(node, part, k, parts.len(), &tris, draw));
+        let r = receiver(node, part, k, parts.len(), &tris, draw, scene.receivers.len());
+        scene.receivers.push(r);
     }
     scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: base });
     Ok(())
@@ -508,6 +534,18 @@ mod tests {
         let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
         assert_eq!(names, ["Box#1", "Box#2"]);
         assert!((s.receivers[1].area - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_mirror_shares_geometry_and_faces_the_other_way() {
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "LOUVER", quad(1.0), true);
+        b.add_mirror("LOUVER", "Mir-LOUVER");
+        let s = b.build().unwrap();
+        assert_eq!(s.receivers.len(), 2);
+        assert_eq!(s.receivers[1].gpu_id, 0);
+        assert_eq!(s.receivers[1].normal, -s.receivers[0].normal);
+        assert_eq!(s.triangle_count(), 2, "drawn once");
     }
 
     #[test]

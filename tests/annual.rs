@@ -67,7 +67,7 @@ fn overhang_window_spline_vs_dense() {
 
 #[test]
 fn example_office_spline_vs_dense() {
-    let options = LoadOptions { receivers: vec!["WIN_S1".into(), "WALL_S".into(), "WIN_E".into(), "ROOF".into()], north: 0.0 };
+    let options = LoadOptions { receivers: vec!["WIN_S1".into(), "WALL_S".into(), "WIN_E".into(), "ROOF".into()], ..Default::default() };
     let scene = load_bytes(&[("office.glb".into(), office(6).to_glb())], &options).unwrap();
     // The neighbour's shadow sweeps the roof and the east window at sunrise faster than 27×19
     // samples follow; refinement (asserted inside) is what brings the office under 0.01.

@@ -131,6 +131,53 @@ fn round_trip_with_polygon_clipping_as_reference() {
     assert!(((a - b) / b).abs() <= 0.02, "{a} vs {b}");
 }
 
+/// The Imported form: the CSV carries every column of EnergyPlus's own eplusshading.csv (shading
+/// surfaces and their Mir- back faces included) and EnergyPlus reads it without a severe error.
+/// (25.2 then ignores the values, the name-lookup bug this form is not the default for.)
+#[test]
+fn imported_form_has_every_column_energyplus_writes() {
+    let dir = scratch("imported");
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, office_idf(3, false, Shading::PolygonClipping)).unwrap();
+    let reference = dir.join("clipping");
+    run_energyplus(&idf, &reference);
+    let csv = dir.join("shading.csv");
+    let hooked = dir.join("hooked.idf");
+    let w = weather();
+    let quick = ["--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
+    let mut args = vec![
+        "annual",
+        idf.to_str().unwrap(),
+        "--epw",
+        w.to_str().unwrap(),
+        "-o",
+        csv.to_str().unwrap(),
+        "--idf-out",
+        hooked.to_str().unwrap(),
+        "--hook",
+        "imported",
+    ];
+    args.extend(quick);
+    sunlit(&args);
+    let header = |p: &Path| -> Vec<String> {
+        let text = std::fs::read_to_string(p).unwrap();
+        let mut names: Vec<String> =
+            text.lines().next().unwrap().split(',').skip(1).filter(|n| !n.is_empty()).map(|n| n.to_uppercase()).collect();
+        names.sort();
+        names
+    };
+    assert_eq!(header(&csv), header(&reference.join("eplusshading.csv")));
+    // The louvres are horizontal plates facing up: the top of the highest is lit whenever the sun
+    // is up, their undersides (the Mir- faces) never, in both files.
+    let (ours, theirs) = (columns(&csv), columns(&reference.join("eplusshading.csv")));
+    let lit = |v: &[f64]| v.iter().filter(|x| **x > 0.5).count();
+    assert!(lit(&ours["LOUVER_2"]) > 15_000 && lit(&theirs["LOUVER_2"]) > 15_000);
+    assert!(ours["MIR-LOUVER_0"].iter().chain(&theirs["MIR-LOUVER_0"]).all(|v| *v == 0.0));
+    let err = run_energyplus(&hooked, &dir.join("hooked"));
+    assert_eq!(severe_count(&err), 0, "{err}");
+    assert!(std::fs::read_to_string(&hooked).unwrap().contains("Schedule:File:Shading,"));
+}
+
 /// A concave caster: EnergyPlus's clipping cannot cast it; with sunlit's fractions it runs and shades.
 #[test]
 fn concave_shading_runs_with_sunlit_fractions() {

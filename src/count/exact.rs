@@ -80,7 +80,7 @@ impl Casters {
         let shadows: Vec<Contour> = self
             .triangles
             .iter()
-            .filter(|(_, id)| *id != Some(request.receiver))
+            .filter(|(_, id)| *id != Some(receiver.gpu_id))
             .filter_map(|(tri, _)| frame.shadow(tri, &bounds, &window, self.area_eps))
             .collect();
         sunlit_ratio(&lit, &shadows, self.area_eps)

@@ -106,6 +106,8 @@ struct GpuMesh {
 
 /// What a view of one receiver needs: where to draw it alone, and how to fit the camera.
 struct ReceiverView {
+    /// The id its pixels carry (its own, or the mirrored surface's).
+    gpu_id: u32,
     mesh: usize,
     indices: Range<u32>,
     slot: u32,
@@ -305,6 +307,7 @@ impl Counter {
             .receivers
             .iter()
             .map(|r| ReceiverView {
+                gpu_id: r.gpu_id,
                 mesh: scene.instances[r.draw.instance].mesh,
                 indices: r.draw.indices.clone(),
                 slot: slot_of[r.draw.instance],
@@ -391,7 +394,7 @@ impl Counter {
             .map(|(slot, (i, view))| GpuView {
                 view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
                 tile: self.tile_origin(slot),
-                target_id: requests[*i].receiver,
+                target_id: scene.receivers[requests[*i].receiver as usize].gpu_id,
                 _pad: 0,
             })
             .collect();

@@ -948,6 +948,21 @@ impl Building {
     /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
     /// written in the file (EnergyPlus itself reports them upper-cased).
     pub fn add_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_surfaces(builder, false)
+    }
+
+    /// As [`Building::add_to`], but every surface receives, and every shading surface also gets
+    /// its back face `Mir-NAME` as EnergyPlus makes it: the columns EnergyPlus's `Imported`
+    /// method looks up (those of its own eplusshading.csv).
+    pub fn add_all_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_surfaces(builder, true)?;
+        for s in self.surfaces.iter().filter(|s| s.is_shading()) {
+            builder.add_mirror(&s.name, &format!("Mir-{}", s.name));
+        }
+        Ok(())
+    }
+
+    fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool) -> Result<()> {
         let holes = self.holes();
         for (i, surface) in self.surfaces.iter().enumerate() {
             let triangles = triangulate(surface, holes.get(&i).map_or(&[][..], Vec::as_slice));
@@ -958,7 +973,7 @@ impl Building {
                 origin: format!("{}: {}", self.file, surface.label()),
                 mesh,
                 transform: DMat4::from_translation(anchor),
-                receiver: surface.receiver,
+                receiver: all || surface.receiver,
             });
         }
         Ok(())

@@ -28,6 +28,9 @@ pub struct LoadOptions {
     /// Degrees clockwise from true north of the model's north (−Z in glTF), as EnergyPlus's
     /// Building North Axis.
     pub north: f64,
+    /// With an EnergyPlus model: every surface receives, shading surfaces with their `Mir-`
+    /// back faces (the columns of EnergyPlus's `Imported` form), not only the outdoor ones.
+    pub all_energyplus_surfaces: bool,
 }
 
 /// The EnergyPlus model among the inputs, kept for `--idf-out`.
@@ -143,8 +146,13 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
     let mut builder = SceneBuilder::new();
     let mut matched = 0usize;
     if let Some(b) = energyplus {
-        b.add_to(&mut builder)?;
-        matched += b.receiver_names().len();
+        if options.all_energyplus_surfaces {
+            b.add_all_to(&mut builder)?;
+            matched += b.surfaces.len();
+        } else {
+            b.add_to(&mut builder)?;
+            matched += b.receiver_names().len();
+        }
     }
     for model in models {
         model.add_to(&mut builder, |n| {
