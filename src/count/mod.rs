@@ -27,7 +27,8 @@ pub fn cos_incidence(normal: DVec3, sun: DVec3) -> f64 {
     normal.dot(sun)
 }
 
-/// Whether a view needs no rendering: the sun is down or behind the surface (fraction 0).
+/// Whether a view needs no rendering: the sun is down (cos zenith below EnergyPlus's 1e-5
+/// "sun is up" threshold) or behind the surface (fraction 0).
 pub fn is_dark(normal: DVec3, sun: DVec3) -> bool {
-    sun.z <= 0.0 || cos_incidence(normal, sun) <= MIN_COS_INCIDENCE
+    sun.z < MIN_COS_INCIDENCE || cos_incidence(normal, sun) <= MIN_COS_INCIDENCE
 }
