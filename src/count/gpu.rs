@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3};
 
+use super::cull::Occluders;
 use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
@@ -46,7 +47,8 @@ impl Default for CounterOptions {
     }
 }
 
-/// One counted view.
+/// One counted view. A view that needed no render (sun down, facing away, or nothing in front
+/// of the receiver) has `covered == 0`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Counted {
     /// Sunlit fraction in [0, 1].
@@ -94,6 +96,7 @@ pub struct GpuScene {
     receivers: Vec<ReceiverView>,
     bounds: (DVec3, DVec3),
     origin: DVec3,
+    occluders: Occluders,
     render_bind: wgpu::BindGroup,
     count_bind: wgpu::BindGroup,
 }
@@ -342,6 +345,7 @@ impl Counter {
             receivers,
             bounds: scene.bounds,
             origin: scene.origin,
+            occluders: Occluders::new(scene),
             render_bind,
             count_bind,
         })
@@ -357,9 +361,15 @@ impl Counter {
                 Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
             })?;
             out[i].cos_incidence = cos_incidence(r.normal, req.sun);
-            if !is_dark(r.normal, req.sun) {
-                lit.push((i, view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution)));
+            if is_dark(r.normal, req.sun) {
+                continue;
             }
+            if scene.occluders.nothing_in_front(&r.points, r.normal, r.gpu_id, req.sun) {
+                // Nothing in the prism in front of it: fully sunlit, no render needed.
+                out[i].fraction = 1.0;
+                continue;
+            }
+            lit.push((i, view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution)));
         }
         let per_batch = self.tiles_per_batch();
         for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {

@@ -4,6 +4,7 @@
 //! two implementations: the GPU pixel counter ([`gpu`], native and web) and the exact CPU
 //! polygon-clipping reference ([`exact`]) that tests hold the GPU to.
 
+pub mod cull;
 pub mod exact;
 pub mod gpu;
 pub mod view;
