@@ -52,8 +52,10 @@ pub struct Timing {
     pub triangles: usize,
     /// Views requested.
     pub views: usize,
-    /// Views rendered (not dark).
+    /// Views rendered (the others were dark, or had nothing in front of the receiver).
     pub rendered: usize,
+    /// Views answered without a render.
+    pub skipped: usize,
     /// Seconds for all views (after one warm-up call).
     pub seconds: f64,
     /// Rendered views per second.
@@ -75,6 +77,7 @@ pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DV
         triangles: scene.triangle_count(),
         views: requests.len(),
         rendered,
+        skipped: requests.len() - rendered,
         seconds,
         views_per_second: rendered as f64 / seconds.max(1e-9),
     })

@@ -196,10 +196,6 @@ fn counter(resolution: u32) -> Result<Counter> {
     pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))
 }
 
-fn counter_with(options: CounterOptions) -> Result<Counter> {
-    pollster::block_on(Counter::new(options))
-}
-
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
     let scene = args.model.load()?;
@@ -409,7 +405,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
-    let counter = counter_with(CounterOptions { resolution: args.resolution, max_atlas: args.atlas })?;
+    let counter = pollster::block_on(Counter::new(CounterOptions { resolution: args.resolution, max_atlas: args.atlas }))?;
     let info = counter.adapter_info();
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
     let start = Instant::now();
