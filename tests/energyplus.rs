@@ -44,9 +44,15 @@ fn severe_count(err: &str) -> usize {
     err.lines().filter(|l| l.contains("** Severe  **") || l.contains("**  Fatal  **")).count()
 }
 
-fn sunlit(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).output().unwrap();
-    assert!(out.status.success(), "sunlit {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+/// `sunlit annual IDF --epw (Golden) -o DIR/shading.csv --idf-out DIR/hooked.idf EXTRA…`; returns
+/// the CSV's and the hooked model's paths.
+fn sunlit_annual(idf: &Path, dir: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let (csv, hooked) = (dir.join("shading.csv"), dir.join("hooked.idf"));
+    let mut command = Command::new(env!("CARGO_BIN_EXE_sunlit"));
+    command.arg("annual").arg(idf).arg("--epw").arg(weather()).arg("-o").arg(&csv).arg("--idf-out").arg(&hooked).args(extra);
+    let out = command.output().unwrap();
+    assert!(out.status.success(), "sunlit annual {}: {}", idf.display(), String::from_utf8_lossy(&out.stderr));
+    (csv, hooked)
 }
 
 /// A CSV as columns by upper-cased header name (first column dropped).
@@ -84,10 +90,7 @@ fn round_trip_with_polygon_clipping_as_reference() {
     assert_eq!(severe_count(&err), 0, "{err}");
 
     // 1. sunlit's CSV against EnergyPlus's own eplusshading.csv.
-    let csv = dir.join("shading.csv");
-    let hooked = dir.join("hooked.idf");
-    let (w, c, h) = (weather(), csv.to_str().unwrap().to_string(), hooked.to_str().unwrap().to_string());
-    sunlit(&["annual", idf.to_str().unwrap(), "--epw", w.to_str().unwrap(), "-o", &c, "--idf-out", &h]);
+    let (csv, hooked) = sunlit_annual(&idf, &dir, &[]);
     let ours = columns(&csv);
     let theirs = columns(&reference.join("eplusshading.csv"));
     // Sun-up timesteps: the unobstructed flat roof is lit in either run.
@@ -141,24 +144,8 @@ fn imported_form_has_every_column_energyplus_writes() {
     std::fs::write(&idf, office_idf(3, false, Shading::PolygonClipping)).unwrap();
     let reference = dir.join("clipping");
     run_energyplus(&idf, &reference);
-    let csv = dir.join("shading.csv");
-    let hooked = dir.join("hooked.idf");
-    let w = weather();
-    let quick = ["--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
-    let mut args = vec![
-        "annual",
-        idf.to_str().unwrap(),
-        "--epw",
-        w.to_str().unwrap(),
-        "-o",
-        csv.to_str().unwrap(),
-        "--idf-out",
-        hooked.to_str().unwrap(),
-        "--hook",
-        "imported",
-    ];
-    args.extend(quick);
-    sunlit(&args);
+    let quick = ["--hook", "imported", "--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
+    let (csv, hooked) = sunlit_annual(&idf, &dir, &quick);
     let header = |p: &Path| -> Vec<String> {
         let text = std::fs::read_to_string(p).unwrap();
         let mut names: Vec<String> =
@@ -188,19 +175,7 @@ fn concave_shading_runs_with_sunlit_fractions() {
     let refusal = clipping_err.lines().find(|l| l.contains("Severe") && l.contains("non-convex"));
     println!("PolygonClipping on the L-shaped canopy: {}", refusal.unwrap_or("(accepted)").trim());
     assert!(refusal.is_some(), "EnergyPlus's own clipping refuses the concave caster:\n{clipping_err}");
-    let csv = dir.join("shading.csv");
-    let hooked = dir.join("hooked.idf");
-    let w = weather();
-    sunlit(&[
-        "annual",
-        idf.to_str().unwrap(),
-        "--epw",
-        w.to_str().unwrap(),
-        "-o",
-        csv.to_str().unwrap(),
-        "--idf-out",
-        hooked.to_str().unwrap(),
-    ]);
+    let (_, hooked) = sunlit_annual(&idf, &dir, &[]);
     let run = dir.join("hooked");
     let err = run_energyplus(&hooked, &run);
     assert_eq!(severe_count(&err), 0, "{err}");
