@@ -44,6 +44,16 @@ fn severe_count(err: &str) -> usize {
     err.lines().filter(|l| l.contains("** Severe  **") || l.contains("**  Fatal  **")).count()
 }
 
+/// A fresh folder with the generated office as `office.idf`, run by EnergyPlus's own
+/// PolygonClipping into `clipping/`; returns the folder, the model and the .err text.
+fn clipping_run(name: &str, louvres: usize, concave: bool) -> (PathBuf, PathBuf, String) {
+    let dir = scratch(name);
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, office_idf(louvres, concave, Shading::PolygonClipping)).unwrap();
+    let err = run_energyplus(&idf, &dir.join("clipping"));
+    (dir, idf, err)
+}
+
 /// `sunlit annual IDF --epw (Golden) -o DIR/shading.csv --idf-out DIR/hooked.idf EXTRA…`; returns
 /// the CSV's and the hooked model's paths.
 fn sunlit_annual(idf: &Path, dir: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
@@ -82,11 +92,8 @@ fn output<'a>(cols: &'a HashMap<String, Vec<f64>>, key: &str, variable: &str) ->
 /// EnergyPlus again with sunlit's fractions hooked in.
 #[test]
 fn round_trip_with_polygon_clipping_as_reference() {
-    let dir = scratch("roundtrip");
-    let idf = dir.join("office.idf");
-    std::fs::write(&idf, office_idf(10, false, Shading::PolygonClipping)).unwrap();
+    let (dir, idf, err) = clipping_run("roundtrip", 10, false);
     let reference = dir.join("clipping");
-    let err = run_energyplus(&idf, &reference);
     assert_eq!(severe_count(&err), 0, "{err}");
 
     // 1. sunlit's CSV against EnergyPlus's own eplusshading.csv.
@@ -139,11 +146,8 @@ fn round_trip_with_polygon_clipping_as_reference() {
 /// (25.2 then ignores the values, the name-lookup bug this form is not the default for.)
 #[test]
 fn imported_form_has_every_column_energyplus_writes() {
-    let dir = scratch("imported");
-    let idf = dir.join("office.idf");
-    std::fs::write(&idf, office_idf(3, false, Shading::PolygonClipping)).unwrap();
+    let (dir, idf, _) = clipping_run("imported", 3, false);
     let reference = dir.join("clipping");
-    run_energyplus(&idf, &reference);
     let quick = ["--hook", "imported", "--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
     let (csv, hooked) = sunlit_annual(&idf, &dir, &quick);
     let header = |p: &Path| -> Vec<String> {
@@ -168,10 +172,7 @@ fn imported_form_has_every_column_energyplus_writes() {
 /// A concave caster: EnergyPlus's clipping cannot cast it; with sunlit's fractions it runs and shades.
 #[test]
 fn concave_shading_runs_with_sunlit_fractions() {
-    let dir = scratch("concave");
-    let idf = dir.join("concave.idf");
-    std::fs::write(&idf, office_idf(0, true, Shading::PolygonClipping)).unwrap();
-    let clipping_err = run_energyplus(&idf, &dir.join("clipping"));
+    let (dir, idf, clipping_err) = clipping_run("concave", 0, true);
     let refusal = clipping_err.lines().find(|l| l.contains("Severe") && l.contains("non-convex"));
     println!("PolygonClipping on the L-shaped canopy: {}", refusal.unwrap_or("(accepted)").trim());
     assert!(refusal.is_some(), "EnergyPlus's own clipping refuses the concave caster:\n{clipping_err}");
