@@ -59,8 +59,10 @@ pub struct Progress {
     pub total: usize,
 }
 
-/// Views per progress report: small enough to move a bar, large enough to fill the atlas.
-const VIEWS_PER_REPORT: usize = 512;
+/// Atlas submissions per progress report: often enough that a cancel (an `Err` from the progress
+/// callback) is seen within a second even on a software rasterizer, and each report still fills
+/// whole atlases.
+const BATCHES_PER_REPORT: usize = 4;
 
 /// The year's schedule for every receiver of `scene`.
 pub async fn annual(
@@ -69,7 +71,7 @@ pub async fn annual(
     scene: &Scene,
     location: &Location,
     options: &AnnualOptions,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
     let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
     let mut schedule = Schedule::zeros(names, options.timesteps);
@@ -90,12 +92,12 @@ struct Views<'a> {
 
 impl Views<'_> {
     /// Counts many views, reporting progress as it goes.
-    async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress)) -> Result<Vec<f64>> {
+    async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
-        progress(Progress { done: 0, total: requests.len() });
-        for chunk in requests.chunks(VIEWS_PER_REPORT) {
+        progress(Progress { done: 0, total: requests.len() })?;
+        for chunk in requests.chunks(self.counter.tiles_per_batch() * BATCHES_PER_REPORT) {
             out.extend(self.counter.fractions(self.gpu, chunk).await?.into_iter().map(|c| c.fraction));
-            progress(Progress { done: out.len(), total: requests.len() });
+            progress(Progress { done: out.len(), total: requests.len() })?;
         }
         Ok(out)
     }
@@ -115,7 +117,7 @@ async fn dense_year(
     scene: &Scene,
     location: &Location,
     schedule: &mut Schedule,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
     let mut requests = Vec::new();
     let mut cells = Vec::new();
@@ -145,7 +147,7 @@ async fn spline_year(
     plan: SamplingPlan,
     refine: f64,
     schedule: &mut Schedule,
-    progress: &mut dyn FnMut(Progress),
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
     let (days, taus) = (plan.sample_days(), plan.taus());
     let grid = AnnualGrid::new(plan.first_day(), DAYS as f64, days.len(), &taus)?;

@@ -56,6 +56,9 @@ pub enum Error {
     /// The GPU could not be set up or failed during a pass.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// The caller asked the run to stop (a progress callback said so, or an `AbortSignal` fired).
+    #[error("cancelled")]
+    Cancelled,
 }
 
 /// The library's result type.

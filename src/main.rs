@@ -274,6 +274,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let mut report = |p: Progress| {
         bar.set_length(p.total as u64);
         bar.set_position(p.done as u64);
+        Ok(())
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
     let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;

@@ -24,7 +24,25 @@ fn year(scene: &Scene, method: Method, refine: f64, resolution: u32) -> Schedule
     let counter = counter(resolution);
     let gpu = counter.upload(scene).unwrap();
     let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine };
-    pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| {})).unwrap()
+    pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| Ok(()))).unwrap()
+}
+
+/// A progress callback that returns an error stops the run with that error, after the reports
+/// so far: how the page's Cancel button and an `AbortSignal` stop a year.
+#[test]
+fn a_failing_progress_callback_cancels_the_year() {
+    let scene = load_bytes(&[("office.glb".into(), office(6).to_glb())], &LoadOptions::default()).unwrap();
+    let counter = counter(128);
+    let gpu = counter.upload(&scene).unwrap();
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method: Method::Dense, refine: 1.0 };
+    let mut reports = Vec::new();
+    let result = pollster::block_on(annual(&counter, &gpu, &scene, &golden(), &options, &mut |p| {
+        reports.push(p);
+        if p.done > 0 { Err(sunlit::Error::Cancelled) } else { Ok(()) }
+    }));
+    assert!(matches!(result, Err(sunlit::Error::Cancelled)), "{result:?}");
+    assert_eq!(reports.len(), 2, "stops at the first report after the start: {reports:?}");
+    assert!(reports[1].done < reports[1].total, "cancelled before the end: {reports:?}");
 }
 
 /// Spline vs dense over lit timesteps; night rows exactly 0 in both. Returns the pure
