@@ -33,5 +33,7 @@ pub mod samples;
 pub mod scene;
 pub mod spline;
 pub mod sun;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 pub use error::{Error, Result};

@@ -10,7 +10,7 @@ use serde_json::json;
 use sunlit::annual::{AnnualOptions, Method, Progress};
 use sunlit::count::gpu::{Counted, Counter, CounterOptions};
 use sunlit::count::{ViewRequest, cos_incidence, exact};
-use sunlit::export::hook::{Hook, HookPlan, patch_epjson, patch_idf};
+use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
@@ -260,7 +260,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
-        (Some(_), Some(ep)) => Some(hook_check(ep, &scene, hook, timesteps)?),
+        (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
     let counter = counter(args.resolution)?;
@@ -301,25 +301,6 @@ fn annual(args: AnnualArgs) -> Result<()> {
     Ok(())
 }
 
-/// The hook form for a model, and a check that every receiver is one of its surfaces.
-fn hook_check(ep: &model::EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timesteps: Timesteps) -> Result<Hook> {
-    let form = match hook {
-        Some(h) => h,
-        None => Hook::for_version(&ep.file, sunlit::model::idf::version(&ep.objects).as_deref())?,
-    };
-    let known = |name: &str| ep.building.surface(name.strip_prefix("Mir-").unwrap_or(name)).is_some();
-    if let Some(r) = scene.receivers.iter().find(|r| !known(&r.name)) {
-        return Err(Error::argument(
-            "--idf-out",
-            format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
-        ));
-    }
-    // The model checks (version, Timestep, existing local environments) before any counting.
-    let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
-    sunlit::export::hook::check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form })?;
-    Ok(form)
-}
-
 /// The model's text with the CSV hooked in. The CSV is named by file name when it sits beside the
 /// patched model (EnergyPlus looks there), by absolute path otherwise.
 fn patch_model(
@@ -338,8 +319,7 @@ fn patch_model(
         (_, Some(b), Some(name)) => b.join(name).display().to_string(),
         _ => csv.display().to_string(),
     };
-    let plan = HookPlan { csv: &csv_text, columns, timesteps, hook };
-    if ep.epjson { patch_epjson(&ep.file, &ep.text, &plan) } else { patch_idf(&ep.file, &ep.text, &ep.objects, &plan) }
+    sunlit::export::hook::patch_model(ep, &HookPlan { csv: &csv_text, columns, timesteps, hook })
 }
 
 /// Fails early, before any counting, when the output folder cannot take the file.

@@ -6,6 +6,7 @@
 //! nodes too. Without one: `--receivers GLOB` (node names, case-insensitive) when given;
 //! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
 //! one; otherwise every named node with a mesh.
+pub mod arrays;
 pub mod building;
 pub mod epjson;
 pub mod glb_write;
@@ -81,7 +82,13 @@ pub fn load_all(paths: &[PathBuf], options: &LoadOptions) -> Result<Loaded> {
 
 /// Reads in-memory model files (name, bytes) into one scene (the web path).
 pub fn load_bytes(files: &[(String, Vec<u8>)], options: &LoadOptions) -> Result<Scene> {
-    Ok(read_inputs(files, &vec![None; files.len()], options)?.scene)
+    Ok(load_bytes_all(files, options)?.scene)
+}
+
+/// Reads in-memory model files into one scene, keeping an EnergyPlus input for patching.
+/// A .gltf among them can only use embedded (data: URI) buffers: there is no folder to look in.
+pub fn load_bytes_all(files: &[(String, Vec<u8>)], options: &LoadOptions) -> Result<Loaded> {
+    read_inputs(files, &vec![None; files.len()], options)
 }
 
 /// Whether a file name is an EnergyPlus model (by extension).

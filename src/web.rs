@@ -1,0 +1,342 @@
+//! The browser's entry points (wasm-bindgen): the same pipeline as the CLI, driven from
+//! JavaScript on the browser's WebGPU.
+//!
+//! Owns the translation between JS values and the library: model files or typed arrays in,
+//! fractions and annual schedules out, progress as a JS callback and cancellation by an
+//! `AbortSignal`. Nothing here blocks: every GPU read is awaited (see `platform`), so the page
+//! (or the worker running this) stays live and an abort is seen at the next progress report.
+//! The hand-written ES module `www/sunlit.js` wraps these bindings for users; its types are in
+//! `www/sunlit.d.ts`.
+
+use std::rc::Rc;
+
+use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
+use serde::Deserialize;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen_futures::future_to_promise;
+
+use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual};
+use crate::count::ViewRequest;
+use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::error::{Error, Result};
+use crate::export::Schedule;
+use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
+use crate::model::arrays::{Arrays, scene_from_arrays};
+use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all};
+use crate::samples::{SamplingPlan, Timesteps};
+use crate::scene::Scene;
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+
+/// A library error as a JS `Error` whose message names the file, object and reason.
+fn js_error(error: Error) -> JsValue {
+    JsError::new(&error.to_string()).into()
+}
+
+/// The GPU counter on this page's WebGPU device.
+#[wasm_bindgen]
+pub struct Engine {
+    counter: Rc<Counter>,
+}
+
+#[wasm_bindgen]
+impl Engine {
+    /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512).
+    pub async fn create(resolution: Option<u32>) -> Result<Engine, JsValue> {
+        let options = CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), ..Default::default() };
+        let counter = Counter::new(options).await.map_err(js_error)?;
+        Ok(Engine { counter: Rc::new(counter) })
+    }
+
+    /// The adapter's name and backend, for the page's status line.
+    #[wasm_bindgen(getter)]
+    pub fn adapter(&self) -> String {
+        // Browsers hide the adapter's name unless asked; say what is known.
+        let info = self.counter.adapter_info();
+        if info.name.is_empty() { "the browser's WebGPU".into() } else { format!("{} ({:?})", info.name, info.backend) }
+    }
+
+    /// Pixels along a view's side.
+    #[wasm_bindgen(getter)]
+    pub fn resolution(&self) -> u32 {
+        self.counter.resolution()
+    }
+
+    /// Reads model files (glb/gltf with embedded buffers, IDF, epJSON) and uploads the scene.
+    /// `names[i]` labels `contents[i]` in messages and picks its reader by extension.
+    #[wasm_bindgen(js_name = loadFiles)]
+    pub fn load_files(&self, names: Vec<String>, contents: Array, receivers: Option<String>, north: Option<f64>) -> Result<Model, JsValue> {
+        if names.len() != contents.length() as usize {
+            return Err(js_error(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length()))));
+        }
+        let files: Vec<(String, Vec<u8>)> =
+            names.into_iter().zip(contents.iter()).map(|(name, bytes)| (name, Uint8Array::new(&bytes).to_vec())).collect();
+        let options = LoadOptions { receivers: receiver_patterns(receivers.as_deref()), north: north.unwrap_or(0.0), ..Default::default() };
+        let loaded = load_bytes_all(&files, &options).map_err(js_error)?;
+        self.model(loaded.scene, loaded.energyplus)
+    }
+
+    /// Builds a scene from typed arrays (see `model::arrays`) and uploads it.
+    #[wasm_bindgen(js_name = fromArrays)]
+    pub fn from_arrays(
+        &self,
+        positions: &[f32],
+        indices: &[u32],
+        triangle_receivers: &[i32],
+        names: Vec<String>,
+        y_up: bool,
+    ) -> Result<Model, JsValue> {
+        let arrays = Arrays { positions, indices, triangle_receivers, names: &names, y_up };
+        self.model(scene_from_arrays(&arrays).map_err(js_error)?, None)
+    }
+
+    fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>) -> Result<Model, JsValue> {
+        let gpu = self.counter.upload(&scene).map_err(js_error)?;
+        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus }) })
+    }
+
+    /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
+    /// direction: a unit vector towards the sun, x east, y north, z up.
+    pub fn fractions(&self, model: &Model, sun_x: f64, sun_y: f64, sun_z: f64) -> Promise {
+        let (counter, model) = (self.counter.clone(), model.inner.clone());
+        future_to_promise(async move {
+            let sun = glam::DVec3::new(sun_x, sun_y, sun_z);
+            if !sun.is_finite() || sun.length() < 1e-9 {
+                return Err(js_error(Error::argument("sun", format!("({sun_x}, {sun_y}, {sun_z}) is not a direction"))));
+            }
+            let sun = sun.normalize();
+            let requests: Vec<ViewRequest> =
+                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+            let counted = counter.fractions(&model.gpu, &requests).await.map_err(js_error)?;
+            let fractions: Vec<f64> = counted.iter().map(|c| c.fraction).collect();
+            Ok(Float64Array::from(fractions.as_slice()).into())
+        })
+    }
+
+    /// Promise of the year's schedule ([`Annual`]). `settings` is a plain object (see
+    /// [`Settings`]); `progress(done, total)` is called as views are counted; an aborted
+    /// `signal` rejects the promise with an `Error` whose message is "cancelled".
+    pub fn annual(&self, model: &Model, settings: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
+        let (counter, model) = (self.counter.clone(), model.inner.clone());
+        future_to_promise(async move {
+            let settings = Settings::from_js(&settings).map_err(js_error)?;
+            let model_timesteps = model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps);
+            let (location, options) = settings.resolve(model_timesteps).map_err(js_error)?;
+            let hook = match &model.energyplus {
+                Some(ep) => Some(hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error)?),
+                None => None,
+            };
+            let mut report = |p: Progress| {
+                if signal.as_ref().is_some_and(|s| s.aborted()) {
+                    return Err(Error::Cancelled);
+                }
+                if let Some(f) = &progress {
+                    // A throwing progress callback is the caller's bug, not a reason to stop.
+                    let _ = f.call2(&JsValue::NULL, &JsValue::from(p.done as f64), &JsValue::from(p.total as f64));
+                }
+                Ok(())
+            };
+            let schedule = annual(&counter, &model.gpu, &model.scene, &location, &options, &mut report).await.map_err(js_error)?;
+            let means = daylight_means(&schedule, &location);
+            Ok(Annual { schedule, means, hook, model }.into())
+        })
+    }
+}
+
+/// The `receivers` setting: comma-separated glob patterns, empty for the default rule.
+fn receiver_patterns(text: Option<&str>) -> Vec<String> {
+    text.unwrap_or("").split(',').map(str::trim).filter(|p| !p.is_empty()).map(String::from).collect()
+}
+
+/// A scene on the engine's device. Only valid with the engine that made it.
+#[wasm_bindgen]
+pub struct Model {
+    inner: Rc<ModelInner>,
+}
+
+struct ModelInner {
+    scene: Scene,
+    gpu: GpuScene,
+    energyplus: Option<EnergyPlusInput>,
+}
+
+#[wasm_bindgen]
+impl Model {
+    /// Receiver names: the CSV's columns, in order.
+    #[wasm_bindgen(getter, js_name = receiverNames)]
+    pub fn receiver_names(&self) -> Vec<String> {
+        self.inner.scene.receivers.iter().map(|r| r.name.clone()).collect()
+    }
+
+    /// Receiver areas, m².
+    #[wasm_bindgen(getter, js_name = receiverAreas)]
+    pub fn receiver_areas(&self) -> Float64Array {
+        let areas: Vec<f64> = self.inner.scene.receivers.iter().map(|r| r.area).collect();
+        Float64Array::from(areas.as_slice())
+    }
+
+    /// Triangle count of everything drawn.
+    #[wasm_bindgen(getter)]
+    pub fn triangles(&self) -> usize {
+        self.inner.scene.triangle_count()
+    }
+
+    /// Whether an EnergyPlus model was among the files (then [`Annual::hooked_model`] works).
+    #[wasm_bindgen(getter, js_name = hasEnergyPlus)]
+    pub fn has_energyplus(&self) -> bool {
+        self.inner.energyplus.is_some()
+    }
+
+    /// Every triangle in world coordinates (x east, y north, z up; 9 floats each), for drawing.
+    #[wasm_bindgen(js_name = worldPositions)]
+    pub fn world_positions(&self) -> Float32Array {
+        let mut out = Vec::with_capacity(self.inner.scene.triangle_count() * 9);
+        for (t, _) in self.inner.scene.world_triangles() {
+            out.extend(t.iter().flat_map(|p| [p.x as f32, p.y as f32, p.z as f32]));
+        }
+        Float32Array::from(out.as_slice())
+    }
+
+    /// Per triangle of [`Self::world_positions`]: its receiver index, or −1 for shading geometry.
+    #[wasm_bindgen(js_name = worldReceivers)]
+    pub fn world_receivers(&self) -> Int32Array {
+        let ids: Vec<i32> = self.inner.scene.world_triangles().map(|(_, r)| r.map_or(-1, |r| r as i32)).collect();
+        Int32Array::from(ids.as_slice())
+    }
+}
+
+/// The settings of an annual run, as the page and the JS API pass them (camelCase keys).
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct Settings {
+    /// Degrees north.
+    latitude: Option<f64>,
+    /// Degrees east.
+    longitude: Option<f64>,
+    /// Hours from UTC of the standard time the CSV is in.
+    time_zone: Option<f64>,
+    /// An EPW file's text: its LOCATION line gives the three above.
+    epw: Option<String>,
+    /// A label for the EPW in messages (its file name).
+    epw_name: Option<String>,
+    /// Output timesteps per hour (EnergyPlus's Timestep); default the model's, else 4.
+    timesteps_per_hour: Option<u32>,
+    /// Sampled days (default 27).
+    days_per_year: Option<usize>,
+    /// Samples per day (default 19).
+    samples_per_day: Option<usize>,
+    /// See [`AnnualOptions::refine`].
+    refine: Option<f64>,
+    /// Count every timestep instead of the spline.
+    dense: Option<bool>,
+}
+
+impl Settings {
+    fn from_js(value: &JsValue) -> Result<Self> {
+        if value.is_undefined() || value.is_null() {
+            return Err(Error::argument("settings", "give at least a location (latitude, longitude, timeZone) or an EPW"));
+        }
+        let text = js_sys::JSON::stringify(value).map_err(|_| Error::argument("settings", "not a plain object"))?;
+        serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("settings", e.to_string()))
+    }
+
+    /// The location and options, with the EnergyPlus model's Timestep as the default.
+    fn resolve(&self, model_timesteps: Option<u32>) -> Result<(Location, AnnualOptions)> {
+        let location = match (&self.epw, self.latitude, self.longitude, self.time_zone) {
+            (Some(epw), ..) => Location::from_epw_text(self.epw_name.as_deref().unwrap_or("EPW"), epw)?,
+            (None, Some(lat), Some(lon), Some(tz)) => Location::new(lat, lon, tz)?,
+            _ => return Err(Error::argument("location", "give an EPW or latitude, longitude and time zone")),
+        };
+        let refine = self.refine.unwrap_or(DEFAULT_REFINE);
+        if !(0.0..=1.0).contains(&refine) {
+            return Err(Error::argument("refine", format!("{refine} is outside 0..=1")));
+        }
+        let method = if self.dense.unwrap_or(false) {
+            Method::Dense
+        } else {
+            let default = SamplingPlan::default();
+            Method::Spline(SamplingPlan::new(self.days_per_year.unwrap_or(default.days), self.samples_per_day.unwrap_or(default.per_day))?)
+        };
+        let timesteps = Timesteps::new(self.timesteps_per_hour.or(model_timesteps).unwrap_or(4))?;
+        Ok((location, AnnualOptions { timesteps, method, refine }))
+    }
+}
+
+/// Each column's mean over the year's sun-up timesteps: the page's colour per surface.
+fn daylight_means(schedule: &Schedule, location: &Location) -> Vec<f64> {
+    let columns = schedule.names.len();
+    let mut sums = vec![0.0; columns];
+    let mut rows = 0usize;
+    for (row, instant) in schedule.timesteps.instants().enumerate() {
+        if sun_direction(location, f64::from(instant.day), instant.hour).z <= 0.0 {
+            continue;
+        }
+        rows += 1;
+        for (c, sum) in sums.iter_mut().enumerate() {
+            *sum += f64::from(schedule.get(row, c));
+        }
+    }
+    sums.into_iter().map(|s| if rows == 0 { 0.0 } else { s / rows as f64 }).collect()
+}
+
+/// A year's sunlit fractions for every receiver.
+#[wasm_bindgen]
+pub struct Annual {
+    schedule: Schedule,
+    means: Vec<f64>,
+    hook: Option<Hook>,
+    model: Rc<ModelInner>,
+}
+
+#[wasm_bindgen]
+impl Annual {
+    /// Column names.
+    #[wasm_bindgen(getter)]
+    pub fn names(&self) -> Vec<String> {
+        self.schedule.names.clone()
+    }
+
+    /// Timesteps per hour.
+    #[wasm_bindgen(getter, js_name = timestepsPerHour)]
+    pub fn timesteps_per_hour(&self) -> u32 {
+        self.schedule.timesteps.per_hour()
+    }
+
+    /// Rows: 8760 × timesteps per hour.
+    #[wasm_bindgen(getter)]
+    pub fn rows(&self) -> usize {
+        self.schedule.timesteps.rows()
+    }
+
+    /// One receiver's fraction at every timestep.
+    pub fn column(&self, index: usize) -> Result<Float32Array, JsValue> {
+        let columns = self.schedule.names.len();
+        if index >= columns {
+            return Err(js_error(Error::argument("column", format!("{index} is not below {columns}"))));
+        }
+        let values: Vec<f32> = self.schedule.values.iter().skip(index).step_by(columns).copied().collect();
+        Ok(Float32Array::from(values.as_slice()))
+    }
+
+    /// Each receiver's mean fraction over sun-up timesteps.
+    #[wasm_bindgen(getter)]
+    pub fn means(&self) -> Float64Array {
+        Float64Array::from(self.means.as_slice())
+    }
+
+    /// The EnergyPlus CSV (the layout EnergyPlus writes as eplusshading.csv).
+    pub fn csv(&self) -> Result<String, JsValue> {
+        self.schedule.to_csv().map_err(js_error)
+    }
+
+    /// With an EnergyPlus model among the files: its text with this CSV hooked in, expecting
+    /// the CSV beside it as `csv_name`.
+    #[wasm_bindgen(js_name = hookedModel)]
+    pub fn hooked_model(&self, csv_name: &str) -> Result<String, JsValue> {
+        let (Some(ep), Some(hook)) = (&self.model.energyplus, self.hook) else {
+            return Err(js_error(Error::argument("hookedModel", "no EnergyPlus model (.idf or .epJSON) was loaded")));
+        };
+        let plan = HookPlan { csv: csv_name, columns: &self.schedule.names, timesteps: self.schedule.timesteps, hook };
+        patch_model(ep, &plan).map_err(js_error)
+    }
+}

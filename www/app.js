@@ -1,0 +1,216 @@
+// The page: collects files and settings, talks to the worker (worker.js) that runs the engine,
+// and shows the results (3D view, table, heat map, downloads). All work stays on this machine.
+import { colourOf, UNCOMPUTED } from './colour.js';
+import { drawHeatmap } from './heatmap.js';
+import { Viewer } from './viewer.js';
+
+const $ = (id) => document.getElementById(id);
+const state = { model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '' };
+const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+
+function status(text, { error = false } = {}) {
+  $('status').textContent = text;
+  $('status').classList.toggle('error', error);
+}
+
+function setBusy(busy) {
+  state.busy = busy;
+  $('compute').disabled = busy || !state.model;
+  $('cancel').disabled = !busy;
+  for (const id of ['model', 'example', 'epw']) $(id).disabled = busy;
+}
+
+function resolution() {
+  const r = Number($('resolution').value);
+  return Number.isInteger(r) && r >= 16 && r <= 2048 ? r : 512;
+}
+
+async function readFiles(list) {
+  return Promise.all([...list].map(async (f) => ({ name: f.name, bytes: new Uint8Array(await f.arrayBuffer()) })));
+}
+
+async function loadFiles(files) {
+  if (!files.length) return;
+  if (state.busy) return status('Busy: cancel the running computation first.', { error: true });
+  state.modelName = files.map((f) => f.name).join(', ');
+  const base = files[0].name.replace(/\.[^.]*$/, '');
+  state.csvName = `${base}-shading.csv`;
+  status(`Reading ${state.modelName}…`);
+  setBusy(true);
+  $('cancel').disabled = true;
+  worker.postMessage({ type: 'load', files, receivers: $('receivers').value, north: 0, resolution: resolution() });
+}
+
+function showModel(msg) {
+  state.model = msg;
+  state.result = null;
+  state.selected = -1;
+  $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receivers, ${msg.triangles.toLocaleString()} triangles`;
+  $('download').disabled = true;
+  $('downloadidf').hidden = !msg.hasEnergyPlus;
+  $('downloadidf').disabled = true;
+  $('heatfigure').hidden = true;
+  fillTable(null);
+  if (state.viewer) {
+    state.viewer.setModel(msg.positions, msg.receivers);
+    state.viewer.setColours(() => UNCOMPUTED);
+  }
+  status(`Loaded ${state.modelName} (${msg.names.length} receivers) on ${msg.adapter}. Set the location and press Compute.`);
+}
+
+function fillTable(means) {
+  const body = $('table').tBodies[0];
+  body.replaceChildren();
+  const { names, areas } = state.model;
+  names.forEach((name, i) => {
+    const row = body.insertRow();
+    row.tabIndex = 0;
+    row.dataset.index = i;
+    // textContent, never innerHTML: names come from the user's file.
+    row.insertCell().textContent = name;
+    const area = row.insertCell();
+    area.textContent = areas[i].toFixed(2);
+    area.className = 'num';
+    const mean = row.insertCell();
+    mean.textContent = means ? means[i].toFixed(3) : '–';
+    mean.className = 'num';
+    if (i === state.selected) row.classList.add('selected');
+  });
+}
+
+function selectReceiver(index) {
+  if (!state.result || index < 0) return;
+  state.selected = index;
+  for (const row of $('table').tBodies[0].rows) row.classList.toggle('selected', Number(row.dataset.index) === index);
+  const { values, rows, timestepsPerHour, names } = state.result;
+  drawHeatmap($('heatmap'), values.subarray(index * rows, (index + 1) * rows), timestepsPerHour);
+  $('heatcaption').textContent = `${names[index]}: sunlit fraction by day of year (across) and time of day (down, standard time).`;
+  $('heatfigure').hidden = false;
+}
+
+function showResult(msg) {
+  state.result = msg;
+  setBusy(false);
+  $('progress').value = 1;
+  fillTable(msg.means);
+  state.viewer?.setColours((r) => colourOf(msg.means[r]));
+  $('download').disabled = false;
+  $('downloadidf').disabled = !msg.hooked;
+  selectReceiver(state.selected >= 0 ? state.selected : 0);
+  status(`Done in ${msg.seconds.toFixed(1)} s: ${msg.names.length} surfaces × ${msg.rows.toLocaleString()} timesteps.`);
+}
+
+function showError(msg) {
+  setBusy(false);
+  $('progress').value = 0;
+  if (msg.cancelled) return status('Cancelled.');
+  $('retry').hidden = !msg.gpu;
+  const what = msg.request === 'load' ? 'Could not read the model' : 'Could not compute';
+  const hint = msg.gpu ? ' The GPU device was lost or failed; press Retry to start a new one.' : '';
+  status(`${what}: ${msg.message}.${hint}`, { error: true });
+}
+
+worker.onmessage = ({ data: msg }) => {
+  if (msg.type === 'ready') {
+    if (!msg.webgpu) noWebGPU();
+    else status('Ready. Choose a model, drop one here, or load the example.');
+    $('compute').disabled = !state.model;
+  } else if (msg.type === 'loaded') {
+    showModel(msg);
+    setBusy(false);
+  } else if (msg.type === 'progress') {
+    $('progress').max = msg.total || 1;
+    $('progress').value = msg.done;
+    status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}`);
+  } else if (msg.type === 'result') {
+    showResult(msg);
+  } else if (msg.type === 'error') {
+    showError(msg);
+  }
+};
+worker.onerror = (e) => showError({ message: e.message || 'the worker failed to start', request: 'start' });
+
+function noWebGPU() {
+  const box = $('nowebgpu');
+  box.hidden = false;
+  box.textContent = 'This browser offers no WebGPU, which sunlit needs to count pixels. Use a current Chrome or Edge (or enable WebGPU in your browser\'s settings).';
+  status('WebGPU is not available.', { error: true });
+  $('compute').disabled = true;
+}
+
+async function settings() {
+  const s = {
+    timestepsPerHour: Number($('timesteps').value),
+    daysPerYear: Number($('days').value),
+    samplesPerDay: Number($('perday').value),
+  };
+  const epw = $('epw').files[0];
+  if (epw) {
+    s.epw = await epw.text();
+    s.epwName = epw.name;
+  } else {
+    s.latitude = Number($('latitude').value);
+    s.longitude = Number($('longitude').value);
+    s.timeZone = Number($('timezone').value);
+  }
+  return s;
+}
+
+function download(name, text, type) {
+  const url = URL.createObjectURL(new Blob([text], { type }));
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 1000);
+}
+
+function wire() {
+  $('model').addEventListener('change', async (e) => loadFiles(await readFiles(e.target.files)));
+  $('example').addEventListener('click', async () => {
+    const bytes = new Uint8Array(await (await fetch('pkg/office.glb')).arrayBuffer());
+    await loadFiles([{ name: 'office.glb', bytes }]);
+  });
+  const drop = $('drop');
+  for (const ev of ['dragenter', 'dragover']) drop.addEventListener(ev, (e) => { e.preventDefault(); drop.classList.add('over'); });
+  for (const ev of ['dragleave', 'drop']) drop.addEventListener(ev, () => drop.classList.remove('over'));
+  drop.addEventListener('drop', async (e) => {
+    e.preventDefault();
+    await loadFiles(await readFiles(e.dataTransfer.files));
+  });
+  $('settings').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    if (!state.model || state.busy) return;
+    $('retry').hidden = true;
+    setBusy(true);
+    $('progress').value = 0;
+    status('Sampling the sun…');
+    worker.postMessage({ type: 'compute', settings: await settings(), resolution: resolution(), csvName: state.csvName });
+  });
+  $('cancel').addEventListener('click', () => worker.postMessage({ type: 'cancel' }));
+  $('retry').addEventListener('click', () => $('settings').requestSubmit());
+  $('download').addEventListener('click', () => state.result && download(state.csvName, state.result.csv, 'text/csv'));
+  $('downloadidf').addEventListener('click', () => {
+    if (!state.result?.hooked) return;
+    const ext = /\.epjson$|\.json$/i.test(state.modelName) ? 'epJSON' : 'idf';
+    download(state.csvName.replace(/-shading\.csv$/, `-sunlit.${ext}`), state.result.hooked, 'text/plain');
+  });
+  const body = $('table').tBodies[0];
+  body.addEventListener('click', (e) => selectReceiver(Number(e.target.closest('tr')?.dataset.index ?? -1)));
+  body.addEventListener('keydown', (e) => {
+    if (e.key === 'Enter' || e.key === ' ') selectReceiver(Number(e.target.closest('tr')?.dataset.index ?? -1));
+  });
+}
+
+async function start() {
+  wire();
+  if (!navigator.gpu) return noWebGPU();
+  try {
+    state.viewer = await Viewer.create($('view'));
+  } catch (error) {
+    status(`The 3D view is unavailable (${error.message}); results still work.`, { error: true });
+  }
+}
+start();

@@ -1,0 +1,107 @@
+// Types of sunlit's JavaScript API (sunlit.js). Axes are EnergyPlus's: x east, y north, z up,
+// metres. Fractions are sunlit area / area, 0..1, for each receiving surface.
+
+/** Whether this browser (or worker) offers WebGPU. */
+export function hasWebGPU(): boolean;
+
+/** Unit vector towards the sun from azimuth (degrees clockwise from north) and altitude (degrees). */
+export function sunDirection(azimuth: number, altitude: number): [number, number, number];
+
+/** Opens the GPU device. `resolution`: pixels along a view's side (default 512). */
+export function createEngine(options?: { resolution?: number }): Promise<SunlitEngine>;
+
+export interface ModelFile {
+  /** File name; its extension picks the reader (.glb, .gltf, .idf, .epJSON). */
+  name: string;
+  bytes: Uint8Array | ArrayBuffer;
+}
+
+export interface ArraysInput {
+  /** x, y, z per vertex. */
+  positions: ArrayLike<number>;
+  /** Three vertex indices per triangle. */
+  indices: ArrayLike<number>;
+  /** Per triangle: index into `names`, or -1 for geometry that only casts shadows. */
+  triangleReceivers: ArrayLike<number>;
+  /** Receiver names, unique: the CSV's columns. */
+  names: string[];
+  /** Positions in glTF axes (+Y up, -Z north) instead of z up. */
+  yUp?: boolean;
+}
+
+export interface AnnualSettings {
+  /** Degrees north; with longitude and timeZone, unless `epw` is given. */
+  latitude?: number;
+  /** Degrees east. */
+  longitude?: number;
+  /** Hours from UTC of the standard time the CSV is in. */
+  timeZone?: number;
+  /** An EPW weather file's text; its LOCATION line gives latitude, longitude and time zone. */
+  epw?: string;
+  /** The EPW's file name, for messages. */
+  epwName?: string;
+  /** EnergyPlus Timestep: output rows per hour (default: the IDF's, else 4). */
+  timestepsPerHour?: number;
+  /** Sampled days over the year (default 27). */
+  daysPerYear?: number;
+  /** Samples per day (default 19). */
+  samplesPerDay?: number;
+  /** Count a timestep directly where neighbouring samples differ by more than this (default 0.3; 1 never). */
+  refine?: number;
+  /** Count every sun-up timestep instead of interpolating (slow). */
+  dense?: boolean;
+}
+
+export interface AnnualRunOptions {
+  /** Called as views are counted. */
+  onProgress?: (done: number, total: number) => void;
+  /** Aborting rejects the run with an AbortError at the next progress report. */
+  signal?: AbortSignal;
+}
+
+export interface SunlitEngine {
+  /** The GPU adapter in use. */
+  readonly adapter: string;
+  /** Pixels along a view's side. */
+  readonly resolution: number;
+  /** Reads model files; throws an Error naming the file, object and reason when one is bad. */
+  loadFiles(files: ModelFile[], options?: { receivers?: string; north?: number }): Model;
+  /** Builds a model from typed arrays; throws an Error naming the array and element when bad. */
+  fromArrays(input: ArraysInput): Model;
+  /** Every receiver's fraction for one sun direction (unit vector towards the sun, or angles). */
+  fractions(model: Model, sun: [number, number, number] | { azimuth: number; altitude: number }): Promise<Float64Array>;
+  /** The year's sunlit fractions at every EnergyPlus timestep. */
+  annual(model: Model, settings: AnnualSettings, options?: AnnualRunOptions): Promise<Annual>;
+}
+
+/** A scene on the engine's GPU device; use it only with the engine that made it. */
+export interface Model {
+  readonly receiverNames: string[];
+  /** m² per receiver. */
+  readonly receiverAreas: Float64Array;
+  readonly triangles: number;
+  /** Whether an EnergyPlus model was among the files (then Annual.hookedModel works). */
+  readonly hasEnergyPlus: boolean;
+  /** Every triangle's corners, 9 floats each, for drawing. */
+  worldPositions(): Float32Array;
+  /** Per triangle of worldPositions(): receiver index or -1. */
+  worldReceivers(): Int32Array;
+  /** Releases the GPU buffers now rather than at garbage collection. */
+  free(): void;
+}
+
+/** A year of fractions: rows = 8760 × timestepsPerHour, one column per receiver. */
+export interface Annual {
+  readonly names: string[];
+  readonly timestepsPerHour: number;
+  readonly rows: number;
+  /** Each receiver's mean fraction over the year's sun-up timesteps. */
+  readonly means: Float64Array;
+  /** One receiver's fraction at every timestep. */
+  column(index: number): Float32Array;
+  /** The EnergyPlus CSV (eplusshading.csv layout). */
+  csv(): string;
+  /** With an IDF/epJSON loaded: the model text with the CSV (saved beside it as csvName) hooked in. */
+  hookedModel(csvName: string): string;
+  free(): void;
+}

@@ -1,0 +1,100 @@
+// sunlit's JavaScript API: sunlit fractions of building surfaces on the browser's WebGPU.
+// Types and documentation: sunlit.d.ts. Example: api-example.html.
+//
+// Wraps the wasm-bindgen bindings (pkg/sunlit_wasm.js, built by scripts/build-web.sh) so that
+// callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
+import init, { Engine } from './pkg/sunlit_wasm.js';
+
+let wasmReady;
+
+/** Loads the wasm module once (later calls share it). */
+function ready() {
+  wasmReady ??= init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) });
+  return wasmReady;
+}
+
+/** Whether this browser (or worker) offers WebGPU at all. */
+export function hasWebGPU() {
+  return typeof navigator !== 'undefined' && !!navigator.gpu;
+}
+
+/** Unit vector towards the sun (x east, y north, z up) from azimuth (degrees clockwise from
+ * north) and altitude (degrees above the horizon). */
+export function sunDirection(azimuth, altitude) {
+  const a = (azimuth * Math.PI) / 180;
+  const h = (altitude * Math.PI) / 180;
+  return [Math.sin(a) * Math.cos(h), Math.cos(a) * Math.cos(h), Math.sin(h)];
+}
+
+/** Opens the GPU device. Rejects with a clear message where WebGPU is missing. */
+export async function createEngine({ resolution } = {}) {
+  if (!hasWebGPU()) {
+    throw new Error('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).');
+  }
+  await ready();
+  return new SunlitEngine(await Engine.create(resolution));
+}
+
+function toBytes(bytes, name) {
+  if (bytes instanceof Uint8Array) return bytes;
+  if (bytes instanceof ArrayBuffer) return new Uint8Array(bytes);
+  if (ArrayBuffer.isView(bytes)) return new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  throw new TypeError(`${name}: bytes must be a Uint8Array or ArrayBuffer`);
+}
+
+function abortError() {
+  return new DOMException('cancelled', 'AbortError');
+}
+
+class SunlitEngine {
+  #engine;
+
+  constructor(engine) {
+    this.#engine = engine;
+  }
+
+  /** The GPU adapter in use. */
+  get adapter() {
+    return this.#engine.adapter;
+  }
+
+  /** Pixels along a view's side. */
+  get resolution() {
+    return this.#engine.resolution;
+  }
+
+  /** A model from files: [{ name, bytes }]; glb/gltf (embedded buffers), IDF or epJSON. */
+  loadFiles(files, { receivers = '', north = 0 } = {}) {
+    const names = files.map((f) => String(f.name));
+    const contents = files.map((f) => toBytes(f.bytes, f.name));
+    return this.#engine.loadFiles(names, contents, receivers, north);
+  }
+
+  /** A model from typed arrays (see sunlit.d.ts). */
+  fromArrays({ positions, indices, triangleReceivers, names, yUp = false }) {
+    return this.#engine.fromArrays(
+      Float32Array.from(positions),
+      Uint32Array.from(indices),
+      Int32Array.from(triangleReceivers),
+      names.map(String),
+      !!yUp,
+    );
+  }
+
+  /** Every receiver's sunlit fraction for one sun: [x, y, z] or { azimuth, altitude }. */
+  async fractions(model, sun) {
+    const [x, y, z] = Array.isArray(sun) ? sun : sunDirection(sun.azimuth, sun.altitude);
+    return this.#engine.fractions(model, x, y, z);
+  }
+
+  /** The year's schedule. Rejects with an AbortError when `signal` aborts. */
+  async annual(model, settings, { onProgress, signal } = {}) {
+    if (signal?.aborted) throw abortError();
+    try {
+      return await this.#engine.annual(model, settings, onProgress, signal);
+    } catch (error) {
+      if (signal?.aborted && String(error?.message ?? error) === 'cancelled') throw abortError();
+      throw error;
+    }
+  }
+}

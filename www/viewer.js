@@ -1,0 +1,162 @@
+// The 3D view: the model's triangles on a WebGPU canvas, coloured per receiver, with an orbit
+// camera (drag to turn, wheel to zoom). Its shader is shaders/viewer.wgsl (copied to pkg/).
+import { GREY } from './colour.js';
+
+const FLOATS_PER_VERTEX = 9; // position, normal, colour
+
+export class Viewer {
+  static async create(canvas) {
+    const adapter = await navigator.gpu.requestAdapter();
+    if (!adapter) throw new Error('no WebGPU adapter for the 3D view');
+    const device = await adapter.requestDevice();
+    const code = await (await fetch(new URL('./pkg/viewer.wgsl', import.meta.url))).text();
+    return new Viewer(canvas, device, code);
+  }
+
+  constructor(canvas, device, code) {
+    this.canvas = canvas;
+    this.device = device;
+    this.context = canvas.getContext('webgpu');
+    this.format = navigator.gpu.getPreferredCanvasFormat();
+    this.context.configure({ device, format: this.format, alphaMode: 'opaque' });
+    const module = device.createShaderModule({ code });
+    this.pipeline = device.createRenderPipeline({
+      layout: 'auto',
+      vertex: {
+        module,
+        entryPoint: 'vs_main',
+        buffers: [{
+          arrayStride: FLOATS_PER_VERTEX * 4,
+          attributes: [
+            { shaderLocation: 0, offset: 0, format: 'float32x3' },
+            { shaderLocation: 1, offset: 12, format: 'float32x3' },
+            { shaderLocation: 2, offset: 24, format: 'float32x3' },
+          ],
+        }],
+      },
+      fragment: { module, entryPoint: 'fs_main', targets: [{ format: this.format }] },
+      primitive: { topology: 'triangle-list', cullMode: 'none' },
+      depthStencil: { format: 'depth32float', depthWriteEnabled: true, depthCompare: 'less' },
+    });
+    this.uniform = device.createBuffer({ size: 80, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
+    this.bind = device.createBindGroup({ layout: this.pipeline.getBindGroupLayout(0), entries: [{ binding: 0, resource: { buffer: this.uniform } }] });
+    this.orbit = { yaw: -0.6, pitch: 0.5, distance: 50, target: [0, 0, 0] };
+    this.vertices = null;
+    this.count = 0;
+    this.listen();
+  }
+
+  /** New geometry: 9 floats per triangle, and per triangle its receiver (−1: shading). */
+  setModel(positions, receivers) {
+    this.positions = positions;
+    this.receivers = receivers;
+    const lo = [Infinity, Infinity, Infinity];
+    const hi = [-Infinity, -Infinity, -Infinity];
+    for (let i = 0; i < positions.length; i += 3) {
+      for (let k = 0; k < 3; k++) {
+        lo[k] = Math.min(lo[k], positions[i + k]);
+        hi[k] = Math.max(hi[k], positions[i + k]);
+      }
+    }
+    this.orbit.target = lo.map((l, k) => (l + hi[k]) / 2);
+    this.orbit.distance = 1.6 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 10;
+  }
+
+  /** Colours per receiver (RGB 0..1); shading geometry stays grey. */
+  setColours(colourOfReceiver) {
+    const { positions, receivers } = this;
+    const triangles = receivers.length;
+    const data = new Float32Array(triangles * 3 * FLOATS_PER_VERTEX);
+    for (let t = 0; t < triangles; t++) {
+      const p = positions.subarray(9 * t, 9 * t + 9);
+      const n = normal(p);
+      const c = receivers[t] >= 0 ? colourOfReceiver(receivers[t]) : GREY;
+      for (let v = 0; v < 3; v++) {
+        data.set([p[3 * v], p[3 * v + 1], p[3 * v + 2], n[0], n[1], n[2], c[0], c[1], c[2]], (3 * t + v) * FLOATS_PER_VERTEX);
+      }
+    }
+    this.vertices?.destroy();
+    this.vertices = this.device.createBuffer({ size: Math.max(data.byteLength, 36), usage: GPUBufferUsage.VERTEX | GPUBufferUsage.COPY_DST });
+    this.device.queue.writeBuffer(this.vertices, 0, data);
+    this.count = triangles * 3;
+    this.draw();
+  }
+
+  listen() {
+    let last = null;
+    this.canvas.addEventListener('pointerdown', (e) => { last = [e.clientX, e.clientY]; this.canvas.setPointerCapture(e.pointerId); });
+    this.canvas.addEventListener('pointerup', () => { last = null; });
+    this.canvas.addEventListener('pointermove', (e) => {
+      if (!last) return;
+      this.orbit.yaw -= (e.clientX - last[0]) * 0.008;
+      this.orbit.pitch = Math.min(1.5, Math.max(-1.5, this.orbit.pitch + (e.clientY - last[1]) * 0.008));
+      last = [e.clientX, e.clientY];
+      this.draw();
+    });
+    this.canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      this.orbit.distance *= Math.exp(e.deltaY * 0.001);
+      this.draw();
+    }, { passive: false });
+  }
+
+  draw() {
+    if (!this.vertices) return;
+    const { width, height } = this.canvas;
+    if (!this.depth || this.depth.width !== width || this.depth.height !== height) {
+      this.depth?.destroy();
+      this.depth = this.device.createTexture({ size: [width, height], format: 'depth32float', usage: GPUTextureUsage.RENDER_ATTACHMENT });
+    }
+    const { yaw, pitch, distance, target } = this.orbit;
+    const eye = [
+      target[0] + distance * Math.cos(pitch) * Math.sin(yaw),
+      target[1] - distance * Math.cos(pitch) * Math.cos(yaw),
+      target[2] + distance * Math.sin(pitch),
+    ];
+    const viewProj = multiply(perspective(0.8, width / height, distance / 100, distance * 10), lookAt(eye, target, [0, 0, 1]));
+    const light = normalise([0.4, -0.6, 0.7]);
+    this.device.queue.writeBuffer(this.uniform, 0, new Float32Array([...viewProj, ...light, 0]));
+    const encoder = this.device.createCommandEncoder();
+    const pass = encoder.beginRenderPass({
+      colorAttachments: [{ view: this.context.getCurrentTexture().createView(), loadOp: 'clear', storeOp: 'store', clearValue: { r: 0.96, g: 0.96, b: 0.95, a: 1 } }],
+      depthStencilAttachment: { view: this.depth.createView(), depthLoadOp: 'clear', depthStoreOp: 'store', depthClearValue: 1 },
+    });
+    pass.setPipeline(this.pipeline);
+    pass.setBindGroup(0, this.bind);
+    pass.setVertexBuffer(0, this.vertices);
+    pass.draw(this.count);
+    pass.end();
+    this.device.queue.submit([encoder.finish()]);
+  }
+}
+
+function normal(p) {
+  const a = [p[3] - p[0], p[4] - p[1], p[5] - p[2]];
+  const b = [p[6] - p[0], p[7] - p[1], p[8] - p[2]];
+  return normalise([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]);
+}
+
+function normalise(v) {
+  const l = Math.hypot(...v) || 1;
+  return v.map((x) => x / l);
+}
+
+// Column-major 4×4 matrices, WebGPU clip depth 0..1.
+function perspective(fovy, aspect, near, far) {
+  const f = 1 / Math.tan(fovy / 2);
+  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, far / (near - far), -1, 0, 0, (near * far) / (near - far), 0];
+}
+
+function lookAt(eye, target, up) {
+  const z = normalise(eye.map((e, i) => e - target[i]));
+  const x = normalise([up[1] * z[2] - up[2] * z[1], up[2] * z[0] - up[0] * z[2], up[0] * z[1] - up[1] * z[0]]);
+  const y = [z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]];
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  return [x[0], y[0], z[0], 0, x[1], y[1], z[1], 0, x[2], y[2], z[2], 0, -dot(x, eye), -dot(y, eye), -dot(z, eye), 1];
+}
+
+function multiply(a, b) {
+  const out = new Array(16).fill(0);
+  for (let c = 0; c < 4; c++) for (let r = 0; r < 4; r++) for (let k = 0; k < 4; k++) out[4 * c + r] += a[4 * k + r] * b[4 * c + k];
+  return out;
+}

@@ -1,0 +1,117 @@
+// The page's worker: holds the engine and the model, runs the year off the main thread, so the
+// page stays responsive. Messages in: load, compute, cancel, reset. Messages out: loaded,
+// progress, result, error (with `gpu: true` when the device failed and a retry may help).
+import { createEngine } from './sunlit.js';
+
+let engine = null;
+let model = null;
+let files = null;
+let loadOptions = null;
+let running = null;
+
+async function engineFor(resolution) {
+  if (!engine || engine.resolution !== resolution) {
+    engine = null;
+    model?.free();
+    model = null;
+    engine = await createEngine({ resolution });
+  }
+  return engine;
+}
+
+function modelOn(e) {
+  if (!model) model = e.loadFiles(files, loadOptions);
+  return model;
+}
+
+function isGpuFailure(message) {
+  return /^GPU:|device (was )?lost|device went away/i.test(message);
+}
+
+function fail(error, request) {
+  const message = String(error?.message ?? error);
+  const gpu = isGpuFailure(message);
+  if (gpu) {
+    // A lost or failed device cannot be reused; the next request makes a new one.
+    engine = null;
+    model = null;
+  }
+  postMessage({ type: 'error', request, message, gpu, cancelled: error?.name === 'AbortError' });
+}
+
+async function load({ files: given, receivers, north, resolution }) {
+  const e = await engineFor(resolution);
+  // Read first: a bad file leaves the last good model in place.
+  const m = e.loadFiles(given, { receivers, north });
+  model?.free();
+  model = m;
+  files = given;
+  loadOptions = { receivers, north };
+  const positions = m.worldPositions();
+  const receiversOf = m.worldReceivers();
+  postMessage(
+    {
+      type: 'loaded',
+      names: m.receiverNames,
+      areas: m.receiverAreas,
+      triangles: m.triangles,
+      hasEnergyPlus: m.hasEnergyPlus,
+      adapter: engine.adapter,
+      positions,
+      receivers: receiversOf,
+    },
+    [positions.buffer, receiversOf.buffer],
+  );
+}
+
+async function compute({ settings, resolution, csvName }) {
+  if (!files) throw new Error('load a model first');
+  const e = await engineFor(resolution);
+  const m = modelOn(e);
+  running = new AbortController();
+  const started = performance.now();
+  let last = 0;
+  const onProgress = (done, total) => {
+    const now = performance.now();
+    if (now - last > 100 || done === total) {
+      last = now;
+      postMessage({ type: 'progress', done, total });
+    }
+  };
+  const annual = await e.annual(m, settings, { onProgress, signal: running.signal });
+  try {
+    const columns = annual.names.length;
+    const values = new Float32Array(annual.rows * columns);
+    for (let c = 0; c < columns; c++) values.set(annual.column(c), c * annual.rows);
+    const result = {
+      type: 'result',
+      names: annual.names,
+      means: annual.means,
+      rows: annual.rows,
+      timestepsPerHour: annual.timestepsPerHour,
+      values,
+      csv: annual.csv(),
+      hooked: m.hasEnergyPlus ? annual.hookedModel(csvName) : null,
+      seconds: (performance.now() - started) / 1000,
+    };
+    postMessage(result, [values.buffer]);
+  } finally {
+    annual.free();
+  }
+}
+
+onmessage = async ({ data }) => {
+  if (data.type === 'cancel') {
+    running?.abort();
+    return;
+  }
+  try {
+    if (data.type === 'load') await load(data);
+    else if (data.type === 'compute') await compute(data);
+  } catch (error) {
+    fail(error, data.type);
+  } finally {
+    if (data.type === 'compute') running = null;
+  }
+};
+postMessage({ type: 'ready', webgpu: !!self.navigator?.gpu });
