@@ -21,10 +21,29 @@ if ! command -v cargo >/dev/null; then
   exit 1
 fi
 
-# The browser build's target (the library is checked for it in the tests).
-if command -v rustup >/dev/null && ! rustup target list --installed | grep -q wasm32-unknown-unknown; then
-  say "adding the wasm32-unknown-unknown target (rustup)"
-  rustup target add wasm32-unknown-unknown >/dev/null || say "could not add wasm32-unknown-unknown; the browser build check will be skipped"
+# The browser build: the wasm32 target, the wasm-bindgen CLI of exactly the crate's version (else
+# "schema version" errors), and for the tests Debian's Chromium + ChromeDriver (WebGPU on its
+# bundled SwiftShader) and playwright-core from npm. `SUNLIT_WEB=1 . scripts/setup.sh`.
+if [ "${SUNLIT_WEB:-0}" = 1 ]; then
+  if ! rustup target list --installed | grep -q wasm32-unknown-unknown; then
+    say "adding the wasm32-unknown-unknown target (rustup)"
+    rustup target add wasm32-unknown-unknown >/dev/null
+  fi
+  wb_version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/[^0-9.]/, ""); print; exit }' Cargo.lock)
+  if [ "$(wasm-bindgen --version 2>/dev/null | cut -d' ' -f2)" != "$wb_version" ]; then
+    say "installing wasm-bindgen-cli $wb_version (cargo install, 5-11 minutes, once)"
+    cargo install --quiet wasm-bindgen-cli --version "$wb_version"
+  fi
+  if [ "${SUNLIT_BROWSER:-0}" = 1 ]; then
+    if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+      apt_install chromium chromium-driver
+    fi
+    export CHROMEDRIVER="${CHROMEDRIVER:-$(command -v chromedriver)}"
+    if [ ! -d node_modules/playwright-core ]; then
+      say "installing playwright-core (npm ci; it uses Debian's Chromium, never downloads one)"
+      npm ci --silent --no-audit --no-fund
+    fi
+  fi
 fi
 
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.

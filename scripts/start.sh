@@ -1,13 +1,10 @@
 #!/usr/bin/env bash
-# The main job: build, make the example office model, and show its receivers and sunlit fractions.
+# The main job: build the browser bundle and serve the page on http://127.0.0.1:${PORT:-8080}
+# with the example office one click away. The CLI: `cargo run --release -- --help`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-. scripts/setup.sh
+SUNLIT_WEB=1 . scripts/setup.sh
 
-cargo build --release --quiet --bin sunlit --example make_office
-./target/release/examples/make_office examples/office.glb >/dev/null
-./target/release/sunlit info examples/office.glb
-./target/release/sunlit fraction examples/office.glb --sun "${SUN:-200,35}"
-mkdir -p out
-./target/release/sunlit annual examples/office.glb --location 39.74,-105.18,-7 -o out/office-shading.csv
-echo "EnergyPlus CSV (Schedule:File:Shading layout): out/office-shading.csv"
+scripts/build-web.sh
+echo "open the page, press 'Load the example office', then Compute; or drop your own .glb/.idf there."
+exec node scripts/serve.mjs

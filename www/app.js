@@ -5,7 +5,7 @@ import { drawHeatmap } from './heatmap.js';
 import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
-const state = { model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '' };
+const state = { files: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '' };
 const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
 
 function status(text, { error = false } = {}) {
@@ -31,13 +31,13 @@ async function readFiles(list) {
 
 async function loadFiles(files) {
   if (!files.length) return;
-  if (state.busy) return status('Busy: cancel the running computation first.', { error: true });
+  if (state.busy) return status('Could not read the model while computing: cancel first.', { error: true });
+  state.files = files;
   state.modelName = files.map((f) => f.name).join(', ');
   const base = files[0].name.replace(/\.[^.]*$/, '');
   state.csvName = `${base}-shading.csv`;
   status(`Reading ${state.modelName}…`);
-  setBusy(true);
-  $('cancel').disabled = true;
+  $('compute').disabled = true;
   worker.postMessage({ type: 'load', files, receivers: $('receivers').value, north: 0, resolution: resolution() });
 }
 
@@ -117,7 +117,7 @@ worker.onmessage = ({ data: msg }) => {
     $('compute').disabled = !state.model;
   } else if (msg.type === 'loaded') {
     showModel(msg);
-    setBusy(false);
+    setBusy(state.busy);
   } else if (msg.type === 'progress') {
     $('progress').max = msg.total || 1;
     $('progress').value = msg.done;
@@ -168,7 +168,14 @@ function download(name, text, type) {
 }
 
 function wire() {
-  $('model').addEventListener('change', async (e) => loadFiles(await readFiles(e.target.files)));
+  $('model').addEventListener('change', async (e) => {
+    const files = await readFiles(e.target.files);
+    // Cleared so that choosing the same file again (after fixing a setting) reads it again.
+    e.target.value = '';
+    await loadFiles(files);
+  });
+  // Receivers decide what the model is: a new pattern re-reads the files.
+  $('receivers').addEventListener('change', () => state.files && loadFiles(state.files));
   $('example').addEventListener('click', async () => {
     const bytes = new Uint8Array(await (await fetch('pkg/office.glb')).arrayBuffer());
     await loadFiles([{ name: 'office.glb', bytes }]);
