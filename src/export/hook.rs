@@ -320,6 +320,32 @@ pub fn patch_epjson(file: &str, text: &str, plan: &HookPlan) -> Result<String> {
     serde_json::to_string_pretty(&root).map_err(|e| Error::model(file, e.to_string()))
 }
 
+/// The hook form for a model (`hook`, or the one its version supports), after checking that
+/// every receiver is one of its surfaces and that the model can take the hook (version, Timestep,
+/// no local environments of its own): all before any counting.
+pub fn hook_for(ep: &EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timesteps: Timesteps) -> Result<Hook> {
+    let form = match hook {
+        Some(h) => h,
+        None => Hook::for_version(&ep.file, crate::model::idf::version(&ep.objects).as_deref())?,
+    };
+    let known = |name: &str| ep.building.surface(name.strip_prefix("Mir-").unwrap_or(name)).is_some();
+    if let Some(r) = scene.receivers.iter().find(|r| !known(&r.name)) {
+        return Err(Error::argument(
+            "hook",
+            format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
+        ));
+    }
+    // The model checks (version, Timestep, existing local environments) before any counting.
+    let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
+    check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form })?;
+    Ok(form)
+}
+
+/// The model's text (IDF or epJSON, as it came) with the CSV hooked in.
+pub fn patch_model(ep: &EnergyPlusInput, plan: &HookPlan) -> Result<String> {
+    if ep.epjson { patch_epjson(&ep.file, &ep.text, plan) } else { patch_idf(&ep.file, &ep.text, &ep.objects, plan) }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -389,30 +415,4 @@ mod tests {
         assert_eq!(out["Schedule:File"]["SUNLIT WIN_S"]["column_number"], 2);
         assert_eq!(out["SurfaceProperty:LocalEnvironment"]["SUNLIT ENV WIN_S"]["exterior_surface_name"], "WIN_S");
     }
-}
-
-/// The hook form for a model (`hook`, or the one its version supports), after checking that
-/// every receiver is one of its surfaces and that the model can take the hook (version, Timestep,
-/// no local environments of its own): all before any counting.
-pub fn hook_for(ep: &EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timesteps: Timesteps) -> Result<Hook> {
-    let form = match hook {
-        Some(h) => h,
-        None => Hook::for_version(&ep.file, crate::model::idf::version(&ep.objects).as_deref())?,
-    };
-    let known = |name: &str| ep.building.surface(name.strip_prefix("Mir-").unwrap_or(name)).is_some();
-    if let Some(r) = scene.receivers.iter().find(|r| !known(&r.name)) {
-        return Err(Error::argument(
-            "hook",
-            format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
-        ));
-    }
-    // The model checks (version, Timestep, existing local environments) before any counting.
-    let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
-    check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form })?;
-    Ok(form)
-}
-
-/// The model's text (IDF or epJSON, as it came) with the CSV hooked in.
-pub fn patch_model(ep: &EnergyPlusInput, plan: &HookPlan) -> Result<String> {
-    if ep.epjson { patch_epjson(&ep.file, &ep.text, plan) } else { patch_idf(&ep.file, &ep.text, &ep.objects, plan) }
 }
