@@ -187,6 +187,12 @@ impl Model {
         self.inner.energyplus.is_some()
     }
 
+    /// The EnergyPlus model's Timestep (rows per hour), if one was loaded: the CSV must match it.
+    #[wasm_bindgen(getter, js_name = modelTimesteps)]
+    pub fn model_timesteps(&self) -> Option<u32> {
+        self.inner.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)
+    }
+
     /// Every triangle in world coordinates (x east, y north, z up; 9 floats each), for drawing.
     #[wasm_bindgen(js_name = worldPositions)]
     pub fn world_positions(&self) -> Float32Array {

@@ -48,6 +48,8 @@ function showModel(msg) {
   $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receivers, ${msg.triangles.toLocaleString()} triangles`;
   $('download').disabled = true;
   $('downloadidf').hidden = !msg.hasEnergyPlus;
+  // The CSV must have the EnergyPlus model's Timestep to be hooked in.
+  if (msg.modelTimesteps) $('timesteps').value = String(msg.modelTimesteps);
   $('downloadidf').disabled = true;
   $('heatfigure').hidden = true;
   fillTable(null);

@@ -82,6 +82,8 @@ export interface Model {
   readonly triangles: number;
   /** Whether an EnergyPlus model was among the files (then Annual.hookedModel works). */
   readonly hasEnergyPlus: boolean;
+  /** The EnergyPlus model's Timestep, if one was loaded (the CSV must match it). */
+  readonly modelTimesteps: number | undefined;
   /** Every triangle's corners, 9 floats each, for drawing. */
   worldPositions(): Float32Array;
   /** Per triangle of worldPositions(): receiver index or -1. */

@@ -56,6 +56,7 @@ async function load({ files: given, receivers, north, resolution }) {
       areas: m.receiverAreas,
       triangles: m.triangles,
       hasEnergyPlus: m.hasEnergyPlus,
+      modelTimesteps: m.modelTimesteps,
       adapter: engine.adapter,
       positions,
       receivers: receiversOf,

@@ -172,6 +172,28 @@ test('bad files get a message naming the problem, and the page keeps working', {
   assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done/);
 });
 
+test('an EnergyPlus IDF loads, and the hooked IDF downloads with its CSV named', { timeout: 300_000 }, async () => {
+  const idf = join(WORK, 'office.idf');
+  execFileSync('cargo', ['run', '--quiet', '--example', 'make_office_idf', '--', idf, '--louvres', '2'], { cwd: ROOT, stdio: 'inherit' });
+  const loaded = await statusAfter(() => page.setInputFiles('#model', idf), /^Loaded|^Could not/);
+  assert.match(loaded, /^Loaded office\.idf \(\d+ receivers\)/);
+  assert.equal(await page.locator('#downloadidf').isVisible(), true);
+  await page.fill('#days', '6');
+  await page.fill('#perday', '5');
+  await page.fill('#resolution', '64');
+  assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done/);
+  const download = page.waitForEvent('download');
+  await page.click('#downloadidf');
+  const saved = join(WORK, 'hooked.idf');
+  await (await download).saveAs(saved);
+  assert.equal((await download).suggestedFilename(), 'office-sunlit.idf');
+  const text = readFileSync(saved, 'utf8');
+  assert.match(text, /Schedule:File,/);
+  assert.match(text, /office-shading\.csv/);
+  assert.match(text, /SurfaceProperty:LocalEnvironment,/);
+  assert.match(text, /Scheduled/);
+});
+
 test('names from a file render as text, never as markup', async () => {
   const name = '<img src=x onerror="window.pwned=1">';
   const positions = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
