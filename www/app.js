@@ -34,7 +34,8 @@ async function loadFiles(files) {
   if (state.busy) return status('Could not read the model while computing: cancel first.', { error: true });
   state.files = files;
   state.modelName = files.map((f) => f.name).join(', ');
-  const base = files[0].name.replace(/\.[^.]*$/, '');
+  const main = files.find((f) => !/\.(bin|png|jpe?g|webp|ktx2)$/i.test(f.name)) ?? files[0];
+  const base = main.name.replace(/\.[^.]*$/, '');
   state.csvName = `${base}-shading.csv`;
   status(`Reading ${state.modelName}…`);
   $('compute').disabled = true;
@@ -45,7 +46,7 @@ function showModel(msg) {
   state.model = msg;
   state.result = null;
   state.selected = -1;
-  $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receivers, ${msg.triangles.toLocaleString()} triangles`;
+  $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receiving surfaces, ${msg.triangles.toLocaleString()} triangles`;
   $('download').disabled = true;
   $('downloadidf').hidden = !msg.hasEnergyPlus;
   // The CSV must have the EnergyPlus model's Timestep to be hooked in.
@@ -53,11 +54,18 @@ function showModel(msg) {
   $('downloadidf').disabled = true;
   $('heatfigure').hidden = true;
   fillTable(null);
-  if (state.viewer) {
-    state.viewer.setModel(msg.positions, msg.receivers);
-    state.viewer.setColours(() => UNCOMPUTED);
-  }
-  status(`Loaded ${state.modelName} (${msg.names.length} receivers) on ${msg.adapter}. Set the location and press Compute.`);
+  showInViewer();
+  const n = msg.names.length;
+  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. Set the location and press Compute.`);
+}
+
+/** The model in the 3D view, coloured by the result when there is one. The viewer may start
+ * after the model arrives, so it is also called once the viewer exists. */
+function showInViewer() {
+  const { viewer, model, result } = state;
+  if (!viewer || !model) return;
+  if (viewer.positions !== model.positions) viewer.setModel(model.positions, model.receivers);
+  viewer.setColours(result ? (r) => colourOf(result.means[r]) : () => UNCOMPUTED);
 }
 
 function fillTable(means) {
@@ -95,7 +103,7 @@ function showResult(msg) {
   setBusy(false);
   $('progress').value = 1;
   fillTable(msg.means);
-  state.viewer?.setColours((r) => colourOf(msg.means[r]));
+  showInViewer();
   $('download').disabled = false;
   $('downloadidf').disabled = !msg.hooked;
   selectReceiver(state.selected >= 0 ? state.selected : 0);
@@ -115,8 +123,8 @@ function showError(msg) {
 worker.onmessage = ({ data: msg }) => {
   if (msg.type === 'ready') {
     if (!msg.webgpu) noWebGPU();
-    else status('Ready. Choose a model, drop one here, or load the example.');
-    $('compute').disabled = !state.model;
+    else if ($('nowebgpu').hidden) status('Ready. Choose a model, drop one here, or load the example.');
+    $('compute').disabled = !state.model || !$('nowebgpu').hidden;
   } else if (msg.type === 'loaded') {
     showModel(msg);
     setBusy(state.busy);
@@ -215,9 +223,12 @@ function wire() {
 
 async function start() {
   wire();
-  if (!navigator.gpu) return noWebGPU();
+  // navigator.gpu can exist with no adapter behind it (WebGPU disabled or blocklisted).
+  const adapter = navigator.gpu ? await navigator.gpu.requestAdapter().catch(() => null) : null;
+  if (!adapter) return noWebGPU();
   try {
     state.viewer = await Viewer.create($('view'));
+    showInViewer();
   } catch (error) {
     status(`The 3D view is unavailable (${error.message}); results still work.`, { error: true });
   }

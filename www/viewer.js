@@ -65,6 +65,7 @@ export class Viewer {
   /** Colours per receiver (RGB 0..1); shading geometry stays grey. */
   setColours(colourOfReceiver) {
     const { positions, receivers } = this;
+    if (!positions) return;
     const triangles = receivers.length;
     const data = new Float32Array(triangles * 3 * FLOATS_PER_VERTEX);
     for (let t = 0; t < triangles; t++) {

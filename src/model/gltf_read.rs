@@ -71,6 +71,17 @@ pub fn read_bytes(file: &str, bytes: &[u8], north_deg: f64) -> Result<GltfModel>
     })
 }
 
+/// Reads glTF from bytes whose external buffers may be among `given` (name, bytes): the files
+/// dropped on the page together, matched by file name (a .gltf with its .bin).
+pub fn read_bytes_among(file: &str, bytes: &[u8], north_deg: f64, given: &[(String, Vec<u8>)]) -> Result<GltfModel> {
+    read_with(file, bytes, north_deg, |uri| {
+        let wanted = uri.rsplit('/').next().unwrap_or(uri);
+        given.iter().find(|(name, _)| name.rsplit(['/', '\\']).next() == Some(wanted)).map(|(_, b)| b.clone()).ok_or_else(|| {
+            format!("external buffer '{uri}' was not given (give it with the .gltf, use a .glb, or embed buffers as data: URIs)")
+        })
+    })
+}
+
 fn read_with(
     file: &str,
     bytes: &[u8],

@@ -103,11 +103,21 @@ fn energyplus_kind(name: &str) -> Option<bool> {
     }
 }
 
+/// Files that are never models themselves: glTF buffers and textures.
+fn is_resource(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    [".bin", ".png", ".jpg", ".jpeg", ".webp", ".ktx2"].iter().any(|ext| lower.ends_with(ext))
+}
+
 fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &LoadOptions) -> Result<Loaded> {
     check_options(options)?;
     let mut models = Vec::new();
     let mut energyplus: Option<EnergyPlusInput> = None;
     for ((name, bytes), dir) in files.iter().zip(dirs) {
+        if dir.is_none() && is_resource(name) {
+            // A .gltf's buffer or texture handed over with it (the web path); read through the .gltf.
+            continue;
+        }
         match energyplus_kind(name) {
             Some(epjson) => {
                 if let Some(first) = &energyplus {
@@ -117,7 +127,7 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
             }
             None => models.push(match dir {
                 Some(d) => gltf_read::read_bytes_beside(name, bytes, d, options.north)?,
-                None => gltf_read::read_bytes(name, bytes, options.north)?,
+                None => gltf_read::read_bytes_among(name, bytes, options.north, files)?,
             }),
         }
     }
@@ -217,5 +227,38 @@ impl Selection {
             Selection::Named => "the models have no named node with a mesh (name nodes, mark them in extras, or use --receivers)".into(),
             Selection::Context => "the EnergyPlus model has no outdoor surface or window".into(),
         }
+    }
+}
+
+#[cfg(test)]
+mod web_path_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A .gltf naming an external buffer, and that buffer: one triangle in the ground plane.
+    fn gltf_with_bin(uri: &str) -> (Vec<u8>, Vec<u8>) {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0].iter().flat_map(|f| f.to_le_bytes()).collect();
+        let json = format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":36}}],"bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,-1],"max":[1,0,0]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"nodes":[{{"name":"tri","mesh":0}}],"scenes":[{{"nodes":[0]}}]}}"#
+        );
+        (json.into_bytes(), bin)
+    }
+
+    #[test]
+    fn a_gltf_finds_its_buffer_among_the_given_files() {
+        let (gltf, bin) = gltf_with_bin("tri.bin");
+        let files = vec![("scene.gltf".to_string(), gltf), ("tri.bin".to_string(), bin)];
+        let scene = load_bytes(&files, &LoadOptions::default()).unwrap();
+        assert_eq!(scene.receivers.len(), 1);
+        assert!((scene.receivers[0].area - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_gltf_without_its_buffer_names_it() {
+        let (gltf, _) = gltf_with_bin("tri.bin");
+        let error = load_bytes(&[("scene.gltf".to_string(), gltf)], &LoadOptions::default()).unwrap_err().to_string();
+        assert!(error.starts_with("scene.gltf: external buffer 'tri.bin' was not given"), "{error}");
     }
 }

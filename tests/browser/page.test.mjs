@@ -127,6 +127,28 @@ test('a dropped file loads like a chosen one', async () => {
     await page.dispatchEvent('#drop', 'drop', { dataTransfer: transfer });
   }, /^Loaded|^Could not/);
   assert.match(status, /^Loaded dropped\.glb \(10 receivers\)/);
+
+  // A .gltf dropped with its external buffer finds it by name.
+  const bin = [...new Uint8Array(new Float32Array([0, 0, 0, 1, 0, 0, 0, 0, -1]).buffer)];
+  const gltf = JSON.stringify({
+    asset: { version: '2.0' },
+    buffers: [{ uri: 'tri.bin', byteLength: 36 }],
+    bufferViews: [{ buffer: 0, byteLength: 36 }],
+    accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, -1], max: [1, 0, 0] }],
+    meshes: [{ primitives: [{ attributes: { POSITION: 0 } }] }],
+    nodes: [{ name: 'tri', mesh: 0 }],
+    scenes: [{ nodes: [0] }],
+  });
+  const pair = await statusAfter(async () => {
+    const transfer = await page.evaluateHandle(({ gltf, bin }) => {
+      const t = new DataTransfer();
+      t.items.add(new File([new Uint8Array(bin)], 'tri.bin'));
+      t.items.add(new File([gltf], 'tri.gltf'));
+      return t;
+    }, { gltf, bin });
+    await page.dispatchEvent('#drop', 'drop', { dataTransfer: transfer });
+  }, /^Loaded|^Could not/);
+  assert.match(pair, /^Loaded tri\.bin, tri\.gltf \(1 receiver\)/);
 });
 
 test('bad files get a message naming the problem, and the page keeps working', { timeout: 300_000 }, async () => {
@@ -209,7 +231,7 @@ test('names from a file render as text, never as markup', async () => {
   const path = join(WORK, 'crafted.gltf');
   writeFileSync(path, JSON.stringify(gltf));
   const status = await statusAfter(() => page.setInputFiles('#model', path), /^Loaded|^Could not/);
-  assert.match(status, /^Loaded crafted\.gltf \(1 receivers\)/);
+  assert.match(status, /^Loaded crafted\.gltf \(1 receiver\)/);
   assert.equal(await page.textContent('#table tbody tr td'), name);
   assert.equal(await page.locator('#table img').count(), 0);
   assert.equal(await page.evaluate(() => window.pwned), undefined);
@@ -224,6 +246,19 @@ test('the API example runs', { timeout: 300_000 }, async () => {
   assert.match(out, /window: 0\.\d{3}/);
   assert.match(out, /8760 rows/);
   await example.close();
+});
+
+test('a browser without WebGPU is told so', async () => {
+  const plain = await launch({ webgpu: false });
+  try {
+    const p = await plain.newPage();
+    await p.goto(`${origin}/`);
+    await p.waitForSelector('#nowebgpu:not([hidden])', { timeout: 60_000 });
+    assert.match(await p.textContent('#nowebgpu'), /no WebGPU, which sunlit needs/);
+    assert.equal(await p.isDisabled('#compute'), true);
+  } finally {
+    await plain.close();
+  }
 });
 
 test('no request left the origin and no script error happened', () => {
