@@ -1,6 +1,9 @@
 // Types of sunlit's JavaScript API (sunlit.js). Axes are EnergyPlus's: x east, y north, z up,
 // metres. Fractions are sunlit area / area, 0..1, for each receiving surface.
 
+/** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
+export function wasmMemoryBytes(): Promise<number>;
+
 /** Whether this browser (or worker) offers WebGPU. */
 export function hasWebGPU(): boolean;
 

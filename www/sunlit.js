@@ -13,6 +13,12 @@ function ready() {
   return wasmReady;
 }
 
+/** Bytes of the wasm linear memory (grows, never shrinks): what a leak would show in. */
+export async function wasmMemoryBytes() {
+  const exports = await ready();
+  return exports.memory.buffer.byteLength;
+}
+
 /** Whether this browser (or worker) offers WebGPU at all. */
 export function hasWebGPU() {
   return typeof navigator !== 'undefined' && !!navigator.gpu;

@@ -12,8 +12,8 @@ export function chromiumFlags() {
   return config['goog:chromeOptions'].args.filter((a) => !a.startsWith('--headless'));
 }
 
-export async function launch({ webgpu = true } = {}) {
+export async function launch({ webgpu = true, extraArgs = [] } = {}) {
   const webgpuFlags = ['--enable-unsafe-webgpu', '--enable-features=Vulkan', '--use-angle=swiftshader', '--use-vulkan=swiftshader'];
-  const args = chromiumFlags().filter((a) => webgpu || !webgpuFlags.includes(a));
+  const args = [...chromiumFlags().filter((a) => webgpu || !webgpuFlags.includes(a)), ...extraArgs];
   return chromium.launch({ executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', args, headless: true });
 }
