@@ -1,9 +1,9 @@
 //! The GPU pixel counter (wgpu; Vulkan/lavapipe natively, WebGPU in the browser).
 //!
 //! Owns the device, the pipelines and the atlas. For each (receiver, sun) view it renders, into
-//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the whole
-//! scene (depth-tested receiver ids); a compute pass counts per tile the pixels where the receiver
-//! is visible and where it is covered. The sunlit fraction is visible / covered: the covered
+//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the scene
+//! (depth-tested receiver ids; only what lies in the prism in front of it, see [`super::cull`]);
+//! a compute pass counts per tile the pixels where the receiver is visible and where it is covered. The sunlit fraction is visible / covered: the covered
 //! count is the pixel estimate of the projected area A·cosθ/Ap of the paper's formula, measured
 //! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
 //! surface gives exactly 1. Many views share one submission (tiles of the atlas).
@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3};
 
-use super::cull::Occluders;
+use super::cull::{Culling, DrawList, Target};
 use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
@@ -90,13 +90,13 @@ struct Atlas {
 /// A scene uploaded to a [`Counter`]'s device.
 pub struct GpuScene {
     meshes: Vec<GpuMesh>,
-    /// Instance slots grouped by mesh: (mesh, slot range).
-    groups: Vec<(usize, Range<u32>)>,
+    /// The static mesh's indices in the culling's spatial order (the scene pass draws ranges of it).
+    static_indices: wgpu::Buffer,
     instance_count: u32,
     receivers: Vec<ReceiverView>,
     bounds: (DVec3, DVec3),
     origin: DVec3,
-    occluders: Occluders,
+    culling: Culling,
     render_bind: wgpu::BindGroup,
     count_bind: wgpu::BindGroup,
 }
@@ -269,20 +269,19 @@ impl Counter {
                 }
             })
             .collect();
-        // Slots: instances sorted by mesh, so each mesh's placements are one instance range.
-        let mut order: Vec<usize> = (0..scene.instances.len()).collect();
-        order.sort_by_key(|&i| scene.instances[i].mesh);
+        // Slots: instances grouped by mesh and ordered spatially within it, so each BVH node of
+        // a mesh's placements is one instance range; the static mesh's triangles likewise.
+        let culling = Culling::new(scene);
+        let order = culling.slot_order().to_vec();
         let mut slot_of = vec![0u32; order.len()];
-        let mut groups: Vec<(usize, Range<u32>)> = Vec::new();
         for (slot, &i) in order.iter().enumerate() {
             slot_of[i] = slot as u32;
-            let mesh = scene.instances[i].mesh;
-            match groups.last_mut() {
-                Some((m, r)) if *m == mesh => r.end = slot as u32 + 1,
-                _ => groups.push((mesh, slot as u32..slot as u32 + 1)),
-            }
         }
-        groups.retain(|(m, _)| meshes[*m].index_count > 0);
+        let static_indices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("static, spatial order"),
+            contents: non_empty(bytemuck::cast_slice(&culling.static_indices(scene))),
+            usage: wgpu::BufferUsages::INDEX,
+        });
         let to_scene = DMat4::from_translation(-scene.origin);
         let instances: Vec<GpuInstance> = order
             .iter()
@@ -340,12 +339,12 @@ impl Counter {
         self.check_errors("uploading the scene")?;
         Ok(GpuScene {
             meshes,
-            groups,
+            static_indices,
             instance_count: params.instance_count,
             receivers,
             bounds: scene.bounds,
             origin: scene.origin,
-            occluders: Occluders::new(scene),
+            culling,
             render_bind,
             count_bind,
         })
@@ -355,7 +354,7 @@ impl Counter {
     /// nothing, the others are rendered in batches of atlas tiles.
     pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
         let mut out = vec![Counted::default(); requests.len()];
-        let mut lit: Vec<(usize, SunView)> = Vec::new();
+        let mut lit: Vec<(usize, SunView, DrawList)> = Vec::new();
         for (i, req) in requests.iter().enumerate() {
             let r = scene.receivers.get(req.receiver as usize).ok_or_else(|| {
                 Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
@@ -364,12 +363,13 @@ impl Counter {
             if is_dark(r.normal, req.sun) {
                 continue;
             }
-            if scene.occluders.nothing_in_front(&r.points, r.normal, r.gpu_id, req.sun) {
+            let view = view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution);
+            let target = Target { points: &r.points, normal: r.normal, gpu_id: r.gpu_id };
+            match scene.culling.select(&view.view_proj, &target, req.sun) {
+                Some(draws) => lit.push((i, view, draws)),
                 // Nothing in the prism in front of it: fully sunlit, no render needed.
-                out[i].fraction = 1.0;
-                continue;
+                None => out[i].fraction = 1.0,
             }
-            lit.push((i, view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution)));
         }
         let per_batch = self.tiles_per_batch();
         for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {
@@ -379,7 +379,7 @@ impl Counter {
             let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await?;
             self.check_errors("counting pixels")?;
             let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
-            for (k, (i, view)) in chunk.iter().enumerate() {
+            for (k, (i, view, _)) in chunk.iter().enumerate() {
                 let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
                 let o = &mut out[*i];
                 o.visible = visible;
@@ -397,11 +397,11 @@ impl Counter {
     }
 
     /// Renders and counts one batch of views; results land in `readback` at batch `index`.
-    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)], index: usize) -> Result<()> {
+    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView, DrawList)], index: usize) -> Result<()> {
         let views: Vec<GpuView> = batch
             .iter()
             .enumerate()
-            .map(|(slot, (i, view))| GpuView {
+            .map(|(slot, (i, view, _))| GpuView {
                 view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
                 tile: self.tile_origin(slot),
                 target_id: scene.receivers[requests[*i].receiver as usize].gpu_id,
@@ -425,7 +425,13 @@ impl Counter {
         Ok(())
     }
 
-    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)]) {
+    fn render_tiles(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        requests: &[ViewRequest],
+        batch: &[(usize, SunView, DrawList)],
+    ) {
         let clear_id = wgpu::Color { r: crate::scene::NO_RECEIVER as f64, g: 0.0, b: 0.0, a: 0.0 };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun views"),
@@ -439,7 +445,7 @@ impl Counter {
         });
         pass.set_bind_group(0, &scene.render_bind, &[]);
         let res = self.options.resolution;
-        for (slot, (i, _)) in batch.iter().enumerate() {
+        for (slot, (i, _, draws)) in batch.iter().enumerate() {
             let [x, y] = self.tile_origin(slot);
             pass.set_viewport(x as f32, y as f32, res as f32, res as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, res, res);
@@ -451,12 +457,28 @@ impl Counter {
             pass.set_vertex_buffer(0, mesh.vertices.slice(..));
             pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
-            // Everything, depth-tested: where the receiver's id survives, it is sunlit.
+            // What lies in the prism in front of it, depth-tested: where the receiver's id
+            // survives, it is sunlit.
             pass.set_pipeline(&self.scene_pipeline);
-            for (m, slots) in &scene.groups {
-                let mesh = &scene.meshes[*m];
+            if let Some(mesh) = scene.meshes.first().filter(|_| !draws.static_triangles.is_empty()) {
+                let s = first + scene.culling.static_slot();
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.set_index_buffer(scene.static_indices.slice(..), wgpu::IndexFormat::Uint32);
+                for t in &draws.static_triangles {
+                    pass.draw_indexed(3 * t.start..3 * t.end, 0, s..s + 1);
+                }
+            }
+            let mut bound = None;
+            for (m, slots) in &draws.instances {
+                let mesh = &scene.meshes[*m];
+                if mesh.index_count == 0 {
+                    continue;
+                }
+                if bound != Some(*m) {
+                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    bound = Some(*m);
+                }
                 pass.draw_indexed(0..mesh.index_count, 0, first + slots.start..first + slots.end);
             }
         }
@@ -496,6 +518,11 @@ impl GpuScene {
     /// World origin the GPU coordinates are relative to.
     pub fn origin(&self) -> DVec3 {
         self.origin
+    }
+
+    /// The spatial index that picks what each view draws (benchmarks report what it saves).
+    pub fn culling(&self) -> &Culling {
+        &self.culling
     }
 }
 
