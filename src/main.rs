@@ -504,6 +504,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             "seconds": t.seconds,
             "estimated_seconds_all_views": estimated,
             "views_per_second": t.views_per_second,
+            "planning_seconds": t.planning_seconds,
             "mean_triangles_drawn": t.mean_triangles_drawn.round(),
             "load_seconds": load_seconds,
             "peak_memory_mib": peak_memory_mib(),

@@ -126,8 +126,10 @@ pub struct ViewTiming {
     pub seconds: f64,
     /// Views timed per second (rendered or not).
     pub views_per_second: f64,
-    /// Mean triangles drawn per rendered view (the culling's selection, measured on the CPU
-    /// over up to 2,000 of the rendered views).
+    /// Of `seconds`, about this much is the CPU's planning: fitting each view and choosing what
+    /// it draws (timed again on its own, since the GPU work overlaps it).
+    pub planning_seconds: f64,
+    /// Mean triangles drawn per rendered view (the culling's choice).
     pub mean_triangles_drawn: f64,
 }
 
@@ -143,34 +145,40 @@ pub async fn time_requests(
     let start = now();
     let counted = counter.fractions(gpu, requests).await?;
     let seconds = now() - start;
-    let rendered: Vec<&ViewRequest> = requests.iter().zip(&counted).filter(|(_, c)| c.covered > 0).map(|(r, _)| r).collect();
+    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    let start = now();
+    let (drawn, planned) = plan_views(scene, gpu, requests, counter.resolution());
+    let planning_seconds = now() - start;
     Ok(ViewTiming {
         views: requests.len(),
-        rendered: rendered.len(),
-        skipped: requests.len() - rendered.len(),
+        rendered,
+        skipped: requests.len() - rendered,
         seconds,
         views_per_second: requests.len() as f64 / seconds.max(1e-9),
-        mean_triangles_drawn: mean_triangles_drawn(scene, gpu, &rendered, counter.resolution()),
+        planning_seconds,
+        mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
     })
 }
 
-fn mean_triangles_drawn(scene: &Scene, gpu: &GpuScene, rendered: &[&ViewRequest], resolution: u32) -> f64 {
-    let stride = rendered.len().div_ceil(2000).max(1);
+/// What [`Counter::fractions`] does on the CPU before drawing: fit each lit view and choose
+/// what it draws. Returns the triangles drawn over all views that need a render, and their count.
+fn plan_views(scene: &Scene, gpu: &GpuScene, requests: &[ViewRequest], resolution: u32) -> (usize, usize) {
+    let points: Vec<Vec<DVec3>> = scene.receivers.iter().map(|r| r.triangles.iter().flatten().copied().collect()).collect();
     let (mut sum, mut n) = (0usize, 0usize);
-    for req in rendered.iter().step_by(stride) {
+    for req in requests {
         let r = &scene.receivers[req.receiver as usize];
         if is_dark(r.normal, req.sun) {
             continue;
         }
-        let points: Vec<DVec3> = r.triangles.iter().flatten().copied().collect();
-        let v = view::fit(&points, req.sun, scene.bounds, scene.origin, resolution);
-        let target = crate::count::cull::Target { points: &points, normal: r.normal, gpu_id: r.gpu_id };
+        let points = &points[req.receiver as usize];
+        let v = view::fit(points, req.sun, scene.bounds, scene.origin, resolution);
+        let target = crate::count::cull::Target { points, normal: r.normal, gpu_id: r.gpu_id };
         if let Some(list) = gpu.culling().select(&v.view_proj, &target, req.sun) {
             sum += list.triangles(gpu.culling());
             n += 1;
         }
     }
-    if n == 0 { 0.0 } else { sum as f64 / n as f64 }
+    (sum, n)
 }
 
 /// A small deterministic generator: benchmarks must not depend on a random crate's versions.
