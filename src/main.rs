@@ -149,6 +149,9 @@ struct BenchArgs {
     /// Time an even spread of at most this many of a model's views and extrapolate the total.
     #[arg(long, value_name = "N")]
     views: Option<usize>,
+    /// Also check this many of the timed views against the exact CPU reference (not timed).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    check: usize,
     /// Location of model files (generated models carry their own): latitude, longitude, time zone.
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true, default_value = "39.74,-105.18,-7")]
     location: String,
@@ -490,7 +493,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         };
         let t = pollster::block_on(bench::time_requests(counter, &scene, &gpu, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
-        let line = json!({
+        let mut line = json!({
             "model": name,
             "receivers": scene.receivers.len(),
             "shading_polygons": shading,
@@ -509,6 +512,12 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             "load_seconds": load_seconds,
             "peak_memory_mib": peak_memory_mib(),
         });
+        if args.check > 0 {
+            let (checked, mean, max) = bench::check_exact(&scene, requests, &t.fractions, args.check);
+            line["exact_views_checked"] = json!(checked);
+            line["mean_abs_error"] = json!(mean);
+            line["max_abs_error"] = json!(max);
+        }
         println!("{line}");
     }
     Ok(())

@@ -262,6 +262,13 @@ fn culled_views_of_a_large_scene_match_the_exact_reference() {
     let counter = counter(512);
     let gpu = counter.upload(&scene).unwrap();
     let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    // The static mesh split over buffers of 1,000 triangles (as for a device with a small buffer
+    // limit) draws the same pixels.
+    let split = counter.upload_in_chunks(&scene, 1000).unwrap();
+    let again = pollster::block_on(counter.fractions(&split, &requests)).unwrap();
+    for (a, b) in counted.iter().zip(&again) {
+        assert_eq!((a.visible, a.covered), (b.visible, b.covered));
+    }
     let exact = exact::sunlit_fractions(&scene, &requests);
     let (mut drawn, mut rendered, mut partial, mut max) = (0usize, 0usize, 0usize, 0.0f64);
     let mut sum = 0.0;
@@ -290,7 +297,7 @@ fn culled_views_of_a_large_scene_match_the_exact_reference() {
         scene.triangle_count()
     );
     assert!(partial > 10, "the cases must exercise partial shading, got {partial}");
-    assert!(share < 0.75, "culling must leave part of the scene out, drew {share}");
+    assert!(share < 0.3, "culling must leave most of the scene out, drew {share}");
     assert!(mean <= 0.002, "mean |error| {mean}");
     assert!(max <= 0.005, "max |error| {max}");
 }

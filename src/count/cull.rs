@@ -3,7 +3,7 @@
 //! Owns the spatial index over the scene and the per-view choice of what to draw:
 //! - the merged static mesh is cut into spatial chunks of about [`LEAF_TRIANGLES`] triangles (a
 //!   bounding volume hierarchy by median splits), and its triangles are reordered so every BVH
-//!   node is one contiguous index range; the GPU draws that reordered copy in the scene pass;
+//!   node is one contiguous range; the GPU stores them in that order;
 //! - the instances of each shared mesh get the same treatment, with instances as items: they are
 //!   ordered spatially within their mesh's slot range, so a BVH node is one instance range;
 //! - a view draws the leaves whose boxes reach into its clip volume (the camera's side planes
@@ -162,7 +162,7 @@ struct Group {
 /// What one view draws in the scene pass.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub struct DrawList {
-    /// Triangle ranges of the static mesh, in the order of [`Culling::static_indices`].
+    /// Triangle ranges of the static mesh, in the order of [`Culling::static_order`].
     pub static_triangles: Vec<Range<u32>>,
     /// Instance slot ranges (absolute slots) with the shared mesh they place.
     pub instances: Vec<(usize, Range<u32>)>,
@@ -299,10 +299,10 @@ impl Culling {
         &self.slot_order
     }
 
-    /// The static mesh's index buffer in BVH order (for the scene pass).
-    pub fn static_indices(&self, scene: &Scene) -> Vec<u32> {
-        let Some(mesh) = scene.meshes.first() else { return Vec::new() };
-        self.static_order.iter().flat_map(|&t| [0, 1, 2].map(|c| mesh.indices[3 * t as usize + c])).collect()
+    /// The static mesh's triangles in BVH order: position → original triangle index. The GPU
+    /// stores them in this order, so every BVH node is one contiguous range.
+    pub fn static_order(&self) -> &[u32] {
+        &self.static_order
     }
 
     /// The slot that places the static mesh.
@@ -461,7 +461,7 @@ mod tests {
         }
         let scene = b.build().unwrap();
         let culling = Culling::new(&scene);
-        assert_eq!(culling.static_indices(&scene).len(), 3 * (4 + 10_000));
+        assert_eq!(culling.static_order().len(), 4 + 10_000);
         let overhead = select(&scene, &culling, DVec3::Z).unwrap();
         assert!(overhead.triangles(&culling) <= LEAF_TRIANGLES as usize, "{}", overhead.triangles(&culling));
         assert!(overhead.instances.is_empty());

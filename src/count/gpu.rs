@@ -90,8 +90,9 @@ struct Atlas {
 /// A scene uploaded to a [`Counter`]'s device.
 pub struct GpuScene {
     meshes: Vec<GpuMesh>,
-    /// The static mesh's indices in the culling's spatial order (the scene pass draws ranges of it).
-    static_indices: wgpu::Buffer,
+    /// The static mesh's triangles in the culling's spatial order, unindexed, in buffers within
+    /// the device's size limit (the scene pass draws ranges of it).
+    static_chunks: Vec<StaticChunk>,
     instance_count: u32,
     receivers: Vec<ReceiverView>,
     bounds: (DVec3, DVec3),
@@ -99,6 +100,12 @@ pub struct GpuScene {
     culling: Culling,
     render_bind: wgpu::BindGroup,
     count_bind: wgpu::BindGroup,
+}
+
+/// Part of the static mesh: the vertices of a range of triangles in the culling's order.
+struct StaticChunk {
+    vertices: wgpu::Buffer,
+    triangles: Range<u32>,
 }
 
 struct GpuMesh {
@@ -113,6 +120,8 @@ struct ReceiverView {
     gpu_id: u32,
     mesh: usize,
     indices: Range<u32>,
+    /// For a receiver in the static mesh: its triangles' ranges in the culling's order.
+    static_triangles: Vec<Range<u32>>,
     slot: u32,
     points: Vec<DVec3>,
     normal: DVec3,
@@ -245,15 +254,30 @@ impl Counter {
         Err(Error::Gpu(format!("{doing}: {all}")))
     }
 
-    /// Uploads a scene's geometry once; views of it then cost only draws.
+    /// Uploads a scene's geometry once; views of it then cost only draws. The static mesh goes
+    /// into as many vertex buffers as the device's buffer size limit needs.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene> {
+        let per_triangle = 3 * size_of::<GpuVertex>() as u64;
+        let limit = (self.device.limits().max_buffer_size / per_triangle).clamp(1, u32::MAX as u64) as u32;
+        self.upload_in_chunks(scene, limit)
+    }
+
+    /// [`Self::upload`] with at most `max_triangles` static triangles a vertex buffer (tests
+    /// exercise the split with small values).
+    pub fn upload_in_chunks(&self, scene: &Scene, max_triangles: u32) -> Result<GpuScene> {
         use wgpu::util::DeviceExt as _;
         let meshes: Vec<GpuMesh> = scene
             .meshes
             .iter()
-            .map(|m| {
-                let vertices: Vec<GpuVertex> =
-                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect();
+            .enumerate()
+            .map(|(index, m)| {
+                // The static mesh (0) is stored in the culling's order below instead.
+                let vertices: Vec<GpuVertex> = if index == 0 {
+                    Vec::new()
+                } else {
+                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect()
+                };
+                let indices: &[u32] = if index == 0 { &[] } else { &m.indices };
                 GpuMesh {
                     vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.label),
@@ -262,10 +286,10 @@ impl Counter {
                     }),
                     indices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.label),
-                        contents: non_empty(bytemuck::cast_slice(&m.indices)),
+                        contents: non_empty(bytemuck::cast_slice(indices)),
                         usage: wgpu::BufferUsages::INDEX,
                     }),
-                    index_count: m.indices.len() as u32,
+                    index_count: indices.len() as u32,
                 }
             })
             .collect();
@@ -277,11 +301,11 @@ impl Counter {
         for (slot, &i) in order.iter().enumerate() {
             slot_of[i] = slot as u32;
         }
-        let static_indices = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("static, spatial order"),
-            contents: non_empty(bytemuck::cast_slice(&culling.static_indices(scene))),
-            usage: wgpu::BufferUsages::INDEX,
-        });
+        let static_chunks = self.static_chunks(scene, culling.static_order(), max_triangles.max(1));
+        let mut position = vec![0u32; culling.static_order().len()];
+        for (p, &t) in culling.static_order().iter().enumerate() {
+            position[t as usize] = p as u32;
+        }
         let to_scene = DMat4::from_translation(-scene.origin);
         let instances: Vec<GpuInstance> = order
             .iter()
@@ -312,6 +336,7 @@ impl Counter {
                 gpu_id: r.gpu_id,
                 mesh: scene.instances[r.draw.instance].mesh,
                 indices: r.draw.indices.clone(),
+                static_triangles: if r.draw.instance == 0 { static_ranges(&position, &r.draw.indices) } else { Vec::new() },
                 slot: slot_of[r.draw.instance],
                 points: r.triangles.iter().flatten().copied().collect(),
                 normal: r.normal,
@@ -339,7 +364,7 @@ impl Counter {
         self.check_errors("uploading the scene")?;
         Ok(GpuScene {
             meshes,
-            static_indices,
+            static_chunks,
             instance_count: params.instance_count,
             receivers,
             bounds: scene.bounds,
@@ -389,6 +414,30 @@ impl Counter {
             }
         }
         Ok(out)
+    }
+
+    /// The static mesh's triangles in the culling's order, unindexed, `max_triangles` a buffer.
+    fn static_chunks(&self, scene: &Scene, order: &[u32], max_triangles: u32) -> Vec<StaticChunk> {
+        use wgpu::util::DeviceExt as _;
+        let Some(mesh) = scene.meshes.first() else { return Vec::new() };
+        let vertex = |v: u32| GpuVertex { position: mesh.positions[v as usize], surface: mesh.surfaces[v as usize] };
+        order
+            .chunks(max_triangles as usize)
+            .enumerate()
+            .map(|(c, part)| {
+                let vertices: Vec<GpuVertex> =
+                    part.iter().flat_map(|&t| (0..3).map(move |k| vertex(mesh.indices[3 * t as usize + k]))).collect();
+                let start = c as u32 * max_triangles;
+                StaticChunk {
+                    vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("static, spatial order"),
+                        contents: non_empty(bytemuck::cast_slice(&vertices)),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    triangles: start..start + part.len() as u32,
+                }
+            })
+            .collect()
     }
 
     fn tile_origin(&self, slot: usize) -> [u32; 2] {
@@ -454,20 +503,17 @@ impl Counter {
             let r = &scene.receivers[requests[*i].receiver as usize];
             let mesh = &scene.meshes[r.mesh];
             pass.set_pipeline(&self.mask_pipeline);
-            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+            if r.static_triangles.is_empty() {
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+            } else {
+                draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
+            }
             // What lies in the prism in front of it, depth-tested: where the receiver's id
             // survives, it is sunlit.
             pass.set_pipeline(&self.scene_pipeline);
-            if let Some(mesh) = scene.meshes.first().filter(|_| !draws.static_triangles.is_empty()) {
-                let s = first + scene.culling.static_slot();
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(scene.static_indices.slice(..), wgpu::IndexFormat::Uint32);
-                for t in &draws.static_triangles {
-                    pass.draw_indexed(3 * t.start..3 * t.end, 0, s..s + 1);
-                }
-            }
+            draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, first + scene.culling.static_slot());
             let mut bound = None;
             for (m, slots) in &draws.instances {
                 let mesh = &scene.meshes[*m];
@@ -524,6 +570,40 @@ impl GpuScene {
     pub fn culling(&self) -> &Culling {
         &self.culling
     }
+}
+
+/// Draws ranges of the static mesh's triangles (culling order), split across its buffers.
+fn draw_static(pass: &mut wgpu::RenderPass<'_>, chunks: &[StaticChunk], ranges: &[Range<u32>], slot: u32) {
+    let mut bound = None;
+    for r in ranges {
+        for (c, chunk) in chunks.iter().enumerate() {
+            let (a, b) = (r.start.max(chunk.triangles.start), r.end.min(chunk.triangles.end));
+            if a >= b {
+                continue;
+            }
+            if bound != Some(c) {
+                pass.set_vertex_buffer(0, chunk.vertices.slice(..));
+                bound = Some(c);
+            }
+            let o = chunk.triangles.start;
+            pass.draw(3 * (a - o)..3 * (b - o), slot..slot + 1);
+        }
+    }
+}
+
+/// A static receiver's triangles (an index range of the static mesh) as ranges of positions in
+/// the culling's order.
+fn static_ranges(position: &[u32], indices: &Range<u32>) -> Vec<Range<u32>> {
+    let mut at: Vec<u32> = (indices.start / 3..indices.end / 3).map(|t| position[t as usize]).collect();
+    at.sort_unstable();
+    let mut ranges: Vec<Range<u32>> = Vec::new();
+    for p in at {
+        match ranges.last_mut() {
+            Some(r) if r.end == p => r.end = p + 1,
+            _ => ranges.push(p..p + 1),
+        }
+    }
+    ranges
 }
 
 fn color(view: &wgpu::TextureView, clear: wgpu::Color) -> Option<wgpu::RenderPassColorAttachment<'_>> {
