@@ -9,8 +9,9 @@
 #   RESOLUTION=256 TIMEOUT=900 scripts/bench-grid.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mkdir -p -m 700 "/tmp/sunlit-runtime-$USER"
-export XDG_RUNTIME_DIR="/tmp/sunlit-runtime-$USER"
+runtime="/tmp/sunlit-runtime-${USER:-$(id -un)}"
+mkdir -p -m 700 "$runtime"
+export XDG_RUNTIME_DIR="$runtime"
 
 MODELS=${MODELS:-"blaas-self blaas-louvres blaas-buildings blaas-trees-summer nyt-self nyt-flat nyt-rods nyt-blocks"}
 PLANS=${PLANS:-"14x15 14x53 27x19 27x53 53x15 53x53"}

@@ -149,7 +149,7 @@ struct BenchArgs {
     /// Time an even spread of at most this many of a model's views and extrapolate the total.
     #[arg(long, value_name = "N")]
     views: Option<usize>,
-    /// Also check this many of the timed views against the exact CPU reference (not timed).
+    /// Also check this many of the rendered views against the exact CPU reference (not timed).
     #[arg(long, value_name = "N", default_value_t = 0)]
     check: usize,
     /// Location of model files (generated models carry their own): latitude, longitude, time zone.

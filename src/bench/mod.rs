@@ -131,9 +131,9 @@ pub struct ViewTiming {
     pub planning_seconds: f64,
     /// Mean triangles drawn per rendered view (the culling's choice).
     pub mean_triangles_drawn: f64,
-    /// The sunlit fraction of every timed view.
+    /// The sunlit fraction of every timed view, and whether it was rendered.
     #[serde(skip)]
-    pub fractions: Vec<f64>,
+    pub fractions: Vec<(f64, bool)>,
 }
 
 /// Times `Counter::fractions` over `requests`; one warm-up batch first.
@@ -160,18 +160,20 @@ pub async fn time_requests(
         views_per_second: requests.len() as f64 / seconds.max(1e-9),
         planning_seconds,
         mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
-        fractions: counted.iter().map(|c| c.fraction).collect(),
+        fractions: counted.iter().map(|c| (c.fraction, c.covered > 0)).collect(),
     })
 }
 
 /// Accuracy of counted fractions against the exact CPU reference over an even spread of at most
-/// `at_most` of the views: (views checked, mean |error|, max |error|).
-pub fn check_exact(scene: &Scene, requests: &[ViewRequest], fractions: &[f64], at_most: usize) -> (usize, f64, f64) {
-    let stride = requests.len().div_ceil(at_most.max(1)).max(1);
-    let picked: Vec<usize> = (0..requests.len()).step_by(stride).collect();
+/// `at_most` of the rendered views (the others are exact by construction): (views checked, mean
+/// |error|, max |error|).
+pub fn check_exact(scene: &Scene, requests: &[ViewRequest], fractions: &[(f64, bool)], at_most: usize) -> (usize, f64, f64) {
+    let rendered: Vec<usize> = (0..requests.len()).filter(|&i| fractions[i].1).collect();
+    let stride = rendered.len().div_ceil(at_most.max(1)).max(1);
+    let picked: Vec<usize> = rendered.into_iter().step_by(stride).collect();
     let chosen: Vec<ViewRequest> = picked.iter().map(|&i| requests[i]).collect();
     let exact = crate::count::exact::sunlit_fractions(scene, &chosen);
-    let errors: Vec<f64> = picked.iter().zip(&exact).map(|(&i, e)| (fractions[i] - e).abs()).collect();
+    let errors: Vec<f64> = picked.iter().zip(&exact).map(|(&i, e)| (fractions[i].0 - e).abs()).collect();
     let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
     (errors.len(), mean, errors.iter().copied().fold(0.0, f64::max))
 }
