@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3};
 
-use super::cull::{Culling, DrawList, Target};
+use super::cull::{CPU_LEAF_TRIANGLES, Culling, DrawList, LEAF_TRIANGLES, Target};
 use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
@@ -295,7 +295,8 @@ impl Counter {
             .collect();
         // Slots: instances grouped by mesh and ordered spatially within it, so each BVH node of
         // a mesh's placements is one instance range; the static mesh's triangles likewise.
-        let culling = Culling::new(scene);
+        let leaf = if self.info.device_type == wgpu::DeviceType::Cpu { CPU_LEAF_TRIANGLES } else { LEAF_TRIANGLES };
+        let culling = Culling::new(scene, leaf);
         let order = culling.slot_order().to_vec();
         let mut slot_of = vec![0u32; order.len()];
         for (slot, &i) in order.iter().enumerate() {
