@@ -473,7 +473,9 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
     let plan = SamplingPlan::new(days, per_day)?;
     for name in &args.models {
         let t0 = now();
-        let (scene, location, shading) = if bench::models::CATALOGUE.iter().any(|(n, _)| n == name) {
+        // A name that is neither generated nor a file gets the list of generated names.
+        let generated = bench::models::CATALOGUE.iter().any(|(n, _)| n == name) || !std::path::Path::new(name).exists();
+        let (scene, location, shading) = if generated {
             let m = bench::models::generate(name)?;
             let scene = model::load_bytes(&[(format!("{name}.glb"), m.glb.to_glb())], &LoadOptions::default())?;
             (scene, m.location, Some(m.shading_polygons))
