@@ -1,14 +1,15 @@
 //! What each view draws: only the geometry in the sun-aligned prism in front of the receiver.
 //!
 //! Owns the spatial index over the scene and the per-view choice of what to draw:
-//! - the merged static mesh is cut into spatial chunks of about [`LEAF_TRIANGLES`] triangles (a
-//!   bounding volume hierarchy by median splits), and its triangles are reordered so every BVH
-//!   node is one contiguous range; the GPU stores them in that order;
+//! - the merged static mesh is cut into spatial chunks of a few dozen triangles (a bounding volume
+//!   hierarchy by median splits, [`LEAF_TRIANGLES`] or [`CPU_LEAF_TRIANGLES`] a leaf), and its
+//!   triangles are reordered so every BVH node is one contiguous range; the GPU stores them in
+//!   that order;
 //! - the instances of each shared mesh get the same treatment, with instances as items: they are
 //!   ordered spatially within their mesh's slot range, so a BVH node is one instance range;
 //! - a view draws the leaves whose boxes reach into its clip volume (the camera's side planes
 //!   are parallel to the sun and enclose the receiver, its far plane lies just behind it), merged
-//!   into as few index and instance ranges as the order allows. What lies outside would be clipped
+//!   into as few triangle and instance ranges as the order allows. What lies outside would be clipped
 //!   by the GPU anyway, so the pixels are the same as drawing everything;
 //! - a view whose leaves hold no triangle that can shade the receiver needs no render at all: its
 //!   fraction is exactly 1. A triangle can only shade the receiver if part of it lies in front of
