@@ -33,7 +33,8 @@ enum Command {
     Info(InfoArgs),
     /// Annual schedule at every EnergyPlus timestep, written as the CSV EnergyPlus reads.
     Annual(AnnualArgs),
-    /// Views per second on synthetic occluder clouds and the example office.
+    /// Time generated benchmark models (see --list) or model files over the views of an annual
+    /// sampling plan; without models, views per second on synthetic occluder clouds and the office.
     Bench(BenchArgs),
 }
 
@@ -135,6 +136,25 @@ struct InfoArgs {
 
 #[derive(Args)]
 struct BenchArgs {
+    /// List the generated benchmark models and exit.
+    #[arg(long)]
+    list: bool,
+    /// Write the one generated model named as glb and exit.
+    #[arg(long, value_name = "FILE.glb")]
+    write: Option<PathBuf>,
+    /// Sampling plan for models: days per year × samples per day (the views `sunlit annual`
+    /// counts for its spline, before refinement).
+    #[arg(long, value_name = "DAYSxPER_DAY", default_value = "27x19")]
+    samples: String,
+    /// Time an even spread of at most this many of a model's views and extrapolate the total.
+    #[arg(long, value_name = "N")]
+    views: Option<usize>,
+    /// Also check this many of the rendered views against the exact CPU reference (not timed).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    check: usize,
+    /// Location of model files (generated models carry their own): latitude, longitude, time zone.
+    #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true, default_value = "39.74,-105.18,-7")]
+    location: String,
     /// Occluder triangle counts for the synthetic cases.
     #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
     triangles: Vec<usize>,
@@ -147,8 +167,8 @@ struct BenchArgs {
     /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
     #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
     atlas: u32,
-    /// Extra models to time (every receiver × every sun).
-    models: Vec<PathBuf>,
+    /// Generated model names (see --list) or glTF/IDF model files.
+    models: Vec<String>,
 }
 
 fn main() -> ExitCode {
@@ -383,6 +403,21 @@ fn info(args: InfoArgs) -> Result<()> {
 }
 
 fn run_bench(args: BenchArgs) -> Result<()> {
+    if args.list {
+        for (name, description) in bench::models::CATALOGUE {
+            println!("{name:<20} {description}");
+        }
+        return Ok(());
+    }
+    if let Some(path) = &args.write {
+        let [name] = args.models.as_slice() else {
+            return Err(Error::argument("--write", "name exactly one generated model (see --list)"));
+        };
+        let model = bench::models::generate(name)?;
+        std::fs::write(path, model.glb.to_glb()).map_err(|source| Error::Io { path: path.clone(), source })?;
+        eprintln!("wrote {} ({} receivers, {} shading polygons)", path.display(), model.receivers, model.shading_polygons);
+        return Ok(());
+    }
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
@@ -391,6 +426,9 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
     let start = Instant::now();
     let now = move || start.elapsed().as_secs_f64();
+    if !args.models.is_empty() {
+        return bench_models(&args, &counter, now);
+    }
     let suns = bench::suns(args.suns, 7);
     let mut cases: Vec<(String, Scene)> = Vec::new();
     for &n in &args.triangles {
@@ -398,12 +436,78 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     }
     let office = sunlit::model::office::office(6).to_glb();
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
-    for path in &args.models {
-        cases.push((path.display().to_string(), model::load(std::slice::from_ref(path), &LoadOptions::default())?));
-    }
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
         println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
     }
     Ok(())
+}
+
+/// Times each model over its sampling plan's views; one JSON line each.
+fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Copy) -> Result<()> {
+    let (days, per_day) = args
+        .samples
+        .split_once(['x', 'X'])
+        .and_then(|(d, s)| Some((d.trim().parse().ok()?, s.trim().parse().ok()?)))
+        .ok_or_else(|| Error::argument("--samples", format!("'{}' is not DAYSxPER_DAY (e.g. 27x19)", args.samples)))?;
+    let plan = SamplingPlan::new(days, per_day)?;
+    for name in &args.models {
+        let t0 = now();
+        // A name that is neither generated nor a file gets the list of generated names.
+        let generated = bench::models::CATALOGUE.iter().any(|(n, _)| n == name) || !std::path::Path::new(name).exists();
+        let (scene, location, shading) = if generated {
+            let m = bench::models::generate(name)?;
+            let scene = model::load_bytes(&[(format!("{name}.glb"), m.glb.to_glb())], &LoadOptions::default())?;
+            (scene, m.location, Some(m.shading_polygons))
+        } else {
+            (model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(&args.location)?, None)
+        };
+        let gpu = counter.upload(&scene)?;
+        let load_seconds = now() - t0;
+        let all = bench::sample_requests(&scene, &location, plan);
+        let spread;
+        let requests = match args.views {
+            Some(n) => {
+                spread = bench::spread(&all, n);
+                &spread
+            }
+            None => &all,
+        };
+        let t = pollster::block_on(bench::time_requests(counter, &scene, &gpu, requests, now))?;
+        let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
+        let mut line = json!({
+            "model": name,
+            "receivers": scene.receivers.len(),
+            "shading_polygons": shading,
+            "triangles": scene.triangle_count(),
+            "samples": format!("{days}x{per_day}"),
+            "resolution": counter.resolution(),
+            "views": all.len(),
+            "views_timed": t.views,
+            "views_rendered": t.rendered,
+            "views_skipped": t.skipped,
+            "seconds": t.seconds,
+            "estimated_seconds_all_views": estimated,
+            "views_per_second": t.views_per_second,
+            "planning_seconds": t.planning_seconds,
+            "mean_triangles_drawn": t.mean_triangles_drawn.round(),
+            "load_seconds": load_seconds,
+            "peak_memory_mib": peak_memory_mib(),
+        });
+        if args.check > 0 {
+            let (checked, mean, max) = bench::check_exact(&scene, requests, &t.fractions, args.check);
+            line["exact_views_checked"] = json!(checked);
+            line["mean_abs_error"] = json!(mean);
+            line["max_abs_error"] = json!(max);
+        }
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Peak resident memory of this process (VmHWM), where the OS reports it.
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?.trim().trim_end_matches("kB").trim().parse().ok()?;
+    Some(kib / 1024.0)
 }

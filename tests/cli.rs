@@ -242,3 +242,31 @@ fn bad_energyplus_models_are_named_with_object_and_line() {
     fails_with(&out, &["Timestep", "--timesteps-per-hour 4"]);
     assert!(!csv.exists() && !idf_out.exists());
 }
+
+#[test]
+fn bench_lists_writes_and_times_generated_models() {
+    let out = sunlit(&["bench", "--list"]);
+    let list = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && list.contains("blaas-louvres") && list.contains("nyt-blocks"), "{list}");
+    // The written model is an ordinary glb: its 62 receivers are read back.
+    let dir = scratch("bench");
+    let path = dir.join("blaas-louvres.glb").display().to_string();
+    let out = sunlit(&["bench", "blaas-louvres", "--write", &path]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = sunlit(&["info", &path, "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["receivers"].as_array().map(Vec::len), Some(62), "{info}");
+    assert_eq!((info["triangles"].as_u64(), info["instances"].as_u64()), (Some(5828), Some(468)), "slats stay instanced");
+    // A timed run of a few views prints the documented JSON.
+    let out = sunlit(&["bench", "blaas-buildings", "--samples", "3x3", "--resolution", "64", "--views", "40", "--check", "5"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for key in ["seconds", "views", "views_rendered", "views_skipped", "views_per_second", "peak_memory_mib", "mean_abs_error"] {
+        assert!(!line[key].is_null(), "{key} missing in {line}");
+    }
+    assert_eq!(line["shading_polygons"], 1045);
+    assert!(line["max_abs_error"].as_f64().unwrap() < 0.05, "{line}");
+    fails_with(&sunlit(&["bench", "no-such-model"]), &["no-such-model", "blaas-self"]);
+    fails_with(&sunlit(&["bench", "--samples", "27by19", "blaas-self"]), &["--samples", "27by19"]);
+    fails_with(&sunlit(&["bench", "--write", &path]), &["--write", "one generated model"]);
+}

@@ -226,6 +226,83 @@ fn random_scenes_match_the_exact_reference() {
 }
 
 #[test]
+fn culled_views_of_a_large_scene_match_the_exact_reference() {
+    // Enough geometry for several BVH leaves: 4,000 small baked triangles and 400 instanced
+    // boxes over 24 m × 24 m, above and among 6 receivers. Each view draws only the leaves in
+    // its prism; the fractions must still match the exact reference, which clips everything.
+    use glam::DMat4;
+    use sunlit::count::cull::Target;
+    use sunlit::count::view;
+    use sunlit::scene::{SceneBuilder, SourceNode};
+    let mut rng = SmallRng::seed_from_u64(99);
+    let mut b = SceneBuilder::new();
+    for r in 0..6 {
+        let q = random_quad(&mut rng, 8.0, (1.0, 2.0));
+        let positions = q.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
+        b.add_object("test", &format!("R{r}"), SourceMesh { positions, indices: vec![0, 1, 2, 0, 2, 3] }, true);
+    }
+    let mut cloud = SourceMesh::default();
+    for t in 0..4000u32 {
+        let q = random_quad(&mut rng, 12.0, (0.05, 0.3));
+        cloud.positions.extend(q[..3].iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]));
+        cloud.indices.extend([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    b.add_object("test", "CLOUD", cloud, false);
+    let cube = common::cube_mesh(0.25);
+    let mesh = b.add_mesh("cube", cube);
+    for k in 0..400 {
+        let at = DVec3::new(rng.random_range(-12.0..12.0), rng.random_range(-12.0..12.0), rng.random_range(0.5..8.0));
+        let name = format!("C{k}");
+        b.add_node(SourceNode { origin: name.clone(), name, mesh, transform: DMat4::from_translation(at), receiver: false });
+    }
+    let scene = b.build().unwrap();
+    let suns: Vec<DVec3> = (0..8).map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(15.0..85.0))).collect();
+    let requests: Vec<ViewRequest> =
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+    let counter = counter(512);
+    let gpu = counter.upload(&scene).unwrap();
+    let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    // The static mesh split over buffers of 1,000 triangles (as for a device with a small buffer
+    // limit) draws the same pixels.
+    let split = counter.upload_in_chunks(&scene, 1000).unwrap();
+    let again = pollster::block_on(counter.fractions(&split, &requests)).unwrap();
+    for (a, b) in counted.iter().zip(&again) {
+        assert_eq!((a.visible, a.covered), (b.visible, b.covered));
+    }
+    let exact = exact::sunlit_fractions(&scene, &requests);
+    let (mut drawn, mut rendered, mut partial, mut max) = (0usize, 0usize, 0usize, 0.0f64);
+    let mut sum = 0.0;
+    for ((req, g), e) in requests.iter().zip(&counted).zip(&exact) {
+        let err = (g.fraction - e).abs();
+        sum += err;
+        max = max.max(err);
+        partial += (*e > 0.01 && *e < 0.99) as usize;
+        let r = &scene.receivers[req.receiver as usize];
+        if g.covered > 0 {
+            let points: Vec<DVec3> = r.triangles.iter().flatten().copied().collect();
+            let v = view::fit(&points, req.sun, scene.bounds, scene.origin, 512);
+            let list =
+                gpu.culling().select(&v.view_proj, &Target { points: &points, normal: r.normal, gpu_id: r.gpu_id }, req.sun).unwrap();
+            drawn += list.triangles(gpu.culling());
+            rendered += 1;
+        }
+    }
+    let mean = sum / requests.len() as f64;
+    let share = drawn as f64 / (rendered.max(1) * scene.triangle_count()) as f64;
+    println!(
+        "culled GPU vs exact: {} views ({rendered} rendered, {partial} partly shaded), mean |error| {mean:.5}, max {max:.5}; \
+         {:.0}% of {} triangles drawn per rendered view",
+        requests.len(),
+        100.0 * share,
+        scene.triangle_count()
+    );
+    assert!(partial > 10, "the cases must exercise partial shading, got {partial}");
+    assert!(share < 0.3, "culling must leave most of the scene out, drew {share}");
+    assert!(mean <= 0.002, "mean |error| {mean}");
+    assert!(max <= 0.005, "max |error| {max}");
+}
+
+#[test]
 fn compute_count_equals_a_cpu_count_of_the_id_atlas() {
     // CPU reference of count_pixels.wgsl: count target ids in each tile of the read-back atlas.
     let scene = overhang_scene(0.6);

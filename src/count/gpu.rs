@@ -1,9 +1,9 @@
 //! The GPU pixel counter (wgpu; Vulkan/lavapipe natively, WebGPU in the browser).
 //!
 //! Owns the device, the pipelines and the atlas. For each (receiver, sun) view it renders, into
-//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the whole
-//! scene (depth-tested receiver ids); a compute pass counts per tile the pixels where the receiver
-//! is visible and where it is covered. The sunlit fraction is visible / covered: the covered
+//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the scene
+//! (depth-tested receiver ids; only what lies in the prism in front of it, see [`super::cull`]);
+//! a compute pass counts per tile the pixels where the receiver is visible and where it is covered. The sunlit fraction is visible / covered: the covered
 //! count is the pixel estimate of the projected area A·cosθ/Ap of the paper's formula, measured
 //! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
 //! surface gives exactly 1. Many views share one submission (tiles of the atlas).
@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3};
 
-use super::cull::Occluders;
+use super::cull::{CPU_LEAF_TRIANGLES, Culling, DrawList, LEAF_TRIANGLES, Target};
 use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
@@ -90,15 +90,22 @@ struct Atlas {
 /// A scene uploaded to a [`Counter`]'s device.
 pub struct GpuScene {
     meshes: Vec<GpuMesh>,
-    /// Instance slots grouped by mesh: (mesh, slot range).
-    groups: Vec<(usize, Range<u32>)>,
+    /// The static mesh's triangles in the culling's spatial order, unindexed, in buffers within
+    /// the device's size limit (the scene pass draws ranges of it).
+    static_chunks: Vec<StaticChunk>,
     instance_count: u32,
     receivers: Vec<ReceiverView>,
     bounds: (DVec3, DVec3),
     origin: DVec3,
-    occluders: Occluders,
+    culling: Culling,
     render_bind: wgpu::BindGroup,
     count_bind: wgpu::BindGroup,
+}
+
+/// Part of the static mesh: the vertices of a range of triangles in the culling's order.
+struct StaticChunk {
+    vertices: wgpu::Buffer,
+    triangles: Range<u32>,
 }
 
 struct GpuMesh {
@@ -113,6 +120,8 @@ struct ReceiverView {
     gpu_id: u32,
     mesh: usize,
     indices: Range<u32>,
+    /// For a receiver in the static mesh: its triangles' ranges in the culling's order.
+    static_triangles: Vec<Range<u32>>,
     slot: u32,
     points: Vec<DVec3>,
     normal: DVec3,
@@ -245,15 +254,30 @@ impl Counter {
         Err(Error::Gpu(format!("{doing}: {all}")))
     }
 
-    /// Uploads a scene's geometry once; views of it then cost only draws.
+    /// Uploads a scene's geometry once; views of it then cost only draws. The static mesh goes
+    /// into as many vertex buffers as the device's buffer size limit needs.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene> {
+        let per_triangle = 3 * size_of::<GpuVertex>() as u64;
+        let limit = (self.device.limits().max_buffer_size / per_triangle).clamp(1, u32::MAX as u64) as u32;
+        self.upload_in_chunks(scene, limit)
+    }
+
+    /// [`Self::upload`] with at most `max_triangles` static triangles a vertex buffer (tests
+    /// exercise the split with small values).
+    pub fn upload_in_chunks(&self, scene: &Scene, max_triangles: u32) -> Result<GpuScene> {
         use wgpu::util::DeviceExt as _;
         let meshes: Vec<GpuMesh> = scene
             .meshes
             .iter()
-            .map(|m| {
-                let vertices: Vec<GpuVertex> =
-                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect();
+            .enumerate()
+            .map(|(index, m)| {
+                // The static mesh (0) is stored in the culling's order below instead.
+                let vertices: Vec<GpuVertex> = if index == 0 {
+                    Vec::new()
+                } else {
+                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect()
+                };
+                let indices: &[u32] = if index == 0 { &[] } else { &m.indices };
                 GpuMesh {
                     vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.label),
@@ -262,27 +286,27 @@ impl Counter {
                     }),
                     indices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some(&m.label),
-                        contents: non_empty(bytemuck::cast_slice(&m.indices)),
+                        contents: non_empty(bytemuck::cast_slice(indices)),
                         usage: wgpu::BufferUsages::INDEX,
                     }),
-                    index_count: m.indices.len() as u32,
+                    index_count: indices.len() as u32,
                 }
             })
             .collect();
-        // Slots: instances sorted by mesh, so each mesh's placements are one instance range.
-        let mut order: Vec<usize> = (0..scene.instances.len()).collect();
-        order.sort_by_key(|&i| scene.instances[i].mesh);
+        // Slots: instances grouped by mesh and ordered spatially within it, so each BVH node of
+        // a mesh's placements is one instance range; the static mesh's triangles likewise.
+        let leaf = if self.info.device_type == wgpu::DeviceType::Cpu { CPU_LEAF_TRIANGLES } else { LEAF_TRIANGLES };
+        let culling = Culling::new(scene, leaf);
+        let order = culling.slot_order().to_vec();
         let mut slot_of = vec![0u32; order.len()];
-        let mut groups: Vec<(usize, Range<u32>)> = Vec::new();
         for (slot, &i) in order.iter().enumerate() {
             slot_of[i] = slot as u32;
-            let mesh = scene.instances[i].mesh;
-            match groups.last_mut() {
-                Some((m, r)) if *m == mesh => r.end = slot as u32 + 1,
-                _ => groups.push((mesh, slot as u32..slot as u32 + 1)),
-            }
         }
-        groups.retain(|(m, _)| meshes[*m].index_count > 0);
+        let static_chunks = self.static_chunks(scene, culling.static_order(), max_triangles.max(1));
+        let mut position = vec![0u32; culling.static_order().len()];
+        for (p, &t) in culling.static_order().iter().enumerate() {
+            position[t as usize] = p as u32;
+        }
         let to_scene = DMat4::from_translation(-scene.origin);
         let instances: Vec<GpuInstance> = order
             .iter()
@@ -313,6 +337,7 @@ impl Counter {
                 gpu_id: r.gpu_id,
                 mesh: scene.instances[r.draw.instance].mesh,
                 indices: r.draw.indices.clone(),
+                static_triangles: if r.draw.instance == 0 { static_ranges(&position, &r.draw.indices) } else { Vec::new() },
                 slot: slot_of[r.draw.instance],
                 points: r.triangles.iter().flatten().copied().collect(),
                 normal: r.normal,
@@ -340,12 +365,12 @@ impl Counter {
         self.check_errors("uploading the scene")?;
         Ok(GpuScene {
             meshes,
-            groups,
+            static_chunks,
             instance_count: params.instance_count,
             receivers,
             bounds: scene.bounds,
             origin: scene.origin,
-            occluders: Occluders::new(scene),
+            culling,
             render_bind,
             count_bind,
         })
@@ -355,7 +380,7 @@ impl Counter {
     /// nothing, the others are rendered in batches of atlas tiles.
     pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
         let mut out = vec![Counted::default(); requests.len()];
-        let mut lit: Vec<(usize, SunView)> = Vec::new();
+        let mut lit: Vec<(usize, SunView, DrawList)> = Vec::new();
         for (i, req) in requests.iter().enumerate() {
             let r = scene.receivers.get(req.receiver as usize).ok_or_else(|| {
                 Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
@@ -364,12 +389,13 @@ impl Counter {
             if is_dark(r.normal, req.sun) {
                 continue;
             }
-            if scene.occluders.nothing_in_front(&r.points, r.normal, r.gpu_id, req.sun) {
+            let view = view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution);
+            let target = Target { points: &r.points, normal: r.normal, gpu_id: r.gpu_id };
+            match scene.culling.select(&view.view_proj, &target, req.sun) {
+                Some(draws) => lit.push((i, view, draws)),
                 // Nothing in the prism in front of it: fully sunlit, no render needed.
-                out[i].fraction = 1.0;
-                continue;
+                None => out[i].fraction = 1.0,
             }
-            lit.push((i, view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution)));
         }
         let per_batch = self.tiles_per_batch();
         for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {
@@ -379,7 +405,7 @@ impl Counter {
             let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await?;
             self.check_errors("counting pixels")?;
             let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
-            for (k, (i, view)) in chunk.iter().enumerate() {
+            for (k, (i, view, _)) in chunk.iter().enumerate() {
                 let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
                 let o = &mut out[*i];
                 o.visible = visible;
@@ -391,17 +417,41 @@ impl Counter {
         Ok(out)
     }
 
+    /// The static mesh's triangles in the culling's order, unindexed, `max_triangles` a buffer.
+    fn static_chunks(&self, scene: &Scene, order: &[u32], max_triangles: u32) -> Vec<StaticChunk> {
+        use wgpu::util::DeviceExt as _;
+        let Some(mesh) = scene.meshes.first() else { return Vec::new() };
+        let vertex = |v: u32| GpuVertex { position: mesh.positions[v as usize], surface: mesh.surfaces[v as usize] };
+        order
+            .chunks(max_triangles as usize)
+            .enumerate()
+            .map(|(c, part)| {
+                let vertices: Vec<GpuVertex> =
+                    part.iter().flat_map(|&t| (0..3).map(move |k| vertex(mesh.indices[3 * t as usize + k]))).collect();
+                let start = c as u32 * max_triangles;
+                StaticChunk {
+                    vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("static, spatial order"),
+                        contents: non_empty(bytemuck::cast_slice(&vertices)),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    triangles: start..start + part.len() as u32,
+                }
+            })
+            .collect()
+    }
+
     fn tile_origin(&self, slot: usize) -> [u32; 2] {
         let t = slot as u32;
         [(t % self.tiles_per_side) * self.options.resolution, (t / self.tiles_per_side) * self.options.resolution]
     }
 
     /// Renders and counts one batch of views; results land in `readback` at batch `index`.
-    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)], index: usize) -> Result<()> {
+    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView, DrawList)], index: usize) -> Result<()> {
         let views: Vec<GpuView> = batch
             .iter()
             .enumerate()
-            .map(|(slot, (i, view))| GpuView {
+            .map(|(slot, (i, view, _))| GpuView {
                 view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
                 tile: self.tile_origin(slot),
                 target_id: scene.receivers[requests[*i].receiver as usize].gpu_id,
@@ -425,7 +475,13 @@ impl Counter {
         Ok(())
     }
 
-    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView)]) {
+    fn render_tiles(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        requests: &[ViewRequest],
+        batch: &[(usize, SunView, DrawList)],
+    ) {
         let clear_id = wgpu::Color { r: crate::scene::NO_RECEIVER as f64, g: 0.0, b: 0.0, a: 0.0 };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun views"),
@@ -439,7 +495,7 @@ impl Counter {
         });
         pass.set_bind_group(0, &scene.render_bind, &[]);
         let res = self.options.resolution;
-        for (slot, (i, _)) in batch.iter().enumerate() {
+        for (slot, (i, _, draws)) in batch.iter().enumerate() {
             let [x, y] = self.tile_origin(slot);
             pass.set_viewport(x as f32, y as f32, res as f32, res as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, res, res);
@@ -448,15 +504,28 @@ impl Counter {
             let r = &scene.receivers[requests[*i].receiver as usize];
             let mesh = &scene.meshes[r.mesh];
             pass.set_pipeline(&self.mask_pipeline);
-            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
-            // Everything, depth-tested: where the receiver's id survives, it is sunlit.
-            pass.set_pipeline(&self.scene_pipeline);
-            for (m, slots) in &scene.groups {
-                let mesh = &scene.meshes[*m];
+            if r.static_triangles.is_empty() {
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                 pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+            } else {
+                draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
+            }
+            // What lies in the prism in front of it, depth-tested: where the receiver's id
+            // survives, it is sunlit.
+            pass.set_pipeline(&self.scene_pipeline);
+            draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, first + scene.culling.static_slot());
+            let mut bound = None;
+            for (m, slots) in &draws.instances {
+                let mesh = &scene.meshes[*m];
+                if mesh.index_count == 0 {
+                    continue;
+                }
+                if bound != Some(*m) {
+                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    bound = Some(*m);
+                }
                 pass.draw_indexed(0..mesh.index_count, 0, first + slots.start..first + slots.end);
             }
         }
@@ -497,6 +566,45 @@ impl GpuScene {
     pub fn origin(&self) -> DVec3 {
         self.origin
     }
+
+    /// The spatial index that picks what each view draws (benchmarks report what it saves).
+    pub fn culling(&self) -> &Culling {
+        &self.culling
+    }
+}
+
+/// Draws ranges of the static mesh's triangles (culling order), split across its buffers.
+fn draw_static(pass: &mut wgpu::RenderPass<'_>, chunks: &[StaticChunk], ranges: &[Range<u32>], slot: u32) {
+    let mut bound = None;
+    for r in ranges {
+        for (c, chunk) in chunks.iter().enumerate() {
+            let (a, b) = (r.start.max(chunk.triangles.start), r.end.min(chunk.triangles.end));
+            if a >= b {
+                continue;
+            }
+            if bound != Some(c) {
+                pass.set_vertex_buffer(0, chunk.vertices.slice(..));
+                bound = Some(c);
+            }
+            let o = chunk.triangles.start;
+            pass.draw(3 * (a - o)..3 * (b - o), slot..slot + 1);
+        }
+    }
+}
+
+/// A static receiver's triangles (an index range of the static mesh) as ranges of positions in
+/// the culling's order.
+fn static_ranges(position: &[u32], indices: &Range<u32>) -> Vec<Range<u32>> {
+    let mut at: Vec<u32> = (indices.start / 3..indices.end / 3).map(|t| position[t as usize]).collect();
+    at.sort_unstable();
+    let mut ranges: Vec<Range<u32>> = Vec::new();
+    for p in at {
+        match ranges.last_mut() {
+            Some(r) if r.end == p => r.end = p + 1,
+            _ => ranges.push(p..p + 1),
+        }
+    }
+    ranges
 }
 
 fn color(view: &wgpu::TextureView, clear: wgpu::Color) -> Option<wgpu::RenderPassColorAttachment<'_>> {

@@ -79,3 +79,11 @@ pub fn gpu_fractions(counter: &Counter, scene: &Scene, requests: &[ViewRequest])
 pub fn receiver_id(scene: &Scene, name: &str) -> u32 {
     scene.receiver(name).unwrap_or_else(|| panic!("receiver {name}")).0
 }
+
+/// A closed cube of side `side` from the origin (12 triangles), for instancing.
+pub fn cube_mesh(side: f32) -> SourceMesh {
+    let positions = (0..8).map(|i| [side * (i & 1) as f32, side * ((i >> 1) & 1) as f32, side * ((i >> 2) & 1) as f32]).collect();
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let indices = quads.iter().flat_map(|q: &[u32; 4]| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+    SourceMesh { positions, indices }
+}

@@ -1,0 +1,217 @@
+//! Benchmark scenes and timing: synthetic occluder clouds of a chosen size, the example office,
+//! and models after the paper's case studies ([`models`]) timed over the views `sunlit annual`
+//! counts for its samples.
+//!
+//! Owns what `sunlit bench` measures, so the figures in the README come from one place.
+
+pub mod models;
+
+use glam::DVec3;
+
+use crate::count::gpu::{Counter, GpuScene};
+use crate::count::{ViewRequest, is_dark, view};
+use crate::error::Result;
+use crate::samples::SamplingPlan;
+use crate::scene::{Scene, SceneBuilder, SourceMesh};
+use crate::sun::location::Location;
+use crate::sun::position::{lit_intervals, sun_direction};
+
+/// A 10 m × 10 m horizontal receiver at z = 0 under a cloud of `triangles` random small
+/// triangles (0.05–0.5 m) between 0.5 m and 10 m up, spread over 20 m × 20 m.
+pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
+    let mut rng = SplitMix64(seed);
+    let mut b = SceneBuilder::new();
+    let floor = SourceMesh { positions: vec![[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]], indices: vec![0, 1, 2, 0, 2, 3] };
+    b.add_object("bench", "FLOOR", floor, true);
+    let mut cloud = SourceMesh::default();
+    for t in 0..triangles {
+        let centre = DVec3::new(rng.range(-5.0, 15.0), rng.range(-5.0, 15.0), rng.range(0.5, 10.0));
+        let size = rng.range(0.05, 0.5);
+        for _ in 0..3 {
+            let d = DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * size;
+            let p = centre + d;
+            cloud.positions.push([p.x as f32, p.y as f32, p.z as f32]);
+        }
+        cloud.indices.extend([3 * t as u32, 3 * t as u32 + 1, 3 * t as u32 + 2]);
+    }
+    b.add_object("bench", "cloud", cloud, false);
+    b.build()
+}
+
+/// `count` sun directions spread over the sky above 10° altitude (deterministic).
+pub fn suns(count: usize, seed: u64) -> Vec<DVec3> {
+    let mut rng = SplitMix64(seed);
+    (0..count)
+        .map(|_| {
+            let az = rng.range(0.0, std::f64::consts::TAU);
+            let alt = rng.range(10f64.to_radians(), 85f64.to_radians());
+            DVec3::new(az.sin() * alt.cos(), az.cos() * alt.cos(), alt.sin())
+        })
+        .collect()
+}
+
+/// Timing of one benchmark case.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Timing {
+    /// Case name.
+    pub case: String,
+    /// Triangles drawn per view.
+    pub triangles: usize,
+    /// Views requested.
+    pub views: usize,
+    /// Views rendered (the others were dark, or had nothing in front of the receiver).
+    pub rendered: usize,
+    /// Views answered without a render.
+    pub skipped: usize,
+    /// Seconds for all views (after one warm-up call).
+    pub seconds: f64,
+    /// Rendered views per second.
+    pub views_per_second: f64,
+}
+
+/// Times `Counter::fractions` over every receiver × sun of a scene; one warm-up call first.
+pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DVec3], now: impl Fn() -> f64) -> Result<Timing> {
+    let gpu: GpuScene = counter.upload(scene)?;
+    let requests: Vec<ViewRequest> =
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+    counter.fractions(&gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
+    let start = now();
+    let counted = counter.fractions(&gpu, &requests).await?;
+    let seconds = now() - start;
+    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    Ok(Timing {
+        case: case.to_string(),
+        triangles: scene.triangle_count(),
+        views: requests.len(),
+        rendered,
+        skipped: requests.len() - rendered,
+        seconds,
+        views_per_second: rendered as f64 / seconds.max(1e-9),
+    })
+}
+
+/// The views `sunlit annual` counts for its samples (before any refinement): every receiver ×
+/// sampled day × lit piece (at most two a day) × sample time, as in its spline fit.
+pub fn sample_requests(scene: &Scene, location: &Location, plan: SamplingPlan) -> Vec<ViewRequest> {
+    let (days, taus) = (plan.sample_days(), plan.taus());
+    let mut requests = Vec::new();
+    for (id, r) in scene.receivers.iter().enumerate() {
+        for &day in &days {
+            for (start, end) in lit_intervals(location, r.normal, day, crate::count::MIN_COS_INCIDENCE).into_iter().take(2) {
+                for tau in &taus {
+                    requests.push(ViewRequest { receiver: id as u32, sun: sun_direction(location, day, start + tau * (end - start)) });
+                }
+            }
+        }
+    }
+    requests
+}
+
+/// Every `stride`-th request, so a long benchmark can time an even spread and extrapolate.
+pub fn spread(requests: &[ViewRequest], at_most: usize) -> Vec<ViewRequest> {
+    let stride = requests.len().div_ceil(at_most.max(1)).max(1);
+    requests.iter().step_by(stride).copied().collect()
+}
+
+/// Timing of a batch of views of one uploaded scene.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ViewTiming {
+    /// Views timed.
+    pub views: usize,
+    /// Views rendered.
+    pub rendered: usize,
+    /// Views answered without a render (sun behind the surface, or nothing in front of it).
+    pub skipped: usize,
+    /// Seconds for the timed views (after a warm-up batch, not counted).
+    pub seconds: f64,
+    /// Views timed per second (rendered or not).
+    pub views_per_second: f64,
+    /// Of `seconds`, about this much is the CPU's planning: fitting each view and choosing what
+    /// it draws (timed again on its own, since the GPU work overlaps it).
+    pub planning_seconds: f64,
+    /// Mean triangles drawn per rendered view (the culling's choice).
+    pub mean_triangles_drawn: f64,
+    /// The sunlit fraction of every timed view, and whether it was rendered.
+    #[serde(skip)]
+    pub fractions: Vec<(f64, bool)>,
+}
+
+/// Times `Counter::fractions` over `requests`; one warm-up batch first.
+pub async fn time_requests(
+    counter: &Counter,
+    scene: &Scene,
+    gpu: &GpuScene,
+    requests: &[ViewRequest],
+    now: impl Fn() -> f64,
+) -> Result<ViewTiming> {
+    counter.fractions(gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
+    let start = now();
+    let counted = counter.fractions(gpu, requests).await?;
+    let seconds = now() - start;
+    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    let start = now();
+    let (drawn, planned) = plan_views(scene, gpu, requests, counter.resolution());
+    let planning_seconds = now() - start;
+    Ok(ViewTiming {
+        views: requests.len(),
+        rendered,
+        skipped: requests.len() - rendered,
+        seconds,
+        views_per_second: requests.len() as f64 / seconds.max(1e-9),
+        planning_seconds,
+        mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
+        fractions: counted.iter().map(|c| (c.fraction, c.covered > 0)).collect(),
+    })
+}
+
+/// Accuracy of counted fractions against the exact CPU reference over an even spread of at most
+/// `at_most` of the rendered views (the others are exact by construction): (views checked, mean
+/// |error|, max |error|).
+pub fn check_exact(scene: &Scene, requests: &[ViewRequest], fractions: &[(f64, bool)], at_most: usize) -> (usize, f64, f64) {
+    let rendered: Vec<usize> = (0..requests.len()).filter(|&i| fractions[i].1).collect();
+    let stride = rendered.len().div_ceil(at_most.max(1)).max(1);
+    let picked: Vec<usize> = rendered.into_iter().step_by(stride).collect();
+    let chosen: Vec<ViewRequest> = picked.iter().map(|&i| requests[i]).collect();
+    let exact = crate::count::exact::sunlit_fractions(scene, &chosen);
+    let errors: Vec<f64> = picked.iter().zip(&exact).map(|(&i, e)| (fractions[i].0 - e).abs()).collect();
+    let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+    (errors.len(), mean, errors.iter().copied().fold(0.0, f64::max))
+}
+
+/// What [`Counter::fractions`] does on the CPU before drawing: fit each lit view and choose
+/// what it draws. Returns the triangles drawn over all views that need a render, and their count.
+fn plan_views(scene: &Scene, gpu: &GpuScene, requests: &[ViewRequest], resolution: u32) -> (usize, usize) {
+    let points: Vec<Vec<DVec3>> = scene.receivers.iter().map(|r| r.triangles.iter().flatten().copied().collect()).collect();
+    let (mut sum, mut n) = (0usize, 0usize);
+    for req in requests {
+        let r = &scene.receivers[req.receiver as usize];
+        if is_dark(r.normal, req.sun) {
+            continue;
+        }
+        let points = &points[req.receiver as usize];
+        let v = view::fit(points, req.sun, scene.bounds, scene.origin, resolution);
+        let target = crate::count::cull::Target { points, normal: r.normal, gpu_id: r.gpu_id };
+        if let Some(list) = gpu.culling().select(&v.view_proj, &target, req.sun) {
+            sum += list.triangles(gpu.culling());
+            n += 1;
+        }
+    }
+    (sum, n)
+}
+
+/// A small deterministic generator: benchmarks must not depend on a random crate's versions.
+pub(crate) struct SplitMix64(pub(crate) u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
