@@ -31,6 +31,7 @@ pub mod model;
 mod platform;
 pub mod samples;
 pub mod scene;
+pub mod season;
 pub mod spline;
 pub mod sun;
 

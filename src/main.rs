@@ -14,6 +14,7 @@ use sunlit::export::hook::{Hook, HookPlan, patch_epjson, patch_idf};
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
+use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
 use sunlit::{Error, Result, bench};
@@ -77,6 +78,29 @@ struct AnnualArgs {
     /// imported (Schedule:File:Shading, ignored by 25.2); default by the model's Version.
     #[arg(long, value_name = "FORM")]
     hook: Option<String>,
+    /// Foliage keeps its leaves all year.
+    #[arg(long, conflicts_with_all = ["leaf_out", "leaf_fall"])]
+    evergreen: bool,
+    /// Leaf-out period, first and last day (MM-DD or day of year); default 04-15,05-31, half a
+    /// year later south of the equator.
+    #[arg(long, value_name = "START,END", requires = "leaf_fall")]
+    leaf_out: Option<String>,
+    /// Leaf-fall period (MM-DD or day of year); default 10-01,11-15, half a year later south of
+    /// the equator.
+    #[arg(long, value_name = "START,END", requires = "leaf_out")]
+    leaf_fall: Option<String>,
+}
+
+impl AnnualArgs {
+    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
+        if self.evergreen {
+            return Ok(LeafCalendar::evergreen());
+        }
+        match (&self.leaf_out, &self.leaf_fall) {
+            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
+            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
+        }
+    }
 }
 
 #[derive(Args)]
@@ -90,20 +114,49 @@ struct ModelArgs {
     /// Degrees clockwise from true north of the model's north (glTF −Z).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     north: f64,
+    /// Foliage: glob over node names; each leaf casts a shadow only while in leaf. Repeatable.
+    #[arg(long = "foliage", value_name = "GLOB")]
+    foliage: Vec<String>,
+    /// See-through nodes (e.g. perforated screens): GLOB=T lets T (0..1) of the beam through. Repeatable.
+    #[arg(long = "transmittance", value_name = "GLOB=T")]
+    transmittance: Vec<String>,
 }
 
 impl ModelArgs {
     fn options(&self) -> LoadOptions {
-        LoadOptions { receivers: self.receivers.clone(), north: self.north, ..Default::default() }
+        LoadOptions {
+            receivers: self.receivers.clone(),
+            north: self.north,
+            foliage: self.foliage.clone(),
+            transmittance: self.transmittance.iter().map(|t| parse_transmittance(t)).collect::<Result<_>>().unwrap_or_default(),
+            ..Default::default()
+        }
+    }
+
+    /// Refuses a malformed `--transmittance` before anything is read.
+    fn check(&self) -> Result<()> {
+        self.transmittance.iter().try_for_each(|t| parse_transmittance(t).map(drop))
     }
 
     fn load(&self) -> Result<Scene> {
+        self.check()?;
         model::load(&self.models, &self.options())
     }
 
     fn load_all(&self, all_energyplus_surfaces: bool) -> Result<model::Loaded> {
+        self.check()?;
         model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
     }
+}
+
+fn parse_transmittance(text: &str) -> Result<(String, f64)> {
+    let bad = || Error::argument("--transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
+    let (glob, t) = text.rsplit_once('=').ok_or_else(bad)?;
+    let t: f64 = t.trim().parse().map_err(|_| bad())?;
+    if glob.is_empty() || !(0.0..1.0).contains(&t) {
+        return Err(bad());
+    }
+    Ok((glob.to_string(), t))
 }
 
 #[derive(Args)]
@@ -116,9 +169,13 @@ struct FractionArgs {
     /// Tile size in pixels.
     #[arg(long, default_value_t = 512)]
     resolution: u32,
-    /// Use the exact CPU polygon-clipping reference instead of the GPU.
+    /// Use the exact CPU polygon-clipping reference instead of the GPU (see-through nodes count
+    /// as opaque there).
     #[arg(long)]
     exact: bool,
+    /// Leaf fraction of foliage, 0 (bare) to 1 (full leaf).
+    #[arg(long, default_value_t = 1.0)]
+    leaves: f64,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -198,11 +255,15 @@ fn counter(resolution: u32) -> Result<Counter> {
 
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
+    if !(0.0..=1.0).contains(&args.leaves) {
+        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
+    }
+    let leaves = args.leaves as f32;
     let scene = args.model.load()?;
     let dir = sun.direction();
     let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
     let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions(&scene, &requests)
+        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
             .into_iter()
             .zip(&scene.receivers)
             .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
@@ -210,7 +271,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     } else {
         let counter = counter(args.resolution)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions(&gpu, &requests))?
+        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
@@ -223,6 +284,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
             "sun": {"azimuth": sun.azimuth, "altitude": sun.altitude},
             "resolution": args.resolution,
             "method": if args.exact { "exact" } else { "gpu" },
+            "leaves": args.leaves,
             "surfaces": surfaces,
         });
         println!("{out:#}");
@@ -250,6 +312,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
     };
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
+    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -277,7 +340,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
         Ok(())
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
-    let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;
+    let schedule =
+        pollster::block_on(sunlit::annual::annual_with_leaves(&counter, &gpu, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -376,6 +440,8 @@ fn info(args: InfoArgs) -> Result<()> {
             "triangles": scene.triangle_count(),
             "meshes": scene.meshes.len(),
             "instances": scene.instances.len(),
+            "leaves": scene.veil_counts().0,
+            "see_through_triangles": scene.veil_counts().1,
             "bounds": {"min": [lo.x, lo.y, lo.z], "max": [hi.x, hi.y, hi.z]},
         });
         println!("{out:#}");
