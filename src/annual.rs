@@ -16,8 +16,9 @@
 //! cover as well as with the sun, and the leaf fraction has corners where leaf-out and leaf fall
 //! begin and end, which a spline across them would round off. So the year is split into regimes
 //! with a fit each: bare (no leaves) and full leaf, each fitted periodically over the whole year
-//! at a fixed leaf fraction (0 or 1), and each ramp fitted over its own days, sampled at least
-//! [`RAMP_DAYS`] times, with the samples mirrored at both ends so the same periodic fit applies.
+//! at a fixed leaf fraction (0 or 1), and each ramp fitted over its own days: sampled from its
+//! first to its last day at least [`RAMP_DAYS`] + 1 times, crowded where few leaves are out (see
+//! [`DayMap::Ramp`]), with the samples mirrored at both ends so the same periodic fit applies.
 //! A day takes the fit of its phase. Without foliage (or evergreen) there is one regime, all leaves.
 
 use glam::DVec3;
@@ -182,9 +183,41 @@ struct Regime {
     grid_days: Vec<usize>,
     grid: AnnualGrid,
     cells: SampleCells,
-    /// Where its days begin: a day of the year is taken into the year that follows it, so a ramp
-    /// over New Year evaluates at 366 rather than 1.
-    start: f64,
+    /// Day of year → the grid's coordinate.
+    map: DayMap,
+}
+
+/// How a regime's grid coordinate follows the day of year.
+#[derive(Debug, Clone, Copy)]
+enum DayMap {
+    /// The day itself (periodic over the year).
+    Year,
+    /// A ramp of `length` days from `start`, in u ∈ [0, 1] with leaf fraction u² (leaf-out) or
+    /// (1 − u)² (leaf fall). A dense canopy closes over the first few percent of its leaves, so
+    /// the fraction changes fastest where the leaf fraction is small: evenly spaced u crowds the
+    /// sample days there, and a function of u² is flat at u = 0, which the mirror at that end
+    /// assumes.
+    Ramp { start: f64, length: f64, rising: bool },
+}
+
+impl DayMap {
+    fn grid_coordinate(self, day: f64) -> f64 {
+        match self {
+            DayMap::Year => day,
+            DayMap::Ramp { start, length, rising } => {
+                let x = ((day - start).rem_euclid(DAYS as f64) / length).clamp(0.0, 1.0);
+                if rising { x.sqrt() } else { 1.0 - (1.0 - x).sqrt() }
+            }
+        }
+    }
+
+    /// The inverse of [`Self::grid_coordinate`] for a ramp's u.
+    fn day(self, u: f64) -> f64 {
+        match self {
+            DayMap::Year => u,
+            DayMap::Ramp { start, length, rising } => start + length * if rising { u * u } else { 1.0 - (1.0 - u) * (1.0 - u) },
+        }
+    }
 }
 
 impl Regime {
@@ -197,24 +230,25 @@ impl Regime {
             grid_days: (0..n).collect(),
             grid: AnnualGrid::new(plan.first_day(), DAYS as f64, n, taus)?,
             cells: SampleCells { first_day: plan.first_day(), spacing: DAYS as f64 / n as f64, days: n, taus: taus.to_vec() },
-            start: 0.0,
+            map: DayMap::Year,
             days,
         })
     }
 
-    /// A leaf ramp of `length` days from `first`: at least [`RAMP_DAYS`] days, or the plan's
-    /// spacing if denser, at interval midpoints; mirrored at both ends into a periodic grid of
-    /// twice the length (the mirror images land on the same even spacing).
-    fn ramp(plan: SamplingPlan, taus: &[f64], calendar: &LeafCalendar, (first, length): (f64, f64)) -> Result<Self> {
+    /// A leaf ramp of `length` days from `first`, on the grid u of [`DayMap::Ramp`]: n + 1 days at
+    /// u = k/n, both ends included (leaf fraction exactly 0 and 1), n at least [`RAMP_DAYS`] or
+    /// the plan's spacing if denser; mirrored at both ends into a periodic grid over u ∈ [0, 2).
+    fn ramp(plan: SamplingPlan, taus: &[f64], calendar: &LeafCalendar, phase: Phase, (first, length): (f64, f64)) -> Result<Self> {
         let n = ((plan.days as f64 * length / DAYS as f64).ceil() as usize).max(RAMP_DAYS);
-        let h = length / n as f64;
-        let days: Vec<f64> = (0..n).map(|k| first + (k as f64 + 0.5) * h).collect();
+        let map = DayMap::Ramp { start: first, length, rising: phase == Phase::LeafOut };
+        let days: Vec<f64> = (0..=n).map(|k| map.day(k as f64 / n as f64)).collect();
+        let leaves = days.iter().map(|d| calendar.fraction(*d) as f32).collect();
         Ok(Regime {
-            leaves: days.iter().map(|d| calendar.fraction(*d) as f32).collect(),
-            grid_days: (0..n).chain((0..n).rev()).collect(),
-            grid: AnnualGrid::new(first + 0.5 * h, 2.0 * length, 2 * n, taus)?,
-            cells: SampleCells { first_day: first + 0.5 * h, spacing: h, days: 2 * n, taus: taus.to_vec() },
-            start: first,
+            leaves,
+            grid_days: (0..=n).chain((1..n).rev()).collect(),
+            grid: AnnualGrid::new(0.0, 2.0, 2 * n, taus)?,
+            cells: SampleCells { first_day: 0.0, spacing: 1.0 / n as f64, days: 2 * n, taus: taus.to_vec() },
+            map,
             days,
         })
     }
@@ -232,7 +266,7 @@ fn regimes(plan: SamplingPlan, taus: &[f64], calendar: &LeafCalendar) -> Result<
     let mut out = vec![Regime::year(plan, taus, 0.0)?, Regime::year(plan, taus, 1.0)?];
     for phase in [Phase::LeafOut, Phase::LeafFall] {
         if let Some(ramp) = calendar.ramp(phase) {
-            out.push(Regime::ramp(plan, taus, calendar, ramp)?);
+            out.push(Regime::ramp(plan, taus, calendar, phase, ramp)?);
         }
     }
     let of = |phase: Phase| match phase {
@@ -294,8 +328,7 @@ async fn spline_year(
     for (regime, samples) in regimes.iter().zip(&samples) {
         fits.push(fit_regime(regime, samples, taus.len())?);
     }
-    let fitted: Vec<FittedRegime> =
-        regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, start: g.start }).collect();
+    let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
     let rough = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
     let requests: Vec<ViewRequest> = rough.iter().map(|(_, column, sun, _)| ViewRequest { receiver: *column as u32, sun: *sun }).collect();
     let leaves: Vec<f32> = rough.iter().map(|(_, _, _, day)| calendar.fraction(*day) as f32).collect();
@@ -322,8 +355,7 @@ fn fit_regime(regime: &Regime, samples: &[Option<f64>], per_day: usize) -> Resul
 struct FittedRegime<'a> {
     fits: &'a [Option<PieceFit>],
     cells: &'a SampleCells,
-    /// [`Regime::start`].
-    start: f64,
+    map: DayMap,
 }
 
 /// A fitted lit piece: the spline and the (filled) samples it passes through.
@@ -372,7 +404,7 @@ fn evaluate(
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, day as f64, MIN_COS_INCIDENCE)).collect();
         let regime = &regimes[regime_of(day as f64)];
-        let grid_day = regime.start + (day as f64 - regime.start).rem_euclid(DAYS as f64);
+        let grid_day = regime.map.grid_coordinate(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
             let sun = sun_direction(location, day as f64, instant.hour);

@@ -48,8 +48,8 @@ fn crown(count: usize, seed: u64) -> SourceMesh {
     mesh
 }
 
-/// The roof (receiver), an opaque trunk east of it, and the crown as foliage.
-fn canopy_over_roof() -> Scene {
+/// The roof (receiver), an opaque trunk east of it, and a crown of `leaves` as foliage.
+fn canopy_over_roof(leaves: usize) -> Scene {
     let mut b = SceneBuilder::new();
     let roof = flat_rect(0.0, 10.0, 0.0, 10.0, 3.0);
     let positions = roof.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect();
@@ -57,7 +57,7 @@ fn canopy_over_roof() -> Scene {
     let (lo, hi) = (DVec3::new(11.8, 4.8, 0.0), DVec3::new(12.2, 5.2, 6.0));
     b.add_object("test", "TRUNK", box_mesh(lo, hi), false);
     b.set_node_veil(b.node_count(), NodeVeil { foliage: true, transmittance: 0.0 });
-    b.add_object("test", "CROWN", crown(LEAVES, 7), false);
+    b.add_object("test", "CROWN", crown(leaves, 7), false);
     b.build().unwrap()
 }
 
@@ -75,7 +75,7 @@ fn suns() -> Vec<DVec3> {
 
 #[test]
 fn the_canopy_matches_the_exact_reference_bare_half_and_in_full_leaf() {
-    let scene = canopy_over_roof();
+    let scene = canopy_over_roof(LEAVES);
     assert!(scene.has_foliage());
     assert_eq!(scene.veil_counts().0, LEAVES, "a leaf is a connected quad");
     let counter = counter(512);
@@ -104,7 +104,7 @@ fn the_canopy_matches_the_exact_reference_bare_half_and_in_full_leaf() {
 
 #[test]
 fn the_spring_ramp_never_adds_sun() {
-    let scene = canopy_over_roof();
+    let scene = canopy_over_roof(LEAVES);
     let counter = counter(256);
     let gpu = counter.upload(&scene).unwrap();
     // Leaf-out in the northern default: the leaf fraction rises day by day; at a fixed sun each
@@ -124,11 +124,18 @@ fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
 }
 
-fn year(scene: &Scene, method: Method, refine: f64) -> Schedule {
+/// The year and the number of views it asked for.
+fn year(scene: &Scene, method: Method, refine: f64) -> (Schedule, usize) {
     let counter = counter(256);
     let gpu = counter.upload(scene).unwrap();
     let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine };
-    pollster::block_on(annual_with_leaves(&counter, &gpu, scene, &golden(), &options, &NORTHERN, &mut |_| Ok(()))).unwrap()
+    let mut views = 0;
+    let schedule = pollster::block_on(annual_with_leaves(&counter, &gpu, scene, &golden(), &options, &NORTHERN, &mut |p| {
+        views = p.total;
+        Ok(())
+    }))
+    .unwrap();
+    (schedule, views)
 }
 
 /// RMS and max over the lit values of the rows of days in `days`.
@@ -147,18 +154,24 @@ fn compare_days(a: &Schedule, b: &Schedule, days: std::ops::RangeInclusive<usize
     ((sq / n.max(1) as f64).sqrt(), max)
 }
 
+/// A dense crown (3,000 leaves) closes over its first few percent of leaves, so the fraction
+/// drops fastest at the start of leaf-out and the end of leaf fall. One periodic fit through the
+/// 27 days with each day's leaf fraction measured ramp RMS 0.0101 and max 0.060 here; the
+/// bounds below are set between that and what the regime fits give (0.0027, 0.019).
 #[test]
 fn the_seasonal_year_follows_dense_counting_through_leaf_out_and_leaf_fall() {
-    let scene = canopy_over_roof();
-    let dense = year(&scene, Method::Dense, 1.0);
-    let spline = year(&scene, Method::Spline(SamplingPlan::default()), DEFAULT_REFINE);
+    let scene = canopy_over_roof(3000);
+    let (dense, dense_views) = year(&scene, Method::Dense, 1.0);
+    let (spline, spline_views) = year(&scene, Method::Spline(SamplingPlan::default()), DEFAULT_REFINE);
+    println!("views: dense {dense_views}, 27×19 with leaf regimes {spline_views}");
     let (mean, rms, max) = compare(&spline, &dense).unwrap();
     let (out_rms, out_max) = compare_days(&spline, &dense, 105..=151);
     let (fall_rms, fall_max) = compare_days(&spline, &dense, 274..=319);
     println!("canopy over roof, 27×19 refined vs dense: mean {mean:.4}, RMS {rms:.4}, max {max:.4}");
     println!("  leaf-out days: RMS {out_rms:.4}, max {out_max:.4}; leaf-fall days: RMS {fall_rms:.4}, max {fall_max:.4}");
-    assert!(rms <= 0.01, "RMS {rms}");
-    assert!(out_rms <= 0.015 && fall_rms <= 0.015, "ramps: {out_rms}, {fall_rms}");
+    assert!(rms <= 0.005, "RMS {rms}");
+    assert!(out_rms <= 0.006 && fall_rms <= 0.006, "ramps: RMS {out_rms}, {fall_rms}");
+    assert!(max <= 0.04, "max {max}");
     // The seasons are in it: at 10:00 the roof is shaded in July, much less in January.
     let at = |s: &Schedule, day: usize| s.values[(day - 1) * 24 + 9] as f64;
     println!("10:00 on 15 Jan {:.3}, 15 Jul {:.3}", at(&dense, 15), at(&dense, 196));
