@@ -460,6 +460,10 @@ fn info(args: InfoArgs) -> Result<()> {
         hi.y,
         hi.z
     );
+    let (leaves, see_through) = scene.veil_counts();
+    if leaves + see_through > 0 {
+        println!("foliage: {leaves} leaves; see-through: {see_through} triangles");
+    }
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>10}  normal (x east, y north, z up)", "surface", "area m²");
     for r in &scene.receivers {

@@ -266,3 +266,66 @@ fn gltf_marks_and_options_choose_foliage_and_screens() {
     let e = load(tree_glb(json!({})), options).unwrap_err().to_string();
     assert!(e.contains("Oak crown") && e.contains("receiver") && e.contains("opaque"), "{e}");
 }
+
+fn cli(args: &[&str]) -> std::process::Output {
+    let runtime = std::env::temp_dir().join("sunlit-test-runtime");
+    std::fs::create_dir_all(&runtime).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    std::process::Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime).output().unwrap()
+}
+
+/// The example office's neighbouring block east of it, taken as foliage or as a screen from the
+/// command line: the east window gets more sun with fewer leaves, and bad values are refused.
+#[test]
+fn the_command_line_takes_foliage_screens_and_leaf_fractions() {
+    let dir = std::env::temp_dir().join(format!("sunlit-foliage-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("office.glb");
+    std::fs::write(&model, sunlit::model::office::office(6).to_glb()).unwrap();
+    let model = model.display().to_string();
+    let east = |extra: &[&str]| {
+        let mut args = vec!["fraction", model.as_str(), "--sun", "95,15", "--json", "--receivers", "WALL_E"];
+        args.extend_from_slice(extra);
+        let out = cli(&args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["surfaces"][0]["fraction"].as_f64().unwrap()
+    };
+    let opaque = east(&[]);
+    let bare = east(&["--foliage", "NEIGHBOUR", "--leaves", "0"]);
+    let full = east(&["--foliage", "NEIGHBOUR", "--leaves", "1"]);
+    let half_exact = east(&["--foliage", "NEIGHBOUR", "--leaves", "0.5", "--exact"]);
+    let half_gpu = east(&["--foliage", "NEIGHBOUR", "--leaves", "0.5"]);
+    let screen = east(&["--transmittance", "NEIGHBOUR=0.5"]);
+    println!(
+        "WALL_E: opaque {opaque:.4}, bare {bare:.4}, half {half_gpu:.4} (exact {half_exact:.4}), full {full:.4}, screen 0.5 {screen:.4}"
+    );
+    assert!(opaque < 0.9, "the block shades the east wall at this sun: {opaque}");
+    assert!(bare > 0.999, "without leaves only the window reveals are in front: {bare}");
+    assert!((full - opaque).abs() < 1e-9, "in full leaf the block is the opaque block");
+    // The block is one connected mesh, so one leaf: at 0.5 it is either there or not, the same on both sides.
+    assert!((half_gpu - half_exact).abs() <= 0.005, "{half_gpu} vs {half_exact}");
+    assert!((screen - (1.0 - (1.0 - opaque) * 0.5)).abs() <= 0.01, "{screen} vs opaque {opaque}");
+    let info = cli(&["info", &model, "--foliage", "NEIGHBOUR"]);
+    assert!(String::from_utf8_lossy(&info.stdout).contains("foliage: "), "{}", String::from_utf8_lossy(&info.stdout));
+    // Bad values: exit 1 with the option named, no panic.
+    let location = ["--location", "39.74,-105.18,-7", "-o"];
+    let csv = dir.join("x.csv").display().to_string();
+    for (args, needle) in [
+        (vec!["fraction", &model, "--sun", "95,15", "--transmittance", "NEIGHBOUR=1.5"], "--transmittance"),
+        (vec!["fraction", &model, "--sun", "95,15", "--transmittance", "NEIGHBOUR"], "--transmittance"),
+        (vec!["fraction", &model, "--sun", "95,15", "--foliage", "NEIGHBOUR", "--leaves", "2"], "--leaves"),
+        (vec!["fraction", &model, "--sun", "95,15", "--foliage", "TREES"], "--foliage TREES"),
+        ([&["annual", &model][..], &location, &[&csv, "--leaf-out", "06-01,05-01", "--leaf-fall", "10-01,11-01"]].concat(), "leaf-out"),
+        ([&["annual", &model][..], &location, &[&csv, "--leaf-out", "04-31,05-01", "--leaf-fall", "10-01,11-01"]].concat(), "04-31"),
+    ] {
+        let out = cli(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
+    }
+}
