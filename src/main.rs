@@ -195,6 +195,10 @@ struct BenchArgs {
     /// Occluder triangle counts for the synthetic cases.
     #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
     triangles: Vec<usize>,
+    /// Leaf counts for street-tree cases (trees in full leaf in front of a facade), e.g.
+    /// 35905,233866 as in the paper's Blaas case; none by default.
+    #[arg(long, value_delimiter = ',')]
+    trees: Vec<usize>,
     /// Sun directions per case.
     #[arg(long, default_value_t = 64)]
     suns: usize,
@@ -485,6 +489,10 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     let mut cases: Vec<(String, Scene)> = Vec::new();
     for &n in &args.triangles {
         cases.push((format!("cloud {n}"), bench::occluder_cloud(n, 42)?));
+    }
+    for &n in &args.trees {
+        let glb = bench::street_trees_glb(n, 11);
+        cases.push((format!("street trees {n} leaves"), model::load_bytes(&[("trees.glb".into(), glb)], &LoadOptions::default())?));
     }
     let office = sunlit::model::office::office(6).to_glb();
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
