@@ -48,7 +48,9 @@ pub fn street_trees_glb(leaves: usize, seed: u64) -> Vec<u8> {
     }
     let trunk = {
         let (lo, hi) = ([-0.2f32, -0.2, 0.0], [0.2f32, 0.2, 6.0]);
-        let c = |i: usize| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+        let c = |i: usize| {
+            [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }]
+        };
         let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
         let indices: Vec<u32> = quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
         w.add_mesh("trunk", &(0..8).map(c).collect::<Vec<_>>(), &indices)

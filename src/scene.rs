@@ -162,6 +162,10 @@ pub struct Scene {
     /// Centre of the input's bounds. The static mesh is stored relative to it (instance 0 adds it
     /// back) so f32 vertices keep millimetres even in georeferenced coordinates.
     pub origin: DVec3,
+    /// Leaves of all foliage placements (see the module doc).
+    pub leaves: usize,
+    /// Triangles of all see-through placements.
+    pub see_through_triangles: usize,
 }
 
 impl Scene {
@@ -198,24 +202,9 @@ impl Scene {
         self.instances.iter().any(|i| self.meshes[i.mesh].veils.iter().any(|v| v.rank >= 0.0))
     }
 
-    /// Leaves (connected groups of foliage triangles) and triangles of see-through geometry, per placement.
+    /// Leaves (connected groups of foliage triangles) and triangles of see-through geometry, over all placements.
     pub fn veil_counts(&self) -> (usize, usize) {
-        let (mut leaves, mut screens) = (0, 0);
-        for inst in &self.instances {
-            let mesh = &self.meshes[inst.mesh];
-            let mut ranks: Vec<u32> = Vec::new();
-            for tri in mesh.indices.chunks_exact(3) {
-                let v = mesh.veils.get(tri[0] as usize).copied().unwrap_or_default();
-                if v.rank >= 0.0 {
-                    ranks.push(v.rank.to_bits());
-                }
-                screens += (v.transmittance > 0.0) as usize;
-            }
-            ranks.sort_unstable();
-            ranks.dedup();
-            leaves += ranks.len();
-        }
-        (leaves, screens)
+        (self.leaves, self.see_through_triangles)
     }
 
     /// Looks a receiver up by name.
@@ -342,6 +331,12 @@ impl SceneBuilder {
         for (i, node) in self.nodes.iter().enumerate() {
             let (label, source) = &self.meshes[node.mesh];
             let veil = self.veil_of(i);
+            if veil.foliage {
+                scene.leaves += leaf_count(source);
+            }
+            if veil.transmittance > 0.0 {
+                scene.see_through_triangles += source.indices.len() / 3;
+            }
             if uses[node.mesh] == 1 {
                 bake_node(&mut scene, node, source, &veil, i as u32)?;
             } else {
@@ -403,6 +398,15 @@ fn node_veils(mesh: &SourceMesh, veil: &NodeVeil, node: u32) -> Vec<Veil> {
         }
     }
     out
+}
+
+/// Leaves of a foliage mesh: the connected groups its triangles use.
+fn leaf_count(mesh: &SourceMesh) -> usize {
+    let leaf = leaf_of_vertex(mesh);
+    let mut used: Vec<u32> = mesh.indices.iter().map(|&v| leaf[v as usize]).collect();
+    used.sort_unstable();
+    used.dedup();
+    used.len()
 }
 
 /// Connected components of a mesh by shared vertex indices (union–find), as a leaf number per vertex.
@@ -735,6 +739,49 @@ mod tests {
         assert_eq!(s.receivers[1].gpu_id, 0);
         assert_eq!(s.receivers[1].normal, -s.receivers[0].normal);
         assert_eq!(s.triangle_count(), 2, "drawn once");
+    }
+
+    #[test]
+    fn leaves_are_connected_groups_and_each_placement_has_its_own() {
+        let mut b = SceneBuilder::new();
+        // Two separate quads: two leaves.
+        let mut two = quad(0.0);
+        two.positions.extend(quad(1.0).positions);
+        two.indices.extend([4, 5, 6, 4, 6, 7]);
+        let m = b.add_mesh("two leaves", two);
+        let foliage = NodeVeil { foliage: true, transmittance: 0.0 };
+        for i in 0..2 {
+            b.set_node_veil(b.node_count(), foliage);
+            b.add_node(node(&format!("tree{i}"), m, false, DMat4::from_translation(DVec3::new(5.0 * i as f64, 0.0, 0.0))));
+        }
+        // The same mesh placed opaque gets its own copy (veils live in the vertices).
+        b.add_node(node("statue", m, false, DMat4::IDENTITY));
+        b.add_object("test", "floor", quad(-1.0), true);
+        let s = b.build().unwrap();
+        assert_eq!(s.meshes.len(), 3, "static + foliage copy + opaque copy");
+        assert_eq!(s.veil_counts(), (4, 0));
+        let ranks: Vec<f32> = s.veiled_triangles().filter(|(_, _, v)| v.rank >= 0.0).map(|(_, _, v)| v.rank).collect();
+        assert_eq!(ranks.len(), 8);
+        assert!(ranks.iter().all(|r| (0.0..1.0).contains(r)));
+        let leaf = |k: usize| ranks[2 * k];
+        assert_eq!(ranks[0], ranks[1], "a quad's two triangles are one leaf");
+        assert!(leaf(0) != leaf(1) && leaf(0) != leaf(2) && leaf(1) != leaf(3), "{ranks:?}");
+        assert!(s.veiled_triangles().all(|(_, _, v)| v.present(0.0, 1.0)));
+        assert_eq!(s.veiled_triangles().filter(|(_, _, v)| !v.present(0.0, 0.0)).count(), 8, "no leaves at 0");
+    }
+
+    #[test]
+    fn see_through_receivers_and_bad_transmittance_are_refused() {
+        let mut b = SceneBuilder::new();
+        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 0.5 });
+        b.add_object("test.glb", "Screen", quad(0.0), true);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("node 'Screen'") && e.contains("must be opaque"), "{e}");
+        let mut b = SceneBuilder::new();
+        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 1.0 });
+        b.add_object("test.glb", "Screen", quad(0.0), false);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("node 'Screen'") && e.contains("outside [0, 1)"), "{e}");
     }
 
     #[test]
