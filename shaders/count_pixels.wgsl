@@ -9,7 +9,7 @@ struct View {
     view_proj: mat4x4<f32>,
     tile: vec2<u32>,
     target_id: u32,
-    _pad: u32,
+    leaves: f32,
 }
 
 struct Params {

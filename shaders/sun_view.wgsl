@@ -5,6 +5,11 @@
 //
 // Instances: a draw covers instance_index = view * instance_count + instance, so one
 // draw_indexed per mesh renders every placement of it for one view.
+//
+// See-through casters: a leaf (rank >= 0) is dropped in the vertex shader when its rank, shifted
+// by its instance, is not below the view's leaf fraction (all three vertices of a leaf triangle
+// share the rank, so the whole triangle goes); a fragment with transmittance t is discarded when
+// a per-pixel hash threshold in [0, 1) falls below t, so on average t of it lets the sun through.
 
 const NO_RECEIVER: u32 = 0xffffffffu;
 
@@ -13,7 +18,8 @@ struct Instance {
     transform: mat4x4<f32>,
     // Added to the per-vertex surface value; NO_RECEIVER for shadow-only placements.
     receiver_base: u32,
-    _pad0: u32,
+    // Added (mod 1) to the leaf ranks of the mesh: each placement of a tree has its own leaves.
+    leaf_shift: f32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -24,7 +30,8 @@ struct View {
     tile: vec2<u32>,
     // The receiver whose pixels this view counts.
     target_id: u32,
-    _pad: u32,
+    // Leaf fraction of the view's day: leaves with a lower rank cast shadows.
+    leaves: f32,
 }
 
 struct Params {
@@ -42,24 +49,55 @@ struct VertexOut {
     // Invariant: the mask pass and the scene pass must rasterise a receiver identically.
     @invariant @builtin(position) position: vec4<f32>,
     @location(0) @interpolate(flat) id: u32,
+    @location(1) @interpolate(flat) transmittance: f32,
+    @location(2) @interpolate(flat) seed: u32,
 }
 
+// Outside every clip volume: a dropped leaf's vertices all go here, so its triangle is clipped away.
+const DROPPED = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+
 @vertex
-fn vs_main(@location(0) position: vec3<f32>, @location(1) surface: u32, @builtin(instance_index) instance_index: u32) -> VertexOut {
+fn vs_main(
+    @location(0) position: vec3<f32>,
+    @location(1) surface: u32,
+    @location(2) veil: vec2<f32>,
+    @location(3) seed: u32,
+    @builtin(instance_index) instance_index: u32,
+) -> VertexOut {
     let view = views[instance_index / params.instance_count];
-    let instance = instances[instance_index % params.instance_count];
+    let slot = instance_index % params.instance_count;
+    let instance = instances[slot];
     var out: VertexOut;
     out.position = view.view_proj * (instance.transform * vec4<f32>(position, 1.0));
+    if veil.x >= 0.0 && fract(veil.x + instance.leaf_shift) >= view.leaves {
+        out.position = DROPPED;
+    }
     if surface == NO_RECEIVER || instance.receiver_base == NO_RECEIVER {
         out.id = NO_RECEIVER;
     } else {
         out.id = instance.receiver_base + surface;
     }
+    out.transmittance = veil.y;
+    out.seed = seed ^ (slot * 0x9e3779b9u);
     return out;
+}
+
+// PCG hash (Jarzynski & Olano 2020): well-mixed 32 bits from 32.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
 }
 
 // Both pipelines share this: the scene pipeline writes only red, the mask pipeline only green.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec2<u32> {
+    if in.transmittance > 0.0 {
+        let pixel = vec2<u32>(in.position.xy);
+        let h = pcg(pixel.x ^ pcg(pixel.y ^ pcg(in.seed)));
+        if f32(h >> 8u) * (1.0 / 16777216.0) < in.transmittance {
+            discard;
+        }
+    }
     return vec2<u32>(in.id, 1u);
 }

@@ -11,6 +11,15 @@
 //! gets its own spline surface over (day of year, τ). Days on which a piece does not exist borrow
 //! the samples of the nearest day that has it, so the periodic fit stays defined. At evaluation
 //! the sun-up and facing tests are applied exactly per timestep; values are clamped to [0, 1].
+//!
+//! Foliage (a scene with leaves, [`crate::season`]): the fraction then changes with the leaf
+//! cover as well as with the sun, and the leaf fraction has corners where leaf-out and leaf fall
+//! begin and end, which a spline across them would round off. So the year is split into regimes
+//! with a fit each: bare (no leaves) and full leaf, each fitted periodically over the whole year
+//! at a fixed leaf fraction (0 or 1), and each ramp fitted over its own days: sampled from its
+//! first to its last day at least [`RAMP_DAYS`] + 1 times, crowded where few leaves are out (see
+//! [`DayMap::Ramp`]), with the samples mirrored at both ends so the same periodic fit applies.
+//! A day takes the fit of its phase. Without foliage (or evergreen) there is one regime, all leaves.
 
 use glam::DVec3;
 
@@ -20,6 +29,7 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::samples::{DAYS, SamplingPlan, Timesteps};
 use crate::scene::Scene;
+use crate::season::{LeafCalendar, Phase};
 use crate::spline::{AnnualGrid, AnnualSpline};
 use crate::sun::location::Location;
 use crate::sun::position::{lit_intervals, sun_direction};
@@ -64,7 +74,12 @@ pub struct Progress {
 /// whole atlases.
 const BATCHES_PER_REPORT: usize = 4;
 
-/// The year's schedule for every receiver of `scene`.
+/// Each leaf ramp gets at least this many sample days, however few the plan gives the year: the
+/// leaf fraction changes by a sixth of the canopy between them.
+pub const RAMP_DAYS: usize = 6;
+
+/// The year's schedule for every receiver of `scene`; foliage follows the default leaf calendar
+/// of the location's hemisphere.
 pub async fn annual(
     counter: &Counter,
     gpu: &GpuScene,
@@ -73,12 +88,26 @@ pub async fn annual(
     options: &AnnualOptions,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
+    annual_with_leaves(counter, gpu, scene, location, options, &LeafCalendar::for_latitude(location.latitude), progress).await
+}
+
+/// As [`annual`], with foliage following `calendar`.
+pub async fn annual_with_leaves(
+    counter: &Counter,
+    gpu: &GpuScene,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Schedule> {
     let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
     let mut schedule = Schedule::zeros(names, options.timesteps);
     let views = Views { counter, gpu };
+    let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
     match options.method {
-        Method::Spline(plan) => spline_year(&views, scene, location, plan, options.refine, &mut schedule, progress).await?,
-        Method::Dense => dense_year(&views, scene, location, &mut schedule, progress).await?,
+        Method::Spline(plan) => spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?,
+        Method::Dense => dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?,
     }
     schedule.validate()?;
     Ok(schedule)
@@ -91,12 +120,13 @@ struct Views<'a> {
 }
 
 impl Views<'_> {
-    /// Counts many views, reporting progress as it goes.
-    async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
+    /// Counts many views (`leaves[i]`: the leaf fraction of view `i`), reporting progress as it goes.
+    async fn count(&self, requests: &[ViewRequest], leaves: &[f32], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
         progress(Progress { done: 0, total: requests.len() })?;
-        for chunk in requests.chunks(self.counter.tiles_per_batch() * BATCHES_PER_REPORT) {
-            out.extend(self.counter.fractions(self.gpu, chunk).await?.into_iter().map(|c| c.fraction));
+        let per_report = self.counter.tiles_per_batch() * BATCHES_PER_REPORT;
+        for (chunk, leaves) in requests.chunks(per_report).zip(leaves.chunks(per_report)) {
+            out.extend(self.counter.fractions_with_leaves(self.gpu, chunk, leaves).await?.into_iter().map(|c| c.fraction));
             progress(Progress { done: out.len(), total: requests.len() })?;
         }
         Ok(out)
@@ -116,10 +146,12 @@ async fn dense_year(
     views: &Views<'_>,
     scene: &Scene,
     location: &Location,
+    calendar: &LeafCalendar,
     schedule: &mut Schedule,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
     let mut requests = Vec::new();
+    let mut leaves = Vec::new();
     let mut cells = Vec::new();
     for (row, instant) in schedule.timesteps.instants().enumerate() {
         let sun = sun_direction(location, instant.day as f64, instant.hour);
@@ -129,61 +161,201 @@ async fn dense_year(
         for (column, r) in scene.receivers.iter().enumerate() {
             if !is_dark(r.normal, sun) {
                 requests.push(ViewRequest { receiver: column as u32, sun });
+                leaves.push(calendar.fraction(instant.day as f64) as f32);
                 cells.push((row, column));
             }
         }
     }
-    let values = views.count(&requests, progress).await?;
+    let values = views.count(&requests, &leaves, progress).await?;
     for ((row, column), v) in cells.into_iter().zip(values) {
         schedule.set(row, column, v as f32);
     }
     Ok(())
 }
 
+/// One fit of the year: its sample days, their leaf fractions and the grid the fit lives on.
+struct Regime {
+    /// Days counted (day of year, possibly past 365 for a ramp over New Year).
+    days: Vec<f64>,
+    /// Leaf fraction on each counted day.
+    leaves: Vec<f32>,
+    /// Grid days → counted days: the identity, or for a ramp its days then their mirror images.
+    grid_days: Vec<usize>,
+    grid: AnnualGrid,
+    cells: SampleCells,
+    /// Day of year → the grid's coordinate.
+    map: DayMap,
+}
+
+/// How a regime's grid coordinate follows the day of year.
+#[derive(Debug, Clone, Copy)]
+enum DayMap {
+    /// The day itself (periodic over the year).
+    Year,
+    /// A ramp of `length` days from `start`, in u ∈ [0, 1] with leaf fraction u² (leaf-out) or
+    /// (1 − u)² (leaf fall). A dense canopy closes over the first few percent of its leaves, so
+    /// the fraction changes fastest where the leaf fraction is small: evenly spaced u crowds the
+    /// sample days there, and a function of u² is flat at u = 0, which the mirror at that end
+    /// assumes.
+    Ramp { start: f64, length: f64, rising: bool },
+}
+
+impl DayMap {
+    fn grid_coordinate(self, day: f64) -> f64 {
+        match self {
+            DayMap::Year => day,
+            DayMap::Ramp { start, length, rising } => {
+                let x = ((day - start).rem_euclid(DAYS as f64) / length).clamp(0.0, 1.0);
+                if rising { x.sqrt() } else { 1.0 - (1.0 - x).sqrt() }
+            }
+        }
+    }
+
+    /// The inverse of [`Self::grid_coordinate`] for a ramp's u.
+    fn day(self, u: f64) -> f64 {
+        match self {
+            DayMap::Year => u,
+            DayMap::Ramp { start, length, rising } => start + length * if rising { u * u } else { 1.0 - (1.0 - u) * (1.0 - u) },
+        }
+    }
+}
+
+impl Regime {
+    /// The whole year at the plan's days with one leaf fraction.
+    fn year(plan: SamplingPlan, taus: &[f64], leaves: f64) -> Result<Self> {
+        let days = plan.sample_days();
+        let n = days.len();
+        Ok(Regime {
+            leaves: vec![leaves as f32; n],
+            grid_days: (0..n).collect(),
+            grid: AnnualGrid::new(plan.first_day(), DAYS as f64, n, taus)?,
+            cells: SampleCells { first_day: plan.first_day(), spacing: DAYS as f64 / n as f64, days: n, taus: taus.to_vec() },
+            map: DayMap::Year,
+            days,
+        })
+    }
+
+    /// A leaf ramp of `length` days from `first`, on the grid u of [`DayMap::Ramp`]: n + 1 days at
+    /// u = k/n, both ends included (leaf fraction exactly 0 and 1), n at least [`RAMP_DAYS`] or
+    /// the plan's spacing if denser; mirrored at both ends into a periodic grid over u ∈ [0, 2).
+    fn ramp(plan: SamplingPlan, taus: &[f64], calendar: &LeafCalendar, phase: Phase, (first, length): (f64, f64)) -> Result<Self> {
+        let n = ((plan.days as f64 * length / DAYS as f64).ceil() as usize).max(RAMP_DAYS);
+        let map = DayMap::Ramp { start: first, length, rising: phase == Phase::LeafOut };
+        let days: Vec<f64> = (0..=n).map(|k| map.day(k as f64 / n as f64)).collect();
+        let leaves = days.iter().map(|d| calendar.fraction(*d) as f32).collect();
+        Ok(Regime {
+            leaves,
+            grid_days: (0..=n).chain((1..n).rev()).collect(),
+            grid: AnnualGrid::new(0.0, 2.0, 2 * n, taus)?,
+            cells: SampleCells { first_day: 0.0, spacing: 1.0 / n as f64, days: 2 * n, taus: taus.to_vec() },
+            map,
+            days,
+        })
+    }
+}
+
+/// Which regime serves a leaf phase.
+type RegimeOf = fn(Phase) -> usize;
+
+/// The regimes of a year and which one serves each phase: one for every phase without foliage,
+/// else bare, full leaf, leaf-out and leaf fall.
+fn regimes(plan: SamplingPlan, taus: &[f64], calendar: &LeafCalendar) -> Result<(Vec<Regime>, RegimeOf)> {
+    if calendar.evergreen {
+        return Ok((vec![Regime::year(plan, taus, 1.0)?], |_| 0));
+    }
+    let mut out = vec![Regime::year(plan, taus, 0.0)?, Regime::year(plan, taus, 1.0)?];
+    for phase in [Phase::LeafOut, Phase::LeafFall] {
+        if let Some(ramp) = calendar.ramp(phase) {
+            out.push(Regime::ramp(plan, taus, calendar, phase, ramp)?);
+        }
+    }
+    let of = |phase: Phase| match phase {
+        Phase::Bare => 0,
+        Phase::Full => 1,
+        Phase::LeafOut => 2,
+        Phase::LeafFall => 3,
+    };
+    Ok((out, of))
+}
+
+/// A day of the year for the sun model: any real day taken into [1, 366).
+fn sun_day(day: f64) -> f64 {
+    (day - 1.0).rem_euclid(DAYS as f64) + 1.0
+}
+
+#[allow(clippy::too_many_arguments)] // The year's inputs and its two outputs; grouping them would hide nothing.
 async fn spline_year(
     views: &Views<'_>,
     scene: &Scene,
     location: &Location,
     plan: SamplingPlan,
+    calendar: &LeafCalendar,
     refine: f64,
     schedule: &mut Schedule,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
-    let (days, taus) = (plan.sample_days(), plan.taus());
-    let grid = AnnualGrid::new(plan.first_day(), DAYS as f64, days.len(), &taus)?;
-    let per_piece = days.len() * taus.len();
+    let taus = plan.taus();
+    let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
     let mut requests = Vec::new();
+    let mut leaves = Vec::new();
     let mut cells = Vec::new();
-    for (id, r) in scene.receivers.iter().enumerate() {
-        for (d, &day) in days.iter().enumerate() {
-            for (p, (start, end)) in lit_intervals(location, r.normal, day, MIN_COS_INCIDENCE).into_iter().take(MAX_PIECES).enumerate() {
-                for (j, tau) in taus.iter().enumerate() {
-                    let sun = sun_direction(location, day, start + tau * (end - start));
-                    requests.push(ViewRequest { receiver: id as u32, sun });
-                    cells.push(((id * MAX_PIECES + p) * days.len() + d) * taus.len() + j);
+    for (g, regime) in regimes.iter().enumerate() {
+        let per_piece = regime.days.len() * taus.len();
+        for (id, r) in scene.receivers.iter().enumerate() {
+            for (d, &day) in regime.days.iter().enumerate() {
+                let day = sun_day(day);
+                for (p, (start, end)) in lit_intervals(location, r.normal, day, MIN_COS_INCIDENCE).into_iter().take(MAX_PIECES).enumerate()
+                {
+                    for (j, tau) in taus.iter().enumerate() {
+                        let sun = sun_direction(location, day, start + tau * (end - start));
+                        requests.push(ViewRequest { receiver: id as u32, sun });
+                        leaves.push(regime.leaves[d]);
+                        cells.push((g, (id * MAX_PIECES + p) * per_piece + d * taus.len() + j));
+                    }
                 }
             }
         }
     }
     // Progress counts the samples and then the refined timesteps, whose number is known later.
     let total = requests.len();
-    let counted = views.count(&requests, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
-    let mut samples: Vec<Option<f64>> = vec![None; scene.receivers.len() * MAX_PIECES * per_piece];
-    for (cell, v) in cells.into_iter().zip(counted) {
-        samples[cell] = Some(v);
+    let counted = views.count(&requests, &leaves, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
+    let mut samples: Vec<Vec<Option<f64>>> =
+        regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
+    for ((g, cell), v) in cells.into_iter().zip(counted) {
+        samples[g][cell] = Some(v);
     }
-    let fits = samples
-        .chunks(per_piece)
-        .map(|piece| fill_dark(piece, days.len(), taus.len()).map(|v| Ok(PieceFit { spline: grid.fit(&v)?, samples: v })).transpose())
-        .collect::<Result<Vec<Option<PieceFit>>>>()?;
-    let cells = SampleCells { first_day: plan.first_day(), spacing: DAYS as f64 / days.len() as f64, days: days.len(), taus };
-    let rough = evaluate(scene, location, &fits, &cells, refine, schedule);
-    let requests: Vec<ViewRequest> = rough.iter().map(|(_, column, sun)| ViewRequest { receiver: *column as u32, sun: *sun }).collect();
-    let refined = views.count(&requests, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
-    for ((row, column, _), v) in rough.into_iter().zip(refined) {
+    let mut fits = Vec::with_capacity(regimes.len());
+    for (regime, samples) in regimes.iter().zip(&samples) {
+        fits.push(fit_regime(regime, samples, taus.len())?);
+    }
+    let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
+    let rough = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
+    let requests: Vec<ViewRequest> = rough.iter().map(|(_, column, sun, _)| ViewRequest { receiver: *column as u32, sun: *sun }).collect();
+    let leaves: Vec<f32> = rough.iter().map(|(_, _, _, day)| calendar.fraction(*day) as f32).collect();
+    let refined = views.count(&requests, &leaves, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
+    for ((row, column, _, _), v) in rough.into_iter().zip(refined) {
         schedule.set(row, column, v as f32);
     }
     Ok(())
+}
+
+/// Fits every (receiver, piece) of a regime from its samples (None where the piece is never lit).
+fn fit_regime(regime: &Regime, samples: &[Option<f64>], per_day: usize) -> Result<Vec<Option<PieceFit>>> {
+    samples
+        .chunks(regime.days.len() * per_day)
+        .map(|piece| {
+            let Some(v) = fill_dark(piece, regime.days.len(), per_day) else { return Ok(None) };
+            let v: Vec<f64> = regime.grid_days.iter().flat_map(|&d| v[d * per_day..(d + 1) * per_day].iter().copied()).collect();
+            Ok(Some(PieceFit { spline: regime.grid.fit(&v)?, samples: v }))
+        })
+        .collect()
+}
+
+/// A regime's fitted pieces (by receiver and piece) and its sample grid.
+struct FittedRegime<'a> {
+    fits: &'a [Option<PieceFit>],
+    cells: &'a SampleCells,
+    map: DayMap,
 }
 
 /// A fitted lit piece: the spline and the (filled) samples it passes through.
@@ -215,21 +387,24 @@ impl SampleCells {
     }
 }
 
-/// Fills every timestep of `schedule` from the fitted pieces (exact zeros where dark) and returns
-/// the (row, column, sun) cells whose sample cell spreads more than `refine`, to count directly.
+/// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
+/// where dark) and returns the (row, column, sun, day) cells whose sample cell spreads more than
+/// `refine`, to count directly.
 fn evaluate(
     scene: &Scene,
     location: &Location,
-    fits: &[Option<PieceFit>],
-    cells: &SampleCells,
+    regimes: &[FittedRegime],
+    regime_of: &dyn Fn(f64) -> usize,
     refine: f64,
     schedule: &mut Schedule,
-) -> Vec<(usize, usize, DVec3)> {
+) -> Vec<(usize, usize, DVec3, f64)> {
     let mut rough = Vec::new();
     let rows_per_day = schedule.timesteps.rows() / DAYS as usize;
     for day in 1..=DAYS {
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, day as f64, MIN_COS_INCIDENCE)).collect();
+        let regime = &regimes[regime_of(day as f64)];
+        let grid_day = regime.map.grid_coordinate(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
             let sun = sun_direction(location, day as f64, instant.hour);
@@ -241,10 +416,10 @@ fn evaluate(
                     continue;
                 }
                 let Some((p, tau)) = piece_at(&pieces[column], instant.hour) else { continue };
-                if let Some(fit) = &fits[column * MAX_PIECES + p.min(MAX_PIECES - 1)] {
-                    schedule.set(row, column, fit.spline.eval(day as f64, tau).clamp(0.0, 1.0) as f32);
-                    if cells.spread(&fit.samples, day as f64, tau) > refine {
-                        rough.push((row, column, sun));
+                if let Some(fit) = &regime.fits[column * MAX_PIECES + p.min(MAX_PIECES - 1)] {
+                    schedule.set(row, column, fit.spline.eval(grid_day, tau).clamp(0.0, 1.0) as f32);
+                    if regime.cells.spread(&fit.samples, grid_day, tau) > refine {
+                        rough.push((row, column, sun, day as f64));
                     }
                 }
             }

@@ -10,6 +10,7 @@
 //! - [`scene`]: triangles that cast shadows and planar receivers, laid out for the GPU;
 //! - [`sun`]: sun positions and directions;
 //! - [`count`]: the GPU pixel counter and the exact CPU polygon-clipping reference.
+//! - [`season`]: the leaf calendar that foliage follows through the year.
 //!
 //! ```no_run
 //! # fn main() -> sunlit::Result<()> {
@@ -31,6 +32,7 @@ pub mod model;
 mod platform;
 pub mod samples;
 pub mod scene;
+pub mod season;
 pub mod spline;
 pub mod sun;
 #[cfg(target_arch = "wasm32")]

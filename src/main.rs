@@ -14,6 +14,7 @@ use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
+use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
 use sunlit::{Error, Result, bench};
@@ -78,6 +79,29 @@ struct AnnualArgs {
     /// imported (Schedule:File:Shading, ignored by 25.2); default by the model's Version.
     #[arg(long, value_name = "FORM")]
     hook: Option<String>,
+    /// Foliage keeps its leaves all year.
+    #[arg(long, conflicts_with_all = ["leaf_out", "leaf_fall"])]
+    evergreen: bool,
+    /// Leaf-out period, first and last day (MM-DD or day of year); default 04-15,05-31, half a
+    /// year later south of the equator.
+    #[arg(long, value_name = "START,END", requires = "leaf_fall")]
+    leaf_out: Option<String>,
+    /// Leaf-fall period (MM-DD or day of year); default 10-01,11-15, half a year later south of
+    /// the equator.
+    #[arg(long, value_name = "START,END", requires = "leaf_out")]
+    leaf_fall: Option<String>,
+}
+
+impl AnnualArgs {
+    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
+        if self.evergreen {
+            return Ok(LeafCalendar::evergreen());
+        }
+        match (&self.leaf_out, &self.leaf_fall) {
+            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
+            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
+        }
+    }
 }
 
 #[derive(Args)]
@@ -91,20 +115,49 @@ struct ModelArgs {
     /// Degrees clockwise from true north of the model's north (glTF −Z).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     north: f64,
+    /// Foliage: glob over node names; each leaf casts a shadow only while in leaf. Repeatable.
+    #[arg(long = "foliage", value_name = "GLOB")]
+    foliage: Vec<String>,
+    /// See-through nodes (e.g. perforated screens): GLOB=T lets T (0..1) of the beam through. Repeatable.
+    #[arg(long = "transmittance", value_name = "GLOB=T")]
+    transmittance: Vec<String>,
 }
 
 impl ModelArgs {
     fn options(&self) -> LoadOptions {
-        LoadOptions { receivers: self.receivers.clone(), north: self.north, ..Default::default() }
+        LoadOptions {
+            receivers: self.receivers.clone(),
+            north: self.north,
+            foliage: self.foliage.clone(),
+            transmittance: self.transmittance.iter().map(|t| parse_transmittance(t)).collect::<Result<_>>().unwrap_or_default(),
+            ..Default::default()
+        }
+    }
+
+    /// Refuses a malformed `--transmittance` before anything is read.
+    fn check(&self) -> Result<()> {
+        self.transmittance.iter().try_for_each(|t| parse_transmittance(t).map(drop))
     }
 
     fn load(&self) -> Result<Scene> {
+        self.check()?;
         model::load(&self.models, &self.options())
     }
 
     fn load_all(&self, all_energyplus_surfaces: bool) -> Result<model::Loaded> {
+        self.check()?;
         model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
     }
+}
+
+fn parse_transmittance(text: &str) -> Result<(String, f64)> {
+    let bad = || Error::argument("--transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
+    let (glob, t) = text.rsplit_once('=').ok_or_else(bad)?;
+    let t: f64 = t.trim().parse().map_err(|_| bad())?;
+    if glob.is_empty() || !(0.0..1.0).contains(&t) {
+        return Err(bad());
+    }
+    Ok((glob.to_string(), t))
 }
 
 #[derive(Args)]
@@ -117,9 +170,13 @@ struct FractionArgs {
     /// Tile size in pixels.
     #[arg(long, default_value_t = 512)]
     resolution: u32,
-    /// Use the exact CPU polygon-clipping reference instead of the GPU.
+    /// Use the exact CPU polygon-clipping reference instead of the GPU (see-through nodes count
+    /// as opaque there).
     #[arg(long)]
     exact: bool,
+    /// Leaf fraction of foliage, 0 (bare) to 1 (full leaf).
+    #[arg(long, default_value_t = 1.0)]
+    leaves: f64,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -158,6 +215,10 @@ struct BenchArgs {
     /// Occluder triangle counts for the synthetic cases.
     #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
     triangles: Vec<usize>,
+    /// Leaf counts for street-tree cases (trees in full leaf in front of a facade), e.g.
+    /// 35905,233866 as in the paper's Blaas case; none by default.
+    #[arg(long, value_delimiter = ',')]
+    trees: Vec<usize>,
     /// Sun directions per case.
     #[arg(long, default_value_t = 64)]
     suns: usize,
@@ -218,11 +279,15 @@ fn counter(resolution: u32) -> Result<Counter> {
 
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
+    if !(0.0..=1.0).contains(&args.leaves) {
+        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
+    }
+    let leaves = args.leaves as f32;
     let scene = args.model.load()?;
     let dir = sun.direction();
     let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
     let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions(&scene, &requests)
+        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
             .into_iter()
             .zip(&scene.receivers)
             .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
@@ -230,7 +295,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     } else {
         let counter = counter(args.resolution)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions(&gpu, &requests))?
+        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
@@ -243,6 +308,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
             "sun": {"azimuth": sun.azimuth, "altitude": sun.altitude},
             "resolution": args.resolution,
             "method": if args.exact { "exact" } else { "gpu" },
+            "leaves": args.leaves,
             "surfaces": surfaces,
         });
         println!("{out:#}");
@@ -270,6 +336,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
     };
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
+    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -297,7 +364,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
         Ok(())
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
-    let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;
+    let schedule =
+        pollster::block_on(sunlit::annual::annual_with_leaves(&counter, &gpu, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -376,6 +444,8 @@ fn info(args: InfoArgs) -> Result<()> {
             "triangles": scene.triangle_count(),
             "meshes": scene.meshes.len(),
             "instances": scene.instances.len(),
+            "leaves": scene.veil_counts().0,
+            "see_through_triangles": scene.veil_counts().1,
             "bounds": {"min": [lo.x, lo.y, lo.z], "max": [hi.x, hi.y, hi.z]},
         });
         println!("{out:#}");
@@ -394,6 +464,10 @@ fn info(args: InfoArgs) -> Result<()> {
         hi.y,
         hi.z
     );
+    let (leaves, see_through) = scene.veil_counts();
+    if leaves + see_through > 0 {
+        println!("foliage: {leaves} leaves; see-through: {see_through} triangles");
+    }
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>10}  normal (x east, y north, z up)", "surface", "area m²");
     for r in &scene.receivers {
@@ -433,6 +507,10 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     let mut cases: Vec<(String, Scene)> = Vec::new();
     for &n in &args.triangles {
         cases.push((format!("cloud {n}"), bench::occluder_cloud(n, 42)?));
+    }
+    for &n in &args.trees {
+        let glb = bench::street_trees_glb(n, 11);
+        cases.push((format!("street trees {n} leaves"), model::load_bytes(&[("trees.glb".into(), glb)], &LoadOptions::default())?));
     }
     let office = sunlit::model::office::office(6).to_glb();
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));

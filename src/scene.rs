@@ -11,6 +11,11 @@
 //! GPU surface ids: a vertex carries a `surface` value, an instance a `receiver_base`; the id a
 //! triangle writes is `receiver_base + surface`, or [`NO_RECEIVER`] when either is [`NO_RECEIVER`].
 //! The merged static mesh has base 0 and absolute receiver ids in its vertices.
+//!
+//! See-through casters ([`Veil`], per vertex): a *leaf* (a connected group of triangles of a
+//! foliage node) carries a fixed random rank in [0, 1) and casts a shadow only on days whose leaf
+//! fraction exceeds it, so one upload serves every day; a node with transmittance t lets t of
+//! the beam through (a stochastic per-pixel threshold on the GPU). Receivers are always opaque.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -40,6 +45,65 @@ pub struct Mesh {
     pub surfaces: Vec<u32>,
     /// Triangle list.
     pub indices: Vec<u32>,
+    /// Per vertex: leaf rank and transmittance ([`Veil::OPAQUE`] for ordinary geometry).
+    pub veils: Vec<Veil>,
+}
+
+/// How a caster's vertex lets the sun through: see the module doc.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Veil {
+    /// Leaf rank in [0, 1): the leaf casts a shadow when its rank is below the day's leaf
+    /// fraction. Negative for geometry that is not foliage (always casts).
+    pub rank: f32,
+    /// Fraction of the beam let through, in [0, 1); 0 is opaque.
+    pub transmittance: f32,
+    /// Decorrelates the per-pixel thresholds of different see-through nodes, so two screens of
+    /// transmittance t behind each other let t² through, not t.
+    pub seed: u32,
+}
+
+impl Veil {
+    /// Ordinary geometry: casts a shadow every day, lets nothing through.
+    pub const OPAQUE: Veil = Veil { rank: -1.0, transmittance: 0.0, seed: 0 };
+
+    /// Whether this vertex's leaf is present when the leaf fraction is `leaves` (the test the GPU
+    /// makes, in the same f32 arithmetic, with the instance's rank shift applied).
+    pub fn present(&self, shift: f32, leaves: f32) -> bool {
+        self.rank < 0.0 || shifted_rank(self.rank, shift) < leaves
+    }
+}
+
+impl Default for Veil {
+    fn default() -> Self {
+        Self::OPAQUE
+    }
+}
+
+/// A leaf's rank after an instance's shift: `fract(rank + shift)`, so every placement of a shared
+/// tree has its own leaves while ranks stay uniform on [0, 1). Same f32 operations as the shader.
+pub fn shifted_rank(rank: f32, shift: f32) -> f32 {
+    let x = rank + shift;
+    x - x.floor()
+}
+
+/// What a node lets through: set with [`SceneBuilder::set_node_veil`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct NodeVeil {
+    /// Its leaves come and go with the seasons.
+    pub foliage: bool,
+    /// Fraction of the beam it lets through (0 = opaque).
+    pub transmittance: f64,
+}
+
+impl NodeVeil {
+    /// Whether this is plain opaque, all-year geometry.
+    pub fn is_opaque(&self) -> bool {
+        !self.foliage && self.transmittance == 0.0
+    }
+
+    fn key(&self) -> (bool, u64) {
+        (self.foliage, self.transmittance.to_bits())
+    }
 }
 
 /// One placement of a mesh in the world.
@@ -51,6 +115,8 @@ pub struct Instance {
     pub transform: DMat4,
     /// Added to the mesh's per-vertex surface values, or [`NO_RECEIVER`].
     pub receiver_base: u32,
+    /// Added (mod 1) to the leaf ranks of its mesh: see [`shifted_rank`].
+    pub leaf_shift: f32,
 }
 
 /// A planar receiving surface.
@@ -96,6 +162,10 @@ pub struct Scene {
     /// Centre of the input's bounds. The static mesh is stored relative to it (instance 0 adds it
     /// back) so f32 vertices keep millimetres even in georeferenced coordinates.
     pub origin: DVec3,
+    /// Leaves of all foliage placements (see the module doc).
+    pub leaves: usize,
+    /// Triangles of all see-through placements.
+    pub see_through_triangles: usize,
 }
 
 impl Scene {
@@ -106,15 +176,35 @@ impl Scene {
 
     /// Every triangle in world coordinates with the receiver it belongs to (if any).
     pub fn world_triangles(&self) -> impl Iterator<Item = ([DVec3; 3], Option<u32>)> + '_ {
+        self.veiled_triangles().map(|(t, id, _)| (t, id))
+    }
+
+    /// Every triangle as [`Self::world_triangles`], with its veil (the rank already shifted by
+    /// its instance, so [`Veil::present`] takes shift 0).
+    pub fn veiled_triangles(&self) -> impl Iterator<Item = ([DVec3; 3], Option<u32>, Veil)> + '_ {
         self.instances.iter().flat_map(move |inst| {
             let mesh = &self.meshes[inst.mesh];
             mesh.indices.chunks_exact(3).map(move |tri| {
                 let p = |i: u32| inst.transform.transform_point3(to_dvec(mesh.positions[i as usize]));
                 let surface = mesh.surfaces[tri[0] as usize];
                 let id = (surface != NO_RECEIVER && inst.receiver_base != NO_RECEIVER).then(|| inst.receiver_base + surface);
-                ([p(tri[0]), p(tri[1]), p(tri[2])], id)
+                let mut veil = mesh.veils.get(tri[0] as usize).copied().unwrap_or_default();
+                if veil.rank >= 0.0 {
+                    veil.rank = shifted_rank(veil.rank, inst.leaf_shift);
+                }
+                ([p(tri[0]), p(tri[1]), p(tri[2])], id, veil)
             })
         })
+    }
+
+    /// Whether any geometry is foliage (its shading changes with the leaf fraction).
+    pub fn has_foliage(&self) -> bool {
+        self.instances.iter().any(|i| self.meshes[i.mesh].veils.iter().any(|v| v.rank >= 0.0))
+    }
+
+    /// Leaves (connected groups of foliage triangles) and triangles of see-through geometry, over all placements.
+    pub fn veil_counts(&self) -> (usize, usize) {
+        (self.leaves, self.see_through_triangles)
     }
 
     /// Looks a receiver up by name.
@@ -151,6 +241,13 @@ pub struct SourceNode {
     pub receiver: bool,
 }
 
+impl SourceNode {
+    fn veil_error(&self, reason: &str) -> Error {
+        let (file, object) = split_origin(&self.origin);
+        Error::object(file, object, reason)
+    }
+}
+
 /// Collects meshes and nodes from one or more model files, then lays them out ([`Self::build`]).
 #[derive(Debug, Default)]
 pub struct SceneBuilder {
@@ -158,6 +255,8 @@ pub struct SceneBuilder {
     nodes: Vec<SourceNode>,
     /// (receiver name, mirror name) pairs: see [`SceneBuilder::add_mirror`].
     mirrors: Vec<(String, String)>,
+    /// See-through nodes, by node index: see [`SceneBuilder::set_node_veil`].
+    veils: HashMap<usize, NodeVeil>,
 }
 
 impl SceneBuilder {
@@ -197,6 +296,12 @@ impl SceneBuilder {
         self.mirrors.push((of.to_string(), name.to_string()));
     }
 
+    /// Makes node `index` (in the order added) foliage and/or see-through. Checked at
+    /// [`Self::build`]: transmittance in [0, 1), and never on a receiver.
+    pub fn set_node_veil(&mut self, index: usize, veil: NodeVeil) {
+        self.veils.insert(index, veil);
+    }
+
     /// Number of nodes added so far.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
@@ -208,29 +313,38 @@ impl SceneBuilder {
         for node in &self.nodes {
             uses[node.mesh] += 1;
         }
-        for node in &self.nodes {
+        for (i, node) in self.nodes.iter().enumerate() {
             check_finite(node, &self.meshes[node.mesh].1)?;
+            check_veil(node, &self.veil_of(i))?;
         }
         let origin = input_centre(&self.nodes, &self.meshes);
         let mut scene = Scene {
             meshes: vec![Mesh { label: "static".into(), ..Default::default() }],
-            instances: vec![Instance { mesh: 0, transform: DMat4::from_translation(origin), receiver_base: 0 }],
+            instances: vec![Instance { mesh: 0, transform: DMat4::from_translation(origin), receiver_base: 0, leaf_shift: 0.0 }],
             origin,
             ..Default::default()
         };
         // Shared meshes are copied once into the scene; parts are found per (mesh, receiving node).
-        let mut shared: HashMap<usize, usize> = HashMap::new();
+        // A shared mesh placed with different veils is kept once per veil.
+        let mut shared: HashMap<(usize, (bool, u64)), usize> = HashMap::new();
         let mut names: HashMap<String, String> = HashMap::new();
-        for node in &self.nodes {
+        for (i, node) in self.nodes.iter().enumerate() {
             let (label, source) = &self.meshes[node.mesh];
+            let veil = self.veil_of(i);
+            if veil.foliage {
+                scene.leaves += leaf_count(source);
+            }
+            if veil.transmittance > 0.0 {
+                scene.see_through_triangles += source.indices.len() / 3;
+            }
             if uses[node.mesh] == 1 {
-                bake_node(&mut scene, node, source)?;
+                bake_node(&mut scene, node, source, &veil, i as u32)?;
             } else {
-                let mesh_index = *shared.entry(node.mesh).or_insert_with(|| {
-                    scene.meshes.push(shared_mesh(label, source));
+                let mesh_index = *shared.entry((node.mesh, veil.key())).or_insert_with(|| {
+                    scene.meshes.push(shared_mesh(label, source, &veil, i as u32));
                     scene.meshes.len() - 1
                 });
-                instance_node(&mut scene, node, mesh_index)?;
+                instance_node(&mut scene, node, mesh_index, i as u32)?;
             }
         }
         for (of, name) in &self.mirrors {
@@ -252,6 +366,80 @@ impl SceneBuilder {
         scene.bounds = bounds(&scene);
         Ok(scene)
     }
+}
+
+impl SceneBuilder {
+    fn veil_of(&self, node: usize) -> NodeVeil {
+        self.veils.get(&node).copied().unwrap_or_default()
+    }
+}
+
+fn check_veil(node: &SourceNode, veil: &NodeVeil) -> Result<()> {
+    if !(0.0..1.0).contains(&veil.transmittance) {
+        return Err(node.veil_error(&format!("transmittance {} is outside [0, 1)", veil.transmittance)));
+    }
+    if node.receiver && !veil.is_opaque() {
+        return Err(node.veil_error("is both a receiver and foliage or see-through; a receiving surface must be opaque"));
+    }
+    Ok(())
+}
+
+/// Per-vertex veils of one node's mesh. Leaves are the connected groups of triangles (sharing
+/// vertex indices), each with a rank drawn from a hash of (node, leaf), so a model gives the same
+/// leaves every run.
+fn node_veils(mesh: &SourceMesh, veil: &NodeVeil, node: u32) -> Vec<Veil> {
+    let seed = splitmix(node as u64 ^ 0x5eed) as u32;
+    let base = Veil { rank: -1.0, transmittance: veil.transmittance as f32, seed };
+    let mut out = vec![base; mesh.positions.len()];
+    if veil.foliage {
+        let leaf = leaf_of_vertex(mesh);
+        for (v, l) in out.iter_mut().zip(leaf) {
+            v.rank = unit_f32(splitmix(((node as u64) << 32) | l as u64));
+        }
+    }
+    out
+}
+
+/// Leaves of a foliage mesh: the connected groups its triangles use.
+fn leaf_count(mesh: &SourceMesh) -> usize {
+    let leaf = leaf_of_vertex(mesh);
+    let mut used: Vec<u32> = mesh.indices.iter().map(|&v| leaf[v as usize]).collect();
+    used.sort_unstable();
+    used.dedup();
+    used.len()
+}
+
+/// Connected components of a mesh by shared vertex indices (union–find), as a leaf number per vertex.
+fn leaf_of_vertex(mesh: &SourceMesh) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for tri in mesh.indices.chunks_exact(3) {
+        let a = find(&mut parent, tri[0]);
+        for &v in &tri[1..] {
+            let b = find(&mut parent, v);
+            parent[b as usize] = a;
+        }
+    }
+    (0..parent.len() as u32).map(|v| find(&mut parent, v)).collect()
+}
+
+/// SplitMix64: a well-mixed hash of a counter, for ranks and seeds.
+fn splitmix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A hash mapped to [0, 1) in f32 (24 bits, exactly representable, never 1).
+fn unit_f32(h: u64) -> f32 {
+    (h >> 40) as f32 / (1u64 << 24) as f32
 }
 
 fn input_centre(nodes: &[SourceNode], meshes: &[(String, SourceMesh)]) -> DVec3 {
@@ -351,13 +539,14 @@ fn no_area_error(node: &SourceNode) -> Error {
 }
 
 /// Appends a single-use node to the static mesh, in world coordinates.
-fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Result<()> {
+fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh, veil: &NodeVeil, index: u32) -> Result<()> {
     let tris = world_tris(node, source);
     let scene_origin = scene.origin;
     if !node.receiver {
+        let veils = node_veils(source, veil, index);
         let mesh = &mut scene.meshes[0];
-        for t in &tris {
-            push_tri(mesh, t, scene_origin, NO_RECEIVER);
+        for (t, tri) in tris.iter().zip(source.indices.chunks_exact(3)) {
+            push_tri(mesh, t, scene_origin, NO_RECEIVER, [0, 1, 2].map(|c| veils[tri[c] as usize]));
         }
         return Ok(());
     }
@@ -370,7 +559,7 @@ fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Resul
         let id = scene.receivers.len() as u32;
         let start = scene.meshes[0].indices.len() as u32;
         for &i in &part.triangles {
-            push_tri(&mut scene.meshes[0], &tris[i], scene_origin, id);
+            push_tri(&mut scene.meshes[0], &tris[i], scene_origin, id, [Veil::OPAQUE; 3]);
             in_part[i] = true;
         }
         let end = scene.meshes[0].indices.len() as u32;
@@ -380,7 +569,7 @@ fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh) -> Resul
     // Degenerate leftovers still go in (harmless), as shadow casters only.
     for (i, t) in tris.iter().enumerate() {
         if !in_part[i] {
-            push_tri(&mut scene.meshes[0], t, scene_origin, NO_RECEIVER);
+            push_tri(&mut scene.meshes[0], t, scene_origin, NO_RECEIVER, [Veil::OPAQUE; 3]);
         }
     }
     Ok(())
@@ -399,31 +588,34 @@ fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVe
     }
 }
 
-fn push_tri(mesh: &mut Mesh, t: &[DVec3; 3], origin: DVec3, surface: u32) {
-    for v in t {
+fn push_tri(mesh: &mut Mesh, t: &[DVec3; 3], origin: DVec3, surface: u32, veils: [Veil; 3]) {
+    for (v, veil) in t.iter().zip(veils) {
         let v = *v - origin;
         mesh.indices.push(mesh.positions.len() as u32);
         mesh.positions.push([v.x as f32, v.y as f32, v.z as f32]);
         mesh.surfaces.push(surface);
+        mesh.veils.push(veil);
     }
 }
 
-fn shared_mesh(label: &str, source: &SourceMesh) -> Mesh {
+fn shared_mesh(label: &str, source: &SourceMesh, veil: &NodeVeil, node: u32) -> Mesh {
     Mesh {
         label: label.to_string(),
         positions: source.positions.clone(),
         surfaces: vec![NO_RECEIVER; source.positions.len()],
         indices: source.indices.clone(),
+        veils: node_veils(source, veil, node),
     }
 }
 
 /// Places a shared mesh. A receiving instance needs per-vertex part values in the mesh; since an
 /// affine transform keeps coplanar triangles coplanar, the parts are a property of the mesh and
 /// are assigned once, on the first receiving instance.
-fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize) -> Result<()> {
+fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize, index: u32) -> Result<()> {
     let instance = scene.instances.len();
     if !node.receiver {
-        scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: NO_RECEIVER });
+        let leaf_shift = unit_f32(splitmix(index as u64 ^ 0x1eaf));
+        scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: NO_RECEIVER, leaf_shift });
         return Ok(());
     }
     let local = SourceMesh { positions: scene.meshes[mesh_index].positions.clone(), indices: scene.meshes[mesh_index].indices.clone() };
@@ -439,7 +631,7 @@ fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize) -> Res
         let r = receiver(node, part, k, parts.len(), &tris, draw, scene.receivers.len());
         scene.receivers.push(r);
     }
-    scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: base });
+    scene.instances.push(Instance { mesh: mesh_index, transform: node.transform, receiver_base: base, leaf_shift: 0.0 });
     Ok(())
 }
 
@@ -456,6 +648,7 @@ fn assign_parts(mesh: &mut Mesh, parts: &[Part]) -> Vec<Range<u32>> {
             new.indices.push(new.positions.len() as u32);
             new.positions.push(old.positions[v]);
             new.surfaces.push(surface);
+            new.veils.push(old.veils.get(v).copied().unwrap_or_default());
         }
     };
     for (k, part) in parts.iter().enumerate() {
@@ -546,6 +739,49 @@ mod tests {
         assert_eq!(s.receivers[1].gpu_id, 0);
         assert_eq!(s.receivers[1].normal, -s.receivers[0].normal);
         assert_eq!(s.triangle_count(), 2, "drawn once");
+    }
+
+    #[test]
+    fn leaves_are_connected_groups_and_each_placement_has_its_own() {
+        let mut b = SceneBuilder::new();
+        // Two separate quads: two leaves.
+        let mut two = quad(0.0);
+        two.positions.extend(quad(1.0).positions);
+        two.indices.extend([4, 5, 6, 4, 6, 7]);
+        let m = b.add_mesh("two leaves", two);
+        let foliage = NodeVeil { foliage: true, transmittance: 0.0 };
+        for i in 0..2 {
+            b.set_node_veil(b.node_count(), foliage);
+            b.add_node(node(&format!("tree{i}"), m, false, DMat4::from_translation(DVec3::new(5.0 * i as f64, 0.0, 0.0))));
+        }
+        // The same mesh placed opaque gets its own copy (veils live in the vertices).
+        b.add_node(node("statue", m, false, DMat4::IDENTITY));
+        b.add_object("test", "floor", quad(-1.0), true);
+        let s = b.build().unwrap();
+        assert_eq!(s.meshes.len(), 3, "static + foliage copy + opaque copy");
+        assert_eq!(s.veil_counts(), (4, 0));
+        let ranks: Vec<f32> = s.veiled_triangles().filter(|(_, _, v)| v.rank >= 0.0).map(|(_, _, v)| v.rank).collect();
+        assert_eq!(ranks.len(), 8);
+        assert!(ranks.iter().all(|r| (0.0..1.0).contains(r)));
+        let leaf = |k: usize| ranks[2 * k];
+        assert_eq!(ranks[0], ranks[1], "a quad's two triangles are one leaf");
+        assert!(leaf(0) != leaf(1) && leaf(0) != leaf(2) && leaf(1) != leaf(3), "{ranks:?}");
+        assert!(s.veiled_triangles().all(|(_, _, v)| v.present(0.0, 1.0)));
+        assert_eq!(s.veiled_triangles().filter(|(_, _, v)| !v.present(0.0, 0.0)).count(), 8, "no leaves at 0");
+    }
+
+    #[test]
+    fn see_through_receivers_and_bad_transmittance_are_refused() {
+        let mut b = SceneBuilder::new();
+        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 0.5 });
+        b.add_object("test.glb", "Screen", quad(0.0), true);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("node 'Screen'") && e.contains("must be opaque"), "{e}");
+        let mut b = SceneBuilder::new();
+        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 1.0 });
+        b.add_object("test.glb", "Screen", quad(0.0), false);
+        let e = b.build().unwrap_err().to_string();
+        assert!(e.contains("node 'Screen'") && e.contains("outside [0, 1)"), "{e}");
     }
 
     #[test]

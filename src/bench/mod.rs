@@ -1,5 +1,5 @@
-//! Benchmark scenes and timing: synthetic occluder clouds of a chosen size, the example office,
-//! and models after the paper's case studies ([`models`]) timed over the views `sunlit annual`
+//! Benchmark scenes and timing: synthetic occluder clouds of a chosen size, street trees in front
+//! of a facade (by leaf count), the example office, and models after the paper's case studies ([`models`]) timed over the views `sunlit annual`
 //! counts for its samples.
 //!
 //! Owns what `sunlit bench` measures, so the figures in the README come from one place.
@@ -36,6 +36,62 @@ pub fn occluder_cloud(triangles: usize, seed: u64) -> Result<Scene> {
     }
     b.add_object("bench", "cloud", cloud, false);
     b.build()
+}
+
+/// Trees along a street: a 30 m × 12 m south facade at y = 0 in three storeys (receivers
+/// `STOREY_1`–`STOREY_3`), and five trees 6 m in front of it (opaque trunks, crowns of radius 3 m
+/// centred 8 m up) whose crowns hold `leaves` square leaves of 0.2 m between them, each crown
+/// marked as foliage in its extras. As a glb, so the bench reads it the way a user's model is read.
+pub fn street_trees_glb(leaves: usize, seed: u64) -> Vec<u8> {
+    use crate::model::glb_write::GlbWriter;
+    let mut rng = SplitMix64(seed);
+    let mut w = GlbWriter::new();
+    let quad = |x0: f32, x1: f32, z0: f32, z1: f32| vec![[x0, 0.0, z0], [x1, 0.0, z0], [x1, 0.0, z1], [x0, 0.0, z1]];
+    for storey in 0..3 {
+        let z = 4.0 * storey as f32;
+        let m = w.add_mesh(&format!("storey {}", storey + 1), &quad(0.0, 30.0, z, z + 4.0), &[0, 1, 2, 0, 2, 3]);
+        w.add_node(&format!("STOREY_{}", storey + 1), m, [0.0; 3], Some(serde_json::json!({"sunlit": {"receiver": true}})));
+    }
+    let trunk = {
+        let (lo, hi) = ([-0.2f32, -0.2, 0.0], [0.2f32, 0.2, 6.0]);
+        let c = |i: usize| {
+            [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }]
+        };
+        let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let indices: Vec<u32> = quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+        w.add_mesh("trunk", &(0..8).map(c).collect::<Vec<_>>(), &indices)
+    };
+    for tree in 0..5 {
+        let x = 3.0 + 6.0 * tree as f32;
+        w.add_node(&format!("TRUNK_{}", tree + 1), trunk, [x, -6.0, 0.0], None);
+        let count = leaves / 5 + usize::from(tree < leaves % 5);
+        let crown = crown_mesh(&mut rng, DVec3::new(x as f64, -6.0, 8.0), 3.0, count);
+        let m = w.add_mesh(&format!("crown {}", tree + 1), &crown.positions, &crown.indices);
+        w.add_node(&format!("CROWN_{}", tree + 1), m, [0.0; 3], Some(serde_json::json!({"sunlit": {"foliage": true}})));
+    }
+    w.to_glb()
+}
+
+/// `count` randomly tilted square leaves (0.2 m) in a ball; a quad (two triangles) per leaf.
+fn crown_mesh(rng: &mut SplitMix64, centre: DVec3, radius: f64, count: usize) -> SourceMesh {
+    let mut mesh = SourceMesh::default();
+    for _ in 0..count {
+        let p = loop {
+            let p = DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            if p.length_squared() <= 1.0 {
+                break centre + radius * p;
+            }
+        };
+        let normal = DVec3::new(rng.range(-0.7, 0.7), rng.range(-0.7, 0.7), 1.0).normalize();
+        let u = normal.any_orthonormal_vector() * 0.1;
+        let v = normal.cross(u);
+        let base = mesh.positions.len() as u32;
+        for c in [p - u - v, p + u - v, p + u + v, p - u + v] {
+            mesh.positions.push([c.x as f32, c.y as f32, c.z as f32]);
+        }
+        mesh.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+    mesh
 }
 
 /// `count` sun directions spread over the sky above 10° altitude (deterministic).

@@ -17,6 +17,10 @@
 //!    fill, all contours counter-clockwise, 64-bit integer grid), and the fraction is its area
 //!    over the area of the union of the receiver's triangles.
 //!
+//! Foliage: a leaf casts a shadow when its rank is below the request's leaf fraction, the same
+//! f32 test the GPU makes, so both see the same leaves. See-through casters count as opaque here
+//! (the reference has no transmittance).
+//!
 //! Degenerate cases: an unknown receiver id, a non-finite sun vector or a receiver without area
 //! give 0 (nothing can be lit); a receiver that nothing shades gives exactly 1.
 
@@ -41,12 +45,17 @@ const WINDOW_MARGIN: f64 = 0.01;
 
 /// Sunlit fraction of one receiver for one sun direction, by exact polygon clipping.
 pub fn sunlit_fraction(scene: &Scene, request: ViewRequest) -> f64 {
-    Casters::new(scene).fraction(scene, request)
+    Casters::new(scene, 1.0).fraction(scene, request)
 }
 
 /// Many at once (may share work, e.g. collect the world triangles once).
 pub fn sunlit_fractions(scene: &Scene, requests: &[ViewRequest]) -> Vec<f64> {
-    let casters = Casters::new(scene);
+    sunlit_fractions_with_leaves(scene, requests, 1.0)
+}
+
+/// Many at once with leaf fraction `leaves`: only the leaves whose rank is below it cast shadows.
+pub fn sunlit_fractions_with_leaves(scene: &Scene, requests: &[ViewRequest], leaves: f32) -> Vec<f64> {
+    let casters = Casters::new(scene, leaves);
     requests.iter().map(|&request| casters.fraction(scene, request)).collect()
 }
 
@@ -61,10 +70,11 @@ struct Casters {
 }
 
 impl Casters {
-    fn new(scene: &Scene) -> Self {
+    fn new(scene: &Scene, leaves: f32) -> Self {
         let extent = (scene.bounds.1 - scene.bounds.0).length();
         let scale = if extent.is_finite() { 1.0 + extent } else { 1.0 };
-        Self { triangles: scene.world_triangles().collect(), eps: PLANE_EPS * scale, area_eps: AREA_EPS * scale * scale }
+        let triangles = scene.veiled_triangles().filter(|(_, _, veil)| veil.present(0.0, leaves)).map(|(t, id, _)| (t, id)).collect();
+        Self { triangles, eps: PLANE_EPS * scale, area_eps: AREA_EPS * scale * scale }
     }
 
     fn fraction(&self, scene: &Scene, request: ViewRequest) -> f64 {

@@ -7,6 +7,11 @@
 //! count is the pixel estimate of the projected area A·cosθ/Ap of the paper's formula, measured
 //! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
 //! surface gives exactly 1. Many views share one submission (tiles of the atlas).
+//!
+//! Foliage and see-through casters ([`crate::scene::Veil`]) are decided on the GPU, so one upload
+//! serves every day: each view carries its day's leaf fraction and the vertex shader drops the
+//! leaves whose rank is not below it; a see-through fragment is discarded (lets the sun through)
+//! where a per-pixel hash threshold falls below its transmittance.
 
 use std::ops::Range;
 use std::sync::{Arc, Mutex};
@@ -18,7 +23,7 @@ use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
 use crate::platform;
-use crate::scene::Scene;
+use crate::scene::{Mesh, Scene};
 
 const SUN_VIEW_WGSL: &str = include_str!("../../shaders/sun_view.wgsl");
 const COUNT_PIXELS_WGSL: &str = include_str!("../../shaders/count_pixels.wgsl");
@@ -132,7 +137,8 @@ struct ReceiverView {
 struct GpuInstance {
     transform: [[f32; 4]; 4],
     receiver_base: u32,
-    _pad: [u32; 3],
+    leaf_shift: f32,
+    _pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -141,7 +147,7 @@ struct GpuView {
     view_proj: [[f32; 4]; 4],
     tile: [u32; 2],
     target_id: u32,
-    _pad: u32,
+    leaves: f32,
 }
 
 #[repr(C)]
@@ -157,6 +163,21 @@ struct GpuParams {
 struct GpuVertex {
     position: [f32; 3],
     surface: u32,
+    /// Leaf rank (negative: not a leaf) and transmittance.
+    veil: [f32; 2],
+    seed: u32,
+}
+
+/// Vertex `v` of `mesh` as the shaders read it: position, surface id, and its leaf rank,
+/// transmittance and dither seed (defaults when the mesh has no see-through parts).
+fn gpu_vertex(mesh: &Mesh, v: usize) -> GpuVertex {
+    let veil = mesh.veils.get(v).copied().unwrap_or_default();
+    GpuVertex { position: mesh.positions[v], surface: mesh.surfaces[v], veil: [veil.rank, veil.transmittance], seed: veil.seed }
+}
+
+/// Vertices `range` of `mesh`, in order.
+fn gpu_vertices(mesh: &Mesh, range: Range<usize>) -> Vec<GpuVertex> {
+    range.map(|v| gpu_vertex(mesh, v)).collect()
 }
 
 impl Counter {
@@ -272,11 +293,7 @@ impl Counter {
             .enumerate()
             .map(|(index, m)| {
                 // The static mesh (0) is stored in the culling's order below instead.
-                let vertices: Vec<GpuVertex> = if index == 0 {
-                    Vec::new()
-                } else {
-                    m.positions.iter().zip(&m.surfaces).map(|(p, s)| GpuVertex { position: *p, surface: *s }).collect()
-                };
+                let vertices: Vec<GpuVertex> = if index == 0 { Vec::new() } else { gpu_vertices(m, 0..m.positions.len()) };
                 let indices: &[u32] = if index == 0 { &[] } else { &m.indices };
                 GpuMesh {
                     vertices: self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -315,7 +332,8 @@ impl Counter {
                 GpuInstance {
                     transform: (to_scene * inst.transform).as_mat4().to_cols_array_2d(),
                     receiver_base: inst.receiver_base,
-                    _pad: [0; 3],
+                    leaf_shift: inst.leaf_shift,
+                    _pad: [0; 2],
                 }
             })
             .collect();
@@ -377,8 +395,18 @@ impl Counter {
     }
 
     /// Sunlit fractions for many (receiver, sun) pairs; dark views (sun down, facing away) cost
-    /// nothing, the others are rendered in batches of atlas tiles.
+    /// nothing, the others are rendered in batches of atlas tiles. Every leaf is on.
     pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
+        self.fractions_with_leaves(scene, requests, &[]).await
+    }
+
+    /// As [`Self::fractions`], with `leaves[i]` the leaf fraction (0..=1) for request `i`: the
+    /// leaves whose rank is below it cast shadows. An empty `leaves` means every leaf is on.
+    pub async fn fractions_with_leaves(&self, scene: &GpuScene, requests: &[ViewRequest], leaves: &[f32]) -> Result<Vec<Counted>> {
+        if !leaves.is_empty() && leaves.len() != requests.len() {
+            return Err(Error::argument("leaves", format!("{} leaf fractions for {} views", leaves.len(), requests.len())));
+        }
+        let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
         let mut out = vec![Counted::default(); requests.len()];
         let mut lit: Vec<(usize, SunView, DrawList)> = Vec::new();
         for (i, req) in requests.iter().enumerate() {
@@ -400,7 +428,7 @@ impl Counter {
         let per_batch = self.tiles_per_batch();
         for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {
             for (b, batch) in chunk.chunks(per_batch).enumerate() {
-                self.submit_batch(scene, requests, batch, b)?;
+                self.submit_batch(scene, requests, &leaves_of, batch, b)?;
             }
             let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await?;
             self.check_errors("counting pixels")?;
@@ -421,7 +449,7 @@ impl Counter {
     fn static_chunks(&self, scene: &Scene, order: &[u32], max_triangles: u32) -> Vec<StaticChunk> {
         use wgpu::util::DeviceExt as _;
         let Some(mesh) = scene.meshes.first() else { return Vec::new() };
-        let vertex = |v: u32| GpuVertex { position: mesh.positions[v as usize], surface: mesh.surfaces[v as usize] };
+        let vertex = |v: u32| gpu_vertex(mesh, v as usize);
         order
             .chunks(max_triangles as usize)
             .enumerate()
@@ -447,7 +475,14 @@ impl Counter {
     }
 
     /// Renders and counts one batch of views; results land in `readback` at batch `index`.
-    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[(usize, SunView, DrawList)], index: usize) -> Result<()> {
+    fn submit_batch(
+        &self,
+        scene: &GpuScene,
+        requests: &[ViewRequest],
+        leaves: &dyn Fn(usize) -> f32,
+        batch: &[(usize, SunView, DrawList)],
+        index: usize,
+    ) -> Result<()> {
         let views: Vec<GpuView> = batch
             .iter()
             .enumerate()
@@ -455,7 +490,7 @@ impl Counter {
                 view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
                 tile: self.tile_origin(slot),
                 target_id: scene.receivers[requests[*i].receiver as usize].gpu_id,
-                _pad: 0,
+                leaves: leaves(*i),
             })
             .collect();
         self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
@@ -711,7 +746,7 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
         bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
-    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32];
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2, 3 => Uint32];
     let make = |label: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(label),

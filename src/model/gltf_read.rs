@@ -10,7 +10,7 @@ use base64::Engine as _;
 use glam::{DMat4, DVec4};
 
 use crate::error::{Error, Result};
-use crate::scene::{SourceMesh, SourceNode};
+use crate::scene::{NodeVeil, SourceMesh, SourceNode};
 
 /// One glTF file, read: its meshes (one per glTF mesh, primitives merged) and mesh nodes.
 #[derive(Debug, Clone)]
@@ -32,6 +32,8 @@ pub struct GltfNode {
     pub named: bool,
     /// Marked `{"sunlit": {"receiver": true}}` in its extras.
     pub marked: bool,
+    /// Foliage and transmittance from its extras: `{"sunlit": {"foliage": true, "transmittance": T}}`.
+    pub veil: NodeVeil,
     /// Index into [`GltfModel::meshes`].
     pub mesh: usize,
     /// Mesh → world (sunlit axes).
@@ -164,7 +166,8 @@ fn collect_nodes(file: &str, node: &::gltf::Node, parent: DMat4, out: &mut Vec<G
     let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
     let world = parent * local;
     if let Some(mesh) = node.mesh() {
-        out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(node), mesh: mesh.index(), transform: world });
+        let veil = extras_veil(node).map_err(|reason| Error::object(file, format!("node '{name}'"), reason))?;
+        out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(node), veil, mesh: mesh.index(), transform: world });
     }
     for child in node.children() {
         collect_nodes(file, &child, world, out, depth + 1)?;
@@ -176,6 +179,21 @@ fn is_marked(node: &::gltf::Node) -> bool {
     let Some(raw) = node.extras() else { return false };
     let value: serde_json::Value = serde_json::from_str(raw.get()).unwrap_or_default();
     value.pointer("/sunlit/receiver").and_then(serde_json::Value::as_bool).unwrap_or(false)
+}
+
+/// Foliage and transmittance marks in a node's extras; a mark of the wrong type is an error.
+fn extras_veil(node: &::gltf::Node) -> std::result::Result<NodeVeil, String> {
+    let Some(raw) = node.extras() else { return Ok(NodeVeil::default()) };
+    let value: serde_json::Value = serde_json::from_str(raw.get()).unwrap_or_default();
+    let foliage = match value.pointer("/sunlit/foliage") {
+        None => false,
+        Some(v) => v.as_bool().ok_or_else(|| format!("extras sunlit.foliage is {v}, expected true or false"))?,
+    };
+    let transmittance = match value.pointer("/sunlit/transmittance") {
+        None => 0.0,
+        Some(v) => v.as_f64().ok_or_else(|| format!("extras sunlit.transmittance is {v}, expected a number in [0, 1)"))?,
+    };
+    Ok(NodeVeil { foliage, transmittance })
 }
 
 fn read_mesh(file: &str, mesh: &::gltf::Mesh, buffers: &[Vec<u8>]) -> Result<SourceMesh> {
@@ -282,12 +300,22 @@ fn read_indices(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Res
 }
 
 impl GltfModel {
-    /// Adds this model's meshes and nodes to a scene builder, choosing receivers with `is_receiver`.
-    pub fn add_to(self, builder: &mut crate::scene::SceneBuilder, mut is_receiver: impl FnMut(&GltfNode) -> bool) {
+    /// Adds this model's meshes and nodes to a scene builder, choosing receivers with `is_receiver`
+    /// and what each node lets through with `veil`.
+    pub fn add_to(
+        self,
+        builder: &mut crate::scene::SceneBuilder,
+        mut is_receiver: impl FnMut(&GltfNode) -> bool,
+        mut veil: impl FnMut(&GltfNode) -> NodeVeil,
+    ) {
         let file = self.file;
         let base: Vec<usize> = self.meshes.into_iter().enumerate().map(|(i, m)| builder.add_mesh(format!("{file}: mesh {i}"), m)).collect();
         for node in self.nodes {
             let receiver = is_receiver(&node);
+            let veil = veil(&node);
+            if !veil.is_opaque() {
+                builder.set_node_veil(builder.node_count(), veil);
+            }
             builder.add_node(SourceNode {
                 origin: node.origin(&file),
                 mesh: base[node.mesh],

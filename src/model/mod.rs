@@ -5,7 +5,8 @@
 //! names) and glTF files are context that only casts shadows, unless `--receivers` picks glTF
 //! nodes too. Without one: `--receivers GLOB` (node names, case-insensitive) when given;
 //! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
-//! one; otherwise every named node with a mesh.
+//! one; otherwise every named node with a mesh. Foliage and see-through nodes (`--foliage`,
+//! `--transmittance`, or their extras marks) are never chosen by the marks-or-names default.
 pub mod arrays;
 pub mod building;
 pub mod epjson;
@@ -18,7 +19,7 @@ pub mod office_idf;
 use std::path::PathBuf;
 
 use crate::error::{Error, Result};
-use crate::scene::{Scene, SceneBuilder};
+use crate::scene::{NodeVeil, Scene, SceneBuilder};
 use gltf_read::{GltfModel, GltfNode};
 
 /// How to read models into a scene.
@@ -32,6 +33,10 @@ pub struct LoadOptions {
     /// With an EnergyPlus model: every surface receives, shading surfaces with their `Mir-`
     /// back faces (the columns of EnergyPlus's `Imported` form), not only the outdoor ones.
     pub all_energyplus_surfaces: bool,
+    /// Glob patterns over node names: these nodes are foliage (besides those marked in extras).
+    pub foliage: Vec<String>,
+    /// (glob, t): matching nodes let t of the beam through (the last matching pattern wins).
+    pub transmittance: Vec<(String, f64)>,
 }
 
 /// The EnergyPlus model among the inputs, kept for `--idf-out`.
@@ -160,6 +165,7 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
         Some(_) if options.receivers.is_empty() => Selection::Context,
         _ => Selection::new(&models, options)?,
     };
+    let veils = Veils::new(options)?;
     let mut builder = SceneBuilder::new();
     let mut matched = 0usize;
     if let Some(b) = energyplus {
@@ -172,16 +178,82 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
         }
     }
     for model in models {
-        model.add_to(&mut builder, |n| {
-            let hit = select.is_receiver(n);
-            matched += hit as usize;
-            hit
-        });
+        model.add_to(
+            &mut builder,
+            |n| {
+                let explicit = matches!(select, Selection::Globs(..));
+                let hit = select.is_receiver(n) && (explicit || veils.of(n).is_opaque());
+                matched += hit as usize;
+                hit
+            },
+            |n| veils.of(n),
+        );
     }
+    veils.check_used()?;
     if matched == 0 {
         return Err(Error::NoReceivers(select.explain()));
     }
     builder.build()
+}
+
+/// The foliage and transmittance rules in force for one load.
+struct Veils {
+    foliage: Vec<(globset::GlobMatcher, String)>,
+    transmittance: Vec<(globset::GlobMatcher, String, f64)>,
+    /// Patterns that matched some node, so a misspelt one is reported rather than ignored.
+    used: std::cell::RefCell<std::collections::HashSet<String>>,
+}
+
+impl Veils {
+    fn new(options: &LoadOptions) -> Result<Self> {
+        let glob = |flag: &str, pattern: &str| {
+            globset::GlobBuilder::new(pattern)
+                .case_insensitive(true)
+                .build()
+                .map(|g| g.compile_matcher())
+                .map_err(|e| Error::argument(flag.to_string(), format!("'{pattern}': {e}")))
+        };
+        let foliage = options.foliage.iter().map(|p| Ok((glob("--foliage", p)?, format!("--foliage {p}")))).collect::<Result<_>>()?;
+        let transmittance = options
+            .transmittance
+            .iter()
+            .map(|(p, t)| {
+                if !(0.0..1.0).contains(t) {
+                    return Err(Error::argument("--transmittance", format!("{p}={t}: the transmittance must be in [0, 1)")));
+                }
+                Ok((glob("--transmittance", p)?, format!("--transmittance {p}={t}"), *t))
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self { foliage, transmittance, used: Default::default() })
+    }
+
+    /// A node's veil: its extras, then the options (which win).
+    fn of(&self, node: &GltfNode) -> NodeVeil {
+        let mut veil = node.veil;
+        let mut used = self.used.borrow_mut();
+        for (g, label) in &self.foliage {
+            if g.is_match(&node.name) {
+                veil.foliage = true;
+                used.insert(label.clone());
+            }
+        }
+        for (g, label, t) in &self.transmittance {
+            if g.is_match(&node.name) {
+                veil.transmittance = *t;
+                used.insert(label.clone());
+            }
+        }
+        veil
+    }
+
+    fn check_used(&self) -> Result<()> {
+        let used = self.used.borrow();
+        let labels = self.foliage.iter().map(|(_, l)| l).chain(self.transmittance.iter().map(|(_, l, _)| l));
+        match labels.into_iter().find(|l| !used.contains(*l)) {
+            Some(label) => Err(Error::argument(label.clone(), "no glTF node name matches it")),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The receiver rule in force for one load.
