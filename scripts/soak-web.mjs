@@ -9,6 +9,9 @@ const server = await serve(0);
 const browser = await launch({ extraArgs: ['--enable-precise-memory-info', '--js-flags=--expose-gc'] });
 try {
   const page = await browser.newPage();
+  // Samples are printed as they come, so a crash still leaves the trend.
+  page.on('console', (m) => m.text().startsWith('{') && console.log(m.text()));
+  page.on('crash', () => console.log('the page crashed'));
   await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
   await page.waitForFunction(() => document.getElementById('out').dataset.state !== 'running', null, { timeout: 120_000 });
   const samples = await page.evaluate(async (runs) => {
@@ -23,14 +26,16 @@ try {
       year.csv();
       year.free();
       model.free();
-      if (i === 1 || i % 50 === 0) {
+      if (i === 1 || i % 10 === 0) {
         globalThis.gc?.();
-        out.push({ run: i, js_heap_mb: performance.memory.usedJSHeapSize / 2 ** 20, wasm_mb: (await wasmMemoryBytes()) / 2 ** 20, seconds: (performance.now() - t0) / 1000 });
+        const sample = { run: i, js_heap_mb: performance.memory.usedJSHeapSize / 2 ** 20, wasm_mb: (await wasmMemoryBytes()) / 2 ** 20, seconds: (performance.now() - t0) / 1000 };
+        console.log(JSON.stringify(sample));
+        out.push(sample);
       }
     }
     return out;
   }, runs);
-  for (const s of samples) console.log(JSON.stringify(s));
+  console.log(`${samples.length} samples; done`);
 } finally {
   await browser.close();
   server.close();

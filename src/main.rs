@@ -129,14 +129,14 @@ impl ModelArgs {
             receivers: self.receivers.clone(),
             north: self.north,
             foliage: self.foliage.clone(),
-            transmittance: self.transmittance.iter().map(|t| parse_transmittance(t)).collect::<Result<_>>().unwrap_or_default(),
+            transmittance: self.transmittance.iter().map(|t| model::parse_transmittance(t)).collect::<Result<_>>().unwrap_or_default(),
             ..Default::default()
         }
     }
 
     /// Refuses a malformed `--transmittance` before anything is read.
     fn check(&self) -> Result<()> {
-        self.transmittance.iter().try_for_each(|t| parse_transmittance(t).map(drop))
+        self.transmittance.iter().try_for_each(|t| model::parse_transmittance(t).map(drop))
     }
 
     fn load(&self) -> Result<Scene> {
@@ -148,16 +148,6 @@ impl ModelArgs {
         self.check()?;
         model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
     }
-}
-
-fn parse_transmittance(text: &str) -> Result<(String, f64)> {
-    let bad = || Error::argument("--transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
-    let (glob, t) = text.rsplit_once('=').ok_or_else(bad)?;
-    let t: f64 = t.trim().parse().map_err(|_| bad())?;
-    if glob.is_empty() || !(0.0..1.0).contains(&t) {
-        return Err(bad());
-    }
-    Ok((glob.to_string(), t))
 }
 
 #[derive(Args)]

@@ -15,16 +15,17 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
-use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual};
+use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
 use crate::count::ViewRequest;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
-use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all};
+use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::samples::{SamplingPlan, Timesteps};
 use crate::scene::Scene;
+use crate::season::{LeafCalendar, parse_period};
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 
@@ -65,13 +66,32 @@ impl Engine {
     /// Reads model files (glb/gltf with embedded buffers, IDF, epJSON) and uploads the scene.
     /// `names[i]` labels `contents[i]` in messages and picks its reader by extension.
     #[wasm_bindgen(js_name = loadFiles)]
-    pub fn load_files(&self, names: Vec<String>, contents: Array, receivers: Option<String>, north: Option<f64>) -> Result<Model, JsValue> {
+    /// `receivers` and `foliage` are comma-separated globs over node names; `transmittance` a
+    /// comma-separated list of `GLOB=T`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn load_files(
+        &self,
+        names: Vec<String>,
+        contents: Array,
+        receivers: Option<String>,
+        north: Option<f64>,
+        foliage: Option<String>,
+        transmittance: Option<String>,
+    ) -> Result<Model, JsValue> {
         if names.len() != contents.length() as usize {
             return Err(js_error(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length()))));
         }
         let files: Vec<(String, Vec<u8>)> =
             names.into_iter().zip(contents.iter()).map(|(name, bytes)| (name, Uint8Array::new(&bytes).to_vec())).collect();
-        let options = LoadOptions { receivers: receiver_patterns(receivers.as_deref()), north: north.unwrap_or(0.0), ..Default::default() };
+        let transmittance =
+            list(transmittance.as_deref()).iter().map(|t| parse_transmittance(t)).collect::<Result<Vec<_>>>().map_err(js_error)?;
+        let options = LoadOptions {
+            receivers: list(receivers.as_deref()),
+            north: north.unwrap_or(0.0),
+            foliage: list(foliage.as_deref()),
+            transmittance,
+            ..Default::default()
+        };
         let loaded = load_bytes_all(&files, &options).map_err(js_error)?;
         self.model(loaded.scene, loaded.energyplus)
     }
@@ -122,6 +142,7 @@ impl Engine {
             let settings = Settings::from_js(&settings).map_err(js_error)?;
             let model_timesteps = model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps);
             let (location, options) = settings.resolve(model_timesteps).map_err(js_error)?;
+            let calendar = settings.calendar(&location).map_err(js_error)?;
             let hook = match &model.energyplus {
                 Some(ep) => Some(hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error)?),
                 None => None,
@@ -136,15 +157,17 @@ impl Engine {
                 }
                 Ok(())
             };
-            let schedule = annual(&counter, &model.gpu, &model.scene, &location, &options, &mut report).await.map_err(js_error)?;
+            let schedule = annual_with_leaves(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report)
+                .await
+                .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
             Ok(Annual { schedule, means, hook, model }.into())
         })
     }
 }
 
-/// The `receivers` setting: comma-separated glob patterns, empty for the default rule.
-fn receiver_patterns(text: Option<&str>) -> Vec<String> {
+/// A comma-separated setting (globs, `GLOB=T` items); empty when not given.
+fn list(text: Option<&str>) -> Vec<String> {
     text.unwrap_or("").split(',').map(str::trim).filter(|p| !p.is_empty()).map(String::from).collect()
 }
 
@@ -179,6 +202,18 @@ impl Model {
     #[wasm_bindgen(getter)]
     pub fn triangles(&self) -> usize {
         self.inner.scene.triangle_count()
+    }
+
+    /// Leaves of the foliage (connected groups of triangles), 0 without foliage.
+    #[wasm_bindgen(getter)]
+    pub fn leaves(&self) -> usize {
+        self.inner.scene.leaves
+    }
+
+    /// Triangles that let part of the beam through (transmittance below 1).
+    #[wasm_bindgen(getter, js_name = seeThroughTriangles)]
+    pub fn see_through_triangles(&self) -> usize {
+        self.inner.scene.see_through_triangles
     }
 
     /// Whether an EnergyPlus model was among the files (then [`Annual::hooked_model`] works).
@@ -235,6 +270,12 @@ pub struct Settings {
     refine: Option<f64>,
     /// Count every timestep instead of the spline.
     dense: Option<bool>,
+    /// Foliage keeps its leaves all year.
+    evergreen: Option<bool>,
+    /// Leaf-out period, `START,END` as `MM-DD` dates (default 04-15,05-31, flipped south).
+    leaf_out: Option<String>,
+    /// Leaf-fall period (default 10-01,11-15).
+    leaf_fall: Option<String>,
 }
 
 impl Settings {
@@ -244,6 +285,18 @@ impl Settings {
         }
         let text = js_sys::JSON::stringify(value).map_err(|_| Error::argument("settings", "not a plain object"))?;
         serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("settings", e.to_string()))
+    }
+
+    /// The foliage calendar: evergreen, the given periods, or the defaults for the latitude.
+    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
+        if self.evergreen.unwrap_or(false) {
+            return Ok(LeafCalendar::evergreen());
+        }
+        match (&self.leaf_out, &self.leaf_fall) {
+            (Some(out), Some(fall)) => LeafCalendar::new(parse_period(out)?, parse_period(fall)?),
+            (None, None) => Ok(LeafCalendar::for_latitude(location.latitude)),
+            _ => Err(Error::argument("leaf dates", "give both leafOut and leafFall, or neither")),
+        }
     }
 
     /// The location and options, with the EnergyPlus model's Timestep as the default.

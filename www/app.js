@@ -39,14 +39,19 @@ async function loadFiles(files) {
   state.csvName = `${base}-shading.csv`;
   status(`Reading ${state.modelName}…`);
   $('compute').disabled = true;
-  worker.postMessage({ type: 'load', files, receivers: $('receivers').value, north: 0, resolution: resolution() });
+  const options = { receivers: $('receivers').value, north: 0, foliage: $('foliage').value, transmittance: $('transmittance').value };
+  worker.postMessage({ type: 'load', files, options, resolution: resolution() });
 }
 
 function showModel(msg) {
   state.model = msg;
   state.result = null;
   state.selected = -1;
-  $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receiving surfaces, ${msg.triangles.toLocaleString()} triangles`;
+  const extras = [msg.leaves ? `${msg.leaves.toLocaleString()} leaves` : '', msg.seeThrough ? `${msg.seeThrough.toLocaleString()} see-through triangles` : '']
+    .filter(Boolean)
+    .map((t) => `, ${t}`)
+    .join('');
+  $('modelinfo').textContent = `${state.modelName}: ${msg.names.length} receiving surfaces, ${msg.triangles.toLocaleString()} triangles${extras}`;
   $('download').disabled = true;
   $('downloadidf').hidden = !msg.hasEnergyPlus;
   // The CSV must have the EnergyPlus model's Timestep to be hooked in.
@@ -154,6 +159,11 @@ async function settings() {
     daysPerYear: Number($('days').value),
     samplesPerDay: Number($('perday').value),
   };
+  if ($('evergreen').checked) s.evergreen = true;
+  else if ($('leafout').value.trim() || $('leaffall').value.trim()) {
+    s.leafOut = $('leafout').value.trim();
+    s.leafFall = $('leaffall').value.trim();
+  }
   const epw = $('epw').files[0];
   if (epw) {
     s.epw = await epw.text();
@@ -184,8 +194,8 @@ function wire() {
     e.target.value = '';
     await loadFiles(files);
   });
-  // Receivers decide what the model is: a new pattern re-reads the files.
-  $('receivers').addEventListener('change', () => state.files && loadFiles(state.files));
+  // These decide what the model is: a change re-reads the files.
+  for (const id of ['receivers', 'foliage', 'transmittance']) $(id).addEventListener('change', () => state.files && loadFiles(state.files));
   $('example').addEventListener('click', async () => {
     const bytes = new Uint8Array(await (await fetch('pkg/office.glb')).arrayBuffer());
     await loadFiles([{ name: 'office.glb', bytes }]);

@@ -19,6 +19,18 @@ export interface ModelFile {
   bytes: Uint8Array | ArrayBuffer;
 }
 
+export interface LoadOptions {
+  /** Comma-separated globs over node names (case-insensitive): the receiving surfaces. Default:
+   * nodes marked {"sunlit":{"receiver":true}} in extras, else every named node with a mesh. */
+  receivers?: string;
+  /** Degrees clockwise from true north of the model's north (glTF -Z). */
+  north?: number;
+  /** Comma-separated globs: these nodes are foliage (also nodes marked {"sunlit":{"foliage":true}}). */
+  foliage?: string;
+  /** Comma-separated GLOB=T items: matching nodes let T (0..1) of the beam through. */
+  transmittance?: string;
+}
+
 export interface ArraysInput {
   /** x, y, z per vertex. */
   positions: ArrayLike<number>;
@@ -53,6 +65,12 @@ export interface AnnualSettings {
   refine?: number;
   /** Count every sun-up timestep instead of interpolating (slow). */
   dense?: boolean;
+  /** Foliage keeps its leaves all year. */
+  evergreen?: boolean;
+  /** Leaf-out period "MM-DD,MM-DD" (default "04-15,05-31"; half a year later south of the equator). */
+  leafOut?: string;
+  /** Leaf-fall period "MM-DD,MM-DD" (default "10-01,11-15"). */
+  leafFall?: string;
 }
 
 export interface AnnualRunOptions {
@@ -68,7 +86,7 @@ export interface SunlitEngine {
   /** Pixels along a view's side. */
   readonly resolution: number;
   /** Reads model files; throws an Error naming the file, object and reason when one is bad. */
-  loadFiles(files: ModelFile[], options?: { receivers?: string; north?: number }): Model;
+  loadFiles(files: ModelFile[], options?: LoadOptions): Model;
   /** Builds a model from typed arrays; throws an Error naming the array and element when bad. */
   fromArrays(input: ArraysInput): Model;
   /** Every receiver's fraction for one sun direction (unit vector towards the sun, or angles). */
@@ -83,6 +101,10 @@ export interface Model {
   /** m² per receiver. */
   readonly receiverAreas: Float64Array;
   readonly triangles: number;
+  /** Leaves of the foliage (0 without). */
+  readonly leaves: number;
+  /** Triangles that let part of the beam through. */
+  readonly seeThroughTriangles: number;
   /** Whether an EnergyPlus model was among the files (then Annual.hookedModel works). */
   readonly hasEnergyPlus: boolean;
   /** The EnergyPlus model's Timestep, if one was loaded (the CSV must match it). */

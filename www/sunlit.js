@@ -69,11 +69,11 @@ class SunlitEngine {
     return this.#engine.resolution;
   }
 
-  /** A model from files: [{ name, bytes }]; glb/gltf (embedded buffers), IDF or epJSON. */
-  loadFiles(files, { receivers = '', north = 0 } = {}) {
+  /** A model from files: [{ name, bytes }]; glb, gltf (+ its .bin files), IDF or epJSON. */
+  loadFiles(files, { receivers = '', north = 0, foliage = '', transmittance = '' } = {}) {
     const names = files.map((f) => String(f.name));
     const contents = files.map((f) => toBytes(f.bytes, f.name));
-    return this.#engine.loadFiles(names, contents, receivers, north);
+    return this.#engine.loadFiles(names, contents, receivers, north, foliage, transmittance);
   }
 
   /** A model from typed arrays (see sunlit.d.ts). */

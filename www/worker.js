@@ -39,14 +39,14 @@ function fail(error, request) {
   postMessage({ type: 'error', request, message, gpu, cancelled: error?.name === 'AbortError' });
 }
 
-async function load({ files: given, receivers, north, resolution }) {
+async function load({ files: given, options, resolution }) {
   const e = await engineFor(resolution);
   // Read first: a bad file leaves the last good model in place.
-  const m = e.loadFiles(given, { receivers, north });
+  const m = e.loadFiles(given, options);
   model?.free();
   model = m;
   files = given;
-  loadOptions = { receivers, north };
+  loadOptions = options;
   const positions = m.worldPositions();
   const receiversOf = m.worldReceivers();
   postMessage(
@@ -55,6 +55,8 @@ async function load({ files: given, receivers, north, resolution }) {
       names: m.receiverNames,
       areas: m.receiverAreas,
       triangles: m.triangles,
+      leaves: m.leaves,
+      seeThrough: m.seeThroughTriangles,
       hasEnergyPlus: m.hasEnergyPlus,
       modelTimesteps: m.modelTimesteps,
       adapter: engine.adapter,

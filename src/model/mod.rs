@@ -108,6 +108,19 @@ fn energyplus_kind(name: &str) -> Option<bool> {
     }
 }
 
+/// Parses `GLOB=T` (a `--transmittance` option, or one item of the page's list): nodes matching
+/// GLOB let T (0 ≤ T < 1) of the beam through.
+pub fn parse_transmittance(text: &str) -> Result<(String, f64)> {
+    let bad = || Error::argument("--transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
+    let (glob, t) = text.rsplit_once('=').ok_or_else(bad)?;
+    let t: f64 = t.trim().parse().map_err(|_| bad())?;
+    let glob = glob.trim();
+    if glob.is_empty() || !(0.0..1.0).contains(&t) {
+        return Err(bad());
+    }
+    Ok((glob.to_string(), t))
+}
+
 /// Files that are never models themselves: glTF buffers and textures.
 fn is_resource(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();

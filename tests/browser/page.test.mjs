@@ -216,6 +216,40 @@ test('an EnergyPlus IDF loads, and the hooked IDF downloads with its CSV named',
   assert.match(text, /Scheduled/);
 });
 
+test('trees shade by season: bare in winter, and evergreen keeps them', { timeout: 600_000 }, async () => {
+  const trees = join(WORK, 'trees.glb');
+  execFileSync('cargo', ['run', '--quiet', '--example', 'make_trees', '--', '3000', trees], { cwd: ROOT, stdio: 'inherit' });
+  const loaded = await statusAfter(() => page.setInputFiles('#model', trees), /^Loaded|^Could not/);
+  assert.match(loaded, /^Loaded trees\.glb \(3 receivers\)/);
+  assert.match(await page.textContent('#modelinfo'), /3,000 leaves/);
+  await page.fill('#days', '14');
+  await page.fill('#perday', '9');
+  await page.fill('#resolution', '128');
+  await page.selectOption('#timesteps', '1');
+  const year = async (evergreen) => {
+    await page.setChecked('#evergreen', evergreen);
+    assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done/);
+    const download = page.waitForEvent('download');
+    await page.click('#download');
+    const file = join(WORK, `trees-${evergreen}.csv`);
+    await (await download).saveAs(file);
+    return parseCsv(readFileSync(file, 'utf8'));
+  };
+  const deciduous = await year(false);
+  const evergreen = await year(true);
+  await page.setChecked('#evergreen', false);
+  // Mean of the ground storey (column 1) over a month's daylight rows.
+  const mean = (csv, firstDay, days) => {
+    const rows = csv.rows.slice(24 * firstDay, 24 * (firstDay + days)).map((r) => Number(r[1])).filter((v) => v > 0);
+    return rows.reduce((a, b) => a + b, 0) / rows.length;
+  };
+  const [winterBare, winterLeafy] = [mean(deciduous, 0, 31), mean(evergreen, 0, 31)];
+  const [summerBare, summerLeafy] = [mean(deciduous, 181, 31), mean(evergreen, 181, 31)];
+  console.log(`STOREY_1 January: deciduous ${winterBare.toFixed(3)}, evergreen ${winterLeafy.toFixed(3)}; July: ${summerBare.toFixed(3)}, ${summerLeafy.toFixed(3)}`);
+  assert.ok(winterBare > winterLeafy + 0.02, 'bare winter trees let more sun through than evergreen ones');
+  assert.ok(Math.abs(summerBare - summerLeafy) < 0.005, 'in full leaf both agree');
+});
+
 test('names from a file render as text, never as markup', async () => {
   const name = '<img src=x onerror="window.pwned=1">';
   const positions = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 1, 0]).buffer);
