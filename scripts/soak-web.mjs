@@ -22,7 +22,7 @@ try {
     const t0 = performance.now();
     for (let i = 1; i <= runs; i++) {
       const model = engine.loadFiles([{ name: 'office.glb', bytes }]);
-      const year = await engine.annual(model, { latitude: 39.74, longitude: -105.18, timeZone: -7, timestepsPerHour: 1, daysPerYear: 6, samplesPerDay: 5 });
+      const year = await engine.annual(model, { latitude: 39.74, longitude: -105.18, timeZone: -7, timestepsPerHour: 1, daysPerYear: 14, samplesPerDay: 9, refine: 1 });
       year.csv();
       year.free();
       model.free();

@@ -37,13 +37,7 @@ fn crown(count: usize, seed: u64) -> SourceMesh {
             }
         };
         let normal = DVec3::new(rng.random_range(-0.6..0.6), rng.random_range(-0.6..0.6), 1.0).normalize();
-        let u = normal.any_orthonormal_vector() * 0.175;
-        let v = normal.cross(u);
-        let base = mesh.positions.len() as u32;
-        for c in [centre - u - v, centre + u - v, centre + u + v, centre - u + v] {
-            mesh.positions.push([c.x as f32, c.y as f32, c.z as f32]);
-        }
-        mesh.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        sunlit::bench::push_leaf(&mut mesh, centre, normal, 0.175);
     }
     mesh
 }

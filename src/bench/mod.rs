@@ -83,15 +83,20 @@ fn crown_mesh(rng: &mut SplitMix64, centre: DVec3, radius: f64, count: usize) ->
             }
         };
         let normal = DVec3::new(rng.range(-0.7, 0.7), rng.range(-0.7, 0.7), 1.0).normalize();
-        let u = normal.any_orthonormal_vector() * 0.1;
-        let v = normal.cross(u);
-        let base = mesh.positions.len() as u32;
-        for c in [p - u - v, p + u - v, p + u + v, p - u + v] {
-            mesh.positions.push([c.x as f32, c.y as f32, c.z as f32]);
-        }
-        mesh.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        push_leaf(&mut mesh, p, normal, 0.1);
     }
     mesh
+}
+
+/// Appends a square leaf (a quad, two triangles) of half-side `half` at `centre`, facing `normal`.
+pub fn push_leaf(mesh: &mut SourceMesh, centre: DVec3, normal: DVec3, half: f64) {
+    let u = normal.any_orthonormal_vector() * half;
+    let v = normal.cross(u);
+    let base = mesh.positions.len() as u32;
+    for c in [centre - u - v, centre + u - v, centre + u + v, centre - u + v] {
+        mesh.positions.push([c.x as f32, c.y as f32, c.z as f32]);
+    }
+    mesh.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
 }
 
 /// `count` sun directions spread over the sky above 10° altitude (deterministic).
