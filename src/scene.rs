@@ -278,6 +278,16 @@ fn check_finite(node: &SourceNode, mesh: &SourceMesh) -> Result<()> {
         };
         return Err(Error::object(file, object, what));
     }
+    // Finite vertices under a finite transform can still land absurdly far away (a scale of 1e30).
+    let world = |p: &[f32; 3]| node.transform.transform_point3(to_dvec(*p));
+    if let Some((i, w)) = mesh.positions.iter().map(world).enumerate().find(|(_, w)| w.abs().max_element() > 1e7) {
+        let (file, object) = split_origin(&node.origin);
+        return Err(Error::object(
+            file,
+            object,
+            format!("vertex {i} is placed at {w}, beyond ±1e7 m (check the node's transform and units)"),
+        ));
+    }
     let n = mesh.positions.len() as u32;
     if let Some(i) = mesh.indices.iter().find(|&&i| i >= n) {
         let (file, object) = split_origin(&node.origin);
