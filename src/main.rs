@@ -154,6 +154,7 @@ struct BenchArgs {
 fn main() -> ExitCode {
     quiet_mesa_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    exit_cleanly_on_ctrl_c();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Fraction(a) => fraction(a),
@@ -167,6 +168,20 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
+/// partial stays beside it, and exit as interrupted (130). Outputs are only written at the end;
+/// before that there is nothing to clean.
+fn exit_cleanly_on_ctrl_c() {
+    let handler = || {
+        sunlit::export::remove_partial_files();
+        eprintln!("interrupted");
+        std::process::exit(130);
+    };
+    if let Err(e) = ctrlc::set_handler(handler) {
+        log::warn!("Ctrl-C will not clean up temporary files: {e}");
     }
 }
 
