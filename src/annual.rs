@@ -84,6 +84,29 @@ pub async fn annual(
     Ok(schedule)
 }
 
+/// [`annual`] surviving one loss of the GPU device (a driver reset, a GPU hang): on
+/// [`Error::DeviceLost`] it makes a new counter with the same options, uploads the scene again
+/// and counts the year once more from the start (progress starts again at 0). A second loss is
+/// returned.
+pub async fn annual_recovering(
+    counter: &mut Counter,
+    gpu: &mut GpuScene,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Schedule> {
+    match annual(counter, gpu, scene, location, options, progress).await {
+        Err(Error::DeviceLost(why)) => {
+            log::warn!("GPU device lost ({why}); making a new one and counting again");
+            *counter = counter.recreate().await?;
+            *gpu = counter.upload(scene)?;
+            annual(counter, gpu, scene, location, options, progress).await
+        }
+        other => other,
+    }
+}
+
 /// The counter and the scene on it: what turns view requests into fractions.
 struct Views<'a> {
     counter: &'a Counter,

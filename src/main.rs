@@ -278,8 +278,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let counter = counter(args.resolution)?;
-    let gpu = counter.upload(&scene)?;
+    let mut counter = counter(args.resolution)?;
+    let mut gpu = counter.upload(&scene)?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -292,7 +292,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
         Ok(())
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
-    let schedule = pollster::block_on(sunlit::annual::annual(&counter, &gpu, &scene, &location, &options, &mut report))?;
+    // A lost GPU device (driver reset) is recreated once; the year is counted again.
+    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut counter, &mut gpu, &scene, &location, &options, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
