@@ -224,6 +224,17 @@ fn broken_gltf_files() {
     bad_version[4] = 1;
     check("glb version 1", Case::model("v1.glb", bad_version, "v1.glb: not a valid glTF 2.0 file: unsupported version"));
     check("empty", Case::model("empty.gltf", vec![], "empty.gltf: the file is empty"));
+    // Found by fuzzing: the gltf crate subtracted the header size from this length unchecked.
+    let mut short = b"glTF\x02\0\0\0\x03\0\0\0".to_vec();
+    short.resize(64, 0);
+    check(
+        "length below header",
+        Case::model(
+            "short.glb",
+            short,
+            "short.glb: not a valid glTF 2.0 file: its GLB header declares 3 bytes in all, less than the header itself",
+        ),
+    );
     check(
         "not json",
         Case::model(

@@ -91,7 +91,10 @@ fn read_with(
 
 fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
     let first = bytes.iter().find(|b| !b.is_ascii_whitespace()).copied();
-    if bytes.starts_with(b"glTF") || first == Some(b'{') {
+    if bytes.starts_with(b"glTF") {
+        return check_glb_length(file, bytes);
+    }
+    if first == Some(b'{') {
         return Ok(());
     }
     if bytes.is_empty() {
@@ -126,6 +129,21 @@ fn load_buffers(file: &str, gltf: &::gltf::Gltf, external: impl Fn(&str) -> std:
 fn decode_data_uri(rest: &str) -> std::result::Result<Vec<u8>, String> {
     let (_, payload) = rest.split_once(";base64,").ok_or("data: URI is not base64")?;
     base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64 data: {e}"))
+}
+
+/// A GLB header's total length must cover the 12-byte header itself: the gltf crate subtracts
+/// 12 from it unchecked (a panic in builds with overflow checks; found by fuzzing).
+fn check_glb_length(file: &str, bytes: &[u8]) -> Result<()> {
+    match bytes.get(8..12) {
+        Some(&[a, b, c, d]) if u32::from_le_bytes([a, b, c, d]) < 12 => Err(Error::model(
+            file,
+            format!(
+                "not a valid glTF 2.0 file: its GLB header declares {} bytes in all, less than the header itself",
+                u32::from_le_bytes([a, b, c, d])
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The nodes to walk: the default scene's, else the first scene's, else every parentless node.
