@@ -266,6 +266,18 @@ fn missing_and_external_buffers() {
             .with_file("geometry.bin", bin[..20].to_vec())
             .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (use a .glb, or embed buffers as data: URIs)")),
     );
+    // Nodes reached twice: a cycle, and a child shared by two parents (exponential to walk).
+    let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let cycle =
+        text.replace(r#""nodes":[{"name":"A","mesh":0}]"#, r#""nodes":[{"name":"A","mesh":0,"children":[1]},{"name":"B","children":[0]}]"#);
+    let message = "cycle.gltf: node 'A': is reached twice in the node hierarchy (a cycle, or more than one parent)";
+    check("cycle", Case::model("cycle.gltf", cycle.into_bytes(), message));
+    let shared = text.replace(
+        r#""nodes":[{"name":"A","mesh":0}],"scenes":[{"nodes":[0]}]"#,
+        r#""nodes":[{"name":"A","mesh":0},{"name":"P","children":[0]},{"name":"Q","children":[0]}],"scenes":[{"nodes":[1,2]}]"#,
+    );
+    let message = "shared.gltf: node 'A': is reached twice in the node hierarchy (a cycle, or more than one parent)";
+    check("shared child", Case::model("shared.gltf", shared.into_bytes(), message));
     let no_buffers = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
     let no_buffers = no_buffers.split("\"buffers\"").next().unwrap().to_string()
         + "\"bufferViews\""

@@ -83,8 +83,9 @@ fn read_with(
     let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
+    let mut walked = vec![false; gltf.document.nodes().len()];
     for root in scene_roots(&gltf.document) {
-        collect_nodes(file, &root, world, &mut nodes, 0)?;
+        collect_nodes(file, &root, world, &mut nodes, &mut walked)?;
     }
     Ok(GltfModel { file: file.to_string(), meshes, nodes })
 }
@@ -160,21 +161,31 @@ fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
     doc.nodes().filter(|n| !has_parent[n.index()]).collect()
 }
 
-/// glTF forbids cycles, but a hostile file may contain one: stop well before the stack does.
-const MAX_DEPTH: usize = 256;
-
-fn collect_nodes(file: &str, node: &::gltf::Node, parent: DMat4, out: &mut Vec<GltfNode>, depth: usize) -> Result<()> {
-    let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
-    if depth > MAX_DEPTH {
-        return Err(Error::object(file, format!("node '{name}'"), "node hierarchy is deeper than 256 levels (a cycle?)"));
-    }
-    let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-    let world = parent * local;
-    if let Some(mesh) = node.mesh() {
-        out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(node), mesh: mesh.index(), transform: world });
-    }
-    for child in node.children() {
-        collect_nodes(file, &child, world, out, depth + 1)?;
+/// glTF gives a node at most one parent. A hostile file may give it several, or a cycle: walking
+/// such a graph would repeat nodes without end, or exponentially often (a DAG of shared children).
+/// The walk keeps its own stack, so a deep (valid) chain cannot overflow the thread's.
+fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &mut Vec<GltfNode>, walked: &mut [bool]) -> Result<()> {
+    let mut stack = vec![(root.clone(), parent)];
+    while let Some((node, parent)) = stack.pop() {
+        let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
+        match walked.get_mut(node.index()) {
+            Some(seen) if !*seen => *seen = true,
+            _ => {
+                return Err(Error::object(
+                    file,
+                    format!("node '{name}'"),
+                    "is reached twice in the node hierarchy (a cycle, or more than one parent)",
+                ));
+            }
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(&node), mesh: mesh.index(), transform: world });
+        }
+        // Reversed onto the stack: children are walked in file order.
+        let children: Vec<_> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
     Ok(())
 }
