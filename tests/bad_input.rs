@@ -386,6 +386,12 @@ fn degenerate_duplicate_and_unmatched_receivers() {
             "lines.glb: node 'Wire': receiver has zero area (all its triangles are degenerate)",
         ),
     );
+    // 1001 parallel triangles 1 cm apart: 1001 planes, past the 1000 a receiver may split into.
+    let stack: Vec<[f32; 3]> =
+        (0..1001).flat_map(|k| [[0.0, 0.0, k as f32 * 0.01], [1.0, 0.0, k as f32 * 0.01], [0.0, 1.0, k as f32 * 0.01]]).collect();
+    let indices: Vec<u32> = (0..stack.len() as u32).collect();
+    let message = "many.glb: node 'Stack': receiver is not planar in fewer than 1000 parts (a curved mesh?): leave it out of the receivers";
+    check("too many planes", Case::model("many.glb", glb(&[("Stack", &stack, &indices)]), message));
     let twins = glb(&[("Twin", &SQUARE, &QUAD), ("Twin", &SQUARE, &QUAD)]);
     check(
         "duplicate",
