@@ -311,6 +311,10 @@ fn accessors_out_of_range() {
         "index past vertices",
         Case::model("index.gltf", gltf(&SQUARE, &[0, 1, 7], node, None), "index.gltf: mesh 0 '': index 7 out of range (4 vertices)"),
     );
+    // Found by fuzzing: gltf-json indexed the accessors with a missing POSITION accessor.
+    let position = text.replacen(r#""POSITION":0"#, r#""POSITION":32"#, 1);
+    let message = "position.gltf: mesh 0: primitive 0: POSITION accessor 32 does not exist (2 accessors)";
+    check("position accessor missing", Case::model("position.gltf", position.into_bytes(), message));
     let view = text.replacen(r#""byteLength":48}"#, r#""byteLength":4800}"#, 1);
     check(
         "view past buffer",

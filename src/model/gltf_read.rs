@@ -78,6 +78,7 @@ fn read_with(
     external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>,
 ) -> Result<GltfModel> {
     check_magic(file, bytes)?;
+    check_position_accessors(file, bytes)?;
     let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(file, &gltf, external)?;
     let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
@@ -145,6 +146,34 @@ fn check_glb_length(file: &str, bytes: &[u8]) -> Result<()> {
         )),
         _ => Ok(()),
     }
+}
+
+/// gltf-json 1.4's validation indexes `accessors` with each primitive's POSITION before checking
+/// that it exists (a panic; found by fuzzing): check it first, on the JSON (chunk).
+fn check_position_accessors(file: &str, bytes: &[u8]) -> Result<()> {
+    let json = if bytes.starts_with(b"glTF") {
+        let length = bytes.get(12..16).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        bytes.get(20..20usize.saturating_add(length)).unwrap_or(&[])
+    } else {
+        bytes
+    };
+    // Anything unreadable here is left for the gltf crate to report.
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(json) else { return Ok(()) };
+    let accessors = root.get("accessors").and_then(serde_json::Value::as_array).map_or(0, Vec::len);
+    let meshes = root.get("meshes").and_then(serde_json::Value::as_array).map_or(&[][..], Vec::as_slice);
+    for (m, mesh) in meshes.iter().enumerate() {
+        let primitives = mesh.get("primitives").and_then(serde_json::Value::as_array).map_or(&[][..], Vec::as_slice);
+        for (p, primitive) in primitives.iter().enumerate() {
+            match primitive.pointer("/attributes/POSITION").and_then(serde_json::Value::as_u64) {
+                Some(i) if i as usize >= accessors => {
+                    let reason = format!("primitive {p}: POSITION accessor {i} does not exist ({accessors} accessors)");
+                    return Err(Error::object(file, format!("mesh {m}"), reason));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The nodes to walk: the default scene's, else the first scene's, else every parentless node.
