@@ -314,7 +314,13 @@ fn accessors_out_of_range() {
     // Found by fuzzing: gltf-json indexed the accessors with a missing POSITION accessor.
     let position = text.replacen(r#""POSITION":0"#, r#""POSITION":32"#, 1);
     let message = "position.gltf: mesh 0: primitive 0: POSITION accessor 32 does not exist (2 accessors)";
-    check("position accessor missing", Case::model("position.gltf", position.into_bytes(), message));
+    check("position accessor missing", Case::model("position.gltf", position.clone().into_bytes(), message));
+    // The same with invalid UTF-8 in a string, which the gltf crate reads anyway (found by fuzzing).
+    let mut latin1 = position.replacen(r#""version":"2.0""#, "\"version\":\"2.0\",\"generator\":\"caf\u{1}\"", 1).into_bytes();
+    let at = latin1.iter().position(|&b| b == 1).unwrap();
+    latin1[at] = 0xE9;
+    let message = "latin1.gltf: mesh 0: primitive 0: POSITION accessor 32 does not exist (2 accessors)";
+    check("position accessor missing, not UTF-8", Case::model("latin1.gltf", latin1, message));
     let view = text.replacen(r#""byteLength":48}"#, r#""byteLength":4800}"#, 1);
     check(
         "view past buffer",
