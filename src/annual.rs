@@ -113,6 +113,30 @@ pub async fn annual_with_leaves(
     Ok(schedule)
 }
 
+/// [`annual`] surviving one loss of the GPU device (a driver reset, a GPU hang): on
+/// [`Error::DeviceLost`] it makes a new counter with the same options, uploads the scene again
+/// and counts the year once more from the start (progress starts again at 0). A second loss is
+/// returned.
+pub async fn annual_recovering(
+    counter: &mut Counter,
+    gpu: &mut GpuScene,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Schedule> {
+    match annual_with_leaves(counter, gpu, scene, location, options, calendar, progress).await {
+        Err(Error::DeviceLost(why)) => {
+            log::warn!("GPU device lost ({why}); making a new one and counting again");
+            *counter = counter.recreate().await?;
+            *gpu = counter.upload(scene)?;
+            annual_with_leaves(counter, gpu, scene, location, options, calendar, progress).await
+        }
+        other => other,
+    }
+}
+
 /// The counter and the scene on it: what turns view requests into fractions.
 struct Views<'a> {
     counter: &'a Counter,

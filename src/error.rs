@@ -56,6 +56,10 @@ pub enum Error {
     /// The GPU could not be set up or failed during a pass.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// The GPU device was lost (driver reset, GPU hung or removed, or destroyed): its results are
+    /// gone, but a new device may work ([`crate::annual::annual_recovering`] makes one).
+    #[error("GPU device lost ({0})")]
+    DeviceLost(String),
     /// The caller asked the run to stop (a progress callback said so, or an `AbortSignal` fired).
     #[error("cancelled")]
     Cancelled,

@@ -225,6 +225,7 @@ struct BenchArgs {
 fn main() -> ExitCode {
     quiet_mesa_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    exit_cleanly_on_ctrl_c();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Fraction(a) => fraction(a),
@@ -238,6 +239,20 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
+/// partial stays beside it, and exit as interrupted (130). Outputs are only written at the end;
+/// before that there is nothing to clean.
+fn exit_cleanly_on_ctrl_c() {
+    let handler = || {
+        sunlit::export::remove_partial_files();
+        eprintln!("interrupted");
+        std::process::exit(130);
+    };
+    if let Err(e) = ctrlc::set_handler(handler) {
+        log::warn!("Ctrl-C will not clean up temporary files: {e}");
     }
 }
 
@@ -340,8 +355,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let counter = counter(args.resolution)?;
-    let gpu = counter.upload(&scene)?;
+    let mut counter = counter(args.resolution)?;
+    let mut gpu = counter.upload(&scene)?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -354,8 +369,9 @@ fn annual(args: AnnualArgs) -> Result<()> {
         Ok(())
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
+    // A lost GPU device (driver reset) is recreated once; the year is counted again.
     let schedule =
-        pollster::block_on(sunlit::annual::annual_with_leaves(&counter, &gpu, &scene, &location, &options, &calendar, &mut report))?;
+        pollster::block_on(sunlit::annual::annual_recovering(&mut counter, &mut gpu, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.

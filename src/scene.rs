@@ -466,6 +466,16 @@ fn check_finite(node: &SourceNode, mesh: &SourceMesh) -> Result<()> {
         };
         return Err(Error::object(file, object, what));
     }
+    // Finite vertices under a finite transform can still land absurdly far away (a scale of 1e30).
+    let world = |p: &[f32; 3]| node.transform.transform_point3(to_dvec(*p));
+    if let Some((i, w)) = mesh.positions.iter().map(world).enumerate().find(|(_, w)| w.abs().max_element() > 1e7) {
+        let (file, object) = split_origin(&node.origin);
+        return Err(Error::object(
+            file,
+            object,
+            format!("vertex {i} is placed at {w}, beyond ±1e7 m (check the node's transform and units)"),
+        ));
+    }
     let n = mesh.positions.len() as u32;
     if let Some(i) = mesh.indices.iter().find(|&&i| i >= n) {
         let (file, object) = split_origin(&node.origin);
@@ -499,7 +509,18 @@ struct Part {
 }
 
 /// Groups triangles by plane, largest triangles first so each part's plane is a large triangle's.
-fn planar_parts(tris: &[[DVec3; 3]]) -> Vec<Part> {
+/// A receiving node splitting into more planar parts than this is not a building surface (a
+/// curved or organic mesh), and finding its parts would take tris × parts steps.
+const MAX_PARTS: usize = 1000;
+
+fn too_many_parts(node: &SourceNode) -> Error {
+    let (file, object) = split_origin(&node.origin);
+    let reason = format!("receiver is not planar in fewer than {MAX_PARTS} parts (a curved mesh?): leave it out of the receivers");
+    Error::object(file, object, reason)
+}
+
+/// Planar parts of a receiver's triangles, or `None` past [`MAX_PARTS`].
+fn planar_parts(tris: &[[DVec3; 3]]) -> Option<Vec<Part>> {
     let mut order: Vec<usize> = (0..tris.len()).filter(|&i| tri_area(&tris[i]) > DEGENERATE_AREA).collect();
     order.sort_by(|&a, &b| tri_area(&tris[b]).total_cmp(&tri_area(&tris[a])));
     let cos_tol = COPLANAR_ANGLE.cos();
@@ -508,8 +529,9 @@ fn planar_parts(tris: &[[DVec3; 3]]) -> Vec<Part> {
         let t = &tris[i];
         let n = tri_normal(t);
         let fits = |p: &Part| n.dot(p.normal) >= cos_tol && t.iter().all(|v| (v.dot(p.normal) - p.offset).abs() <= COPLANAR_DISTANCE);
-        match parts.iter_mut().find(|p| fits(p)) {
-            Some(p) => p.triangles.push(i),
+        match parts.iter().position(fits) {
+            Some(k) => parts[k].triangles.push(i),
+            None if parts.len() == MAX_PARTS => return None,
             None => parts.push(Part { normal: n, offset: n.dot(t[0]), triangles: vec![i] }),
         }
     }
@@ -518,7 +540,7 @@ fn planar_parts(tris: &[[DVec3; 3]]) -> Vec<Part> {
         p.triangles.sort_unstable();
     }
     parts.sort_by_key(|p| p.triangles[0]);
-    parts
+    Some(parts)
 }
 
 fn tri_area(t: &[DVec3; 3]) -> f64 {
@@ -550,7 +572,7 @@ fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh, veil: &N
         }
         return Ok(());
     }
-    let parts = planar_parts(&tris);
+    let parts = planar_parts(&tris).ok_or_else(|| too_many_parts(node))?;
     if parts.is_empty() {
         return Err(no_area_error(node));
     }
@@ -620,7 +642,7 @@ fn instance_node(scene: &mut Scene, node: &SourceNode, mesh_index: usize, index:
     }
     let local = SourceMesh { positions: scene.meshes[mesh_index].positions.clone(), indices: scene.meshes[mesh_index].indices.clone() };
     let tris = world_tris(node, &local);
-    let parts = planar_parts(&tris);
+    let parts = planar_parts(&tris).ok_or_else(|| too_many_parts(node))?;
     if parts.is_empty() {
         return Err(no_area_error(node));
     }

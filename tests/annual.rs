@@ -146,6 +146,10 @@ fn cli_writes_the_energyplus_csv() {
         }
     }
     assert!(lit > 20_000, "windows are lit for much of the year: {lit}");
+    // The library's reader takes the file back whole, with the timestep count found from its rows.
+    let schedule = sunlit::export::Schedule::from_csv("shading.csv", &text).unwrap();
+    assert_eq!((schedule.names.len(), schedule.timesteps.per_hour()), (5, 4));
+    assert_eq!(schedule.values.iter().filter(|&&v| v > 0.0).count(), lit);
 }
 
 #[test]

@@ -34,6 +34,8 @@ const ROWS_PER_GROUP: u32 = 64;
 /// count reads one texel per pixel.
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// How the uncaptured-error sink records an out-of-memory error, for the hint in its message.
+const OUT_OF_MEMORY: &str = "out of GPU memory";
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 const BATCHES_PER_READBACK: usize = 32;
 
@@ -85,6 +87,8 @@ pub struct Counter {
     counts: wgpu::Buffer,
     readback: wgpu::Buffer,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Why the device was lost, once it is (set by wgpu's device-lost callback).
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 struct Atlas {
@@ -206,9 +210,16 @@ impl Counter {
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             if let Ok(mut list) = sink.lock() {
-                list.push(e.to_string());
+                list.push(if matches!(e, wgpu::Error::OutOfMemory { .. }) { OUT_OF_MEMORY.to_string() } else { e.to_string() });
             }
         }));
+        let lost = Arc::new(Mutex::new(None));
+        let lost_sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            if let Ok(mut slot) = lost_sink.lock() {
+                *slot = Some(format!("{reason:?}: {message}"));
+            }
+        });
         let render_layout = render_bind_layout(&device);
         let count_layout = count_bind_layout(&device);
         let (scene_pipeline, mask_pipeline) = render_pipelines(&device, &render_layout);
@@ -245,6 +256,7 @@ impl Counter {
             counts,
             readback,
             errors,
+            lost,
         };
         counter.check_errors("setting up the GPU")?;
         Ok(counter)
@@ -266,13 +278,63 @@ impl Counter {
     }
 
     fn check_errors(&self, doing: &str) -> Result<()> {
+        self.check_lost()?;
         let mut list = self.errors.lock().map_err(|_| Error::Gpu("error log poisoned".into()))?;
         if list.is_empty() {
             return Ok(());
         }
+        let out_of_memory = list.iter().any(|e| e == OUT_OF_MEMORY);
         let all = list.join("; ");
         list.clear();
+        if out_of_memory {
+            let hint = format!("lower --resolution (now {}) or count fewer triangles (split the model)", self.options.resolution);
+            return Err(Error::Gpu(format!("{doing}: out of GPU memory; {hint}")));
+        }
         Err(Error::Gpu(format!("{doing}: {all}")))
+    }
+
+    /// Refuses, before allocating, a scene whose buffers exceed this device's limits: wgpu would
+    /// otherwise fail with a validation error, or the driver run out of memory. The static mesh
+    /// (mesh 0) is exempt: it is split over as many buffers as it needs.
+    fn check_fits(&self, scene: &Scene) -> Result<()> {
+        let limits = self.device.limits();
+        let mesh_bytes = |m: &crate::scene::Mesh| (m.positions.len() * size_of::<GpuVertex>()).max(m.indices.len() * 4);
+        let vertices = scene.meshes.iter().skip(1).map(mesh_bytes).max().unwrap_or(0) as u64;
+        let instances = (scene.instances.len() * size_of::<GpuInstance>()) as u64;
+        let (need, limit) = if vertices > limits.max_buffer_size {
+            (vertices, limits.max_buffer_size)
+        } else if instances > limits.max_storage_buffer_binding_size {
+            (instances, limits.max_storage_buffer_binding_size)
+        } else {
+            return Ok(());
+        };
+        let mib = |b: u64| b as f64 / (1 << 20) as f64;
+        Err(Error::Gpu(format!(
+            "the scene needs a {:.0} MiB buffer, more than this GPU's {:.0} MiB limit: count fewer triangles or placements (split the model, or leave out far context)",
+            mib(need),
+            mib(limit)
+        )))
+    }
+
+    /// [`Error::DeviceLost`] once the device is gone: every later error is a consequence of it.
+    fn check_lost(&self) -> Result<()> {
+        match self.lost.lock().map(|l| l.clone()) {
+            Ok(Some(why)) => Err(Error::DeviceLost(why)),
+            _ => Ok(()),
+        }
+    }
+
+    /// A new counter with the same options on a new device (after [`Error::DeviceLost`]).
+    pub async fn recreate(&self) -> Result<Counter> {
+        Counter::new(self.options).await
+    }
+
+    /// Tests only: a function that destroys this counter's device, as a driver reset would lose
+    /// it, from wherever it is called (a progress callback, mid-run).
+    #[doc(hidden)]
+    pub fn device_loss_trigger(&self) -> impl Fn() + 'static {
+        let device = self.device.clone();
+        move || device.destroy()
     }
 
     /// Uploads a scene's geometry once; views of it then cost only draws. The static mesh goes
@@ -287,6 +349,9 @@ impl Counter {
     /// exercise the split with small values).
     pub fn upload_in_chunks(&self, scene: &Scene, max_triangles: u32) -> Result<GpuScene> {
         use wgpu::util::DeviceExt as _;
+        // wgpu's create_buffer_init panics on a lost device (its mapped range is invalid).
+        self.check_lost()?;
+        self.check_fits(scene)?;
         let meshes: Vec<GpuMesh> = scene
             .meshes
             .iter()
@@ -430,8 +495,10 @@ impl Counter {
             for (b, batch) in chunk.chunks(per_batch).enumerate() {
                 self.submit_batch(scene, requests, &leaves_of, batch, b)?;
             }
-            let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await?;
+            let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await;
+            // A failed read on a lost device is the loss, not a read error.
             self.check_errors("counting pixels")?;
+            let counts = counts?;
             let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
             for (k, (i, view, _)) in chunk.iter().enumerate() {
                 let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);

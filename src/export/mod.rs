@@ -93,22 +93,110 @@ impl Schedule {
     pub fn to_csv(&self) -> Result<String> {
         String::from_utf8(self.csv_bytes()?).map_err(|e| Error::argument("schedule", e.to_string()))
     }
+
+    /// Reads a CSV in the layout [`Self::csv_bytes`] writes (EnergyPlus's eplusshading.csv):
+    /// the timestep count comes from the row count, every row's stamp must be the one expected
+    /// at its place, and the result passes [`Self::validate`]. `file` names the source in errors.
+    pub fn from_csv(file: &str, text: &str) -> Result<Self> {
+        let fail = |line: usize, reason: String| Error::model(file, format!("line {line}: {reason}"));
+        let mut lines = text.lines();
+        let header = lines.next().unwrap_or("");
+        let Some(names) = header.strip_prefix("Surface Name,") else {
+            return Err(fail(1, format!("expected the header 'Surface Name,NAME,…,', got '{}'", excerpt(header))));
+        };
+        let names: Vec<String> = csv_fields(names).map(str::to_string).collect();
+        let rows: Vec<&str> = lines.collect();
+        let per_hour = rows.len() / (DAYS_HOURS as usize);
+        let timesteps = match Timesteps::new(per_hour as u32) {
+            Ok(t) if rows.len() == t.rows() => t,
+            _ => {
+                let reason = format!("{} rows; a year is 8760 × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows", rows.len());
+                return Err(Error::model(file, reason));
+            }
+        };
+        let mut values = Vec::with_capacity(rows.len() * names.len());
+        for (row, text) in rows.iter().enumerate() {
+            let line = row + 2;
+            let mut fields = csv_fields(text);
+            let stamp = fields.next().unwrap_or("");
+            let expected = timesteps.stamp(row);
+            if stamp.trim() != expected.trim() {
+                return Err(fail(line, format!("timestamp '{}', expected '{}'", excerpt(stamp), expected.trim())));
+            }
+            let before = values.len();
+            // Names first: zip stops on them without taking a surplus value from `fields`.
+            for (name, value) in names.iter().zip(fields.by_ref()) {
+                let v =
+                    value.trim().parse::<f32>().map_err(|_| fail(line, format!("'{}' for '{name}' is not a number", excerpt(value))))?;
+                values.push(v);
+            }
+            let found = values.len() - before + fields.count();
+            if found != names.len() {
+                return Err(fail(line, format!("{found} values for {} surfaces", names.len())));
+            }
+        }
+        let schedule = Schedule { names, timesteps, values };
+        schedule.validate().map_err(|e| Error::model(file, e.to_string()))?;
+        Ok(schedule)
+    }
+}
+
+/// Hours in EnergyPlus's schedule year.
+const DAYS_HOURS: u32 = crate::samples::DAYS * 24;
+
+/// A CSV line's fields, without the one trailing comma EnergyPlus writes (and `\r`).
+fn csv_fields(line: &str) -> std::str::Split<'_, char> {
+    let line = line.strip_suffix('\r').unwrap_or(line);
+    line.strip_suffix(',').unwrap_or(line).split(',')
+}
+
+/// At most 40 characters of `text`, for messages.
+fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(40) {
+        Some((at, _)) => format!("{}…", &text[..at]),
+        None => text.to_string(),
+    }
+}
+
+/// Temporary files of writes in progress, so an interrupted process can remove them
+/// ([`remove_partial_files`]). The lock is held across each rename, so a remover sees a write
+/// either before its rename (and removes the temporary file) or after it (and finds nothing).
+static PARTIALS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn partials() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    // A panic while holding the lock leaves the list as valid as before: keep using it.
+    PARTIALS.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file beside it, flushed, then renamed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source: std::io::Error, p: &Path| Error::Io { path: p.to_path_buf(), source };
     let tmp = temporary_sibling(path);
-    let result = (|| {
+    partials().push(tmp.clone());
+    let written = (|| {
         let mut file = std::fs::File::create(&tmp).map_err(|e| io(e, path))?;
         file.write_all(bytes).map_err(|e| io(e, path))?;
-        file.sync_all().map_err(|e| io(e, path))?;
-        std::fs::rename(&tmp, path).map_err(|e| io(e, path))
+        file.sync_all().map_err(|e| io(e, path))
     })();
+    let mut list = partials();
+    let result = written.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| io(e, path)));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    list.retain(|p| *p != tmp);
     result
+}
+
+/// Removes the temporary files of writes in progress (from a Ctrl-C handler: the process is
+/// about to exit, and a half-written temporary file must not stay beside the output).
+pub fn remove_partial_files() {
+    remove_listed(&mut partials());
+}
+
+fn remove_listed(list: &mut Vec<PathBuf>) {
+    for tmp in list.drain(..) {
+        let _ = std::fs::remove_file(tmp);
+    }
 }
 
 fn temporary_sibling(path: &Path) -> PathBuf {
@@ -158,6 +246,41 @@ mod tests {
     }
 
     #[test]
+    fn csv_reads_back_what_is_written() {
+        let s = schedule();
+        let back = Schedule::from_csv("s.csv", &s.to_csv().unwrap()).unwrap();
+        assert_eq!(back, s);
+        // EnergyPlus's own files may end lines with \r\n.
+        let crlf = s.to_csv().unwrap().replace('\n', "\r\n");
+        assert_eq!(Schedule::from_csv("s.csv", &crlf).unwrap(), s);
+    }
+
+    #[test]
+    fn bad_csv_names_line_and_reason() {
+        let text = schedule().to_csv().unwrap();
+        let cases = [
+            (String::new(), "s.csv: line 1: expected the header 'Surface Name,NAME,…,', got ''"),
+            (text.replacen(" 01/01 00:30", " 01/01 00:31", 1), "s.csv: line 3: timestamp ' 01/01 00:31', expected '01/01 00:30'"),
+            (text.replacen("0.12500000", "half", 1), "s.csv: line 52: 'half' for 'WIN_S' is not a number"),
+            (text.replacen("0.12500000", "1.5", 1), "s.csv: invalid schedule: value 1.5 for 'WIN_S' at row 50 is outside [0, 1]"),
+            (text.replacen("0.12500000,", "", 1), "s.csv: line 52: 1 values for 2 surfaces"),
+            (text.replacen("0.12500000,", "0.1,0.2,", 1), "s.csv: line 52: 3 values for 2 surfaces"),
+            (
+                text.lines().take(1001).collect::<Vec<_>>().join("\n"),
+                "s.csv: 1000 rows; a year is 8760 × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows",
+            ),
+            (
+                text.replacen("WIN_S", "wall_s", 1),
+                "s.csv: invalid schedule: surface name 'wall_s' appears twice (EnergyPlus names are case-insensitive)",
+            ),
+        ];
+        for (text, expected) in cases {
+            // Not unwrap_err: a wrongly accepted schedule would print 35 040 rows.
+            assert_eq!(Schedule::from_csv("s.csv", &text).err().map(|e| e.to_string()).as_deref(), Some(expected));
+        }
+    }
+
+    #[test]
     fn atomic_write_replaces_or_leaves_nothing() {
         let dir = std::env::temp_dir().join(format!("sunlit-atomic-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -174,5 +297,20 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().ends_with(".partial"))
             .collect();
         assert!(leftovers.is_empty());
+        assert!(partials().iter().all(|p| !p.starts_with(&dir)), "finished writes are unregistered");
+    }
+
+    #[test]
+    fn interrupted_writes_leave_no_temporary_file() {
+        let dir = std::env::temp_dir().join(format!("sunlit-interrupted-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("b.csv");
+        // A write caught between its temporary file and its rename, as a Ctrl-C would find it
+        // (a list of its own: the global one may hold other tests' writes in progress).
+        let tmp = temporary_sibling(&path);
+        std::fs::write(&tmp, b"half").unwrap();
+        let mut list = vec![tmp.clone()];
+        remove_listed(&mut list);
+        assert!(!tmp.exists() && !path.exists() && list.is_empty());
     }
 }

@@ -135,6 +135,7 @@ const SETTINGS: [&str; 5] = ["Version", "Building", "GlobalGeometryRules", "Zone
 /// Reads the geometry of an EnergyPlus model.
 pub fn read_building(file: &str, objects: &[IdfObject]) -> Result<Building> {
     let version = super::idf::version(objects);
+    check_unknown_geometry(file, objects)?;
     let mut reader = Reader::new(file, objects, IddLayout::from_version(version.as_deref()))?;
     for object in objects {
         reader.base_surface(object)?;
@@ -147,6 +148,41 @@ pub fn read_building(file: &str, objects: &[IdfObject]) -> Result<Building> {
     }
     let skipped = skipped_classes(objects, &reader.handled);
     reader.finish(version, skipped)
+}
+
+/// Class-name prefixes under which every EnergyPlus class is geometry, and every one of them is
+/// read here: an unknown class with one of these prefixes is a misspelling (or a class from a
+/// newer EnergyPlus), and skipping it would silently lose a surface and its shadow.
+const GEOMETRY_PREFIXES: [&str; 6] = ["BuildingSurface:", "FenestrationSurface:", "Shading:", "Wall:", "Floor:", "Ceiling:"];
+
+/// The classes under [`GEOMETRY_PREFIXES`] that are read, besides [`RECT_SURFACES`].
+const PREFIXED_GEOMETRY: [&str; 13] = [
+    "BuildingSurface:Detailed",
+    "FenestrationSurface:Detailed",
+    "Shading:Site",
+    "Shading:Site:Detailed",
+    "Shading:Building",
+    "Shading:Building:Detailed",
+    "Shading:Zone:Detailed",
+    "Shading:Overhang",
+    "Shading:Overhang:Projection",
+    "Shading:Fin",
+    "Shading:Fin:Projection",
+    "Wall:Detailed",
+    "Floor:Detailed",
+];
+
+/// Refuses, before anything is read, an object whose class looks like geometry but is unknown,
+/// so the message names it rather than a surface that depended on it.
+fn check_unknown_geometry(file: &str, objects: &[IdfObject]) -> Result<()> {
+    let prefixed = |class: &str| GEOMETRY_PREFIXES.iter().any(|p| class.get(..p.len()).is_some_and(|c| c.eq_ignore_ascii_case(p)));
+    let known = |o: &IdfObject| PREFIXED_GEOMETRY.iter().chain(RECT_SURFACES.iter().map(|r| &r.class)).any(|c| o.is(c));
+    match objects.iter().find(|o| prefixed(&o.class) && !known(o)) {
+        Some(object) => {
+            Err(Error::object(file, object.label(), "is not a geometry class sunlit knows (misspelt?); reading on would lose its surface"))
+        }
+        None => Ok(()),
+    }
 }
 
 /// Degrees clockwise (seen from above) → the matching rotation of (x, y), as EnergyPlus's

@@ -91,20 +91,25 @@ fn read_with(
     external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>,
 ) -> Result<GltfModel> {
     check_magic(file, bytes)?;
+    check_position_accessors(file, bytes)?;
     let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
     let buffers = load_buffers(file, &gltf, external)?;
     let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
+    let mut walked = vec![false; gltf.document.nodes().len()];
     for root in scene_roots(&gltf.document) {
-        collect_nodes(file, &root, world, &mut nodes, 0)?;
+        collect_nodes(file, &root, world, &mut nodes, &mut walked)?;
     }
     Ok(GltfModel { file: file.to_string(), meshes, nodes })
 }
 
 fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
     let first = bytes.iter().find(|b| !b.is_ascii_whitespace()).copied();
-    if bytes.starts_with(b"glTF") || first == Some(b'{') {
+    if bytes.starts_with(b"glTF") {
+        return check_glb_length(file, bytes);
+    }
+    if first == Some(b'{') {
         return Ok(());
     }
     if bytes.is_empty() {
@@ -141,6 +146,50 @@ fn decode_data_uri(rest: &str) -> std::result::Result<Vec<u8>, String> {
     base64::engine::general_purpose::STANDARD.decode(payload).map_err(|e| format!("bad base64 data: {e}"))
 }
 
+/// A GLB header's total length must cover the 12-byte header itself: the gltf crate subtracts
+/// 12 from it unchecked (a panic in builds with overflow checks; found by fuzzing).
+fn check_glb_length(file: &str, bytes: &[u8]) -> Result<()> {
+    match bytes.get(8..12) {
+        Some(&[a, b, c, d]) if u32::from_le_bytes([a, b, c, d]) < 12 => Err(Error::model(
+            file,
+            format!(
+                "not a valid glTF 2.0 file: its GLB header declares {} bytes in all, less than the header itself",
+                u32::from_le_bytes([a, b, c, d])
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// gltf-json 1.4's validation indexes `accessors` with each primitive's POSITION before checking
+/// that it exists (a panic; found by fuzzing): check it first, on the JSON (chunk).
+fn check_position_accessors(file: &str, bytes: &[u8]) -> Result<()> {
+    let json = if bytes.starts_with(b"glTF") {
+        let length = bytes.get(12..16).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        bytes.get(20..20usize.saturating_add(length)).unwrap_or(&[])
+    } else {
+        bytes
+    };
+    // Anything unreadable here is left for the gltf crate to report.
+    // Lossy: the gltf crate reads strings holding invalid UTF-8, so this check must too.
+    let Ok(root) = serde_json::from_str::<serde_json::Value>(&String::from_utf8_lossy(json)) else { return Ok(()) };
+    let accessors = root.get("accessors").and_then(serde_json::Value::as_array).map_or(0, Vec::len);
+    let meshes = root.get("meshes").and_then(serde_json::Value::as_array).map_or(&[][..], Vec::as_slice);
+    for (m, mesh) in meshes.iter().enumerate() {
+        let primitives = mesh.get("primitives").and_then(serde_json::Value::as_array).map_or(&[][..], Vec::as_slice);
+        for (p, primitive) in primitives.iter().enumerate() {
+            match primitive.pointer("/attributes/POSITION").and_then(serde_json::Value::as_u64) {
+                Some(i) if i as usize >= accessors => {
+                    let reason = format!("primitive {p}: POSITION accessor {i} does not exist ({accessors} accessors)");
+                    return Err(Error::object(file, format!("mesh {m}"), reason));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The nodes to walk: the default scene's, else the first scene's, else every parentless node.
 fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
     if let Some(scene) = doc.default_scene().or_else(|| doc.scenes().next()) {
@@ -155,22 +204,32 @@ fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
     doc.nodes().filter(|n| !has_parent[n.index()]).collect()
 }
 
-/// glTF forbids cycles, but a hostile file may contain one: stop well before the stack does.
-const MAX_DEPTH: usize = 256;
-
-fn collect_nodes(file: &str, node: &::gltf::Node, parent: DMat4, out: &mut Vec<GltfNode>, depth: usize) -> Result<()> {
-    let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
-    if depth > MAX_DEPTH {
-        return Err(Error::object(file, format!("node '{name}'"), "node hierarchy is deeper than 256 levels (a cycle?)"));
-    }
-    let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-    let world = parent * local;
-    if let Some(mesh) = node.mesh() {
-        let veil = extras_veil(node).map_err(|reason| Error::object(file, format!("node '{name}'"), reason))?;
-        out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(node), veil, mesh: mesh.index(), transform: world });
-    }
-    for child in node.children() {
-        collect_nodes(file, &child, world, out, depth + 1)?;
+/// glTF gives a node at most one parent. A hostile file may give it several, or a cycle: walking
+/// such a graph would repeat nodes without end, or exponentially often (a DAG of shared children).
+/// The walk keeps its own stack, so a deep (valid) chain cannot overflow the thread's.
+fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &mut Vec<GltfNode>, walked: &mut [bool]) -> Result<()> {
+    let mut stack = vec![(root.clone(), parent)];
+    while let Some((node, parent)) = stack.pop() {
+        let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
+        match walked.get_mut(node.index()) {
+            Some(seen) if !*seen => *seen = true,
+            _ => {
+                return Err(Error::object(
+                    file,
+                    format!("node '{name}'"),
+                    "is reached twice in the node hierarchy (a cycle, or more than one parent)",
+                ));
+            }
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            let veil = extras_veil(&node).map_err(|reason| Error::object(file, format!("node '{name}'"), reason))?;
+            out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(&node), veil, mesh: mesh.index(), transform: world });
+        }
+        // Reversed onto the stack: children are walked in file order.
+        let children: Vec<_> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
     }
     Ok(())
 }

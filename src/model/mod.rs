@@ -154,7 +154,11 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
 }
 
 fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusInput> {
-    let text = String::from_utf8(bytes.to_vec()).map_err(|e| Error::model(name, format!("not UTF-8 text: {e}")))?;
+    let text = match std::str::from_utf8(bytes) {
+        Ok(text) => text.to_string(),
+        // The IDF reader's message names the line and byte; epJSON must be UTF-8 just the same.
+        Err(_) => return Err(idf::parse_idf_bytes(name, bytes).err().unwrap_or_else(|| Error::model(name, "not UTF-8 text"))),
+    };
     let objects = if epjson { epjson::parse_epjson(name, &text)? } else { idf::parse_idf(name, &text)? };
     let building = building::read_building(name, &objects)?;
     for warning in &building.warnings {

@@ -82,6 +82,9 @@ impl Location {
         let fail = |reason: String| Error::model(file_label, reason);
         let line = text.lines().next().unwrap_or("").trim_start_matches('\u{feff}').trim();
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if line.is_empty() {
+            return Err(fail("the first line is empty; an EPW weather file starts with its LOCATION record".into()));
+        }
         if !fields.first().is_some_and(|keyword| keyword.eq_ignore_ascii_case("LOCATION")) {
             return Err(fail(format!("first line is not an EPW LOCATION record (starts with '{}')", excerpt(line))));
         }
@@ -195,7 +198,7 @@ mod tests {
     #[test]
     fn epw_errors_name_file_and_reason() {
         let cases = [
-            ("", "not an EPW LOCATION record"),
+            ("", "the first line is empty; an EPW weather file starts with its LOCATION record"),
             ("DESIGN CONDITIONS,0\nLOCATION,A,B,C,D,1,40,-105,-7,1600", "starts with 'DESIGN CONDITIONS,0'"),
             ("LOCATION,Denver,CO,USA,TMY3,724666,39.74,-105.18", "has 8 fields, expected 10"),
             ("LOCATION,Denver,CO,USA,TMY3,724666,north,-105.18,-7.0,1793.0", "field 6 (latitude) is not a number: 'north'"),

@@ -1,0 +1,654 @@
+//! The bad-input corpus: one case per class of input users' tools can produce wrongly, each held
+//! to its exact message (file, object or node, reason), exit code 1, no panic, no hang and no
+//! file left behind, through the CLI (`sunlit annual … -o out.csv`) and, for model files, through
+//! `sunlit::model::load_bytes` (what the JS API calls).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use base64::Engine as _;
+use sunlit::model::glb_write::GlbWriter;
+use sunlit::model::office::office;
+use sunlit::model::office_idf::{Shading, office_idf};
+use sunlit::model::{LoadOptions, load_bytes};
+
+/// A bad input can take no longer than this to be refused (a hang fails the test).
+const REFUSE_WITHIN: Duration = Duration::from_secs(120);
+
+/// One input and what it must produce.
+struct Case {
+    /// Files written into the case's folder: (name, bytes).
+    files: Vec<(String, Vec<u8>)>,
+    /// Arguments after the model files; `{dir}` is the case's folder. `--location 40,-105,-7`,
+    /// `-o {dir}/out.csv` and `--resolution 64` are added unless given (or `--epw` is).
+    args: Vec<String>,
+    /// The CLI's whole `error:` line after `error: `, paths relative to the case's folder (which
+    /// itself reads `{dir}`).
+    cli: String,
+    /// `load_bytes`'s message for the model files, when the class is the model's.
+    api: Option<String>,
+}
+
+impl Case {
+    fn model(name: &str, bytes: Vec<u8>, message: &str) -> Self {
+        Case { files: vec![(name.into(), bytes)], args: vec![], cli: message.into(), api: Some(message.into()) }
+    }
+
+    fn args(mut self, args: &[&str]) -> Self {
+        self.args = args.iter().map(|s| s.to_string()).collect();
+        self
+    }
+
+    fn api(mut self, message: Option<&str>) -> Self {
+        self.api = message.map(str::to_string);
+        self
+    }
+
+    fn with_file(mut self, name: &str, bytes: Vec<u8>) -> Self {
+        self.files.push((name.into(), bytes));
+        self
+    }
+}
+
+fn runtime_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join("sunlit-test-runtime");
+    std::fs::create_dir_all(&dir).unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
+    }
+    dir
+}
+
+/// Runs `sunlit annual` on the case in a fresh folder and checks everything the CLI promises.
+fn check_cli(label: &str, case: &Case) {
+    let dir = std::env::temp_dir().join(format!("sunlit-bad-{label}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut models = Vec::new();
+    for (name, bytes) in &case.files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+        // Companion files (external buffers, weather) are not models.
+        if !name.ends_with(".bin") && !name.ends_with(".epw") {
+            models.push(dir.join(name).display().to_string());
+        }
+    }
+    let d = dir.display().to_string();
+    let mut args: Vec<String> = vec!["annual".into()];
+    args.extend(models);
+    args.extend(case.args.iter().map(|a| a.replace("{dir}", &d)));
+    let has = |flags: &[&str]| case.args.iter().any(|a| flags.contains(&a.as_str()));
+    if !has(&["--epw", "--location"]) {
+        args.extend(["--location".into(), "40,-105,-7".into()]);
+    }
+    if !has(&["-o"]) {
+        args.extend(["-o".into(), format!("{d}/out.csv")]);
+    }
+    if !has(&["--resolution"]) {
+        args.extend(["--resolution".into(), "64".into()]);
+    }
+    let (code, stderr) = run(&args);
+    assert!(!stderr.contains("panicked"), "{label}: {stderr}");
+    assert_eq!(code, Some(1), "{label}: exit code; stderr: {stderr}");
+    let line = stderr.lines().find(|l| l.starts_with("error: ")).unwrap_or_else(|| panic!("{label}: no error line in: {stderr}"));
+    assert_eq!(device_limit(&line.replace(&format!("{d}/"), "").replace(&d, "{dir}")), format!("error: {}", case.cli), "{label}");
+    let mut left: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    let mut given: Vec<String> = case.files.iter().map(|(n, _)| n.clone()).collect();
+    given.sort();
+    assert_eq!(left, given, "{label}: files left behind");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The texture size limit in a `--resolution` message reads `{limit}`: it is the device's.
+fn device_limit(message: &str) -> String {
+    match message.split_once("16..=") {
+        Some((head, tail)) => format!("{head}16..={{limit}}{}", tail.trim_start_matches(|c: char| c.is_ascii_digit())),
+        None => message.to_string(),
+    }
+}
+
+/// Runs the CLI with a time limit; returns (exit code, stderr).
+fn run(args: &[String]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", runtime_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > REFUSE_WITHIN {
+            let _ = child.kill();
+            panic!("sunlit {args:?} did not finish within {REFUSE_WITHIN:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// The same model files through the library's in-memory loader.
+fn check_api(label: &str, case: &Case) {
+    let Some(expected) = &case.api else { return };
+    let models: Vec<(String, Vec<u8>)> = case.files.iter().filter(|(n, _)| !n.ends_with(".bin") && !n.ends_with(".epw")).cloned().collect();
+    let mut options = LoadOptions::default();
+    let mut args = case.args.iter();
+    while let Some(a) = args.next() {
+        if a == "--receivers" {
+            options.receivers.push(args.next().unwrap().clone());
+        }
+    }
+    let err = load_bytes(&models, &options).err().unwrap_or_else(|| panic!("{label}: load_bytes accepted it"));
+    assert_eq!(&err.to_string(), expected, "{label} (load_bytes)");
+}
+
+fn check(label: &str, case: Case) {
+    check_api(label, &case);
+    check_cli(label, &case);
+}
+
+const SQUARE: [[f32; 3]; 4] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 0.0, 1.0]];
+const QUAD: [u32; 6] = [0, 1, 2, 0, 2, 3];
+
+/// A node of a test model: name, positions, triangle indices.
+type Node<'a> = (&'a str, &'a [[f32; 3]], &'a [u32]);
+
+/// A .glb with one node per entry.
+fn glb(nodes: &[Node]) -> Vec<u8> {
+    let mut w = GlbWriter::new();
+    for (name, positions, indices) in nodes {
+        let m = w.add_mesh(name, positions, indices);
+        w.add_node(name, m, [0.0; 3], None);
+    }
+    w.to_glb()
+}
+
+/// A .gltf with one triangle-list mesh in an embedded buffer; `node` is the node's JSON, `buffer`
+/// the buffer's (its `uri` replaced by the data when it is `"DATA"`).
+fn gltf(positions: &[[f32; 3]], indices: &[u32], node: &str, buffer_uri: Option<&str>) -> Vec<u8> {
+    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let bound = |f: fn(f32, f32) -> f32, start: f32| {
+        let b = (0..3).map(|k| positions.iter().fold(start, |a, p| f(a, p[k])).to_string()).collect::<Vec<_>>();
+        if positions.is_empty() { "[0,0,0]".to_string() } else { format!("[{}]", b.join(",")) }
+    };
+    let (min, max) = (bound(f32::min, f32::INFINITY), bound(f32::max, f32::NEG_INFINITY));
+    let pos_len = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let uri = match buffer_uri {
+        Some(u) => u.to_string(),
+        None => format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin)),
+    };
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":{len}}}],
+        "bufferViews":[{{"buffer":0,"byteLength":{pos_len}}},{{"buffer":0,"byteOffset":{pos_len},"byteLength":{idx_len}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{n},"type":"VEC3","min":{min},"max":{max}}},{{"bufferView":1,"componentType":5125,"count":{m},"type":"SCALAR"}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"nodes":[{node}],"scenes":[{{"nodes":[0]}}]}}"#,
+        len = bin.len(),
+        idx_len = bin.len() - pos_len,
+        n = positions.len(),
+        m = indices.len(),
+    )
+    .into_bytes()
+}
+
+#[test]
+fn broken_gltf_files() {
+    let office = office(1).to_glb();
+    check(
+        "truncated",
+        Case::model(
+            "cut.glb",
+            office[..office.len() / 2].to_vec(),
+            "cut.glb: not a valid glTF 2.0 file: could not completely read the object",
+        ),
+    );
+    check(
+        "header only",
+        Case::model("head.glb", office[..10].to_vec(), "head.glb: not a valid glTF 2.0 file: failed to fill whole buffer"),
+    );
+    check(
+        "wrong magic",
+        Case::model(
+            "zip.glb",
+            b"PK\x03\x04 a zip archive".to_vec(),
+            "zip.glb: not a glTF file: expected the binary magic 'glTF' or a JSON object",
+        ),
+    );
+    let mut bad_version = office.clone();
+    bad_version[4] = 1;
+    check("glb version 1", Case::model("v1.glb", bad_version, "v1.glb: not a valid glTF 2.0 file: unsupported version"));
+    check("empty", Case::model("empty.gltf", vec![], "empty.gltf: the file is empty"));
+    // Found by fuzzing: the gltf crate subtracted the header size from this length unchecked.
+    let mut short = b"glTF\x02\0\0\0\x03\0\0\0".to_vec();
+    short.resize(64, 0);
+    check(
+        "length below header",
+        Case::model(
+            "short.glb",
+            short,
+            "short.glb: not a valid glTF 2.0 file: its GLB header declares 3 bytes in all, less than the header itself",
+        ),
+    );
+    check(
+        "not json",
+        Case::model(
+            "bad.gltf",
+            b"{\"asset\": ".to_vec(),
+            "bad.gltf: not a valid glTF 2.0 file: EOF while parsing a value at line 1 column 10",
+        ),
+    );
+}
+
+#[test]
+fn missing_and_external_buffers() {
+    let node = r#"{"name":"A","mesh":0}"#;
+    let external = gltf(&SQUARE, &QUAD, node, Some("geometry.bin"));
+    check(
+        "external buffer missing",
+        Case::model(
+            "ext.gltf",
+            external.clone(),
+            "ext.gltf: external buffer 'geometry.bin' could not be read: No such file or directory (os error 2)",
+        )
+        .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (use a .glb, or embed buffers as data: URIs)")),
+    );
+    // Present beside the file: the CLI reads it, the in-memory loader cannot.
+    let bin: Vec<u8> = SQUARE.iter().flatten().flat_map(|c| c.to_le_bytes()).chain(QUAD.iter().flat_map(|i| i.to_le_bytes())).collect();
+    check(
+        "external buffer short",
+        Case::model("ext.gltf", external.clone(), "ext.gltf: buffer 0 is truncated: 20 bytes present, 72 declared")
+            .with_file("geometry.bin", bin[..20].to_vec())
+            .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (use a .glb, or embed buffers as data: URIs)")),
+    );
+    // Nodes reached twice: a cycle, and a child shared by two parents (exponential to walk).
+    let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let cycle =
+        text.replace(r#""nodes":[{"name":"A","mesh":0}]"#, r#""nodes":[{"name":"A","mesh":0,"children":[1]},{"name":"B","children":[0]}]"#);
+    let message = "cycle.gltf: node 'A': is reached twice in the node hierarchy (a cycle, or more than one parent)";
+    check("cycle", Case::model("cycle.gltf", cycle.into_bytes(), message));
+    let shared = text.replace(
+        r#""nodes":[{"name":"A","mesh":0}],"scenes":[{"nodes":[0]}]"#,
+        r#""nodes":[{"name":"A","mesh":0},{"name":"P","children":[0]},{"name":"Q","children":[0]}],"scenes":[{"nodes":[1,2]}]"#,
+    );
+    let message = "shared.gltf: node 'A': is reached twice in the node hierarchy (a cycle, or more than one parent)";
+    check("shared child", Case::model("shared.gltf", shared.into_bytes(), message));
+    let no_buffers = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let no_buffers = no_buffers.split("\"buffers\"").next().unwrap().to_string()
+        + "\"bufferViews\""
+        + no_buffers.split("\"bufferViews\"").nth(1).unwrap();
+    check(
+        "no buffers array",
+        Case::model(
+            "nobuf.gltf",
+            no_buffers.into_bytes(),
+            "nobuf.gltf: not a valid glTF 2.0 file: invalid glTF: bufferViews[0].buffer: Index out of bounds; bufferViews[1].buffer: Index out of bounds;",
+        ),
+    );
+    let bad_uri = gltf(&SQUARE, &QUAD, node, Some("data:application/octet-stream;base64,@@@"));
+    check("bad data uri", Case::model("uri.gltf", bad_uri, "uri.gltf: buffer 0: bad base64 data: Invalid symbol 64, offset 0."));
+}
+
+#[test]
+fn accessors_out_of_range() {
+    let node = r#"{"name":"A","mesh":0}"#;
+    let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let long = text.replacen(r#""count":4"#, r#""count":400"#, 1);
+    check(
+        "count past view",
+        Case::model(
+            "count.gltf",
+            long.into_bytes(),
+            "count.gltf: mesh 0 '': accessor 0 reads bytes 0..4800 beyond its buffer view (ends at 48) or buffer (72 bytes)",
+        ),
+    );
+    check(
+        "index past vertices",
+        Case::model("index.gltf", gltf(&SQUARE, &[0, 1, 7], node, None), "index.gltf: mesh 0 '': index 7 out of range (4 vertices)"),
+    );
+    // Found by fuzzing: gltf-json indexed the accessors with a missing POSITION accessor.
+    let position = text.replacen(r#""POSITION":0"#, r#""POSITION":32"#, 1);
+    let message = "position.gltf: mesh 0: primitive 0: POSITION accessor 32 does not exist (2 accessors)";
+    check("position accessor missing", Case::model("position.gltf", position.clone().into_bytes(), message));
+    // The same with invalid UTF-8 in a string, which the gltf crate reads anyway (found by fuzzing).
+    let mut latin1 = position.replacen(r#""version":"2.0""#, "\"version\":\"2.0\",\"generator\":\"caf\u{1}\"", 1).into_bytes();
+    let at = latin1.iter().position(|&b| b == 1).unwrap();
+    latin1[at] = 0xE9;
+    let message = "latin1.gltf: mesh 0: primitive 0: POSITION accessor 32 does not exist (2 accessors)";
+    check("position accessor missing, not UTF-8", Case::model("latin1.gltf", latin1, message));
+    let view = text.replacen(r#""byteLength":48}"#, r#""byteLength":4800}"#, 1);
+    check(
+        "view past buffer",
+        Case::model(
+            "view.gltf",
+            view.into_bytes(),
+            "view.gltf: mesh 0 '': accessor 0 reads bytes 0..48 beyond its buffer view (ends at 4800) or buffer (72 bytes)",
+        ),
+    );
+    let huge = text.replacen(r#""count":4"#, r#""count":4294967295"#, 1);
+    check(
+        "count overflows",
+        Case::model(
+            "huge.gltf",
+            huge.into_bytes(),
+            "huge.gltf: mesh 0 '': accessor 0 reads bytes 0..51539607540 beyond its buffer view (ends at 48) or buffer (72 bytes)",
+        ),
+    );
+}
+
+/// Replaces the one occurrence of an f32 in a binary with another value (min/max stay finite).
+fn patch_f32(bytes: &mut [u8], from: f32, to: f32) {
+    let needle = from.to_le_bytes();
+    let at = bytes.windows(4).position(|w| w == needle).expect("value present");
+    bytes[at..at + 4].copy_from_slice(&to.to_le_bytes());
+}
+
+#[test]
+fn absurd_coordinates() {
+    for (value, label, shown) in [(f32::NAN, "nan", "NaN"), (f32::INFINITY, "inf", "inf"), (1e30, "far", "1e30")] {
+        let mut p = SQUARE;
+        p[2][0] = 1234.5;
+        let mut bytes = glb(&[("Wall", &p, &QUAD)]);
+        patch_f32(&mut bytes, 1234.5, value);
+        let message =
+            format!("{label}.glb: node 'Wall': vertex 2 has a non-finite or absurd coordinate [{shown}, 1.0, 0.0] (limit ±1e7 m)");
+        check(label, Case::model(&format!("{label}.glb"), bytes, &message));
+    }
+    // Finite vertices and a finite transform can still put a node 1e30 m away.
+    let node = r#"{"name":"Far","mesh":0,"scale":[1e30,1e30,1e30]}"#;
+    let message = "scale.gltf: node 'Far': vertex 1 is placed at [1000000015047466200000000000000, 0, 0], beyond ±1e7 m (check the node's transform and units)";
+    check("far by scale", Case::model("scale.gltf", gltf(&SQUARE, &QUAD, node, None), message));
+    let node = r#"{"name":"Flat","mesh":0,"matrix":[0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1]}"#;
+    let message = "matrix.gltf: node 'Flat': receiver has zero area (all its triangles are degenerate)";
+    check("singular matrix", Case::model("matrix.gltf", gltf(&SQUARE, &QUAD, node, None), message));
+}
+
+#[test]
+fn degenerate_duplicate_and_unmatched_receivers() {
+    let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+    check(
+        "collinear",
+        Case::model(
+            "line.glb",
+            glb(&[("Sliver", &line, &[0, 1, 2])]),
+            "line.glb: node 'Sliver': receiver has zero area (all its triangles are degenerate)",
+        ),
+    );
+    let point = [[3.0, 3.0, 3.0]; 3];
+    check(
+        "zero area",
+        Case::model(
+            "point.glb",
+            glb(&[("Dot", &point, &[0, 1, 2])]),
+            "point.glb: node 'Dot': receiver has zero area (all its triangles are degenerate)",
+        ),
+    );
+    check(
+        "no triangles",
+        Case::model(
+            "lines.glb",
+            glb(&[("Wire", &SQUARE, &[])]),
+            "lines.glb: node 'Wire': receiver has zero area (all its triangles are degenerate)",
+        ),
+    );
+    // 1001 parallel triangles 1 cm apart: 1001 planes, past the 1000 a receiver may split into.
+    let stack: Vec<[f32; 3]> =
+        (0..1001).flat_map(|k| [[0.0, 0.0, k as f32 * 0.01], [1.0, 0.0, k as f32 * 0.01], [0.0, 1.0, k as f32 * 0.01]]).collect();
+    let indices: Vec<u32> = (0..stack.len() as u32).collect();
+    let message = "many.glb: node 'Stack': receiver is not planar in fewer than 1000 parts (a curved mesh?): leave it out of the receivers";
+    check("too many planes", Case::model("many.glb", glb(&[("Stack", &stack, &indices)]), message));
+    let twins = glb(&[("Twin", &SQUARE, &QUAD), ("Twin", &SQUARE, &QUAD)]);
+    check(
+        "duplicate",
+        Case::model("twins.glb", twins, "duplicate receiver name 'Twin': twins.glb: node 'Twin' and twins.glb: node 'Twin'"),
+    );
+    check(
+        "no match",
+        Case::model("wall.glb", glb(&[("Wall", &SQUARE, &QUAD)]), "no receiving surface: no node name matches --receivers Roof*")
+            .args(&["--receivers", "Roof*"]),
+    );
+    let node = r#"{"mesh":0}"#;
+    check(
+        "unnamed only",
+        Case::model(
+            "anon.gltf",
+            gltf(&SQUARE, &QUAD, node, None),
+            "no receiving surface: the models have no named node with a mesh (name nodes, mark them in extras, or use --receivers)",
+        ),
+    );
+    // Two models can clash by name too.
+    check(
+        "duplicate across files",
+        Case::model("a.glb", glb(&[("Wall", &SQUARE, &QUAD)]), "duplicate receiver name 'Wall': a.glb: node 'Wall' and b.glb: node 'Wall'")
+            .with_file("b.glb", glb(&[("Wall", &SQUARE, &QUAD)])),
+    );
+}
+
+/// A receiving node that bends is split into planar receivers `NAME#1`, `NAME#2`, … by design
+/// (a sunlit fraction is defined per plane); the API and `info` show the parts.
+#[test]
+fn non_planar_receivers_are_split_into_planar_parts() {
+    let bent = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 0.0, 1.0], [1.0, 1.0, 0.0], [1.0, 1.0, 1.0]];
+    let indices = [0, 1, 2, 0, 2, 3, 1, 4, 5, 1, 5, 2];
+    let scene = load_bytes(&[("bent.glb".into(), glb(&[("Bent", &bent, &indices)]))], &LoadOptions::default()).unwrap();
+    let names: Vec<&str> = scene.receivers.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["Bent#1", "Bent#2"]);
+    for r in &scene.receivers {
+        assert!((r.area - 1.0).abs() < 1e-6, "{}: {}", r.name, r.area);
+        assert_eq!(r.origin, "bent.glb: node 'Bent'");
+    }
+    let normals: Vec<[i32; 3]> = scene.receivers.iter().map(|r| r.normal.round().as_ivec3().to_array()).collect();
+    assert_eq!(normals, [[0, -1, 0], [1, 0, 0]], "south-facing and east-facing parts");
+}
+
+fn idf() -> String {
+    office_idf(1, false, Shading::None)
+}
+
+#[test]
+fn malformed_idf() {
+    let open = format!("{}\nBuildingSurface:Detailed,\n  LOOSE_END,\n  Wall,\n", idf());
+    check(
+        "unterminated",
+        Case::model(
+            "open.idf",
+            open.into_bytes(),
+            "open.idf: object 'BuildingSurface:Detailed' 'LOOSE_END' starting at line 173 is not terminated by ';'",
+        ),
+    );
+    let bad_number = idf().replacen("  10,0,3.5,", "  10,zero,3.5,", 1);
+    check(
+        "word for number",
+        Case::model(
+            "number.idf",
+            bad_number.into_bytes(),
+            "number.idf: BuildingSurface:Detailed 'WALL_E' (line 43): vertex 1 y-coordinate 'zero' is not a number",
+        ),
+    );
+    let misspelled = idf().replacen("BuildingSurface:Detailed,", "BuildingSurface:Detailled,", 1);
+    check(
+        "misspelled geometry class",
+        Case::model(
+            "typo.idf",
+            misspelled.into_bytes(),
+            "typo.idf: BuildingSurface:Detailled 'WALL_S' (line 26): is not a geometry class sunlit knows (misspelt?); reading on would lose its surface",
+        ),
+    );
+    let vertices = idf().replacen("  10,0,3.5,", "  10,0,", 1);
+    check(
+        "vertex count",
+        Case::model(
+            "vertices.idf",
+            vertices.into_bytes(),
+            "vertices.idf: BuildingSurface:Detailed 'WALL_E' (line 43): has 11 vertex coordinates, not x, y, z triples",
+        ),
+    );
+    check(
+        "not utf-8",
+        Case::model(
+            "latin1.idf",
+            b"Version,25.2;\nZone,Caf\xe9;\n".to_vec(),
+            "latin1.idf: not UTF-8 text: invalid byte 0xE9 at line 2 (re-save the file as UTF-8)",
+        ),
+    );
+    let no_zone = idf().replacen("Zone,", "Zone_Typo,", 1);
+    check(
+        "missing zone",
+        Case::model(
+            "nozone.idf",
+            no_zone.into_bytes(),
+            "nozone.idf: BuildingSurface:Detailed 'WALL_S' (line 26): zone 'OFFICE' does not exist",
+        ),
+    );
+}
+
+/// Unknown classes that are not geometry (the many EnergyPlus classes sunlit has no use for) are
+/// ignored: a model with them still loads.
+#[test]
+fn unknown_non_geometry_classes_are_ignored() {
+    let text = format!("{}\nFrobnicator:Settings,\n  F1,\n  42;\n", idf());
+    let scene = load_bytes(&[("extra.idf".into(), text.into_bytes())], &LoadOptions::default()).unwrap();
+    assert!(!scene.receivers.is_empty());
+}
+
+#[test]
+fn malformed_epjson() {
+    check(
+        "truncated",
+        Case::model(
+            "cut.epJSON",
+            b"{\"Version\": {\"Version 1\": ".to_vec(),
+            "cut.epJSON: not valid epJSON: EOF while parsing a value at line 1 column 26",
+        ),
+    );
+    check(
+        "array",
+        Case::model(
+            "list.epJSON",
+            b"[1, 2]".to_vec(),
+            "list.epJSON: not valid epJSON: invalid type: sequence, expected a JSON object at line 1 column 0",
+        ),
+    );
+    let number_as_text = br#"{"Zone": {"Z1": {}}, "Shading:Site:Detailed": {"S1": {"vertices": [{"vertex_x_coordinate": "ten", "vertex_y_coordinate": 0, "vertex_z_coordinate": 0}]}}}"#;
+    check(
+        "text for number",
+        Case::model(
+            "text.epJSON",
+            number_as_text.to_vec(),
+            "text.epJSON: Shading:Site:Detailed 'S1' (line 1): 'vertex_x_coordinate' of vertex 1 must be a number, not the string \"ten\"",
+        ),
+    );
+    let not_object = br#"{"Shading:Site:Detailed": {"S1": 7}}"#;
+    check(
+        "object is a number",
+        Case::model(
+            "seven.epJSON",
+            not_object.to_vec(),
+            "seven.epJSON: Shading:Site:Detailed 'S1' (line 1): must be a JSON object of fields, not the number 7",
+        ),
+    );
+    let misspelled = br#"{"Shading:Site:Detailled": {"S1": {}}}"#;
+    check(
+        "misspelled geometry class",
+        Case::model(
+            "typo.epJSON",
+            misspelled.to_vec(),
+            "typo.epJSON: Shading:Site:Detailled 'S1' (line 1): is not a geometry class sunlit knows (misspelt?); reading on would lose its surface",
+        ),
+    );
+}
+
+fn office_glb() -> Vec<u8> {
+    office(1).to_glb()
+}
+
+#[test]
+fn bad_weather_files() {
+    let epw = |name: &str, text: &str, message: &str| {
+        Case::model("office.glb", office_glb(), message)
+            .with_file(name, text.as_bytes().to_vec())
+            .args(&["--epw", &format!("{{dir}}/{name}")])
+            .api(None)
+    };
+    check(
+        "no location",
+        epw("w.epw", "DESIGN CONDITIONS,0\n", "w.epw: first line is not an EPW LOCATION record (starts with 'DESIGN CONDITIONS,0')"),
+    );
+    check("empty", epw("w.epw", "", "w.epw: the first line is empty; an EPW weather file starts with its LOCATION record"));
+    check(
+        "short",
+        epw(
+            "w.epw",
+            "LOCATION,Golden,CO,USA\n",
+            "w.epw: LOCATION record has 4 fields, expected 10 (LOCATION,City,State,Country,Source,WMO,Latitude,Longitude,TimeZone,Elevation)",
+        ),
+    );
+    check(
+        "word",
+        epw(
+            "w.epw",
+            "LOCATION,Golden,CO,USA,TMY3,724666,north,-105.18,-7.0,1829.0\n",
+            "w.epw: LOCATION field 6 (latitude) is not a number: 'north'",
+        ),
+    );
+    check(
+        "range",
+        epw(
+            "w.epw",
+            "LOCATION,Golden,CO,USA,TMY3,724666,95,-105.18,-7.0,1829.0\n",
+            "w.epw: LOCATION record: latitude 95 is outside -90..90 degrees",
+        ),
+    );
+    check(
+        "nan",
+        epw(
+            "w.epw",
+            "LOCATION,Golden,CO,USA,TMY3,724666,39.74,NaN,-7.0,1829.0\n",
+            "w.epw: LOCATION field 7 (longitude) is not a number: 'NaN'",
+        ),
+    );
+    let missing = Case::model("office.glb", office_glb(), "none.epw: No such file or directory (os error 2)")
+        .args(&["--epw", "{dir}/none.epw"])
+        .api(None);
+    check("missing", missing);
+}
+
+#[test]
+fn out_of_range_options() {
+    let office = |message: &str, args: &[&str]| Case::model("office.glb", office_glb(), message).args(args).api(None);
+    check(
+        "resolution 0",
+        office("invalid --resolution: 0 is outside 16..={limit} (this device's texture size limit)", &["--resolution", "0"]),
+    );
+    check(
+        "resolution huge",
+        office("invalid --resolution: 1000000 is outside 16..={limit} (this device's texture size limit)", &["--resolution", "1000000"]),
+    );
+    check("days 0", office("invalid --days-per-year: 0 is outside 3..=365", &["--days-per-year", "0"]));
+    check("samples 0", office("invalid --samples-per-day: 0 is outside 3..=240", &["--samples-per-day", "0"]));
+    check(
+        "timesteps 7",
+        office(
+            "invalid --timesteps-per-hour: 7 is not one EnergyPlus accepts ([1, 2, 3, 4, 5, 6, 10, 12, 15, 20, 30, 60])",
+            &["--timesteps-per-hour", "7"],
+        ),
+    );
+    check("refine 2", office("invalid --refine: 2 is outside 0..=1", &["--refine", "2"]));
+    check("north nan", office("invalid --north: NaN is not a finite angle", &["--north", "NaN"]));
+    check("latitude", office("invalid --location: latitude 91 is outside -90..90 degrees", &["--location", "91,0,0"]));
+    check(
+        "location words",
+        office(
+            "invalid --location: expected LAT,LON,TZ (degrees north, degrees east, hours from UTC, e.g. 39.74,-105.18,-7), got 'here'",
+            &["--location", "here"],
+        ),
+    );
+    check("hook", office("invalid --hook: 'sideways': expected scheduled or imported", &["--hook", "sideways"]));
+    check("output folder", office("invalid --output: {dir} is a folder", &["-o", "{dir}"]));
+    check("output in missing folder", office("no/such/out.csv: No such file or directory (os error 2)", &["-o", "{dir}/no/such/out.csv"]));
+}
