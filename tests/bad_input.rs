@@ -256,7 +256,7 @@ fn missing_and_external_buffers() {
             external.clone(),
             "ext.gltf: external buffer 'geometry.bin' could not be read: No such file or directory (os error 2)",
         )
-        .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (use a .glb, or embed buffers as data: URIs)")),
+        .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (give it with the .gltf, use a .glb, or embed buffers as data: URIs)")),
     );
     // Present beside the file: the CLI reads it, the in-memory loader cannot.
     let bin: Vec<u8> = SQUARE.iter().flatten().flat_map(|c| c.to_le_bytes()).chain(QUAD.iter().flat_map(|i| i.to_le_bytes())).collect();
@@ -264,7 +264,7 @@ fn missing_and_external_buffers() {
         "external buffer short",
         Case::model("ext.gltf", external.clone(), "ext.gltf: buffer 0 is truncated: 20 bytes present, 72 declared")
             .with_file("geometry.bin", bin[..20].to_vec())
-            .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (use a .glb, or embed buffers as data: URIs)")),
+            .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (give it with the .gltf, use a .glb, or embed buffers as data: URIs)")),
     );
     // Nodes reached twice: a cycle, and a child shared by two parents (exponential to walk).
     let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
