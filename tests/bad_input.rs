@@ -256,7 +256,9 @@ fn missing_and_external_buffers() {
             external.clone(),
             "ext.gltf: external buffer 'geometry.bin' could not be read: No such file or directory (os error 2)",
         )
-        .api(Some("ext.gltf: external buffer 'geometry.bin' was not given (give it with the .gltf, use a .glb, or embed buffers as data: URIs)")),
+        .api(Some(
+            "ext.gltf: external buffer 'geometry.bin' was not given (give it with the .gltf, use a .glb, or embed buffers as data: URIs)",
+        )),
     );
     // Present beside the file: the CLI reads it, the in-memory loader cannot.
     let bin: Vec<u8> = SQUARE.iter().flatten().flat_map(|c| c.to_le_bytes()).chain(QUAD.iter().flat_map(|i| i.to_le_bytes())).collect();
