@@ -5,7 +5,9 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
-use std::path::PathBuf;
+mod common;
+use common::runtime_dir;
+
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -51,17 +53,6 @@ impl Case {
         self.files.push((name.into(), bytes));
         self
     }
-}
-
-fn runtime_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join("sunlit-test-runtime");
-    std::fs::create_dir_all(&dir).unwrap();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
-    }
-    dir
 }
 
 /// Runs `sunlit annual` on the case in a fresh folder and checks everything the CLI promises.

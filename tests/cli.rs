@@ -3,6 +3,9 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
+mod common;
+use common::runtime_dir;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -11,17 +14,6 @@ use sunlit::model::office::office;
 
 fn sunlit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("run sunlit")
-}
-
-fn runtime_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join("sunlit-test-runtime");
-    std::fs::create_dir_all(&dir).unwrap();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
-    }
-    dir
 }
 
 /// A fresh folder per test.

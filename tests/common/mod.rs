@@ -1,6 +1,8 @@
 //! Scene-building helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use std::path::PathBuf;
+
 use glam::DVec3;
 use sunlit::count::ViewRequest;
 use sunlit::count::gpu::{Counted, Counter, CounterOptions};
@@ -86,4 +88,13 @@ pub fn cube_mesh(side: f32) -> SourceMesh {
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let indices = quads.iter().flat_map(|q: &[u32; 4]| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
     SourceMesh { positions, indices }
+}
+
+/// A private XDG_RUNTIME_DIR for the CLI under test, so Mesa does not warn on stderr.
+pub fn runtime_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join("sunlit-test-runtime");
+    std::fs::create_dir_all(&dir).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
+    dir
 }
