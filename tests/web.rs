@@ -113,3 +113,20 @@ fn bad_arrays_are_refused_with_the_element_named() {
             .to_string();
     assert_eq!(error, "arrays: indices[4]: 99 is past the 18 vertices");
 }
+
+#[wasm_bindgen_test]
+async fn a_lost_webgpu_device_is_reported_and_a_new_one_counts() {
+    let scene = scene();
+    let counter = Counter::new(CounterOptions { resolution: 128, ..Default::default() }).await.unwrap();
+    let gpu = counter.upload(&scene).unwrap();
+    let request = [ViewRequest { receiver: 0, sun: sun(180.0, 35.0) }];
+    let before = counter.fractions(&gpu, &request).await.unwrap()[0].fraction;
+    counter.device_loss_trigger()();
+    let error = counter.fractions(&gpu, &request).await.map(|c| c[0].fraction);
+    let message = format!("{error:?}");
+    assert!(matches!(error, Err(sunlit::Error::DeviceLost(_))), "a lost device is reported as such: {message}");
+    let fresh = counter.recreate().await.unwrap();
+    let gpu = fresh.upload(&scene).unwrap();
+    let after = fresh.fractions(&gpu, &request).await.unwrap()[0].fraction;
+    assert_eq!(before, after, "the new device counts the same");
+}

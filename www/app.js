@@ -137,6 +137,8 @@ worker.onmessage = ({ data: msg }) => {
     $('progress').max = msg.total || 1;
     $('progress').value = msg.done;
     status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}`);
+  } else if (msg.type === 'notice') {
+    status(msg.text);
   } else if (msg.type === 'result') {
     showResult(msg);
   } else if (msg.type === 'error') {

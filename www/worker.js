@@ -1,6 +1,6 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: load, compute, cancel, reset. Messages out: loaded,
-// progress, result, error (with `gpu: true` when the device failed and a retry may help).
+// page stays responsive. Messages in: load, compute, cancel. Messages out: loaded, progress,
+// notice, result, error (with `gpu: true` when the device failed twice and a retry may help).
 import { createEngine } from './sunlit.js';
 
 let engine = null;
@@ -67,7 +67,20 @@ async function load({ files: given, options, resolution }) {
   );
 }
 
-async function compute({ settings, resolution, csvName }) {
+/** A year; on a lost or failed device, once more on a new one (as the CLI does). */
+async function compute(request) {
+  try {
+    return await computeOnce(request);
+  } catch (error) {
+    if (error?.name === 'AbortError' || !isGpuFailure(String(error?.message ?? error))) throw error;
+    engine = null;
+    model = null;
+    postMessage({ type: 'notice', text: `The GPU device failed (${error.message}); counting again on a new one…` });
+    return computeOnce(request);
+  }
+}
+
+async function computeOnce({ settings, resolution, csvName }) {
   if (!files) throw new Error('load a model first');
   const e = await engineFor(resolution);
   const m = modelOn(e);
