@@ -27,12 +27,12 @@ use crate::count::gpu::{Counter, GpuScene};
 use crate::count::{MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::samples::{DAYS, SamplingPlan, Timesteps};
+use crate::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::scene::Scene;
 use crate::season::{LeafCalendar, Phase};
 use crate::spline::{AnnualGrid, AnnualSpline};
 use crate::sun::location::Location;
-use crate::sun::position::{lit_intervals, sun_direction};
+use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
 
 /// How the year is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -205,6 +205,8 @@ struct Regime {
     leaves: Vec<f32>,
     /// Grid days → counted days: the identity, or for a ramp its days then their mirror images.
     grid_days: Vec<usize>,
+    /// Counted day → the day with the same declination whose views it shares (itself if none).
+    twins: Vec<usize>,
     grid: AnnualGrid,
     cells: SampleCells,
     /// Day of year → the grid's coordinate.
@@ -214,8 +216,8 @@ struct Regime {
 /// How a regime's grid coordinate follows the day of year.
 #[derive(Debug, Clone, Copy)]
 enum DayMap {
-    /// The day itself (periodic over the year).
-    Year,
+    /// The season axis's coordinate (periodic over the year; see [`SeasonAxis`]).
+    Year(SeasonAxis),
     /// A ramp of `length` days from `start`, in u ∈ [0, 1] with leaf fraction u² (leaf-out) or
     /// (1 − u)² (leaf fall). A dense canopy closes over the first few percent of its leaves, so
     /// the fraction changes fastest where the leaf fraction is small: evenly spaced u crowds the
@@ -227,7 +229,7 @@ enum DayMap {
 impl DayMap {
     fn grid_coordinate(self, day: f64) -> f64 {
         match self {
-            DayMap::Year => day,
+            DayMap::Year(axis) => axis.coordinate(day),
             DayMap::Ramp { start, length, rising } => {
                 let x = ((day - start).rem_euclid(DAYS as f64) / length).clamp(0.0, 1.0);
                 if rising { x.sqrt() } else { 1.0 - (1.0 - x).sqrt() }
@@ -238,7 +240,7 @@ impl DayMap {
     /// The inverse of [`Self::grid_coordinate`] for a ramp's u.
     fn day(self, u: f64) -> f64 {
         match self {
-            DayMap::Year => u,
+            DayMap::Year(axis) => axis.day(u),
             DayMap::Ramp { start, length, rising } => start + length * if rising { u * u } else { 1.0 - (1.0 - u) * (1.0 - u) },
         }
     }
@@ -252,9 +254,10 @@ impl Regime {
         Ok(Regime {
             leaves: vec![leaves as f32; n],
             grid_days: (0..n).collect(),
+            twins: (0..n).map(|d| plan.twin(d)).collect(),
             grid: AnnualGrid::new(plan.first_day(), DAYS as f64, n, taus)?,
-            cells: SampleCells { first_day: plan.first_day(), spacing: DAYS as f64 / n as f64, days: n, taus: taus.to_vec() },
-            map: DayMap::Year,
+            cells: SampleCells { first_day: plan.first_day(), spacing: plan.spacing(), days: n, taus: taus.to_vec() },
+            map: DayMap::Year(SeasonAxis::new()),
             days,
         })
     }
@@ -270,6 +273,8 @@ impl Regime {
         Ok(Regime {
             leaves,
             grid_days: (0..=n).chain((1..n).rev()).collect(),
+            // The leaf fraction differs from day to day: nothing to share.
+            twins: (0..=n).collect(),
             grid: AnnualGrid::new(0.0, 2.0, 2 * n, taus)?,
             cells: SampleCells { first_day: 0.0, spacing: 1.0 / n as f64, days: 2 * n, taus: taus.to_vec() },
             map,
@@ -320,33 +325,14 @@ async fn spline_year(
 ) -> Result<()> {
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
-    let mut requests = Vec::new();
-    let mut leaves = Vec::new();
-    let mut cells = Vec::new();
-    for (g, regime) in regimes.iter().enumerate() {
-        let per_piece = regime.days.len() * taus.len();
-        for (id, r) in scene.receivers.iter().enumerate() {
-            for (d, &day) in regime.days.iter().enumerate() {
-                let day = sun_day(day);
-                for (p, (start, end)) in lit_intervals(location, r.normal, day, MIN_COS_INCIDENCE).into_iter().take(MAX_PIECES).enumerate()
-                {
-                    for (j, tau) in taus.iter().enumerate() {
-                        let sun = sun_direction(location, day, start + tau * (end - start));
-                        requests.push(ViewRequest { receiver: id as u32, sun });
-                        leaves.push(regime.leaves[d]);
-                        cells.push((g, (id * MAX_PIECES + p) * per_piece + d * taus.len() + j));
-                    }
-                }
-            }
-        }
-    }
+    let SampleViews { requests, leaves, cells } = sample_views(scene, location, &regimes, &taus);
     // Progress counts the samples and then the refined timesteps, whose number is known later.
     let total = requests.len();
     let counted = views.count(&requests, &leaves, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
     let mut samples: Vec<Vec<Option<f64>>> =
         regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
-    for ((g, cell), v) in cells.into_iter().zip(counted) {
-        samples[g][cell] = Some(v);
+    for (request, g, cell) in cells {
+        samples[g][cell] = Some(counted[request]);
     }
     let mut fits = Vec::with_capacity(regimes.len());
     for (regime, samples) in regimes.iter().zip(&samples) {
@@ -361,6 +347,74 @@ async fn spline_year(
         schedule.set(row, column, v as f32);
     }
     Ok(())
+}
+
+/// The views the sample grids need, and where each count goes.
+struct SampleViews {
+    requests: Vec<ViewRequest>,
+    /// Leaf fraction of each request.
+    leaves: Vec<f32>,
+    /// (request, regime, cell): the count of `request` fills `cell` of `regime`'s samples.
+    cells: Vec<(usize, usize, usize)>,
+}
+
+/// Lists the views of every regime's samples: per receiver, sample day, lit piece and time of
+/// day. A day whose twin (same declination, see [`SeasonAxis`]) has been listed and whose lit
+/// pieces are the twin's, shifted by the difference in solar noon, takes the twin's views: the
+/// sun directions are the same, so the counts would be.
+fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[f64]) -> SampleViews {
+    let mut out = SampleViews { requests: Vec::new(), leaves: Vec::new(), cells: Vec::new() };
+    for (g, regime) in regimes.iter().enumerate() {
+        let per_piece = regime.days.len() * taus.len();
+        for (id, r) in scene.receivers.iter().enumerate() {
+            // First request of each (day, piece), to share with the twin day.
+            let mut first: Vec<Vec<(f64, f64, usize)>> = vec![Vec::new(); regime.days.len()];
+            for (d, &day) in regime.days.iter().enumerate() {
+                let day = sun_day(day);
+                let noon = solar_noon_hour(location, day);
+                let pieces: Vec<(f64, f64)> =
+                    lit_intervals(location, r.normal, day, MIN_COS_INCIDENCE).into_iter().take(MAX_PIECES).collect();
+                let twin = regime.twins[d];
+                let shared = twin < d && same_declination(day, sun_day(regime.days[twin])) && same_pieces(&first[twin], &pieces, noon);
+                for (p, (start, end)) in pieces.into_iter().enumerate() {
+                    let base = if shared { first[twin][p].2 } else { out.requests.len() };
+                    first[d].push((start - noon, end - noon, base));
+                    for (j, tau) in taus.iter().enumerate() {
+                        if !shared {
+                            let sun = sun_direction(location, day, start + tau * (end - start));
+                            out.requests.push(ViewRequest { receiver: id as u32, sun });
+                            out.leaves.push(regime.leaves[d]);
+                        }
+                        out.cells.push((base + j, g, (id * MAX_PIECES + p) * per_piece + d * taus.len() + j));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether two days have the same declination (to rounding): no twin exists across New Year,
+/// where the sun model's 366-day series meets the schedule's 365-day year.
+fn same_declination(a: f64, b: f64) -> bool {
+    (declination_and_equation_of_time(a).0 - declination_and_equation_of_time(b).0).abs() < 1e-10
+}
+
+/// Whether a day's lit pieces (clock hours, solar noon at `noon`) are the twin's (hours from its
+/// solar noon): the same hour angles, so the same sun directions. They differ only where a piece
+/// is cut at midnight (polar day), which the equation of time moves.
+fn same_pieces(twin: &[(f64, f64, usize)], pieces: &[(f64, f64)], noon: f64) -> bool {
+    const HOURS: f64 = 1e-6;
+    twin.len() == pieces.len()
+        && twin.iter().zip(pieces).all(|(t, p)| (t.0 - (p.0 - noon)).abs() < HOURS && (t.1 - (p.1 - noon)).abs() < HOURS)
+}
+
+/// The views the spline pass counts for a scene without foliage: the plan's samples, a day that
+/// shares its twin's views listed once. What `sunlit bench` times.
+pub fn sample_requests(scene: &Scene, location: &Location, plan: SamplingPlan) -> Result<Vec<ViewRequest>> {
+    let taus = plan.taus();
+    let regime = Regime::year(plan, &taus, 1.0)?;
+    Ok(sample_views(scene, location, std::slice::from_ref(&regime), &taus).requests)
 }
 
 /// Fits every (receiver, piece) of a regime from its samples (None where the piece is never lit).
@@ -527,6 +581,50 @@ pub fn compare(a: &Schedule, b: &Schedule) -> Result<(f64, f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::{SceneBuilder, SourceMesh};
+
+    /// Five receivers facing south, east, north-west, up and a tilted north-east.
+    fn facets() -> Scene {
+        let mut b = SceneBuilder::new();
+        let quads: [[[f32; 3]; 4]; 5] = [
+            [[0., 0., 0.], [1., 0., 0.], [1., 0., 1.], [0., 0., 1.]],
+            [[1., 0., 0.], [1., 1., 0.], [1., 1., 1.], [1., 0., 1.]],
+            [[1., 1., 0.], [0., 2., 0.], [0., 2., 1.], [1., 1., 1.]],
+            [[0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]],
+            [[2., 2., 0.], [3., 1., 0.], [2.5, 0.5, 1.], [1.5, 1.5, 1.]],
+        ];
+        for (k, q) in quads.iter().enumerate() {
+            b.add_object("test", &format!("R{k}"), SourceMesh { positions: q.to_vec(), indices: vec![0, 1, 2, 0, 2, 3] }, true);
+        }
+        b.build().unwrap()
+    }
+
+    /// Every sample cell gets a view whose sun is the one its own day and time would give, and
+    /// twin days share views except where their pieces differ (polar day, New Year).
+    #[test]
+    fn twin_days_share_views_with_the_same_sun() {
+        let scene = facets();
+        let plan = SamplingPlan::new(27, 7).unwrap();
+        let taus = plan.taus();
+        for (latitude, at_least) in [(40.0, 0.45), (-33.9, 0.45), (75.0, 0.2)] {
+            let location = Location::new(latitude, 10.0, 1.0).unwrap();
+            let regimes = vec![Regime::year(plan, &taus, 1.0).unwrap()];
+            let views = sample_views(&scene, &location, &regimes, &taus);
+            let per_piece = plan.days * taus.len();
+            for &(request, _, cell) in &views.cells {
+                let (id, rest) = (cell / (MAX_PIECES * per_piece), cell % (MAX_PIECES * per_piece));
+                let (p, d, j) = (rest / per_piece, (rest % per_piece) / taus.len(), rest % taus.len());
+                let day = sun_day(regimes[0].days[d]);
+                let (start, end) = lit_intervals(&location, scene.receivers[id].normal, day, MIN_COS_INCIDENCE)[p];
+                let own = sun_direction(&location, day, start + taus[j] * (end - start));
+                let used = views.requests[request];
+                assert_eq!(used.receiver as usize, id);
+                assert!(own.distance(used.sun) < 1e-7, "{latitude}: receiver {id} day {day} τ {}: {own} vs {}", taus[j], used.sun);
+            }
+            let saved = 1.0 - views.requests.len() as f64 / views.cells.len() as f64;
+            assert!(saved >= at_least && saved < 0.5, "{latitude}: shared {saved:.3} of the views");
+        }
+    }
 
     #[test]
     fn dark_samples_take_the_nearest_lit_value() {

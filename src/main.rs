@@ -548,7 +548,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         };
         let gpu = counter.upload(&scene)?;
         let load_seconds = now() - t0;
-        let all = bench::sample_requests(&scene, &location, plan);
+        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {

@@ -11,10 +11,7 @@ use glam::DVec3;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::count::{ViewRequest, is_dark, view};
 use crate::error::Result;
-use crate::samples::SamplingPlan;
 use crate::scene::{Scene, SceneBuilder, SourceMesh};
-use crate::sun::location::Location;
-use crate::sun::position::{lit_intervals, sun_direction};
 
 /// A 10 m × 10 m horizontal receiver at z = 0 under a cloud of `triangles` random small
 /// triangles (0.05–0.5 m) between 0.5 m and 10 m up, spread over 20 m × 20 m.
@@ -149,23 +146,6 @@ pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DV
         seconds,
         views_per_second: rendered as f64 / seconds.max(1e-9),
     })
-}
-
-/// The views `sunlit annual` counts for its samples (before any refinement): every receiver ×
-/// sampled day × lit piece (at most two a day) × sample time, as in its spline fit.
-pub fn sample_requests(scene: &Scene, location: &Location, plan: SamplingPlan) -> Vec<ViewRequest> {
-    let (days, taus) = (plan.sample_days(), plan.taus());
-    let mut requests = Vec::new();
-    for (id, r) in scene.receivers.iter().enumerate() {
-        for &day in &days {
-            for (start, end) in lit_intervals(location, r.normal, day, crate::count::MIN_COS_INCIDENCE).into_iter().take(2) {
-                for tau in &taus {
-                    requests.push(ViewRequest { receiver: id as u32, sun: sun_direction(location, day, start + tau * (end - start)) });
-                }
-            }
-        }
-    }
-    requests
 }
 
 /// Every `stride`-th request, so a long benchmark can time an even spread and extrapolate.

@@ -151,6 +151,11 @@ fn crossings(k: &[f64; 3], threshold: f64, noon: f64) -> Vec<f64> {
     out
 }
 
+/// Standard time (hours) of solar noon on a day: where the hour angle is zero.
+pub fn solar_noon_hour(location: &Location, day_of_year: f64) -> f64 {
+    solar_noon(location, declination_and_equation_of_time(day_of_year).1)
+}
+
 /// `SUN4`'s hour angle in degrees (positive before solar noon):
 /// 15·(12 − (t + EoT)) + (TimeZoneMeridian − Longitude).
 fn hour_angle_degrees(location: &Location, equation_of_time: f64, standard_hour: f64) -> f64 {
