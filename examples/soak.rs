@@ -23,15 +23,16 @@ fn main() -> Result<(), Box<dyn Error>> {
     let scene = load_bytes(&[("office.glb".into(), office(2).to_glb())], &LoadOptions::default())?;
     let location = Location::new(39.74, -105.18, -7.0)?;
     let options = AnnualOptions { timesteps: Timesteps::new(1)?, method: Method::Spline(SamplingPlan::new(6, 7)?), refine: 1.0 };
-    let mut counter = pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))?;
+    let counter = pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))?;
+    let gpu = counter.upload(&scene)?;
+    let mut lanes = vec![(counter, gpu)];
     let start = Instant::now();
     let mut first = None;
     for run in 1..=runs {
         // A fresh upload per run, as the page and the CLI do per computation.
-        let mut gpu = counter.upload(&scene)?;
+        lanes[0].1 = lanes[0].0.upload(&scene)?;
         let schedule = pollster::block_on(annual_recovering(
-            &mut counter,
-            &mut gpu,
+            &mut lanes,
             &scene,
             &location,
             &options,

@@ -24,6 +24,7 @@
 use glam::DVec3;
 
 use crate::count::gpu::{Counter, GpuScene};
+use crate::count::lanes::{Lane, fractions_side_by_side};
 use crate::count::{MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
@@ -101,9 +102,22 @@ pub async fn annual_with_leaves(
     calendar: &LeafCalendar,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
+    annual_on(&[Lane { counter, gpu }], scene, location, options, calendar, progress).await
+}
+
+/// As [`annual_with_leaves`], the views shared out over several counters side by side
+/// ([`crate::count::lanes`]), each holding its own upload of `scene`.
+pub async fn annual_on(
+    lanes: &[Lane<'_>],
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Schedule> {
     let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
     let mut schedule = Schedule::zeros(names, options.timesteps);
-    let views = Views { counter, gpu };
+    let views = Views { lanes };
     let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
     match options.method {
         Method::Spline(plan) => spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?,
@@ -113,34 +127,39 @@ pub async fn annual_with_leaves(
     Ok(schedule)
 }
 
-/// [`annual`] surviving one loss of the GPU device (a driver reset, a GPU hang): on
-/// [`Error::DeviceLost`] it makes a new counter with the same options, uploads the scene again
-/// and counts the year once more from the start (progress starts again at 0). A second loss is
-/// returned.
+/// [`annual_on`] the lanes' counters, surviving one loss of a GPU device (a driver reset, a GPU
+/// hang): on [`Error::DeviceLost`] it makes every lane a new counter with the same options,
+/// uploads the scene again and counts the year once more from the start (progress starts again
+/// at 0). A second loss is returned.
 pub async fn annual_recovering(
-    counter: &mut Counter,
-    gpu: &mut GpuScene,
+    lanes: &mut [(Counter, GpuScene)],
     scene: &Scene,
     location: &Location,
     options: &AnnualOptions,
     calendar: &LeafCalendar,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
-    match annual_with_leaves(counter, gpu, scene, location, options, calendar, progress).await {
+    let first = annual_on(&borrowed(lanes), scene, location, options, calendar, progress).await;
+    match first {
         Err(Error::DeviceLost(why)) => {
             log::warn!("GPU device lost ({why}); making a new one and counting again");
-            *counter = counter.recreate().await?;
-            *gpu = counter.upload(scene)?;
-            annual_with_leaves(counter, gpu, scene, location, options, calendar, progress).await
+            for (counter, gpu) in lanes.iter_mut() {
+                *counter = counter.recreate().await?;
+                *gpu = counter.upload(scene)?;
+            }
+            annual_on(&borrowed(lanes), scene, location, options, calendar, progress).await
         }
         other => other,
     }
 }
 
-/// The counter and the scene on it: what turns view requests into fractions.
+fn borrowed(lanes: &[(Counter, GpuScene)]) -> Vec<Lane<'_>> {
+    lanes.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect()
+}
+
+/// The counters and their scenes: what turns view requests into fractions.
 struct Views<'a> {
-    counter: &'a Counter,
-    gpu: &'a GpuScene,
+    lanes: &'a [Lane<'a>],
 }
 
 impl Views<'_> {
@@ -148,9 +167,10 @@ impl Views<'_> {
     async fn count(&self, requests: &[ViewRequest], leaves: &[f32], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
         progress(Progress { done: 0, total: requests.len() })?;
-        let per_report = self.counter.tiles_per_batch() * BATCHES_PER_REPORT;
+        let batch = self.lanes.first().map_or(1, |l| l.counter.tiles_per_batch());
+        let per_report = batch * BATCHES_PER_REPORT * self.lanes.len().max(1);
         for (chunk, leaves) in requests.chunks(per_report).zip(leaves.chunks(per_report)) {
-            out.extend(self.counter.fractions_with_leaves(self.gpu, chunk, leaves).await?.into_iter().map(|c| c.fraction));
+            out.extend(fractions_side_by_side(self.lanes, chunk, leaves).await?.into_iter().map(|c| c.fraction));
             progress(Progress { done: out.len(), total: requests.len() })?;
         }
         Ok(out)

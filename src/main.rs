@@ -8,7 +8,8 @@ use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
 use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions};
+use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{ViewRequest, cos_incidence, exact};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
@@ -62,6 +63,10 @@ struct AnnualArgs {
     /// Tile size in pixels.
     #[arg(long, default_value_t = 512)]
     resolution: u32,
+    /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
+    /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
+    #[arg(long, value_name = "N")]
+    lanes: Option<usize>,
     /// Count every sun-up timestep directly instead of interpolating (the reference; slow).
     #[arg(long)]
     dense: bool,
@@ -218,6 +223,10 @@ struct BenchArgs {
     /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
     #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
     atlas: u32,
+    /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
+    /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
+    #[arg(long, value_name = "N")]
+    lanes: Option<usize>,
     /// Generated model names (see --list) or glTF/IDF model files.
     models: Vec<String>,
 }
@@ -280,6 +289,27 @@ fn quiet_mesa_runtime_dir() {
 
 fn counter(resolution: u32) -> Result<Counter> {
     pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))
+}
+
+/// `first` and as many more counters with its options as `lanes` asks (default: see
+/// [`default_lanes`]), each with `scene` uploaded.
+fn lanes(first: Counter, lanes: Option<usize>, scene: &Scene) -> Result<Vec<(Counter, GpuScene)>> {
+    let n = lanes.unwrap_or_else(|| default_lanes(first.adapter_info()));
+    if n == 0 {
+        return Err(Error::argument("--lanes", "must be at least 1"));
+    }
+    let options = first.options();
+    let mut counters = vec![first];
+    for _ in 1..n {
+        counters.push(pollster::block_on(Counter::new(options))?);
+    }
+    counters
+        .into_iter()
+        .map(|counter| {
+            let gpu = counter.upload(scene)?;
+            Ok((counter, gpu))
+        })
+        .collect()
 }
 
 fn fraction(args: FractionArgs) -> Result<()> {
@@ -355,8 +385,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let mut counter = counter(args.resolution)?;
-    let mut gpu = counter.upload(&scene)?;
+    let mut lanes = lanes(counter(args.resolution)?, args.lanes, &scene)?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -370,8 +399,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule =
-        pollster::block_on(sunlit::annual::annual_recovering(&mut counter, &mut gpu, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -535,6 +563,15 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         .and_then(|(d, s)| Some((d.trim().parse().ok()?, s.trim().parse().ok()?)))
         .ok_or_else(|| Error::argument("--samples", format!("'{}' is not DAYSxPER_DAY (e.g. 27x19)", args.samples)))?;
     let plan = SamplingPlan::new(days, per_day)?;
+    let lane_count = args.lanes.unwrap_or_else(|| default_lanes(counter.adapter_info()));
+    if lane_count == 0 {
+        return Err(Error::argument("--lanes", "must be at least 1"));
+    }
+    let mut counters = vec![];
+    for _ in 1..lane_count {
+        counters.push(pollster::block_on(Counter::new(counter.options()))?);
+    }
+    let counters: Vec<&Counter> = std::iter::once(counter).chain(&counters).collect();
     for name in &args.models {
         let t0 = now();
         // A name that is neither generated nor a file gets the list of generated names.
@@ -546,7 +583,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         } else {
             (model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(&args.location)?, None)
         };
-        let gpu = counter.upload(&scene)?;
+        let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
+        let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
         let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
         let spread;
@@ -557,7 +595,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(counter, &scene, &gpu, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
@@ -566,6 +604,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             "triangles": scene.triangle_count(),
             "samples": format!("{days}x{per_day}"),
             "resolution": counter.resolution(),
+            "lanes": lanes.len(),
             "views": all.len(),
             "views_timed": t.views,
             "views_rendered": t.rendered,

@@ -54,3 +54,37 @@ fn wait_for_maps(_device: &wgpu::Device) -> Result<()> {
     // The browser resolves the map on its own event loop; the future above is awaited instead.
     Ok(())
 }
+
+/// Runs `job` on every item at once and returns the results in item order: natively one thread
+/// per item (each blocks on its own device); on the web, where there are no threads to block,
+/// one after the other.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) async fn side_by_side<I, T, F, Fut>(items: &[I], job: F) -> Vec<T>
+where
+    I: Sync,
+    T: Send,
+    F: Fn(&I) -> Fut + Sync,
+    Fut: std::future::Future<Output = T>,
+{
+    if let [only] = items {
+        return vec![job(only).await];
+    }
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = items.iter().map(|item| scope.spawn(|| pollster::block_on(job(item)))).collect();
+        // A panicking lane is a bug; carry its panic to the caller rather than invent a result.
+        handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect()
+    })
+}
+
+#[cfg(target_arch = "wasm32")]
+pub(crate) async fn side_by_side<I, T, F, Fut>(items: &[I], job: F) -> Vec<T>
+where
+    F: Fn(&I) -> Fut,
+    Fut: std::future::Future<Output = T>,
+{
+    let mut out = Vec::with_capacity(items.len());
+    for item in items {
+        out.push(job(item).await);
+    }
+    out
+}

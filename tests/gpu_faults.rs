@@ -58,26 +58,19 @@ fn annual_recovers_from_a_device_lost_mid_year() {
         let gpu = counter.upload(&scene).unwrap();
         pollster::block_on(annual(&counter, &gpu, &scene, &golden(), &options(), &mut |_| Ok(()))).unwrap()
     };
-    let mut counter = counter();
-    let mut gpu = counter.upload(&scene).unwrap();
+    let counter = counter();
+    let gpu = counter.upload(&scene).unwrap();
     let lose = counter.device_loss_trigger();
+    let mut lanes = vec![(counter, gpu)];
     let mut reports = Vec::new();
-    let schedule = pollster::block_on(annual_recovering(
-        &mut counter,
-        &mut gpu,
-        &scene,
-        &golden(),
-        &options(),
-        &LeafCalendar::evergreen(),
-        &mut |p| {
-            // Lose the device at the first report after the start: mid-year, once.
-            if p.done > 0 && reports.iter().all(|r: &Progress| r.done == 0) {
-                lose();
-            }
-            reports.push(p);
-            Ok(())
-        },
-    ))
+    let schedule = pollster::block_on(annual_recovering(&mut lanes, &scene, &golden(), &options(), &LeafCalendar::evergreen(), &mut |p| {
+        // Lose the device at the first report after the start: mid-year, once.
+        if p.done > 0 && reports.iter().all(|r: &Progress| r.done == 0) {
+            lose();
+        }
+        reports.push(p);
+        Ok(())
+    }))
     .unwrap();
     let restarts = reports.windows(2).filter(|w| w[1].done < w[0].done).count();
     assert_eq!(restarts, 1, "counted again from the start once: {reports:?}");
@@ -85,16 +78,9 @@ fn annual_recovers_from_a_device_lost_mid_year() {
     let worst = schedule.values.iter().zip(&reference.values).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
     assert!(worst <= 1e-6, "the recovered year equals an undisturbed one (max |Δ| {worst})");
     // A device lost between runs is found at the start of the next, and recovered from too.
-    counter.device_loss_trigger()();
-    let again = pollster::block_on(annual_recovering(
-        &mut counter,
-        &mut gpu,
-        &scene,
-        &golden(),
-        &options(),
-        &LeafCalendar::evergreen(),
-        &mut |_| Ok(()),
-    ))
-    .unwrap();
+    lanes[0].0.device_loss_trigger()();
+    let again =
+        pollster::block_on(annual_recovering(&mut lanes, &scene, &golden(), &options(), &LeafCalendar::evergreen(), &mut |_| Ok(())))
+            .unwrap();
     assert_eq!(again, schedule);
 }

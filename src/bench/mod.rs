@@ -9,6 +9,7 @@ pub mod models;
 use glam::DVec3;
 
 use crate::count::gpu::{Counter, GpuScene};
+use crate::count::lanes::{Lane, fractions_side_by_side};
 use crate::count::{ViewRequest, is_dark, view};
 use crate::error::Result;
 use crate::scene::{Scene, SceneBuilder, SourceMesh};
@@ -177,17 +178,14 @@ pub struct ViewTiming {
     pub fractions: Vec<(f64, bool)>,
 }
 
-/// Times `Counter::fractions` over `requests`; one warm-up batch first.
-pub async fn time_requests(
-    counter: &Counter,
-    scene: &Scene,
-    gpu: &GpuScene,
-    requests: &[ViewRequest],
-    now: impl Fn() -> f64,
-) -> Result<ViewTiming> {
-    counter.fractions(gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
+/// Times counting `requests` over the lanes (side by side); one warm-up batch a lane first.
+pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRequest], now: impl Fn() -> f64) -> Result<ViewTiming> {
+    let Some(&Lane { counter, gpu }) = lanes.first() else { return Err(crate::error::Error::argument("lanes", "none to count on")) };
+    // Warm every lane (pipelines, first submission) outside the timing.
+    let warm = requests.len().min(counter.tiles_per_batch() * lanes.len());
+    fractions_side_by_side(lanes, &requests[..warm], &[]).await?;
     let start = now();
-    let counted = counter.fractions(gpu, requests).await?;
+    let counted = fractions_side_by_side(lanes, requests, &[]).await?;
     let seconds = now() - start;
     let rendered = counted.iter().filter(|c| c.covered > 0).count();
     let start = now();

@@ -267,6 +267,11 @@ impl Counter {
         &self.info
     }
 
+    /// The options it was made with.
+    pub fn options(&self) -> CounterOptions {
+        self.options
+    }
+
     /// Tile resolution in pixels.
     pub fn resolution(&self) -> u32 {
         self.options.resolution
