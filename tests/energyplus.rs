@@ -158,11 +158,15 @@ fn imported_form_has_every_column_energyplus_writes() {
         names
     };
     assert_eq!(header(&csv), header(&reference.join("eplusshading.csv")));
-    // The louvres are horizontal plates facing up: the top of the highest is lit whenever the sun
-    // is up, their undersides (the Mir- faces) never, in both files.
+    // The louvres are horizontal plates facing up: the top of the highest is lit most of the time
+    // the sun is up (the wall shades it when the sun is behind the building), their undersides
+    // (the Mir- faces) never, in both files. A 3×3-sample year at 64² is coarse near the ends of
+    // the day, so the counts of mostly lit timesteps agree to a few percent, not exactly.
     let (ours, theirs) = (columns(&csv), columns(&reference.join("eplusshading.csv")));
-    let lit = |v: &[f64]| v.iter().filter(|x| **x > 0.5).count();
-    assert!(lit(&ours["LOUVER_2"]) > 15_000 && lit(&theirs["LOUVER_2"]) > 15_000);
+    let lit = |v: &[f64]| v.iter().filter(|x| **x > 0.5).count() as f64;
+    let (a, b) = (lit(&ours["LOUVER_2"]), lit(&theirs["LOUVER_2"]));
+    println!("LOUVER_2 mostly lit in {a} timesteps (sunlit), {b} (EnergyPlus) of {}", ours["LOUVER_2"].len());
+    assert!(b > 12_000.0 && (a - b).abs() < 0.04 * b, "LOUVER_2 mostly lit: sunlit {a} vs EnergyPlus {b} timesteps");
     assert!(ours["MIR-LOUVER_0"].iter().chain(&theirs["MIR-LOUVER_0"]).all(|v| *v == 0.0));
     let err = run_energyplus(&hooked, &dir.join("hooked"));
     assert_eq!(severe_count(&err), 0, "{err}");
