@@ -1,7 +1,7 @@
 // Sun-view render: draws the scene into an atlas tile with an orthographic camera that looks
 // along the sun's rays, writing each fragment's receiver id (or NO_RECEIVER) to the red channel
-// of an rg32uint target. The mask pipeline draws the target receiver alone (no depth test) into
-// the green channel: its coverage, the denominator of the sunlit fraction.
+// of an rg32uint target. The mask pipeline draws the tile's receivers alone (no depth test) into
+// the green channel, each its own id: their coverage, the denominators of the sunlit fractions.
 //
 // Instances: a draw covers instance_index = view * instance_count + instance, so one
 // draw_indexed per mesh renders every placement of it for one view.
@@ -28,10 +28,14 @@ struct View {
     view_proj: mat4x4<f32>,
     // Top-left pixel of the view's tile in the atlas.
     tile: vec2<u32>,
-    // The receiver whose pixels this view counts.
-    target_id: u32,
+    // The receivers whose pixels this view counts (read by the count pass only).
+    first_member: u32,
+    member_count: u32,
     // Leaf fraction of the view's day: leaves with a lower rank cast shadows.
     leaves: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct Params {
@@ -89,7 +93,8 @@ fn pcg(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-// Both pipelines share this: the scene pipeline writes only red, the mask pipeline only green.
+// Both pipelines share this: the scene pipeline writes only red (the visible id), the mask
+// pipeline only green (the covering member's id).
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec2<u32> {
     if in.transmittance > 0.0 {
@@ -99,5 +104,5 @@ fn fs_main(in: VertexOut) -> @location(0) vec2<u32> {
             discard;
         }
     }
-    return vec2<u32>(in.id, 1u);
+    return vec2<u32>(in.id, in.id);
 }

@@ -411,7 +411,28 @@ fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[
             }
         }
     }
-    out
+    by_sun(out)
+}
+
+/// Reorders the views so that those at one sun (and leaf fraction) are adjacent: receivers of
+/// one view group (a wall and its windows, [`crate::count::group`]) then share a tile even when
+/// the views are counted a batch at a time.
+fn by_sun(views: SampleViews) -> SampleViews {
+    let key = |k: usize| {
+        let (r, leaves) = (views.requests[k], views.leaves[k]);
+        (r.sun.x.to_bits(), r.sun.y.to_bits(), r.sun.z.to_bits(), leaves.to_bits(), r.receiver)
+    };
+    let mut order: Vec<usize> = (0..views.requests.len()).collect();
+    order.sort_by_key(|&k| key(k));
+    let mut new_index = vec![0; order.len()];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new;
+    }
+    SampleViews {
+        requests: order.iter().map(|&k| views.requests[k]).collect(),
+        leaves: order.iter().map(|&k| views.leaves[k]).collect(),
+        cells: views.cells.into_iter().map(|(request, g, cell)| (new_index[request], g, cell)).collect(),
+    }
 }
 
 /// Whether two days have the same declination (to rounding): no twin exists across New Year,

@@ -614,6 +614,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             "views_per_second": t.views_per_second,
             "planning_seconds": t.planning_seconds,
             "mean_triangles_drawn": t.mean_triangles_drawn.round(),
+            "tiles_rendered": t.tiles_rendered,
+            "mean_triangles_per_tile": t.mean_triangles_per_tile.round(),
             "load_seconds": load_seconds,
             "peak_memory_mib": peak_memory_mib(),
         });

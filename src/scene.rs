@@ -28,9 +28,9 @@ use crate::error::{Error, Result};
 pub const NO_RECEIVER: u32 = u32::MAX;
 
 /// Two triangles are coplanar when their normals are within this angle (radians)…
-const COPLANAR_ANGLE: f64 = 0.5 * std::f64::consts::PI / 180.0;
+pub(crate) const COPLANAR_ANGLE: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// …and every vertex lies within this distance (metres) of the part's plane.
-const COPLANAR_DISTANCE: f64 = 1e-3;
+pub(crate) const COPLANAR_DISTANCE: f64 = 1e-3;
 /// Triangles with less area than this (m²) are ignored when building receivers.
 const DEGENERATE_AREA: f64 = 1e-10;
 

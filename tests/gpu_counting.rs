@@ -350,3 +350,110 @@ fn louvre_slats_parallel_to_the_window_edges() {
     assert!(exact.iter().filter(|e| **e > 0.02 && **e < 0.98).count() > 10, "mostly partial shading: {exact:?}");
     assert!(worst <= TOL, "max |error| {worst}");
 }
+
+/// A 4 × 3 m south wall (x 0..4, z 0..3, y = 0) with two 1.6 × 2.2 m holes (x 0.2..1.8 and
+/// 2.2..3.8, z 0.4..2.6) holding the windows WIN_A and WIN_B (29% of the wall's outline each,
+/// enough to share its view), an overhang 0.8 m deep along its top and five louvre slats in
+/// front of the windows.
+fn facade_scene() -> Scene {
+    let mut wall = SourceMesh::default();
+    for (x0, x1, z0, z1) in [(0.0, 4.0, 0.0, 0.4), (0.0, 4.0, 2.6, 3.0), (0.0, 0.2, 0.4, 2.6), (1.8, 2.2, 0.4, 2.6), (3.8, 4.0, 0.4, 2.6)] {
+        let base = wall.positions.len() as u32;
+        wall.positions.extend(south_rect(x0, x1, z0, z1, 0.0).iter().map(|p| p.as_vec3().to_array()));
+        wall.indices.extend([0, 1, 2, 0, 2, 3].map(|i| base + i));
+    }
+    let mut s = TestScene::new();
+    s.mesh("WALL", wall, true);
+    s.polygon("WIN_A", &south_rect(0.2, 1.8, 0.4, 2.6, 0.0), true);
+    s.polygon("WIN_B", &south_rect(2.2, 3.8, 0.4, 2.6, 0.0), true);
+    s.polygon("OVERHANG", &flat_rect(-1.0, 5.0, -0.8, 0.0, 3.0), false);
+    for i in 0..5 {
+        let z = 0.6 + 0.4 * i as f64;
+        s.cuboid(&format!("SLAT{i}"), DVec3::new(0.0, -0.45, z), DVec3::new(4.0, -0.25, z + 0.03));
+    }
+    s.build()
+}
+
+fn facade_suns() -> Vec<DVec3> {
+    (0..8).map(|i| sun(120.0 + 15.0 * i as f64, 15.0 + 7.0 * i as f64)).collect()
+}
+
+#[test]
+fn a_wall_and_its_windows_counted_in_one_view_match_the_exact_reference() {
+    let scene = facade_scene();
+    let [wall, a, b] = ["WALL", "WIN_A", "WIN_B"].map(|n| receiver_id(&scene, n));
+    let counter = counter(512);
+    let gpu = counter.upload(&scene).unwrap();
+    let shared: Vec<Vec<u32>> = gpu.view_groups().shared().map(|m| m.to_vec()).collect();
+    assert_eq!(shared, vec![vec![wall, a, b]], "the wall owns the group, the windows follow");
+    // Every sun for all three; then, at the same suns, partial groups: a window alone, and the
+    // wall with one window (a receiver asked for twice at one sun opens another tile).
+    let suns = facade_suns();
+    let mut requests: Vec<ViewRequest> = suns.iter().flat_map(|&sun| [wall, a, b].map(|receiver| ViewRequest { receiver, sun })).collect();
+    requests.extend(suns.iter().step_by(2).map(|&sun| ViewRequest { receiver: a, sun }));
+    requests.extend(suns.iter().skip(1).step_by(2).flat_map(|&sun| [b, wall].map(|receiver| ViewRequest { receiver, sun })));
+    let (tiles_before, _) = counter.rendered();
+    let got = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    let tiles = counter.rendered().0 - tiles_before;
+    let lit = got.iter().filter(|c| c.covered > 0).count();
+    assert_eq!(lit, requests.len(), "every view is rendered (the overhang is always in front)");
+    assert_eq!(tiles as usize, 8 + 4 + 4, "one tile per sun and group");
+    let exact = exact::sunlit_fractions(&scene, &requests);
+    let mut worst: f64 = 0.0;
+    for ((req, g), e) in requests.iter().zip(&got).zip(&exact) {
+        assert!(
+            (g.fraction - e).abs() < TOL,
+            "{} sun {}: gpu {} vs exact {e}",
+            scene.receivers[req.receiver as usize].name,
+            req.sun,
+            g.fraction
+        );
+        worst = worst.max((g.fraction - e).abs());
+    }
+    println!("facade, grouped: max |gpu − exact| {worst:.5} over {} views in {tiles} tiles", requests.len());
+    assert!(exact.iter().filter(|e| **e > 0.05 && **e < 0.95).count() > 20, "mostly partial shading: {exact:?}");
+    // The windows' views alone (ungrouped tiles) agree with their grouped counts.
+    let alone: Vec<ViewRequest> = suns.iter().map(|&sun| ViewRequest { receiver: b, sun }).collect();
+    let single = pollster::block_on(counter.fractions(&gpu, &alone)).unwrap();
+    for (k, s) in single.iter().enumerate() {
+        let grouped = got[3 * k + 2];
+        assert!((s.fraction - grouped.fraction).abs() < TOL, "WIN_B alone {} vs grouped {}", s.fraction, grouped.fraction);
+        assert!(s.covered > 2 * grouped.covered, "alone it has its own tile");
+    }
+}
+
+#[test]
+fn grouped_compute_counts_equal_a_cpu_count_of_the_id_atlas() {
+    // CPU reference of count_pixels.wgsl for tiles of several members: per member, visible where
+    // red is its id and covered where green is its id.
+    let scene = facade_scene();
+    let ids = ["WALL", "WIN_A", "WIN_B"].map(|n| receiver_id(&scene, n));
+    let counter = counter(128);
+    let gpu = counter.upload(&scene).unwrap();
+    // Tiles follow their first request; members the group's order (wall first). Sun 2 counts
+    // the windows only.
+    let suns = &facade_suns();
+    let members = |k: usize| if k == 2 { &ids[1..] } else { &ids[..] };
+    let requests: Vec<ViewRequest> =
+        (0..suns.len()).flat_map(|k| members(k).iter().rev().map(move |&receiver| ViewRequest { receiver, sun: suns[k] })).collect();
+    let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    let (side, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
+    let res = counter.resolution();
+    let mut next = 0;
+    for k in 0..suns.len() {
+        let [x0, y0] = counter.tile_of(k);
+        let tile: Vec<[u32; 2]> =
+            (y0..y0 + res).flat_map(|y| (x0..x0 + res).map(move |x| (y * side + x) as usize)).map(|i| atlas[i]).collect();
+        for &r in members(k).iter().rev() {
+            let c = counted[next];
+            next += 1;
+            let id = scene.receivers[r as usize].gpu_id;
+            let visible = tile.iter().filter(|t| t[0] == id).count() as u32;
+            let covered = tile.iter().filter(|t| t[1] == id).count() as u32;
+            assert_eq!((c.visible, c.covered), (visible, covered), "sun {k}, receiver {r}");
+            assert!(covered > 0 && visible <= covered);
+        }
+        // Nothing but the tile's members in green.
+        assert!(tile.iter().all(|t| t[1] == sunlit::scene::NO_RECEIVER || members(k).contains(&t[1])));
+    }
+}

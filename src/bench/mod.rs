@@ -149,10 +149,16 @@ pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DV
     })
 }
 
-/// Every `stride`-th request, so a long benchmark can time an even spread and extrapolate.
+/// An even spread of about `at_most` requests, so a long benchmark can time it and extrapolate:
+/// every k-th sun with all its requests (those at one sun adjacent, as `sample_requests` lists them).
 pub fn spread(requests: &[ViewRequest], at_most: usize) -> Vec<ViewRequest> {
-    let stride = requests.len().div_ceil(at_most.max(1)).max(1);
-    requests.iter().step_by(stride).copied().collect()
+    // Whole suns: the views of a wall and its windows at one sun share a tile, which picking
+    // single views would break up.
+    let suns: Vec<&[ViewRequest]> = requests.chunk_by(|a, b| a.sun == b.sun).collect();
+    let per_sun = requests.len() as f64 / suns.len().max(1) as f64;
+    let wanted = ((at_most as f64 / per_sun).floor() as usize).max(1);
+    let stride = suns.len().div_ceil(wanted).max(1);
+    suns.into_iter().step_by(stride).flatten().copied().collect()
 }
 
 /// Timing of a batch of views of one uploaded scene.
@@ -173,6 +179,11 @@ pub struct ViewTiming {
     pub planning_seconds: f64,
     /// Mean triangles drawn per rendered view (the culling's choice).
     pub mean_triangles_drawn: f64,
+    /// Tiles rendered: a tile counts one view, or several of one view group (a wall and its
+    /// windows at one sun).
+    pub tiles_rendered: u64,
+    /// Mean triangles the scene pass drew per tile rendered.
+    pub mean_triangles_per_tile: f64,
     /// The sunlit fraction of every timed view, and whether it was rendered.
     #[serde(skip)]
     pub fractions: Vec<(f64, bool)>,
@@ -185,8 +196,12 @@ pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRe
     let warm = requests.len().min(counter.tiles_per_batch() * lanes.len());
     fractions_side_by_side(lanes, &requests[..warm], &[]).await?;
     let start = now();
+    let rendered_so_far = || lanes.iter().fold((0, 0), |(t, n), l| (t + l.counter.rendered().0, n + l.counter.rendered().1));
+    let before = rendered_so_far();
     let counted = fractions_side_by_side(lanes, requests, &[]).await?;
     let seconds = now() - start;
+    let after = rendered_so_far();
+    let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);
     let rendered = counted.iter().filter(|c| c.covered > 0).count();
     let start = now();
     let (drawn, planned) = plan_views(scene, gpu, requests, counter.resolution());
@@ -199,6 +214,8 @@ pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRe
         views_per_second: requests.len() as f64 / seconds.max(1e-9),
         planning_seconds,
         mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
+        tiles_rendered: tiles,
+        mean_triangles_per_tile: triangles as f64 / tiles.max(1) as f64,
         fractions: counted.iter().map(|c| (c.fraction, c.covered > 0)).collect(),
     })
 }

@@ -8,17 +8,25 @@
 //! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
 //! surface gives exactly 1. Many views share one submission (tiles of the atlas).
 //!
+//! Requests for receivers of one view group ([`super::group`]: a wall and the windows in it) at
+//! the same sun and leaf fraction share a tile: the mask pass draws each requested member with its
+//! own id, the scene is drawn once, and the count pass counts each member apart.
+//!
 //! Foliage and see-through casters ([`crate::scene::Veil`]) are decided on the GPU, so one upload
 //! serves every day: each view carries its day's leaf fraction and the vertex shader drops the
 //! leaves whose rank is not below it; a see-through fragment is discarded (lets the sun through)
 //! where a per-pixel hash threshold falls below its transmittance.
 
+use std::borrow::Cow;
+use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use glam::{DMat4, DVec3};
 
 use super::cull::{CPU_LEAF_TRIANGLES, Culling, DrawList, LEAF_TRIANGLES, Target};
+use super::group::{MAX_MEMBERS, ViewGroups};
 use super::view::{self, SunView};
 use super::{ViewRequest, cos_incidence, is_dark};
 use crate::error::{Error, Result};
@@ -84,8 +92,13 @@ pub struct Counter {
     count_pipeline: wgpu::ComputePipeline,
     atlas: Atlas,
     views: wgpu::Buffer,
+    /// Receiver ids of the tiles' members (the count pass's `members`).
+    members: wgpu::Buffer,
     counts: wgpu::Buffer,
     readback: wgpu::Buffer,
+    /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
+    tiles_rendered: AtomicU64,
+    triangles_drawn: AtomicU64,
     errors: Arc<Mutex<Vec<String>>>,
     /// Why the device was lost, once it is (set by wgpu's device-lost callback).
     lost: Arc<Mutex<Option<String>>>,
@@ -104,6 +117,7 @@ pub struct GpuScene {
     static_chunks: Vec<StaticChunk>,
     instance_count: u32,
     receivers: Vec<ReceiverView>,
+    groups: ViewGroups,
     bounds: (DVec3, DVec3),
     origin: DVec3,
     culling: Culling,
@@ -150,8 +164,18 @@ struct GpuInstance {
 struct GpuView {
     view_proj: [[f32; 4]; 4],
     tile: [u32; 2],
-    target_id: u32,
+    first_member: u32,
+    member_count: u32,
     leaves: f32,
+    _pad: [u32; 3],
+}
+
+/// One tile to render: requests of one view group at one sun and leaf fraction.
+struct Tile {
+    /// Request indices, their receivers distinct, the group's owner first.
+    requests: Vec<usize>,
+    view: SunView,
+    draws: DrawList,
 }
 
 #[repr(C)]
@@ -230,14 +254,20 @@ impl Counter {
             depth: attachment(&device, "depth", side, DEPTH_FORMAT, false),
         };
         let tiles = (tiles_per_side * tiles_per_side) as u64;
+        let entries = tiles * MAX_MEMBERS as u64;
         let views =
             buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
-        let counts =
-            buffer(&device, "counts", tiles * 8, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
+        let members = buffer(&device, "members", entries * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let counts = buffer(
+            &device,
+            "counts",
+            entries * 8,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
         let readback = buffer(
             &device,
             "readback",
-            tiles * 8 * BATCHES_PER_READBACK as u64,
+            entries * 8 * BATCHES_PER_READBACK as u64,
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
         let counter = Self {
@@ -253,8 +283,11 @@ impl Counter {
             count_pipeline,
             atlas,
             views,
+            members,
             counts,
             readback,
+            tiles_rendered: AtomicU64::new(0),
+            triangles_drawn: AtomicU64::new(0),
             errors,
             lost,
         };
@@ -280,6 +313,12 @@ impl Counter {
     /// Views rendered per submission.
     pub fn tiles_per_batch(&self) -> usize {
         (self.tiles_per_side * self.tiles_per_side) as usize
+    }
+
+    /// Tiles rendered since this counter was made (a tile counts one request, or several of one
+    /// view group), and the triangles drawn in them by the scene pass.
+    pub fn rendered(&self) -> (u64, u64) {
+        (self.tiles_rendered.load(Ordering::Relaxed), self.triangles_drawn.load(Ordering::Relaxed))
     }
 
     fn check_errors(&self, doing: &str) -> Result<()> {
@@ -448,6 +487,7 @@ impl Counter {
                 entry(1, self.views.as_entire_binding()),
                 entry(2, params_buffer.as_entire_binding()),
                 entry(3, self.counts.as_entire_binding()),
+                entry(4, self.members.as_entire_binding()),
             ],
         });
         self.check_errors("uploading the scene")?;
@@ -456,6 +496,7 @@ impl Counter {
             static_chunks,
             instance_count: params.instance_count,
             receivers,
+            groups: ViewGroups::find(scene),
             bounds: scene.bounds,
             origin: scene.origin,
             culling,
@@ -478,7 +519,48 @@ impl Counter {
         }
         let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
         let mut out = vec![Counted::default(); requests.len()];
-        let mut lit: Vec<(usize, SunView, DrawList)> = Vec::new();
+        let tiles = self.plan_tiles(scene, requests, &leaves_of, &mut out)?;
+        let per_batch = self.tiles_per_batch();
+        for chunk in tiles.chunks(per_batch * BATCHES_PER_READBACK) {
+            // Each batch's counts land in the readback right after the previous batch's.
+            let mut entries = 0;
+            for batch in chunk.chunks(per_batch) {
+                entries += self.submit_batch(scene, requests, &leaves_of, batch, entries)?;
+            }
+            let counts = platform::read_buffer(&self.device, &self.readback, (entries * 8) as u64).await;
+            // A failed read on a lost device is the loss, not a read error.
+            self.check_errors("counting pixels")?;
+            let counts = counts?;
+            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
+            let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
+            for (k, (i, pixel_area)) in members.enumerate() {
+                let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
+                let o = &mut out[i];
+                o.visible = visible;
+                o.covered = covered;
+                o.pixel_area = pixel_area;
+                o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
+            }
+            let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.culling)).sum();
+            self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
+            self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
+        }
+        Ok(out)
+    }
+
+    /// Sorts the requests into tiles: dark ones get their cosine only, the others join the tile
+    /// of their view group, sun and leaf fraction (bitwise: the sampler asks for a wall and its
+    /// windows at the very same sun vectors). Each tile's view is fitted to its requested
+    /// members; a tile with nothing in front of any member gets fraction 1 without a render.
+    fn plan_tiles(
+        &self,
+        scene: &GpuScene,
+        requests: &[ViewRequest],
+        leaves_of: &dyn Fn(usize) -> f32,
+        out: &mut [Counted],
+    ) -> Result<Vec<Tile>> {
+        let mut open: HashMap<(u32, [u64; 3], u32), usize> = HashMap::new();
+        let mut pending: Vec<Vec<usize>> = Vec::new();
         for (i, req) in requests.iter().enumerate() {
             let r = scene.receivers.get(req.receiver as usize).ok_or_else(|| {
                 Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
@@ -487,34 +569,39 @@ impl Counter {
             if is_dark(r.normal, req.sun) {
                 continue;
             }
-            let view = view::fit(&r.points, req.sun, scene.bounds, scene.origin, self.options.resolution);
-            let target = Target { points: &r.points, normal: r.normal, gpu_id: r.gpu_id };
-            match scene.culling.select(&view.view_proj, &target, req.sun) {
-                Some(draws) => lit.push((i, view, draws)),
-                // Nothing in the prism in front of it: fully sunlit, no render needed.
-                None => out[i].fraction = 1.0,
+            let (group, _) = scene.groups.place(req.receiver);
+            let key = (group, req.sun.to_array().map(f64::to_bits), leaves_of(i).to_bits());
+            // A receiver asked for twice (or a full tile) opens another tile.
+            let joins = |t: &Vec<usize>| t.len() < MAX_MEMBERS && t.iter().all(|&j| requests[j].receiver != req.receiver);
+            match open.get(&key) {
+                Some(&t) if joins(&pending[t]) => pending[t].push(i),
+                _ => {
+                    open.insert(key, pending.len());
+                    pending.push(vec![i]);
+                }
             }
         }
-        let per_batch = self.tiles_per_batch();
-        for chunk in lit.chunks(per_batch * BATCHES_PER_READBACK) {
-            for (b, batch) in chunk.chunks(per_batch).enumerate() {
-                self.submit_batch(scene, requests, &leaves_of, batch, b)?;
-            }
-            let counts = platform::read_buffer(&self.device, &self.readback, (chunk.len() * 8) as u64).await;
-            // A failed read on a lost device is the loss, not a read error.
-            self.check_errors("counting pixels")?;
-            let counts = counts?;
-            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
-            for (k, (i, view, _)) in chunk.iter().enumerate() {
-                let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
-                let o = &mut out[*i];
-                o.visible = visible;
-                o.covered = covered;
-                o.pixel_area = view.pixel_area;
-                o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
+        let mut tiles = Vec::with_capacity(pending.len());
+        for mut members in pending {
+            // The owner (largest outline) first: its plane and id guide the culling.
+            members.sort_by_key(|&i| scene.groups.place(requests[i].receiver).1);
+            let owner = &scene.receivers[requests[members[0]].receiver as usize];
+            let points: Cow<'_, [DVec3]> = if members.len() == 1 {
+                Cow::Borrowed(&owner.points)
+            } else {
+                Cow::Owned(members.iter().flat_map(|&i| scene.receivers[requests[i].receiver as usize].points.iter().copied()).collect())
+            };
+            let sun = requests[members[0]].sun;
+            let view = view::fit(&points, sun, scene.bounds, scene.origin, self.options.resolution);
+            // The union of the members: the draw list covers every member's prism.
+            let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
+            match scene.culling.select(&view.view_proj, &target, sun) {
+                Some(draws) => tiles.push(Tile { requests: members, view, draws }),
+                // Nothing in the prism in front of any member: all fully sunlit, no render needed.
+                None => members.iter().for_each(|&i| out[i].fraction = 1.0),
             }
         }
-        Ok(out)
+        Ok(tiles)
     }
 
     /// The static mesh's triangles in the culling's order, unindexed, `max_triangles` a buffer.
@@ -546,26 +633,35 @@ impl Counter {
         [(t % self.tiles_per_side) * self.options.resolution, (t / self.tiles_per_side) * self.options.resolution]
     }
 
-    /// Renders and counts one batch of views; results land in `readback` at batch `index`.
+    /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
+    /// `first_entry` on. Returns the number of member entries.
     fn submit_batch(
         &self,
         scene: &GpuScene,
         requests: &[ViewRequest],
         leaves: &dyn Fn(usize) -> f32,
-        batch: &[(usize, SunView, DrawList)],
-        index: usize,
-    ) -> Result<()> {
+        batch: &[Tile],
+        first_entry: usize,
+    ) -> Result<usize> {
+        let mut members: Vec<u32> = Vec::with_capacity(batch.len());
         let views: Vec<GpuView> = batch
             .iter()
             .enumerate()
-            .map(|(slot, (i, view, _))| GpuView {
-                view_proj: view.view_proj.as_mat4().to_cols_array_2d(),
-                tile: self.tile_origin(slot),
-                target_id: scene.receivers[requests[*i].receiver as usize].gpu_id,
-                leaves: leaves(*i),
+            .map(|(slot, tile)| {
+                let first_member = members.len() as u32;
+                members.extend(tile.requests.iter().map(|&i| scene.receivers[requests[i].receiver as usize].gpu_id));
+                GpuView {
+                    view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
+                    tile: self.tile_origin(slot),
+                    first_member,
+                    member_count: tile.requests.len() as u32,
+                    leaves: leaves(tile.requests[0]),
+                    _pad: [0; 3],
+                }
             })
             .collect();
         self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
+        self.queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
         encoder.clear_buffer(&self.counts, 0, None);
         self.render_tiles(&mut encoder, scene, requests, batch);
@@ -575,21 +671,16 @@ impl Counter {
             pass.set_bind_group(0, &scene.count_bind, &[]);
             pass.dispatch_workgroups(self.options.resolution.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
         }
-        let bytes = (batch.len() * 8) as u64;
-        let offset = (index * self.tiles_per_batch() * 8) as u64;
-        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.readback, offset, bytes);
+        let bytes = (members.len() * 8) as u64;
+        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.readback, (first_entry * 8) as u64, bytes);
         self.queue.submit([encoder.finish()]);
-        Ok(())
+        Ok(members.len())
     }
 
-    fn render_tiles(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &GpuScene,
-        requests: &[ViewRequest],
-        batch: &[(usize, SunView, DrawList)],
-    ) {
-        let clear_id = wgpu::Color { r: crate::scene::NO_RECEIVER as f64, g: 0.0, b: 0.0, a: 0.0 };
+    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[Tile]) {
+        let no_receiver = crate::scene::NO_RECEIVER as f64;
+        // Green too starts at NO_RECEIVER: receiver 0 is a valid id there.
+        let clear_id = wgpu::Color { r: no_receiver, g: no_receiver, b: 0.0, a: 0.0 };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun views"),
             color_attachments: &[color(&self.atlas.ids, clear_id)],
@@ -602,25 +693,28 @@ impl Counter {
         });
         pass.set_bind_group(0, &scene.render_bind, &[]);
         let res = self.options.resolution;
-        for (slot, (i, _, draws)) in batch.iter().enumerate() {
+        for (slot, tile) in batch.iter().enumerate() {
             let [x, y] = self.tile_origin(slot);
             pass.set_viewport(x as f32, y as f32, res as f32, res as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, res, res);
             let first = slot as u32 * scene.instance_count;
-            // The receiver alone: its coverage, the denominator.
-            let r = &scene.receivers[requests[*i].receiver as usize];
-            let mesh = &scene.meshes[r.mesh];
+            // The members alone, each writing its id: their coverage, the denominators.
             pass.set_pipeline(&self.mask_pipeline);
-            if r.static_triangles.is_empty() {
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
-            } else {
-                draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
+            for &i in &tile.requests {
+                let r = &scene.receivers[requests[i].receiver as usize];
+                if r.static_triangles.is_empty() {
+                    let mesh = &scene.meshes[r.mesh];
+                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+                } else {
+                    draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
+                }
             }
-            // What lies in the prism in front of it, depth-tested: where the receiver's id
+            // What lies in the prisms in front of them, depth-tested: where a member's id
             // survives, it is sunlit.
             pass.set_pipeline(&self.scene_pipeline);
+            let draws = &tile.draws;
             draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, first + scene.culling.static_slot());
             let mut bound = None;
             for (m, slots) in &draws.instances {
@@ -638,8 +732,16 @@ impl Counter {
         }
     }
 
-    /// Reads back the id atlas (for tests comparing the compute count with a CPU count).
+    /// Reads back the red channel of the id atlas: the visible surface ids (for tests comparing
+    /// the compute count with a CPU count).
     pub async fn read_ids(&self) -> Result<(u32, Vec<u32>)> {
+        let (side, texels) = self.read_atlas().await?;
+        Ok((side, texels.iter().map(|t| t[0]).collect()))
+    }
+
+    /// Reads back the id atlas: per pixel the visible surface id (red) and the covering member's
+    /// id (green, `NO_RECEIVER` where no member covers it).
+    pub async fn read_atlas(&self) -> Result<(u32, Vec<[u32; 2]>)> {
         let side = self.tiles_per_side * self.options.resolution;
         let bytes_per_row = side * 8;
         let size = (bytes_per_row * side) as u64;
@@ -657,12 +759,12 @@ impl Counter {
         self.queue.submit([encoder.finish()]);
         let bytes = platform::read_buffer(&self.device, &target, size).await?;
         self.check_errors("reading the id atlas")?;
-        // Keep the red channel: the visible surface ids.
         let texels: &[[u32; 2]] = bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
-        Ok((side, texels.iter().map(|t| t[0]).collect()))
+        Ok((side, texels.to_vec()))
     }
 
-    /// Where view `slot` of the last batch was drawn (top-left pixel).
+    /// Where tile `slot` of the last batch was drawn (top-left pixel). Tiles follow the order of
+    /// their first request.
     pub fn tile_of(&self, slot: usize) -> [u32; 2] {
         self.tile_origin(slot)
     }
@@ -672,6 +774,11 @@ impl GpuScene {
     /// World origin the GPU coordinates are relative to.
     pub fn origin(&self) -> DVec3 {
         self.origin
+    }
+
+    /// The receivers that share a view (a wall and the windows in it).
+    pub fn view_groups(&self) -> &ViewGroups {
+        &self.groups
     }
 
     /// The spatial index that picks what each view draws (benchmarks report what it saves).
@@ -802,7 +909,13 @@ fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let cs = wgpu::ShaderStages::COMPUTE;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("count"),
-        entries: &[uint_texture_entry(0), storage_entry(1, cs, true), uniform_entry(2, cs), storage_entry(3, cs, false)],
+        entries: &[
+            uint_texture_entry(0),
+            storage_entry(1, cs, true),
+            uniform_entry(2, cs),
+            storage_entry(3, cs, false),
+            storage_entry(4, cs, true),
+        ],
     })
 }
 

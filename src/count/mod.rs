@@ -7,6 +7,7 @@
 pub mod cull;
 pub mod exact;
 pub mod gpu;
+pub mod group;
 pub mod lanes;
 pub mod view;
 
