@@ -33,14 +33,16 @@ struct View {
     member_count: u32,
     // Leaf fraction of the view's day: leaves with a lower rank cast shadows.
     leaves: f32,
-    _pad0: u32,
+    // The tile's side in pixels (read by the count pass only).
+    side: u32,
     _pad1: u32,
     _pad2: u32,
 }
 
 struct Params {
     instance_count: u32,
-    resolution: u32,
+    // Read by the count pass only.
+    count_edges: u32,
     _pad0: u32,
     _pad1: u32,
 }

@@ -42,9 +42,12 @@ pub struct Engine {
 
 #[wasm_bindgen]
 impl Engine {
-    /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512).
-    pub async fn create(resolution: Option<u32>) -> Result<Engine, JsValue> {
-        let options = CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), ..Default::default() };
+    /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512);
+    /// `accuracy`: a target |error| per view, counting each at 64² first and finer, up to
+    /// `resolution`, only where its shadow edges need it (default: every view at `resolution`).
+    pub async fn create(resolution: Option<u32>, accuracy: Option<f64>) -> Result<Engine, JsValue> {
+        let options =
+            CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), accuracy, ..Default::default() };
         let counter = Counter::new(options).await.map_err(js_error)?;
         Ok(Engine { counter: Rc::new(counter) })
     }

@@ -75,6 +75,16 @@ fn fraction_json_matches_exact_and_has_the_documented_shape() {
         partly += (fb > 0.01 && fb < 0.99) as usize;
     }
     assert!(partly >= 2, "the louvres and overhang shade the south facade partly");
+    // With an accuracy target: within it of the exact fractions, each surface at its own side.
+    let adaptive = run(&["--accuracy", "0.002"]);
+    assert_eq!(adaptive["accuracy"], 0.002);
+    let mut sides = std::collections::BTreeSet::new();
+    for (a, b) in adaptive["surfaces"].as_array().unwrap().iter().zip(e) {
+        let (fa, fb) = (a["fraction"].as_f64().unwrap(), b["fraction"].as_f64().unwrap());
+        assert!((fa - fb).abs() <= 0.002, "{}: adaptive {fa} exact {fb}", a["name"]);
+        sides.insert(a["side"].as_u64().unwrap());
+    }
+    assert!(sides.iter().any(|s| (64..=512).contains(s)), "rendered surfaces report their side: {sides:?}");
 }
 
 #[test]
@@ -178,6 +188,8 @@ fn malformed_sun_and_options() {
     fails_with(&sunlit(&["fraction", &model, "--sun", "south,40"]), &["--sun"]);
     fails_with(&sunlit(&["fraction", &model, "--sun", "180,120"]), &["--sun", "altitude 120"]);
     fails_with(&sunlit(&["fraction", &model, "--sun", "180,40", "--resolution", "1000000"]), &["--resolution", "texture size limit"]);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "180,40", "--accuracy", "2"]), &["--accuracy", "not a fraction error"]);
+    fails_with(&sunlit(&["fraction", &model, "--sun", "180,40", "--accuracy", "0"]), &["--accuracy"]);
     // A negative altitude is a valid request: every fraction is 0.
     let out = sunlit(&["fraction", &model, "--sun", "180,-10", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));

@@ -314,7 +314,7 @@ fn compute_count_equals_a_cpu_count_of_the_id_atlas() {
     let (side, ids) = pollster::block_on(counter.read_ids()).unwrap();
     let res = counter.resolution();
     for (slot, c) in counted.iter().enumerate() {
-        let [x0, y0] = counter.tile_of(slot);
+        let [x0, y0] = counter.tile_of(slot, res);
         let mut n = 0;
         for y in y0..y0 + res {
             for x in x0..x0 + res {
@@ -349,6 +349,80 @@ fn louvre_slats_parallel_to_the_window_edges() {
     println!("louvres: max |gpu − exact| {worst:.5}");
     assert!(exact.iter().filter(|e| **e > 0.02 && **e < 0.98).count() > 10, "mostly partial shading: {exact:?}");
     assert!(worst <= TOL, "max |error| {worst}");
+}
+
+/// The louvre window of [`louvre_slats_parallel_to_the_window_edges`] and 60 suns over it.
+fn louvre_window() -> (Scene, Vec<ViewRequest>) {
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 2.5, 1.0, 2.5, 0.0), true);
+    for i in 0..10 {
+        let z = 1.05 + 0.15 * i as f64;
+        s.cuboid(&format!("SLAT{i}"), DVec3::new(-2.0, -0.35, z), DVec3::new(4.5, -0.1, z + 0.02));
+    }
+    // A post beside the window: one straight shadow edge for the suns from the west.
+    s.cuboid("POST", DVec3::new(2.6, -1.0, 0.0), DVec3::new(2.8, -0.8, 3.0));
+    let requests = (0..60).map(|i| ViewRequest { receiver: 0, sun: sun(100.0 + 2.7 * i as f64, 5.0 + 1.1 * i as f64) }).collect();
+    (s.build(), requests)
+}
+
+#[test]
+fn adaptive_resolution_meets_its_accuracy_against_the_exact_reference() {
+    // With a target, each view is counted at 64² and again, finer, where its shadow edges make
+    // the estimated error larger than the target. Every view must then be within the target, and
+    // the sides must differ between views (the point: few pixels where few are needed).
+    let (scene, requests) = louvre_window();
+    let exact = exact::sunlit_fractions(&scene, &requests);
+    let target = 0.002;
+    let adaptive = gpu_fractions(&adaptive_counter(512, target), &scene, &requests);
+    let coarse = gpu_fractions(&counter(64), &scene, &requests);
+    let error =
+        |counted: &[sunlit::count::gpu::Counted]| counted.iter().zip(&exact).map(|(g, e)| (g.fraction - e).abs()).fold(0.0, f64::max);
+    let mut sides: Vec<u32> = adaptive.iter().map(|c| c.side).filter(|&s| s > 0).collect();
+    sides.sort();
+    sides.dedup();
+    println!("adaptive ±{target}: max |error| {:.5} at sides {sides:?}; fixed 64²: {:.5}", error(&adaptive), error(&coarse));
+    assert!(exact.iter().filter(|e| **e > 0.02 && **e < 0.98).count() > 20, "mostly partial shading: {exact:?}");
+    assert!(error(&coarse) > target, "64² alone must miss the target, or the test shows nothing");
+    assert!(error(&adaptive) <= target, "adaptive counting missed its target: {}", error(&adaptive));
+    assert!(sides.len() >= 2 && sides[0] < 512, "one side for all views: {sides:?}");
+    for (c, e) in adaptive.iter().zip(&exact) {
+        assert!(c.side == 512 || c.error_estimate() <= target, "{c:?} stopped above its target");
+        assert!((c.fraction - e).abs() <= c.error_estimate().max(1e-9) || c.side == 512, "{c:?}: exact {e}, beyond its estimate");
+    }
+}
+
+#[test]
+fn edge_counts_equal_a_cpu_count_of_the_id_atlas() {
+    // CPU reference of count_pixels.wgsl's edge pairs: right and lower neighbours both covered by
+    // the member, one visible and one not. (Resolution 64 with a target: one side, edges on.)
+    let (scene, requests) = louvre_window();
+    let requests = &requests[..12];
+    let counter = adaptive_counter(64, 0.5);
+    let gpu = counter.upload(&scene).unwrap();
+    let counted = pollster::block_on(counter.fractions(&gpu, requests)).unwrap();
+    let (side, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
+    let id = scene.receivers[0].gpu_id;
+    let mut edged = 0;
+    // Tiles follow the rendered views in order.
+    for (slot, c) in counted.iter().filter(|c| c.side > 0).enumerate() {
+        let [x0, y0] = counter.tile_of(slot, 64);
+        let texel = |x: u32, y: u32| atlas[((y0 + y) * side + x0 + x) as usize];
+        let pair = |a: [u32; 2], b: [u32; 2]| (a[1] == id && b[1] == id && (a[0] == id) != (b[0] == id)) as u32;
+        let mut edges = 0;
+        for y in 0..64 {
+            for x in 0..64 {
+                if x + 1 < 64 {
+                    edges += pair(texel(x, y), texel(x + 1, y));
+                }
+                if y + 1 < 64 {
+                    edges += pair(texel(x, y), texel(x, y + 1));
+                }
+            }
+        }
+        assert_eq!(c.edges, edges, "view {slot}");
+        edged += (edges > 0) as usize;
+    }
+    assert!(edged > 6, "most views have shadow edges: {edged}");
 }
 
 /// A 4 × 3 m south wall (x 0..4, z 0..3, y = 0) with two 1.6 × 2.2 m holes (x 0.2..1.8 and
@@ -441,7 +515,7 @@ fn grouped_compute_counts_equal_a_cpu_count_of_the_id_atlas() {
     let res = counter.resolution();
     let mut next = 0;
     for k in 0..suns.len() {
-        let [x0, y0] = counter.tile_of(k);
+        let [x0, y0] = counter.tile_of(k, res);
         let tile: Vec<[u32; 2]> =
             (y0..y0 + res).flat_map(|y| (x0..x0 + res).map(move |x| (y * side + x) as usize)).map(|i| atlas[i]).collect();
         for &r in members(k).iter().rev() {

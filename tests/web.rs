@@ -90,7 +90,7 @@ async fn webgpu_counts_match_the_exact_reference() {
 
 #[wasm_bindgen_test]
 async fn the_page_bindings_give_the_analytic_overhang_shadow() {
-    let engine = Engine::create(Some(512)).await.map_err(|e| format!("{e:?}")).unwrap();
+    let engine = Engine::create(Some(512), None).await.map_err(|e| format!("{e:?}")).unwrap();
     let (positions, indices, receivers, names) = arrays();
     let model = engine.from_arrays(&positions, &indices, &receivers, names, false).map_err(|e| format!("{e:?}")).unwrap();
     for altitude in [20.0f64, 35.0, 50.0] {

@@ -10,8 +10,11 @@ export function hasWebGPU(): boolean;
 /** Unit vector towards the sun from azimuth (degrees clockwise from north) and altitude (degrees). */
 export function sunDirection(azimuth: number, altitude: number): [number, number, number];
 
-/** Opens the GPU device. `resolution`: pixels along a view's side (default 512). */
-export function createEngine(options?: { resolution?: number }): Promise<SunlitEngine>;
+/** Opens the GPU device. `resolution`: pixels along a view's side (default 512). `accuracy`: a
+ * target |error| per view (e.g. 0.002): each view is counted at 64² first and again, finer up to
+ * `resolution`, only where its shadow edges make the estimated error larger; without it every
+ * view is counted at `resolution`. */
+export function createEngine(options?: { resolution?: number; accuracy?: number }): Promise<SunlitEngine>;
 
 export interface ModelFile {
   /** File name; its extension picks the reader (.glb, .gltf, .idf, .epJSON). */

@@ -33,12 +33,12 @@ export function sunDirection(azimuth, altitude) {
 }
 
 /** Opens the GPU device. Rejects with a clear message where WebGPU is missing. */
-export async function createEngine({ resolution } = {}) {
+export async function createEngine({ resolution, accuracy } = {}) {
   if (!hasWebGPU()) {
     throw new Error('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).');
   }
   await ready();
-  return new SunlitEngine(await Engine.create(resolution));
+  return new SunlitEngine(await Engine.create(resolution, accuracy));
 }
 
 function toBytes(bytes, name) {

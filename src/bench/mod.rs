@@ -6,9 +6,11 @@
 
 pub mod models;
 
+use std::collections::BTreeMap;
+
 use glam::DVec3;
 
-use crate::count::gpu::{Counter, GpuScene};
+use crate::count::gpu::{Counted, Counter, GpuScene};
 use crate::count::lanes::{Lane, fractions_side_by_side};
 use crate::count::{ViewRequest, is_dark, view};
 use crate::error::Result;
@@ -184,9 +186,12 @@ pub struct ViewTiming {
     pub tiles_rendered: u64,
     /// Mean triangles the scene pass drew per tile rendered.
     pub mean_triangles_per_tile: f64,
-    /// The sunlit fraction of every timed view, and whether it was rendered.
+    /// Rendered views by the tile side they were last counted at (one side without an
+    /// accuracy target; with one, how far adaptive counting had to go).
+    pub sides: BTreeMap<u32, usize>,
+    /// Every timed view's count.
     #[serde(skip)]
-    pub fractions: Vec<(f64, bool)>,
+    pub counted: Vec<Counted>,
 }
 
 /// Times counting `requests` over the lanes (side by side); one warm-up batch a lane first.
@@ -216,22 +221,44 @@ pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRe
         mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
         tiles_rendered: tiles,
         mean_triangles_per_tile: triangles as f64 / tiles.max(1) as f64,
-        fractions: counted.iter().map(|c| (c.fraction, c.covered > 0)).collect(),
+        sides: counted.iter().filter(|c| c.side > 0).fold(BTreeMap::new(), |mut m, c| {
+            *m.entry(c.side).or_insert(0) += 1;
+            m
+        }),
+        counted,
     })
 }
 
-/// Accuracy of counted fractions against the exact CPU reference over an even spread of at most
-/// `at_most` of the rendered views (the others are exact by construction): (views checked, mean
-/// |error|, max |error|).
-pub fn check_exact(scene: &Scene, requests: &[ViewRequest], fractions: &[(f64, bool)], at_most: usize) -> (usize, f64, f64) {
-    let rendered: Vec<usize> = (0..requests.len()).filter(|&i| fractions[i].1).collect();
+/// Counted fractions against the exact CPU reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactCheck {
+    /// Rendered views checked.
+    pub views: usize,
+    /// Mean |counted − exact|.
+    pub mean: f64,
+    /// Largest |counted − exact|.
+    pub max: f64,
+    /// Views whose |error| exceeded their own [`Counted::error_estimate`] (with an accuracy
+    /// target: how often the estimate that chose the side was too hopeful).
+    pub above_estimate: usize,
+}
+
+/// Checks an even spread of at most `at_most` of the rendered views against the exact CPU
+/// reference (the others are exact by construction).
+pub fn check_exact(scene: &Scene, requests: &[ViewRequest], counted: &[Counted], at_most: usize) -> ExactCheck {
+    let rendered: Vec<usize> = (0..requests.len()).filter(|&i| counted[i].side > 0).collect();
     let stride = rendered.len().div_ceil(at_most.max(1)).max(1);
     let picked: Vec<usize> = rendered.into_iter().step_by(stride).collect();
     let chosen: Vec<ViewRequest> = picked.iter().map(|&i| requests[i]).collect();
     let exact = crate::count::exact::sunlit_fractions(scene, &chosen);
-    let errors: Vec<f64> = picked.iter().zip(&exact).map(|(&i, e)| (fractions[i].0 - e).abs()).collect();
-    let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
-    (errors.len(), mean, errors.iter().copied().fold(0.0, f64::max))
+    let errors: Vec<(f64, f64)> =
+        picked.iter().zip(&exact).map(|(&i, e)| ((counted[i].fraction - e).abs(), counted[i].error_estimate())).collect();
+    ExactCheck {
+        views: errors.len(),
+        mean: errors.iter().map(|e| e.0).sum::<f64>() / errors.len().max(1) as f64,
+        max: errors.iter().map(|e| e.0).fold(0.0, f64::max),
+        above_estimate: errors.iter().filter(|(error, estimate)| error > estimate).count(),
+    }
 }
 
 /// What [`Counter::fractions`] does on the CPU before drawing: fit each lit view and choose

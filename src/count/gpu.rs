@@ -16,9 +16,16 @@
 //! serves every day: each view carries its day's leaf fraction and the vertex shader drops the
 //! leaves whose rank is not below it; a see-through fragment is discarded (lets the sun through)
 //! where a per-pixel hash threshold falls below its transmittance.
+//!
+//! Adaptive resolution ([`CounterOptions::accuracy`]): every tile is first counted at a small
+//! side; the count pass also counts each member's shadow-edge pixel pairs, from which
+//! [`error_estimate`] predicts the count's error, and tiles predicted worse than the target are
+//! counted again at the side predicted to reach it (up to `resolution`). Fully lit and fully
+//! shaded views, most of a year, then cost a small tile; views crossed by many shadow edges get
+//! the full side.
 
 use std::borrow::Cow;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -47,19 +54,42 @@ const OUT_OF_MEMORY: &str = "out of GPU memory";
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 const BATCHES_PER_READBACK: usize = 32;
 
+/// The side adaptive counting starts at: ~2,000 pixels on the receiver, enough that a view
+/// without shadow edges is within 0.001 and the edge count is a fair guide for the others.
+pub const ADAPTIVE_FIRST_SIDE: u32 = 64;
+
 /// Settings of a [`Counter`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CounterOptions {
-    /// Tile size in pixels (square); 512 gives about three decimals.
+    /// Tile size in pixels (square); 512 gives about three decimals. With `accuracy`, the
+    /// largest side a view gets.
     pub resolution: u32,
     /// Largest atlas side in pixels; tiles per submission = (atlas / resolution)².
     pub max_atlas: u32,
+    /// Target |error| of each fraction: `Some` counts every view at
+    /// [`ADAPTIVE_FIRST_SIDE`] first and again, at a side up to `resolution`, only where the
+    /// estimated error is larger ([`error_estimate`]). `None`: every view at `resolution`.
+    pub accuracy: Option<f64>,
 }
 
 impl Default for CounterOptions {
     fn default() -> Self {
-        Self { resolution: 512, max_atlas: 2048 }
+        Self { resolution: 512, max_atlas: 2048, accuracy: None }
     }
+}
+
+/// Estimated |error| of a fraction counted from `covered` pixels with `edges` shadow-edge pixel
+/// pairs: each boundary pixel is decided by its centre and is off by up to half a pixel. Were
+/// these errors independent they would add like a random walk, sqrt(edges/12) pixels; along a
+/// straight edge they are not (a nearly axis-aligned edge repeats its sub-pixel offsets), and on
+/// louvre shadows, many parallel straight edges, the exact reference showed errors up to
+/// 2.6·sqrt(edges) pixels. The estimate takes 3·sqrt(edges), plus one pixel for the receiver's
+/// own outline, over the covered pixels.
+pub fn error_estimate(covered: u32, edges: u32) -> f64 {
+    if covered == 0 {
+        return f64::INFINITY;
+    }
+    (3.0 * (edges as f64).sqrt() + 1.0) / covered as f64
 }
 
 /// One counted view. A view that needed no render (sun down, facing away, or nothing in front
@@ -76,6 +106,17 @@ pub struct Counted {
     pub covered: u32,
     /// Area per pixel on the view plane (m²; 0 when not rendered).
     pub pixel_area: f64,
+    /// Side of the tile it was counted in (0 when not rendered).
+    pub side: u32,
+    /// Shadow-edge pixel pairs on the receiver (counted only with an accuracy target).
+    pub edges: u32,
+}
+
+impl Counted {
+    /// [`error_estimate`] of this count (0 when not rendered: exact by construction).
+    pub fn error_estimate(&self) -> f64 {
+        if self.side == 0 { 0.0 } else { error_estimate(self.covered, self.edges) }
+    }
 }
 
 /// The device, pipelines and atlas; reusable across scenes.
@@ -84,7 +125,8 @@ pub struct Counter {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     options: CounterOptions,
-    tiles_per_side: u32,
+    /// The atlas's side in pixels: a whole number of tiles at every side used.
+    atlas_side: u32,
     render_layout: wgpu::BindGroupLayout,
     count_layout: wgpu::BindGroupLayout,
     scene_pipeline: wgpu::RenderPipeline,
@@ -167,7 +209,8 @@ struct GpuView {
     first_member: u32,
     member_count: u32,
     leaves: f32,
-    _pad: [u32; 3],
+    side: u32,
+    _pad: [u32; 2],
 }
 
 /// One tile to render: requests of one view group at one sun and leaf fraction.
@@ -182,7 +225,7 @@ struct Tile {
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuParams {
     instance_count: u32,
-    resolution: u32,
+    count_edges: u32,
     _pad: [u32; 2],
 }
 
@@ -224,8 +267,12 @@ impl Counter {
                 format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
             ));
         }
-        let atlas_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d);
-        let tiles_per_side = atlas_side / resolution;
+        if let Some(a) = options.accuracy {
+            if !(a > 0.0 && a < 1.0) {
+                return Err(Error::argument("--accuracy", format!("{a} is not a fraction error in (0, 1)")));
+            }
+        }
+        let tiles_per_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d) / resolution;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: limits, ..Default::default() })
             .await
@@ -248,12 +295,14 @@ impl Counter {
         let count_layout = count_bind_layout(&device);
         let (scene_pipeline, mask_pipeline) = render_pipelines(&device, &render_layout);
         let count_pipeline = count_pipeline(&device, &count_layout);
-        let side = tiles_per_side * resolution;
+        let atlas_side = tiles_per_side * resolution;
         let atlas = Atlas {
-            ids: attachment(&device, "ids", side, ID_FORMAT, true),
-            depth: attachment(&device, "depth", side, DEPTH_FORMAT, false),
+            ids: attachment(&device, "ids", atlas_side, ID_FORMAT, true),
+            depth: attachment(&device, "depth", atlas_side, DEPTH_FORMAT, false),
         };
-        let tiles = (tiles_per_side * tiles_per_side) as u64;
+        // Buffers hold a batch at the smallest side used.
+        let smallest = sides(&options).first().copied().unwrap_or(resolution);
+        let tiles = ((atlas_side / smallest) as u64).pow(2);
         let entries = tiles * MAX_MEMBERS as u64;
         let views =
             buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
@@ -261,13 +310,13 @@ impl Counter {
         let counts = buffer(
             &device,
             "counts",
-            entries * 8,
+            entries * COUNTS_PER_MEMBER * 4,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
         );
         let readback = buffer(
             &device,
             "readback",
-            entries * 8 * BATCHES_PER_READBACK as u64,
+            entries * COUNTS_PER_MEMBER * 4 * BATCHES_PER_READBACK as u64,
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
         let counter = Self {
@@ -275,7 +324,7 @@ impl Counter {
             queue,
             info: adapter.get_info(),
             options,
-            tiles_per_side,
+            atlas_side,
             render_layout,
             count_layout,
             scene_pipeline,
@@ -310,9 +359,14 @@ impl Counter {
         self.options.resolution
     }
 
-    /// Views rendered per submission.
+    /// Views rendered per submission at `resolution`.
     pub fn tiles_per_batch(&self) -> usize {
-        (self.tiles_per_side * self.tiles_per_side) as usize
+        self.tiles_at(self.options.resolution)
+    }
+
+    /// Tiles per submission at side `side`.
+    fn tiles_at(&self, side: u32) -> usize {
+        ((self.atlas_side / side) as usize).pow(2)
     }
 
     /// Tiles rendered since this counter was made (a tile counts one request, or several of one
@@ -451,7 +505,8 @@ impl Counter {
             contents: non_empty(bytemuck::cast_slice(&instances)),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let params = GpuParams { instance_count: instances.len().max(1) as u32, resolution: self.options.resolution, _pad: [0; 2] };
+        let params =
+            GpuParams { instance_count: instances.len().max(1) as u32, count_edges: self.options.accuracy.is_some() as u32, _pad: [0; 2] };
         let params_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
             contents: bytemuck::bytes_of(&params),
@@ -519,25 +574,55 @@ impl Counter {
         }
         let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
         let mut out = vec![Counted::default(); requests.len()];
-        let tiles = self.plan_tiles(scene, requests, &leaves_of, &mut out)?;
-        let per_batch = self.tiles_per_batch();
+        let ladder = sides(&self.options);
+        let first = ladder.first().copied().unwrap_or(self.options.resolution);
+        let tiles = self.plan_tiles(scene, requests, &leaves_of, first, &mut out)?;
+        // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
+        let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
+        while let Some((side, tiles)) = waiting.pop_first() {
+            self.count_tiles(scene, requests, &leaves_of, &tiles, side, &mut out).await?;
+            let Some(target) = self.options.accuracy else { continue };
+            for tile in tiles {
+                let worst = tile.requests.iter().map(|&i| out[i].error_estimate()).fold(0.0, f64::max);
+                if let Some(next) = finer_side(&ladder, side, worst, target) {
+                    let view = self.fit_tile(scene, requests, &tile.requests, next);
+                    waiting.entry(next).or_default().push(Tile { view, ..tile });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Renders and counts `tiles` at side `side` and writes their members' counts into `out`.
+    async fn count_tiles(
+        &self,
+        scene: &GpuScene,
+        requests: &[ViewRequest],
+        leaves_of: &dyn Fn(usize) -> f32,
+        tiles: &[Tile],
+        side: u32,
+        out: &mut [Counted],
+    ) -> Result<()> {
+        let per_batch = self.tiles_at(side);
         for chunk in tiles.chunks(per_batch * BATCHES_PER_READBACK) {
             // Each batch's counts land in the readback right after the previous batch's.
             let mut entries = 0;
             for batch in chunk.chunks(per_batch) {
-                entries += self.submit_batch(scene, requests, &leaves_of, batch, entries)?;
+                entries += self.submit_batch(scene, requests, leaves_of, batch, side, entries)?;
             }
-            let counts = platform::read_buffer(&self.device, &self.readback, (entries * 8) as u64).await;
+            let counts = platform::read_buffer(&self.device, &self.readback, entries as u64 * COUNTS_PER_MEMBER * 4).await;
             // A failed read on a lost device is the loss, not a read error.
             self.check_errors("counting pixels")?;
             let counts = counts?;
             let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
             let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
-            for (k, (i, pixel_area)) in members.enumerate() {
-                let (visible, covered) = (counts[2 * k], counts[2 * k + 1]);
+            for ((i, pixel_area), c) in members.zip(counts.chunks_exact(COUNTS_PER_MEMBER as usize)) {
+                let (visible, covered, edges) = (c[0], c[1], c[2]);
                 let o = &mut out[i];
                 o.visible = visible;
                 o.covered = covered;
+                o.edges = edges;
+                o.side = side;
                 o.pixel_area = pixel_area;
                 o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
             }
@@ -545,7 +630,13 @@ impl Counter {
             self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
             self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
         }
-        Ok(out)
+        Ok(())
+    }
+
+    /// The view of a tile's members (the union of their outlines) at side `side`.
+    fn fit_tile(&self, scene: &GpuScene, requests: &[ViewRequest], members: &[usize], side: u32) -> SunView {
+        let points = tile_points(scene, requests, members);
+        view::fit(&points, requests[members[0]].sun, scene.bounds, scene.origin, side)
     }
 
     /// Sorts the requests into tiles: dark ones get their cosine only, the others join the tile
@@ -557,6 +648,7 @@ impl Counter {
         scene: &GpuScene,
         requests: &[ViewRequest],
         leaves_of: &dyn Fn(usize) -> f32,
+        side: u32,
         out: &mut [Counted],
     ) -> Result<Vec<Tile>> {
         let mut open: HashMap<(u32, [u64; 3], u32), usize> = HashMap::new();
@@ -586,13 +678,9 @@ impl Counter {
             // The owner (largest outline) first: its plane and id guide the culling.
             members.sort_by_key(|&i| scene.groups.place(requests[i].receiver).1);
             let owner = &scene.receivers[requests[members[0]].receiver as usize];
-            let points: Cow<'_, [DVec3]> = if members.len() == 1 {
-                Cow::Borrowed(&owner.points)
-            } else {
-                Cow::Owned(members.iter().flat_map(|&i| scene.receivers[requests[i].receiver as usize].points.iter().copied()).collect())
-            };
+            let points = tile_points(scene, requests, &members);
             let sun = requests[members[0]].sun;
-            let view = view::fit(&points, sun, scene.bounds, scene.origin, self.options.resolution);
+            let view = view::fit(&points, sun, scene.bounds, scene.origin, side);
             // The union of the members: the draw list covers every member's prism.
             let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
             match scene.culling.select(&view.view_proj, &target, sun) {
@@ -628,9 +716,9 @@ impl Counter {
             .collect()
     }
 
-    fn tile_origin(&self, slot: usize) -> [u32; 2] {
-        let t = slot as u32;
-        [(t % self.tiles_per_side) * self.options.resolution, (t / self.tiles_per_side) * self.options.resolution]
+    fn tile_origin(&self, slot: usize, side: u32) -> [u32; 2] {
+        let (t, per_row) = (slot as u32, self.atlas_side / side);
+        [(t % per_row) * side, (t / per_row) * side]
     }
 
     /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
@@ -641,6 +729,7 @@ impl Counter {
         requests: &[ViewRequest],
         leaves: &dyn Fn(usize) -> f32,
         batch: &[Tile],
+        side: u32,
         first_entry: usize,
     ) -> Result<usize> {
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());
@@ -652,11 +741,12 @@ impl Counter {
                 members.extend(tile.requests.iter().map(|&i| scene.receivers[requests[i].receiver as usize].gpu_id));
                 GpuView {
                     view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
-                    tile: self.tile_origin(slot),
+                    tile: self.tile_origin(slot, side),
                     first_member,
                     member_count: tile.requests.len() as u32,
                     leaves: leaves(tile.requests[0]),
-                    _pad: [0; 3],
+                    side,
+                    _pad: [0; 2],
                 }
             })
             .collect();
@@ -664,20 +754,21 @@ impl Counter {
         self.queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
         encoder.clear_buffer(&self.counts, 0, None);
-        self.render_tiles(&mut encoder, scene, requests, batch);
+        self.render_tiles(&mut encoder, scene, requests, batch, side);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("count"), timestamp_writes: None });
             pass.set_pipeline(&self.count_pipeline);
             pass.set_bind_group(0, &scene.count_bind, &[]);
-            pass.dispatch_workgroups(self.options.resolution.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
+            pass.dispatch_workgroups(side.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
         }
-        let bytes = (members.len() * 8) as u64;
-        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.readback, (first_entry * 8) as u64, bytes);
+        let entry_bytes = COUNTS_PER_MEMBER * 4;
+        let bytes = members.len() as u64 * entry_bytes;
+        encoder.copy_buffer_to_buffer(&self.counts, 0, &self.readback, first_entry as u64 * entry_bytes, bytes);
         self.queue.submit([encoder.finish()]);
         Ok(members.len())
     }
 
-    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[Tile]) {
+    fn render_tiles(&self, encoder: &mut wgpu::CommandEncoder, scene: &GpuScene, requests: &[ViewRequest], batch: &[Tile], side: u32) {
         let no_receiver = crate::scene::NO_RECEIVER as f64;
         // Green too starts at NO_RECEIVER: receiver 0 is a valid id there.
         let clear_id = wgpu::Color { r: no_receiver, g: no_receiver, b: 0.0, a: 0.0 };
@@ -692,11 +783,10 @@ impl Counter {
             ..Default::default()
         });
         pass.set_bind_group(0, &scene.render_bind, &[]);
-        let res = self.options.resolution;
         for (slot, tile) in batch.iter().enumerate() {
-            let [x, y] = self.tile_origin(slot);
-            pass.set_viewport(x as f32, y as f32, res as f32, res as f32, 0.0, 1.0);
-            pass.set_scissor_rect(x, y, res, res);
+            let [x, y] = self.tile_origin(slot, side);
+            pass.set_viewport(x as f32, y as f32, side as f32, side as f32, 0.0, 1.0);
+            pass.set_scissor_rect(x, y, side, side);
             let first = slot as u32 * scene.instance_count;
             // The members alone, each writing its id: their coverage, the denominators.
             pass.set_pipeline(&self.mask_pipeline);
@@ -742,7 +832,7 @@ impl Counter {
     /// Reads back the id atlas: per pixel the visible surface id (red) and the covering member's
     /// id (green, `NO_RECEIVER` where no member covers it).
     pub async fn read_atlas(&self) -> Result<(u32, Vec<[u32; 2]>)> {
-        let side = self.tiles_per_side * self.options.resolution;
+        let side = self.atlas_side;
         let bytes_per_row = side * 8;
         let size = (bytes_per_row * side) as u64;
         let target = buffer(&self.device, "ids readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
@@ -763,10 +853,10 @@ impl Counter {
         Ok((side, texels.to_vec()))
     }
 
-    /// Where tile `slot` of the last batch was drawn (top-left pixel). Tiles follow the order of
-    /// their first request.
-    pub fn tile_of(&self, slot: usize) -> [u32; 2] {
-        self.tile_origin(slot)
+    /// Where tile `slot` of the last batch was drawn (top-left pixel) when its side was `side`.
+    /// Tiles follow the order of their first request.
+    pub fn tile_of(&self, slot: usize, side: u32) -> [u32; 2] {
+        self.tile_origin(slot, side)
     }
 }
 
@@ -784,6 +874,47 @@ impl GpuScene {
     /// The spatial index that picks what each view draws (benchmarks report what it saves).
     pub fn culling(&self) -> &Culling {
         &self.culling
+    }
+}
+
+/// Counts the count pass writes per member: visible, covered, edge pairs.
+const COUNTS_PER_MEMBER: u64 = 3;
+
+/// The sides views are counted at: with an accuracy target, ADAPTIVE_FIRST_SIDE doubling up to
+/// `resolution` (which ends the ladder whatever it is); without, `resolution` alone.
+fn sides(options: &CounterOptions) -> Vec<u32> {
+    let mut ladder = Vec::new();
+    if options.accuracy.is_some() {
+        let mut side = ADAPTIVE_FIRST_SIDE;
+        while side < options.resolution {
+            ladder.push(side);
+            side *= 2;
+        }
+    }
+    ladder.push(options.resolution);
+    ladder
+}
+
+/// The side to count a tile again at, or None when its worst member's estimate meets the target
+/// or it already had the largest side. The estimate falls about as side^1.5 (edge pixels grow as
+/// the side, covered pixels as its square), so the predicted side is side·(worst/target)^(2/3);
+/// at least the next step of the ladder, so every round makes progress.
+fn finer_side(ladder: &[u32], side: u32, worst: f64, target: f64) -> Option<u32> {
+    if worst <= target {
+        return None;
+    }
+    let predicted = side as f64 * (worst / target).powf(2.0 / 3.0);
+    let mut finer = ladder.iter().copied().filter(|&s| s > side);
+    let next = finer.clone().next()?;
+    Some(finer.find(|&s| s as f64 >= predicted).unwrap_or_else(|| ladder.last().copied().unwrap_or(next)).max(next))
+}
+
+/// The outline points of a tile's members: the owner's alone, or the union of several.
+fn tile_points<'a>(scene: &'a GpuScene, requests: &[ViewRequest], members: &[usize]) -> Cow<'a, [DVec3]> {
+    if let [only] = members {
+        Cow::Borrowed(&scene.receivers[requests[*only].receiver as usize].points)
+    } else {
+        Cow::Owned(members.iter().flat_map(|&i| scene.receivers[requests[i].receiver as usize].points.iter().copied()).collect())
     }
 }
 
@@ -993,3 +1124,38 @@ fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu
 
 /// WGSL sources, for validation in tests.
 pub const SHADERS: [(&str, &str); 2] = [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL)];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(resolution: u32, accuracy: Option<f64>) -> CounterOptions {
+        CounterOptions { resolution, accuracy, ..Default::default() }
+    }
+
+    #[test]
+    fn sides_double_from_the_first_up_to_the_resolution() {
+        assert_eq!(sides(&options(512, None)), [512]);
+        assert_eq!(sides(&options(512, Some(0.002))), [64, 128, 256, 512]);
+        assert_eq!(sides(&options(300, Some(0.002))), [64, 128, 256, 300]);
+        assert_eq!(sides(&options(48, Some(0.002))), [48]);
+    }
+
+    #[test]
+    fn a_finer_side_is_predicted_from_the_estimate_and_always_progresses() {
+        let ladder = sides(&options(512, Some(0.002)));
+        assert_eq!(finer_side(&ladder, 64, 0.001, 0.002), None, "within the target");
+        assert_eq!(finer_side(&ladder, 64, 0.0021, 0.002), Some(128), "just above: the next step");
+        // 64·(0.015/0.002)^(2/3) = 245: the first side at least that.
+        assert_eq!(finer_side(&ladder, 64, 0.015, 0.002), Some(256));
+        assert_eq!(finer_side(&ladder, 64, f64::INFINITY, 0.002), Some(512), "no pixels: straight to the largest");
+        assert_eq!(finer_side(&ladder, 512, 0.1, 0.002), None, "nothing finer");
+    }
+
+    #[test]
+    fn the_error_estimate_falls_with_fewer_edges_and_more_pixels() {
+        assert_eq!(error_estimate(0, 0), f64::INFINITY);
+        assert_eq!(error_estimate(1000, 0), 0.001, "one pixel of outline");
+        assert!(error_estimate(4000, 200) < error_estimate(1000, 100));
+    }
+}

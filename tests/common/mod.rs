@@ -72,6 +72,13 @@ pub fn counter(resolution: u32) -> Counter {
         .expect("a GPU adapter (lavapipe: apt-get install mesa-vulkan-drivers) — GPU tests never skip")
 }
 
+/// A counter that counts each view at 64² first and finer, up to `resolution`, where its
+/// estimated error exceeds `accuracy`.
+pub fn adaptive_counter(resolution: u32, accuracy: f64) -> Counter {
+    pollster::block_on(Counter::new(CounterOptions { resolution, accuracy: Some(accuracy), ..Default::default() }))
+        .expect("a GPU adapter (lavapipe: apt-get install mesa-vulkan-drivers) — GPU tests never skip")
+}
+
 /// GPU fractions for every receiver of `scene` under each sun.
 pub fn gpu_fractions(counter: &Counter, scene: &Scene, requests: &[ViewRequest]) -> Vec<Counted> {
     let gpu = counter.upload(scene).expect("upload");
