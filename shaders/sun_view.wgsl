@@ -4,7 +4,10 @@
 // the green channel, each its own id: their coverage, the denominators of the sunlit fractions.
 //
 // Instances: a draw covers instance_index = view * instance_count + instance, so one
-// draw_indexed per mesh renders every placement of it for one view.
+// draw_indexed per mesh renders every placement of it for one view. The static mesh (single-use
+// nodes baked in scene coordinates relative to the origin, receiver ids absolute) has its own
+// entry point, vs_static, that reads no instance: its placement is the identity, and on a CPU
+// rasteriser the instance's load and transform were a quarter of a view's cost on NYT-like models.
 //
 // See-through casters: a leaf (rank >= 0) is dropped in the vertex shader when its rank, shifted
 // by its instance, is not below the view's leaf fraction (all three vertices of a leaf triangle
@@ -43,7 +46,8 @@ struct Params {
     instance_count: u32,
     // Read by the count pass only.
     count_edges: u32,
-    _pad0: u32,
+    // The static mesh's instance slot (its dither seeds depend on it, as a placement's do).
+    static_slot: u32,
     _pad1: u32,
 }
 
@@ -73,18 +77,38 @@ fn vs_main(
     let view = views[instance_index / params.instance_count];
     let slot = instance_index % params.instance_count;
     let instance = instances[slot];
+    let clip = view.view_proj * (instance.transform * vec4<f32>(position, 1.0));
+    return shade(clip, view.leaves, veil, instance.leaf_shift, surface, instance.receiver_base, seed ^ (slot * 0x9e3779b9u));
+}
+
+@vertex
+fn vs_static(
+    @location(0) position: vec3<f32>,
+    @location(1) surface: u32,
+    @location(2) veil: vec2<f32>,
+    @location(3) seed: u32,
+    @builtin(instance_index) instance_index: u32,
+) -> VertexOut {
+    let view = views[instance_index / params.instance_count];
+    let clip = view.view_proj * vec4<f32>(position, 1.0);
+    return shade(clip, view.leaves, veil, 0.0, surface, 0u, seed ^ (params.static_slot * 0x9e3779b9u));
+}
+
+// What both entry points pass on: the clip position (DROPPED for a leaf not in leaf), the id
+// (NO_RECEIVER for shading-only geometry), the transmittance and the dither seed.
+fn shade(clip: vec4<f32>, leaves: f32, veil: vec2<f32>, leaf_shift: f32, surface: u32, receiver_base: u32, seed: u32) -> VertexOut {
     var out: VertexOut;
-    out.position = view.view_proj * (instance.transform * vec4<f32>(position, 1.0));
-    if veil.x >= 0.0 && fract(veil.x + instance.leaf_shift) >= view.leaves {
+    out.position = clip;
+    if veil.x >= 0.0 && fract(veil.x + leaf_shift) >= leaves {
         out.position = DROPPED;
     }
-    if surface == NO_RECEIVER || instance.receiver_base == NO_RECEIVER {
+    if surface == NO_RECEIVER || receiver_base == NO_RECEIVER {
         out.id = NO_RECEIVER;
     } else {
-        out.id = instance.receiver_base + surface;
+        out.id = receiver_base + surface;
     }
     out.transmittance = veil.y;
-    out.seed = seed ^ (slot * 0x9e3779b9u);
+    out.seed = seed;
     return out;
 }
 

@@ -129,8 +129,7 @@ pub struct Counter {
     atlas_side: u32,
     render_layout: wgpu::BindGroupLayout,
     count_layout: wgpu::BindGroupLayout,
-    scene_pipeline: wgpu::RenderPipeline,
-    mask_pipeline: wgpu::RenderPipeline,
+    pipelines: ViewPipelines,
     count_pipeline: wgpu::ComputePipeline,
     atlas: Atlas,
     views: wgpu::Buffer,
@@ -228,7 +227,8 @@ struct Tile {
 struct GpuParams {
     instance_count: u32,
     count_edges: u32,
-    _pad: [u32; 2],
+    static_slot: u32,
+    _pad: u32,
 }
 
 #[repr(C)]
@@ -295,7 +295,7 @@ impl Counter {
         });
         let render_layout = render_bind_layout(&device);
         let count_layout = count_bind_layout(&device);
-        let (scene_pipeline, mask_pipeline) = render_pipelines(&device, &render_layout);
+        let pipelines = render_pipelines(&device, &render_layout);
         let count_pipeline = count_pipeline(&device, &count_layout);
         let atlas_side = tiles_per_side * resolution;
         let atlas = Atlas {
@@ -329,8 +329,7 @@ impl Counter {
             atlas_side,
             render_layout,
             count_layout,
-            scene_pipeline,
-            mask_pipeline,
+            pipelines,
             count_pipeline,
             atlas,
             views,
@@ -507,8 +506,12 @@ impl Counter {
             contents: non_empty(bytemuck::cast_slice(&instances)),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let params =
-            GpuParams { instance_count: instances.len().max(1) as u32, count_edges: self.options.accuracy.is_some() as u32, _pad: [0; 2] };
+        let params = GpuParams {
+            instance_count: instances.len().max(1) as u32,
+            count_edges: self.options.accuracy.is_some() as u32,
+            static_slot: culling.static_slot(),
+            _pad: 0,
+        };
         let params_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
             contents: bytemuck::bytes_of(&params),
@@ -797,23 +800,25 @@ impl Counter {
             pass.set_scissor_rect(x, y, side, side);
             let first = slot as u32 * scene.instance_count;
             // The members alone, each writing its id: their coverage, the denominators.
-            pass.set_pipeline(&self.mask_pipeline);
             for &i in &tile.requests {
                 let r = &scene.receivers[requests[i].receiver as usize];
                 if r.static_triangles.is_empty() {
+                    pass.set_pipeline(&self.pipelines.mask);
                     let mesh = &scene.meshes[r.mesh];
                     pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                     pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
                     pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
                 } else {
+                    pass.set_pipeline(&self.pipelines.static_mask);
                     draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
                 }
             }
             // What lies in the prisms in front of them, depth-tested: where a member's id
             // survives, it is sunlit.
-            pass.set_pipeline(&self.scene_pipeline);
             let draws = &tile.draws;
+            pass.set_pipeline(&self.pipelines.static_scene);
             draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, first + scene.culling.static_slot());
+            pass.set_pipeline(&self.pipelines.scene);
             let mut bound = None;
             for (m, slots) in &draws.instances {
                 let mesh = &scene.meshes[*m];
@@ -1081,7 +1086,16 @@ fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 
 /// The scene pipeline (depth-tested ids) and the mask pipeline (the receiver alone, always
 /// passing, no depth write); they differ only in depth state and the channel they write.
-fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (wgpu::RenderPipeline, wgpu::RenderPipeline) {
+/// The sun-view pipelines: scene (depth-tested ids into red) and mask (coverage into green),
+/// each for placed meshes (`vs_main`) and for the static mesh (`vs_static`, no instance to read).
+struct ViewPipelines {
+    scene: wgpu::RenderPipeline,
+    mask: wgpu::RenderPipeline,
+    static_scene: wgpu::RenderPipeline,
+    static_mask: wgpu::RenderPipeline,
+}
+
+fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> ViewPipelines {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("sun_view.wgsl"),
         source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
@@ -1092,13 +1106,13 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
         immediate_size: 0,
     });
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2, 3 => Uint32];
-    let make = |label: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
+    let make = |label: &str, vertex: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(label),
             layout: Some(&pipeline_layout),
             vertex: wgpu::VertexState {
                 module: &module,
-                entry_point: Some("vs_main"),
+                entry_point: Some(vertex),
                 compilation_options: Default::default(),
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: size_of::<GpuVertex>() as u64,
@@ -1125,10 +1139,14 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> (w
             cache: None,
         })
     };
-    (
-        make("scene", true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED),
-        make("mask", false, wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN),
-    )
+    let scene = |label, vertex| make(label, vertex, true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED);
+    let mask = |label, vertex| make(label, vertex, false, wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN);
+    ViewPipelines {
+        scene: scene("scene", "vs_main"),
+        mask: mask("mask", "vs_main"),
+        static_scene: scene("scene, static mesh", "vs_static"),
+        static_mask: mask("mask, static mesh", "vs_static"),
+    }
 }
 
 fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
