@@ -29,10 +29,11 @@ struct View {
 }
 
 struct Params {
-    instance_count: u32,
     // Non-zero: count shadow-edge pairs too (adaptive resolution); zero skips their loads.
     count_edges: u32,
+    // Read by the render pass only.
     static_slot: u32,
+    _pad0: u32,
     _pad1: u32,
 }
 

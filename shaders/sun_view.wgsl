@@ -3,8 +3,10 @@
 // of an rg32uint target. The mask pipeline draws the tile's receivers alone (no depth test) into
 // the green channel, each its own id: their coverage, the denominators of the sunlit fractions.
 //
-// Instances: a draw covers instance_index = view * instance_count + instance, so one
-// draw_indexed per mesh renders every placement of it for one view. The static mesh (single-use
+// Views: the tile being drawn is bound as a uniform at a dynamic offset (one per tile), so a
+// draw's vertices share one load of it; the count pass reads the same data from a storage array.
+// Instances: instance_index is the placement's slot, so one draw_indexed per mesh renders every
+// placement of it in one view. The static mesh (single-use
 // nodes baked in scene coordinates relative to the origin, receiver ids absolute) has its own
 // entry point, vs_static, that reads no instance: its placement is the identity, and on a CPU
 // rasteriser the instance's load and transform were a quarter of a view's cost on NYT-like models.
@@ -27,33 +29,27 @@ struct Instance {
     _pad2: u32,
 }
 
-struct View {
+struct TileView {
     view_proj: mat4x4<f32>,
-    // Top-left pixel of the view's tile in the atlas.
-    tile: vec2<u32>,
-    // The receivers whose pixels this view counts (read by the count pass only).
-    first_member: u32,
-    member_count: u32,
     // Leaf fraction of the view's day: leaves with a lower rank cast shadows.
     leaves: f32,
-    // The tile's side in pixels (read by the count pass only).
-    side: u32,
+    _pad0: u32,
     _pad1: u32,
     _pad2: u32,
 }
 
 struct Params {
-    instance_count: u32,
     // Read by the count pass only.
     count_edges: u32,
     // The static mesh's instance slot (its dither seeds depend on it, as a placement's do).
     static_slot: u32,
+    _pad0: u32,
     _pad1: u32,
 }
 
 @group(0) @binding(0) var<storage, read> instances: array<Instance>;
-@group(0) @binding(1) var<storage, read> views: array<View>;
 @group(0) @binding(2) var<uniform> params: Params;
+@group(1) @binding(0) var<uniform> view: TileView;
 
 struct VertexOut {
     // Invariant: the mask pass and the scene pass must rasterise a receiver identically.
@@ -74,11 +70,9 @@ fn vs_main(
     @location(3) seed: u32,
     @builtin(instance_index) instance_index: u32,
 ) -> VertexOut {
-    let view = views[instance_index / params.instance_count];
-    let slot = instance_index % params.instance_count;
-    let instance = instances[slot];
+    let instance = instances[instance_index];
     let clip = view.view_proj * (instance.transform * vec4<f32>(position, 1.0));
-    return shade(clip, view.leaves, veil, instance.leaf_shift, surface, instance.receiver_base, seed ^ (slot * 0x9e3779b9u));
+    return shade(clip, view.leaves, veil, instance.leaf_shift, surface, instance.receiver_base, seed ^ (instance_index * 0x9e3779b9u));
 }
 
 @vertex
@@ -87,9 +81,7 @@ fn vs_static(
     @location(1) surface: u32,
     @location(2) veil: vec2<f32>,
     @location(3) seed: u32,
-    @builtin(instance_index) instance_index: u32,
 ) -> VertexOut {
-    let view = views[instance_index / params.instance_count];
     let clip = view.view_proj * vec4<f32>(position, 1.0);
     return shade(clip, view.leaves, veil, 0.0, surface, 0u, seed ^ (params.static_slot * 0x9e3779b9u));
 }

@@ -133,6 +133,11 @@ pub struct Counter {
     count_pipeline: wgpu::ComputePipeline,
     atlas: Atlas,
     views: wgpu::Buffer,
+    /// The same views as the vertex shaders read them: one uniform per tile, `tile_stride` apart,
+    /// bound at a dynamic offset by `tile_bind`.
+    tile_views: wgpu::Buffer,
+    tile_bind: wgpu::BindGroup,
+    tile_stride: u32,
     /// Receiver ids of the tiles' members (the count pass's `members`).
     members: wgpu::Buffer,
     counts: wgpu::Buffer,
@@ -156,7 +161,6 @@ pub struct GpuScene {
     /// The static mesh's triangles in the culling's spatial order, in buffers within the device's
     /// size limit, each indexed into its distinct vertices (the scene pass draws ranges of it).
     static_chunks: Vec<StaticChunk>,
-    instance_count: u32,
     receivers: Vec<ReceiverView>,
     groups: ViewGroups,
     bounds: (DVec3, DVec3),
@@ -214,6 +218,15 @@ struct GpuView {
     _pad: [u32; 2],
 }
 
+/// A tile's view as the vertex shaders read it (`TileView` in sun_view.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuTileView {
+    view_proj: [[f32; 4]; 4],
+    leaves: f32,
+    _pad: [u32; 3],
+}
+
 /// One tile to render: requests of one view group at one sun and leaf fraction.
 struct Tile {
     /// Request indices, their receivers distinct, the group's owner first.
@@ -225,10 +238,9 @@ struct Tile {
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuParams {
-    instance_count: u32,
     count_edges: u32,
     static_slot: u32,
-    _pad: u32,
+    _pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -294,8 +306,9 @@ impl Counter {
             }
         });
         let render_layout = render_bind_layout(&device);
+        let tile_layout = tile_bind_layout(&device);
         let count_layout = count_bind_layout(&device);
-        let pipelines = render_pipelines(&device, &render_layout);
+        let pipelines = render_pipelines(&device, &render_layout, &tile_layout);
         let count_pipeline = count_pipeline(&device, &count_layout);
         let atlas_side = tiles_per_side * resolution;
         let atlas = Atlas {
@@ -308,6 +321,21 @@ impl Counter {
         let entries = tiles * MAX_MEMBERS as u64;
         let views =
             buffer(&device, "views", tiles * size_of::<GpuView>() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
+        let tile_stride = (size_of::<GpuTileView>() as u32).next_multiple_of(device.limits().min_uniform_buffer_offset_alignment);
+        let tile_views =
+            buffer(&device, "tile views", tiles * tile_stride as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let tile_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tile view"),
+            layout: &tile_layout,
+            entries: &[entry(
+                0,
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &tile_views,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(size_of::<GpuTileView>() as u64),
+                }),
+            )],
+        });
         let members = buffer(&device, "members", entries * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
         let counts = buffer(
             &device,
@@ -333,6 +361,9 @@ impl Counter {
             count_pipeline,
             atlas,
             views,
+            tile_views,
+            tile_bind,
+            tile_stride,
             members,
             counts,
             readback,
@@ -506,12 +537,7 @@ impl Counter {
             contents: non_empty(bytemuck::cast_slice(&instances)),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let params = GpuParams {
-            instance_count: instances.len().max(1) as u32,
-            count_edges: self.options.accuracy.is_some() as u32,
-            static_slot: culling.static_slot(),
-            _pad: 0,
-        };
+        let params = GpuParams { count_edges: self.options.accuracy.is_some() as u32, static_slot: culling.static_slot(), _pad: [0; 2] };
         let params_buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
             contents: bytemuck::bytes_of(&params),
@@ -533,11 +559,7 @@ impl Counter {
         let render_bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("render"),
             layout: &self.render_layout,
-            entries: &[
-                entry(0, instance_buffer.as_entire_binding()),
-                entry(1, self.views.as_entire_binding()),
-                entry(2, params_buffer.as_entire_binding()),
-            ],
+            entries: &[entry(0, instance_buffer.as_entire_binding()), entry(2, params_buffer.as_entire_binding())],
         });
         let count_bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("count"),
@@ -554,7 +576,6 @@ impl Counter {
         Ok(GpuScene {
             meshes,
             static_chunks,
-            instance_count: params.instance_count,
             receivers,
             groups: ViewGroups::find(scene),
             bounds: scene.bounds,
@@ -762,6 +783,13 @@ impl Counter {
             })
             .collect();
         self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
+        let stride = self.tile_stride as usize;
+        let mut tile_views = vec![0u8; views.len() * stride];
+        for (v, at) in views.iter().zip(tile_views.chunks_exact_mut(stride)) {
+            let tile = GpuTileView { view_proj: v.view_proj, leaves: v.leaves, _pad: [0; 3] };
+            at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&tile));
+        }
+        self.queue.write_buffer(&self.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
         encoder.clear_buffer(&self.counts, 0, None);
@@ -798,7 +826,7 @@ impl Counter {
             let [x, y] = self.tile_origin(slot, side);
             pass.set_viewport(x as f32, y as f32, side as f32, side as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, side, side);
-            let first = slot as u32 * scene.instance_count;
+            pass.set_bind_group(1, &self.tile_bind, &[slot as u32 * self.tile_stride]);
             // The members alone, each writing its id: their coverage, the denominators.
             for &i in &tile.requests {
                 let r = &scene.receivers[requests[i].receiver as usize];
@@ -807,17 +835,17 @@ impl Counter {
                     let mesh = &scene.meshes[r.mesh];
                     pass.set_vertex_buffer(0, mesh.vertices.slice(..));
                     pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(r.indices.clone(), 0, first + r.slot..first + r.slot + 1);
+                    pass.draw_indexed(r.indices.clone(), 0, r.slot..r.slot + 1);
                 } else {
                     pass.set_pipeline(&self.pipelines.static_mask);
-                    draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, first + r.slot);
+                    draw_static(&mut pass, &scene.static_chunks, &r.static_triangles, r.slot);
                 }
             }
             // What lies in the prisms in front of them, depth-tested: where a member's id
             // survives, it is sunlit.
             let draws = &tile.draws;
             pass.set_pipeline(&self.pipelines.static_scene);
-            draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, first + scene.culling.static_slot());
+            draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, scene.culling.static_slot());
             pass.set_pipeline(&self.pipelines.scene);
             let mut bound = None;
             for (m, slots) in &draws.instances {
@@ -830,7 +858,7 @@ impl Counter {
                     pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
                     bound = Some(*m);
                 }
-                pass.draw_indexed(0..mesh.index_count, 0, first + slots.start..first + slots.end);
+                pass.draw_indexed(0..mesh.index_count, 0, slots.clone());
             }
         }
     }
@@ -1066,7 +1094,24 @@ fn render_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let vs = wgpu::ShaderStages::VERTEX;
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("render"),
-        entries: &[storage_entry(0, vs, true), storage_entry(1, vs, true), uniform_entry(2, vs)],
+        entries: &[storage_entry(0, vs, true), uniform_entry(2, vs)],
+    })
+}
+
+/// The tile's view, one uniform at a dynamic offset per tile.
+fn tile_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("tile view"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(size_of::<GpuTileView>() as u64),
+            },
+            count: None,
+        }],
     })
 }
 
@@ -1095,14 +1140,14 @@ struct ViewPipelines {
     static_mask: wgpu::RenderPipeline,
 }
 
-fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> ViewPipelines {
+fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_layout: &wgpu::BindGroupLayout) -> ViewPipelines {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("sun_view.wgsl"),
         source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("sun view"),
-        bind_group_layouts: &[Some(layout)],
+        bind_group_layouts: &[Some(layout), Some(tile_layout)],
         immediate_size: 0,
     });
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2, 3 => Uint32];
