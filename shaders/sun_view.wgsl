@@ -62,45 +62,43 @@ struct VertexOut {
 // Outside every clip volume: a dropped leaf's vertices all go here, so its triangle is clipped away.
 const DROPPED = vec4<f32>(2.0, 2.0, 2.0, 1.0);
 
-@vertex
-fn vs_main(
+// One vertex of a mesh (GpuVertex in gpu.rs).
+struct VertexIn {
     @location(0) position: vec3<f32>,
+    // Receiver id (relative to the placement's receiver_base), or NO_RECEIVER.
     @location(1) surface: u32,
+    // Leaf rank (negative: not a leaf) and transmittance.
     @location(2) veil: vec2<f32>,
     @location(3) seed: u32,
-    @builtin(instance_index) instance_index: u32,
-) -> VertexOut {
-    let instance = instances[instance_index];
-    let clip = view.view_proj * (instance.transform * vec4<f32>(position, 1.0));
-    return shade(clip, view.leaves, veil, instance.leaf_shift, surface, instance.receiver_base, seed ^ (instance_index * 0x9e3779b9u));
 }
 
 @vertex
-fn vs_static(
-    @location(0) position: vec3<f32>,
-    @location(1) surface: u32,
-    @location(2) veil: vec2<f32>,
-    @location(3) seed: u32,
-) -> VertexOut {
-    let clip = view.view_proj * vec4<f32>(position, 1.0);
-    return shade(clip, view.leaves, veil, 0.0, surface, 0u, seed ^ (params.static_slot * 0x9e3779b9u));
+fn vs_main(v: VertexIn, @builtin(instance_index) instance_index: u32) -> VertexOut {
+    let instance = instances[instance_index];
+    let clip = view.view_proj * (instance.transform * vec4<f32>(v.position, 1.0));
+    return shade(clip, v, instance.leaf_shift, instance.receiver_base, instance_index);
+}
+
+@vertex
+fn vs_static(v: VertexIn) -> VertexOut {
+    return shade(view.view_proj * vec4<f32>(v.position, 1.0), v, 0.0, 0u, params.static_slot);
 }
 
 // What both entry points pass on: the clip position (DROPPED for a leaf not in leaf), the id
 // (NO_RECEIVER for shading-only geometry), the transmittance and the dither seed.
-fn shade(clip: vec4<f32>, leaves: f32, veil: vec2<f32>, leaf_shift: f32, surface: u32, receiver_base: u32, seed: u32) -> VertexOut {
+fn shade(clip: vec4<f32>, v: VertexIn, leaf_shift: f32, receiver_base: u32, slot: u32) -> VertexOut {
     var out: VertexOut;
     out.position = clip;
-    if veil.x >= 0.0 && fract(veil.x + leaf_shift) >= leaves {
+    if v.veil.x >= 0.0 && fract(v.veil.x + leaf_shift) >= view.leaves {
         out.position = DROPPED;
     }
-    if surface == NO_RECEIVER || receiver_base == NO_RECEIVER {
+    if v.surface == NO_RECEIVER || receiver_base == NO_RECEIVER {
         out.id = NO_RECEIVER;
     } else {
-        out.id = receiver_base + surface;
+        out.id = receiver_base + v.surface;
     }
-    out.transmittance = veil.y;
-    out.seed = seed;
+    out.transmittance = v.veil.y;
+    out.seed = v.seed ^ (slot * 0x9e3779b9u);
     return out;
 }
 
