@@ -14,18 +14,17 @@ const MAX_MEMBERS: u32 = 4u;
 // A texel no member covers (the library's scene::NO_RECEIVER).
 const NONE: u32 = 0xffffffffu;
 
+// A tile as the count reads it (its view, for the render, is sun_view.wgsl's TileView).
 struct View {
-    view_proj: mat4x4<f32>,
+    // Top-left pixel of the tile in the atlas.
     tile: vec2<u32>,
     // The tile's receivers: members[first_member ..][.. member_count]; their counts go to the
     // same indices of counts.
     first_member: u32,
     member_count: u32,
-    leaves: f32,
     // The tile's side in pixels (tiles of one batch share it).
     side: u32,
-    _pad1: u32,
-    _pad2: u32,
+    _pad0: u32,
 }
 
 struct Params {
@@ -78,9 +77,13 @@ fn count_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation
             for (var k = 0u; k < n; k++) {
                 visible[k] += select(0u, 1u, texel.r == id[k]);
                 covered[k] += select(0u, 1u, texel.g == id[k]);
-                edges[k] += edge(texel, left, id[k]) + edge(texel, under, id[k]);
             }
-            left = select(vec2<u32>(NONE, NONE), texel, params.count_edges != 0u);
+            if params.count_edges != 0u {
+                for (var k = 0u; k < n; k++) {
+                    edges[k] += edge(texel, left, id[k]) + edge(texel, under, id[k]);
+                }
+                left = texel;
+            }
         }
     }
     for (var k = 0u; k < MAX_MEMBERS; k++) {

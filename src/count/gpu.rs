@@ -209,13 +209,11 @@ struct GpuInstance {
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct GpuView {
-    view_proj: [[f32; 4]; 4],
     tile: [u32; 2],
     first_member: u32,
     member_count: u32,
-    leaves: f32,
     side: u32,
-    _pad: [u32; 2],
+    _pad: u32,
 }
 
 /// A tile's view as the vertex shaders read it (`TileView` in sun_view.wgsl).
@@ -764,31 +762,22 @@ impl Counter {
         side: u32,
         first_entry: usize,
     ) -> Result<usize> {
+        // Each tile twice, for its two readers: where and whom to count (the count pass), and the
+        // view to draw it with (the render, a uniform per tile at `tile_stride`).
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());
-        let views: Vec<GpuView> = batch
-            .iter()
-            .enumerate()
-            .map(|(slot, tile)| {
-                let first_member = members.len() as u32;
-                members.extend(tile.requests.iter().map(|&i| scene.receivers[requests[i].receiver as usize].gpu_id));
-                GpuView {
-                    view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
-                    tile: self.tile_origin(slot, side),
-                    first_member,
-                    member_count: tile.requests.len() as u32,
-                    leaves: leaves(tile.requests[0]),
-                    side,
-                    _pad: [0; 2],
-                }
-            })
-            .collect();
-        self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
+        let mut views: Vec<GpuView> = Vec::with_capacity(batch.len());
         let stride = self.tile_stride as usize;
-        let mut tile_views = vec![0u8; views.len() * stride];
-        for (v, at) in views.iter().zip(tile_views.chunks_exact_mut(stride)) {
-            let tile = GpuTileView { view_proj: v.view_proj, leaves: v.leaves, _pad: [0; 3] };
-            at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&tile));
+        let mut tile_views = vec![0u8; batch.len() * stride];
+        for ((slot, tile), at) in batch.iter().enumerate().zip(tile_views.chunks_exact_mut(stride)) {
+            let first_member = members.len() as u32;
+            members.extend(tile.requests.iter().map(|&i| scene.receivers[requests[i].receiver as usize].gpu_id));
+            let tile_origin = self.tile_origin(slot, side);
+            views.push(GpuView { tile: tile_origin, first_member, member_count: tile.requests.len() as u32, side, _pad: 0 });
+            let view =
+                GpuTileView { view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(), leaves: leaves(tile.requests[0]), _pad: [0; 3] };
+            at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&view));
         }
+        self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
         self.queue.write_buffer(&self.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
