@@ -60,14 +60,8 @@ struct AnnualArgs {
     /// Samples per day, evenly over daylight.
     #[arg(long, default_value_t = SamplingPlan::default().per_day)]
     samples_per_day: usize,
-    /// Tile size in pixels.
-    #[arg(long, default_value_t = 512)]
-    resolution: u32,
-    /// Target |error| per counted view: count each view at 64² first and again, up to
-    /// --resolution, only where shadow edges make the estimated error larger (see README,
-    /// "Adaptive resolution"). Without it every view is counted at --resolution.
-    #[arg(long, value_name = "A")]
-    accuracy: Option<f64>,
+    #[command(flatten)]
+    pixels: PixelArgs,
     /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
     /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
     #[arg(long, value_name = "N")]
@@ -160,13 +154,9 @@ impl ModelArgs {
     }
 }
 
+/// How views are counted: the tile side, or a target error (fraction, annual, bench).
 #[derive(Args)]
-struct FractionArgs {
-    #[command(flatten)]
-    model: ModelArgs,
-    /// Sun position: azimuth (degrees clockwise from north), altitude (degrees above the horizon).
-    #[arg(long, value_name = "AZ,ALT", allow_hyphen_values = true)]
-    sun: String,
+struct PixelArgs {
     /// Tile size in pixels.
     #[arg(long, default_value_t = 512)]
     resolution: u32,
@@ -175,6 +165,23 @@ struct FractionArgs {
     /// "Adaptive resolution"). Without it every view is counted at --resolution.
     #[arg(long, value_name = "A")]
     accuracy: Option<f64>,
+}
+
+impl PixelArgs {
+    fn options(&self) -> CounterOptions {
+        CounterOptions { resolution: self.resolution, accuracy: self.accuracy, ..Default::default() }
+    }
+}
+
+#[derive(Args)]
+struct FractionArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Sun position: azimuth (degrees clockwise from north), altitude (degrees above the horizon).
+    #[arg(long, value_name = "AZ,ALT", allow_hyphen_values = true)]
+    sun: String,
+    #[command(flatten)]
+    pixels: PixelArgs,
     /// Use the exact CPU polygon-clipping reference instead of the GPU (see-through nodes count
     /// as opaque there).
     #[arg(long)]
@@ -227,17 +234,11 @@ struct BenchArgs {
     /// Sun directions per case.
     #[arg(long, default_value_t = 64)]
     suns: usize,
-    /// Tile size in pixels.
-    #[arg(long, default_value_t = 512)]
-    resolution: u32,
+    #[command(flatten)]
+    pixels: PixelArgs,
     /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
     #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
     atlas: u32,
-    /// Target |error| per counted view: count each view at 64² first and again, up to
-    /// --resolution, only where shadow edges make the estimated error larger (see README,
-    /// "Adaptive resolution"). Without it every view is counted at --resolution.
-    #[arg(long, value_name = "A")]
-    accuracy: Option<f64>,
     /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
     /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
     #[arg(long, value_name = "N")]
@@ -302,8 +303,8 @@ fn quiet_mesa_runtime_dir() {
     }
 }
 
-fn counter(resolution: u32, accuracy: Option<f64>) -> Result<Counter> {
-    pollster::block_on(Counter::new(CounterOptions { resolution, accuracy, ..Default::default() }))
+fn counter(pixels: &PixelArgs) -> Result<Counter> {
+    pollster::block_on(Counter::new(pixels.options()))
 }
 
 /// `first` and as many more counters with its options as `lanes` asks (default: see
@@ -343,7 +344,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
             .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
             .collect()
     } else {
-        let counter = counter(args.resolution, args.accuracy)?;
+        let counter = counter(&args.pixels)?;
         let gpu = counter.upload(&scene)?;
         pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
     };
@@ -361,8 +362,8 @@ fn fraction(args: FractionArgs) -> Result<()> {
             .collect();
         let out = json!({
             "sun": {"azimuth": sun.azimuth, "altitude": sun.altitude},
-            "resolution": args.resolution,
-            "accuracy": args.accuracy,
+            "resolution": args.pixels.resolution,
+            "accuracy": args.pixels.accuracy,
             "method": if args.exact { "exact" } else { "gpu" },
             "leaves": args.leaves,
             "surfaces": surfaces,
@@ -370,10 +371,10 @@ fn fraction(args: FractionArgs) -> Result<()> {
         println!("{out:#}");
         return Ok(());
     }
-    let method = match (args.exact, args.accuracy) {
+    let method = match (args.exact, args.pixels.accuracy) {
         (true, _) => "exact polygon clipping".to_string(),
-        (false, None) => format!("GPU pixel counting, {0}×{0}", args.resolution),
-        (false, Some(a)) => format!("GPU pixel counting, up to {0}×{0} for ±{a}", args.resolution),
+        (false, None) => format!("GPU pixel counting, {0}×{0}", args.pixels.resolution),
+        (false, Some(a)) => format!("GPU pixel counting, up to {0}×{0} for ±{a}", args.pixels.resolution),
     };
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
@@ -410,7 +411,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let mut lanes = lanes(counter(args.resolution, args.accuracy)?, args.lanes, &scene)?;
+    let mut lanes = lanes(counter(&args.pixels)?, args.lanes, &scene)?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -554,8 +555,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
-    let counter =
-        pollster::block_on(Counter::new(CounterOptions { resolution: args.resolution, max_atlas: args.atlas, accuracy: args.accuracy }))?;
+    let counter = pollster::block_on(Counter::new(CounterOptions { max_atlas: args.atlas, ..args.pixels.options() }))?;
     let info = counter.adapter_info();
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
     let start = Instant::now();
