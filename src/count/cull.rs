@@ -343,6 +343,32 @@ impl Culling {
         shaded.then_some(list)
     }
 
+    /// Calls `f` with the triangle positions (see [`Self::triangle_sources`]) of every leaf that
+    /// reaches into the clip volume of `view_proj`, in position order: what a view would draw,
+    /// for engines that clip polygons instead of drawing them.
+    pub fn visit_triangles(&self, view_proj: &DMat4, mut f: impl FnMut(Range<usize>)) {
+        let clip = ClipVolume::new(view_proj);
+        self.static_bvh.visit(&clip, |r| f(r.start as usize..r.end as usize));
+        for g in &self.groups {
+            let n = g.triangles_per_instance;
+            g.bvh.visit(&clip, |r| f(g.first_triangle + r.start as usize * n..g.first_triangle + r.end as usize * n));
+        }
+    }
+
+    /// For every triangle position of [`Self::visit_triangles`]: the scene instance that places it
+    /// and its triangle's index in that instance's mesh.
+    pub fn triangle_sources(&self) -> Vec<(usize, u32)> {
+        let mut out: Vec<(usize, u32)> = self.static_order.iter().map(|&t| (0, t)).collect();
+        for g in &self.groups {
+            let n = g.triangles_per_instance as u32;
+            for slot in g.slots.clone() {
+                let instance = self.slot_order[slot as usize];
+                out.extend((0..n).map(|t| (instance, t)));
+            }
+        }
+        out
+    }
+
     fn any_shades(&self, prism: &Prism, own: u32, range: Range<usize>) -> bool {
         self.triangles[range.clone()].iter().zip(&self.ids[range]).any(|(t, id)| (*id != own || own == NO_RECEIVER) && prism.may_shade(t))
     }

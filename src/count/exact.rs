@@ -33,6 +33,9 @@ use i_overlay::float::overlay::FloatOverlay;
 use super::{ViewRequest, is_dark};
 use crate::scene::{Receiver, Scene};
 
+pub mod engine;
+mod objects;
+
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).
 type Contour = Vec<[f64; 2]>;
 
@@ -345,9 +348,13 @@ mod tests {
         }
     }
 
+    /// The reference's fraction, after checking that the fast engine gives the same.
     fn fraction(scene: &Scene, name: &str, sun: DVec3) -> f64 {
         let (receiver, _) = scene.receiver(name).unwrap();
-        sunlit_fraction(scene, ViewRequest { receiver, sun })
+        let want = sunlit_fraction(scene, ViewRequest { receiver, sun });
+        let fast = engine::ExactEngine::new(scene).fractions(&[ViewRequest { receiver, sun }], &[]);
+        assert!((fast[0] - want).abs() < TOL, "fast engine {} against the reference {want}", fast[0]);
+        want
     }
 
     fn assert_close(got: f64, want: f64) {

@@ -1,0 +1,540 @@
+//! The fast exact engine: the reference's polygon clipping ([`super`]), fast enough to answer
+//! views in production.
+//!
+//! Owns the per-view work and its scheduling over threads. What differs from the reference:
+//! - a view clips only the triangles of the BVH leaves in its prism ([`Culling::visit_triangles`],
+//!   the walk the GPU path draws from), not every triangle of the scene;
+//! - the triangles of one convex object ([`super::objects`]: a box, a slat, a rod, a leaf) cast
+//!   one shadow, the hull of their clipped vertices' projections, so the union sees a few dozen
+//!   convex polygons instead of hundreds of triangles;
+//! - each receiver's 2D outline is made once, the scratch memory (polygon buffers, the overlay's
+//!   graph) is per thread and reused, so no triangle allocates;
+//! - natively, views are spread over every core (threads take chunks of views in turn); a view's
+//!   answer depends only on the view, never on the thread that computed it.
+//!
+//! The boolean step is the reference's: one i_overlay graph on a 64-bit integer grid fitted to
+//! the view's own polygons, receiver minus the union of the shadows, areas from that graph.
+
+use std::ops::Range;
+
+use glam::{DVec2, DVec3};
+use i_overlay::core::extract::BooleanExtractionBuffer;
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::core::solver::Solver;
+use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
+
+use super::objects::{self, MeshObjects};
+use super::{AREA_EPS, Contour, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN, shapes_area};
+use crate::count::cull::{CPU_LEAF_TRIANGLES, Culling};
+use crate::count::{ViewRequest, is_dark, view};
+use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
+
+/// Side passed to [`view::fit`] for a view's clip volume: the margin it adds (a pixel at this
+/// side) only lets a few more triangles through the walk, which the shadow test then drops.
+const PRISM_SIDE: u32 = 512;
+/// Views a thread takes at a time.
+const CHUNK: usize = 16;
+/// No object: the triangle casts its own shadow.
+const NO_OBJECT: u32 = u32::MAX;
+
+/// A receiver as the engine needs it, made once: its plane frame's axes and its 2D outline.
+struct Outline {
+    /// The receiver's triangles as counter-clockwise contours in its plane frame.
+    lit: Vec<Contour>,
+    bounds: Rect,
+    window: Rect,
+    /// Its vertices (world), for the view's clip volume.
+    points: Vec<DVec3>,
+    normal: DVec3,
+    gpu_id: u32,
+}
+
+/// The fast exact engine over one scene. Build once, then ask [`Self::fractions`].
+pub struct ExactEngine {
+    outlines: Vec<Option<Outline>>,
+    frames: Vec<Option<PlaneFrame>>,
+    culling: Culling,
+    /// Per triangle position (the culling's order): the world triangle, as the reference makes it.
+    triangles: Vec<[DVec3; 3]>,
+    /// Per position: the receiver it belongs to ([`NO_RECEIVER`] for shading geometry).
+    owner: Vec<u32>,
+    /// Per position: its veil (leaf rank already shifted by its instance).
+    veils: Vec<Veil>,
+    /// Per position: its convex object, or [`NO_OBJECT`].
+    object: Vec<u32>,
+    /// Per convex object: its triangle positions, a range of `object_triangles`.
+    objects: Vec<Range<u32>>,
+    object_triangles: Vec<u32>,
+    /// Prefix counts of see-through triangles by position (the exact engine counts them as opaque).
+    see_through_before: Vec<u32>,
+    bounds: (DVec3, DVec3),
+    origin: DVec3,
+    area_eps: f64,
+}
+
+/// Per-thread memory, reused from view to view.
+pub struct Scratch {
+    /// Per convex object: the view that last cast its shadow.
+    stamp: Vec<u32>,
+    epoch: u32,
+    in_front: Vec<DVec3>,
+    clipped: Vec<DVec3>,
+    flat: Vec<DVec2>,
+    hull: Vec<DVec2>,
+    window_a: Vec<DVec2>,
+    window_b: Vec<DVec2>,
+    /// The view's shadows, flattened, and each one's range.
+    shadow_points: Vec<[f64; 2]>,
+    shadows: Vec<Range<usize>>,
+    overlay: FloatOverlay<[f64; 2], i64>,
+    buffer: BooleanExtractionBuffer<i64>,
+}
+
+/// What a view costs the exact engine, known before clipping: from the BVH walk alone.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ViewLoad {
+    /// Triangles in the leaves that reach into the view's prism (0 for a dark view).
+    pub triangles: usize,
+    /// Of those, see-through ones (the exact engine counts them as opaque).
+    pub see_through: usize,
+}
+
+impl ExactEngine {
+    /// Indexes `scene`: world triangles in BVH order, objects and their convexity, outlines.
+    pub fn new(scene: &Scene) -> Self {
+        let culling = Culling::new(scene, CPU_LEAF_TRIANGLES);
+        let sources = culling.triangle_sources();
+        let extent = (scene.bounds.1 - scene.bounds.0).length();
+        let scale = if extent.is_finite() { 1.0 + extent } else { 1.0 };
+        let eps = PLANE_EPS * scale;
+        // Objects of each mesh, in mesh coordinates; every placement has its own copies.
+        let mesh_objects: Vec<MeshObjects> = scene.meshes.iter().map(mesh_objects).collect();
+        let mut object_base = Vec::with_capacity(scene.instances.len());
+        let mut total = 0u32;
+        for inst in &scene.instances {
+            object_base.push(total);
+            total += mesh_objects[inst.mesh].convex.len() as u32;
+        }
+        let n = sources.len();
+        let (mut triangles, mut owner, mut veils, mut object) =
+            (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut see_through_before = Vec::with_capacity(n + 1);
+        see_through_before.push(0u32);
+        for &(i, t) in &sources {
+            let inst = &scene.instances[i];
+            let mesh = &scene.meshes[inst.mesh];
+            let idx = &mesh.indices[3 * t as usize..3 * t as usize + 3];
+            let p = |v: u32| inst.transform.transform_point3(DVec3::from_array(mesh.positions[v as usize].map(f64::from)));
+            triangles.push([p(idx[0]), p(idx[1]), p(idx[2])]);
+            let surface = mesh.surfaces[idx[0] as usize];
+            owner.push(if surface == NO_RECEIVER || inst.receiver_base == NO_RECEIVER { NO_RECEIVER } else { inst.receiver_base + surface });
+            let mut veil = mesh.veils.get(idx[0] as usize).copied().unwrap_or_default();
+            if veil.rank >= 0.0 {
+                veil.rank = shifted_rank(veil.rank, inst.leaf_shift);
+            }
+            let last = *see_through_before.last().unwrap_or(&0);
+            see_through_before.push(last + u32::from(veil.transmittance > 0.0));
+            veils.push(veil);
+            let objs = &mesh_objects[inst.mesh];
+            let local = objs.object_of[t as usize];
+            object.push(if objs.convex[local as usize] { object_base[i] + local } else { NO_OBJECT });
+        }
+        let (objects, object_triangles) = group_positions(&object, total as usize);
+        let frames: Vec<Option<PlaneFrame>> = scene.receivers.iter().map(|r| PlaneFrame::new(r, DVec3::Z, eps)).collect();
+        let outlines = scene.receivers.iter().zip(&frames).map(|(r, f)| f.as_ref().and_then(|f| outline(r, f, eps))).collect();
+        Self {
+            outlines,
+            frames,
+            culling,
+            triangles,
+            owner,
+            veils,
+            object,
+            objects,
+            object_triangles,
+            see_through_before,
+            bounds: scene.bounds,
+            origin: scene.origin,
+            area_eps: AREA_EPS * scale * scale,
+        }
+    }
+
+    /// Fresh scratch memory for one thread.
+    pub fn scratch(&self) -> Scratch {
+        let options: OverlayOptions<f64, i64> = OverlayOptions::default();
+        Scratch {
+            stamp: vec![0; self.objects.len()],
+            epoch: 0,
+            in_front: Vec::new(),
+            clipped: Vec::new(),
+            flat: Vec::new(),
+            hull: Vec::new(),
+            window_a: Vec::new(),
+            window_b: Vec::new(),
+            shadow_points: Vec::new(),
+            shadows: Vec::new(),
+            overlay: FloatOverlay::new_empty(options, Solver::default(), 64),
+            buffer: BooleanExtractionBuffer::default(),
+        }
+    }
+
+    /// Convex objects found (shadows merged per object).
+    pub fn convex_objects(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Triangles indexed.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Sunlit fractions of `requests`, `leaves[i]` the leaf fraction of request `i` (every leaf
+    /// on when empty). Natively over every core.
+    pub fn fractions(&self, requests: &[ViewRequest], leaves: &[f32]) -> Vec<f64> {
+        let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
+        let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
+        if threads == 1 {
+            let mut scratch = self.scratch();
+            return requests.iter().enumerate().map(|(i, &r)| self.fraction(r, leaves_of(i), &mut scratch)).collect();
+        }
+        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), |i, scratch| self.fraction(requests[i], leaves_of(i), scratch))
+    }
+
+    /// What a view costs before clipping: the triangles its BVH walk reaches.
+    pub fn load(&self, request: ViewRequest) -> ViewLoad {
+        let Some(Some(outline)) = self.outlines.get(request.receiver as usize) else { return ViewLoad::default() };
+        if !request.sun.is_finite() || is_dark(outline.normal, request.sun) {
+            return ViewLoad::default();
+        }
+        let view = view::fit(&outline.points, request.sun, self.bounds, self.origin, PRISM_SIDE);
+        let mut load = ViewLoad::default();
+        self.culling.visit_triangles(&view.view_proj, |r| {
+            load.triangles += r.len();
+            load.see_through += (self.see_through_before[r.end] - self.see_through_before[r.start]) as usize;
+        });
+        load
+    }
+
+    /// Sunlit fraction of one view with leaf fraction `leaves`.
+    pub fn fraction(&self, request: ViewRequest, leaves: f32, scratch: &mut Scratch) -> f64 {
+        let sun = request.sun;
+        let (Some(Some(outline)), Some(Some(frame))) =
+            (self.outlines.get(request.receiver as usize), self.frames.get(request.receiver as usize))
+        else {
+            return 0.0;
+        };
+        if !sun.is_finite() || is_dark(outline.normal, sun) {
+            return 0.0;
+        }
+        let frame = frame.towards(sun);
+        let view = view::fit(&outline.points, sun, self.bounds, self.origin, PRISM_SIDE);
+        scratch.epoch = scratch.epoch.wrapping_add(1);
+        if scratch.epoch == 0 {
+            scratch.stamp.fill(0);
+            scratch.epoch = 1;
+        }
+        scratch.shadow_points.clear();
+        scratch.shadows.clear();
+        self.culling.visit_triangles(&view.view_proj, |range| {
+            for p in range {
+                if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
+                    continue;
+                }
+                match self.object[p] {
+                    NO_OBJECT => self.triangle_shadow(&frame, outline, p, scratch),
+                    o => {
+                        if scratch.stamp[o as usize] != scratch.epoch {
+                            scratch.stamp[o as usize] = scratch.epoch;
+                            self.object_shadow(&frame, outline, o, scratch);
+                        }
+                    }
+                }
+            }
+        });
+        self.sunlit_ratio(outline, scratch)
+    }
+
+    /// The shadow of one triangle, as the reference casts it.
+    fn triangle_shadow(&self, frame: &PlaneFrame, outline: &Outline, p: usize, s: &mut Scratch) {
+        s.flat.clear();
+        push_projected(frame, &self.triangles[p], &mut s.in_front, &mut s.clipped, &mut s.flat);
+        self.push_shadow(outline, false, s);
+    }
+
+    /// The shadow of a convex object: the hull of its in-front vertices' projections.
+    fn object_shadow(&self, frame: &PlaneFrame, outline: &Outline, o: u32, s: &mut Scratch) {
+        s.flat.clear();
+        let range = &self.objects[o as usize];
+        for &p in &self.object_triangles[range.start as usize..range.end as usize] {
+            push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
+        }
+        self.push_shadow(outline, true, s);
+    }
+
+    /// Adds the polygon in `s.flat` (a projected triangle, or an object's projected points to
+    /// take the hull of) to the view's shadows, clipped to the receiver's window.
+    fn push_shadow(&self, outline: &Outline, hull: bool, s: &mut Scratch) {
+        if s.flat.len() < 3 || !s.flat.iter().all(|p| p.is_finite()) {
+            return;
+        }
+        let (lo, hi) = s.flat.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        if !(Rect { min: lo, max: hi }).overlaps(&outline.bounds) {
+            return;
+        }
+        if hull {
+            objects::convex_hull(&mut s.flat, &mut s.hull);
+            std::mem::swap(&mut s.flat, &mut s.hull);
+        }
+        clip_to_window(&outline.window, &s.flat, &mut s.window_a, &mut s.window_b);
+        let polygon = &s.window_a;
+        if polygon.len() < 3 {
+            return;
+        }
+        let area = objects::polygon_area(polygon);
+        if area.abs() <= self.area_eps {
+            return;
+        }
+        let start = s.shadow_points.len();
+        if area > 0.0 {
+            s.shadow_points.extend(polygon.iter().map(|p| p.to_array()));
+        } else {
+            s.shadow_points.extend(polygon.iter().rev().map(|p| p.to_array()));
+        }
+        s.shadows.push(start..s.shadow_points.len());
+    }
+
+    /// `area(receiver − ∪ shadows) / area(∪ receiver)`, as the reference computes it.
+    fn sunlit_ratio(&self, outline: &Outline, s: &mut Scratch) -> f64 {
+        if outline.lit.is_empty() {
+            return 0.0;
+        }
+        if s.shadows.is_empty() {
+            return 1.0;
+        }
+        let shadows: Vec<&[[f64; 2]]> = s.shadows.iter().map(|r| &s.shadow_points[r.clone()]).collect();
+        s.overlay.reinit_with_subj_and_clip(outline.lit.as_slice(), shadows.as_slice());
+        let Some(graph) = s.overlay.build_graph_view(FillRule::NonZero) else { return 0.0 };
+        let whole = shapes_area(&graph.extract_shapes(OverlayRule::Subject, &mut s.buffer));
+        if whole <= self.area_eps {
+            return 0.0;
+        }
+        let lit = shapes_area(&graph.extract_shapes(OverlayRule::Difference, &mut s.buffer));
+        if lit <= self.area_eps {
+            return 0.0;
+        }
+        (lit / whole).clamp(0.0, 1.0)
+    }
+}
+
+impl PlaneFrame {
+    /// The same frame with the sun's shift set for `sun` (its axes do not depend on the sun).
+    fn towards(&self, sun: DVec3) -> PlaneFrame {
+        let shift_per_height = -DVec2::new(sun.dot(self.e1), sun.dot(self.e2)) / self.normal.dot(sun);
+        PlaneFrame { shift_per_height, ..*self }
+    }
+}
+
+/// Objects of one mesh: triangles grouped by shared positions, surface value and veil.
+fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
+    let tris: Vec<[[f32; 3]; 3]> = mesh.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| mesh.positions[t[k] as usize])).collect();
+    let keys: Vec<u64> = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let v = t[0] as usize;
+            let veil = mesh.veils.get(v).copied().unwrap_or_default();
+            let surface = mesh.surfaces[v] as u64;
+            // Surface, leaf rank and whether see-through: an object shares all three.
+            (surface << 32) ^ (veil.rank.to_bits() as u64).rotate_left(7) ^ ((veil.transmittance > 0.0) as u64) << 63
+        })
+        .collect();
+    objects::group(&tris, &keys)
+}
+
+/// Per convex object its triangle positions (counting sort by object).
+fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>) {
+    let mut count = vec![0u32; objects + 1];
+    for &o in object.iter().filter(|&&o| o != NO_OBJECT) {
+        count[o as usize + 1] += 1;
+    }
+    for k in 0..objects {
+        count[k + 1] += count[k];
+    }
+    let ranges: Vec<Range<u32>> = (0..objects).map(|k| count[k]..count[k + 1]).collect();
+    let mut next: Vec<u32> = count[..objects].to_vec();
+    let mut out = vec![0u32; count[objects] as usize];
+    for (p, &o) in object.iter().enumerate().filter(|(_, o)| **o != NO_OBJECT) {
+        out[next[o as usize] as usize] = p as u32;
+        next[o as usize] += 1;
+    }
+    (ranges, out)
+}
+
+/// The receiver's outline in its frame: counter-clockwise triangles, bounds and the window
+/// shadows are clipped to (as in the reference).
+fn outline(r: &crate::scene::Receiver, frame: &PlaneFrame, eps: f64) -> Option<Outline> {
+    let lit: Vec<Contour> = r.triangles.iter().filter_map(|t| frame.receiver_contour(t)).collect();
+    let bounds = Rect::around(lit.iter().flatten().map(|&[x, y]| DVec2::new(x, y)))?;
+    let window = bounds.expanded(WINDOW_MARGIN * bounds.size().length() + eps);
+    Some(Outline { lit, bounds, window, points: r.triangles.iter().flatten().copied().collect(), normal: r.normal, gpu_id: r.gpu_id })
+}
+
+/// Appends the projections of the part of `tri` in front of the plane to `flat` (nothing when
+/// none of it is in front), clipping as the reference does.
+fn push_projected(frame: &PlaneFrame, tri: &[DVec3; 3], in_front: &mut Vec<DVec3>, clipped: &mut Vec<DVec3>, flat: &mut Vec<DVec2>) {
+    let h = tri.map(|p| frame.height(p));
+    if h.iter().all(|&h| h <= 0.0) {
+        return;
+    }
+    if h.iter().all(|&h| h >= 0.0) {
+        flat.extend(tri.iter().zip(h).map(|(&p, h)| frame.to_2d(p) + frame.shift_per_height * h));
+        return;
+    }
+    in_front.clear();
+    in_front.extend_from_slice(tri);
+    clip_into(in_front, clipped, |p| frame.height(*p));
+    flat.extend(clipped.iter().map(|&p| frame.project_along_sun(p)));
+}
+
+/// A convex polygon clipped to the window box, into `a` (`b` is scratch).
+fn clip_to_window(window: &Rect, polygon: &[DVec2], a: &mut Vec<DVec2>, b: &mut Vec<DVec2>) {
+    a.clear();
+    a.extend_from_slice(polygon);
+    clip_into(a, b, |p| p.x - window.min.x);
+    clip_into(b, a, |p| window.max.x - p.x);
+    clip_into(a, b, |p| p.y - window.min.y);
+    clip_into(b, a, |p| window.max.y - p.y);
+}
+
+/// The reference's Sutherland–Hodgman step ([`super::clip_half_space`]) into a reused buffer.
+fn clip_into<P>(polygon: &[P], out: &mut Vec<P>, dist: impl Fn(&P) -> f64)
+where
+    P: Copy + std::ops::Add<Output = P> + std::ops::Sub<Output = P> + std::ops::Mul<f64, Output = P>,
+{
+    out.clear();
+    for (i, &a) in polygon.iter().enumerate() {
+        let b = polygon[(i + 1) % polygon.len()];
+        let (da, db) = (dist(&a), dist(&b));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if da > 0.0 && db < 0.0 {
+            out.push(super::crossing(a, da, b, db));
+        } else if da < 0.0 && db > 0.0 {
+            out.push(super::crossing(b, db, a, da));
+        }
+    }
+}
+
+/// Threads for exact views: every core natively, one on the web (no threads to block there).
+fn worker_threads() -> usize {
+    if cfg!(target_arch = "wasm32") { 1 } else { std::thread::available_parallelism().map_or(1, |n| n.get()) }
+}
+
+/// `job(i, scratch)` for every `i < n`, over `threads` threads taking `chunk` items at a time, in
+/// item order whatever thread ran each.
+#[cfg(not(target_arch = "wasm32"))]
+fn parallel_chunks<S, T: Send + Default + Clone>(
+    n: usize,
+    threads: usize,
+    chunk: usize,
+    scratch: impl Fn() -> S + Sync,
+    job: impl Fn(usize, &mut S) -> T + Sync,
+) -> Vec<T> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let parts: Vec<Vec<(usize, Vec<T>)>> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut s = scratch();
+                    let mut done = Vec::new();
+                    loop {
+                        let start = next.fetch_add(chunk, Ordering::Relaxed);
+                        if start >= n {
+                            break done;
+                        }
+                        done.push((start, (start..(start + chunk).min(n)).map(|i| job(i, &mut s)).collect()));
+                    }
+                })
+            })
+            .collect();
+        workers.into_iter().map(|w| w.join().unwrap_or_default()).collect()
+    });
+    let mut out = vec![T::default(); n];
+    for (start, values) in parts.into_iter().flatten() {
+        for (k, v) in values.into_iter().enumerate() {
+            out[start + k] = v;
+        }
+    }
+    out
+}
+
+/// One thread on the web.
+#[cfg(target_arch = "wasm32")]
+fn parallel_chunks<S, T: Send + Default + Clone>(
+    n: usize,
+    _threads: usize,
+    _chunk: usize,
+    scratch: impl Fn() -> S + Sync,
+    job: impl Fn(usize, &mut S) -> T + Sync,
+) -> Vec<T> {
+    let mut s = scratch();
+    (0..n).map(|i| job(i, &mut s)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
+    use glam::DMat4;
+
+    /// A box [lo, hi] as 12 triangles, outward.
+    fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+        let c = |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+        let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
+    }
+
+    fn wall() -> SourceMesh {
+        SourceMesh { positions: vec![[0., 0., 0.], [4., 0., 0.], [4., 0., 3.], [0., 0., 3.]], indices: vec![0, 1, 2, 0, 2, 3] }
+    }
+
+    /// A south wall under 40 instanced slats and some baked boxes, one straddling the wall's plane.
+    fn louvred_wall() -> Scene {
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "WALL", wall(), true);
+        b.add_object("test", "BOX", cuboid([1.0, -1.0, 2.0], [1.5, -0.5, 2.4]), false);
+        b.add_object("test", "THROUGH", cuboid([2.5, -0.4, 1.0], [3.0, 0.3, 1.2]), false);
+        let slat = b.add_mesh("slat", cuboid([-0.5, -0.3, 0.0], [4.5, -0.1, 0.04]));
+        for k in 0..40 {
+            let transform = DMat4::from_translation(DVec3::new(0.0, 0.0, 0.075 * k as f64));
+            let name = format!("S{k}");
+            b.add_node(SourceNode { origin: name.clone(), name, mesh: slat, transform, receiver: false });
+        }
+        b.build().unwrap()
+    }
+
+    #[test]
+    fn the_fast_engine_agrees_with_the_reference() {
+        let scene = louvred_wall();
+        let engine = ExactEngine::new(&scene);
+        assert_eq!(engine.convex_objects(), 1 + 2 + 40, "the wall (flat, it shades other receivers), two boxes, the slats");
+        let mut requests = Vec::new();
+        for az in [120.0f64, 150.0, 180.0, 200.0, 240.0] {
+            for alt in [5.0f64, 20.0, 35.0, 60.0] {
+                let (a, h) = (az.to_radians(), alt.to_radians());
+                requests.push(ViewRequest { receiver: 0, sun: DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin()) });
+            }
+        }
+        let fast = engine.fractions(&requests, &[]);
+        let reference = super::super::sunlit_fractions(&scene, &requests);
+        let mut partly = 0;
+        for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+            assert!((f - r).abs() < 1e-9, "{q:?}: fast {f}, reference {r}");
+            partly += usize::from(*r > 0.01 && *r < 0.99);
+        }
+        assert!(partly >= 10, "only {partly} views partly shaded");
+    }
+}

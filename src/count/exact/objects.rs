@@ -1,0 +1,234 @@
+//! Objects for the fast exact engine: which triangles of a mesh form one convex solid or one flat
+//! convex polygon, so their shadows can be merged into one silhouette before the union.
+//!
+//! Owns the grouping and the convexity test. An *object* is a connected group of a mesh's
+//! triangles (sharing vertex positions, bit for bit) that also share their surface id and veil,
+//! so an object never mixes a receiver with other geometry, nor leaves of different ranks. An
+//! object is *convex* when it is
+//! - a closed convex polyhedron: every edge is used by exactly two of its triangles and every
+//!   triangle's plane has all the object's vertices on one side (boxes, slats, hexagonal rods); or
+//! - a flat convex polygon: all vertices in one plane, no edge used more than twice, and its
+//!   triangles' areas add up to the area of their convex hull (quads, leaves).
+//!
+//! The shadow of a convex object's part in front of a plane is the convex hull of its clipped
+//! vertices' projections, exactly the union of its triangles' shadows: a sun ray through the
+//! solid crosses its surface, and at most one of those crossings lies on the cutting plane.
+//! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) are not tested and stay per-triangle.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3};
+
+/// Objects with more triangles than this are not tested for convexity (the test is quadratic).
+pub(super) const MAX_CONVEX_TRIANGLES: usize = 64;
+/// Relative tolerance (of the object's size) of the convexity and flatness tests.
+const CONVEX_TOLERANCE: f64 = 1e-9;
+/// Relative difference allowed between a flat object's area and its hull's.
+const FLAT_AREA_TOLERANCE: f64 = 1e-9;
+
+/// A mesh's triangles grouped into objects.
+#[derive(Debug, Default)]
+pub(super) struct MeshObjects {
+    /// Per triangle of the mesh: its object.
+    pub object_of: Vec<u32>,
+    /// Per object: whether it is convex (see the module doc).
+    pub convex: Vec<bool>,
+    /// Per object: its triangles (indices into the mesh's triangle list), flattened.
+    pub triangles: Vec<u32>,
+    /// Per object: its range in `triangles`.
+    pub ranges: Vec<std::ops::Range<u32>>,
+}
+
+/// Groups `triangles` (mesh coordinates, with a key per triangle that objects must share: surface
+/// id and veil) into objects and tests each for convexity.
+pub(super) fn group(triangles: &[[[f32; 3]; 3]], keys: &[u64]) -> MeshObjects {
+    let n = triangles.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    // First triangle seen at each (vertex position, key): later ones join its object.
+    let mut first: HashMap<([u32; 3], u64), u32> = HashMap::with_capacity(n * 2);
+    for (t, tri) in triangles.iter().enumerate() {
+        for p in tri {
+            let bits = p.map(f32::to_bits);
+            let other = *first.entry((bits, keys[t])).or_insert(t as u32);
+            union(&mut parent, other, t as u32);
+        }
+    }
+    let mut object_of = vec![0u32; n];
+    let mut index_of_root: HashMap<u32, u32> = HashMap::new();
+    let mut members: Vec<Vec<u32>> = Vec::new();
+    for t in 0..n as u32 {
+        let root = find(&mut parent, t);
+        let next = members.len() as u32;
+        let o = *index_of_root.entry(root).or_insert(next);
+        if o == next {
+            members.push(Vec::new());
+        }
+        members[o as usize].push(t);
+        object_of[t as usize] = o;
+    }
+    let mut out = MeshObjects { object_of, ..Default::default() };
+    for m in &members {
+        let tris: Vec<[DVec3; 3]> = m.iter().map(|&t| triangles[t as usize].map(|p| DVec3::from_array(p.map(f64::from)))).collect();
+        out.convex.push(tris.len() <= MAX_CONVEX_TRIANGLES && is_convex(&tris));
+        let start = out.triangles.len() as u32;
+        out.triangles.extend(m);
+        out.ranges.push(start..out.triangles.len() as u32);
+    }
+    out
+}
+
+fn find(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        parent[x as usize] = parent[parent[x as usize] as usize];
+        x = parent[x as usize];
+    }
+    x
+}
+
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        parent[rb.max(ra) as usize] = rb.min(ra);
+    }
+}
+
+/// Whether the triangles form a closed convex polyhedron or a flat convex polygon.
+pub(super) fn is_convex(tris: &[[DVec3; 3]]) -> bool {
+    let points: Vec<DVec3> = tris.iter().flatten().copied().collect();
+    let Some(size) = extent(&points) else { return false };
+    let tol = CONVEX_TOLERANCE * size.max(f64::MIN_POSITIVE);
+    // Edges by their endpoints' bits, undirected: how many triangles use each.
+    let mut uses: HashMap<([u64; 3], [u64; 3]), u32> = HashMap::new();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k].to_array().map(f64::to_bits), t[(k + 1) % 3].to_array().map(f64::to_bits));
+            *uses.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
+        }
+    }
+    if uses.values().any(|&u| u > 2) {
+        return false;
+    }
+    let mut flat = true;
+    for t in tris {
+        let normal = (t[1] - t[0]).cross(t[2] - t[0]);
+        let length = normal.length();
+        if length <= tol * size {
+            return false;
+        }
+        let normal = normal / length;
+        let (mut below, mut above) = (false, false);
+        for p in &points {
+            let h = normal.dot(*p - t[0]);
+            below |= h < -tol;
+            above |= h > tol;
+        }
+        if below && above {
+            return false;
+        }
+        flat &= !below && !above;
+    }
+    if flat {
+        return flat_polygon_is_covered(tris, &points);
+    }
+    uses.values().all(|&u| u == 2)
+}
+
+/// A flat object is its convex hull when its triangles' areas add up to the hull's area (and no
+/// edge is used more than twice, checked by the caller, so they do not overlap).
+fn flat_polygon_is_covered(tris: &[[DVec3; 3]], points: &[DVec3]) -> bool {
+    let t = tris[0];
+    let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+    let e1 = normal.any_orthonormal_vector();
+    let e2 = normal.cross(e1);
+    let flat: Vec<DVec2> = points.iter().map(|p| DVec2::new((*p - t[0]).dot(e1), (*p - t[0]).dot(e2))).collect();
+    let mut hull = Vec::new();
+    convex_hull(&mut flat.clone(), &mut hull);
+    let hull_area = polygon_area(&hull);
+    let sum: f64 = tris.iter().map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()).sum();
+    hull_area > 0.0 && (sum - hull_area).abs() <= FLAT_AREA_TOLERANCE * hull_area
+}
+
+fn extent(points: &[DVec3]) -> Option<f64> {
+    let (lo, hi) = points.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let size = (hi - lo).length();
+    size.is_finite().then_some(size)
+}
+
+/// Signed area of a polygon (positive counter-clockwise).
+pub(super) fn polygon_area(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    0.5 * (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f64>()
+}
+
+/// Andrew's monotone chain: the hull of `points` (sorted in place) into `hull`, counter-clockwise,
+/// without collinear points or a repeated first point.
+pub(super) fn convex_hull(points: &mut [DVec2], hull: &mut Vec<DVec2>) {
+    hull.clear();
+    points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    if points.len() < 3 {
+        hull.extend_from_slice(points);
+        return;
+    }
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    for &q in points.iter() {
+        while hull.len() >= 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+            hull.pop();
+        }
+        hull.push(q);
+    }
+    let lower = hull.len() + 1;
+    for &q in points.iter().rev().skip(1) {
+        while hull.len() >= lower && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+            hull.pop();
+        }
+        hull.push(q);
+    }
+    hull.pop();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> Vec<[DVec3; 3]> {
+        let c = |i: usize| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64);
+        let quads: [[usize; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+    }
+
+    #[test]
+    fn boxes_and_quads_are_convex_open_or_concave_shapes_are_not() {
+        let cube = cube();
+        assert!(is_convex(&cube));
+        assert!(!is_convex(&cube[..6]), "three faces of a cube are open");
+        assert!(is_convex(&cube[..2]), "one face, a flat square");
+        // An L of three unit squares in one plane: flat, but its hull is larger than it.
+        let sq = |x: f64, y: f64| {
+            let p = |dx: f64, dy: f64| DVec3::new(x + dx, y + dy, 0.0);
+            [[p(0., 0.), p(1., 0.), p(1., 1.)], [p(0., 0.), p(1., 1.), p(0., 1.)]]
+        };
+        let l: Vec<[DVec3; 3]> = [sq(0., 0.), sq(1., 0.), sq(0., 1.)].concat();
+        assert!(!is_convex(&l));
+        // Two cubes side by side sharing no vertex are two objects; glued into a 2×1 box with
+        // the shared face left inside, edges are used more than twice.
+        let shifted: Vec<[DVec3; 3]> = cube.iter().map(|t| t.map(|p| p + DVec3::X)).collect();
+        assert!(!is_convex(&[cube.clone(), shifted].concat()));
+    }
+
+    #[test]
+    fn objects_are_connected_triangles_with_one_key() {
+        let to_f32 = |t: &[DVec3; 3]| t.map(|p| p.as_vec3().to_array());
+        let mut tris: Vec<[[f32; 3]; 3]> = cube().iter().map(to_f32).collect();
+        tris.extend(cube().iter().map(|t| to_f32(&t.map(|p| p + DVec3::splat(5.0)))));
+        let mut keys = vec![0u64; tris.len()];
+        let objects = group(&tris, &keys);
+        assert_eq!(objects.ranges.len(), 2);
+        assert_eq!(objects.convex, vec![true, true]);
+        // A different key on one face splits it off: the rest is no longer closed.
+        keys[0] = 1;
+        keys[1] = 1;
+        let objects = group(&tris, &keys);
+        assert_eq!(objects.ranges.len(), 3);
+        assert_eq!(objects.convex.iter().filter(|c| **c).count(), 2, "the face and the other cube");
+    }
+}
