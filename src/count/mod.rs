@@ -8,6 +8,7 @@ pub mod cull;
 pub mod exact;
 pub mod gpu;
 pub mod group;
+pub mod hybrid;
 pub mod lanes;
 pub mod view;
 

@@ -201,6 +201,12 @@ impl ExactEngine {
         parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), |i, scratch| self.fraction(requests[i], leaves_of(i), scratch))
     }
 
+    /// [`Self::load`] of every request, natively over every core.
+    pub fn loads(&self, requests: &[ViewRequest]) -> Vec<ViewLoad> {
+        let threads = worker_threads().min(requests.len().div_ceil(4 * CHUNK)).max(1);
+        parallel_chunks(requests.len(), threads, 4 * CHUNK, || (), |i, _| self.load(requests[i]))
+    }
+
     /// What a view costs before clipping: the triangles its BVH walk reaches.
     pub fn load(&self, request: ViewRequest) -> ViewLoad {
         let Some(Some(outline)) = self.outlines.get(request.receiver as usize) else { return ViewLoad::default() };

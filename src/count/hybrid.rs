@@ -1,0 +1,621 @@
+//! The hybrid engine: every view answered by the cheaper of exact clipping ([`ExactEngine`]) and
+//! GPU pixels ([`Counter`]), routed by a cost model measured on the device.
+//!
+//! Owns the choice of engine ([`EngineKind`]), the cost model ([`Profile`]), its calibration and
+//! cache, and the split of a batch of views between the engines:
+//! - a view's *load* is what the BVH walk in its prism finds ([`ViewLoad`]): the triangles it
+//!   reaches. Each engine's cost is modelled as `per_view + per_triangle × triangles` µs; the GPU's
+//!   `per_view` holds its pixels at the run's side, so a profile belongs to one resolution;
+//! - `auto` routes each view to the engine with the lower modelled cost; views with see-through
+//!   geometry in their prism go to the GPU (the exact engine counts it as opaque); views with
+//!   nothing in their prism or the sun behind the surface are exact at no cost. If the views
+//!   routed to the GPU would save less than its start-up, they go to the exact engine too, and no
+//!   device is made;
+//! - routing depends only on the loads and the profile, never on timing during the run, so the
+//!   same inputs with the same profile give the same answers byte for byte. The profile is
+//!   measured once per device (a probe of both engines on the model's own views, a few hundred
+//!   ms), kept in a cache file keyed by adapter, driver, resolution and cores, and can be pinned
+//!   with a profile file of its own;
+//! - both engines run at once: natively the exact views on every core's threads while the GPU
+//!   lanes count theirs; on the web one after the other (one thread).
+
+use std::cell::OnceCell;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::exact::engine::{ExactEngine, ViewLoad};
+use super::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use super::lanes::{Lane, default_lanes, fractions_side_by_side};
+use super::{ViewRequest, cos_incidence};
+use crate::error::{Error, Result};
+use crate::platform;
+use crate::scene::Scene;
+
+/// Views each engine is timed on when calibrating (spread over the loads).
+const PROBE_EXACT_VIEWS: usize = 48;
+/// Most time the exact probe may take (s); it stops early past it.
+const PROBE_EXACT_SECONDS: f64 = 0.15;
+/// Views per GPU probe batch (a light and a heavy batch).
+const PROBE_GPU_VIEWS: usize = 32;
+/// Start-up a GPU is assumed to cost (s) before one has been measured: below this much work
+/// in total, `auto` answers everything exactly without making a device.
+const ASSUMED_GPU_STARTUP: f64 = 0.5;
+
+/// Which engine answers views.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EngineKind {
+    /// Per view, the cheaper of the two (see the module doc).
+    #[default]
+    Auto,
+    /// GPU pixel counting only.
+    Gpu,
+    /// Exact polygon clipping only (see-through geometry counts as opaque).
+    Exact,
+}
+
+impl EngineKind {
+    /// `auto`, `gpu` or `exact`.
+    pub fn parse(text: &str) -> Result<Self> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(Self::Auto),
+            "gpu" => Ok(Self::Gpu),
+            "exact" => Ok(Self::Exact),
+            other => Err(Error::argument("engine", format!("'{other}' is not one of auto, gpu, exact"))),
+        }
+    }
+
+    /// The name [`Self::parse`] takes.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Gpu => "gpu",
+            Self::Exact => "exact",
+        }
+    }
+}
+
+/// One engine's modelled cost of a view: `per_view + per_triangle × triangles` µs.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Cost {
+    /// µs a view costs whatever it holds (the GPU's pixels, the exact engine's set-up).
+    pub per_view_us: f64,
+    /// µs per triangle in the view's prism.
+    pub per_triangle_us: f64,
+}
+
+impl Cost {
+    /// Modelled µs of a view with `load`.
+    pub fn of(&self, load: ViewLoad) -> f64 {
+        self.per_view_us + self.per_triangle_us * load.triangles as f64
+    }
+}
+
+/// A device's cost model: what `auto` routes by.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Profile {
+    /// The device it was measured on (adapter, driver, CPU threads, tile side).
+    pub device: String,
+    /// The exact engine on this machine's threads.
+    pub exact: Cost,
+    /// The GPU at the profile's side; `None` until measured (no view has needed it yet).
+    pub gpu: Option<Cost>,
+    /// Seconds to make the GPU device(s) and upload a scene, when measured.
+    pub gpu_startup_seconds: Option<f64>,
+}
+
+/// Where a view is answered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Route {
+    /// Exact polygon clipping.
+    Exact,
+    /// GPU pixel counting.
+    Gpu,
+}
+
+impl Profile {
+    /// Routes views with these loads: see the module doc. A pure function of its inputs.
+    pub fn route(&self, loads: &[ViewLoad]) -> Vec<Route> {
+        let mut routes: Vec<Route> = loads.iter().map(|&l| self.route_one(l)).collect();
+        let needed = loads.iter().any(|l| l.see_through > 0);
+        let saving_us: f64 = loads
+            .iter()
+            .zip(&routes)
+            .filter(|(_, r)| **r == Route::Gpu)
+            .map(|(&l, _)| self.exact.of(l) - self.gpu.map_or(0.0, |g| g.of(l)))
+            .sum();
+        let startup_us = 1e6 * self.gpu_startup_seconds.unwrap_or(ASSUMED_GPU_STARTUP);
+        if !needed && saving_us < startup_us {
+            routes.iter_mut().for_each(|r| *r = Route::Exact);
+        }
+        routes
+    }
+
+    fn route_one(&self, load: ViewLoad) -> Route {
+        if load.triangles == 0 {
+            return Route::Exact;
+        }
+        if load.see_through > 0 {
+            return Route::Gpu;
+        }
+        match self.gpu {
+            Some(gpu) if gpu.of(load) < self.exact.of(load) => Route::Gpu,
+            _ => Route::Exact,
+        }
+    }
+
+    /// Modelled µs of all these views on the exact engine alone.
+    pub fn exact_total_us(&self, loads: &[ViewLoad]) -> f64 {
+        loads.iter().filter(|l| l.triangles > 0).map(|&l| self.exact.of(l)).sum()
+    }
+}
+
+/// Where the profile comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ProfileSource {
+    /// The per-device cache file (made by a probe the first time).
+    Cache,
+    /// This file: read when it exists, else measured and written there (pins the routing).
+    File(PathBuf),
+    /// Measured now and kept nowhere.
+    Probe,
+}
+
+/// Counts per engine and the wall time each took (they overlap when both run).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct EngineStats {
+    /// Views answered exactly (including dark views and views with nothing in front).
+    pub exact_views: usize,
+    /// Views counted on the GPU.
+    pub gpu_views: usize,
+    /// Wall seconds the exact engine worked.
+    pub exact_seconds: f64,
+    /// Wall seconds the GPU lanes worked.
+    pub gpu_seconds: f64,
+    /// Seconds spent calibrating (probing both engines).
+    pub calibration_seconds: f64,
+    /// Seconds spent making GPU devices and uploading the scene.
+    pub gpu_startup_seconds: f64,
+}
+
+/// Counts views of one scene with the engine chosen; the GPU is made only when a view needs it.
+pub struct HybridEngine<'a> {
+    scene: &'a Scene,
+    kind: EngineKind,
+    options: CounterOptions,
+    lanes_wanted: Option<usize>,
+    source: ProfileSource,
+    exact: Option<ExactEngine>,
+    gpu: OnceCell<Vec<(Counter, GpuScene)>>,
+    profile: OnceCell<(Profile, &'static str)>,
+    stats: std::cell::Cell<EngineStats>,
+}
+
+impl<'a> HybridEngine<'a> {
+    /// An engine over `scene`; `options` and `lanes` (default: [`default_lanes`]) for the GPU.
+    pub fn new(scene: &'a Scene, kind: EngineKind, options: CounterOptions, lanes: Option<usize>, source: ProfileSource) -> Result<Self> {
+        if lanes == Some(0) {
+            return Err(Error::argument("lanes", "must be at least 1"));
+        }
+        let exact = (kind != EngineKind::Gpu).then(|| ExactEngine::new(scene));
+        Ok(Self {
+            scene,
+            kind,
+            options,
+            lanes_wanted: lanes,
+            source,
+            exact,
+            gpu: OnceCell::new(),
+            profile: OnceCell::new(),
+            stats: Default::default(),
+        })
+    }
+
+    /// Uses `lanes` (counters with `scene` uploaded) instead of making them when first needed.
+    pub fn with_lanes(self, lanes: Vec<(Counter, GpuScene)>) -> Self {
+        let _ = self.gpu.set(lanes);
+        self
+    }
+
+    /// The engine chosen.
+    pub fn kind(&self) -> EngineKind {
+        self.kind
+    }
+
+    /// The profile `auto` routes by and where it came from (`cache`, `file`, `probe`), once known.
+    pub fn profile(&self) -> Option<(&Profile, &'static str)> {
+        self.profile.get().map(|(p, s)| (p, *s))
+    }
+
+    /// Views and seconds per engine so far.
+    pub fn stats(&self) -> EngineStats {
+        self.stats.get()
+    }
+
+    /// The GPU lanes, if made.
+    pub fn lanes(&self) -> Option<&[(Counter, GpuScene)]> {
+        self.gpu.get().map(Vec::as_slice)
+    }
+
+    /// The exact engine (absent with [`EngineKind::Gpu`]).
+    pub fn exact(&self) -> Option<&ExactEngine> {
+        self.exact.as_ref()
+    }
+
+    /// Drops the GPU lanes (after a lost device); the next view that needs one makes them anew.
+    pub fn forget_gpu(&mut self) {
+        self.gpu = OnceCell::new();
+    }
+
+    fn add_stats(&self, f: impl FnOnce(&mut EngineStats)) {
+        let mut s = self.stats.get();
+        f(&mut s);
+        self.stats.set(s);
+    }
+
+    async fn gpu_lanes(&self) -> Result<&[(Counter, GpuScene)]> {
+        if let Some(lanes) = self.gpu.get() {
+            return Ok(lanes);
+        }
+        let start = now();
+        let first = Counter::new(self.options).await?;
+        let n = self.lanes_wanted.unwrap_or_else(|| default_lanes(first.adapter_info()));
+        let mut counters = vec![first];
+        for _ in 1..n {
+            counters.push(Counter::new(self.options).await?);
+        }
+        let lanes = counters
+            .into_iter()
+            .map(|c| {
+                let gpu = c.upload(self.scene)?;
+                Ok((c, gpu))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let seconds = now() - start;
+        self.add_stats(|s| s.gpu_startup_seconds += seconds);
+        let _ = self.gpu.set(lanes);
+        self.gpu.get().map(Vec::as_slice).ok_or_else(|| Error::Gpu("GPU lanes went missing".into()))
+    }
+
+    /// Counts `requests` (`leaves[i]` the leaf fraction of request `i`; all leaves on when empty).
+    pub async fn count(&self, requests: &[ViewRequest], leaves: &[f32]) -> Result<Vec<Counted>> {
+        if !leaves.is_empty() && leaves.len() != requests.len() {
+            return Err(Error::argument("leaves", format!("{} leaf fractions for {} views", leaves.len(), requests.len())));
+        }
+        let routes = match (self.kind, &self.exact) {
+            (EngineKind::Gpu, _) | (_, None) => vec![Route::Gpu; requests.len()],
+            (EngineKind::Exact, Some(_)) => vec![Route::Exact; requests.len()],
+            (EngineKind::Auto, Some(exact)) => {
+                let loads = exact.loads(requests);
+                let profile = self.ensure_profile(exact, requests, leaves, &loads).await?;
+                profile.route(&loads)
+            }
+        };
+        self.count_routed(requests, leaves, &routes).await
+    }
+
+    /// Counts each request on the engine `routes` names, both engines at once.
+    pub async fn count_routed(&self, requests: &[ViewRequest], leaves: &[f32], routes: &[Route]) -> Result<Vec<Counted>> {
+        let pick = |route: Route| -> (Vec<usize>, Vec<ViewRequest>, Vec<f32>) {
+            let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
+            let reqs = idx.iter().map(|&i| requests[i]).collect();
+            let lv = if leaves.is_empty() { Vec::new() } else { idx.iter().map(|&i| leaves[i]).collect() };
+            (idx, reqs, lv)
+        };
+        let (exact_idx, exact_reqs, exact_leaves) = pick(Route::Exact);
+        let (gpu_idx, gpu_reqs, gpu_leaves) = pick(Route::Gpu);
+        let lanes: Vec<Lane<'_>> = if gpu_reqs.is_empty() {
+            Vec::new()
+        } else {
+            self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect()
+        };
+        let exact = match (&self.exact, exact_reqs.is_empty()) {
+            (_, true) => None,
+            (Some(e), false) => Some(e),
+            (None, false) => return Err(Error::argument("engine", "views routed to the exact engine of a GPU-only engine")),
+        };
+        #[derive(Clone, Copy)]
+        enum Part<'p> {
+            Exact(&'p ExactEngine),
+            Gpu,
+        }
+        let mut parts = Vec::new();
+        if let Some(e) = exact {
+            parts.push(Part::Exact(e));
+        }
+        if !gpu_reqs.is_empty() {
+            parts.push(Part::Gpu);
+        }
+        let results = platform::side_by_side(&parts, |part| {
+            let (part, lanes, exact_reqs, exact_leaves, gpu_reqs, gpu_leaves) = (*part, &lanes, &exact_reqs, &exact_leaves, &gpu_reqs, &gpu_leaves);
+            async move {
+                let start = now();
+                let counted = match part {
+                    Part::Exact(e) => Ok(e.fractions(exact_reqs, exact_leaves).into_iter().map(|fraction| Counted { fraction, ..Default::default() }).collect()),
+                    Part::Gpu => fractions_side_by_side(lanes, gpu_reqs, gpu_leaves).await,
+                };
+                (counted, now() - start)
+            }
+        })
+        .await;
+        // Exact answers carry their fraction and cosine; the GPU's their pixel counts too.
+        let mut out: Vec<Counted> = requests
+            .iter()
+            .map(|r| Counted {
+                cos_incidence: self.scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
+                ..Default::default()
+            })
+            .collect();
+        for (part, (counted, seconds)) in parts.iter().zip(results) {
+            let counted: Vec<Counted> = counted?;
+            match part {
+                Part::Exact(_) => {
+                    for (&i, c) in exact_idx.iter().zip(counted) {
+                        out[i].fraction = c.fraction;
+                    }
+                    self.add_stats(|s| {
+                        s.exact_views += exact_idx.len();
+                        s.exact_seconds += seconds;
+                    });
+                }
+                Part::Gpu => {
+                    for (&i, c) in gpu_idx.iter().zip(counted) {
+                        out[i] = c;
+                    }
+                    self.add_stats(|s| {
+                        s.gpu_views += gpu_idx.len();
+                        s.gpu_seconds += seconds;
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The profile to route by: pinned, cached or measured now (see [`ProfileSource`]).
+    async fn ensure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad]) -> Result<&Profile> {
+        if let Some((p, _)) = self.profile.get() {
+            return Ok(p);
+        }
+        let key = device_key(&self.options).await;
+        let (profile, from) = match &self.source {
+            ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
+            ProfileSource::Cache => match cached(&key) {
+                Some(p) => (p, "cache"),
+                None => (self.calibrate(exact, requests, leaves, loads, key.clone()).await?, "probe"),
+            },
+            _ => (self.calibrate(exact, requests, leaves, loads, key.clone()).await?, "probe"),
+        };
+        if from == "probe" {
+            match &self.source {
+                ProfileSource::File(path) => write_profile(path, &profile)?,
+                ProfileSource::Cache => store_cached(&key, &profile),
+                ProfileSource::Probe => {}
+            }
+        }
+        let _ = self.profile.set((profile, from));
+        self.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
+    }
+
+    /// Measures both engines on a spread of these views (the GPU only if the exact engine alone
+    /// would take longer than a GPU's start-up).
+    async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad], key: String) -> Result<Profile> {
+        let start = now();
+        let probe = probe_views(loads, PROBE_EXACT_VIEWS);
+        let exact_cost = probe_exact(exact, requests, leaves, loads, &probe);
+        let mut profile = Profile { device: key, exact: exact_cost, gpu: None, gpu_startup_seconds: None };
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+        if profile.exact_total_us(loads) / threads > 1e6 * ASSUMED_GPU_STARTUP {
+            let before = self.stats().gpu_startup_seconds;
+            let lanes = self.gpu_lanes().await?;
+            profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
+            profile.gpu = Some(probe_gpu(lanes, requests, leaves, loads).await?);
+        }
+        let seconds = now() - start;
+        self.add_stats(|s| s.calibration_seconds += seconds);
+        Ok(profile)
+    }
+}
+
+/// Indices of up to `n` views with something in their prism, spread evenly over their loads.
+fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
+    let mut loaded: Vec<usize> = (0..loads.len()).filter(|&i| loads[i].triangles > 0 && loads[i].see_through == 0).collect();
+    loaded.sort_by_key(|&i| (loads[i].triangles, i));
+    let stride = loaded.len().div_ceil(n.max(1)).max(1);
+    loaded.into_iter().step_by(stride).collect()
+}
+
+/// Times the exact engine view by view on one thread and fits its cost line.
+fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad], probe: &[usize]) -> Cost {
+    let mut scratch = exact.scratch();
+    let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
+    // Warm caches and the scratch memory first.
+    for &i in probe.iter().take(4) {
+        exact.fraction(requests[i], leaves_of(i), &mut scratch);
+    }
+    let started = now();
+    let mut samples = Vec::new();
+    for &i in probe {
+        let t0 = now();
+        exact.fraction(requests[i], leaves_of(i), &mut scratch);
+        samples.push((loads[i].triangles as f64, 1e6 * (now() - t0)));
+        if now() - started > PROBE_EXACT_SECONDS {
+            break;
+        }
+    }
+    // Work spreads over every core: a view costs the machine its time over the threads.
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+    let line = fit_line(&samples);
+    Cost { per_view_us: line.per_view_us / threads, per_triangle_us: line.per_triangle_us / threads }
+}
+
+/// Times a light and a heavy batch of views on the GPU lanes and fits its cost line.
+async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad]) -> Result<Cost> {
+    let lanes: Vec<Lane<'_>> = lanes.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
+    let views = probe_views(loads, 6 * PROBE_GPU_VIEWS);
+    let third = views.len() / 3;
+    let batch = |part: &[usize]| -> (Vec<ViewRequest>, Vec<f32>, f64) {
+        let reqs: Vec<ViewRequest> = part.iter().map(|&i| requests[i]).collect();
+        let lv = if leaves.is_empty() { Vec::new() } else { part.iter().map(|&i| leaves[i]).collect() };
+        let mean = part.iter().map(|&i| loads[i].triangles as f64).sum::<f64>() / part.len().max(1) as f64;
+        (reqs, lv, mean)
+    };
+    let light = &views[..third.min(PROBE_GPU_VIEWS)];
+    let heavy = &views[views.len() - third.min(PROBE_GPU_VIEWS)..];
+    // Warm-up (pipelines, first submission), not timed.
+    let (warm, warm_leaves, _) = batch(&views[..views.len().min(4)]);
+    fractions_side_by_side(&lanes, &warm, &warm_leaves).await?;
+    let mut samples = Vec::new();
+    for part in [light, heavy] {
+        if part.is_empty() {
+            continue;
+        }
+        let (reqs, lv, mean) = batch(part);
+        let t0 = now();
+        fractions_side_by_side(&lanes, &reqs, &lv).await?;
+        samples.push((mean, 1e6 * (now() - t0) / part.len() as f64));
+    }
+    Ok(fit_line(&samples))
+}
+
+/// Least-squares line `per_view + per_triangle × x` through `(x, µs)` samples, both terms ≥ 0.
+fn fit_line(samples: &[(f64, f64)]) -> Cost {
+    let n = samples.len() as f64;
+    if samples.is_empty() {
+        return Cost { per_view_us: 0.0, per_triangle_us: 0.0 };
+    }
+    let (sx, sy) = samples.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let sxx: f64 = samples.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+    let sxy: f64 = samples.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    let slope = if sxx > 0.0 { (sxy / sxx).max(0.0) } else { 0.0 };
+    let intercept = (my - slope * mx).max(0.0);
+    // A negative intercept clamped to 0: refit the slope through the origin.
+    let slope = if intercept == 0.0 && sxx > 0.0 {
+        let s2: f64 = samples.iter().map(|(x, _)| x * x).sum();
+        if s2 > 0.0 { samples.iter().map(|(x, y)| x * y).sum::<f64>() / s2 } else { slope }
+    } else {
+        slope
+    };
+    Cost { per_view_us: intercept, per_triangle_us: slope.max(0.0) }
+}
+
+/// What identifies the device a profile belongs to: adapter, driver, CPU threads and tile side.
+pub async fn device_key(options: &CounterOptions) -> String {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let adapter = match platform::instance().request_adapter(&wgpu::RequestAdapterOptions::default()).await {
+        Ok(a) => {
+            let info = a.get_info();
+            format!("{} ({:?}, {} {})", info.name, info.backend, info.driver, info.driver_info)
+        }
+        Err(_) => "no GPU adapter".to_string(),
+    };
+    let accuracy = options.accuracy.map_or(String::new(), |a| format!(" ±{a}"));
+    format!("{adapter}; {threads} CPU threads; {}²{accuracy}", options.resolution)
+}
+
+/// Reads a profile file.
+pub fn read_profile(path: &Path) -> Result<Profile> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    serde_json::from_str(&text).map_err(|e| Error::argument("engine profile", format!("{}: {e}", path.display())))
+}
+
+/// Writes a profile file (atomically).
+pub fn write_profile(path: &Path, profile: &Profile) -> Result<()> {
+    let text = serde_json::to_string_pretty(profile).map_err(|e| Error::argument("engine profile", e.to_string()))?;
+    crate::export::write_atomic(path, text.as_bytes())
+}
+
+/// The per-device cache: `$XDG_CACHE_HOME/sunlit/engine-profiles.json` (else `~/.cache/…`).
+fn cache_file() -> Option<PathBuf> {
+    if cfg!(target_arch = "wasm32") {
+        return None;
+    }
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("sunlit").join("engine-profiles.json"))
+}
+
+fn cached(key: &str) -> Option<Profile> {
+    let text = std::fs::read_to_string(cache_file()?).ok()?;
+    let all: std::collections::BTreeMap<String, Profile> = serde_json::from_str(&text).ok()?;
+    all.get(key).cloned()
+}
+
+/// Adds a profile to the cache; a cache that cannot be written only costs a probe next time.
+fn store_cached(key: &str, profile: &Profile) {
+    let Some(path) = cache_file() else { return };
+    let mut all: std::collections::BTreeMap<String, Profile> =
+        std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str(&t).ok()).unwrap_or_default();
+    all.insert(key.to_string(), profile.clone());
+    let written = path.parent().map(std::fs::create_dir_all).transpose().ok().and_then(|_| serde_json::to_string_pretty(&all).ok());
+    if let Some(text) = written {
+        if let Err(e) = crate::export::write_atomic(&path, text.as_bytes()) {
+            log::warn!("could not cache the engine profile in {}: {e}", path.display());
+        }
+    }
+}
+
+/// Seconds since some fixed point (for timing engines; not on the web).
+fn now() -> f64 {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use std::sync::OnceLock;
+        static START: OnceLock<std::time::Instant> = OnceLock::new();
+        START.get_or_init(std::time::Instant::now).elapsed().as_secs_f64()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        js_sys::Date::now() / 1e3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(triangles: usize) -> ViewLoad {
+        ViewLoad { triangles, see_through: 0 }
+    }
+
+    #[test]
+    fn routing_follows_the_cheaper_modelled_cost() {
+        let profile = Profile {
+            device: "test".into(),
+            exact: Cost { per_view_us: 10.0, per_triangle_us: 1.0 },
+            gpu: Some(Cost { per_view_us: 500.0, per_triangle_us: 0.1 }),
+            gpu_startup_seconds: Some(0.0),
+        };
+        // Break-even at 10 + n = 500 + 0.1 n, n ≈ 544.
+        let loads = [load(0), load(100), load(544), load(545), load(5_000), ViewLoad { triangles: 3, see_through: 1 }];
+        let routes = profile.route(&loads);
+        assert_eq!(routes, vec![Route::Exact, Route::Exact, Route::Exact, Route::Gpu, Route::Gpu, Route::Gpu]);
+        // A GPU start-up the saving does not pay: all exact, but see-through views need the GPU.
+        let slow_start = Profile { gpu_startup_seconds: Some(10.0), ..profile.clone() };
+        assert_eq!(slow_start.route(&loads[..5]), vec![Route::Exact; 5]);
+        assert_eq!(slow_start.route(&loads)[5], Route::Gpu);
+        // No GPU measured: all exact.
+        let exact_only = Profile { gpu: None, ..profile };
+        assert!(exact_only.route(&loads[..5]).iter().all(|r| *r == Route::Exact));
+    }
+
+    #[test]
+    fn a_line_fits_its_samples() {
+        let c = fit_line(&[(0.0, 5.0), (10.0, 25.0), (20.0, 45.0)]);
+        assert!((c.per_view_us - 5.0).abs() < 1e-9 && (c.per_triangle_us - 2.0).abs() < 1e-9, "{c:?}");
+        let through_origin = fit_line(&[(10.0, 10.0), (20.0, 30.0)]);
+        assert_eq!(through_origin.per_view_us, 0.0);
+        assert!(through_origin.per_triangle_us > 0.0);
+    }
+
+    #[test]
+    fn engine_names_parse() {
+        for kind in [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact] {
+            assert_eq!(EngineKind::parse(kind.name()).unwrap(), kind);
+        }
+        assert!(EngineKind::parse("pixels").unwrap_err().to_string().contains("auto, gpu, exact"));
+    }
+}
