@@ -17,7 +17,7 @@
 //! use sunlit::{model, count::{gpu::Counter, ViewRequest}, sun::SunPosition};
 //! let scene = model::load(&["examples/office.glb".into()], &model::LoadOptions::default())?;
 //! let sun = SunPosition::new(180.0, 40.0)?.direction();
-//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
 //! let counter = pollster::block_on(Counter::new(Default::default()))?;
 //! let fractions = pollster::block_on(counter.fractions(&counter.upload(&scene)?, &requests))?;
 //! # Ok(()) }

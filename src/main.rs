@@ -8,9 +8,10 @@ use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
 use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::exact::Exact;
+use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
@@ -336,27 +337,24 @@ fn fraction(args: FractionArgs) -> Result<()> {
     let leaves = args.leaves as f32;
     let scene = args.model.load()?;
     let dir = sun.direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
-    let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
-            .into_iter()
-            .zip(&scene.receivers)
-            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
-            .collect()
+    let requests: Vec<ViewRequest> =
+        (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, dir).with_leaves(leaves)).collect();
+    let answers: Vec<ViewAnswer> = if args.exact {
+        pollster::block_on(Exact { scene: &scene }.answer(&requests))?
     } else {
         let counter = counter(&args.pixels)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
+        pollster::block_on(Lane { counter: &counter, gpu: &gpu }.answer(&requests))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
             .receivers
             .iter()
-            .zip(&counted)
+            .zip(&answers)
             .map(|(r, c)| {
                 json!({
                     "name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6),
-                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side,
+                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side.unwrap_or(0),
                 })
             })
             .collect();
@@ -379,7 +377,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
-    for (r, c) in scene.receivers.iter().zip(&counted) {
+    for (r, c) in scene.receivers.iter().zip(&answers) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
     }
     Ok(())

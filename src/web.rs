@@ -16,8 +16,9 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
 use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
-use crate::count::ViewRequest;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::count::lanes::Lane;
+use crate::count::{Engine as _, ViewRequest};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
@@ -129,9 +130,9 @@ impl Engine {
             }
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
-                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
-            let counted = counter.fractions(&model.gpu, &requests).await.map_err(js_error)?;
-            let fractions: Vec<f64> = counted.iter().map(|c| c.fraction).collect();
+                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
+            let answers = Lane { counter: &counter, gpu: &model.gpu }.answer(&requests).await.map_err(js_error)?;
+            let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
         })
     }

@@ -40,7 +40,7 @@ fn a_lost_device_is_reported_as_lost() {
     let counter = counter();
     let gpu = counter.upload(&scene).unwrap();
     let sun = SunPosition::new(180.0, 30.0).unwrap().direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
     assert!(pollster::block_on(counter.fractions(&gpu, &requests)).is_ok());
     counter.device_loss_trigger()();
     let err = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap_err();

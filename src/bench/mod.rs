@@ -134,7 +134,7 @@ pub struct Timing {
 pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DVec3], now: impl Fn() -> f64) -> Result<Timing> {
     let gpu: GpuScene = counter.upload(scene)?;
     let requests: Vec<ViewRequest> =
-        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest::new(receiver, sun))).collect();
     counter.fractions(&gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
     let start = now();
     let counted = counter.fractions(&gpu, &requests).await?;
@@ -199,11 +199,11 @@ pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRe
     let Some(&Lane { counter, gpu }) = lanes.first() else { return Err(crate::error::Error::argument("lanes", "none to count on")) };
     // Warm every lane (pipelines, first submission) outside the timing.
     let warm = requests.len().min(counter.tiles_per_batch() * lanes.len());
-    fractions_side_by_side(lanes, &requests[..warm], &[]).await?;
+    fractions_side_by_side(lanes, &requests[..warm]).await?;
     let start = now();
     let rendered_so_far = || lanes.iter().fold((0, 0), |(t, n), l| (t + l.counter.rendered().0, n + l.counter.rendered().1));
     let before = rendered_so_far();
-    let counted = fractions_side_by_side(lanes, requests, &[]).await?;
+    let counted = fractions_side_by_side(lanes, requests).await?;
     let seconds = now() - start;
     let after = rendered_so_far();
     let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);

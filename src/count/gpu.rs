@@ -35,7 +35,7 @@ use glam::{DMat4, DVec3};
 use super::cull::{CPU_LEAF_TRIANGLES, Culling, DrawList, LEAF_TRIANGLES, Target};
 use super::group::{MAX_MEMBERS, ViewGroups};
 use super::view::{self, SunView};
-use super::{ViewRequest, cos_incidence, is_dark};
+use super::{ViewAnswer, ViewRequest, check_receivers, cos_incidence, is_dark};
 use crate::error::{Error, Result};
 use crate::platform;
 use crate::scene::{Mesh, Scene};
@@ -116,6 +116,19 @@ impl Counted {
     /// [`error_estimate`] of this count (0 when not rendered: exact by construction).
     pub fn error_estimate(&self) -> f64 {
         if self.side == 0 { 0.0 } else { error_estimate(self.covered, self.edges) }
+    }
+
+    /// The common answer; `edges_counted`: whether the count pass counted shadow edges (only
+    /// with an accuracy target), without which a rendered view has no error estimate.
+    pub fn answer(&self, edges_counted: bool) -> ViewAnswer {
+        let rendered = self.side > 0;
+        ViewAnswer {
+            fraction: self.fraction,
+            cos_incidence: self.cos_incidence,
+            covered: rendered.then_some(self.covered),
+            side: rendered.then_some(self.side),
+            error_estimate: (!rendered || edges_counted).then(|| self.error_estimate()),
+        }
     }
 }
 
@@ -584,27 +597,18 @@ impl Counter {
         })
     }
 
-    /// Sunlit fractions for many (receiver, sun) pairs; dark views (sun down, facing away) cost
-    /// nothing, the others are rendered in batches of atlas tiles. Every leaf is on.
+    /// Sunlit fractions for many views, each at its own leaf fraction (the leaves whose rank is
+    /// below it cast shadows); dark views (sun down, facing away) cost nothing, the others are
+    /// rendered in batches of atlas tiles.
     pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
-        self.fractions_with_leaves(scene, requests, &[]).await
-    }
-
-    /// As [`Self::fractions`], with `leaves[i]` the leaf fraction (0..=1) for request `i`: the
-    /// leaves whose rank is below it cast shadows. An empty `leaves` means every leaf is on.
-    pub async fn fractions_with_leaves(&self, scene: &GpuScene, requests: &[ViewRequest], leaves: &[f32]) -> Result<Vec<Counted>> {
-        if !leaves.is_empty() && leaves.len() != requests.len() {
-            return Err(Error::argument("leaves", format!("{} leaf fractions for {} views", leaves.len(), requests.len())));
-        }
-        let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
         let mut out = vec![Counted::default(); requests.len()];
         let ladder = sides(&self.options);
         let first = ladder.first().copied().unwrap_or(self.options.resolution);
-        let tiles = self.plan_tiles(scene, requests, &leaves_of, first, &mut out)?;
+        let tiles = self.plan_tiles(scene, requests, first, &mut out)?;
         // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
         let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
         while let Some((side, tiles)) = waiting.pop_first() {
-            self.count_tiles(scene, requests, &leaves_of, &tiles, side, &mut out).await?;
+            self.count_tiles(scene, requests, &tiles, side, &mut out).await?;
             let Some(target) = self.options.accuracy else { continue };
             for tile in tiles {
                 let worst = tile.requests.iter().map(|&i| out[i].error_estimate()).fold(0.0, f64::max);
@@ -617,22 +621,21 @@ impl Counter {
         Ok(out)
     }
 
+    /// [`Self::fractions`] as the common answer ([`ViewAnswer`]).
+    pub async fn answer(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        let counted = self.fractions(scene, requests).await?;
+        let edges_counted = self.options.accuracy.is_some();
+        Ok(counted.iter().map(|c| c.answer(edges_counted)).collect())
+    }
+
     /// Renders and counts `tiles` at side `side` and writes their members' counts into `out`.
-    async fn count_tiles(
-        &self,
-        scene: &GpuScene,
-        requests: &[ViewRequest],
-        leaves_of: &dyn Fn(usize) -> f32,
-        tiles: &[Tile],
-        side: u32,
-        out: &mut [Counted],
-    ) -> Result<()> {
+    async fn count_tiles(&self, scene: &GpuScene, requests: &[ViewRequest], tiles: &[Tile], side: u32, out: &mut [Counted]) -> Result<()> {
         let per_batch = self.tiles_at(side);
         for chunk in tiles.chunks(per_batch * BATCHES_PER_READBACK) {
             // Each batch's counts land in the readback right after the previous batch's.
             let mut entries = 0;
             for batch in chunk.chunks(per_batch) {
-                entries += self.submit_batch(scene, requests, leaves_of, batch, side, entries)?;
+                entries += self.submit_batch(scene, requests, batch, side, entries)?;
             }
             let counts = platform::read_buffer(&self.device, &self.readback, entries as u64 * COUNTS_PER_MEMBER * 4).await;
             // A failed read on a lost device is the loss, not a read error.
@@ -667,26 +670,18 @@ impl Counter {
     /// of their view group, sun and leaf fraction (bitwise: the sampler asks for a wall and its
     /// windows at the very same sun vectors). Each tile's view is fitted to its requested
     /// members; a tile with nothing in front of any member gets fraction 1 without a render.
-    fn plan_tiles(
-        &self,
-        scene: &GpuScene,
-        requests: &[ViewRequest],
-        leaves_of: &dyn Fn(usize) -> f32,
-        side: u32,
-        out: &mut [Counted],
-    ) -> Result<Vec<Tile>> {
+    fn plan_tiles(&self, scene: &GpuScene, requests: &[ViewRequest], side: u32, out: &mut [Counted]) -> Result<Vec<Tile>> {
         let mut open: HashMap<(u32, [u64; 3], u32), usize> = HashMap::new();
         let mut pending: Vec<Vec<usize>> = Vec::new();
+        check_receivers(scene.receivers.len(), requests)?;
         for (i, req) in requests.iter().enumerate() {
-            let r = scene.receivers.get(req.receiver as usize).ok_or_else(|| {
-                Error::argument("receiver", format!("id {} out of range ({} receivers)", req.receiver, scene.receivers.len()))
-            })?;
+            let r = &scene.receivers[req.receiver as usize];
             out[i].cos_incidence = cos_incidence(r.normal, req.sun);
             if is_dark(r.normal, req.sun) {
                 continue;
             }
             let (group, _) = scene.groups.place(req.receiver);
-            let key = (group, req.sun.to_array().map(f64::to_bits), leaves_of(i).to_bits());
+            let key = (group, req.sun.to_array().map(f64::to_bits), req.leaves.to_bits());
             // A receiver asked for twice (or a full tile) opens another tile.
             let joins = |t: &Vec<usize>| t.len() < MAX_MEMBERS && t.iter().all(|&j| requests[j].receiver != req.receiver);
             match open.get(&key) {
@@ -753,15 +748,7 @@ impl Counter {
 
     /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
     /// `first_entry` on. Returns the number of member entries.
-    fn submit_batch(
-        &self,
-        scene: &GpuScene,
-        requests: &[ViewRequest],
-        leaves: &dyn Fn(usize) -> f32,
-        batch: &[Tile],
-        side: u32,
-        first_entry: usize,
-    ) -> Result<usize> {
+    fn submit_batch(&self, scene: &GpuScene, requests: &[ViewRequest], batch: &[Tile], side: u32, first_entry: usize) -> Result<usize> {
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());
@@ -773,8 +760,11 @@ impl Counter {
             members.extend(tile.requests.iter().map(|&i| scene.receivers[requests[i].receiver as usize].gpu_id));
             let tile_origin = self.tile_origin(slot, side);
             views.push(GpuView { tile: tile_origin, first_member, member_count: tile.requests.len() as u32, side, _pad: 0 });
-            let view =
-                GpuTileView { view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(), leaves: leaves(tile.requests[0]), _pad: [0; 3] };
+            let view = GpuTileView {
+                view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
+                leaves: requests[tile.requests[0]].leaves,
+                _pad: [0; 3],
+            };
             at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&view));
         }
         self.queue.write_buffer(&self.views, 0, bytemuck::cast_slice(&views));
