@@ -262,10 +262,36 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", e.render(&flag));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The library's parameter names and the flags that set them: errors name the flag.
+const FLAGS: &[(&str, &str)] = &[
+    ("receivers", "--receivers"),
+    ("north", "--north"),
+    ("foliage", "--foliage"),
+    ("transmittance", "--transmittance"),
+    ("location", "--location"),
+    ("sun", "--sun"),
+    ("leaves", "--leaves"),
+    ("timesteps_per_hour", "--timesteps-per-hour"),
+    ("days_per_year", "--days-per-year"),
+    ("samples_per_day", "--samples-per-day"),
+    ("refine", "--refine"),
+    ("resolution", "--resolution"),
+    ("accuracy", "--accuracy"),
+    ("hook", "--hook"),
+    ("leaf_out", "--leaf-out"),
+    ("leaf_fall", "--leaf-fall"),
+    ("lanes", "--lanes"),
+];
+
+/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
+fn flag(param: &str) -> String {
+    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
@@ -574,7 +600,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
-        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
 }

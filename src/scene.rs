@@ -22,7 +22,7 @@ use std::ops::Range;
 
 use glam::{DMat4, DVec3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, NoReceivers, Result};
 
 /// Surface id of geometry that only casts shadows.
 pub const NO_RECEIVER: u32 = u32::MAX;
@@ -349,7 +349,7 @@ impl SceneBuilder {
         }
         for (of, name) in &self.mirrors {
             let Some(original) = scene.receivers.iter().find(|r| r.name == *of).cloned() else {
-                return Err(Error::NoReceivers(format!("'{name}' mirrors '{of}', which is not a receiver")));
+                return Err(Error::NoReceivers(NoReceivers::Other(format!("'{name}' mirrors '{of}', which is not a receiver"))));
             };
             scene.receivers.push(Receiver {
                 name: name.clone(),

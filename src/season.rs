@@ -64,7 +64,7 @@ impl LeafCalendar {
         let ordered = out > 0.0 && full >= out && fall > full && fall < YEAR;
         if !leaf_out.0.is_finite() || !leaf_out.1.is_finite() || !leaf_fall.0.is_finite() || !leaf_fall.1.is_finite() || !ordered {
             return Err(Error::argument(
-                "--leaf-out/--leaf-fall",
+                "leaf_out/leaf_fall",
                 "leaf-out and leaf fall must each last at least a day, in the order leaf-out, summer, leaf fall, winter".to_string(),
             ));
         }

@@ -30,9 +30,48 @@ use crate::season::{LeafCalendar, parse_period};
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 
-/// A library error as a JS `Error` whose message names the file, object and reason.
+/// A library error as a JS `Error` whose message names the file, object or option (as the JS API
+/// spells it: `timestepsPerHour`) and the reason. Its properties: `code` ([`Error::code`], what
+/// programs switch on, never the message), and where known `file`, `object`, `option` and, for
+/// `code: 'gpu'`, `gpu` ([`crate::error::GpuError::code`], e.g. `out-of-memory`).
 fn js_error(error: Error) -> JsValue {
-    JsError::new(&error.to_string()).into()
+    let js = js_sys::Error::new(&error.render(&js_option));
+    let set = |key: &str, value: &str| {
+        // Setting a property of a fresh Error cannot fail; were it to, the message still tells.
+        let _ = js_sys::Reflect::set(&js, &key.into(), &value.into());
+    };
+    set("code", error.code());
+    if let Some(file) = error.file() {
+        set("file", &file);
+    }
+    if let Some(object) = error.object_name() {
+        set("object", object);
+    }
+    if let Some(option) = error.parameter() {
+        set("option", &js_option(option));
+    }
+    if let Error::Gpu(gpu) = &error {
+        set("gpu", gpu.code());
+    }
+    js.into()
+}
+
+/// The JS API's name for a library parameter: camelCase (`timesteps_per_hour` →
+/// `timestepsPerHour`), as the settings object and `loadFiles`' options spell them.
+pub fn js_option(param: &str) -> String {
+    let mut out = String::with_capacity(param.len());
+    let mut upper = false;
+    for c in param.chars() {
+        match c {
+            '_' => upper = true,
+            c if upper => {
+                out.extend(c.to_uppercase());
+                upper = false;
+            }
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// The GPU counter on this page's WebGPU device.

@@ -256,7 +256,7 @@ fn gltf_marks_and_options_choose_foliage_and_screens() {
     let e = load(tree_glb(json!({"sunlit": {"foliage": "yes"}})), LoadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("Oak crown") && e.contains("sunlit.foliage"), "{e}");
     let e = load(tree_glb(json!({})), LoadOptions { foliage: vec!["pine*".into()], ..Default::default() }).unwrap_err().to_string();
-    assert!(e.contains("--foliage pine*") && e.contains("no glTF node"), "{e}");
+    assert!(e.contains("foliage pine*") && e.contains("no glTF node"), "{e}");
     let options = LoadOptions { receivers: vec!["*".into()], foliage: vec!["oak*".into()], ..Default::default() };
     let e = load(tree_glb(json!({})), options).unwrap_err().to_string();
     assert!(e.contains("Oak crown") && e.contains("receiver") && e.contains("opaque"), "{e}");

@@ -36,7 +36,7 @@ use super::cull::{CPU_LEAF_TRIANGLES, Culling, DrawList, LEAF_TRIANGLES, Target}
 use super::group::{MAX_MEMBERS, ViewGroups};
 use super::view::{self, SunView};
 use super::{ViewAnswer, ViewRequest, check_receivers, cos_incidence, is_dark};
-use crate::error::{Error, Result};
+use crate::error::{Error, GpuError, Result};
 use crate::platform;
 use crate::scene::{Mesh, Scene};
 
@@ -49,8 +49,12 @@ const ROWS_PER_GROUP: u32 = 64;
 /// count reads one texel per pixel.
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// How the uncaptured-error sink records an out-of-memory error, for the hint in its message.
-const OUT_OF_MEMORY: &str = "out of GPU memory";
+/// What the uncaptured-error sink records: out-of-memory apart, so it gets its own error.
+#[derive(Debug, PartialEq)]
+enum Uncaptured {
+    OutOfMemory,
+    Other(String),
+}
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 const BATCHES_PER_READBACK: usize = 32;
 
@@ -158,7 +162,7 @@ pub struct Counter {
     /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
     tiles_rendered: AtomicU64,
     triangles_drawn: AtomicU64,
-    errors: Arc<Mutex<Vec<String>>>,
+    errors: Arc<Mutex<Vec<Uncaptured>>>,
     /// Why the device was lost, once it is (set by wgpu's device-lost callback).
     lost: Arc<Mutex<Option<String>>>,
 }
@@ -283,30 +287,34 @@ impl Counter {
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions::default())
             .await
-            .map_err(|e| Error::Gpu(format!("{} ({e})", platform::no_adapter_hint())))?;
+            .map_err(|e| GpuError::NoAdapter { hint: platform::no_adapter_hint().into(), reason: e.to_string() })?;
         let limits = adapter.limits();
         let resolution = options.resolution;
         if !(16..=limits.max_texture_dimension_2d).contains(&resolution) {
             return Err(Error::argument(
-                "--resolution",
+                "resolution",
                 format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
             ));
         }
         if let Some(a) = options.accuracy {
             if !(a > 0.0 && a < 1.0) {
-                return Err(Error::argument("--accuracy", format!("{a} is not a fraction error in (0, 1)")));
+                return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
             }
         }
         let tiles_per_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d) / resolution;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: limits, ..Default::default() })
             .await
-            .map_err(|e| Error::Gpu(format!("could not open the GPU device: {e}")))?;
+            .map_err(|e| GpuError::Device(e.to_string()))?;
         let errors = Arc::new(Mutex::new(Vec::new()));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             if let Ok(mut list) = sink.lock() {
-                list.push(if matches!(e, wgpu::Error::OutOfMemory { .. }) { OUT_OF_MEMORY.to_string() } else { e.to_string() });
+                list.push(if matches!(e, wgpu::Error::OutOfMemory { .. }) {
+                    Uncaptured::OutOfMemory
+                } else {
+                    Uncaptured::Other(e.to_string())
+                });
             }
         }));
         let lost = Arc::new(Mutex::new(None));
@@ -420,18 +428,22 @@ impl Counter {
 
     fn check_errors(&self, doing: &str) -> Result<()> {
         self.check_lost()?;
-        let mut list = self.errors.lock().map_err(|_| Error::Gpu("error log poisoned".into()))?;
+        let mut list = self
+            .errors
+            .lock()
+            .map_err(|_| GpuError::Validation { doing: doing.into(), message: "the error log was poisoned by a panic".into() })?;
         if list.is_empty() {
             return Ok(());
         }
-        let out_of_memory = list.iter().any(|e| e == OUT_OF_MEMORY);
-        let all = list.join("; ");
+        let out_of_memory = list.contains(&Uncaptured::OutOfMemory);
+        let all: Vec<&str> = list.iter().filter_map(|e| if let Uncaptured::Other(m) = e { Some(m.as_str()) } else { None }).collect();
+        let error = if out_of_memory {
+            GpuError::OutOfMemory { doing: doing.into(), resolution: self.options.resolution }
+        } else {
+            GpuError::Validation { doing: doing.into(), message: all.join("; ") }
+        };
         list.clear();
-        if out_of_memory {
-            let hint = format!("lower --resolution (now {}) or count fewer triangles (split the model)", self.options.resolution);
-            return Err(Error::Gpu(format!("{doing}: out of GPU memory; {hint}")));
-        }
-        Err(Error::Gpu(format!("{doing}: {all}")))
+        Err(error.into())
     }
 
     /// Refuses, before allocating, a scene whose buffers exceed this device's limits: wgpu would
@@ -442,19 +454,14 @@ impl Counter {
         let mesh_bytes = |m: &crate::scene::Mesh| (m.positions.len() * size_of::<GpuVertex>()).max(m.indices.len() * 4);
         let vertices = scene.meshes.iter().skip(1).map(mesh_bytes).max().unwrap_or(0) as u64;
         let instances = (scene.instances.len() * size_of::<GpuInstance>()) as u64;
-        let (need, limit) = if vertices > limits.max_buffer_size {
-            (vertices, limits.max_buffer_size)
+        let (limit_name, need, limit) = if vertices > limits.max_buffer_size {
+            ("max_buffer_size", vertices, limits.max_buffer_size)
         } else if instances > limits.max_storage_buffer_binding_size {
-            (instances, limits.max_storage_buffer_binding_size)
+            ("max_storage_buffer_binding_size", instances, limits.max_storage_buffer_binding_size)
         } else {
             return Ok(());
         };
-        let mib = |b: u64| b as f64 / (1 << 20) as f64;
-        Err(Error::Gpu(format!(
-            "the scene needs a {:.0} MiB buffer, more than this GPU's {:.0} MiB limit: count fewer triangles or placements (split the model, or leave out far context)",
-            mib(need),
-            mib(limit)
-        )))
+        Err(GpuError::OverLimit { limit_name, need, limit }.into())
     }
 
     /// [`Error::DeviceLost`] once the device is gone: every later error is a consequence of it.
@@ -641,7 +648,7 @@ impl Counter {
             // A failed read on a lost device is the loss, not a read error.
             self.check_errors("counting pixels")?;
             let counts = counts?;
-            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
+            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
             let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
             for ((i, pixel_area), c) in members.zip(counts.chunks_exact(COUNTS_PER_MEMBER as usize)) {
                 let (visible, covered, edges) = (c[0], c[1], c[2]);
@@ -869,7 +876,7 @@ impl Counter {
         self.queue.submit([encoder.finish()]);
         let bytes = platform::read_buffer(&self.device, &target, size).await?;
         self.check_errors("reading the id atlas")?;
-        let texels: &[[u32; 2]] = bytemuck::try_cast_slice(&bytes).map_err(|e| Error::Gpu(format!("bad readback: {e}")))?;
+        let texels: &[[u32; 2]] = bytemuck::try_cast_slice(&bytes).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
         Ok((side, texels.to_vec()))
     }
 

@@ -37,7 +37,7 @@ impl Hook {
         match text.to_ascii_lowercase().as_str() {
             "scheduled" => Ok(Hook::Scheduled),
             "imported" => Ok(Hook::Imported),
-            _ => Err(Error::argument("--hook", format!("'{text}': expected scheduled or imported"))),
+            _ => Err(Error::argument("hook", format!("'{text}': expected scheduled or imported"))),
         }
     }
 
@@ -203,14 +203,7 @@ pub fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result
     if let Some(ts) = objects.iter().find(|o| o.is("Timestep")) {
         let n: u32 = ts.field(0).trim().parse().unwrap_or(1);
         if n != plan.timesteps.per_hour() {
-            return Err(Error::object(
-                file,
-                ts.label(),
-                format!(
-                    "the model runs {n} timesteps per hour but the CSV has {}: use --timesteps-per-hour {n}",
-                    plan.timesteps.per_hour()
-                ),
-            ));
+            return Err(Error::TimestepMismatch { file: file.into(), object: ts.label(), model: n, schedule: plan.timesteps.per_hour() });
         }
     }
     if plan.hook == Hook::Scheduled {
@@ -380,7 +373,7 @@ mod tests {
         let columns = vec!["WIN_S".to_string()];
         let objects = parse_idf("m.idf", "Version, 25.2;\nTimestep, 6;\n").unwrap();
         let e = patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string();
-        assert!(e.contains("Timestep") && e.contains("--timesteps-per-hour 6"), "{e}");
+        assert!(e.contains("Timestep") && e.contains("timesteps_per_hour 6"), "{e}");
         let objects = parse_idf("m.idf", "Version, 8.9;\n").unwrap();
         assert!(patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string().contains("9.0"));
         let objects = parse_idf("m.idf", "Version, 25.2;\nSurfaceProperty:LocalEnvironment, E, win_s, S;\n").unwrap();
