@@ -645,7 +645,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
