@@ -76,7 +76,7 @@ pub enum Error {
     /// The GPU could not be set up or failed during a pass.
     Gpu(GpuError),
     /// The GPU device was lost (driver reset, GPU hung or removed, or destroyed): its results are
-    /// gone, but a new device may work ([`crate::annual::annual_recovering`] makes one).
+    /// gone, but a new device may work ([`crate::year::annual::annual_recovering`] makes one).
     DeviceLost(String),
     /// The caller asked the run to stop (a progress callback said so, or an `AbortSignal` fired).
     Cancelled,

@@ -23,19 +23,16 @@
 //! # Ok(()) }
 //! ```
 
-pub mod annual;
 pub mod bench;
 pub mod count;
 pub mod error;
 pub mod export;
 pub mod model;
 mod platform;
-pub mod samples;
 pub mod scene;
-pub mod season;
-pub mod spline;
 pub mod sun;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
+pub mod year;
 
 pub use error::{Error, Result};

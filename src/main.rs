@@ -7,18 +7,18 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
-use sunlit::annual::{AnnualOptions, Method, Progress};
 use sunlit::count::exact::Exact;
 use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, Method, Progress};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::{self, LeafCalendar};
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -72,7 +72,7 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
@@ -449,7 +449,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule =
+        pollster::block_on(sunlit::year::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -636,7 +637,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
-        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {

@@ -15,7 +15,6 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
-use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
 use crate::count::lanes::Lane;
 use crate::count::{Engine as _, ViewRequest};
@@ -24,11 +23,12 @@ use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
-use crate::samples::{SamplingPlan, Timesteps};
 use crate::scene::Scene;
-use crate::season::{LeafCalendar, parse_period};
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
+use crate::year::samples::{SamplingPlan, Timesteps};
+use crate::year::season::{LeafCalendar, parse_period};
 
 /// A library error as a JS `Error` whose message names the file, object or option (as the JS API
 /// spells it: `timestepsPerHour`) and the reason. Its properties: `code` ([`Error::code`], what

@@ -12,15 +12,15 @@ use glam::DVec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use serde_json::json;
-use sunlit::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual_with_leaves, compare};
 use sunlit::count::{ViewRequest, exact};
 use sunlit::export::Schedule;
 use sunlit::model::glb_write::GlbWriter;
 use sunlit::model::{LoadOptions, load_bytes};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::{NodeVeil, Scene, SceneBuilder, SourceMesh};
-use sunlit::season::NORTHERN;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual_with_leaves, compare};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::NORTHERN;
 
 const LEAVES: usize = 600;
 

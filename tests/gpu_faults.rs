@@ -6,15 +6,15 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 use sunlit::Error;
-use sunlit::annual::{AnnualOptions, Method, Progress, annual, annual_recovering};
 use sunlit::count::ViewRequest;
 use sunlit::count::gpu::{Counter, CounterOptions};
 use sunlit::model::{LoadOptions, load_bytes, office::office};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::LeafCalendar;
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, Method, Progress, annual, annual_recovering};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::LeafCalendar;
 
 fn office_scene() -> Scene {
     load_bytes(&[("office.glb".into(), office(2).to_glb())], &LoadOptions::default()).unwrap()

@@ -19,8 +19,8 @@ use std::fmt::Write as _;
 use crate::error::{Error, Result};
 use crate::model::EnergyPlusInput;
 use crate::model::idf::IdfObject;
-use crate::samples::Timesteps;
 use crate::scene::Scene;
+use crate::year::samples::Timesteps;
 
 /// How EnergyPlus is told to use the CSV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

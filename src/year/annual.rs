@@ -12,7 +12,7 @@
 //! the samples of the nearest day that has it, so the periodic fit stays defined. At evaluation
 //! the sun-up and facing tests are applied exactly per timestep; values are clamped to [0, 1].
 //!
-//! Foliage (a scene with leaves, [`crate::season`]): the fraction then changes with the leaf
+//! Foliage (a scene with leaves, [`crate::year::season`]): the fraction then changes with the leaf
 //! cover as well as with the sun, and the leaf fraction has corners where leaf-out and leaf fall
 //! begin and end, which a spline across them would round off. So the year is split into regimes
 //! with a fit each: bare (no leaves) and full leaf, each fitted periodically over the whole year
@@ -28,12 +28,12 @@ use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::scene::Scene;
-use crate::season::{LeafCalendar, Phase};
-use crate::spline::{AnnualGrid, AnnualSpline};
 use crate::sun::location::Location;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
+use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
+use crate::year::season::{LeafCalendar, Phase};
+use crate::year::spline::{AnnualGrid, AnnualSpline};
 
 /// How the year is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
