@@ -27,6 +27,7 @@ pub mod bench;
 pub mod count;
 pub mod error;
 pub mod export;
+pub mod geometry;
 pub mod model;
 mod platform;
 pub mod scene;
