@@ -23,6 +23,7 @@
 //! # Ok(()) }
 //! ```
 
+#[cfg(feature = "fixtures")]
 pub mod bench;
 pub mod count;
 pub mod error;

@@ -10,10 +10,13 @@
 pub mod arrays;
 pub mod building;
 pub mod epjson;
+#[cfg(feature = "fixtures")]
 pub mod glb_write;
 pub mod gltf_read;
 pub mod idf;
+#[cfg(feature = "fixtures")]
 pub mod office;
+#[cfg(feature = "fixtures")]
 pub mod office_idf;
 
 use std::path::PathBuf;
