@@ -29,6 +29,8 @@ pub mod count;
 pub mod error;
 pub mod export;
 pub mod geometry;
+#[cfg(test)]
+mod js_api;
 pub mod model;
 mod platform;
 pub mod scene;
