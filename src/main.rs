@@ -1,4 +1,8 @@
 //! `sunlit`, the command line: a thin edge over the library.
+//!
+//! Owns the flags: clap parses them, they become the library's settings
+//! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
+//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -2,7 +2,9 @@
 //! JavaScript on the browser's WebGPU.
 //!
 //! Owns the translation between JS values and the library: model files or typed arrays in,
-//! fractions and annual schedules out, progress as a JS callback and cancellation by an
+//! fractions and annual schedules out, the settings object into the library's resolver
+//! ([`crate::year::settings`]), library errors into JS `Error`s with a stable `code` and the
+//! option named as the JS API spells it, progress as a JS callback and cancellation by an
 //! `AbortSignal`. Nothing here blocks: every GPU read is awaited (see `platform`), so the page
 //! (or the worker running this) stays live and an abort is seen at the next progress report.
 //! The hand-written ES module `www/sunlit.js` wraps these bindings for users; its types are in
