@@ -1,4 +1,8 @@
 //! `sunlit`, the command line: a thin edge over the library.
+//!
+//! Owns the flags: clap parses them, they become the library's settings
+//! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
+//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,17 +11,19 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
-use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::exact::Exact;
+use sunlit::count::gpu::{Counter, CounterOptions};
+use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::Progress;
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::settings::AnnualSettings;
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -66,12 +72,14 @@ struct AnnualArgs {
     /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
     #[arg(long, value_name = "N")]
     lanes: Option<usize>,
+    #[command(flatten)]
+    engine: EngineArgs,
     /// Count every sun-up timestep directly instead of interpolating (the reference; slow).
     #[arg(long)]
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
@@ -97,14 +105,24 @@ struct AnnualArgs {
 }
 
 impl AnnualArgs {
-    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
-        if self.evergreen {
-            return Ok(LeafCalendar::evergreen());
-        }
-        match (&self.leaf_out, &self.leaf_fall) {
-            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
-            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
-        }
+    /// The flags as the library's settings (resolved there, as the web's are).
+    fn settings(&self) -> Result<AnnualSettings> {
+        let coordinates = self.location.as_deref().map(Location::parse).transpose()?;
+        Ok(AnnualSettings {
+            latitude: coordinates.as_ref().map(|l| l.latitude),
+            longitude: coordinates.as_ref().map(|l| l.longitude),
+            time_zone: coordinates.as_ref().map(|l| l.time_zone),
+            epw_file: self.epw.clone(),
+            timesteps_per_hour: self.timesteps_per_hour,
+            days_per_year: Some(self.days_per_year),
+            samples_per_day: Some(self.samples_per_day),
+            refine: Some(self.refine),
+            dense: Some(self.dense),
+            evergreen: Some(self.evergreen),
+            leaf_out: self.leaf_out.clone(),
+            leaf_fall: self.leaf_fall.clone(),
+            ..Default::default()
+        })
     }
 }
 
@@ -173,6 +191,30 @@ impl PixelArgs {
     }
 }
 
+/// Which engine answers views (fraction, annual, bench).
+#[derive(Args)]
+struct EngineArgs {
+    /// auto: each view on the cheaper of exact clipping and GPU pixels, by a cost model measured
+    /// once on this device (see README, "Hybrid engine"); gpu: pixels only; exact: clipping only
+    /// (see-through nodes count as opaque there).
+    #[arg(long, value_name = "auto|gpu|exact", default_value = "auto")]
+    engine: String,
+    /// The cost model `auto` routes by: read from FILE when it exists, else measured and written
+    /// there (pins the routing); default: a per-device cache.
+    #[arg(long, value_name = "FILE")]
+    engine_profile: Option<PathBuf>,
+}
+
+impl EngineArgs {
+    fn kind(&self) -> Result<EngineKind> {
+        EngineKind::parse(&self.engine).map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))
+    }
+
+    fn source(&self) -> ProfileSource {
+        self.engine_profile.clone().map_or(ProfileSource::Cache, ProfileSource::File)
+    }
+}
+
 #[derive(Args)]
 struct FractionArgs {
     #[command(flatten)]
@@ -186,6 +228,8 @@ struct FractionArgs {
     /// as opaque there).
     #[arg(long)]
     exact: bool,
+    #[command(flatten)]
+    engine: EngineArgs,
     /// Leaf fraction of foliage, 0 (bare) to 1 (full leaf).
     #[arg(long, default_value_t = 1.0)]
     leaves: f64,
@@ -243,6 +287,8 @@ struct BenchArgs {
     /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
     #[arg(long, value_name = "N")]
     lanes: Option<usize>,
+    #[command(flatten)]
+    engine: EngineArgs,
     /// Generated model names (see --list) or glTF/IDF model files.
     models: Vec<String>,
 }
@@ -261,10 +307,36 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", e.render(&flag));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The library's parameter names and the flags that set them: errors name the flag.
+const FLAGS: &[(&str, &str)] = &[
+    ("receivers", "--receivers"),
+    ("north", "--north"),
+    ("foliage", "--foliage"),
+    ("transmittance", "--transmittance"),
+    ("location", "--location"),
+    ("sun", "--sun"),
+    ("leaves", "--leaves"),
+    ("timesteps_per_hour", "--timesteps-per-hour"),
+    ("days_per_year", "--days-per-year"),
+    ("samples_per_day", "--samples-per-day"),
+    ("refine", "--refine"),
+    ("resolution", "--resolution"),
+    ("accuracy", "--accuracy"),
+    ("hook", "--hook"),
+    ("leaf_out", "--leaf-out"),
+    ("leaf_fall", "--leaf-fall"),
+    ("lanes", "--lanes"),
+];
+
+/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
+fn flag(param: &str) -> String {
+    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
@@ -303,60 +375,30 @@ fn quiet_mesa_runtime_dir() {
     }
 }
 
-fn counter(pixels: &PixelArgs) -> Result<Counter> {
-    pollster::block_on(Counter::new(pixels.options()))
-}
-
-/// `first` and as many more counters with its options as `lanes` asks (default: see
-/// [`default_lanes`]), each with `scene` uploaded.
-fn lanes(first: Counter, lanes: Option<usize>, scene: &Scene) -> Result<Vec<(Counter, GpuScene)>> {
-    let n = lanes.unwrap_or_else(|| default_lanes(first.adapter_info()));
-    if n == 0 {
-        return Err(Error::argument("--lanes", "must be at least 1"));
-    }
-    let options = first.options();
-    let mut counters = vec![first];
-    for _ in 1..n {
-        counters.push(pollster::block_on(Counter::new(options))?);
-    }
-    counters
-        .into_iter()
-        .map(|counter| {
-            let gpu = counter.upload(scene)?;
-            Ok((counter, gpu))
-        })
-        .collect()
-}
-
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
-    if !(0.0..=1.0).contains(&args.leaves) {
-        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
-    }
-    let leaves = args.leaves as f32;
+    let leaves = leaf_fraction(args.leaves)?;
     let scene = args.model.load()?;
     let dir = sun.direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
-    let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
-            .into_iter()
-            .zip(&scene.receivers)
-            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
-            .collect()
+    let requests: Vec<ViewRequest> =
+        (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, dir).with_leaves(leaves)).collect();
+    let kind = if args.exact { EngineKind::Exact } else { args.engine.kind()? };
+    let answers: Vec<ViewAnswer> = if args.exact {
+        pollster::block_on(Exact { scene: &scene }.answer(&requests))?
     } else {
-        let counter = counter(&args.pixels)?;
-        let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
+        let engine = HybridEngine::new(&scene, kind, args.pixels.options(), None, args.engine.source())?;
+        pollster::block_on(engine.answer(&requests))?
     };
+    let method_name = kind.name();
     if args.json {
         let surfaces: Vec<_> = scene
             .receivers
             .iter()
-            .zip(&counted)
+            .zip(&answers)
             .map(|(r, c)| {
                 json!({
                     "name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6),
-                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side,
+                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side.unwrap_or(0),
                 })
             })
             .collect();
@@ -364,22 +406,23 @@ fn fraction(args: FractionArgs) -> Result<()> {
             "sun": {"azimuth": sun.azimuth, "altitude": sun.altitude},
             "resolution": args.pixels.resolution,
             "accuracy": args.pixels.accuracy,
-            "method": if args.exact { "exact" } else { "gpu" },
+            "method": method_name,
             "leaves": args.leaves,
             "surfaces": surfaces,
         });
         println!("{out:#}");
         return Ok(());
     }
-    let method = match (args.exact, args.pixels.accuracy) {
-        (true, _) => "exact polygon clipping".to_string(),
-        (false, None) => format!("GPU pixel counting, {0}×{0}", args.pixels.resolution),
-        (false, Some(a)) => format!("GPU pixel counting, up to {0}×{0} for ±{a}", args.pixels.resolution),
+    let method = match (kind, args.pixels.accuracy) {
+        (EngineKind::Exact, _) => "exact polygon clipping".to_string(),
+        (EngineKind::Auto, _) => format!("auto: exact clipping or GPU pixels at {0}×{0}, per view", args.pixels.resolution),
+        (EngineKind::Gpu, None) => format!("GPU pixel counting, {0}×{0}", args.pixels.resolution),
+        (EngineKind::Gpu, Some(a)) => format!("GPU pixel counting, up to {0}×{0} for ±{a}", args.pixels.resolution),
     };
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
-    for (r, c) in scene.receivers.iter().zip(&counted) {
+    for (r, c) in scene.receivers.iter().zip(&answers) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
     }
     Ok(())
@@ -387,17 +430,8 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
-    if !(0.0..=1.0).contains(&args.refine) {
-        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
-    }
-    let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
+    let settings = args.settings()?.resolve()?;
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
-    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -405,13 +439,14 @@ fn annual(args: AnnualArgs) -> Result<()> {
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
-    let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
+    let timesteps = options.timesteps;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let mut lanes = lanes(counter(&args.pixels)?, args.lanes, &scene)?;
+    let mut engine = HybridEngine::new(&scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -423,9 +458,18 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
-    let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let mut year = |engine: &HybridEngine<'_>| {
+        pollster::block_on(sunlit::year::annual::annual_with(engine, &scene, &settings.location, &options, &settings.calendar, &mut report))
+    };
+    let schedule = match year(&engine) {
+        Err(Error::DeviceLost(why)) => {
+            log::warn!("GPU device lost ({why}); making a new one and counting again");
+            engine.forget_gpu();
+            year(&engine)?
+        }
+        other => other?,
+    };
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -555,6 +599,10 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
+    if !args.models.is_empty() && args.engine.kind()? != EngineKind::Gpu {
+        let start = Instant::now();
+        return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
+    }
     let counter = pollster::block_on(Counter::new(CounterOptions { max_atlas: args.atlas, ..args.pixels.options() }))?;
     let info = counter.adapter_info();
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
@@ -576,7 +624,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
-        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
 }
@@ -612,7 +660,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
-        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {
@@ -621,7 +669,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
@@ -655,6 +703,88 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             if counter.options().accuracy.is_some() {
                 line["views_above_their_error_estimate"] = json!(check.above_estimate);
             }
+        }
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// The sampling plan `--samples` names.
+fn bench_plan(samples: &str) -> Result<(usize, usize, SamplingPlan)> {
+    let (days, per_day) = samples
+        .split_once(['x', 'X'])
+        .and_then(|(d, s)| Some((d.trim().parse().ok()?, s.trim().parse().ok()?)))
+        .ok_or_else(|| Error::argument("--samples", format!("'{samples}' is not DAYSxPER_DAY (e.g. 27x19)")))?;
+    Ok((days, per_day, SamplingPlan::new(days, per_day)?))
+}
+
+/// [`bench_models`] with `--engine auto` or `exact`: times the hybrid engine over each model's
+/// views (calibration and GPU start-up included, and reported apart); `--check` compares the
+/// GPU-routed views, and as many exactly-clipped ones, with the exact reference.
+fn bench_hybrid(args: &BenchArgs, now: impl Fn() -> f64 + Copy) -> Result<()> {
+    let (days, per_day, plan) = bench_plan(&args.samples)?;
+    let kind = args.engine.kind()?;
+    let options = CounterOptions { max_atlas: args.atlas, ..args.pixels.options() };
+    for name in &args.models {
+        let t0 = now();
+        let generated = bench::models::CATALOGUE.iter().any(|(n, _)| n == name) || !std::path::Path::new(name).exists();
+        let (scene, location, shading) = if generated {
+            let m = bench::models::generate(name)?;
+            let scene = model::load_bytes(&[(format!("{name}.glb"), m.glb.to_glb())], &LoadOptions::default())?;
+            (scene, m.location, Some(m.shading_polygons))
+        } else {
+            (model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(&args.location)?, None)
+        };
+        let engine = HybridEngine::new(&scene, kind, options, args.lanes, args.engine.source())?;
+        let load_seconds = now() - t0;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
+        let requests = match args.views {
+            Some(n) => bench::spread(&all, n),
+            None => all.clone(),
+        };
+        let t1 = now();
+        let answers = pollster::block_on(engine.answer(&requests))?;
+        let seconds = now() - t1;
+        let stats = engine.stats();
+        let estimated = seconds * all.len() as f64 / requests.len().max(1) as f64;
+        let rendered = answers.iter().filter(|a| a.side.is_some()).count();
+        let mut sides: std::collections::BTreeMap<u32, usize> = Default::default();
+        answers.iter().filter_map(|a| a.side).for_each(|s| *sides.entry(s).or_default() += 1);
+        let mut line = json!({
+            "model": name,
+            "engine": kind.name(),
+            "receivers": scene.receivers.len(),
+            "shading_polygons": shading,
+            "triangles": scene.triangle_count(),
+            "samples": format!("{days}x{per_day}"),
+            "resolution": options.resolution,
+            "accuracy": options.accuracy,
+            "sides": sides,
+            "lanes": engine.lanes().map_or(0, |l| l.len()),
+            "views": all.len(),
+            "views_timed": requests.len(),
+            "views_rendered": rendered,
+            "seconds": seconds,
+            "estimated_seconds_all_views": estimated,
+            "views_per_second": requests.len() as f64 / seconds.max(1e-9),
+            "exact_views": stats.exact_views,
+            "gpu_views": stats.gpu_views,
+            "exact_seconds": stats.exact_seconds,
+            "gpu_seconds": stats.gpu_seconds,
+            "calibration_seconds": stats.calibration_seconds,
+            "gpu_startup_seconds": stats.gpu_startup_seconds,
+            "convex_objects": engine.exact().map(|e| e.convex_objects()),
+            "calibration": engine.profile().map(|(p, from)| json!({"from": from, "profile": p})),
+            "load_seconds": load_seconds,
+            "peak_memory_mib": peak_memory_mib(),
+        });
+        if args.check > 0 {
+            let (gpu_check, exact_check) = bench::check_answers(&scene, &requests, &answers, args.check);
+            line["exact_views_checked"] = json!(gpu_check.views);
+            line["mean_abs_error"] = json!(gpu_check.mean);
+            line["max_abs_error"] = json!(gpu_check.max);
+            line["exact_engine_views_checked"] = json!(exact_check.views);
+            line["exact_engine_max_abs_difference"] = json!(exact_check.max);
         }
         println!("{line}");
     }

@@ -25,10 +25,10 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::exact::engine::{ExactEngine, ViewLoad};
-use super::gpu::{Counted, Counter, CounterOptions, GpuScene};
-use super::lanes::{Lane, default_lanes, fractions_side_by_side};
-use super::{ViewRequest, cos_incidence};
-use crate::error::{Error, Result};
+use super::gpu::{Counter, CounterOptions, GpuScene};
+use super::lanes::{Lane, Lanes, default_lanes};
+use super::{Engine, ViewAnswer, ViewRequest, check_receivers, cos_incidence};
+use crate::error::{Error, GpuError, Result};
 use crate::platform;
 use crate::scene::Scene;
 
@@ -275,36 +275,33 @@ impl<'a> HybridEngine<'a> {
         let seconds = now() - start;
         self.add_stats(|s| s.gpu_startup_seconds += seconds);
         let _ = self.gpu.set(lanes);
-        self.gpu.get().map(Vec::as_slice).ok_or_else(|| Error::Gpu("GPU lanes went missing".into()))
+        self.gpu.get().map(Vec::as_slice).ok_or_else(|| Error::Gpu(GpuError::Device("GPU lanes went missing".into())))
     }
 
-    /// Counts `requests` (`leaves[i]` the leaf fraction of request `i`; all leaves on when empty).
-    pub async fn count(&self, requests: &[ViewRequest], leaves: &[f32]) -> Result<Vec<Counted>> {
-        if !leaves.is_empty() && leaves.len() != requests.len() {
-            return Err(Error::argument("leaves", format!("{} leaf fractions for {} views", leaves.len(), requests.len())));
-        }
+    /// Answers `requests`, each on the engine the choice (and for `auto` the profile) routes it to.
+    pub async fn count(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        check_receivers(self.scene.receivers.len(), requests)?;
         let routes = match (self.kind, &self.exact) {
             (EngineKind::Gpu, _) | (_, None) => vec![Route::Gpu; requests.len()],
             (EngineKind::Exact, Some(_)) => vec![Route::Exact; requests.len()],
             (EngineKind::Auto, Some(exact)) => {
                 let loads = exact.loads(requests);
-                let profile = self.ensure_profile(exact, requests, leaves, &loads).await?;
+                let profile = self.ensure_profile(exact, requests, &loads).await?;
                 profile.route(&loads)
             }
         };
-        self.count_routed(requests, leaves, &routes).await
+        self.count_routed(requests, &routes).await
     }
 
     /// Counts each request on the engine `routes` names, both engines at once.
-    pub async fn count_routed(&self, requests: &[ViewRequest], leaves: &[f32], routes: &[Route]) -> Result<Vec<Counted>> {
-        let pick = |route: Route| -> (Vec<usize>, Vec<ViewRequest>, Vec<f32>) {
+    pub async fn count_routed(&self, requests: &[ViewRequest], routes: &[Route]) -> Result<Vec<ViewAnswer>> {
+        let pick = |route: Route| -> (Vec<usize>, Vec<ViewRequest>) {
             let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
             let reqs = idx.iter().map(|&i| requests[i]).collect();
-            let lv = if leaves.is_empty() { Vec::new() } else { idx.iter().map(|&i| leaves[i]).collect() };
-            (idx, reqs, lv)
+            (idx, reqs)
         };
-        let (exact_idx, exact_reqs, exact_leaves) = pick(Route::Exact);
-        let (gpu_idx, gpu_reqs, gpu_leaves) = pick(Route::Gpu);
+        let (exact_idx, exact_reqs) = pick(Route::Exact);
+        let (gpu_idx, gpu_reqs) = pick(Route::Gpu);
         let lanes: Vec<Lane<'_>> = if gpu_reqs.is_empty() {
             Vec::new()
         } else {
@@ -328,31 +325,32 @@ impl<'a> HybridEngine<'a> {
             parts.push(Part::Gpu);
         }
         let results = platform::side_by_side(&parts, |part| {
-            let (part, lanes, exact_reqs, exact_leaves, gpu_reqs, gpu_leaves) = (*part, &lanes, &exact_reqs, &exact_leaves, &gpu_reqs, &gpu_leaves);
+            let (part, lanes, exact_reqs, gpu_reqs) = (*part, &lanes, &exact_reqs, &gpu_reqs);
             async move {
                 let start = now();
                 let counted = match part {
-                    Part::Exact(e) => Ok(e.fractions(exact_reqs, exact_leaves).into_iter().map(|fraction| Counted { fraction, ..Default::default() }).collect()),
-                    Part::Gpu => fractions_side_by_side(lanes, gpu_reqs, gpu_leaves).await,
+                    Part::Exact(e) => Ok(e.fractions(exact_reqs).into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect()),
+                    Part::Gpu => Lanes(lanes).answer(gpu_reqs).await,
                 };
                 (counted, now() - start)
             }
         })
         .await;
         // Exact answers carry their fraction and cosine; the GPU's their pixel counts too.
-        let mut out: Vec<Counted> = requests
+        let mut out: Vec<ViewAnswer> = requests
             .iter()
-            .map(|r| Counted {
+            .map(|r| ViewAnswer {
                 cos_incidence: self.scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
                 ..Default::default()
             })
             .collect();
         for (part, (counted, seconds)) in parts.iter().zip(results) {
-            let counted: Vec<Counted> = counted?;
+            let counted: Vec<ViewAnswer> = counted?;
             match part {
                 Part::Exact(_) => {
                     for (&i, c) in exact_idx.iter().zip(counted) {
                         out[i].fraction = c.fraction;
+                        out[i].error_estimate = Some(0.0);
                     }
                     self.add_stats(|s| {
                         s.exact_views += exact_idx.len();
@@ -374,7 +372,7 @@ impl<'a> HybridEngine<'a> {
     }
 
     /// The profile to route by: pinned, cached or measured now (see [`ProfileSource`]).
-    async fn ensure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad]) -> Result<&Profile> {
+    async fn ensure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
         if let Some((p, _)) = self.profile.get() {
             return Ok(p);
         }
@@ -383,9 +381,9 @@ impl<'a> HybridEngine<'a> {
             ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
             ProfileSource::Cache => match cached(&key) {
                 Some(p) => (p, "cache"),
-                None => (self.calibrate(exact, requests, leaves, loads, key.clone()).await?, "probe"),
+                None => (self.calibrate(exact, requests, loads, key.clone()).await?, "probe"),
             },
-            _ => (self.calibrate(exact, requests, leaves, loads, key.clone()).await?, "probe"),
+            _ => (self.calibrate(exact, requests, loads, key.clone()).await?, "probe"),
         };
         if from == "probe" {
             match &self.source {
@@ -400,21 +398,32 @@ impl<'a> HybridEngine<'a> {
 
     /// Measures both engines on a spread of these views (the GPU only if the exact engine alone
     /// would take longer than a GPU's start-up).
-    async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad], key: String) -> Result<Profile> {
+    async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], key: String) -> Result<Profile> {
         let start = now();
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
-        let exact_cost = probe_exact(exact, requests, leaves, loads, &probe);
+        let exact_cost = probe_exact(exact, requests, loads, &probe);
         let mut profile = Profile { device: key, exact: exact_cost, gpu: None, gpu_startup_seconds: None };
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
         if profile.exact_total_us(loads) / threads > 1e6 * ASSUMED_GPU_STARTUP {
             let before = self.stats().gpu_startup_seconds;
             let lanes = self.gpu_lanes().await?;
             profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
-            profile.gpu = Some(probe_gpu(lanes, requests, leaves, loads).await?);
+            profile.gpu = Some(probe_gpu(lanes, requests, loads).await?);
         }
         let seconds = now() - start;
         self.add_stats(|s| s.calibration_seconds += seconds);
         Ok(profile)
+    }
+}
+
+impl Engine for HybridEngine<'_> {
+    fn batch(&self) -> usize {
+        // Enough views that both engines have work and the GPU whole atlases.
+        self.lanes().and_then(|l| l.first()).map_or(1024, |(c, _)| (c.tiles_per_batch() * 16).max(1024))
+    }
+
+    async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        self.count(requests).await
     }
 }
 
@@ -427,9 +436,9 @@ fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
 }
 
 /// Times the exact engine view by view on one thread and fits its cost line.
-fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad], probe: &[usize]) -> Cost {
+fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize]) -> Cost {
     let mut scratch = exact.scratch();
-    let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
+    let leaves_of = |i: usize| requests[i].leaves;
     // Warm caches and the scratch memory first.
     for &i in probe.iter().take(4) {
         exact.fraction(requests[i], leaves_of(i), &mut scratch);
@@ -451,29 +460,28 @@ fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], leaves: &[f32], lo
 }
 
 /// Times a light and a heavy batch of views on the GPU lanes and fits its cost line.
-async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], leaves: &[f32], loads: &[ViewLoad]) -> Result<Cost> {
+async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Cost> {
     let lanes: Vec<Lane<'_>> = lanes.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
     let views = probe_views(loads, 6 * PROBE_GPU_VIEWS);
     let third = views.len() / 3;
-    let batch = |part: &[usize]| -> (Vec<ViewRequest>, Vec<f32>, f64) {
+    let batch = |part: &[usize]| -> (Vec<ViewRequest>, f64) {
         let reqs: Vec<ViewRequest> = part.iter().map(|&i| requests[i]).collect();
-        let lv = if leaves.is_empty() { Vec::new() } else { part.iter().map(|&i| leaves[i]).collect() };
         let mean = part.iter().map(|&i| loads[i].triangles as f64).sum::<f64>() / part.len().max(1) as f64;
-        (reqs, lv, mean)
+        (reqs, mean)
     };
     let light = &views[..third.min(PROBE_GPU_VIEWS)];
     let heavy = &views[views.len() - third.min(PROBE_GPU_VIEWS)..];
     // Warm-up (pipelines, first submission), not timed.
-    let (warm, warm_leaves, _) = batch(&views[..views.len().min(4)]);
-    fractions_side_by_side(&lanes, &warm, &warm_leaves).await?;
+    let (warm, _) = batch(&views[..views.len().min(4)]);
+    Lanes(&lanes).answer(&warm).await?;
     let mut samples = Vec::new();
     for part in [light, heavy] {
         if part.is_empty() {
             continue;
         }
-        let (reqs, lv, mean) = batch(part);
+        let (reqs, mean) = batch(part);
         let t0 = now();
-        fractions_side_by_side(&lanes, &reqs, &lv).await?;
+        Lanes(&lanes).answer(&reqs).await?;
         samples.push((mean, 1e6 * (now() - t0) / part.len() as f64));
     }
     Ok(fit_line(&samples))

@@ -189,10 +189,9 @@ impl ExactEngine {
         self.triangles.len()
     }
 
-    /// Sunlit fractions of `requests`, `leaves[i]` the leaf fraction of request `i` (every leaf
-    /// on when empty). Natively over every core.
-    pub fn fractions(&self, requests: &[ViewRequest], leaves: &[f32]) -> Vec<f64> {
-        let leaves_of = |i: usize| leaves.get(i).copied().unwrap_or(1.0);
+    /// Sunlit fractions of `requests`, each at its leaf fraction. Natively over every core.
+    pub fn fractions(&self, requests: &[ViewRequest]) -> Vec<f64> {
+        let leaves_of = |i: usize| requests[i].leaves;
         let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
         if threads == 1 {
             let mut scratch = self.scratch();
@@ -531,10 +530,10 @@ mod tests {
         for az in [120.0f64, 150.0, 180.0, 200.0, 240.0] {
             for alt in [5.0f64, 20.0, 35.0, 60.0] {
                 let (a, h) = (az.to_radians(), alt.to_radians());
-                requests.push(ViewRequest { receiver: 0, sun: DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin()) });
+                requests.push(ViewRequest::new(0, DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin())));
             }
         }
-        let fast = engine.fractions(&requests, &[]);
+        let fast = engine.fractions(&requests);
         let reference = super::super::sunlit_fractions(&scene, &requests);
         let mut partly = 0;
         for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
