@@ -390,7 +390,9 @@ mod tests {
         let (receiver, _) = scene.receiver(name).unwrap();
         let want = sunlit_fraction(scene, ViewRequest::new(receiver, sun));
         let fast = engine::ExactEngine::new(scene).fractions(&[ViewRequest::new(receiver, sun)]);
-        assert!((fast[0] - want).abs() < TOL, "fast engine {} against the reference {want}", fast[0]);
+        // The fast engine's 32-bit grid rounds each vertex to ~10⁻⁹ of the window; crossings of
+        // many edges add up to ~10⁻⁷ of a fraction (measured on blaas-louvres: 7e-8).
+        assert!((fast[0] - want).abs() < 1e-6, "fast engine {} against the reference {want}", fast[0]);
         want
     }
 
