@@ -1,0 +1,155 @@
+//! The hybrid engine: `auto`, `exact` and `gpu` agree (the GPU within its tolerance), a profile
+//! that favours either engine gives the same answers, the same profile gives the same CSV byte
+//! for byte, and the GPU path still answers alone.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use glam::{DMat4, DVec3};
+use sunlit::count::gpu::CounterOptions;
+use sunlit::count::hybrid::{Cost, EngineKind, HybridEngine, Profile, ProfileSource, write_profile};
+use sunlit::count::{ViewAnswer, ViewRequest, exact};
+use sunlit::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
+
+/// |GPU − exact| allowed at 256² (the GPU tests' bound at 512² is 0.005 on random scenes).
+const GPU_TOLERANCE: f64 = 0.01;
+
+fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+    let c = |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+    let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
+}
+
+fn quad(x0: f32, x1: f32, z0: f32, z1: f32) -> SourceMesh {
+    SourceMesh { positions: vec![[x0, 0., z0], [x1, 0., z0], [x1, 0., z1], [x0, 0., z1]], indices: vec![0, 1, 2, 0, 2, 3] }
+}
+
+/// Two south walls, one under 30 instanced slats and a fin, one bare.
+fn louvred_walls() -> Scene {
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "LOUVRED", quad(0.0, 4.0, 0.0, 3.0), true);
+    b.add_object("test", "BARE", quad(10.0, 14.0, 0.0, 3.0), true);
+    b.add_object("test", "FIN", cuboid([4.0, -1.0, 0.0], [4.1, 0.0, 3.0]), false);
+    let slat = b.add_mesh("slat", cuboid([-0.5, -0.4, 0.0], [4.5, -0.1, 0.03]));
+    for k in 0..30 {
+        let transform = DMat4::from_translation(DVec3::new(0.0, 0.0, 0.1 * k as f64));
+        let name = format!("S{k}");
+        b.add_node(SourceNode { origin: name.clone(), name, mesh: slat, transform, receiver: false });
+    }
+    b.build().unwrap()
+}
+
+fn requests(scene: &Scene) -> Vec<ViewRequest> {
+    let mut out = Vec::new();
+    for az in [100.0f64, 140.0, 180.0, 220.0, 260.0] {
+        for alt in [8.0f64, 25.0, 45.0, 70.0] {
+            let (a, h) = (az.to_radians(), alt.to_radians());
+            let sun = DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin());
+            out.extend((0..scene.receivers.len() as u32).map(|r| ViewRequest::new(r, sun)));
+        }
+    }
+    out
+}
+
+fn options() -> CounterOptions {
+    CounterOptions { resolution: 256, ..Default::default() }
+}
+
+fn temp_dir() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-hybrid-{}-{:?}", std::process::id(), std::thread::current().id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn answers(scene: &Scene, kind: EngineKind, source: ProfileSource) -> (Vec<ViewAnswer>, usize) {
+    let engine = HybridEngine::new(scene, kind, options(), Some(1), source).unwrap();
+    let out = pollster::block_on(engine.count(&requests(scene))).unwrap();
+    (out, engine.stats().gpu_views)
+}
+
+/// A pinned profile: `gpu_cheap` makes every loaded view cheaper on the GPU, else on the CPU.
+fn pinned(gpu_cheap: bool) -> ProfileSource {
+    let (exact, gpu) = if gpu_cheap { (1e6, 1.0) } else { (1.0, 1e6) };
+    let profile = Profile {
+        device: "test".into(),
+        exact: Cost { per_view_us: exact, per_triangle_us: 0.0 },
+        gpu: Some(Cost { per_view_us: gpu, per_triangle_us: 0.0 }),
+        gpu_startup_seconds: Some(0.0),
+    };
+    let path = temp_dir().join(if gpu_cheap { "gpu.json" } else { "exact.json" });
+    write_profile(&path, &profile).unwrap();
+    ProfileSource::File(path)
+}
+
+#[test]
+fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
+    let scene = louvred_walls();
+    let reference = exact::sunlit_fractions(&scene, &requests(&scene));
+    let (exact_answers, exact_gpu_views) = answers(&scene, EngineKind::Exact, ProfileSource::Probe);
+    let (gpu_answers, _) = answers(&scene, EngineKind::Gpu, ProfileSource::Probe);
+    let (auto_cpu, cpu_routed) = answers(&scene, EngineKind::Auto, pinned(false));
+    let (auto_gpu, gpu_routed) = answers(&scene, EngineKind::Auto, pinned(true));
+    assert_eq!(exact_gpu_views, 0);
+    assert_eq!(cpu_routed, 0, "a profile with a dear GPU routes nothing to it");
+    assert!(gpu_routed > 0, "a profile with a cheap GPU routes the loaded views to it");
+    let mut partly = 0;
+    for (i, want) in reference.iter().enumerate() {
+        assert!((exact_answers[i].fraction - want).abs() < 1e-6, "view {i}: exact engine {} vs reference {want}", exact_answers[i].fraction);
+        assert!((gpu_answers[i].fraction - want).abs() < GPU_TOLERANCE, "view {i}: gpu {} vs reference {want}", gpu_answers[i].fraction);
+        assert_eq!(auto_cpu[i].fraction, exact_answers[i].fraction, "view {i}: auto on the CPU is the exact engine");
+        // Routed to the GPU, a view gets the GPU's pixels; the schedule agrees within their tolerance.
+        assert!((auto_gpu[i].fraction - want).abs() < GPU_TOLERANCE, "view {i}: auto (GPU-favouring) {} vs {want}", auto_gpu[i].fraction);
+        assert_eq!(auto_gpu[i].side.is_some(), gpu_answers[i].side.is_some(), "view {i}: the loaded views go to the GPU");
+        partly += usize::from(*want > 0.02 && *want < 0.98);
+    }
+    assert!(partly >= 10, "only {partly} views partly shaded");
+}
+
+fn sunlit(args: &[&str], cache: &std::path::Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_CACHE_HOME", cache).output().expect("run sunlit")
+}
+
+#[test]
+fn the_same_profile_gives_the_same_csv_byte_for_byte() {
+    let dir = temp_dir();
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
+    let profile = dir.join("profile.json");
+    let mut csvs = Vec::new();
+    for run in 0..2 {
+        let csv = dir.join(format!("run{run}.csv"));
+        let args = [
+            "annual", glb, "--location", "40,-105,-7", "--days-per-year", "6", "--samples-per-day", "7", "--resolution", "128",
+            "--engine-profile", profile.to_str().unwrap(), "-o", csv.to_str().unwrap(),
+        ];
+        let out = sunlit(&args, &dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        csvs.push(std::fs::read(&csv).unwrap());
+    }
+    assert!(profile.exists(), "the first run measured and pinned the profile");
+    assert!(csvs[0] == csvs[1], "two runs with one profile differ");
+}
+
+#[test]
+fn the_gpu_engine_answers_alone() {
+    let dir = temp_dir();
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
+    let run = |engine: &str| {
+        let out = sunlit(&["fraction", glb, "--sun", "200,35", "--resolution", "256", "--engine", engine, "--json"], &dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (gpu, exact) = (run("gpu"), run("exact"));
+    assert_eq!(gpu["method"], "gpu");
+    let surfaces = |v: &serde_json::Value| v["surfaces"].as_array().unwrap().clone();
+    let mut rendered = 0;
+    for (g, e) in surfaces(&gpu).iter().zip(surfaces(&exact)) {
+        assert_eq!(e["side"], 0, "the exact engine counts no pixels");
+        rendered += usize::from(g["side"] == 256);
+        let (g, e) = (g["fraction"].as_f64().unwrap(), e["fraction"].as_f64().unwrap());
+        assert!((g - e).abs() < GPU_TOLERANCE, "gpu {g} vs exact {e}");
+    }
+    assert!(rendered > 0, "the GPU rendered no view");
+    let bad = sunlit(&["fraction", glb, "--sun", "200,35", "--engine", "pixels"], &dir);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--engine"), "{}", String::from_utf8_lossy(&bad.stderr));
+}
