@@ -207,7 +207,8 @@ struct EngineArgs {
 
 impl EngineArgs {
     fn kind(&self) -> Result<EngineKind> {
-        EngineKind::parse(&self.engine).map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))
+        EngineKind::parse(&self.engine)
+            .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))
     }
 
     fn source(&self) -> ProfileSource {
@@ -764,6 +765,7 @@ fn bench_hybrid(args: &BenchArgs, now: impl Fn() -> f64 + Copy) -> Result<()> {
             "views": all.len(),
             "views_timed": requests.len(),
             "views_rendered": rendered,
+            "views_skipped": requests.len() - rendered,
             "seconds": seconds,
             "estimated_seconds_all_views": estimated,
             "views_per_second": requests.len() as f64 / seconds.max(1e-9),

@@ -15,7 +15,8 @@ use sunlit::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
 const GPU_TOLERANCE: f64 = 0.01;
 
 fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
-    let c = |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+    let c =
+        |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
     let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
 }
@@ -94,7 +95,11 @@ fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
     assert!(gpu_routed > 0, "a profile with a cheap GPU routes the loaded views to it");
     let mut partly = 0;
     for (i, want) in reference.iter().enumerate() {
-        assert!((exact_answers[i].fraction - want).abs() < 1e-6, "view {i}: exact engine {} vs reference {want}", exact_answers[i].fraction);
+        assert!(
+            (exact_answers[i].fraction - want).abs() < 1e-6,
+            "view {i}: exact engine {} vs reference {want}",
+            exact_answers[i].fraction
+        );
         assert!((gpu_answers[i].fraction - want).abs() < GPU_TOLERANCE, "view {i}: gpu {} vs reference {want}", gpu_answers[i].fraction);
         assert_eq!(auto_cpu[i].fraction, exact_answers[i].fraction, "view {i}: auto on the CPU is the exact engine");
         // Routed to the GPU, a view gets the GPU's pixels; the schedule agrees within their tolerance.
@@ -118,8 +123,20 @@ fn the_same_profile_gives_the_same_csv_byte_for_byte() {
     for run in 0..2 {
         let csv = dir.join(format!("run{run}.csv"));
         let args = [
-            "annual", glb, "--location", "40,-105,-7", "--days-per-year", "6", "--samples-per-day", "7", "--resolution", "128",
-            "--engine-profile", profile.to_str().unwrap(), "-o", csv.to_str().unwrap(),
+            "annual",
+            glb,
+            "--location",
+            "40,-105,-7",
+            "--days-per-year",
+            "6",
+            "--samples-per-day",
+            "7",
+            "--resolution",
+            "128",
+            "--engine-profile",
+            profile.to_str().unwrap(),
+            "-o",
+            csv.to_str().unwrap(),
         ];
         let out = sunlit(&args, &dir);
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

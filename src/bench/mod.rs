@@ -247,7 +247,12 @@ pub struct ExactCheck {
 /// For answers of a hybrid run: an even spread of at most `at_most` GPU-counted views against the
 /// exact reference (their error), and as many exactly clipped views with something in front
 /// (the fast engine against the straightforward reference; should be ~0).
-pub fn check_answers(scene: &Scene, requests: &[ViewRequest], answers: &[crate::count::ViewAnswer], at_most: usize) -> (ExactCheck, ExactCheck) {
+pub fn check_answers(
+    scene: &Scene,
+    requests: &[ViewRequest],
+    answers: &[crate::count::ViewAnswer],
+    at_most: usize,
+) -> (ExactCheck, ExactCheck) {
     let check = |picked: Vec<usize>| {
         let stride = picked.len().div_ceil(at_most.max(1)).max(1);
         let picked: Vec<usize> = picked.into_iter().step_by(stride).collect();
@@ -263,7 +268,8 @@ pub fn check_answers(scene: &Scene, requests: &[ViewRequest], answers: &[crate::
     };
     let gpu = (0..requests.len()).filter(|&i| answers[i].side.is_some()).collect();
     // Exactly clipped views that were neither dark nor unshaded: where clipping did work.
-    let exact = (0..requests.len()).filter(|&i| answers[i].side.is_none() && answers[i].fraction > 0.0 && answers[i].fraction < 1.0).collect();
+    let exact =
+        (0..requests.len()).filter(|&i| answers[i].side.is_none() && answers[i].fraction > 0.0 && answers[i].fraction < 1.0).collect();
     (check(gpu), check(exact))
 }
 

@@ -198,6 +198,12 @@ impl<'a> HybridEngine<'a> {
         if lanes == Some(0) {
             return Err(Error::argument("lanes", "must be at least 1"));
         }
+        // Refused here too, as the GPU would: `auto` may never make a device.
+        if let Some(a) = options.accuracy {
+            if !(a > 0.0 && a < 1.0) {
+                return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
+            }
+        }
         let exact = (kind != EngineKind::Gpu).then(|| ExactEngine::new(scene));
         Ok(Self {
             scene,
@@ -329,7 +335,9 @@ impl<'a> HybridEngine<'a> {
             async move {
                 let start = now();
                 let counted = match part {
-                    Part::Exact(e) => Ok(e.fractions(exact_reqs).into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect()),
+                    Part::Exact(e) => {
+                        Ok(e.fractions(exact_reqs).into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect())
+                    }
                     Part::Gpu => Lanes(lanes).answer(gpu_reqs).await,
                 };
                 (counted, now() - start)
@@ -376,7 +384,7 @@ impl<'a> HybridEngine<'a> {
         if let Some((p, _)) = self.profile.get() {
             return Ok(p);
         }
-        let key = device_key(&self.options).await;
+        let key = device_key(&self.options).await?;
         let (profile, from) = match &self.source {
             ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
             ProfileSource::Cache => match cached(&key) {
@@ -510,17 +518,26 @@ fn fit_line(samples: &[(f64, f64)]) -> Cost {
 }
 
 /// What identifies the device a profile belongs to: adapter, driver, CPU threads and tile side.
-pub async fn device_key(options: &CounterOptions) -> String {
+/// Refuses a side the adapter cannot render, as the GPU would (without making a device).
+pub async fn device_key(options: &CounterOptions) -> Result<String> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let resolution = options.resolution;
     let adapter = match platform::instance().request_adapter(&wgpu::RequestAdapterOptions::default()).await {
         Ok(a) => {
+            let limit = a.limits().max_texture_dimension_2d;
+            if !(16..=limit).contains(&resolution) {
+                return Err(Error::argument(
+                    "resolution",
+                    format!("{resolution} is outside 16..={limit} (this device's texture size limit)"),
+                ));
+            }
             let info = a.get_info();
             format!("{} ({:?}, {} {})", info.name, info.backend, info.driver, info.driver_info)
         }
         Err(_) => "no GPU adapter".to_string(),
     };
     let accuracy = options.accuracy.map_or(String::new(), |a| format!(" ±{a}"));
-    format!("{adapter}; {threads} CPU threads; {}²{accuracy}", options.resolution)
+    Ok(format!("{adapter}; {threads} CPU threads; {resolution}²{accuracy}"))
 }
 
 /// Reads a profile file.

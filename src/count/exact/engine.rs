@@ -135,7 +135,11 @@ impl ExactEngine {
             let p = |v: u32| inst.transform.transform_point3(DVec3::from_array(mesh.positions[v as usize].map(f64::from)));
             triangles.push([p(idx[0]), p(idx[1]), p(idx[2])]);
             let surface = mesh.surfaces[idx[0] as usize];
-            owner.push(if surface == NO_RECEIVER || inst.receiver_base == NO_RECEIVER { NO_RECEIVER } else { inst.receiver_base + surface });
+            owner.push(if surface == NO_RECEIVER || inst.receiver_base == NO_RECEIVER {
+                NO_RECEIVER
+            } else {
+                inst.receiver_base + surface
+            });
             let mut veil = mesh.veils.get(idx[0] as usize).copied().unwrap_or_default();
             if veil.rank >= 0.0 {
                 veil.rank = shifted_rank(veil.rank, inst.leaf_shift);
@@ -504,9 +508,14 @@ mod tests {
 
     /// A box [lo, hi] as 12 triangles, outward.
     fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
-        let c = |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+        let c = |i: u32| {
+            [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }]
+        };
         let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
+        SourceMesh {
+            positions: (0..8).map(c).collect(),
+            indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect(),
+        }
     }
 
     fn wall() -> SourceMesh {
