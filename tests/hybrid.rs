@@ -1,6 +1,7 @@
 //! The hybrid engine: `auto`, `exact` and `gpu` agree (the GPU within its tolerance), a profile
 //! that favours either engine gives the same answers, the same profile gives the same CSV byte
 //! for byte, and the GPU path still answers alone.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 use std::path::PathBuf;
 use std::process::Command;
