@@ -14,7 +14,7 @@
 //! - routing depends only on the loads and the profile, never on timing during the run, so the
 //!   same inputs with the same profile give the same answers byte for byte. The profile is
 //!   measured once per device (a probe of both engines on the model's own views, a few hundred
-//!   ms), kept in a cache file keyed by adapter, driver, resolution and cores, and can be pinned
+//!   ms), kept in a cache file keyed by adapter, driver, resolution, cores and the scene's size, and can be pinned
 //!   with a profile file of its own;
 //! - both engines run at once: natively the exact views on every core's threads while the GPU
 //!   lanes count theirs; on the web one after the other (one thread).
@@ -384,7 +384,14 @@ impl<'a> HybridEngine<'a> {
         if let Some((p, _)) = self.profile.get() {
             return Ok(p);
         }
-        let key = device_key(&self.options).await?;
+        // A profile is measured on the model's own views: its loads cost differently per model (leaves
+        // overlap far more than slats), so the key names the scene's size too.
+        let key = format!(
+            "{}; scene {} triangles, {} receivers",
+            device_key(&self.options).await?,
+            self.scene.triangle_count(),
+            self.scene.receivers.len()
+        );
         let (profile, from) = match &self.source {
             ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
             ProfileSource::Cache => match cached(&key) {
