@@ -189,3 +189,39 @@ fn concave_shading_runs_with_sunlit_fractions() {
     let shaded = used.iter().filter(|v| **v > 0.0 && **v < 0.95).count();
     assert!(shaded > 500, "the canopy shades the east window part of the time: {shaded} timesteps");
 }
+
+/// Windows off their wall's plane, as EnergyPlus places them: WIN_S set back 0.15 m into the
+/// wall (a reveal, whose sides shade it) and WIN_E 0.1 m proud of it (drawn in the wall's plane).
+/// Both are cut out of their walls. Against EnergyPlus's own clipping of the same model.
+#[test]
+fn inset_and_proud_windows_follow_energyplus() {
+    let dir = scratch("inset");
+    let office = office_idf(3, false, Shading::PolygonClipping);
+    let set_back = "  2,0.15,2.5,\n  2,0.15,1,\n  8,0.15,1,\n  8,0.15,2.5;";
+    let proud = "  10.1,2,2.4,\n  10.1,2,1,\n  10.1,6,1,\n  10.1,6,2.4;";
+    let text = office.replacen("  2,0,2.5,\n  2,0,1,\n  8,0,1,\n  8,0,2.5;", set_back, 1).replacen(
+        "  10,2,2.4,\n  10,2,1,\n  10,6,1,\n  10,6,2.4;",
+        proud,
+        1,
+    );
+    assert!(text.contains(set_back) && text.contains(proud));
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, &text).unwrap();
+    let err = run_energyplus(&idf, &dir.join("clipping"));
+    assert_eq!(severe_count(&err), 0, "{err}");
+    let (csv, hooked) = sunlit_annual(&idf, &dir, &["--resolution", "256"]);
+    let (ours, theirs) = (columns(&csv), columns(&dir.join("clipping/eplusshading.csv")));
+    // The reveal's own shade: EnergyPlus's WIN_S is darker than a flush window's, but lit.
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    assert!(mean(&theirs["WIN_S"]) > 0.1, "EnergyPlus lights the set-back window");
+    for name in ["WIN_S", "WIN_E", "WALL_S", "WALL_E"] {
+        let (a, b) = (&ours[name], &theirs[name]);
+        assert_eq!(a.len(), b.len(), "{name}: rows");
+        let lit: Vec<f64> = a.iter().zip(b).filter(|(x, y)| **x > 0.0 || **y > 0.0).map(|(x, y)| (x - y).abs()).collect();
+        let m = mean(&lit);
+        println!("{name}: mean |sunlit − EnergyPlus| {m:.4} over {} lit timesteps (means {:.4} vs {:.4})", lit.len(), mean(a), mean(b));
+        assert!(lit.len() > 1000 && m <= 0.02, "{name}: mean |Δ| {m}");
+    }
+    let err = run_energyplus(&hooked, &dir.join("hooked"));
+    assert_eq!(severe_count(&err), 0, "{err}");
+}
