@@ -430,7 +430,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
-        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, out, &args.output, &schedule.names, timesteps, form)?)),
+        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form)?)),
         _ => None,
     };
     sunlit::export::write_atomic(&args.output, &bytes)?;
@@ -449,24 +449,22 @@ fn annual(args: AnnualArgs) -> Result<()> {
     Ok(())
 }
 
-/// The model's text with the CSV hooked in. The CSV is named by file name when it sits beside the
-/// patched model (EnergyPlus looks there), by absolute path otherwise.
-fn patch_model(
-    ep: &model::EnergyPlusInput,
-    out: &std::path::Path,
-    csv: &std::path::Path,
-    columns: &[String],
-    timesteps: Timesteps,
-    hook: Hook,
-) -> Result<String> {
-    let folder = |p: &std::path::Path| {
-        std::fs::canonicalize(p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."))).ok()
+/// The model's text with the CSV hooked in. The CSV is named by its absolute path, so EnergyPlus
+/// finds it wherever it is started from and wherever the hooked model is moved to.
+fn patch_model(ep: &model::EnergyPlusInput, csv: &std::path::Path, columns: &[String], timesteps: Timesteps, hook: Hook) -> Result<String> {
+    let folder = std::fs::canonicalize(csv.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new(".")))
+        .map_err(|source| Error::Io { path: csv.to_path_buf(), source })?;
+    let csv_text = match csv.file_name() {
+        Some(name) => folder.join(name).display().to_string(),
+        None => csv.display().to_string(),
     };
-    let csv_text = match (folder(out), folder(csv), csv.file_name()) {
-        (Some(a), Some(b), Some(name)) if a == b => name.to_string_lossy().into_owned(),
-        (_, Some(b), Some(name)) => b.join(name).display().to_string(),
-        _ => csv.display().to_string(),
-    };
+    // An IDF field ends at ',' or ';' and a comment starts at '!': such a path cannot be written.
+    if !ep.epjson && csv_text.contains([',', ';', '!']) {
+        return Err(Error::argument(
+            "output",
+            format!("'{csv_text}': an IDF field cannot hold ',', ';' or '!'; choose a path without them"),
+        ));
+    }
     sunlit::export::hook::patch_model(ep, &HookPlan { csv: &csv_text, columns, timesteps, hook })
 }
 

@@ -225,3 +225,33 @@ fn inset_and_proud_windows_follow_energyplus() {
     let err = run_energyplus(&hooked, &dir.join("hooked"));
     assert_eq!(severe_count(&err), 0, "{err}");
 }
+
+/// The hooked model names its CSV so that EnergyPlus finds it wherever it is started from and
+/// wherever the model is moved to: here the model is copied to another folder and EnergyPlus is
+/// started from a third, with a relative path to the model.
+#[test]
+fn hooked_model_finds_its_csv_from_any_folder() {
+    let dir = scratch("anywhere");
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, office_idf(2, false, Shading::None)).unwrap();
+    let quick = ["--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
+    let (csv, hooked) = sunlit_annual(&idf, &dir, &quick);
+    let (moved, start) = (dir.join("moved"), dir.join("start"));
+    std::fs::create_dir_all(&moved).unwrap();
+    std::fs::create_dir_all(&start).unwrap();
+    std::fs::copy(&hooked, moved.join("hooked.idf")).unwrap();
+    let out = Command::new(energyplus())
+        .current_dir(&start)
+        .args(["-r", "-w"])
+        .arg(weather())
+        .args(["-d", "run", "../moved/hooked.idf"])
+        .output()
+        .unwrap();
+    let err = std::fs::read_to_string(start.join("run/eplusout.err")).unwrap_or_default();
+    assert!(out.status.success() && severe_count(&err) == 0, "{err}");
+    let used = columns(&start.join("run/eplusout.csv"));
+    let used = output(&used, "WIN_S", "Surface Outside Face Sunlit Fraction");
+    let given = &columns(&csv)["WIN_S"];
+    let worst = used.iter().zip(given).filter(|(u, _)| **u > 0.0).map(|(u, g)| (u - g).abs()).fold(0.0, f64::max);
+    assert!(used.iter().any(|v| *v > 0.0 && *v < 0.99) && worst < 1e-4, "EnergyPlus did not use the CSV (max |Δ| {worst})");
+}

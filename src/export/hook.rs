@@ -61,7 +61,7 @@ impl Hook {
 /// What to hook in: the CSV as the model will find it and its columns.
 #[derive(Debug, Clone)]
 pub struct HookPlan<'a> {
-    /// The CSV's path as written into the model (a bare file name when it sits beside the model).
+    /// The CSV's path as written into the model (the CLI writes its absolute path).
     pub csv: &'a str,
     /// Surface names, in CSV column order (the CSV's first column is the time stamp).
     pub columns: &'a [String],
