@@ -45,7 +45,8 @@ struct AnnualArgs {
     #[command(flatten)]
     model: ModelArgs,
     /// Weather file whose LOCATION line gives latitude, longitude and time zone.
-    #[arg(long, value_name = "FILE", conflicts_with = "location", required_unless_present = "location")]
+    /// Without --epw or --location, an EnergyPlus model's own Site:Location is used.
+    #[arg(long, value_name = "FILE", conflicts_with = "location")]
     epw: Option<PathBuf>,
     /// Latitude (° north), longitude (° east), time zone (hours from UTC).
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true)]
@@ -391,13 +392,12 @@ fn annual(args: AnnualArgs) -> Result<()> {
         return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
     }
     let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+    let given = match (&args.epw, &args.location) {
+        (Some(epw), _) => Some(Location::from_epw(epw)?),
+        (None, Some(text)) => Some(Location::parse(text)?),
+        (None, None) => None,
     };
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
-    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -405,6 +405,26 @@ fn annual(args: AnnualArgs) -> Result<()> {
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
+    let location = match (given, &energyplus) {
+        (Some(location), _) => location,
+        (None, Some(ep)) => match model::site::site_location(&ep.file, &ep.objects)? {
+            Some(site) => {
+                eprintln!(
+                    "location: {}'s Site:Location '{}' ({}° N, {}° E, UTC{:+}); --epw or --location overrides it",
+                    ep.file, site.name, site.latitude, site.longitude, site.time_zone
+                );
+                site
+            }
+            None => {
+                return Err(Error::argument(
+                    "location",
+                    format!("give --epw FILE or --location LAT,LON,TZ ({} has no Site:Location)", ep.file),
+                ));
+            }
+        },
+        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+    };
+    let calendar = args.calendar(&location)?;
     let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
