@@ -518,8 +518,8 @@ fn evaluate(
     schedule: &mut Schedule,
 ) -> Vec<(usize, usize, DVec3, f64)> {
     let mut rough = Vec::new();
-    let rows_per_day = schedule.timesteps.rows() / DAYS as usize;
-    for day in 1..=DAYS {
+    let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
+    for day in 1..=schedule.timesteps.days() {
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, day as f64, MIN_COS_INCIDENCE)).collect();
         let regime = &regimes[regime_of(day as f64)];

@@ -55,6 +55,11 @@ struct AnnualArgs {
     /// EnergyPlus model's Timestep, else 4.
     #[arg(long)]
     timesteps_per_hour: Option<u32>,
+    /// The calendar year (a leap year gives 366 days, 8784 rows per timestep per hour); default:
+    /// the EnergyPlus model's RunPeriod Begin Year, else the EPW's year if it has a Feb 29, else
+    /// a non-leap year.
+    #[arg(long)]
+    year: Option<i32>,
     /// Sampled days, evenly over the year.
     #[arg(long, default_value_t = SamplingPlan::default().days)]
     days_per_year: usize,
@@ -426,6 +431,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let calendar = args.calendar(&location)?;
     let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let timesteps = timesteps.leap_year(run_year(&args, energyplus.as_ref())?);
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
@@ -467,6 +473,28 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.length().unwrap_or(0)
     );
     Ok(())
+}
+
+/// Whether the run's year is a leap year (`--year`, else the model's RunPeriod, else the EPW's
+/// Feb 29), saying which year was chosen and why.
+fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> Result<bool> {
+    use sunlit::model::run_year::{YearSource, choose, is_leap};
+    let epw = match &args.epw {
+        Some(path) => {
+            Some(String::from_utf8_lossy(&std::fs::read(path).map_err(|source| Error::Io { path: path.clone(), source })?).into_owned())
+        }
+        None => None,
+    };
+    let Some((year, source)) = choose(args.year, energyplus.map(|e| e.objects.as_slice()), epw.as_deref()) else { return Ok(false) };
+    let leap = is_leap(year);
+    let from = match source {
+        YearSource::Given => "--year".to_string(),
+        YearSource::RunPeriod => format!("{}'s RunPeriod", energyplus.map_or("", |e| e.file.as_str())),
+        YearSource::Weather => "the weather file's Feb 29".to_string(),
+    };
+    let days = if leap { "a leap year: 366 days, 8784 hours" } else { "365 days, 8760 hours" };
+    eprintln!("year: {year} (from {from}), {days}");
+    Ok(leap)
 }
 
 /// The model's text with the CSV hooked in. The CSV is named by its absolute path, so EnergyPlus

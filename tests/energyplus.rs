@@ -255,3 +255,87 @@ fn hooked_model_finds_its_csv_from_any_folder() {
     let worst = used.iter().zip(given).filter(|(u, _)| **u > 0.0).map(|(u, g)| (u - g).abs()).fold(0.0, f64::max);
     assert!(used.iter().any(|v| *v > 0.0 && *v < 0.99) && worst < 1e-4, "EnergyPlus did not use the CSV (max |Δ| {worst})");
 }
+
+/// An actual-year weather file of a leap year: the Golden TMY3 with every year set to 2020 and a
+/// Feb 29 (a copy of Feb 28) inserted, its header saying a leap year is observed. Every data
+/// row's date is checked, so a wrong edit fails here rather than in EnergyPlus.
+fn leap_weather(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(weather()).unwrap();
+    let mut out = String::new();
+    let mut feb28 = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if i < 8 {
+            let line = if line.starts_with("HOLIDAYS/DAYLIGHT SAVINGS,No,") { line.replacen(",No,", ",Yes,", 1) } else { line.to_string() };
+            out.push_str(&line);
+            out.push('\n');
+            continue;
+        }
+        let (_, rest) = line.split_once(',').unwrap();
+        let row = format!("2020,{rest}");
+        if rest.starts_with("2,28,") {
+            feb28.push(format!("2020,2,29,{}", rest.splitn(3, ',').nth(2).unwrap()));
+        }
+        if rest.starts_with("3,1,1,") {
+            assert_eq!(feb28.len(), 24);
+            for r in feb28.drain(..) {
+                out.push_str(&r);
+                out.push('\n');
+            }
+        }
+        out.push_str(&row);
+        out.push('\n');
+    }
+    assert_eq!(out.lines().count(), 8 + 8784);
+    let path = dir.join("leap2020.epw");
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+/// A leap year: a RunPeriod in 2020 with an actual-year 2020 weather file. sunlit writes
+/// 8784 × 4 rows and hooks them as 8784 hours; EnergyPlus runs 366 days without a severe error
+/// and uses the CSV's fractions on every lit timestep, Feb 29 and Dec 31 included.
+#[test]
+fn leap_year_runs_366_days_in_energyplus() {
+    let dir = scratch("leap");
+    let epw = leap_weather(&dir);
+    let office = office_idf(2, false, Shading::None);
+    let year = "RunPeriod, YEAR, 1, 1, 2020, 12, 31, 2020, , No, No, No, Yes, Yes, No;";
+    let text = office.replacen("RunPeriod, YEAR, 1, 1, , 12, 31, , , No, No, No, Yes, Yes, No;", year, 1);
+    assert!(text.contains(year));
+    let idf = dir.join("office.idf");
+    std::fs::write(&idf, &text).unwrap();
+    let (csv, hooked) = (dir.join("shading.csv"), dir.join("hooked.idf"));
+    let quick = ["--days-per-year", "5", "--samples-per-day", "5", "--resolution", "64", "--refine", "1"];
+    let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .arg("annual")
+        .arg(&idf)
+        .arg("--epw")
+        .arg(&epw)
+        .arg("-o")
+        .arg(&csv)
+        .arg("--idf-out")
+        .arg(&hooked)
+        .args(quick)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && stderr.contains("year: 2020"), "{stderr}");
+    let given = &columns(&csv)["WIN_S"];
+    assert_eq!(given.len(), 8784 * 4);
+    let csv_text = std::fs::read_to_string(&csv).unwrap();
+    assert!(csv_text.contains("\n 02/29 12:00,") && csv_text.trim_end().lines().last().unwrap().starts_with(" 12/31 24:00,"));
+    let run = dir.join("hooked");
+    let status = Command::new(energyplus()).arg("-r").arg("-w").arg(&epw).arg("-d").arg(&run).arg(&hooked).output().unwrap();
+    let err = std::fs::read_to_string(run.join("eplusout.err")).unwrap_or_default();
+    assert!(status.status.success() && severe_count(&err) == 0, "{err}");
+    let used = columns(&run.join("eplusout.csv"));
+    let used = output(&used, "WIN_S", "Surface Outside Face Sunlit Fraction");
+    assert_eq!(used.len(), 8784 * 4, "EnergyPlus ran 366 days");
+    let day = |d: usize| (d - 1) * 96..d * 96;
+    for (label, rows) in [("Feb 29", day(60)), ("Dec 31", day(366)), ("year", 0..8784 * 4)] {
+        let lit: Vec<usize> = rows.filter(|&r| used[r] > 0.0).collect();
+        let worst = lit.iter().map(|&r| (used[r] - given[r]).abs()).fold(0.0, f64::max);
+        println!("{label}: {} lit timesteps, max |EnergyPlus − CSV| {worst:.2e}", lit.len());
+        assert!(lit.len() >= 20 && lit.iter().any(|&r| used[r] < 0.99) && worst < 1e-4, "{label}: max |Δ| {worst}");
+    }
+}

@@ -16,6 +16,7 @@ pub mod idf;
 pub mod office;
 pub mod office_idf;
 pub mod reveal;
+pub mod run_year;
 pub mod site;
 
 use std::path::PathBuf;
