@@ -168,6 +168,20 @@ fn imported_form_has_every_column_energyplus_writes() {
     println!("LOUVER_2 mostly lit in {a} timesteps (sunlit), {b} (EnergyPlus) of {}", ours["LOUVER_2"].len());
     assert!(b > 12_000.0 && (a - b).abs() < 0.04 * b, "LOUVER_2 mostly lit: sunlit {a} vs EnergyPlus {b} timesteps");
     assert!(ours["MIR-LOUVER_0"].iter().chain(&theirs["MIR-LOUVER_0"]).all(|v| *v == 0.0));
+    // The header rules a reader of this form relies on whatever its EnergyPlus version (PR #11445
+    // upper-cases schedule names on import, so names match case-insensitively): the time stamp
+    // column first, then one column per surface (any order: they are looked up by name), each
+    // shading surface with its `Mir-` back face spelled so, and a full year of rows (8760 × 4 here) with the same stamps.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let first: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    assert_eq!(first[0], "Surface Name");
+    for name in first.iter().filter(|n| n.to_uppercase().starts_with("LOUVER_")) {
+        assert!(first.contains(&format!("Mir-{name}").as_str()), "{name} has its Mir- column: {first:?}");
+    }
+    assert!(ours.values().chain(theirs.values()).all(|v| v.len() == 8760 * 4));
+    let reference = std::fs::read_to_string(reference.join("eplusshading.csv")).unwrap();
+    let stamps = |t: &str| t.lines().skip(1).map(|l| l.split(',').next().unwrap().trim().to_string()).collect::<Vec<_>>();
+    assert_eq!(stamps(&text), stamps(&reference));
     let err = run_energyplus(&hooked, &dir.join("hooked"));
     assert_eq!(severe_count(&err), 0, "{err}");
     assert!(std::fs::read_to_string(&hooked).unwrap().contains("Schedule:File:Shading,"));
