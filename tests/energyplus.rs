@@ -119,6 +119,15 @@ fn round_trip_with_polygon_clipping_as_reference() {
         assert!(lit.len() > 1000 && mean <= 0.02, "{name}: mean {mean}");
     }
 
+    // 1b. Both say the same timesteps are dark (sun down, or behind the surface), sunrise, sunset
+    // and grazing sun included: sunlit takes EnergyPlus's shading sun (the previous day's
+    // declination and equation of time). Unshaded surfaces, so only the sun decides.
+    for name in ["ROOF", "WALL_E", "WALL_W", "WALL_N", "WIN_E"] {
+        let differ = ours[name].iter().zip(&theirs[name]).filter(|(a, b)| (**a > 0.0) != (**b > 0.0)).count();
+        println!("{name}: {differ} timesteps lit in one and dark in the other");
+        assert_eq!(differ, 0, "{name}: sunlit and EnergyPlus disagree on which timesteps are dark");
+    }
+
     // 2. EnergyPlus with sunlit's fractions: no severe error, no "not found", the fractions used.
     let run = dir.join("hooked");
     let err = run_energyplus(&hooked, &run);
