@@ -543,7 +543,11 @@ fn evaluate(
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
         let regime = &regimes[regime_of(day as f64)];
-        let grid_day = regime.map.grid_coordinate(shading_sun_day(day));
+        // The year's fit is over the sun's day; a foliage ramp's over the leaves' (calendar) day.
+        let grid_day = match regime.map {
+            DayMap::Year(_) => regime.map.grid_coordinate(shading_sun_day(day)),
+            DayMap::Ramp { .. } => regime.map.grid_coordinate(day as f64),
+        };
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
             let sun = sun_direction(location, shading_sun_day(day), instant.hour);
