@@ -270,6 +270,15 @@ impl Model {
         self.inner.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)
     }
 
+    /// The EnergyPlus model's own Site:Location as `[latitude, longitude, time zone]`, if it has
+    /// one: the page uses it unless an EPW or other coordinates are given.
+    #[wasm_bindgen(getter, js_name = siteLocation)]
+    pub fn site_location(&self) -> Result<Option<Vec<f64>>, JsValue> {
+        let Some(ep) = self.inner.energyplus.as_ref() else { return Ok(None) };
+        let site = crate::model::site::site_location(&ep.file, &ep.objects).map_err(js_error)?;
+        Ok(site.map(|l| vec![l.latitude, l.longitude, l.time_zone]))
+    }
+
     /// Every triangle in world coordinates (x east, y north, z up; 9 floats each), for drawing.
     #[wasm_bindgen(js_name = worldPositions)]
     pub fn world_positions(&self) -> Float32Array {

@@ -91,7 +91,9 @@ fn spline_matches_dense(scene: &Scene, label: &str) -> f64 {
     let mut night = 0;
     for row in 0..ts.rows() {
         let i = ts.instant(row);
-        if sun_direction(&golden(), i.day as f64, i.hour).z < 0.0 {
+        // Night by the sun EnergyPlus's shading uses on that day (the previous day's, see
+        // `shading_sun_day`), which the schedule follows.
+        if sun_direction(&golden(), sunlit::year::annual::shading_sun_day(i.day), i.hour).z < 0.0 {
             night += 1;
             for c in 0..spline.names.len() {
                 assert_eq!(spline.get(row, c), 0.0, "{label}: night row {row} must be exactly 0");

@@ -277,3 +277,24 @@ fn bench_lists_writes_and_times_generated_models() {
     fails_with(&sunlit(&["bench", "--samples", "27by19", "blaas-self"]), &["--samples", "27by19"]);
     fails_with(&sunlit(&["bench", "--write", &path]), &["--write", "one generated model"]);
 }
+
+/// An EnergyPlus model's own Site:Location is its location when neither --epw nor --location is
+/// given: the CLI says so, and the CSV is the one --location with the same coordinates gives.
+#[test]
+fn energyplus_site_location_is_used_and_named() {
+    let dir = scratch("site");
+    let idf = sunlit::model::office_idf::office_idf(1, false, sunlit::model::office_idf::Shading::None);
+    let with_site = write(&dir, "site.idf", format!("{idf}\nSite:Location, Chicago Test, 41.99, -87.91, -6.0, 205;\n").as_bytes());
+    let quick = ["--days-per-year", "3", "--samples-per-day", "3", "--resolution", "64", "--refine", "1"];
+    let (a, b) = (dir.join("site.csv"), dir.join("given.csv"));
+    let out = sunlit(&[&["annual", &with_site, "-o", a.to_str().unwrap()][..], &quick].concat());
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("Site:Location 'Chicago Test' (41.99° N, -87.91° E, UTC-6)"), "{err}");
+    let out = sunlit(&[&["annual", &with_site, "--location", "41.99,-87.91,-6", "-o", b.to_str().unwrap()][..], &quick].concat());
+    assert!(out.status.success() && !stderr(&out).contains("Site:Location"), "{}", stderr(&out));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    // Without one, the refusal says what to give.
+    let bare = write(&dir, "bare.idf", idf.as_bytes());
+    fails_with(&sunlit(&["annual", &bare, "-o", dir.join("c.csv").to_str().unwrap()]), &["--epw", "--location", "has no Site:Location"]);
+}

@@ -61,7 +61,13 @@ function showModel(msg) {
   fillTable(null);
   showInViewer();
   const n = msg.names.length;
-  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. Set the location and press Compute.`);
+  // An EnergyPlus model's own Site:Location is its location (an EPW, if chosen, still wins).
+  let where = 'Set the location';
+  if (msg.siteLocation) {
+    [$('latitude').value, $('longitude').value, $('timezone').value] = msg.siteLocation.map(String);
+    where = `Location from the model's Site:Location (${msg.siteLocation.join(', ')}); change it or choose an EPW if needed`;
+  }
+  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. ${where}, and press Compute.`);
 }
 
 /** The model in the 3D view, coloured by the result when there is one. The viewer may start

@@ -64,6 +64,7 @@ async function load({ files: given, options, resolution }) {
       seeThrough: m.seeThroughTriangles,
       hasEnergyPlus: m.hasEnergyPlus,
       modelTimesteps: m.modelTimesteps,
+      siteLocation: m.siteLocation,
       adapter: engine.adapter,
       positions,
       receivers: receiversOf,

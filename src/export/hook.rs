@@ -62,7 +62,7 @@ impl Hook {
 /// What to hook in: the CSV as the model will find it and its columns.
 #[derive(Debug, Clone)]
 pub struct HookPlan<'a> {
-    /// The CSV's path as written into the model (a bare file name when it sits beside the model).
+    /// The CSV's path as written into the model (the CLI writes its absolute path).
     pub csv: &'a str,
     /// Surface names, in CSV column order (the CSV's first column is the time stamp).
     pub columns: &'a [String],
@@ -211,10 +211,11 @@ fn hook_objects(existing: Option<&IdfObject>, plan: &HookPlan) -> String {
         Hook::Imported => object(&mut out, "Schedule:File:Shading", &[plan.csv]),
         Hook::Scheduled => {
             let minutes = (60 / plan.timesteps.per_hour()).to_string();
+            let hours = (24 * plan.timesteps.days()).to_string();
             for (k, surface) in plan.columns.iter().enumerate() {
                 let schedule = schedule_name(surface);
                 let column = (k + 2).to_string();
-                object(&mut out, "Schedule:File", &[&schedule, LIMITS, plan.csv, &column, "1", "8760", "Comma", "No", &minutes, "No"]);
+                object(&mut out, "Schedule:File", &[&schedule, LIMITS, plan.csv, &column, "1", &hours, "Comma", "No", &minutes, "No"]);
                 let env = format!("SUNLIT ENV {surface}");
                 object(&mut out, "SurfaceProperty:LocalEnvironment", &[&env, surface, &schedule]);
             }
@@ -268,7 +269,7 @@ pub fn patch_epjson(file: &str, text: &str, plan: &HookPlan) -> Result<String> {
                 let schedule = schedule_name(surface);
                 schedules.insert(
                     schedule.clone(),
-                    json!({"schedule_type_limits_name": LIMITS, "file_name": plan.csv, "column_number": k + 2, "rows_to_skip_at_top": 1, "number_of_hours_of_data": 8760,
+                    json!({"schedule_type_limits_name": LIMITS, "file_name": plan.csv, "column_number": k + 2, "rows_to_skip_at_top": 1, "number_of_hours_of_data": 24 * plan.timesteps.days(),
                            "column_separator": "Comma", "interpolate_to_timestep": "No", "minutes_per_item": minutes,
                            "adjust_schedule_for_daylight_savings": "No"}),
                 );

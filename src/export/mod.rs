@@ -106,11 +106,16 @@ impl Schedule {
         };
         let names: Vec<String> = csv_fields(names).map(str::to_string).collect();
         let rows: Vec<&str> = lines.collect();
-        let per_hour = rows.len() / (DAYS_HOURS as usize);
-        let timesteps = match Timesteps::new(per_hour as u32) {
+        // 8760·N rows, or 8784·N for a leap year.
+        let leap = rows.len() % (DAYS_HOURS as usize) != 0;
+        let per_hour = rows.len() / (DAYS_HOURS as usize + 24 * usize::from(leap));
+        let timesteps = match Timesteps::new(per_hour as u32).map(|t| t.leap_year(leap)) {
             Ok(t) if rows.len() == t.rows() => t,
             _ => {
-                let reason = format!("{} rows; a year is 8760 × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows", rows.len());
+                let reason = format!(
+                    "{} rows; a year is 8760 (8784 in a leap year) × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows",
+                    rows.len()
+                );
                 return Err(Error::model(file, reason));
             }
         };
@@ -267,7 +272,7 @@ mod tests {
             (text.replacen("0.12500000,", "0.1,0.2,", 1), "s.csv: line 52: 3 values for 2 surfaces"),
             (
                 text.lines().take(1001).collect::<Vec<_>>().join("\n"),
-                "s.csv: 1000 rows; a year is 8760 × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows",
+                "s.csv: 1000 rows; a year is 8760 (8784 in a leap year) × timesteps per hour (1 2 3 4 5 6 10 12 15 20 30 60) rows",
             ),
             (
                 text.replacen("WIN_S", "wall_s", 1),

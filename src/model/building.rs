@@ -37,6 +37,7 @@ use std::collections::HashMap;
 use glam::{DMat4, DVec2, DVec3};
 
 use super::idf::{IdfObject, object_label};
+use super::reveal::{self, Placement as SubPlacement};
 use crate::error::{Error, Result};
 use crate::geometry::{self, Plane, inside_or_on, newell, plane_deviation};
 use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
@@ -875,10 +876,8 @@ fn azimuth_tilt(vertices: &[DVec3]) -> (f64, f64) {
 fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String> {
     let plane = Plane::of_polygon(&base.vertices);
     let outline: Vec<DVec2> = base.vertices.iter().map(|p| plane.project(*p)).collect();
-    let off = hole.vertices.iter().map(|p| plane.height(*p).abs()).fold(0.0, f64::max);
-    if off > 0.01 {
-        return Some(format!("is {off:.3} m off its base surface's plane"));
-    }
+    // Off the plane is no problem: EnergyPlus cuts a sub-surface's projection out of its base
+    // surface at any offset (see `super::reveal`).
     if hole.vertices.iter().any(|p| !inside_or_on(plane.project(*p), &outline, EDGE_TOLERANCE)) {
         return Some(format!("is not within its base surface '{}'", base.name));
     }
@@ -928,6 +927,14 @@ impl Building {
     fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool) -> Result<()> {
         let holes = self.holes();
         for (i, surface) in self.surfaces.iter().enumerate() {
+            let placed = self.placed(surface);
+            let surface = match &placed {
+                Some(SubPlacement::InPlane(vertices)) => &EpSurface { vertices: vertices.clone(), ..surface.clone() },
+                _ => surface,
+            };
+            if let Some(SubPlacement::SetBack { sides, .. }) = &placed {
+                self.add_reveal(builder, surface, sides);
+            }
             let triangles = triangulate(surface, holes.get(&i).map_or(&[][..], Vec::as_slice));
             let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
             let mesh = builder.add_mesh(format!("{}: {}", self.file, surface.label()), relative_mesh(&triangles, anchor));
@@ -940,6 +947,30 @@ impl Building {
             });
         }
         Ok(())
+    }
+
+    /// Where EnergyPlus puts a window or door against its base surface (None for other surfaces).
+    fn placed(&self, surface: &EpSurface) -> Option<SubPlacement> {
+        let base = surface.base.as_deref().filter(|_| surface.is_fenestration()).and_then(|b| self.surface(b))?;
+        if base.is_fenestration() || base.is_shading() {
+            return None;
+        }
+        reveal::place(&base.vertices, &surface.vertices)
+    }
+
+    /// The sides of a set-back window's reveal: casters only, never receivers (not EnergyPlus
+    /// surfaces), named `<window> reveal`.
+    fn add_reveal(&self, builder: &mut SceneBuilder, surface: &EpSurface, sides: &[[DVec3; 3]]) {
+        let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
+        let origin = format!("{}: the reveal of {}", self.file, surface.label());
+        let mesh = builder.add_mesh(origin.clone(), relative_mesh(sides, anchor));
+        builder.add_node(SourceNode {
+            name: format!("{} reveal", surface.name),
+            origin,
+            mesh,
+            transform: DMat4::from_translation(anchor),
+            receiver: false,
+        });
     }
 
     /// Names of the receivers in the order [`Building::add_to`] adds them.

@@ -20,6 +20,9 @@ pub mod idf;
 pub mod office;
 #[cfg(feature = "fixtures")]
 pub mod office_idf;
+pub mod reveal;
+pub mod run_year;
+pub mod site;
 
 use std::path::PathBuf;
 

@@ -194,6 +194,16 @@ impl<E: Engine> Views<'_, E> {
 /// wall in summer is lit in the morning and again in the evening.
 const MAX_PIECES: usize = 2;
 
+/// The day of the sun model whose sun EnergyPlus's shading uses on calendar day `day`: the day
+/// before. Measured against EnergyPlus 25.2's eplusshading.csv (Golden, annual, Timestep 4): with
+/// the calendar day's sun, 44 timesteps a year disagree on whether the sun is up (sunrise,
+/// sunset), and walls facing east or west on whether the sun is in front of them near noon; with
+/// the previous day's declination and equation of time, none do. So the dark timesteps, and the
+/// fractions at grazing sun, are EnergyPlus's.
+pub fn shading_sun_day(day: u32) -> f64 {
+    f64::from(day) - 1.0
+}
+
 /// Whether the sun counts as up (EnergyPlus's SunIsUp threshold on cos zenith).
 fn sun_is_up(sun: DVec3) -> bool {
     sun.z >= MIN_COS_INCIDENCE
@@ -210,7 +220,7 @@ async fn dense_year(
     let mut requests = Vec::new();
     let mut cells = Vec::new();
     for (row, instant) in schedule.timesteps.instants().enumerate() {
-        let sun = sun_direction(location, instant.day as f64, instant.hour);
+        let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
         if !sun_is_up(sun) {
             continue;
         }
@@ -528,15 +538,19 @@ fn evaluate(
     schedule: &mut Schedule,
 ) -> Vec<(usize, usize, DVec3, f64)> {
     let mut rough = Vec::new();
-    let rows_per_day = schedule.timesteps.rows() / DAYS as usize;
-    for day in 1..=DAYS {
+    let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
+    for day in 1..=schedule.timesteps.days() {
         let pieces: Vec<Vec<(f64, f64)>> =
-            scene.receivers.iter().map(|r| lit_intervals(location, r.normal, day as f64, MIN_COS_INCIDENCE)).collect();
+            scene.receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
         let regime = &regimes[regime_of(day as f64)];
-        let grid_day = regime.map.grid_coordinate(day as f64);
+        // The year's fit is over the sun's day; a foliage ramp's over the leaves' (calendar) day.
+        let grid_day = match regime.map {
+            DayMap::Year(_) => regime.map.grid_coordinate(shading_sun_day(day)),
+            DayMap::Ramp { .. } => regime.map.grid_coordinate(day as f64),
+        };
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
-            let sun = sun_direction(location, day as f64, instant.hour);
+            let sun = sun_direction(location, shading_sun_day(day), instant.hour);
             if !sun_is_up(sun) {
                 continue;
             }

@@ -31,14 +31,15 @@ pub const VALID_TIMESTEPS: [u32; 12] = [1, 2, 3, 4, 5, 6, 10, 12, 15, 20, 30, 60
 pub const DAYS: u32 = 365;
 const MONTH_DAYS: [u32; 12] = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
 
-/// Timesteps per hour, checked against what EnergyPlus accepts.
+/// Timesteps per hour, checked against what EnergyPlus accepts, and whether the year is a leap
+/// year (366 days, 8784·N rows, Feb 29 as day 60, as EnergyPlus runs a leap year).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Timesteps(u32);
+pub struct Timesteps(u32, bool);
 
 /// One output row's instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Instant {
-    /// Day of year, 1..=365.
+    /// Day of year, 1..=365 (366 in a leap year).
     pub day: u32,
     /// Local standard time in hours at which the value holds.
     pub hour: f64,
@@ -48,7 +49,7 @@ impl Timesteps {
     /// `per_hour` must be one of [`VALID_TIMESTEPS`].
     pub fn new(per_hour: u32) -> Result<Self> {
         if VALID_TIMESTEPS.contains(&per_hour) {
-            Ok(Self(per_hour))
+            Ok(Self(per_hour, false))
         } else {
             Err(Error::argument("timesteps_per_hour", format!("{per_hour} is not one EnergyPlus accepts ({VALID_TIMESTEPS:?})")))
         }
@@ -59,9 +60,24 @@ impl Timesteps {
         self.0
     }
 
-    /// Rows in a year: 8760·N.
+    /// The same timesteps over a leap year (366 days) or not.
+    pub fn leap_year(self, leap: bool) -> Self {
+        Self(self.0, leap)
+    }
+
+    /// Whether the year has 366 days.
+    pub fn is_leap(self) -> bool {
+        self.1
+    }
+
+    /// Days in the year: 365, or 366 in a leap year.
+    pub fn days(self) -> u32 {
+        DAYS + u32::from(self.1)
+    }
+
+    /// Rows in a year: 8760·N, or 8784·N in a leap year.
     pub fn rows(self) -> usize {
-        (DAYS * 24 * self.0) as usize
+        (self.days() * 24 * self.0) as usize
     }
 
     /// The instant of row `row` (0-based).
@@ -84,15 +100,21 @@ impl Timesteps {
         let n = self.0 as usize;
         let day = row / (24 * n) + 1;
         let minutes = ((row % (24 * n)) + 1) * 60 / n;
-        let (month, dom) = month_day(day as u32);
+        let (month, dom) = month_day_of(day as u32, self.1);
         format!(" {month:02}/{dom:02} {:02}:{:02}", minutes / 60, minutes % 60)
     }
 }
 
 /// Month and day of month (1-based) of a day of a non-leap year.
 pub fn month_day(day_of_year: u32) -> (u32, u32) {
-    let mut d = day_of_year.clamp(1, DAYS);
+    month_day_of(day_of_year, false)
+}
+
+/// Month and day of month (1-based) of a day of a leap year (`leap`) or not.
+pub fn month_day_of(day_of_year: u32, leap: bool) -> (u32, u32) {
+    let mut d = day_of_year.clamp(1, DAYS + u32::from(leap));
     for (m, len) in MONTH_DAYS.iter().enumerate() {
+        let len = &(len + u32::from(leap && m == 1));
         if d <= *len {
             return (m as u32 + 1, d);
         }
