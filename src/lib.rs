@@ -11,6 +11,7 @@
 //! - [`sun`]: sun positions and directions;
 //! - [`count`]: the GPU pixel counter and the exact CPU polygon-clipping reference.
 //! - [`season`]: the leaf calendar that foliage follows through the year.
+//! - `sweep` (native only): many annual runs from a manifest, locally or as a Slurm job array.
 //!
 //! ```no_run
 //! # fn main() -> sunlit::Result<()> {
@@ -35,6 +36,8 @@ pub mod scene;
 pub mod season;
 pub mod spline;
 pub mod sun;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod sweep;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 
