@@ -1,4 +1,8 @@
 //! `sunlit`, the command line: a thin edge over the library.
+//!
+//! Owns the flags: clap parses them, they become the library's settings
+//! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
+//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,17 +11,18 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
-use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::exact::Exact;
+use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::Progress;
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::settings::AnnualSettings;
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -74,7 +79,7 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
@@ -100,14 +105,24 @@ struct AnnualArgs {
 }
 
 impl AnnualArgs {
-    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
-        if self.evergreen {
-            return Ok(LeafCalendar::evergreen());
-        }
-        match (&self.leaf_out, &self.leaf_fall) {
-            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
-            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
-        }
+    /// The flags as the library's settings (resolved there, as the web's are).
+    fn settings(&self) -> Result<AnnualSettings> {
+        let coordinates = self.location.as_deref().map(Location::parse).transpose()?;
+        Ok(AnnualSettings {
+            latitude: coordinates.as_ref().map(|l| l.latitude),
+            longitude: coordinates.as_ref().map(|l| l.longitude),
+            time_zone: coordinates.as_ref().map(|l| l.time_zone),
+            epw_file: self.epw.clone(),
+            timesteps_per_hour: self.timesteps_per_hour,
+            days_per_year: Some(self.days_per_year),
+            samples_per_day: Some(self.samples_per_day),
+            refine: Some(self.refine),
+            dense: Some(self.dense),
+            evergreen: Some(self.evergreen),
+            leaf_out: self.leaf_out.clone(),
+            leaf_fall: self.leaf_fall.clone(),
+            ..Default::default()
+        })
     }
 }
 
@@ -265,10 +280,39 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", e.render(&flag));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The library's parameter names and the flags that set them: errors name the flag.
+const FLAGS: &[(&str, &str)] = &[
+    ("receivers", "--receivers"),
+    ("north", "--north"),
+    ("foliage", "--foliage"),
+    ("transmittance", "--transmittance"),
+    ("location", "--location"),
+    ("sun", "--sun"),
+    ("leaves", "--leaves"),
+    ("timesteps_per_hour", "--timesteps-per-hour"),
+    ("days_per_year", "--days-per-year"),
+    ("samples_per_day", "--samples-per-day"),
+    ("refine", "--refine"),
+    ("resolution", "--resolution"),
+    ("accuracy", "--accuracy"),
+    ("hook", "--hook"),
+    ("leaf_out", "--leaf-out"),
+    ("leaf_fall", "--leaf-fall"),
+    ("lanes", "--lanes"),
+    ("jobs", "--jobs"),
+    ("per_task", "--per-task"),
+    ("index", "--index"),
+];
+
+/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
+fn flag(param: &str) -> String {
+    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
@@ -334,33 +378,27 @@ fn lanes(first: Counter, lanes: Option<usize>, scene: &Scene) -> Result<Vec<(Cou
 
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
-    if !(0.0..=1.0).contains(&args.leaves) {
-        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
-    }
-    let leaves = args.leaves as f32;
+    let leaves = leaf_fraction(args.leaves)?;
     let scene = args.model.load()?;
     let dir = sun.direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
-    let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
-            .into_iter()
-            .zip(&scene.receivers)
-            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
-            .collect()
+    let requests: Vec<ViewRequest> =
+        (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, dir).with_leaves(leaves)).collect();
+    let answers: Vec<ViewAnswer> = if args.exact {
+        pollster::block_on(Exact { scene: &scene }.answer(&requests))?
     } else {
         let counter = counter(&args.pixels)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
+        pollster::block_on(Lane { counter: &counter, gpu: &gpu }.answer(&requests))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
             .receivers
             .iter()
-            .zip(&counted)
+            .zip(&answers)
             .map(|(r, c)| {
                 json!({
                     "name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6),
-                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side,
+                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side.unwrap_or(0),
                 })
             })
             .collect();
@@ -383,7 +421,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
-    for (r, c) in scene.receivers.iter().zip(&counted) {
+    for (r, c) in scene.receivers.iter().zip(&answers) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
     }
     Ok(())
@@ -391,17 +429,8 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
-    if !(0.0..=1.0).contains(&args.refine) {
-        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
-    }
-    let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
+    let settings = args.settings()?.resolve()?;
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
-    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -409,7 +438,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
-    let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
+    let timesteps = options.timesteps;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
@@ -427,9 +457,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
-    let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule = pollster::block_on(sunlit::year::annual::annual_recovering(
+        &mut lanes,
+        &scene,
+        &settings.location,
+        &options,
+        &settings.calendar,
+        &mut report,
+    ))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -580,7 +616,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
-        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
 }
@@ -616,7 +652,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
-        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {
@@ -625,7 +661,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
@@ -753,30 +789,16 @@ fn sweep_line_problem(variant: &sunlit::sweep::Variant, dir: &std::path::Path) -
             return Some(first.join(" ").trim_start_matches("error:").trim().to_string());
         }
     };
-    annual_refusals(&line.args).err().map(|e| e.to_string())
+    annual_refusals(&line.args).err().map(|e| e.render(&flag))
 }
 
-/// The checks `annual` makes before loading the models (refine, sampling plan, location, hook,
-/// leaf calendar, timesteps, lanes).
+/// The checks `annual` makes before loading the models (its settings resolved, the hook, lanes).
 fn annual_refusals(args: &AnnualArgs) -> Result<()> {
-    if !(0.0..=1.0).contains(&args.refine) {
-        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
-    }
-    if !args.dense {
-        SamplingPlan::new(args.days_per_year, args.samples_per_day)?;
-    }
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
+    let settings = args.settings()?.resolve()?;
+    settings.options(None)?;
     args.hook.as_deref().map(Hook::parse).transpose()?;
-    args.calendar(&location)?;
-    if let Some(t) = args.timesteps_per_hour {
-        Timesteps::new(t)?;
-    }
     if args.lanes == Some(0) {
-        return Err(Error::argument("--lanes", "must be at least 1"));
+        return Err(Error::argument("lanes", "must be at least 1"));
     }
     Ok(())
 }
@@ -786,10 +808,10 @@ fn sweep(args: SweepArgs) -> Result<()> {
     let io = |source: std::io::Error, path: &std::path::Path| Error::Io { path: path.to_path_buf(), source };
     let dir = std::path::absolute(&args.output).map_err(|e| io(e, &args.output))?;
     if args.jobs == 0 {
-        return Err(Error::argument("--jobs", "must be at least 1"));
+        return Err(Error::argument("jobs", "must be at least 1"));
     }
     if args.per_task == 0 {
-        return Err(Error::argument("--per-task", "must be at least 1"));
+        return Err(Error::argument("per_task", "must be at least 1"));
     }
     // Every line is checked, and every problem reported, before anything is counted.
     let mut manifest = Manifest::read(&args.manifest, &annual_schema())?;

@@ -29,7 +29,7 @@ pub const FAILED_CSV: &str = "failed.csv";
 /// `per_task` consecutive variants in manifest order.
 pub fn chunk(variants: &[Variant], index: usize, per_task: usize) -> Result<Vec<&Variant>> {
     if per_task == 0 {
-        return Err(Error::argument("per-task", "must be at least 1"));
+        return Err(Error::argument("per_task", "must be at least 1"));
     }
     let tasks = variants.len().div_ceil(per_task);
     if index >= tasks {

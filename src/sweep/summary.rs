@@ -90,7 +90,7 @@ fn field(text: &str) -> String {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
-    use crate::samples::Timesteps;
+    use crate::year::samples::Timesteps;
 
     #[test]
     fn means_count_only_sun_up_timesteps() {
