@@ -15,7 +15,8 @@
 //!   polygon-clipping reference ([`count::exact`]);
 //! - [`year`]: sampling plan, leaf calendar, the settings resolver, the spline and the annual run;
 //! - [`export`]: the EnergyPlus CSV and the model hooked to it;
-//! - [`error`]: the one typed error, naming parameters, files and objects.
+//! - [`error`]: the one typed error, naming parameters, files and objects;
+//! - `sweep` (native only): many annual runs from a manifest, locally or as a Slurm job array.
 //!
 //! Two thin edges drive it: the CLI (`src/main.rs`) and the wasm-bindgen API (`web`, wasm
 //! only). With the `fixtures` feature (the CLI's), `bench` and `model::{office, office_idf,
@@ -47,6 +48,8 @@ pub mod model;
 mod platform;
 pub mod scene;
 pub mod sun;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod sweep;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 pub mod year;

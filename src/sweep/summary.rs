@@ -1,0 +1,121 @@
+//! The sweep's summary: per variant and surface, the mean sunlit fraction over the year's sun-up
+//! timesteps, beside the variant's settings, as `summary.csv`.
+//!
+//! The means are taken once, when a variant finishes, from its CSV (read back with
+//! [`Schedule::from_csv`]) and the sun at each timestep, and kept in its done record; the summary
+//! is assembled from the records. Annual irradiation (where an EPW gives the weather) belongs
+//! beside the mean as further [`SurfaceMean`] fields and columns here.
+
+use std::path::Path;
+
+use super::manifest::Variant;
+use super::record::{Done, SurfaceMean};
+use crate::count::MIN_COS_INCIDENCE;
+use crate::error::{Error, Result};
+use crate::export::Schedule;
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+
+/// The summary's file name in the output folder.
+pub const SUMMARY: &str = "summary.csv";
+
+/// Where the variant's sun is: its `epw` file's LOCATION, else its `location` setting.
+pub fn location(variant: &Variant) -> Result<Location> {
+    match (variant.arg("epw"), variant.arg("location")) {
+        (Some(epw), _) => Location::from_epw(Path::new(epw)),
+        (None, Some(text)) => Location::parse(text),
+        (None, None) => Err(Error::argument(format!("variant '{}'", variant.id), "has neither epw nor location")),
+    }
+}
+
+/// Per column of `schedule`, the mean over the timesteps with the sun up (EnergyPlus's rule:
+/// cosine of the zenith at least [`MIN_COS_INCIDENCE`]).
+pub fn means(schedule: &Schedule, location: &Location) -> Vec<SurfaceMean> {
+    let columns = schedule.names.len();
+    let mut sums = vec![0.0f64; columns];
+    let mut up = 0usize;
+    for (row, instant) in schedule.timesteps.instants().enumerate() {
+        if sun_direction(location, instant.day as f64, instant.hour).z < MIN_COS_INCIDENCE {
+            continue;
+        }
+        up += 1;
+        for (c, sum) in sums.iter_mut().enumerate() {
+            *sum += schedule.get(row, c) as f64;
+        }
+    }
+    schedule
+        .names
+        .iter()
+        .zip(sums)
+        .map(|(name, sum)| SurfaceMean { surface: name.clone(), mean_fraction: sum / up.max(1) as f64, sunup_timesteps: up })
+        .collect()
+}
+
+/// The means of the variant's CSV in `dir`.
+pub fn means_of(dir: &Path, variant: &Variant) -> Result<Vec<SurfaceMean>> {
+    let path = variant.csv(dir);
+    let text = std::fs::read_to_string(&path).map_err(|source| Error::Io { path: path.clone(), source })?;
+    let schedule = Schedule::from_csv(&path.display().to_string(), &text)?;
+    Ok(means(&schedule, &location(variant)?))
+}
+
+/// The summary's text: a header, then a row per finished variant and surface, in manifest order.
+/// Settings columns are every key any variant sets, sorted; a variant without it leaves it empty.
+pub fn summary_csv(finished: &[(&Variant, &Done)]) -> String {
+    let mut keys: Vec<&str> = finished.iter().flat_map(|(v, _)| v.settings.iter().map(|(k, _)| k.as_str())).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    let mut header = vec!["id", "surface", "mean_sunlit_fraction", "sunup_timesteps"];
+    header.extend(&keys);
+    let mut out = header.iter().map(|h| field(h)).collect::<Vec<_>>().join(",");
+    out.push('\n');
+    for (variant, done) in finished {
+        let settings: Vec<String> = keys.iter().map(|k| field(variant.setting(k).unwrap_or(""))).collect();
+        for s in &done.surfaces {
+            let mut row = vec![field(&variant.id), field(&s.surface), format!("{:.6}", s.mean_fraction), s.sunup_timesteps.to_string()];
+            row.extend(settings.iter().cloned());
+            out.push_str(&row.join(","));
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// A CSV field, quoted when it holds a comma, quote or line break.
+fn field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) { format!("\"{}\"", text.replace('"', "\"\"")) } else { text.to_string() }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::year::samples::Timesteps;
+
+    #[test]
+    fn means_count_only_sun_up_timesteps() {
+        // Golden, CO: 1.0 by day and 0.5 by night means 1.0 over the sun-up rows.
+        let location = Location::new(39.74, -105.18, -7.0).unwrap();
+        let t = Timesteps::new(1).unwrap();
+        let mut s = Schedule::zeros(vec!["A".into(), "B".into()], t);
+        let mut up = 0;
+        for (row, i) in t.instants().enumerate() {
+            let day = sun_direction(&location, i.day as f64, i.hour).z >= MIN_COS_INCIDENCE;
+            up += day as usize;
+            s.set(row, 0, if day { 1.0 } else { 0.5 });
+            s.set(row, 1, if day && row % 2 == 0 { 1.0 } else { 0.0 });
+        }
+        let m = means(&s, &location);
+        assert!((4300..4500).contains(&up), "about half the hours of a year: {up}");
+        assert_eq!(m[0].mean_fraction, 1.0);
+        assert_eq!(m[0].sunup_timesteps, up);
+        assert!((m[1].mean_fraction - 0.5).abs() < 0.01, "{}", m[1].mean_fraction);
+    }
+
+    #[test]
+    fn fields_with_commas_are_quoted() {
+        assert_eq!(field("46.5,11.35,1"), "\"46.5,11.35,1\"");
+        assert_eq!(field("a,\"b\""), "\"a,\"\"b\"\"\"");
+        assert_eq!(field("WIN_S1"), "WIN_S1");
+    }
+}

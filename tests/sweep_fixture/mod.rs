@@ -1,0 +1,94 @@
+//! The sweep tests' variants: the example office with louvres of two depths (generated here with
+//! the library's glb writer) at three orientations, at small settings so a variant takes seconds.
+#![allow(dead_code, clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sunlit::model::glb_write::GlbWriter;
+use sunlit::model::office::office;
+
+/// Louvre depths (cm) and orientations (degrees of `north`).
+pub const DEPTHS: [u32; 2] = [20, 50];
+pub const NORTHS: [u32; 3] = [0, 90, 180];
+/// `annual` options every variant shares.
+pub const SMALL: &str =
+    r#""location": "46.5,11.35,1", "days-per-year": 3, "samples-per-day": 5, "resolution": 64, "timesteps-per-hour": 1"#;
+
+pub fn sunlit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).output().expect("run sunlit")
+}
+
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A fresh folder.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Six slats `depth` m deep in front of the office's south windows (x 1.25–8.75 m, sill 1 m to
+/// head 2.5 m), 0.1 m out from the wall: a context file that only casts shadows.
+pub fn louvres(depth: f32) -> Vec<u8> {
+    let (w, t) = (7.5f32, 0.02f32);
+    let c = |i: usize| [if i & 1 == 0 { 0.0 } else { w }, if i & 2 == 0 { -depth } else { 0.0 }, if i & 4 == 0 { 0.0 } else { t }];
+    let positions: Vec<[f32; 3]> = (0..8).map(c).collect();
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let indices: Vec<u32> = quads.iter().flat_map(|q: &[u32; 4]| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+    let mut glb = GlbWriter::new();
+    let mesh = glb.add_mesh("SLAT", &positions, &indices);
+    for k in 0..6 {
+        glb.add_node(&format!("SLAT_{k}"), mesh, [1.25, -0.1, 1.0 + 0.25 * k as f32 + 0.1], None);
+    }
+    glb.to_glb()
+}
+
+/// Writes the models and returns the manifest's lines: `d{depth}_n{north}`, depth × north.
+pub fn variants(dir: &Path) -> Vec<String> {
+    std::fs::write(dir.join("office.glb"), office(0).to_glb()).unwrap();
+    let mut lines = Vec::new();
+    for d in DEPTHS {
+        std::fs::write(dir.join(format!("louvres-{d}.glb")), louvres(d as f32 / 100.0)).unwrap();
+        for n in NORTHS {
+            lines.push(format!(r#"{{"id": "d{d}_n{n}", "models": ["office.glb", "louvres-{d}.glb"], "north": {n}, {SMALL}}}"#));
+        }
+    }
+    lines
+}
+
+pub fn write_manifest(dir: &Path, name: &str, lines: &[String]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+    path
+}
+
+/// The ids of `lines`, in order.
+pub fn ids(lines: &[String]) -> Vec<String> {
+    lines.iter().map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["id"].as_str().unwrap().to_string()).collect()
+}
+
+/// Every file under `dir` whose name says it is a write in progress.
+pub fn partial_files(dir: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.to_string_lossy().ends_with(".partial") {
+                found.push(p);
+            }
+        }
+    }
+    found
+}
+
+/// Modification times of the done records, by id.
+pub fn record_times(out: &Path, ids: &[String]) -> Vec<Option<std::time::SystemTime>> {
+    ids.iter().map(|id| std::fs::metadata(out.join(".done").join(format!("{id}.json"))).and_then(|m| m.modified()).ok()).collect()
+}
