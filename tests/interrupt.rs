@@ -20,11 +20,24 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// A dense annual run on the example office: tens of seconds of counting on lavapipe.
+/// A dense annual run on the example office, counted by the GPU path: tens of seconds on lavapipe
+/// (the exact engine that `auto` picks for this model would finish before the signal).
 fn start_annual(dir: &Path) -> Child {
     std::fs::write(dir.join("office.glb"), office(2).to_glb()).unwrap();
     Command::new(env!("CARGO_BIN_EXE_sunlit"))
-        .args(["annual", "office.glb", "--location", "40,-105,-7", "--dense", "--timesteps-per-hour", "4", "-o", "out.csv"])
+        .args([
+            "annual",
+            "office.glb",
+            "--location",
+            "40,-105,-7",
+            "--dense",
+            "--engine",
+            "gpu",
+            "--timesteps-per-hour",
+            "4",
+            "-o",
+            "out.csv",
+        ])
         .current_dir(dir)
         .env("XDG_RUNTIME_DIR", runtime_dir())
         .stdout(Stdio::null())

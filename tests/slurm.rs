@@ -173,8 +173,9 @@ fn slurm_array_equals_the_local_sweep_and_a_cancelled_task_is_all_a_resubmission
     let dir = scratch("sweep-slurm");
     let cluster = Cluster::start(&dir.join("slurm"));
     let fast = variants(&dir);
-    // The seventh variant counts every timestep densely: slow enough to be cancelled running.
-    let slow = r#"{"id": "slow", "models": ["office.glb", "louvres-50.glb"], "dense": true, "location": "46.5,11.35,1", "resolution": 64, "timesteps-per-hour": 2}"#.to_string();
+    // The seventh variant counts every timestep densely on the GPU path (the exact engine would finish it
+    // in a second): slow enough to be cancelled running.
+    let slow = r#"{"id": "slow", "models": ["office.glb", "louvres-50.glb"], "dense": true, "engine": "gpu", "location": "46.5,11.35,1", "resolution": 64, "timesteps-per-hour": 2}"#.to_string();
     let local = write_manifest(&dir, "local.jsonl", &fast);
     let all: Vec<String> = fast.iter().cloned().chain([slow]).collect();
     let ids = ids(&all);
