@@ -1,14 +1,17 @@
 //! glTF 2.0 reader (.gltf and .glb, from a path or from bytes) into [`SourceNode`]s and meshes.
 //!
-//! Owns: resolving buffers (GLB chunk, `data:` URIs, files beside a `.gltf`), reading positions
-//! and indices with explicit bounds checks (a hostile file must give an error, never a panic),
-//! node transforms, the glTF → sunlit axis change (x, y, z) = (gx, −gz, gy) and the north rotation.
+//! Owns: resolving buffers (GLB chunk, `data:` URIs, files beside a `.gltf`), the order of the
+//! extension passes (`gltf_extensions`, `gltf_draco`) before validation, meshes from primitives
+//! (every triangle mode; points and lines left out), the scene's node walk with transforms, the
+//! glTF → sunlit axis change (x, y, z) = (gx, −gz, gy) and the north rotation. Accessors are read
+//! in `gltf_accessor`, with explicit bounds checks (a hostile file gives an error, never a panic).
 
 use std::path::Path;
 
 use base64::Engine as _;
 use glam::{DMat4, DVec4};
 
+use super::{gltf_accessor, gltf_draco, gltf_extensions};
 use crate::error::{Error, Result};
 use crate::scene::{NodeVeil, SourceMesh, SourceNode};
 
@@ -92,16 +95,38 @@ fn read_with(
 ) -> Result<GltfModel> {
     check_magic(file, bytes)?;
     check_position_accessors(file, bytes)?;
-    let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
-    let buffers = load_buffers(file, &gltf, external)?;
-    let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
+    let invalid = |e: ::gltf::Error| Error::model(file, format!("not a valid glTF 2.0 file: {e}"));
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // Extensions are resolved on the JSON before the gltf crate validates it: compressed views
+    // and primitives are decoded into plain buffers, so the rest reads plain glTF.
+    let mut root = document.into_json();
+    gltf_extensions::accept_required(file, &mut root)?;
+    let mut buffers = load_buffers(file, &root, blob, external)?;
+    gltf_extensions::decode_meshopt(file, &mut root, &mut buffers)?;
+    gltf_draco::decode_draco(file, &mut root, &mut buffers)?;
+    let document = ::gltf::Document::from_json(root).map_err(invalid)?;
+    let meshes = document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
+    warn_skipped_primitives(file, &document);
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
-    let mut walked = vec![false; gltf.document.nodes().len()];
-    for root in scene_roots(&gltf.document) {
+    let mut walked = vec![false; document.nodes().len()];
+    for root in scene_roots(&document) {
         collect_nodes(file, &root, world, &mut nodes, &mut walked)?;
     }
     Ok(GltfModel { file: file.to_string(), meshes, nodes })
+}
+
+/// Points and lines cast no shadow and have no area: they are left out, and the user told once.
+fn warn_skipped_primitives(file: &str, document: &::gltf::Document) {
+    use ::gltf::mesh::Mode;
+    let skipped = document
+        .meshes()
+        .flat_map(|m| m.primitives())
+        .filter(|p| matches!(p.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip))
+        .count();
+    if skipped > 0 {
+        log::warn!("{file}: {skipped} point or line primitive(s) left out (they cast no shadow)");
+    }
 }
 
 fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
@@ -118,23 +143,29 @@ fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
     Err(Error::model(file, "not a glTF file: expected the binary magic 'glTF' or a JSON object"))
 }
 
-fn load_buffers(file: &str, gltf: &::gltf::Gltf, external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>) -> Result<Vec<Vec<u8>>> {
+fn load_buffers(
+    file: &str,
+    root: &::gltf::json::Root,
+    blob: Option<Vec<u8>>,
+    external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>,
+) -> Result<Vec<Vec<u8>>> {
     let mut out = Vec::new();
-    for buffer in gltf.document.buffers() {
-        let data = match buffer.source() {
-            ::gltf::buffer::Source::Bin => {
-                gltf.blob.clone().ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?
-            }
-            ::gltf::buffer::Source::Uri(uri) => match uri.strip_prefix("data:") {
-                Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {}: {r}", buffer.index())))?,
+    for (index, buffer) in root.buffers.iter().enumerate() {
+        if gltf_extensions::is_fallback(buffer) {
+            // Stands in for meshopt-compressed data; its views are decoded into new buffers.
+            out.push(Vec::new());
+            continue;
+        }
+        let data = match &buffer.uri {
+            None => blob.clone().ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?,
+            Some(uri) => match uri.strip_prefix("data:") {
+                Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {index}: {r}")))?,
                 None => external(uri).map_err(|r| Error::model(file, r))?,
             },
         };
-        if data.len() < buffer.length() {
-            return Err(Error::model(
-                file,
-                format!("buffer {} is truncated: {} bytes present, {} declared", buffer.index(), data.len(), buffer.length()),
-            ));
+        let declared = buffer.byte_length.0;
+        if (data.len() as u64) < declared {
+            return Err(Error::model(file, format!("buffer {index} is truncated: {} bytes present, {declared} declared", data.len())));
         }
         out.push(data);
     }
@@ -263,9 +294,9 @@ fn read_mesh(file: &str, mesh: &::gltf::Mesh, buffers: &[Vec<u8>]) -> Result<Sou
         let Some(pos) = prim.get(&::gltf::Semantic::Positions) else {
             return Err(err(format!("primitive {} has no POSITION attribute", prim.index())));
         };
-        let positions = read_positions(&pos, buffers).map_err(&err)?;
+        let positions = gltf_accessor::read_positions(&pos, buffers).map_err(&err)?;
         let indices = match prim.indices() {
-            Some(acc) => read_indices(&acc, buffers).map_err(&err)?,
+            Some(acc) => gltf_accessor::read_indices(&acc, buffers).map_err(&err)?,
             None => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
@@ -290,72 +321,6 @@ fn triangles(mode: ::gltf::mesh::Mode, idx: &[u32]) -> std::result::Result<Vec<u
         Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
         Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
     })
-}
-
-/// The bytes of an accessor's elements, bounds-checked against its view and buffer.
-fn accessor_bytes<'a>(acc: &::gltf::Accessor, buffers: &'a [Vec<u8>], elem: usize) -> std::result::Result<(&'a [u8], usize), String> {
-    if acc.sparse().is_some() {
-        return Err(format!("accessor {} is sparse, which is not supported", acc.index()));
-    }
-    let view = acc.view().ok_or_else(|| format!("accessor {} has no buffer view", acc.index()))?;
-    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| format!("buffer {} is missing", view.buffer().index()))?;
-    let stride = view.stride().unwrap_or(elem);
-    let start = view.offset().checked_add(acc.offset()).ok_or("offset overflow")?;
-    let view_end = view.offset().checked_add(view.length()).ok_or("offset overflow")?;
-    let need = match acc.count() {
-        0 => 0,
-        n => stride.checked_mul(n - 1).and_then(|x| x.checked_add(elem)).ok_or("size overflow")?,
-    };
-    let end = start.checked_add(need).ok_or("size overflow")?;
-    if end > view_end || view_end > buffer.len() {
-        return Err(format!(
-            "accessor {} reads bytes {start}..{end} beyond its buffer view (ends at {view_end}) or buffer ({} bytes)",
-            acc.index(),
-            buffer.len()
-        ));
-    }
-    Ok((&buffer[start..end], stride))
-}
-
-fn read_positions(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<[f32; 3]>, String> {
-    use ::gltf::accessor::{DataType, Dimensions};
-    if acc.data_type() != DataType::F32 || acc.dimensions() != Dimensions::Vec3 {
-        return Err(format!("POSITION accessor {} must be float VEC3 (quantized positions are not supported)", acc.index()));
-    }
-    let (bytes, stride) = accessor_bytes(acc, buffers, 12)?;
-    Ok((0..acc.count())
-        .map(|i| {
-            let f = |k: usize| {
-                let o = i * stride + 4 * k;
-                f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]])
-            };
-            [f(0), f(1), f(2)]
-        })
-        .collect())
-}
-
-fn read_indices(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<u32>, String> {
-    use ::gltf::accessor::{DataType, Dimensions};
-    let size = match acc.data_type() {
-        DataType::U8 => 1,
-        DataType::U16 => 2,
-        DataType::U32 => 4,
-        other => return Err(format!("index accessor {} has type {other:?}; expected an unsigned integer", acc.index())),
-    };
-    if acc.dimensions() != Dimensions::Scalar {
-        return Err(format!("index accessor {} is not SCALAR", acc.index()));
-    }
-    let (bytes, stride) = accessor_bytes(acc, buffers, size)?;
-    Ok((0..acc.count())
-        .map(|i| {
-            let o = i * stride;
-            match size {
-                1 => bytes[o] as u32,
-                2 => u16::from_le_bytes([bytes[o], bytes[o + 1]]) as u32,
-                _ => u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]),
-            }
-        })
-        .collect())
 }
 
 impl GltfModel {
