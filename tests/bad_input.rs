@@ -645,3 +645,72 @@ fn out_of_range_options() {
     check("output folder", office("invalid --output: {dir} is a folder", &["-o", "{dir}"]));
     check("output in missing folder", office("no/such/out.csv: No such file or directory (os error 2)", &["-o", "{dir}/no/such/out.csv"]));
 }
+
+/// glTF extensions: one sunlit does not read is named with what to run; compressed data that
+/// does not decode names its view or primitive, the reason, and the same conversion.
+#[test]
+fn unread_extensions_and_undecodable_compression() {
+    let node = r#"{"name":"A","mesh":0}"#;
+    let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let convert = "convert it to plain glTF, e.g. with glTF Transform: `npx @gltf-transform/cli copy IN.glb OUT.glb` (which writes no compression), or re-export it without that extension";
+    let required = |ext: &str| {
+        text.replacen(
+            r#"{"asset":{"version":"2.0"},"#,
+            &format!(r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["{ext}"],"extensionsRequired":["{ext}"],"#),
+            1,
+        )
+    };
+    check(
+        "unread required extension",
+        Case::model(
+            "instanced.gltf",
+            required("EXT_mesh_gpu_instancing").into_bytes(),
+            &format!(
+                "instanced.gltf: requires the glTF extension 'EXT_mesh_gpu_instancing', which sunlit does not read (it reads \
+                 KHR_mesh_quantization, EXT_meshopt_compression, KHR_meshopt_compression, KHR_draco_mesh_compression); {convert}"
+            ),
+        ),
+    );
+    // A view claiming meshopt-compressed vertices, whose "compressed" bytes are the plain indices.
+    let meshopt = required("EXT_meshopt_compression").replacen(
+        r#"{"buffer":0,"byteLength":48}"#,
+        r#"{"buffer":0,"byteLength":48,"byteStride":12,"extensions":{"EXT_meshopt_compression":{"buffer":0,"byteOffset":48,"byteLength":24,"byteStride":12,"count":4,"mode":"ATTRIBUTES"}}}"#,
+        1,
+    );
+    check(
+        "meshopt data that does not decode",
+        Case::model(
+            "meshopt.gltf",
+            meshopt.into_bytes(),
+            &format!(
+                "meshopt.gltf: bufferView 0: EXT_meshopt_compression: the attributes data could not be decoded (invalid encoded stream); {convert}"
+            ),
+        ),
+    );
+    // A primitive claiming Draco data, whose bytes are the plain positions.
+    let draco = required("KHR_draco_mesh_compression").replacen(
+        r#""attributes":{"POSITION":0},"indices":1}"#,
+        r#""attributes":{"POSITION":0},"indices":1,"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}"#,
+        1,
+    );
+    check(
+        "draco data that does not decode",
+        Case::model(
+            "draco.gltf",
+            draco.into_bytes(),
+            &format!(
+                "draco.gltf: mesh 0 primitive 0: KHR_draco_mesh_compression: the Draco data in bufferView 0 could not be decoded (General error: Invalid magic); {convert}"
+            ),
+        ),
+    );
+    // Unsigned ints are no position type, quantized or not.
+    let uint = text.replacen(r#""componentType":5126"#, r#""componentType":5125"#, 1);
+    check(
+        "positions of unsigned ints",
+        Case::model(
+            "uint.gltf",
+            uint.into_bytes(),
+            "uint.gltf: mesh 0 '': POSITION accessor 0 is Vec3 of U32; expected VEC3 of float, or of (normalized) byte or short (KHR_mesh_quantization)",
+        ),
+    );
+}
