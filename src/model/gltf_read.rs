@@ -353,6 +353,7 @@ impl GltfModel {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
     use glam::DVec3;
 
@@ -372,6 +373,68 @@ mod tests {
         for (bytes, needle) in [(&b""[..], "empty"), (b"PK\x03\x04", "not a glTF"), (b"glTF\x02\x00\x00\x00", "not a valid glTF")] {
             let e = read_bytes("x.glb", bytes, 0.0).unwrap_err().to_string();
             assert!(e.starts_with("x.glb: ") && e.contains(needle), "{e}");
+        }
+    }
+
+    /// A unit square in the ground plane as a strip, a fan and a list; its positions stored
+    /// sparse (no buffer view: zeros, then three substituted vertices).
+    fn square(mode: u32, indices: &[u8]) -> Vec<u8> {
+        // Sparse: vertices 1, 2, 3 of four (vertex 0 stays at the origin).
+        let mut bin: Vec<u8> = vec![1, 2, 3, 0];
+        for p in [[1.0f32, 0.0, 0.0], [1.0, 0.0, -1.0], [0.0, 0.0, -1.0]] {
+            bin.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        bin.extend(indices);
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":{len}}}],
+            "bufferViews":[{{"buffer":0,"byteLength":4}},{{"buffer":0,"byteOffset":4,"byteLength":36}},{{"buffer":0,"byteOffset":40,"byteLength":{n}}}],
+            "accessors":[{{"componentType":5126,"count":4,"type":"VEC3","min":[0,0,-1],"max":[1,0,0],
+                "sparse":{{"count":3,"indices":{{"bufferView":0,"componentType":5121}},"values":{{"bufferView":1}}}}}},
+                {{"bufferView":2,"componentType":5121,"count":{n},"type":"SCALAR"}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"mode":{mode}}}]}}],
+            "nodes":[{{"name":"sq","mesh":0}}],"scenes":[{{"nodes":[0]}}]}}"#,
+            len = bin.len(),
+            n = indices.len()
+        )
+        .into_bytes()
+    }
+
+    /// The area of a mesh's triangles (sunlit axes do not matter for an area).
+    fn area(mesh: &SourceMesh) -> f64 {
+        mesh.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = |i: u32| glam::Vec3::from(mesh.positions[i as usize]).as_dvec3();
+                (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length() / 2.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn strips_fans_lists_and_sparse_positions_give_the_same_square() {
+        // glTF modes: 4 TRIANGLES, 5 TRIANGLE_STRIP, 6 TRIANGLE_FAN.
+        for (mode, indices) in [(4, &[0u8, 1, 2, 0, 2, 3][..]), (5, &[1, 2, 0, 3][..]), (6, &[0, 1, 2, 3][..])] {
+            let model = read_bytes("sq.gltf", &square(mode, indices), 0.0).unwrap();
+            let mesh = &model.meshes[0];
+            assert_eq!(mesh.indices.len(), 6, "mode {mode}");
+            assert!((area(mesh) - 1.0).abs() < 1e-9, "mode {mode}: area {}", area(mesh));
+            // Every triangle faces up (+Y in glTF): strips alternate their winding back.
+            for t in mesh.indices.chunks_exact(3) {
+                let p = |i: u32| glam::Vec3::from(mesh.positions[i as usize]);
+                assert!((p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).y > 0.0, "mode {mode}: {t:?} faces down");
+            }
+        }
+    }
+
+    #[test]
+    fn points_and_lines_are_left_out() {
+        for mode in [0, 1, 2, 3] {
+            let model = read_bytes("sq.gltf", &square(mode, &[0, 1, 2, 3]), 0.0).unwrap();
+            assert!(model.meshes[0].indices.is_empty(), "mode {mode}");
         }
     }
 }
