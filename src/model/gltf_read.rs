@@ -385,7 +385,7 @@ mod tests {
             bin.extend(p.iter().flat_map(|c| c.to_le_bytes()));
         }
         bin.extend(indices);
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         let data = base64::engine::general_purpose::STANDARD.encode(&bin);
