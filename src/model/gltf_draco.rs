@@ -15,6 +15,10 @@ use crate::error::{Error, Result};
 
 const NAME: &str = "KHR_draco_mesh_compression";
 
+/// The most one primitive may decode to (bytes of attribute values), far past any building model:
+/// a tiny stream may legitimately declare millions of points, so only a ceiling stops an absurd one.
+const MAX_DECODED_BYTES: u64 = 512 << 20;
+
 /// Decodes every Draco primitive of the document.
 pub fn decode_draco(file: &str, root: &mut json::Root, buffers: &mut Vec<Vec<u8>>) -> Result<()> {
     for m in 0..root.meshes.len() {
@@ -53,7 +57,8 @@ fn decode_primitive(
         .get(view.buffer.value())
         .and_then(|b| b.get(start..start.checked_add(view.byte_length.0 as usize)?))
         .ok_or_else(|| format!("bufferView {view_index} lies outside its buffer"))?;
-    let mut buffer = draco_core::DecoderBuffer::new(bytes).with_limits(draco_core::DecodeLimits::default());
+    let mut buffer =
+        draco_core::DecoderBuffer::new(bytes).with_limits(draco_core::DecodeLimits::default().with_max_decoded_bytes(MAX_DECODED_BYTES));
     let mut mesh = draco_core::Mesh::new();
     draco_core::MeshDecoder::new()
         .decode(&mut buffer, &mut mesh)

@@ -55,7 +55,8 @@ pub fn is_fallback(buffer: &json::Buffer) -> bool {
 
 /// Decodes every meshopt-compressed buffer view into a new buffer and points the view at it.
 pub fn decode_meshopt(file: &str, root: &mut json::Root, buffers: &mut Vec<Vec<u8>>) -> Result<()> {
-    let mut workspace = meshoptimizer_rs::Workspace::default();
+    // A ceiling on what one view decodes to (and the decoder's scratch), far past any building model.
+    let mut workspace = meshoptimizer_rs::Workspace::new(meshoptimizer_rs::Limits { max_bytes: 512 << 20, ..Default::default() });
     for v in 0..root.buffer_views.len() {
         let view = &root.buffer_views[v];
         let Some((name, ext)) = view.extensions.as_ref().and_then(|e| MESHOPT.iter().find_map(|n| e.others.get(*n).map(|x| (*n, x))))
