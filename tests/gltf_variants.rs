@@ -107,6 +107,29 @@ fn required_extensions(glb: &Path) -> Vec<String> {
     json["extensionsRequired"].as_array().map_or(vec![], |a| a.iter().map(|e| e.as_str().unwrap().to_string()).collect())
 }
 
+/// glTF Transform 4.5 writes only EXT_meshopt_compression. KHR_meshopt_compression reads the
+/// same bitstreams (version 0 is common to both), so its meshopt file with the extension renamed
+/// (same length: the GLB stays valid) is a KHR_meshopt_compression file.
+fn khr_meshopt(dir: &Path) -> PathBuf {
+    let ext = transform(dir, "meshopt", "meshopt-for-khr.glb", &[]);
+    let bytes = std::fs::read(ext).unwrap();
+    let (from, to) = (b"EXT_meshopt_compression", b"KHR_meshopt_compression");
+    let mut renamed = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i..].starts_with(from) {
+            renamed.extend_from_slice(to);
+            i += from.len();
+        } else {
+            renamed.push(bytes[i]);
+            i += 1;
+        }
+    }
+    let path = dir.join("meshopt-khr.glb");
+    std::fs::write(&path, renamed).unwrap();
+    path
+}
+
 #[test]
 fn gltf_transform_variants_give_the_originals_fractions() {
     let dir = scratch("exact");
@@ -118,6 +141,12 @@ fn gltf_transform_variants_give_the_originals_fractions() {
             vec!["KHR_mesh_quantization"],
         ),
         ("meshopt", transform(&dir, "meshopt", "meshopt.glb", &[]), vec!["EXT_meshopt_compression", "KHR_mesh_quantization"]),
+        (
+            "meshopt (medium)",
+            transform(&dir, "meshopt", "meshopt-medium.glb", &["--level", "medium"]),
+            vec!["EXT_meshopt_compression", "KHR_mesh_quantization"],
+        ),
+        ("meshopt as KHR_meshopt_compression", khr_meshopt(&dir), vec!["KHR_meshopt_compression", "KHR_mesh_quantization"]),
         ("draco", transform(&dir, "draco", "draco.glb", &[]), vec!["KHR_draco_mesh_compression"]),
         ("weld", transform(&dir, "weld", "weld.glb", &[]), vec![]),
         ("unweld", transform(&dir, "unweld", "unweld.glb", &[]), vec![]),
