@@ -663,11 +663,12 @@ fn unread_extensions_and_undecodable_compression() {
     check(
         "unread required extension",
         Case::model(
-            "instanced.gltf",
-            required("EXT_mesh_gpu_instancing").into_bytes(),
+            "lod.gltf",
+            required("MSFT_lod").into_bytes(),
             &format!(
-                "instanced.gltf: requires the glTF extension 'EXT_mesh_gpu_instancing', which sunlit does not read (it reads \
-                 KHR_mesh_quantization, EXT_meshopt_compression, KHR_meshopt_compression, KHR_draco_mesh_compression); {convert}"
+                "lod.gltf: requires the glTF extension 'MSFT_lod', which sunlit does not read (it reads \
+                 KHR_mesh_quantization, EXT_meshopt_compression, KHR_meshopt_compression, KHR_draco_mesh_compression, \
+                 EXT_mesh_gpu_instancing); {convert}"
             ),
         ),
     );

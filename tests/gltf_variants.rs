@@ -1,7 +1,8 @@
 //! glTF as the web ships it, made by the real tools: glTF Transform (npm `@gltf-transform/cli`,
-//! what web pipelines run) writes quantized, meshopt- and Draco-compressed, welded, unwelded,
-//! deduplicated, flattened and .gltf+.bin variants of `examples/office.glb`, and each must give
-//! the original's sunlit fractions within 0.002 for several suns (exact reference; one GPU run).
+//! what web pipelines run) writes quantized, meshopt- and Draco-compressed, instanced, optimized,
+//! welded, unwelded, deduplicated, flattened and .gltf+.bin variants of `examples/office.glb`, and
+//! each must give the original's sunlit fractions within 0.002 for several suns (exact reference;
+//! one GPU run).
 //! Khronos's glTF-Validator (npm `gltf-validator`) must find no error in sunlit's own glb output.
 //!
 //! The tools come from `npm ci` (scripts/setup.sh runs it); without them these tests fail and say so.
@@ -148,6 +149,16 @@ fn gltf_transform_variants_give_the_originals_fractions() {
         ),
         ("meshopt as KHR_meshopt_compression", khr_meshopt(&dir), vec!["KHR_meshopt_compression", "KHR_mesh_quantization"]),
         ("draco", transform(&dir, "draco", "draco.glb", &[]), vec!["KHR_draco_mesh_compression"]),
+        // The louvre slats become one node with 6 instances (EXT_mesh_gpu_instancing, used but
+        // not required: a reader that ignored it would silently lose them).
+        ("instance", transform(&dir, "instance", "instance.glb", &[]), vec![]),
+        // `optimize` as a web pipeline runs it, less what changes names or geometry on purpose
+        // (joining meshes, flattening, simplifying): instancing, meshopt, quantization, pruning.
+        (
+            "optimize (no join, flatten or simplify)",
+            transform(&dir, "optimize", "optimize.glb", &["--join", "false", "--flatten", "false", "--simplify", "false"]),
+            vec!["EXT_meshopt_compression", "KHR_mesh_quantization"],
+        ),
         ("weld", transform(&dir, "weld", "weld.glb", &[]), vec![]),
         ("unweld", transform(&dir, "unweld", "unweld.glb", &[]), vec![]),
         ("dedup", transform(&dir, "dedup", "dedup.glb", &[]), vec![]),

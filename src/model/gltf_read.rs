@@ -11,7 +11,7 @@ use std::path::Path;
 use base64::Engine as _;
 use glam::{DMat4, DVec4};
 
-use super::{gltf_accessor, gltf_draco, gltf_extensions};
+use super::{gltf_accessor, gltf_draco, gltf_extensions, gltf_instancing};
 use crate::error::{Error, Result};
 use crate::scene::{NodeVeil, SourceMesh, SourceNode};
 
@@ -111,7 +111,7 @@ fn read_with(
     let mut nodes = Vec::new();
     let mut walked = vec![false; document.nodes().len()];
     for root in scene_roots(&document) {
-        collect_nodes(file, &root, world, &mut nodes, &mut walked)?;
+        collect_nodes(file, &root, world, (&document, &buffers), &mut nodes, &mut walked)?;
     }
     Ok(GltfModel { file: file.to_string(), meshes, nodes })
 }
@@ -238,7 +238,14 @@ fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
 /// glTF gives a node at most one parent. A hostile file may give it several, or a cycle: walking
 /// such a graph would repeat nodes without end, or exponentially often (a DAG of shared children).
 /// The walk keeps its own stack, so a deep (valid) chain cannot overflow the thread's.
-fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &mut Vec<GltfNode>, walked: &mut [bool]) -> Result<()> {
+fn collect_nodes<'a>(
+    file: &str,
+    root: &::gltf::Node<'a>,
+    parent: DMat4,
+    (document, buffers): (&::gltf::Document, &[Vec<u8>]),
+    out: &mut Vec<GltfNode>,
+    walked: &mut [bool],
+) -> Result<()> {
     let mut stack = vec![(root.clone(), parent)];
     while let Some((node, parent)) = stack.pop() {
         let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
@@ -255,8 +262,21 @@ fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &m
         let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
-            let veil = extras_veil(&node).map_err(|reason| Error::object(file, format!("node '{name}'"), reason))?;
-            out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(&node), veil, mesh: mesh.index(), transform: world });
+            let err = |reason: String| Error::object(file, format!("node '{name}'"), reason);
+            let veil = extras_veil(&node).map_err(err)?;
+            let (named, marked, mesh) = (node.name().is_some(), is_marked(&node), mesh.index());
+            match gltf_instancing::instance_transforms(&node, document, buffers).map_err(err)? {
+                // One node per instance, `NAME[k]`: each may be a receiver of its own.
+                Some(instances) => out.extend(instances.into_iter().enumerate().map(|(k, instance)| GltfNode {
+                    name: format!("{name}[{k}]"),
+                    named,
+                    marked,
+                    veil,
+                    mesh,
+                    transform: world * instance,
+                })),
+                None => out.push(GltfNode { name, named, marked, veil, mesh, transform: world }),
+            }
         }
         // Reversed onto the stack: children are walked in file order.
         let children: Vec<_> = node.children().collect();

@@ -14,6 +14,7 @@ pub mod glb_write;
 pub mod gltf_accessor;
 pub mod gltf_draco;
 pub mod gltf_extensions;
+pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
 pub mod office;
