@@ -175,10 +175,8 @@ mod tests {
 
     #[test]
     fn an_unread_required_extension_is_named_with_what_to_run() {
-        let mut root: json::Root = serde_json::from_str(
-            r#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_materials_variants","MSFT_lod"]}"#,
-        )
-        .unwrap();
+        let mut root: json::Root =
+            serde_json::from_str(r#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_materials_variants","MSFT_lod"]}"#).unwrap();
         let e = accept_required("x.glb", &mut root).unwrap_err().to_string();
         assert!(e.starts_with("x.glb: requires the glTF extension 'MSFT_lod', which sunlit does not read"), "{e}");
         assert!(e.contains("@gltf-transform/cli copy"), "{e}");

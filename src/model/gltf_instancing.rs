@@ -48,7 +48,8 @@ pub fn instance_transforms(node: &::gltf::Node, document: &::gltf::Document, buf
                 None => DQuat::IDENTITY,
                 Some(v) => {
                     let q = DQuat::from_xyzw(v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]);
-                    if !(q.length() > 1e-6) {
+                    let length = q.length();
+                    if !length.is_finite() || length <= 1e-6 {
                         return Err(format!("{NAME}: instance {i} has a zero or non-finite rotation"));
                     }
                     q.normalize()
