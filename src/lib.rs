@@ -17,25 +17,24 @@
 //! use sunlit::{model, count::{gpu::Counter, ViewRequest}, sun::SunPosition};
 //! let scene = model::load(&["examples/office.glb".into()], &model::LoadOptions::default())?;
 //! let sun = SunPosition::new(180.0, 40.0)?.direction();
-//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
 //! let counter = pollster::block_on(Counter::new(Default::default()))?;
 //! let fractions = pollster::block_on(counter.fractions(&counter.upload(&scene)?, &requests))?;
 //! # Ok(()) }
 //! ```
 
-pub mod annual;
+#[cfg(feature = "fixtures")]
 pub mod bench;
 pub mod count;
 pub mod error;
 pub mod export;
+pub mod geometry;
 pub mod model;
 mod platform;
-pub mod samples;
 pub mod scene;
-pub mod season;
-pub mod spline;
 pub mod sun;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
+pub mod year;
 
 pub use error::{Error, Result};

@@ -7,17 +7,18 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
-use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::exact::Exact;
+use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, Method, Progress};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::{self, LeafCalendar};
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -71,7 +72,7 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
@@ -261,10 +262,36 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", e.render(&flag));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The library's parameter names and the flags that set them: errors name the flag.
+const FLAGS: &[(&str, &str)] = &[
+    ("receivers", "--receivers"),
+    ("north", "--north"),
+    ("foliage", "--foliage"),
+    ("transmittance", "--transmittance"),
+    ("location", "--location"),
+    ("sun", "--sun"),
+    ("leaves", "--leaves"),
+    ("timesteps_per_hour", "--timesteps-per-hour"),
+    ("days_per_year", "--days-per-year"),
+    ("samples_per_day", "--samples-per-day"),
+    ("refine", "--refine"),
+    ("resolution", "--resolution"),
+    ("accuracy", "--accuracy"),
+    ("hook", "--hook"),
+    ("leaf_out", "--leaf-out"),
+    ("leaf_fall", "--leaf-fall"),
+    ("lanes", "--lanes"),
+];
+
+/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
+fn flag(param: &str) -> String {
+    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
@@ -336,27 +363,24 @@ fn fraction(args: FractionArgs) -> Result<()> {
     let leaves = args.leaves as f32;
     let scene = args.model.load()?;
     let dir = sun.direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
-    let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
-            .into_iter()
-            .zip(&scene.receivers)
-            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
-            .collect()
+    let requests: Vec<ViewRequest> =
+        (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, dir).with_leaves(leaves)).collect();
+    let answers: Vec<ViewAnswer> = if args.exact {
+        pollster::block_on(Exact { scene: &scene }.answer(&requests))?
     } else {
         let counter = counter(&args.pixels)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
+        pollster::block_on(Lane { counter: &counter, gpu: &gpu }.answer(&requests))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
             .receivers
             .iter()
-            .zip(&counted)
+            .zip(&answers)
             .map(|(r, c)| {
                 json!({
                     "name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6),
-                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side,
+                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side.unwrap_or(0),
                 })
             })
             .collect();
@@ -379,7 +403,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
-    for (r, c) in scene.receivers.iter().zip(&counted) {
+    for (r, c) in scene.receivers.iter().zip(&answers) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
     }
     Ok(())
@@ -425,7 +449,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule =
+        pollster::block_on(sunlit::year::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -576,7 +601,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
-        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
 }
@@ -612,7 +637,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
-        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {
@@ -621,7 +646,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,

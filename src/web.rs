@@ -15,23 +15,63 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
-use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
-use crate::count::ViewRequest;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::count::lanes::Lane;
+use crate::count::{Engine as _, ViewRequest};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
-use crate::samples::{SamplingPlan, Timesteps};
 use crate::scene::Scene;
-use crate::season::{LeafCalendar, parse_period};
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
+use crate::year::samples::{SamplingPlan, Timesteps};
+use crate::year::season::{LeafCalendar, parse_period};
 
-/// A library error as a JS `Error` whose message names the file, object and reason.
+/// A library error as a JS `Error` whose message names the file, object or option (as the JS API
+/// spells it: `timestepsPerHour`) and the reason. Its properties: `code` ([`Error::code`], what
+/// programs switch on, never the message), and where known `file`, `object`, `option` and, for
+/// `code: 'gpu'`, `gpu` ([`crate::error::GpuError::code`], e.g. `out-of-memory`).
 fn js_error(error: Error) -> JsValue {
-    JsError::new(&error.to_string()).into()
+    let js = js_sys::Error::new(&error.render(&js_option));
+    let set = |key: &str, value: &str| {
+        // Setting a property of a fresh Error cannot fail; were it to, the message still tells.
+        let _ = js_sys::Reflect::set(&js, &key.into(), &value.into());
+    };
+    set("code", error.code());
+    if let Some(file) = error.file() {
+        set("file", &file);
+    }
+    if let Some(object) = error.object_name() {
+        set("object", object);
+    }
+    if let Some(option) = error.parameter() {
+        set("option", &js_option(option));
+    }
+    if let Error::Gpu(gpu) = &error {
+        set("gpu", gpu.code());
+    }
+    js.into()
+}
+
+/// The JS API's name for a library parameter: camelCase (`timesteps_per_hour` →
+/// `timestepsPerHour`), as the settings object and `loadFiles`' options spell them.
+pub fn js_option(param: &str) -> String {
+    let mut out = String::with_capacity(param.len());
+    let mut upper = false;
+    for c in param.chars() {
+        match c {
+            '_' => upper = true,
+            c if upper => {
+                out.extend(c.to_uppercase());
+                upper = false;
+            }
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// The GPU counter on this page's WebGPU device.
@@ -129,9 +169,9 @@ impl Engine {
             }
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
-                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
-            let counted = counter.fractions(&model.gpu, &requests).await.map_err(js_error)?;
-            let fractions: Vec<f64> = counted.iter().map(|c| c.fraction).collect();
+                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
+            let answers = Lane { counter: &counter, gpu: &model.gpu }.answer(&requests).await.map_err(js_error)?;
+            let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
         })
     }

@@ -166,7 +166,7 @@ test('bad files get a message naming the problem, and the page keeps working', {
   }
   await page.fill('#receivers', 'Nothing*');
   const none = await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/);
-  assert.match(none, /no receiving surface: no node name matches --receivers Nothing\*/);
+  assert.match(none, /no receiving surface: no node name matches receivers Nothing\*/);
   await page.fill('#receivers', '');
 
   const epw = join(WORK, 'nowhere.epw');
