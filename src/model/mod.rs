@@ -239,8 +239,8 @@ fn many_receivers_note(scene: &Scene, nodes: usize) -> String {
     let first: Vec<&str> = scene.receivers.iter().take(5).map(|r| r.name.as_str()).collect();
     format!(
         "{} receivers ({nodes} nodes: {}, …) were chosen by the default rule, every named node with a mesh, as no node is \
-         marked {{\"sunlit\": {{\"receiver\": true}}}} in its extras; each one is a column of the output and is counted \
-         in every view. To count fewer, choose receivers by node name with the receivers option (glob patterns, e.g. \
+         marked {{\"sunlit\": {{\"receiver\": true}}}} in its extras; each one is a column of the output and a view of \
+         its own for every sun. To count fewer, choose receivers by node name with the receivers option (glob patterns, e.g. \
          'Wall*'), or mark the receiving nodes in their extras",
         scene.receivers.len(),
         first.join(", ")
