@@ -457,4 +457,17 @@ mod tests {
             assert!(model.meshes[0].indices.is_empty(), "mode {mode}");
         }
     }
+
+    #[test]
+    fn a_required_texture_extension_is_ignored() {
+        // A KTX2 texture has no `source` of its own: fine, sunlit reads no texture.
+        let text = String::from_utf8(square(4, &[0, 1, 2, 0, 2, 3])).unwrap().replacen(
+            r#"{"asset":{"version":"2.0"},"#,
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_basisu"],"extensionsRequired":["KHR_texture_basisu"],
+            "textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}],"images":[{"uri":"wall.ktx2"}],"#,
+            1,
+        );
+        let model = read_bytes("ktx2.gltf", text.as_bytes(), 0.0).unwrap();
+        assert_eq!(model.meshes[0].indices.len(), 6);
+    }
 }
