@@ -61,7 +61,9 @@ function showModel(msg) {
   fillTable(null);
   showInViewer();
   const n = msg.names.length;
-  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. Set the location and press Compute.`);
+  // Notes: what loading chose that the user should know (e.g. many receivers by the default rule).
+  const notes = msg.notes?.length ? ` Note: ${msg.notes.join(' ')}` : '';
+  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. Set the location and press Compute.${notes}`);
 }
 
 /** The model in the 3D view, coloured by the result when there is one. The viewer may start
