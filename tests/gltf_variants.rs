@@ -149,6 +149,18 @@ fn gltf_transform_variants_give_the_originals_fractions() {
         ),
         ("meshopt as KHR_meshopt_compression", khr_meshopt(&dir), vec!["KHR_meshopt_compression", "KHR_mesh_quantization"]),
         ("draco", transform(&dir, "draco", "draco.glb", &[]), vec!["KHR_draco_mesh_compression"]),
+        // Speed 0: Draco's slowest, most compressed coding (Blender's default level is a low speed too).
+        (
+            "draco (speed 0)",
+            transform(&dir, "draco", "draco-slow.glb", &["--encode-speed", "0", "--decode-speed", "0"]),
+            vec!["KHR_draco_mesh_compression"],
+        ),
+        ("draco (sequential)", transform(&dir, "draco", "draco-seq.glb", &["--method", "sequential"]), vec!["KHR_draco_mesh_compression"]),
+        (
+            "draco of the quantized office",
+            transform_file(&transform(&dir, "quantize", "to-draco.glb", &[]), &dir, "draco", "quantized-draco.glb", &[]),
+            vec!["KHR_draco_mesh_compression", "KHR_mesh_quantization"],
+        ),
         // The louvre slats become one node with 6 instances (EXT_mesh_gpu_instancing, used but
         // not required: a reader that ignored it would silently lose them).
         ("instance", transform(&dir, "instance", "instance.glb", &[]), vec![]),
