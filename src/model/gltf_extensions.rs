@@ -83,6 +83,10 @@ pub fn decode_meshopt(file: &str, root: &mut json::Root, buffers: &mut Vec<Vec<u
         let view = &mut root.buffer_views[v];
         view.buffer = decoded_buffer;
         view.byte_offset = Some(json::validation::USize64(0));
+        if spec.mode == "ATTRIBUTES" && view.byte_stride.is_none() {
+            // The decoded elements are `byteStride` apart whatever the view says (it must say so).
+            view.byte_stride = Some(json::buffer::Stride(spec.stride));
+        }
     }
     Ok(())
 }
