@@ -1,4 +1,8 @@
 //! `sunlit`, the command line: a thin edge over the library.
+//!
+//! Owns the flags: clap parses them, they become the library's settings
+//! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
+//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,15 +14,15 @@ use serde_json::json;
 use sunlit::count::exact::Exact;
 use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{Engine, ViewAnswer, ViewRequest};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
-use sunlit::year::annual::{AnnualOptions, Method, Progress};
+use sunlit::year::annual::Progress;
 use sunlit::year::samples::{SamplingPlan, Timesteps};
-use sunlit::year::season::{self, LeafCalendar};
+use sunlit::year::settings::AnnualSettings;
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -98,14 +102,24 @@ struct AnnualArgs {
 }
 
 impl AnnualArgs {
-    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
-        if self.evergreen {
-            return Ok(LeafCalendar::evergreen());
-        }
-        match (&self.leaf_out, &self.leaf_fall) {
-            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
-            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
-        }
+    /// The flags as the library's settings (resolved there, as the web's are).
+    fn settings(&self) -> Result<AnnualSettings> {
+        let coordinates = self.location.as_deref().map(Location::parse).transpose()?;
+        Ok(AnnualSettings {
+            latitude: coordinates.as_ref().map(|l| l.latitude),
+            longitude: coordinates.as_ref().map(|l| l.longitude),
+            time_zone: coordinates.as_ref().map(|l| l.time_zone),
+            epw_file: self.epw.clone(),
+            timesteps_per_hour: self.timesteps_per_hour,
+            days_per_year: Some(self.days_per_year),
+            samples_per_day: Some(self.samples_per_day),
+            refine: Some(self.refine),
+            dense: Some(self.dense),
+            evergreen: Some(self.evergreen),
+            leaf_out: self.leaf_out.clone(),
+            leaf_fall: self.leaf_fall.clone(),
+            ..Default::default()
+        })
     }
 }
 
@@ -357,10 +371,7 @@ fn lanes(first: Counter, lanes: Option<usize>, scene: &Scene) -> Result<Vec<(Cou
 
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
-    if !(0.0..=1.0).contains(&args.leaves) {
-        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
-    }
-    let leaves = args.leaves as f32;
+    let leaves = leaf_fraction(args.leaves)?;
     let scene = args.model.load()?;
     let dir = sun.direction();
     let requests: Vec<ViewRequest> =
@@ -411,17 +422,8 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
-    if !(0.0..=1.0).contains(&args.refine) {
-        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
-    }
-    let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
+    let settings = args.settings()?.resolve()?;
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
-    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
@@ -429,7 +431,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
-    let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
+    let timesteps = options.timesteps;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
@@ -447,10 +450,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
-    let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule =
-        pollster::block_on(sunlit::year::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule = pollster::block_on(sunlit::year::annual::annual_recovering(
+        &mut lanes,
+        &scene,
+        &settings.location,
+        &options,
+        &settings.calendar,
+        &mut report,
+    ))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.

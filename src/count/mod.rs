@@ -80,6 +80,14 @@ pub trait Engine {
     fn answer(&self, requests: &[ViewRequest]) -> impl Future<Output = Result<Vec<ViewAnswer>>>;
 }
 
+/// A leaf fraction as a [`ViewRequest`] takes it, refused outside 0 (bare) ..= 1 (full leaf).
+pub fn leaf_fraction(leaves: f64) -> Result<f32> {
+    if !(0.0..=1.0).contains(&leaves) {
+        return Err(Error::argument("leaves", format!("{leaves} is outside 0..=1")));
+    }
+    Ok(leaves as f32)
+}
+
 /// Refuses a request for a receiver the scene does not have (both engines do, alike).
 pub(crate) fn check_receivers(receivers: usize, requests: &[ViewRequest]) -> Result<()> {
     match requests.iter().find(|r| r.receiver as usize >= receivers) {

@@ -1,4 +1,6 @@
-//! Model readers and writers: glTF/glb and EnergyPlus IDF/epJSON in, glb and IDF out.
+//! Model readers: glTF/glb, EnergyPlus IDF/epJSON and typed arrays in, one [`Scene`] out (with
+//! the EnergyPlus model kept for the hook, [`crate::export::hook`]). With the `fixtures` feature,
+//! also the glb writer and the generated example office (`glb_write`, `office`, `office_idf`).
 //!
 //! Owns the choice of receivers across all input files. With an EnergyPlus model among the
 //! inputs, it gives the receivers (its outdoor surfaces and fenestration, by their EnergyPlus

@@ -1,6 +1,7 @@
 //! The annual schedule: count at sparse sun samples, fit the B-spline surface, evaluate it at
 //! every EnergyPlus timestep ([`Method::Spline`]); or count every sun-up timestep ([`Method::Dense`],
-//! the reference the spline is tested against).
+//! the reference the spline is tested against). Any [`Engine`] answers the views
+//! ([`annual_with`]); the GPU lanes are the usual one ([`annual_on`], [`annual_recovering`]).
 //!
 //! Owns the handling of the terminator. A surface's fraction drops to exactly 0 where it turns
 //! away from the sun (cos θ ≤ 1e-5) or the sun sets; fitting through those zeros would make the

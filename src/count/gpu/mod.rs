@@ -25,13 +25,13 @@
 //! the full side.
 //!
 //! The parts, in the order a count goes through them:
-//! - [`device`]: opening the adapter and device within its limits; uncaptured errors and device
+//! - `device`: opening the adapter and device within its limits; uncaptured errors and device
 //!   loss, surfaced as typed errors per stage;
-//! - [`pipelines`]: the WGSL programs, the structs they read, bind group layouts and pipelines;
-//! - [`upload`]: a scene's buffers (static mesh in chunks within the device's buffer limit);
+//! - `pipelines`: the WGSL programs, the structs they read, bind group layouts and pipelines;
+//! - `upload`: a scene's buffers (static mesh in chunks within the device's buffer limit);
 //! - [`plan`]: CPU only — which views need a render, tiles, their cameras, adaptive sides;
-//! - [`encode`]: the per-batch buffers, render and count passes, one submission per batch;
-//! - [`readback`]: mapping the counts and turning them into fractions.
+//! - `encode`: the per-batch buffers, render and count passes, one submission per batch;
+//! - `readback`: mapping the counts and turning them into fractions.
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
@@ -222,7 +222,7 @@ impl Counter {
         self.faults.check(doing, self.options.resolution)
     }
 
-    /// A new counter with the same options on a new device (after [`Error::DeviceLost`]).
+    /// A new counter with the same options on a new device (after [`crate::Error::DeviceLost`]).
     pub async fn recreate(&self) -> Result<Counter> {
         Counter::new(self.options).await
     }
