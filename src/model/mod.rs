@@ -9,6 +9,7 @@
 //! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
 //! one; otherwise every named node with a mesh. Foliage and see-through nodes (the `foliage` and
 //! `transmittance` patterns, or their extras marks) are never chosen by the marks-or-names default.
+//! When the names default chooses more than [`MANY_RECEIVERS`], [`Loaded::notes`] says so.
 pub mod arrays;
 pub mod building;
 pub mod epjson;
