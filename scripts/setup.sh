@@ -17,7 +17,7 @@ apt_install() {
 }
 
 if ! command -v cargo >/dev/null; then
-  say "cargo not found: install Rust 1.85 or newer (https://rustup.rs), then run this again"
+  say "cargo not found: install Rust 1.88 or newer (https://rustup.rs), then run this again"
   exit 1
 fi
 
@@ -39,11 +39,20 @@ if [ "${SUNLIT_WEB:-0}" = 1 ]; then
       apt_install chromium chromium-driver
     fi
     export CHROMEDRIVER="${CHROMEDRIVER:-$(command -v chromedriver)}"
-    if [ ! -d node_modules/playwright-core ]; then
-      say "installing playwright-core (npm ci; it uses Debian's Chromium, never downloads one)"
-      npm ci --silent --no-audit --no-fund
-    fi
   fi
+fi
+
+# npm devDependencies: playwright-core (the browser tests; it uses Debian's Chromium, never
+# downloads one), @gltf-transform/cli and gltf-validator (tests/gltf_variants.rs makes glTF
+# variants with the first and checks sunlit's glb output with the second).
+if command -v npm >/dev/null; then
+  for package in playwright-core @gltf-transform/cli gltf-validator; do
+    if [ ! -d "node_modules/$package" ]; then
+      say "installing the npm devDependencies (npm ci: $package is missing)"
+      npm ci --silent --no-audit --no-fund
+      break
+    fi
+  done
 fi
 
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.

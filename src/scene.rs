@@ -482,7 +482,7 @@ fn check_finite(node: &SourceNode, mesh: &SourceMesh) -> Result<()> {
         let (file, object) = split_origin(&node.origin);
         return Err(Error::object(file, object, format!("index {i} out of range ({n} vertices)")));
     }
-    if mesh.indices.len() % 3 != 0 {
+    if !mesh.indices.len().is_multiple_of(3) {
         let (file, object) = split_origin(&node.origin);
         return Err(Error::object(file, object, "index count is not a multiple of 3"));
     }

@@ -136,7 +136,7 @@ impl Engine {
             ..Default::default()
         };
         let loaded = load_bytes_all(&files, &options).map_err(js_error)?;
-        self.model(loaded.scene, loaded.energyplus)
+        self.model(loaded.scene, loaded.energyplus, loaded.notes)
     }
 
     /// Builds a scene from typed arrays (see `model::arrays`) and uploads it.
@@ -150,12 +150,12 @@ impl Engine {
         y_up: bool,
     ) -> Result<Model, JsValue> {
         let arrays = Arrays { positions, indices, triangle_receivers, names: &names, y_up };
-        self.model(scene_from_arrays(&arrays).map_err(js_error)?, None)
+        self.model(scene_from_arrays(&arrays).map_err(js_error)?, None, Vec::new())
     }
 
-    fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>) -> Result<Model, JsValue> {
+    fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
         let gpu = self.counter.upload(&scene).map_err(js_error)?;
-        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus }) })
+        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes }) })
     }
 
     /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
@@ -223,10 +223,19 @@ struct ModelInner {
     scene: Scene,
     gpu: GpuScene,
     energyplus: Option<EnergyPlusInput>,
+    /// What loading chose that the user should hear (e.g. many default receivers).
+    notes: Vec<String>,
 }
 
 #[wasm_bindgen]
 impl Model {
+    /// What loading chose that the user should hear, e.g. that the default rule (every named
+    /// node) chose many receivers, and how to narrow it. Empty when there is nothing to say.
+    #[wasm_bindgen(getter)]
+    pub fn notes(&self) -> Vec<String> {
+        self.inner.notes.clone()
+    }
+
     /// Receiver names: the CSV's columns, in order.
     #[wasm_bindgen(getter, js_name = receiverNames)]
     pub fn receiver_names(&self) -> Vec<String> {

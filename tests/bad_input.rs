@@ -647,3 +647,108 @@ fn out_of_range_options() {
     check("output folder", office("invalid --output: {dir} is a folder", &["-o", "{dir}"]));
     check("output in missing folder", office("no/such/out.csv: No such file or directory (os error 2)", &["-o", "{dir}/no/such/out.csv"]));
 }
+
+/// glTF extensions: one sunlit does not read is named with what to run; compressed data that
+/// does not decode names its view or primitive, the reason, and the same conversion.
+#[test]
+fn unread_extensions_and_undecodable_compression() {
+    let node = r#"{"name":"A","mesh":0}"#;
+    let text = String::from_utf8(gltf(&SQUARE, &QUAD, node, None)).unwrap();
+    let convert = "convert it to plain glTF, e.g. with glTF Transform: `npx @gltf-transform/cli copy IN.glb OUT.glb` (which writes no compression), or re-export it without that extension";
+    let required = |ext: &str| {
+        text.replacen(
+            r#"{"asset":{"version":"2.0"},"#,
+            &format!(r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["{ext}"],"extensionsRequired":["{ext}"],"#),
+            1,
+        )
+    };
+    check(
+        "unread required extension",
+        Case::model(
+            "lod.gltf",
+            required("MSFT_lod").into_bytes(),
+            &format!(
+                "lod.gltf: requires the glTF extension 'MSFT_lod', which sunlit does not read (it reads \
+                 KHR_mesh_quantization, EXT_meshopt_compression, KHR_meshopt_compression, KHR_draco_mesh_compression, \
+                 EXT_mesh_gpu_instancing); {convert}"
+            ),
+        ),
+    );
+    // A view claiming meshopt-compressed vertices, whose "compressed" bytes are the plain indices.
+    let meshopt = required("EXT_meshopt_compression").replacen(
+        r#"{"buffer":0,"byteLength":48}"#,
+        r#"{"buffer":0,"byteLength":48,"byteStride":12,"extensions":{"EXT_meshopt_compression":{"buffer":0,"byteOffset":48,"byteLength":24,"byteStride":12,"count":4,"mode":"ATTRIBUTES"}}}"#,
+        1,
+    );
+    check(
+        "meshopt data that does not decode",
+        Case::model(
+            "meshopt.gltf",
+            meshopt.into_bytes(),
+            &format!(
+                "meshopt.gltf: bufferView 0: EXT_meshopt_compression: the attributes data could not be decoded (invalid encoded stream); {convert}"
+            ),
+        ),
+    );
+    // A primitive claiming Draco data, whose bytes are the plain positions.
+    let draco = required("KHR_draco_mesh_compression").replacen(
+        r#""attributes":{"POSITION":0},"indices":1}"#,
+        r#""attributes":{"POSITION":0},"indices":1,"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}"#,
+        1,
+    );
+    check(
+        "draco data that does not decode",
+        Case::model(
+            "draco.gltf",
+            draco.into_bytes(),
+            &format!(
+                "draco.gltf: mesh 0 primitive 0: KHR_draco_mesh_compression: the Draco data in bufferView 0 could not be decoded (General error: Invalid magic); {convert}"
+            ),
+        ),
+    );
+    // Unsigned ints are no position type, quantized or not.
+    let uint = text.replacen(r#""componentType":5126"#, r#""componentType":5125"#, 1);
+    check(
+        "positions of unsigned ints",
+        Case::model(
+            "uint.gltf",
+            uint.into_bytes(),
+            "uint.gltf: mesh 0 '': POSITION accessor 0 is Vec3 of U32; expected VEC3 of float, or of (normalized) byte or short (KHR_mesh_quantization)",
+        ),
+    );
+}
+
+/// Compressed glTF with its bytes flipped (a fixed-seed sample of what fuzzing does to the
+/// quantized, meshopt and Draco seeds): every mutant loads or gives an error; none panics.
+#[test]
+fn corrupted_compressed_gltf_never_panics() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::SmallRng::seed_from_u64(15);
+    let seeds: [&[u8]; 3] = [
+        include_bytes!("../fuzz/seeds/gltf/office-quantized.glb"),
+        include_bytes!("../fuzz/seeds/gltf/office-meshopt.glb"),
+        include_bytes!("../fuzz/seeds/gltf/office-draco.glb"),
+    ];
+    let (mut loaded, mut refused) = (0, 0);
+    for seed in seeds {
+        // The binary chunk starts after the 20-byte header and the JSON chunk: mutate data there,
+        // where the decoders read, so the JSON stays valid and the decoders see the damage.
+        let json_length = u32::from_le_bytes(seed[12..16].try_into().unwrap()) as usize;
+        let bin = 20 + json_length + 8;
+        for _ in 0..2000 {
+            let mut bytes = seed.to_vec();
+            for _ in 0..rng.random_range(1..8) {
+                let at = rng.random_range(bin..bytes.len());
+                bytes[at] = rng.random();
+            }
+            let result = std::panic::catch_unwind(|| load_bytes(&[("mutant.glb".to_string(), bytes.clone())], &LoadOptions::default()));
+            match result {
+                Ok(Ok(_)) => loaded += 1,
+                Ok(Err(_)) => refused += 1,
+                Err(_) => panic!("a mutant of a compressed seed panicked: {bytes:?}"),
+            }
+        }
+    }
+    // Both outcomes occur: the mutations reach the decoders and do not all fail the same way.
+    assert!(loaded > 0 && refused > 0, "{loaded} loaded, {refused} refused");
+}

@@ -154,3 +154,31 @@ async fn a_lost_webgpu_device_is_reported_and_a_new_one_counts() {
     let after = fresh.fractions(&gpu, &request).await.unwrap()[0].fraction;
     assert_eq!(before, after, "the new device counts the same");
 }
+
+/// The glTF decoders are pure Rust, so the wasm build reads what glTF Transform writes: the
+/// office quantized, meshopt- and Draco-compressed (the fuzz seeds, made by
+/// `gltf-transform quantize|meshopt|draco examples/office.glb`) gives the original's exact
+/// fractions within 0.002 here too (tests/gltf_variants.rs checks the same natively).
+#[wasm_bindgen_test]
+fn compressed_gltf_reads_in_wasm() {
+    use sunlit::model::{LoadOptions, load_bytes};
+    let load = |name: &str, bytes: &[u8]| load_bytes(&[(name.to_string(), bytes.to_vec())], &LoadOptions::default()).unwrap();
+    let original = load("office.glb", include_bytes!("../examples/office.glb"));
+    let requests: Vec<ViewRequest> = [(200.0, 35.0), (120.0, 20.0), (250.0, 50.0)]
+        .iter()
+        .flat_map(|&(a, h)| (0..original.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun: sun(a, h) }))
+        .collect();
+    let reference = exact::sunlit_fractions(&original, &requests);
+    for (name, bytes) in [
+        ("office-quantized.glb", &include_bytes!("../fuzz/seeds/gltf/office-quantized.glb")[..]),
+        ("office-meshopt.glb", &include_bytes!("../fuzz/seeds/gltf/office-meshopt.glb")[..]),
+        ("office-draco.glb", &include_bytes!("../fuzz/seeds/gltf/office-draco.glb")[..]),
+    ] {
+        let scene = load(name, bytes);
+        let names = |s: &Scene| s.receivers.iter().map(|r| r.name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(&scene), names(&original), "{name}");
+        for ((r, f), e) in requests.iter().zip(exact::sunlit_fractions(&scene, &requests)).zip(&reference) {
+            assert!((f - e).abs() <= 0.002, "{name} {r:?}: {f:.4} against the original's {e:.4}");
+        }
+    }
+}

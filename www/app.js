@@ -67,7 +67,9 @@ function showModel(msg) {
     [$('latitude').value, $('longitude').value, $('timezone').value] = msg.siteLocation.map(String);
     where = `Location from the model's Site:Location (${msg.siteLocation.join(', ')}); change it or choose an EPW if needed`;
   }
-  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. ${where}, and press Compute.`);
+  // Notes: what loading chose that the user should know (e.g. many receivers by the default rule).
+  const notes = msg.notes?.length ? ` Note: ${msg.notes.join(' ')}` : '';
+  status(`Loaded ${state.modelName} (${n} receiver${n === 1 ? '' : 's'}) on ${msg.adapter}. ${where}, and press Compute.${notes}`);
 }
 
 /** The model in the 3D view, coloured by the result when there is one. The viewer may start

@@ -129,6 +129,9 @@ export interface SunlitEngine {
 /** A scene on the engine's GPU device; use it only with the engine that made it. */
 export interface Model {
   readonly receiverNames: string[];
+  /** What loading chose that the user should hear, e.g. that the default rule (every named node)
+   * chose more than 200 receivers, and how to narrow them; empty when there is nothing to say. */
+  readonly notes: string[];
   /** m² per receiver. */
   readonly receiverAreas: Float64Array;
   readonly triangles: number;

@@ -58,6 +58,7 @@ async function load({ files: given, options, resolution }) {
     {
       type: 'loaded',
       names: m.receiverNames,
+      notes: m.notes,
       areas: m.receiverAreas,
       triangles: m.triangles,
       leaves: m.leaves,

@@ -72,7 +72,7 @@ pub fn scene_from_arrays(arrays: &Arrays) -> Result<Scene> {
 
 /// The vertices in sunlit's axes, each checked to be finite.
 fn points(arrays: &Arrays) -> Result<Vec<DVec3>> {
-    if arrays.positions.len() % 3 != 0 {
+    if !arrays.positions.len().is_multiple_of(3) {
         return Err(Error::object(SOURCE, "positions", format!("length {} is not a multiple of 3", arrays.positions.len())));
     }
     arrays
@@ -94,7 +94,7 @@ fn points(arrays: &Arrays) -> Result<Vec<DVec3>> {
 }
 
 fn check_triangles(arrays: &Arrays, vertices: usize) -> Result<()> {
-    if arrays.indices.len() % 3 != 0 {
+    if !arrays.indices.len().is_multiple_of(3) {
         return Err(Error::object(SOURCE, "indices", format!("length {} is not a multiple of 3", arrays.indices.len())));
     }
     let triangles = arrays.indices.len() / 3;

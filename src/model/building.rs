@@ -739,7 +739,7 @@ fn vertices(file: &str, o: &IdfObject, count: usize, first: usize) -> Result<Vec
     while coords.last().is_some_and(|c| c.is_empty()) {
         coords = &coords[..coords.len() - 1];
     }
-    if coords.len() % 3 != 0 {
+    if !coords.len().is_multiple_of(3) {
         return Err(err(format!("has {} vertex coordinates, not x, y, z triples", coords.len())));
     }
     let given = coords.len() / 3;

@@ -77,7 +77,7 @@ impl GlbWriter {
     /// Adds a mesh given in SUNLIT axes (x east, y north, z up); converts to glTF axes internally.
     /// Returns the mesh index. `indices` is a triangle list into `positions`.
     pub fn add_mesh(&mut self, name: &str, positions: &[[f32; 3]], indices: &[u32]) -> usize {
-        debug_assert!(indices.len() % 3 == 0, "mesh '{name}': index count not a multiple of 3");
+        debug_assert!(indices.len().is_multiple_of(3), "mesh '{name}': index count not a multiple of 3");
         debug_assert!(indices.iter().all(|&i| (i as usize) < positions.len()), "mesh '{name}': index out of range");
         self.meshes.push(MeshData {
             name: name.to_owned(),
@@ -236,7 +236,7 @@ fn bounds(points: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
 
 /// Pads `bytes` with `fill` to a multiple of 4.
 fn pad(bytes: &mut Vec<u8>, fill: u8) {
-    while bytes.len() % 4 != 0 {
+    while !bytes.len().is_multiple_of(4) {
         bytes.push(fill);
     }
 }

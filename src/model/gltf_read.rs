@@ -1,14 +1,17 @@
 //! glTF 2.0 reader (.gltf and .glb, from a path or from bytes) into [`SourceNode`]s and meshes.
 //!
-//! Owns: resolving buffers (GLB chunk, `data:` URIs, files beside a `.gltf`), reading positions
-//! and indices with explicit bounds checks (a hostile file must give an error, never a panic),
-//! node transforms, the glTF → sunlit axis change (x, y, z) = (gx, −gz, gy) and the north rotation.
+//! Owns: resolving buffers (GLB chunk, `data:` URIs, files beside a `.gltf`), the order of the
+//! extension passes (`gltf_extensions`, `gltf_draco`) before validation, meshes from primitives
+//! (every triangle mode; points and lines left out), the scene's node walk with transforms, the
+//! glTF → sunlit axis change (x, y, z) = (gx, −gz, gy) and the north rotation. Accessors are read
+//! in `gltf_accessor`, with explicit bounds checks (a hostile file gives an error, never a panic).
 
 use std::path::Path;
 
 use base64::Engine as _;
 use glam::{DMat4, DVec4};
 
+use super::{gltf_accessor, gltf_draco, gltf_extensions, gltf_instancing};
 use crate::error::{Error, Result};
 use crate::scene::{NodeVeil, SourceMesh, SourceNode};
 
@@ -92,16 +95,38 @@ fn read_with(
 ) -> Result<GltfModel> {
     check_magic(file, bytes)?;
     check_position_accessors(file, bytes)?;
-    let gltf = ::gltf::Gltf::from_slice(bytes).map_err(|e| Error::model(file, format!("not a valid glTF 2.0 file: {e}")))?;
-    let buffers = load_buffers(file, &gltf, external)?;
-    let meshes = gltf.document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
+    let invalid = |e: ::gltf::Error| Error::model(file, format!("not a valid glTF 2.0 file: {e}"));
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice_without_validation(bytes).map_err(invalid)?;
+    // Extensions are resolved on the JSON before the gltf crate validates it: compressed views
+    // and primitives are decoded into plain buffers, so the rest reads plain glTF.
+    let mut root = document.into_json();
+    gltf_extensions::accept_required(file, &mut root)?;
+    let mut buffers = load_buffers(file, &root, blob, external)?;
+    gltf_extensions::decode_meshopt(file, &mut root, &mut buffers)?;
+    gltf_draco::decode_draco(file, &mut root, &mut buffers)?;
+    let document = ::gltf::Document::from_json(root).map_err(invalid)?;
+    let meshes = document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
+    warn_skipped_primitives(file, &document);
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
-    let mut walked = vec![false; gltf.document.nodes().len()];
-    for root in scene_roots(&gltf.document) {
-        collect_nodes(file, &root, world, &mut nodes, &mut walked)?;
+    let mut walked = vec![false; document.nodes().len()];
+    for root in scene_roots(&document) {
+        collect_nodes(file, &root, world, (&document, &buffers), &mut nodes, &mut walked)?;
     }
     Ok(GltfModel { file: file.to_string(), meshes, nodes })
+}
+
+/// Points and lines cast no shadow and have no area: they are left out, and the user told once.
+fn warn_skipped_primitives(file: &str, document: &::gltf::Document) {
+    use ::gltf::mesh::Mode;
+    let skipped = document
+        .meshes()
+        .flat_map(|m| m.primitives())
+        .filter(|p| matches!(p.mode(), Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip))
+        .count();
+    if skipped > 0 {
+        log::warn!("{file}: {skipped} point or line primitive(s) left out (they cast no shadow)");
+    }
 }
 
 fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
@@ -118,23 +143,29 @@ fn check_magic(file: &str, bytes: &[u8]) -> Result<()> {
     Err(Error::model(file, "not a glTF file: expected the binary magic 'glTF' or a JSON object"))
 }
 
-fn load_buffers(file: &str, gltf: &::gltf::Gltf, external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>) -> Result<Vec<Vec<u8>>> {
+fn load_buffers(
+    file: &str,
+    root: &::gltf::json::Root,
+    blob: Option<Vec<u8>>,
+    external: impl Fn(&str) -> std::result::Result<Vec<u8>, String>,
+) -> Result<Vec<Vec<u8>>> {
     let mut out = Vec::new();
-    for buffer in gltf.document.buffers() {
-        let data = match buffer.source() {
-            ::gltf::buffer::Source::Bin => {
-                gltf.blob.clone().ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?
-            }
-            ::gltf::buffer::Source::Uri(uri) => match uri.strip_prefix("data:") {
-                Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {}: {r}", buffer.index())))?,
+    for (index, buffer) in root.buffers.iter().enumerate() {
+        if gltf_extensions::is_fallback(buffer) {
+            // Stands in for meshopt-compressed data; its views are decoded into new buffers.
+            out.push(Vec::new());
+            continue;
+        }
+        let data = match &buffer.uri {
+            None => blob.clone().ok_or_else(|| Error::model(file, "buffer 0 refers to the GLB binary chunk, which is missing"))?,
+            Some(uri) => match uri.strip_prefix("data:") {
+                Some(rest) => decode_data_uri(rest).map_err(|r| Error::model(file, format!("buffer {index}: {r}")))?,
                 None => external(uri).map_err(|r| Error::model(file, r))?,
             },
         };
-        if data.len() < buffer.length() {
-            return Err(Error::model(
-                file,
-                format!("buffer {} is truncated: {} bytes present, {} declared", buffer.index(), data.len(), buffer.length()),
-            ));
+        let declared = buffer.byte_length.0;
+        if (data.len() as u64) < declared {
+            return Err(Error::model(file, format!("buffer {index} is truncated: {} bytes present, {declared} declared", data.len())));
         }
         out.push(data);
     }
@@ -207,7 +238,14 @@ fn scene_roots<'a>(doc: &'a ::gltf::Document) -> Vec<::gltf::Node<'a>> {
 /// glTF gives a node at most one parent. A hostile file may give it several, or a cycle: walking
 /// such a graph would repeat nodes without end, or exponentially often (a DAG of shared children).
 /// The walk keeps its own stack, so a deep (valid) chain cannot overflow the thread's.
-fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &mut Vec<GltfNode>, walked: &mut [bool]) -> Result<()> {
+fn collect_nodes<'a>(
+    file: &str,
+    root: &::gltf::Node<'a>,
+    parent: DMat4,
+    (document, buffers): (&::gltf::Document, &[Vec<u8>]),
+    out: &mut Vec<GltfNode>,
+    walked: &mut [bool],
+) -> Result<()> {
     let mut stack = vec![(root.clone(), parent)];
     while let Some((node, parent)) = stack.pop() {
         let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
@@ -224,8 +262,21 @@ fn collect_nodes<'a>(file: &str, root: &::gltf::Node<'a>, parent: DMat4, out: &m
         let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
-            let veil = extras_veil(&node).map_err(|reason| Error::object(file, format!("node '{name}'"), reason))?;
-            out.push(GltfNode { name, named: node.name().is_some(), marked: is_marked(&node), veil, mesh: mesh.index(), transform: world });
+            let err = |reason: String| Error::object(file, format!("node '{name}'"), reason);
+            let veil = extras_veil(&node).map_err(err)?;
+            let (named, marked, mesh) = (node.name().is_some(), is_marked(&node), mesh.index());
+            match gltf_instancing::instance_transforms(&node, document, buffers).map_err(err)? {
+                // One node per instance, `NAME[k]`: each may be a receiver of its own.
+                Some(instances) => out.extend(instances.into_iter().enumerate().map(|(k, instance)| GltfNode {
+                    name: format!("{name}[{k}]"),
+                    named,
+                    marked,
+                    veil,
+                    mesh,
+                    transform: world * instance,
+                })),
+                None => out.push(GltfNode { name, named, marked, veil, mesh, transform: world }),
+            }
         }
         // Reversed onto the stack: children are walked in file order.
         let children: Vec<_> = node.children().collect();
@@ -263,9 +314,9 @@ fn read_mesh(file: &str, mesh: &::gltf::Mesh, buffers: &[Vec<u8>]) -> Result<Sou
         let Some(pos) = prim.get(&::gltf::Semantic::Positions) else {
             return Err(err(format!("primitive {} has no POSITION attribute", prim.index())));
         };
-        let positions = read_positions(&pos, buffers).map_err(&err)?;
+        let positions = gltf_accessor::read_positions(&pos, buffers).map_err(&err)?;
         let indices = match prim.indices() {
-            Some(acc) => read_indices(&acc, buffers).map_err(&err)?,
+            Some(acc) => gltf_accessor::read_indices(&acc, buffers).map_err(&err)?,
             None => (0..positions.len() as u32).collect(),
         };
         if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
@@ -290,72 +341,6 @@ fn triangles(mode: ::gltf::mesh::Mode, idx: &[u32]) -> std::result::Result<Vec<u
         Mode::TriangleFan => (2..idx.len()).flat_map(|i| [idx[0], idx[i - 1], idx[i]]).collect(),
         Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => Vec::new(),
     })
-}
-
-/// The bytes of an accessor's elements, bounds-checked against its view and buffer.
-fn accessor_bytes<'a>(acc: &::gltf::Accessor, buffers: &'a [Vec<u8>], elem: usize) -> std::result::Result<(&'a [u8], usize), String> {
-    if acc.sparse().is_some() {
-        return Err(format!("accessor {} is sparse, which is not supported", acc.index()));
-    }
-    let view = acc.view().ok_or_else(|| format!("accessor {} has no buffer view", acc.index()))?;
-    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| format!("buffer {} is missing", view.buffer().index()))?;
-    let stride = view.stride().unwrap_or(elem);
-    let start = view.offset().checked_add(acc.offset()).ok_or("offset overflow")?;
-    let view_end = view.offset().checked_add(view.length()).ok_or("offset overflow")?;
-    let need = match acc.count() {
-        0 => 0,
-        n => stride.checked_mul(n - 1).and_then(|x| x.checked_add(elem)).ok_or("size overflow")?,
-    };
-    let end = start.checked_add(need).ok_or("size overflow")?;
-    if end > view_end || view_end > buffer.len() {
-        return Err(format!(
-            "accessor {} reads bytes {start}..{end} beyond its buffer view (ends at {view_end}) or buffer ({} bytes)",
-            acc.index(),
-            buffer.len()
-        ));
-    }
-    Ok((&buffer[start..end], stride))
-}
-
-fn read_positions(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<[f32; 3]>, String> {
-    use ::gltf::accessor::{DataType, Dimensions};
-    if acc.data_type() != DataType::F32 || acc.dimensions() != Dimensions::Vec3 {
-        return Err(format!("POSITION accessor {} must be float VEC3 (quantized positions are not supported)", acc.index()));
-    }
-    let (bytes, stride) = accessor_bytes(acc, buffers, 12)?;
-    Ok((0..acc.count())
-        .map(|i| {
-            let f = |k: usize| {
-                let o = i * stride + 4 * k;
-                f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]])
-            };
-            [f(0), f(1), f(2)]
-        })
-        .collect())
-}
-
-fn read_indices(acc: &::gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<Vec<u32>, String> {
-    use ::gltf::accessor::{DataType, Dimensions};
-    let size = match acc.data_type() {
-        DataType::U8 => 1,
-        DataType::U16 => 2,
-        DataType::U32 => 4,
-        other => return Err(format!("index accessor {} has type {other:?}; expected an unsigned integer", acc.index())),
-    };
-    if acc.dimensions() != Dimensions::Scalar {
-        return Err(format!("index accessor {} is not SCALAR", acc.index()));
-    }
-    let (bytes, stride) = accessor_bytes(acc, buffers, size)?;
-    Ok((0..acc.count())
-        .map(|i| {
-            let o = i * stride;
-            match size {
-                1 => bytes[o] as u32,
-                2 => u16::from_le_bytes([bytes[o], bytes[o + 1]]) as u32,
-                _ => u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]),
-            }
-        })
-        .collect())
 }
 
 impl GltfModel {
@@ -388,6 +373,7 @@ impl GltfModel {
 
 #[cfg(test)]
 mod tests {
+    #![allow(clippy::unwrap_used)]
     use super::*;
     use glam::DVec3;
 
@@ -408,5 +394,80 @@ mod tests {
             let e = read_bytes("x.glb", bytes, 0.0).unwrap_err().to_string();
             assert!(e.starts_with("x.glb: ") && e.contains(needle), "{e}");
         }
+    }
+
+    /// A unit square in the ground plane as a strip, a fan and a list; its positions stored
+    /// sparse (no buffer view: zeros, then three substituted vertices).
+    fn square(mode: u32, indices: &[u8]) -> Vec<u8> {
+        // Sparse: vertices 1, 2, 3 of four (vertex 0 stays at the origin).
+        let mut bin: Vec<u8> = vec![1, 2, 3, 0];
+        for p in [[1.0f32, 0.0, 0.0], [1.0, 0.0, -1.0], [0.0, 0.0, -1.0]] {
+            bin.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        bin.extend(indices);
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":{len}}}],
+            "bufferViews":[{{"buffer":0,"byteLength":4}},{{"buffer":0,"byteOffset":4,"byteLength":36}},{{"buffer":0,"byteOffset":40,"byteLength":{n}}}],
+            "accessors":[{{"componentType":5126,"count":4,"type":"VEC3","min":[0,0,-1],"max":[1,0,0],
+                "sparse":{{"count":3,"indices":{{"bufferView":0,"componentType":5121}},"values":{{"bufferView":1}}}}}},
+                {{"bufferView":2,"componentType":5121,"count":{n},"type":"SCALAR"}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"mode":{mode}}}]}}],
+            "nodes":[{{"name":"sq","mesh":0}}],"scenes":[{{"nodes":[0]}}]}}"#,
+            len = bin.len(),
+            n = indices.len()
+        )
+        .into_bytes()
+    }
+
+    /// The area of a mesh's triangles (sunlit axes do not matter for an area).
+    fn area(mesh: &SourceMesh) -> f64 {
+        mesh.indices
+            .chunks_exact(3)
+            .map(|t| {
+                let p = |i: u32| glam::Vec3::from(mesh.positions[i as usize]).as_dvec3();
+                (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length() / 2.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn strips_fans_lists_and_sparse_positions_give_the_same_square() {
+        // glTF modes: 4 TRIANGLES, 5 TRIANGLE_STRIP, 6 TRIANGLE_FAN.
+        for (mode, indices) in [(4, &[0u8, 1, 2, 0, 2, 3][..]), (5, &[1, 2, 0, 3][..]), (6, &[0, 1, 2, 3][..])] {
+            let model = read_bytes("sq.gltf", &square(mode, indices), 0.0).unwrap();
+            let mesh = &model.meshes[0];
+            assert_eq!(mesh.indices.len(), 6, "mode {mode}");
+            assert!((area(mesh) - 1.0).abs() < 1e-9, "mode {mode}: area {}", area(mesh));
+            // Every triangle faces up (+Y in glTF): strips alternate their winding back.
+            for t in mesh.indices.chunks_exact(3) {
+                let p = |i: u32| glam::Vec3::from(mesh.positions[i as usize]);
+                assert!((p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).y > 0.0, "mode {mode}: {t:?} faces down");
+            }
+        }
+    }
+
+    #[test]
+    fn points_and_lines_are_left_out() {
+        for mode in [0, 1, 2, 3] {
+            let model = read_bytes("sq.gltf", &square(mode, &[0, 1, 2, 3]), 0.0).unwrap();
+            assert!(model.meshes[0].indices.is_empty(), "mode {mode}");
+        }
+    }
+
+    #[test]
+    fn a_required_texture_extension_is_ignored() {
+        // A KTX2 texture has no `source` of its own: fine, sunlit reads no texture.
+        let text = String::from_utf8(square(4, &[0, 1, 2, 0, 2, 3])).unwrap().replacen(
+            r#"{"asset":{"version":"2.0"},"#,
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_texture_basisu"],"extensionsRequired":["KHR_texture_basisu"],
+            "textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}],"images":[{"uri":"wall.ktx2"}],"#,
+            1,
+        );
+        let model = read_bytes("ktx2.gltf", text.as_bytes(), 0.0).unwrap();
+        assert_eq!(model.meshes[0].indices.len(), 6);
     }
 }

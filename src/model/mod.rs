@@ -9,11 +9,16 @@
 //! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
 //! one; otherwise every named node with a mesh. Foliage and see-through nodes (the `foliage` and
 //! `transmittance` patterns, or their extras marks) are never chosen by the marks-or-names default.
+//! When the names default chooses more than [`MANY_RECEIVERS`], [`Loaded::notes`] says so.
 pub mod arrays;
 pub mod building;
 pub mod epjson;
 #[cfg(feature = "fixtures")]
 pub mod glb_write;
+pub mod gltf_accessor;
+pub mod gltf_draco;
+pub mod gltf_extensions;
+pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
 #[cfg(feature = "fixtures")]
@@ -76,7 +81,14 @@ pub struct Loaded {
     pub scene: Scene,
     /// The EnergyPlus model, if any.
     pub energyplus: Option<EnergyPlusInput>,
+    /// What the caller should hear about the choices made (also logged as warnings), e.g. that
+    /// the default receiver rule chose more than [`MANY_RECEIVERS`] receivers.
+    pub notes: Vec<String>,
 }
+
+/// More receivers than this, chosen by the default rule (every named node), are reported: a CAD
+/// export with thousands of named nodes should not silently become thousands of receivers.
+pub const MANY_RECEIVERS: usize = 200;
 
 /// Reads model files into one scene.
 pub fn load(paths: &[PathBuf], options: &LoadOptions) -> Result<Scene> {
@@ -157,8 +169,8 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
             }),
         }
     }
-    let scene = build(models, energyplus.as_ref().map(|e| &e.building), options)?;
-    Ok(Loaded { scene, energyplus })
+    let (scene, notes) = build(models, energyplus.as_ref().map(|e| &e.building), options)?;
+    Ok(Loaded { scene, energyplus, notes })
 }
 
 fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusInput> {
@@ -185,7 +197,7 @@ fn check_options(options: &LoadOptions) -> Result<()> {
     Ok(())
 }
 
-fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, options: &LoadOptions) -> Result<Scene> {
+fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, options: &LoadOptions) -> Result<(Scene, Vec<String>)> {
     let select = match energyplus {
         Some(_) if options.receivers.is_empty() => Selection::Context,
         _ => Selection::new(&models, options)?,
@@ -218,7 +230,27 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
     if matched == 0 {
         return Err(Error::NoReceivers(select.explain()));
     }
-    builder.build()
+    let scene = builder.build()?;
+    let mut notes = Vec::new();
+    if matches!(select, Selection::Named) && scene.receivers.len() > MANY_RECEIVERS {
+        let note = many_receivers_note(&scene, matched);
+        log::warn!("{note}");
+        notes.push(note);
+    }
+    Ok((scene, notes))
+}
+
+/// What the default rule chose, when it chose many, and how to narrow it.
+fn many_receivers_note(scene: &Scene, nodes: usize) -> String {
+    let first: Vec<&str> = scene.receivers.iter().take(5).map(|r| r.name.as_str()).collect();
+    format!(
+        "{} receivers ({nodes} nodes: {}, …) were chosen by the default rule, every named node with a mesh, as no node is \
+         marked {{\"sunlit\": {{\"receiver\": true}}}} in its extras; each one is a column of the output and a view of \
+         its own for every sun. To count fewer, choose receivers by node name with the receivers option (glob patterns, e.g. \
+         'Wall*'), or mark the receiving nodes in their extras",
+        scene.receivers.len(),
+        first.join(", ")
+    )
 }
 
 /// A node pattern as given: the parameter and its text (`("foliage", "pine*")`).
@@ -360,5 +392,51 @@ mod web_path_tests {
         let (gltf, _) = gltf_with_bin("tri.bin");
         let error = load_bytes(&[("scene.gltf".to_string(), gltf)], &LoadOptions::default()).unwrap_err().to_string();
         assert!(error.starts_with("scene.gltf: external buffer 'tri.bin' was not given"), "{error}");
+    }
+}
+
+#[cfg(test)]
+mod many_receivers_tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use base64::Engine as _;
+
+    /// `n` named nodes placing one ground triangle side by side, embedded as one .gltf.
+    fn named_triangles(n: usize) -> Vec<u8> {
+        let bin: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0].iter().flat_map(|f| f.to_le_bytes()).collect();
+        let data = base64::engine::general_purpose::STANDARD.encode(bin);
+        let nodes: Vec<String> = (0..n).map(|i| format!(r#"{{"name":"part{i}","mesh":0,"translation":[{},0,0]}}"#, 2 * i)).collect();
+        let roots: Vec<String> = (0..n).map(|i| i.to_string()).collect();
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":36}}],
+            "bufferViews":[{{"buffer":0,"byteLength":36}}],
+            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,-1],"max":[1,0,0]}}],
+            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"nodes":[{}],"scenes":[{{"nodes":[{}]}}]}}"#,
+            nodes.join(","),
+            roots.join(",")
+        )
+        .into_bytes()
+    }
+
+    #[test]
+    fn many_default_receivers_are_reported_with_how_to_narrow_them() {
+        let loaded = load_bytes_all(&[("cad.gltf".into(), named_triangles(MANY_RECEIVERS + 1))], &LoadOptions::default()).unwrap();
+        assert_eq!(loaded.scene.receivers.len(), MANY_RECEIVERS + 1);
+        let [note] = loaded.notes.as_slice() else { panic!("{:?}", loaded.notes) };
+        assert!(
+            note.starts_with("201 receivers (201 nodes: part0, part1, part2, part3, part4, …) were chosen by the default rule"),
+            "{note}"
+        );
+        assert!(note.contains("receivers option") && note.contains("extras"), "{note}");
+    }
+
+    #[test]
+    fn few_or_chosen_receivers_are_not_reported() {
+        let few = load_bytes_all(&[("cad.gltf".into(), named_triangles(MANY_RECEIVERS))], &LoadOptions::default()).unwrap();
+        assert!(few.notes.is_empty());
+        let chosen = LoadOptions { receivers: vec!["part*".into()], ..Default::default() };
+        let many = load_bytes_all(&[("cad.gltf".into(), named_triangles(MANY_RECEIVERS + 1))], &chosen).unwrap();
+        assert_eq!(many.scene.receivers.len(), MANY_RECEIVERS + 1);
+        assert!(many.notes.is_empty());
     }
 }

@@ -154,7 +154,7 @@ impl SamplingPlan {
     /// the first sample is the June solstice (its own twin); with D even the solstice falls
     /// half a spacing before it, so every sample has a distinct twin.
     pub fn first_day(&self) -> f64 {
-        let offset = if self.days % 2 == 0 { 0.5 } else { 0.0 };
+        let offset = if self.days.is_multiple_of(2) { 0.5 } else { 0.0 };
         SeasonAxis::new().june_solstice() + offset * self.spacing()
     }
 
@@ -178,7 +178,7 @@ impl SamplingPlan {
     /// and −ψ_d, i.e. d ↔ D − d (D odd) or d ↔ D − 1 − d (D even).
     pub fn twin(&self, d: usize) -> usize {
         let n = self.days;
-        if n % 2 == 0 { n - 1 - d } else { (n - d) % n }
+        if n.is_multiple_of(2) { n - 1 - d } else { (n - d) % n }
     }
 
     /// Normalised times τ of the samples within each lit piece (Chebyshev nodes on (0, 1)).

@@ -271,6 +271,33 @@ test('names from a file render as text, never as markup', async () => {
   assert.equal(await page.evaluate(() => window.pwned), undefined);
 });
 
+test('compressed glTF loads in the page, and many default receivers come with a note', async () => {
+  // The Draco and meshopt office that glTF Transform writes (kept as fuzz seeds).
+  for (const name of ['office-draco.glb', 'office-meshopt.glb']) {
+    const path = join(ROOT, 'fuzz/seeds/gltf', name);
+    const status = await statusAfter(() => page.setInputFiles('#model', path), /^Loaded|^Could not/);
+    assert.match(status, new RegExp(`^Loaded ${name.replace('.', '\\.')} \\(10 receivers\\)`));
+    assert.doesNotMatch(status, /Note:/);
+  }
+  // A CAD-like export: 250 named nodes, no receiver marks.
+  const positions = Buffer.from(new Float32Array([0, 0, 0, 1, 0, 0, 0, 0, -1]).buffer);
+  const count = 250;
+  const gltf = {
+    asset: { version: '2.0' },
+    buffers: [{ byteLength: 36, uri: `data:application/octet-stream;base64,${positions.toString('base64')}` }],
+    bufferViews: [{ buffer: 0, byteLength: 36 }],
+    accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3', min: [0, 0, -1], max: [1, 0, 0] }],
+    meshes: [{ primitives: [{ attributes: { POSITION: 0 } }] }],
+    nodes: Array.from({ length: count }, (_, i) => ({ name: `part${i}`, mesh: 0, translation: [2 * i, 0, 0] })),
+    scenes: [{ nodes: Array.from({ length: count }, (_, i) => i) }],
+  };
+  const path = join(WORK, 'cad.gltf');
+  writeFileSync(path, JSON.stringify(gltf));
+  const status = await statusAfter(() => page.setInputFiles('#model', path), /^Loaded|^Could not/);
+  assert.match(status, /^Loaded cad\.gltf \(250 receivers\)/);
+  assert.match(status, /Note: 250 receivers \(250 nodes: part0, part1, part2, part3, part4, …\) were chosen by the default rule/);
+});
+
 test('the API example runs', { timeout: 300_000 }, async () => {
   const example = await page.context().newPage();
   example.on('request', (r) => requests.push(r.url()));

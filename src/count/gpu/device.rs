@@ -39,10 +39,10 @@ pub(super) async fn open(options: &CounterOptions) -> Result<Opened> {
             format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
         ));
     }
-    if let Some(a) = options.accuracy {
-        if !(a > 0.0 && a < 1.0) {
-            return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
-        }
+    if let Some(a) = options.accuracy
+        && !(a > 0.0 && a < 1.0)
+    {
+        return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
     }
     let tiles_per_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d) / resolution;
     let (device, queue) = adapter
