@@ -147,10 +147,10 @@ impl Drop for Cluster {
         for p in &pids {
             let _ = Command::new("kill").args(["-9", p]).output();
         }
-        if self.started_munged {
-            if let Ok(pid) = std::fs::read_to_string("/run/munge/munged.pid") {
-                let _ = Command::new("kill").arg(pid.trim()).output();
-            }
+        if self.started_munged
+            && let Ok(pid) = std::fs::read_to_string("/run/munge/munged.pid")
+        {
+            let _ = Command::new("kill").arg(pid.trim()).output();
         }
     }
 }

@@ -199,10 +199,10 @@ impl<'a> HybridEngine<'a> {
             return Err(Error::argument("lanes", "must be at least 1"));
         }
         // Refused here too, as the GPU would: `auto` may never make a device.
-        if let Some(a) = options.accuracy {
-            if !(a > 0.0 && a < 1.0) {
-                return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
-            }
+        if let Some(a) = options.accuracy
+            && !(a > 0.0 && a < 1.0)
+        {
+            return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
         }
         let exact = (kind != EngineKind::Gpu).then(|| ExactEngine::new(scene));
         Ok(Self {
@@ -584,10 +584,10 @@ fn store_cached(key: &str, profile: &Profile) {
         std::fs::read_to_string(&path).ok().and_then(|t| serde_json::from_str(&t).ok()).unwrap_or_default();
     all.insert(key.to_string(), profile.clone());
     let written = path.parent().map(std::fs::create_dir_all).transpose().ok().and_then(|_| serde_json::to_string_pretty(&all).ok());
-    if let Some(text) = written {
-        if let Err(e) = crate::export::write_atomic(&path, text.as_bytes()) {
-            log::warn!("could not cache the engine profile in {}: {e}", path.display());
-        }
+    if let Some(text) = written
+        && let Err(e) = crate::export::write_atomic(&path, text.as_bytes())
+    {
+        log::warn!("could not cache the engine profile in {}: {e}", path.display());
     }
 }
 

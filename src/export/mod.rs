@@ -107,7 +107,7 @@ impl Schedule {
         let names: Vec<String> = csv_fields(names).map(str::to_string).collect();
         let rows: Vec<&str> = lines.collect();
         // 8760·N rows, or 8784·N for a leap year.
-        let leap = rows.len() % (DAYS_HOURS as usize) != 0;
+        let leap = !rows.len().is_multiple_of(DAYS_HOURS as usize);
         let per_hour = rows.len() / (DAYS_HOURS as usize + 24 * usize::from(leap));
         let timesteps = match Timesteps::new(per_hour as u32).map(|t| t.leap_year(leap)) {
             Ok(t) if rows.len() == t.rows() => t,
