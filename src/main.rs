@@ -3,6 +3,10 @@
 //! Owns the flags: clap parses them, they become the library's settings
 //! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
 //! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
+//!
+//! It is one file of about a thousand lines because it is clap's argument structs for five
+//! subcommands and, for each, a short translation into library calls; no logic of the pipeline
+//! lives here, so a change to one subcommand reads only its own argument struct and function.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
