@@ -166,7 +166,7 @@ fn compressed_gltf_reads_in_wasm() {
     let original = load("office.glb", include_bytes!("../examples/office.glb"));
     let requests: Vec<ViewRequest> = [(200.0, 35.0), (120.0, 20.0), (250.0, 50.0)]
         .iter()
-        .flat_map(|&(a, h)| (0..original.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun: sun(a, h) }))
+        .flat_map(|&(a, h)| (0..original.receivers.len() as u32).map(move |receiver| ViewRequest::new(receiver, sun(a, h))))
         .collect();
     let reference = exact::sunlit_fractions(&original, &requests);
     for (name, bytes) in [
