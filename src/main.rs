@@ -12,6 +12,7 @@ use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{ViewRequest, cos_incidence, exact};
 use sunlit::export::hook::{Hook, HookPlan};
+use sunlit::export::irradiation;
 use sunlit::model::{self, LoadOptions};
 use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
@@ -76,6 +77,11 @@ struct AnnualArgs {
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
+    /// Also write a per-surface summary (JSON or CSV, by extension; written atomically): area,
+    /// mean fraction over sun-up timesteps and, with --epw, annual direct irradiation (kWh/m²)
+    /// with and without shading, from the EPW's direct normal irradiance.
+    #[arg(long, value_name = "FILE.json|FILE.csv")]
+    summary: Option<PathBuf>,
     /// Also write a copy of the EnergyPlus model (IDF or epJSON, as given) that uses the CSV.
     #[arg(long, value_name = "FILE")]
     idf_out: Option<PathBuf>,
@@ -399,6 +405,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
     let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
+    let summary = summary_plan(&args)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
     }
@@ -433,7 +440,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, out, &args.output, &schedule.names, timesteps, form)?)),
         _ => None,
     };
+    let summary_text = match &summary {
+        Some((_, to_text, dni)) => Some(to_text(&irradiation::summarize(&scene, &schedule, &location, dni.as_ref())?)),
+        None => None,
+    };
     sunlit::export::write_atomic(&args.output, &bytes)?;
+    if let (Some((path, ..)), Some(text)) = (&summary, summary_text) {
+        sunlit::export::write_atomic(path, text.as_bytes())?;
+        eprintln!("wrote {}", path.display());
+    }
     if let Some((out, form, text)) = patched {
         sunlit::export::write_atomic(out, text.as_bytes())?;
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
@@ -447,6 +462,24 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.length().unwrap_or(0)
     );
     Ok(())
+}
+
+/// Writes a summary as JSON or CSV.
+type SummaryFormat = fn(&[irradiation::SurfaceSummary]) -> String;
+
+/// `--summary`'s file, its format by extension, and the EPW's direct normal irradiance (read
+/// now, so a bad weather file is refused before the counting).
+fn summary_plan(args: &AnnualArgs) -> Result<Option<(PathBuf, SummaryFormat, Option<irradiation::DirectNormal>)>> {
+    let Some(path) = &args.summary else { return Ok(None) };
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let format: SummaryFormat = match extension.as_deref() {
+        Some("json") => irradiation::summary_json,
+        Some("csv") => irradiation::summary_csv,
+        _ => return Err(Error::argument("--summary", format!("{}: give a .json or .csv file", path.display()))),
+    };
+    check_writable(path)?;
+    let dni = args.epw.as_deref().map(irradiation::DirectNormal::from_epw).transpose()?;
+    Ok(Some((path.clone(), format, dni)))
 }
 
 /// The model's text with the CSV hooked in. The CSV is named by file name when it sits beside the
