@@ -10,6 +10,8 @@
 
 use std::rc::Rc;
 
+mod embed;
+
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
 use serde::Deserialize;
 use wasm_bindgen::prelude::*;
@@ -164,7 +166,9 @@ impl Engine {
                 .await
                 .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
-            Ok(Annual { schedule, means, hook, model }.into())
+            let epw = settings.epw.as_deref().map(|text| (settings.epw_name.as_deref().unwrap_or("EPW"), text));
+            let extra = embed::Extra::new(&model.scene, &schedule, &location, epw);
+            Ok(Annual { schedule, means, hook, model, extra }.into())
         })
     }
 }
@@ -348,6 +352,7 @@ pub struct Annual {
     means: Vec<f64>,
     hook: Option<Hook>,
     model: Rc<ModelInner>,
+    extra: embed::Extra,
 }
 
 #[wasm_bindgen]

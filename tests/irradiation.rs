@@ -35,7 +35,11 @@ fn constant_epw(dni: f64) -> String {
     text.push_str("COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n");
     for h in 0..8760u32 {
         let (month, day) = month_day(h / 24 + 1);
-        let _ = writeln!(text, "1999,{month},{day},{},60,x,10,5,50,80000,0,1300,300,500,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0", h % 24 + 1);
+        let _ = writeln!(
+            text,
+            "1999,{month},{day},{},60,x,10,5,50,80000,0,1300,300,500,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0",
+            h % 24 + 1
+        );
     }
     text
 }
@@ -46,7 +50,8 @@ fn roofs(dir: &Path) -> String {
     let roof = glb.add_mesh("roof", &[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [0.0, 1.0, 0.0]], &[0, 1, 2, 0, 2, 3]);
     glb.add_node("ROOF_A", roof, [10.0, 0.0, 0.0], None);
     glb.add_node("ROOF_B", roof, [-10.0, 0.0, 0.0], None);
-    let sheet = glb.add_mesh("sheet", &[[-15.0, -3.0, 0.01], [-9.0, -3.0, 0.01], [-9.0, 4.0, 0.01], [-15.0, 4.0, 0.01]], &[0, 1, 2, 0, 2, 3]);
+    let sheet =
+        glb.add_mesh("sheet", &[[-15.0, -3.0, 0.01], [-9.0, -3.0, 0.01], [-9.0, 4.0, 0.01], [-15.0, 4.0, 0.01]], &[0, 1, 2, 0, 2, 3]);
     glb.add_node("SHEET", sheet, [0.0, 0.0, 0.0], None);
     let path = dir.join("roofs.glb");
     std::fs::write(&path, glb.to_glb()).unwrap();
@@ -135,7 +140,16 @@ fn summary_refuses_unknown_formats_and_bad_weather_before_counting() {
     let model = roofs(&dir);
     let csv = dir.join("s.csv");
     let args = |epw: &str, summary: &str| {
-        vec!["annual".to_string(), model.clone(), "--epw".into(), epw.into(), "-o".into(), csv.display().to_string(), "--summary".into(), summary.into()]
+        vec![
+            "annual".to_string(),
+            model.clone(),
+            "--epw".into(),
+            epw.into(),
+            "-o".into(),
+            csv.display().to_string(),
+            "--summary".into(),
+            summary.into(),
+        ]
     };
     let run = |a: Vec<String>| sunlit(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let good = dir.join("good.epw");

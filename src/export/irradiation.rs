@@ -63,7 +63,11 @@ impl DirectNormal {
             }
             let fields: Vec<&str> = line.split(',').map(str::trim).collect();
             if fields.len() <= EPW_DNI_FIELD {
-                return Err(record_error(file_label, line_number, format!("{} fields, expected at least {}", fields.len(), EPW_DNI_FIELD + 1)));
+                return Err(record_error(
+                    file_label,
+                    line_number,
+                    format!("{} fields, expected at least {}", fields.len(), EPW_DNI_FIELD + 1),
+                ));
             }
             if fields[1] == "2" && fields[2] == "29" {
                 continue;
@@ -211,7 +215,10 @@ mod tests {
 
     /// A 1 m² horizontal roof (facing up).
     fn roof_scene() -> Scene {
-        let mesh = SourceMesh { positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]], indices: vec![0, 1, 2, 0, 2, 3] };
+        let mesh = SourceMesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        };
         let mut builder = SceneBuilder::new();
         builder.add_object("test", "ROOF", mesh, true);
         builder.build().unwrap()
@@ -284,7 +291,10 @@ mod tests {
         for h in 0..records {
             let (day, hour) = (h / 24 + 1, h % 24 + 1);
             let (month, dom) = crate::samples::month_day(day as u32);
-            let _ = writeln!(text, "1999,{month},{dom},{hour},60,x,10,5,50,80000,0,1000,300,400,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0");
+            let _ = writeln!(
+                text,
+                "1999,{month},{dom},{hour},60,x,10,5,50,80000,0,1000,300,400,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0"
+            );
         }
         text
     }

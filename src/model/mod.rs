@@ -15,6 +15,7 @@ pub mod gltf_read;
 pub mod idf;
 pub mod office;
 pub mod office_idf;
+pub mod placed;
 
 use std::path::PathBuf;
 
