@@ -10,11 +10,11 @@
 use std::error::Error;
 use std::time::Instant;
 
-use sunlit::annual::{AnnualOptions, Method, annual_recovering};
 use sunlit::count::gpu::{Counter, CounterOptions};
 use sunlit::model::{LoadOptions, load_bytes, office::office};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, Method, annual_recovering};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
 
 fn main() -> Result<(), Box<dyn Error>> {
     let mut args = std::env::args().skip(1);
@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             &scene,
             &location,
             &options,
-            &sunlit::season::LeafCalendar::evergreen(),
+            &sunlit::year::season::LeafCalendar::evergreen(),
             &mut |_| Ok(()),
         ))?;
         let sum: f64 = schedule.values.iter().map(|&v| v as f64).sum();

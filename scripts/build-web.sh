@@ -5,9 +5,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 profile="${SUNLIT_WEB_PROFILE:-release}"
 flag=(); [ "$profile" = release ] && flag=(--release)
-CARGO_PROFILE_RELEASE_DEBUG=0 cargo rustc --lib "${flag[@]}" --target wasm32-unknown-unknown --crate-type cdylib
+# No default features: the CLI's fixtures (model generators) stay out of the bundle.
+CARGO_PROFILE_RELEASE_DEBUG=0 cargo rustc --lib "${flag[@]}" --no-default-features --target wasm32-unknown-unknown --crate-type cdylib
 rm -rf www/pkg.tmp && mkdir -p www/pkg.tmp
-wasm-bindgen --target web --out-dir www/pkg.tmp --out-name sunlit_wasm \
+# The `name` section (function names, ~16% of the bytes) only serves a debugger: left out.
+wasm-bindgen --target web --remove-name-section --remove-producers-section --out-dir www/pkg.tmp --out-name sunlit_wasm \
   "target/wasm32-unknown-unknown/$profile/sunlit.wasm"
 cp shaders/viewer.wgsl www/pkg.tmp/viewer.wgsl
 cp examples/office.glb www/pkg.tmp/office.glb

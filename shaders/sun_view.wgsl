@@ -4,7 +4,8 @@
 // the green channel, each its own id: their coverage, the denominators of the sunlit fractions.
 //
 // Views: the tile being drawn is bound as a uniform at a dynamic offset (one per tile), so a
-// draw's vertices share one load of it; the count pass reads the same data from a storage array.
+// draw's vertices share one load of it. Only the render reads the view and the leaf fraction;
+// the count pass reads where each tile is and whom it counts (count_pixels.wgsl's View).
 // Instances: instance_index is the placement's slot, so one draw_indexed per mesh renders every
 // placement of it in one view. The static mesh (single-use
 // nodes baked in scene coordinates relative to the origin, receiver ids absolute) has its own

@@ -5,37 +5,50 @@
 //! receiving surface and a sun direction, render the scene with an orthographic camera looking
 //! along the sun's rays, fitted tightly to the surface, and count the surface's visible pixels.
 //!
-//! The modules follow the pipeline:
-//! - [`model`]: model files in (glTF/glb) and out (glb writer for examples and benchmarks);
+//! The modules follow the pipeline, one stage a folder or file:
+//! - [`model`]: model files in (glTF/glb, EnergyPlus IDF/epJSON, typed arrays);
 //! - [`scene`]: triangles that cast shadows and planar receivers, laid out for the GPU;
-//! - [`sun`]: sun positions and directions;
-//! - [`count`]: the GPU pixel counter and the exact CPU polygon-clipping reference.
-//! - [`season`]: the leaf calendar that foliage follows through the year.
+//! - [`geometry`]: planar geometry the readers, the scene and the hook share;
+//! - [`sun`]: locations, sun positions and directions;
+//! - [`count`]: one request and one answer ([`count::ViewRequest`], [`count::ViewAnswer`]) and
+//!   the engines that answer it: the GPU pixel counter ([`count::gpu`]) and the exact CPU
+//!   polygon-clipping reference ([`count::exact`]);
+//! - [`year`]: sampling plan, leaf calendar, the settings resolver, the spline and the annual run;
+//! - [`export`]: the EnergyPlus CSV and the model hooked to it;
+//! - [`error`]: the one typed error, naming parameters, files and objects.
+//!
+//! Two thin edges drive it: the CLI (`src/main.rs`) and the wasm-bindgen API (`web`, wasm
+//! only). With the `fixtures` feature (the CLI's), `bench` and `model::{office, office_idf,
+//! glb_write}` generate example and benchmark models; the wasm bundle is built without them.
 //!
 //! ```no_run
 //! # fn main() -> sunlit::Result<()> {
-//! use sunlit::{model, count::{gpu::Counter, ViewRequest}, sun::SunPosition};
+//! use sunlit::{model, count::{self, Engine, gpu::Counter, ViewRequest}, sun::SunPosition};
 //! let scene = model::load(&["examples/office.glb".into()], &model::LoadOptions::default())?;
 //! let sun = SunPosition::new(180.0, 40.0)?.direction();
-//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+//! let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
 //! let counter = pollster::block_on(Counter::new(Default::default()))?;
-//! let fractions = pollster::block_on(counter.fractions(&counter.upload(&scene)?, &requests))?;
+//! let gpu = counter.upload(&scene)?;
+//! // The GPU or the exact reference: both are a count::Engine.
+//! let answers = pollster::block_on(count::lanes::Lane { counter: &counter, gpu: &gpu }.answer(&requests))?;
+//! let exact = pollster::block_on(count::exact::Exact { scene: &scene }.answer(&requests))?;
 //! # Ok(()) }
 //! ```
 
-pub mod annual;
+#[cfg(feature = "fixtures")]
 pub mod bench;
 pub mod count;
 pub mod error;
 pub mod export;
+pub mod geometry;
+#[cfg(test)]
+mod js_api;
 pub mod model;
 mod platform;
-pub mod samples;
 pub mod scene;
-pub mod season;
-pub mod spline;
 pub mod sun;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
+pub mod year;
 
 pub use error::{Error, Result};

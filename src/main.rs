@@ -1,4 +1,8 @@
 //! `sunlit`, the command line: a thin edge over the library.
+//!
+//! Owns the flags: clap parses them, they become the library's settings
+//! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
+//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -7,18 +11,19 @@ use std::time::Instant;
 use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
-use sunlit::annual::{AnnualOptions, Method, Progress};
-use sunlit::count::gpu::{Counted, Counter, CounterOptions, GpuScene};
+use sunlit::count::exact::Exact;
+use sunlit::count::gpu::{Counter, CounterOptions, GpuScene};
 use sunlit::count::lanes::{Lane, default_lanes};
-use sunlit::count::{ViewRequest, cos_incidence, exact};
+use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::export::irradiation;
 use sunlit::model::{self, LoadOptions};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::{self, LeafCalendar};
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::Progress;
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::settings::AnnualSettings;
 use sunlit::{Error, Result, bench};
 
 #[derive(Parser)]
@@ -72,7 +77,7 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::annual::DEFAULT_REFINE)]
+    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
@@ -103,14 +108,24 @@ struct AnnualArgs {
 }
 
 impl AnnualArgs {
-    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
-        if self.evergreen {
-            return Ok(LeafCalendar::evergreen());
-        }
-        match (&self.leaf_out, &self.leaf_fall) {
-            (Some(out), Some(fall)) => LeafCalendar::new(season::parse_period(out)?, season::parse_period(fall)?),
-            _ => Ok(LeafCalendar::for_latitude(location.latitude)),
-        }
+    /// The flags as the library's settings (resolved there, as the web's are).
+    fn settings(&self) -> Result<AnnualSettings> {
+        let coordinates = self.location.as_deref().map(Location::parse).transpose()?;
+        Ok(AnnualSettings {
+            latitude: coordinates.as_ref().map(|l| l.latitude),
+            longitude: coordinates.as_ref().map(|l| l.longitude),
+            time_zone: coordinates.as_ref().map(|l| l.time_zone),
+            epw_file: self.epw.clone(),
+            timesteps_per_hour: self.timesteps_per_hour,
+            days_per_year: Some(self.days_per_year),
+            samples_per_day: Some(self.samples_per_day),
+            refine: Some(self.refine),
+            dense: Some(self.dense),
+            evergreen: Some(self.evergreen),
+            leaf_out: self.leaf_out.clone(),
+            leaf_fall: self.leaf_fall.clone(),
+            ..Default::default()
+        })
     }
 }
 
@@ -267,10 +282,37 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", e.render(&flag));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The library's parameter names and the flags that set them: errors name the flag.
+const FLAGS: &[(&str, &str)] = &[
+    ("receivers", "--receivers"),
+    ("north", "--north"),
+    ("foliage", "--foliage"),
+    ("transmittance", "--transmittance"),
+    ("location", "--location"),
+    ("sun", "--sun"),
+    ("leaves", "--leaves"),
+    ("timesteps_per_hour", "--timesteps-per-hour"),
+    ("days_per_year", "--days-per-year"),
+    ("samples_per_day", "--samples-per-day"),
+    ("refine", "--refine"),
+    ("resolution", "--resolution"),
+    ("accuracy", "--accuracy"),
+    ("hook", "--hook"),
+    ("leaf_out", "--leaf-out"),
+    ("leaf_fall", "--leaf-fall"),
+    ("lanes", "--lanes"),
+    ("summary", "--summary"),
+];
+
+/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
+fn flag(param: &str) -> String {
+    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing
@@ -336,33 +378,27 @@ fn lanes(first: Counter, lanes: Option<usize>, scene: &Scene) -> Result<Vec<(Cou
 
 fn fraction(args: FractionArgs) -> Result<()> {
     let sun = SunPosition::parse(&args.sun)?;
-    if !(0.0..=1.0).contains(&args.leaves) {
-        return Err(Error::argument("--leaves", format!("{} is outside 0..=1", args.leaves)));
-    }
-    let leaves = args.leaves as f32;
+    let leaves = leaf_fraction(args.leaves)?;
     let scene = args.model.load()?;
     let dir = sun.direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun: dir }).collect();
-    let counted: Vec<Counted> = if args.exact {
-        exact::sunlit_fractions_with_leaves(&scene, &requests, leaves)
-            .into_iter()
-            .zip(&scene.receivers)
-            .map(|(fraction, r)| Counted { fraction, cos_incidence: cos_incidence(r.normal, dir), ..Default::default() })
-            .collect()
+    let requests: Vec<ViewRequest> =
+        (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, dir).with_leaves(leaves)).collect();
+    let answers: Vec<ViewAnswer> = if args.exact {
+        pollster::block_on(Exact { scene: &scene }.answer(&requests))?
     } else {
         let counter = counter(&args.pixels)?;
         let gpu = counter.upload(&scene)?;
-        pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()]))?
+        pollster::block_on(Lane { counter: &counter, gpu: &gpu }.answer(&requests))?
     };
     if args.json {
         let surfaces: Vec<_> = scene
             .receivers
             .iter()
-            .zip(&counted)
+            .zip(&answers)
             .map(|(r, c)| {
                 json!({
                     "name": r.name, "fraction": round(c.fraction, 6), "area": round(r.area, 6),
-                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side,
+                    "cos_incidence": round(c.cos_incidence, 6), "side": c.side.unwrap_or(0),
                 })
             })
             .collect();
@@ -385,7 +421,7 @@ fn fraction(args: FractionArgs) -> Result<()> {
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>8}  {:>10}  {:>8}", "surface", "fraction", "area m²", "cos θ");
-    for (r, c) in scene.receivers.iter().zip(&counted) {
+    for (r, c) in scene.receivers.iter().zip(&answers) {
         println!("{:<width$}  {:>8.4}  {:>10.3}  {:>8.4}", r.name, c.fraction, r.area, c.cos_incidence);
     }
     Ok(())
@@ -393,17 +429,8 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
-    if !(0.0..=1.0).contains(&args.refine) {
-        return Err(Error::argument("--refine", format!("{} is outside 0..=1", args.refine)));
-    }
-    let method = if args.dense { Method::Dense } else { Method::Spline(SamplingPlan::new(args.days_per_year, args.samples_per_day)?) };
-    let location = match (&args.epw, &args.location) {
-        (Some(epw), _) => Location::from_epw(epw)?,
-        (None, Some(text)) => Location::parse(text)?,
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
+    let settings = args.settings()?.resolve()?;
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
-    let calendar = args.calendar(&location)?;
     check_writable(&args.output)?;
     let summary = summary_plan(&args)?;
     if let Some(out) = &args.idf_out {
@@ -412,7 +439,8 @@ fn annual(args: AnnualArgs) -> Result<()> {
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
     let (scene, energyplus) = (loaded.scene, loaded.energyplus);
-    let timesteps = Timesteps::new(args.timesteps_per_hour.or(energyplus.as_ref().and_then(|e| e.timesteps())).unwrap_or(4))?;
+    let options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
+    let timesteps = options.timesteps;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
@@ -430,9 +458,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
-    let options = AnnualOptions { timesteps, method, refine: args.refine };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let schedule = pollster::block_on(sunlit::annual::annual_recovering(&mut lanes, &scene, &location, &options, &calendar, &mut report))?;
+    let schedule = pollster::block_on(sunlit::year::annual::annual_recovering(
+        &mut lanes,
+        &scene,
+        &settings.location,
+        &options,
+        &settings.calendar,
+        &mut report,
+    ))?;
     bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
@@ -441,7 +475,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         _ => None,
     };
     let summary_text = match &summary {
-        Some((_, to_text, dni)) => Some(to_text(&irradiation::summarize(&scene, &schedule, &location, dni.as_ref())?)),
+        Some((_, to_text, dni)) => Some(to_text(&irradiation::summarize(&scene, &schedule, &settings.location, dni.as_ref())?)),
         None => None,
     };
     sunlit::export::write_atomic(&args.output, &bytes)?;
@@ -475,7 +509,7 @@ fn summary_plan(args: &AnnualArgs) -> Result<Option<(PathBuf, SummaryFormat, Opt
     let format: SummaryFormat = match extension.as_deref() {
         Some("json") => irradiation::summary_json,
         Some("csv") => irradiation::summary_csv,
-        _ => return Err(Error::argument("--summary", format!("{}: give a .json or .csv file", path.display()))),
+        _ => return Err(Error::argument("summary", format!("{}: give a .json or .csv file", path.display()))),
     };
     check_writable(path)?;
     let dni = args.epw.as_deref().map(irradiation::DirectNormal::from_epw).transpose()?;
@@ -609,7 +643,7 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
     for (name, scene) in &cases {
         let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
-        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Gpu(e.to_string()))?);
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
 }
@@ -645,7 +679,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
-        let all = sunlit::annual::sample_requests(&scene, &location, plan)?;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
         let spread;
         let requests = match args.views {
             Some(n) => {
@@ -654,7 +688,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
             }
             None => &all,
         };
-        let t = pollster::block_on(bench::time_requests(&lanes, &scene, requests, now))?;
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,

@@ -3,7 +3,7 @@
 //! Natively the thread blocks in `Device::poll` until the map completes; on the web `poll` is a
 //! no-op and blocking would freeze the page, so the map's callback completes a future instead.
 
-use crate::error::{Error, Result};
+use crate::error::{GpuError, Result};
 
 /// The wgpu instance for this platform: the browser's WebGPU on the web; natively Vulkan, Metal
 /// or DX12, overridable with `WGPU_BACKEND` (e.g. `vulkan`).
@@ -37,16 +37,19 @@ pub(crate) async fn read_buffer(device: &wgpu::Device, buffer: &wgpu::Buffer, si
     wait_for_maps(device)?;
     receiver
         .await
-        .map_err(|_| Error::Gpu("the GPU device went away while reading results".into()))?
-        .map_err(|e| Error::Gpu(format!("reading results back failed: {e}")))?;
-    let bytes = slice.get_mapped_range().map_err(|e| Error::Gpu(format!("mapping results failed: {e}")))?.to_vec();
+        .map_err(|_| GpuError::Readback("the GPU device went away while reading results".into()))?
+        .map_err(|e| GpuError::Readback(format!("reading results back failed: {e}")))?;
+    let bytes = slice.get_mapped_range().map_err(|e| GpuError::Readback(format!("mapping results failed: {e}")))?.to_vec();
     buffer.unmap();
     Ok(bytes)
 }
 
 #[cfg(not(target_arch = "wasm32"))]
 fn wait_for_maps(device: &wgpu::Device) -> Result<()> {
-    device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| GpuError::Readback(format!("waiting for the GPU failed: {e}")).into())
 }
 
 #[cfg(target_arch = "wasm32")]

@@ -22,7 +22,8 @@ use std::ops::Range;
 
 use glam::{DMat4, DVec3};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, NoReceivers, Result};
+use crate::geometry::{triangle_area, triangle_normal};
 
 /// Surface id of geometry that only casts shadows.
 pub const NO_RECEIVER: u32 = u32::MAX;
@@ -349,7 +350,7 @@ impl SceneBuilder {
         }
         for (of, name) in &self.mirrors {
             let Some(original) = scene.receivers.iter().find(|r| r.name == *of).cloned() else {
-                return Err(Error::NoReceivers(format!("'{name}' mirrors '{of}', which is not a receiver")));
+                return Err(Error::NoReceivers(NoReceivers::Other(format!("'{name}' mirrors '{of}', which is not a receiver"))));
             };
             scene.receivers.push(Receiver {
                 name: name.clone(),
@@ -521,13 +522,13 @@ fn too_many_parts(node: &SourceNode) -> Error {
 
 /// Planar parts of a receiver's triangles, or `None` past [`MAX_PARTS`].
 fn planar_parts(tris: &[[DVec3; 3]]) -> Option<Vec<Part>> {
-    let mut order: Vec<usize> = (0..tris.len()).filter(|&i| tri_area(&tris[i]) > DEGENERATE_AREA).collect();
-    order.sort_by(|&a, &b| tri_area(&tris[b]).total_cmp(&tri_area(&tris[a])));
+    let mut order: Vec<usize> = (0..tris.len()).filter(|&i| triangle_area(&tris[i]) > DEGENERATE_AREA).collect();
+    order.sort_by(|&a, &b| triangle_area(&tris[b]).total_cmp(&triangle_area(&tris[a])));
     let cos_tol = COPLANAR_ANGLE.cos();
     let mut parts: Vec<Part> = Vec::new();
     for i in order {
         let t = &tris[i];
-        let n = tri_normal(t);
+        let n = triangle_normal(t);
         let fits = |p: &Part| n.dot(p.normal) >= cos_tol && t.iter().all(|v| (v.dot(p.normal) - p.offset).abs() <= COPLANAR_DISTANCE);
         match parts.iter().position(fits) {
             Some(k) => parts[k].triangles.push(i),
@@ -541,14 +542,6 @@ fn planar_parts(tris: &[[DVec3; 3]]) -> Option<Vec<Part>> {
     }
     parts.sort_by_key(|p| p.triangles[0]);
     Some(parts)
-}
-
-fn tri_area(t: &[DVec3; 3]) -> f64 {
-    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
-}
-
-fn tri_normal(t: &[DVec3; 3]) -> DVec3 {
-    (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero()
 }
 
 fn part_name(node: &str, k: usize, count: usize) -> String {
@@ -602,7 +595,7 @@ fn receiver(node: &SourceNode, part: &Part, k: usize, count: usize, tris: &[[DVe
     Receiver {
         name: part_name(&node.name, k, count),
         origin: node.origin.clone(),
-        area: triangles.iter().map(tri_area).sum(),
+        area: triangles.iter().map(triangle_area).sum(),
         triangles,
         normal: part.normal,
         draw,

@@ -2,7 +2,9 @@
 //! JavaScript on the browser's WebGPU.
 //!
 //! Owns the translation between JS values and the library: model files or typed arrays in,
-//! fractions and annual schedules out, progress as a JS callback and cancellation by an
+//! fractions and annual schedules out, the settings object into the library's resolver
+//! ([`crate::year::settings`]), library errors into JS `Error`s with a stable `code` and the
+//! option named as the JS API spells it, progress as a JS callback and cancellation by an
 //! `AbortSignal`. Nothing here blocks: every GPU read is awaited (see `platform`), so the page
 //! (or the worker running this) stays live and an abort is seen at the next progress report.
 //! The hand-written ES module `www/sunlit.js` wraps these bindings for users; its types are in
@@ -13,27 +15,65 @@ use std::rc::Rc;
 mod embed;
 
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
-use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
-use crate::annual::{AnnualOptions, DEFAULT_REFINE, Method, Progress, annual_with_leaves};
-use crate::count::ViewRequest;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::count::lanes::Lane;
+use crate::count::{Engine as _, ViewRequest};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
-use crate::samples::{SamplingPlan, Timesteps};
 use crate::scene::Scene;
-use crate::season::{LeafCalendar, parse_period};
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::annual::{Progress, annual_with_leaves};
+use crate::year::settings::AnnualSettings;
 
-/// A library error as a JS `Error` whose message names the file, object and reason.
+/// A library error as a JS `Error` whose message names the file, object or option (as the JS API
+/// spells it: `timestepsPerHour`) and the reason. Its properties: `code` ([`Error::code`], what
+/// programs switch on, never the message), and where known `file`, `object`, `option` and, for
+/// `code: 'gpu'`, `gpu` ([`crate::error::GpuError::code`], e.g. `out-of-memory`).
 fn js_error(error: Error) -> JsValue {
-    JsError::new(&error.to_string()).into()
+    let js = js_sys::Error::new(&error.render(&js_option));
+    let set = |key: &str, value: &str| {
+        // Setting a property of a fresh Error cannot fail; were it to, the message still tells.
+        let _ = js_sys::Reflect::set(&js, &key.into(), &value.into());
+    };
+    set("code", error.code());
+    if let Some(file) = error.file() {
+        set("file", &file);
+    }
+    if let Some(object) = error.object_name() {
+        set("object", object);
+    }
+    if let Some(option) = error.parameter() {
+        set("option", &js_option(option));
+    }
+    if let Error::Gpu(gpu) = &error {
+        set("gpu", gpu.code());
+    }
+    js.into()
+}
+
+/// The JS API's name for a library parameter: camelCase (`timesteps_per_hour` →
+/// `timestepsPerHour`), as the settings object and `loadFiles`' options spell them.
+pub fn js_option(param: &str) -> String {
+    let mut out = String::with_capacity(param.len());
+    let mut upper = false;
+    for c in param.chars() {
+        match c {
+            '_' => upper = true,
+            c if upper => {
+                out.extend(c.to_uppercase());
+                upper = false;
+            }
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// The GPU counter on this page's WebGPU device.
@@ -131,23 +171,23 @@ impl Engine {
             }
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
-                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
-            let counted = counter.fractions(&model.gpu, &requests).await.map_err(js_error)?;
-            let fractions: Vec<f64> = counted.iter().map(|c| c.fraction).collect();
+                (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
+            let answers = Lane { counter: &counter, gpu: &model.gpu }.answer(&requests).await.map_err(js_error)?;
+            let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
         })
     }
 
     /// Promise of the year's schedule ([`Annual`]). `settings` is a plain object (see
-    /// [`Settings`]); `progress(done, total)` is called as views are counted; an aborted
-    /// `signal` rejects the promise with an `Error` whose message is "cancelled".
+    /// [`AnnualSettings`]); `progress(done, total)` is called as views are counted; an aborted
+    /// `signal` rejects the promise with an `Error` whose `code` is `cancelled`.
     pub fn annual(&self, model: &Model, settings: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
         let (counter, model) = (self.counter.clone(), model.inner.clone());
         future_to_promise(async move {
-            let settings = Settings::from_js(&settings).map_err(js_error)?;
-            let model_timesteps = model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps);
-            let (location, options) = settings.resolve(model_timesteps).map_err(js_error)?;
-            let calendar = settings.calendar(&location).map_err(js_error)?;
+            let given = settings_from_js(&settings).map_err(js_error)?;
+            let settings = given.resolve().map_err(js_error)?;
+            let options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
+            let (location, calendar) = (settings.location, settings.calendar);
             let hook = match &model.energyplus {
                 Some(ep) => Some(hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error)?),
                 None => None,
@@ -166,7 +206,7 @@ impl Engine {
                 .await
                 .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
-            let epw = settings.epw.as_deref().map(|text| (settings.epw_name.as_deref().unwrap_or("EPW"), text));
+            let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
             let extra = embed::Extra::new(&model.scene, &schedule, &location, epw);
             Ok(Annual { schedule, means, hook, model, extra }.into())
         })
@@ -253,79 +293,14 @@ impl Model {
     }
 }
 
-/// The settings of an annual run, as the page and the JS API pass them (camelCase keys).
-#[derive(Debug, Deserialize)]
-#[serde(rename_all = "camelCase", deny_unknown_fields)]
-pub struct Settings {
-    /// Degrees north.
-    latitude: Option<f64>,
-    /// Degrees east.
-    longitude: Option<f64>,
-    /// Hours from UTC of the standard time the CSV is in.
-    time_zone: Option<f64>,
-    /// An EPW file's text: its LOCATION line gives the three above.
-    epw: Option<String>,
-    /// A label for the EPW in messages (its file name).
-    epw_name: Option<String>,
-    /// Output timesteps per hour (EnergyPlus's Timestep); default the model's, else 4.
-    timesteps_per_hour: Option<u32>,
-    /// Sampled days (default 27).
-    days_per_year: Option<usize>,
-    /// Samples per day (default 19).
-    samples_per_day: Option<usize>,
-    /// See [`AnnualOptions::refine`].
-    refine: Option<f64>,
-    /// Count every timestep instead of the spline.
-    dense: Option<bool>,
-    /// Foliage keeps its leaves all year.
-    evergreen: Option<bool>,
-    /// Leaf-out period, `START,END` as `MM-DD` dates (default 04-15,05-31, flipped south).
-    leaf_out: Option<String>,
-    /// Leaf-fall period (default 10-01,11-15).
-    leaf_fall: Option<String>,
-}
-
-impl Settings {
-    fn from_js(value: &JsValue) -> Result<Self> {
-        if value.is_undefined() || value.is_null() {
-            return Err(Error::argument("settings", "give at least a location (latitude, longitude, timeZone) or an EPW"));
-        }
-        let text = js_sys::JSON::stringify(value).map_err(|_| Error::argument("settings", "not a plain object"))?;
-        serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("settings", e.to_string()))
+/// The JS settings object as the library's [`AnnualSettings`] (its camelCase keys are the JS
+/// API's), refused with a message when it is missing or not a plain object.
+fn settings_from_js(value: &JsValue) -> Result<AnnualSettings> {
+    if value.is_undefined() || value.is_null() {
+        return Err(Error::argument("settings", "give at least a location (latitude, longitude, timeZone) or an EPW"));
     }
-
-    /// The foliage calendar: evergreen, the given periods, or the defaults for the latitude.
-    fn calendar(&self, location: &Location) -> Result<LeafCalendar> {
-        if self.evergreen.unwrap_or(false) {
-            return Ok(LeafCalendar::evergreen());
-        }
-        match (&self.leaf_out, &self.leaf_fall) {
-            (Some(out), Some(fall)) => LeafCalendar::new(parse_period(out)?, parse_period(fall)?),
-            (None, None) => Ok(LeafCalendar::for_latitude(location.latitude)),
-            _ => Err(Error::argument("leaf dates", "give both leafOut and leafFall, or neither")),
-        }
-    }
-
-    /// The location and options, with the EnergyPlus model's Timestep as the default.
-    fn resolve(&self, model_timesteps: Option<u32>) -> Result<(Location, AnnualOptions)> {
-        let location = match (&self.epw, self.latitude, self.longitude, self.time_zone) {
-            (Some(epw), ..) => Location::from_epw_text(self.epw_name.as_deref().unwrap_or("EPW"), epw)?,
-            (None, Some(lat), Some(lon), Some(tz)) => Location::new(lat, lon, tz)?,
-            _ => return Err(Error::argument("location", "give an EPW or latitude, longitude and time zone")),
-        };
-        let refine = self.refine.unwrap_or(DEFAULT_REFINE);
-        if !(0.0..=1.0).contains(&refine) {
-            return Err(Error::argument("refine", format!("{refine} is outside 0..=1")));
-        }
-        let method = if self.dense.unwrap_or(false) {
-            Method::Dense
-        } else {
-            let default = SamplingPlan::default();
-            Method::Spline(SamplingPlan::new(self.days_per_year.unwrap_or(default.days), self.samples_per_day.unwrap_or(default.per_day))?)
-        };
-        let timesteps = Timesteps::new(self.timesteps_per_hour.or(model_timesteps).unwrap_or(4))?;
-        Ok((location, AnnualOptions { timesteps, method, refine }))
-    }
+    let text = js_sys::JSON::stringify(value).map_err(|_| Error::argument("settings", "not a plain object"))?;
+    serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("settings", e.to_string()))
 }
 
 /// Each column's mean over the year's sun-up timesteps: the page's colour per surface.

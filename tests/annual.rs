@@ -8,14 +8,14 @@ mod common;
 use std::process::Command;
 
 use common::*;
-use sunlit::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual, annual_on, compare};
 use sunlit::count::lanes::Lane;
 use sunlit::export::Schedule;
 use sunlit::model::{LoadOptions, load_bytes, office::office};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
 use sunlit::sun::location::Location;
 use sunlit::sun::position::sun_direction;
+use sunlit::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual, annual_on, compare};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
 
 fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
@@ -43,7 +43,7 @@ fn two_lanes_count_the_same_year_as_one() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
     };
-    let calendar = sunlit::season::LeafCalendar::evergreen();
+    let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut reports = 0;
     let two = pollster::block_on(annual_on(&lanes, &scene, &golden(), &options, &calendar, &mut |_| {
         reports += 1;

@@ -403,7 +403,8 @@ fn degenerate_duplicate_and_unmatched_receivers() {
     check(
         "no match",
         Case::model("wall.glb", glb(&[("Wall", &SQUARE, &QUAD)]), "no receiving surface: no node name matches --receivers Roof*")
-            .args(&["--receivers", "Roof*"]),
+            .args(&["--receivers", "Roof*"])
+            .api(Some("no receiving surface: no node name matches receivers Roof*")),
     );
     let node = r#"{"mesh":0}"#;
     check(
@@ -412,7 +413,8 @@ fn degenerate_duplicate_and_unmatched_receivers() {
             "anon.gltf",
             gltf(&SQUARE, &QUAD, node, None),
             "no receiving surface: the models have no named node with a mesh (name nodes, mark them in extras, or use --receivers)",
-        ),
+        )
+        .api(Some("no receiving surface: the models have no named node with a mesh (name nodes, mark them in extras, or use receivers)")),
     );
     // Two models can clash by name too.
     check(

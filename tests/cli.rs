@@ -176,6 +176,8 @@ fn bad_geometry_is_named() {
     w.add_node("Roof", m, [0.0; 3], None);
     let path = write(&dir, "roof.glb", &w.to_glb());
     fails_with(&sunlit(&["info", &path, "--receivers", "Wall*"]), &["no receiving surface", "--receivers Wall*"]);
+    // The library names its parameter (`foliage`); the CLI names its flag.
+    fails_with(&sunlit(&["info", &path, "--foliage", "pine*"]), &["invalid --foliage pine*: no glTF node name matches it"]);
     let out = sunlit(&["info", &path, "--receivers", "ROO?"]);
     assert!(out.status.success(), "globs are case-insensitive: {}", stderr(&out));
 }

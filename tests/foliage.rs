@@ -12,15 +12,15 @@ use glam::DVec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use serde_json::json;
-use sunlit::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual_with_leaves, compare};
 use sunlit::count::{ViewRequest, exact};
 use sunlit::export::Schedule;
 use sunlit::model::glb_write::GlbWriter;
 use sunlit::model::{LoadOptions, load_bytes};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::{NodeVeil, Scene, SceneBuilder, SourceMesh};
-use sunlit::season::NORTHERN;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual_with_leaves, compare};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::NORTHERN;
 
 const LEAVES: usize = 600;
 
@@ -74,11 +74,12 @@ fn the_canopy_matches_the_exact_reference_bare_half_and_in_full_leaf() {
     assert_eq!(scene.veil_counts().0, LEAVES, "a leaf is a connected quad");
     let counter = counter(512);
     let gpu = counter.upload(&scene).unwrap();
-    let requests: Vec<ViewRequest> = suns().into_iter().map(|sun| ViewRequest { receiver: 0, sun }).collect();
+    let requests: Vec<ViewRequest> = suns().into_iter().map(|sun| ViewRequest::new(0, sun)).collect();
     let mut by_leaves = Vec::new();
     for leaves in [0.0f32, 0.5, 1.0] {
-        let truth = exact::sunlit_fractions_with_leaves(&scene, &requests, leaves);
-        let counted = pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &vec![leaves; requests.len()])).unwrap();
+        let at_leaves: Vec<ViewRequest> = requests.iter().map(|r| r.with_leaves(leaves)).collect();
+        let truth = exact::sunlit_fractions(&scene, &at_leaves);
+        let counted = pollster::block_on(counter.fractions(&gpu, &at_leaves)).unwrap();
         for (k, (c, t)) in counted.iter().zip(&truth).enumerate() {
             println!("leaves {leaves}: sun {k}: gpu {:.5}, exact {t:.5}", c.fraction);
             assert!((c.fraction - t).abs() <= 0.005, "leaves {leaves}, sun {k}: gpu {} vs exact {t}", c.fraction);
@@ -106,8 +107,8 @@ fn the_spring_ramp_never_adds_sun() {
     let days: Vec<f64> = (100..=156).step_by(4).map(f64::from).collect();
     let leaves: Vec<f32> = days.iter().map(|d| NORTHERN.fraction(*d) as f32).collect();
     assert_eq!((leaves[0], *leaves.last().unwrap()), (0.0, 1.0));
-    let requests = vec![ViewRequest { receiver: 0, sun: sun(100.0, 40.0) }; days.len()];
-    let counted = pollster::block_on(counter.fractions_with_leaves(&gpu, &requests, &leaves)).unwrap();
+    let requests: Vec<ViewRequest> = leaves.iter().map(|&l| ViewRequest::new(0, sun(100.0, 40.0)).with_leaves(l)).collect();
+    let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     let f: Vec<f64> = counted.iter().map(|c| c.fraction).collect();
     println!("leaf-out at a fixed sun: {f:.4?}");
     assert!(f.windows(2).all(|w| w[1] <= w[0]), "monotone: {f:?}");
@@ -199,7 +200,7 @@ fn a_screen_lets_its_transmittance_through_where_it_covers() {
     ];
     for (label, screens) in cases {
         let scene = window_with_screens(&screens);
-        let request = [ViewRequest { receiver: 0, sun: s }];
+        let request = [ViewRequest::new(0, s)];
         // Truth: the opaque shadow of each screen from the exact reference, then t of each
         // screen's beam through, independently.
         let mut expected = 1.0;
@@ -255,7 +256,7 @@ fn gltf_marks_and_options_choose_foliage_and_screens() {
     let e = load(tree_glb(json!({"sunlit": {"foliage": "yes"}})), LoadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("Oak crown") && e.contains("sunlit.foliage"), "{e}");
     let e = load(tree_glb(json!({})), LoadOptions { foliage: vec!["pine*".into()], ..Default::default() }).unwrap_err().to_string();
-    assert!(e.contains("--foliage pine*") && e.contains("no glTF node"), "{e}");
+    assert!(e.contains("foliage pine*") && e.contains("no glTF node"), "{e}");
     let options = LoadOptions { receivers: vec!["*".into()], foliage: vec!["oak*".into()], ..Default::default() };
     let e = load(tree_glb(json!({})), options).unwrap_err().to_string();
     assert!(e.contains("Oak crown") && e.contains("receiver") && e.contains("opaque"), "{e}");

@@ -17,10 +17,10 @@ const TOL: f64 = 0.005;
 
 fn check(scene: &Scene, cases: &[(&str, DVec3, f64)]) {
     let counter = counter(512);
-    let requests: Vec<ViewRequest> = cases.iter().map(|(n, s, _)| ViewRequest { receiver: receiver_id(scene, n), sun: *s }).collect();
+    let requests: Vec<ViewRequest> = cases.iter().map(|(n, s, _)| ViewRequest::new(receiver_id(scene, n), *s)).collect();
     let gpu = gpu_fractions(&counter, scene, &requests);
     for ((name, sun, want), got) in cases.iter().zip(&gpu) {
-        let exact = exact::sunlit_fraction(scene, ViewRequest { receiver: receiver_id(scene, name), sun: *sun });
+        let exact = exact::sunlit_fraction(scene, ViewRequest::new(receiver_id(scene, name), *sun));
         // Scene vertices are f32: the exact reference agrees with the analytic value to ~1e-8.
         assert!((exact - want).abs() < 1e-6, "{name} sun {sun}: exact {exact} vs analytic {want}");
         assert!((got.fraction - want).abs() < TOL, "{name} sun {sun}: gpu {} vs analytic {want} ({got:?})", got.fraction);
@@ -167,7 +167,7 @@ fn instanced_and_baked_occluders_shade_alike() {
     let baked = baked.build().unwrap();
     let counter = counter(512);
     let requests: Vec<ViewRequest> =
-        [(180.0, 30.0), (200.0, 50.0), (150.0, 20.0)].iter().map(|&(az, alt)| ViewRequest { receiver: 0, sun: sun(az, alt) }).collect();
+        [(180.0, 30.0), (200.0, 50.0), (150.0, 20.0)].iter().map(|&(az, alt)| ViewRequest::new(0, sun(az, alt))).collect();
     let a = gpu_fractions(&counter, &shared, &requests);
     let b = gpu_fractions(&counter, &baked, &requests);
     let e = exact::sunlit_fractions(&shared, &requests);
@@ -209,7 +209,7 @@ fn random_scenes_match_the_exact_reference() {
         let scene = s.build();
         let suns: Vec<DVec3> = (0..6).map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(5.0..85.0))).collect();
         let requests: Vec<ViewRequest> =
-            suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+            suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest::new(receiver, sun))).collect();
         let gpu = gpu_fractions(&counter, &scene, &requests);
         let exact = exact::sunlit_fractions(&scene, &requests);
         for (g, e) in gpu.iter().zip(&exact) {
@@ -258,7 +258,7 @@ fn culled_views_of_a_large_scene_match_the_exact_reference() {
     let scene = b.build().unwrap();
     let suns: Vec<DVec3> = (0..8).map(|_| sun(rng.random_range(0.0..360.0), rng.random_range(15.0..85.0))).collect();
     let requests: Vec<ViewRequest> =
-        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest::new(receiver, sun))).collect();
     let counter = counter(512);
     let gpu = counter.upload(&scene).unwrap();
     let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
@@ -307,8 +307,7 @@ fn compute_count_equals_a_cpu_count_of_the_id_atlas() {
     // CPU reference of count_pixels.wgsl: count target ids in each tile of the read-back atlas.
     let scene = overhang_scene(0.6);
     let counter = counter(128);
-    let requests: Vec<ViewRequest> =
-        (0..10).map(|i| ViewRequest { receiver: 0, sun: sun(150.0 + 6.0 * i as f64, 20.0 + 5.0 * i as f64) }).collect();
+    let requests: Vec<ViewRequest> = (0..10).map(|i| ViewRequest::new(0, sun(150.0 + 6.0 * i as f64, 20.0 + 5.0 * i as f64))).collect();
     let gpu = counter.upload(&scene).unwrap();
     let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     let (side, ids) = pollster::block_on(counter.read_ids()).unwrap();
@@ -342,7 +341,7 @@ fn louvre_slats_parallel_to_the_window_edges() {
     }
     let scene = s.build();
     let suns: Vec<DVec3> = (0..24).map(|i| sun(130.0 + 4.0 * i as f64, 10.0 + 2.5 * i as f64)).collect();
-    let requests: Vec<ViewRequest> = suns.iter().map(|&sun| ViewRequest { receiver: 0, sun }).collect();
+    let requests: Vec<ViewRequest> = suns.iter().map(|&sun| ViewRequest::new(0, sun)).collect();
     let gpu = gpu_fractions(&counter(512), &scene, &requests);
     let exact = exact::sunlit_fractions(&scene, &requests);
     let worst = gpu.iter().zip(&exact).map(|(g, e)| (g.fraction - e).abs()).fold(0.0, f64::max);
@@ -361,7 +360,7 @@ fn louvre_window() -> (Scene, Vec<ViewRequest>) {
     }
     // A post beside the window: one straight shadow edge for the suns from the west.
     s.cuboid("POST", DVec3::new(2.6, -1.0, 0.0), DVec3::new(2.8, -0.8, 3.0));
-    let requests = (0..60).map(|i| ViewRequest { receiver: 0, sun: sun(100.0 + 2.7 * i as f64, 5.0 + 1.1 * i as f64) }).collect();
+    let requests = (0..60).map(|i| ViewRequest::new(0, sun(100.0 + 2.7 * i as f64, 5.0 + 1.1 * i as f64))).collect();
     (s.build(), requests)
 }
 
@@ -463,9 +462,10 @@ fn a_wall_and_its_windows_counted_in_one_view_match_the_exact_reference() {
     // Every sun for all three; then, at the same suns, partial groups: a window alone, and the
     // wall with one window (a receiver asked for twice at one sun opens another tile).
     let suns = facade_suns();
-    let mut requests: Vec<ViewRequest> = suns.iter().flat_map(|&sun| [wall, a, b].map(|receiver| ViewRequest { receiver, sun })).collect();
-    requests.extend(suns.iter().step_by(2).map(|&sun| ViewRequest { receiver: a, sun }));
-    requests.extend(suns.iter().skip(1).step_by(2).flat_map(|&sun| [b, wall].map(|receiver| ViewRequest { receiver, sun })));
+    let mut requests: Vec<ViewRequest> =
+        suns.iter().flat_map(|&sun| [wall, a, b].map(|receiver| ViewRequest::new(receiver, sun))).collect();
+    requests.extend(suns.iter().step_by(2).map(|&sun| ViewRequest::new(a, sun)));
+    requests.extend(suns.iter().skip(1).step_by(2).flat_map(|&sun| [b, wall].map(|receiver| ViewRequest::new(receiver, sun))));
     let (tiles_before, _) = counter.rendered();
     let got = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     let tiles = counter.rendered().0 - tiles_before;
@@ -487,7 +487,7 @@ fn a_wall_and_its_windows_counted_in_one_view_match_the_exact_reference() {
     println!("facade, grouped: max |gpu − exact| {worst:.5} over {} views in {tiles} tiles", requests.len());
     assert!(exact.iter().filter(|e| **e > 0.05 && **e < 0.95).count() > 20, "mostly partial shading: {exact:?}");
     // The windows' views alone (ungrouped tiles) agree with their grouped counts.
-    let alone: Vec<ViewRequest> = suns.iter().map(|&sun| ViewRequest { receiver: b, sun }).collect();
+    let alone: Vec<ViewRequest> = suns.iter().map(|&sun| ViewRequest::new(b, sun)).collect();
     let single = pollster::block_on(counter.fractions(&gpu, &alone)).unwrap();
     for (k, s) in single.iter().enumerate() {
         let grouped = got[3 * k + 2];
@@ -509,7 +509,7 @@ fn grouped_compute_counts_equal_a_cpu_count_of_the_id_atlas() {
     let suns = &facade_suns();
     let members = |k: usize| if k == 2 { &ids[1..] } else { &ids[..] };
     let requests: Vec<ViewRequest> =
-        (0..suns.len()).flat_map(|k| members(k).iter().rev().map(move |&receiver| ViewRequest { receiver, sun: suns[k] })).collect();
+        (0..suns.len()).flat_map(|k| members(k).iter().rev().map(move |&receiver| ViewRequest::new(receiver, suns[k]))).collect();
     let counted = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     let (side, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
     let res = counter.resolution();

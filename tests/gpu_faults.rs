@@ -6,15 +6,15 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 use sunlit::Error;
-use sunlit::annual::{AnnualOptions, Method, Progress, annual, annual_recovering};
 use sunlit::count::ViewRequest;
 use sunlit::count::gpu::{Counter, CounterOptions};
 use sunlit::model::{LoadOptions, load_bytes, office::office};
-use sunlit::samples::{SamplingPlan, Timesteps};
 use sunlit::scene::Scene;
-use sunlit::season::LeafCalendar;
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
+use sunlit::year::annual::{AnnualOptions, Method, Progress, annual, annual_recovering};
+use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::season::LeafCalendar;
 
 fn office_scene() -> Scene {
     load_bytes(&[("office.glb".into(), office(2).to_glb())], &LoadOptions::default()).unwrap()
@@ -40,7 +40,7 @@ fn a_lost_device_is_reported_as_lost() {
     let counter = counter();
     let gpu = counter.upload(&scene).unwrap();
     let sun = SunPosition::new(180.0, 30.0).unwrap().direction();
-    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest { receiver, sun }).collect();
+    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
     assert!(pollster::block_on(counter.fractions(&gpu, &requests)).is_ok());
     counter.device_loss_trigger()();
     let err = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap_err();

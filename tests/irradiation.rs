@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use sunlit::model::glb_write::GlbWriter;
-use sunlit::samples::month_day;
 use sunlit::sun::position::declination_and_equation_of_time;
+use sunlit::year::samples::month_day;
 
 const LATITUDE: f64 = 39.74;
 const DNI: f64 = 700.0;

@@ -74,7 +74,7 @@ async fn webgpu_counts_match_the_exact_reference() {
     for azimuth in (100..=260).step_by(20) {
         for altitude in (10..=70).step_by(15) {
             for receiver in 0..scene.receivers.len() as u32 {
-                requests.push(ViewRequest { receiver, sun: sun(f64::from(azimuth), f64::from(altitude)) });
+                requests.push(ViewRequest::new(receiver, sun(f64::from(azimuth), f64::from(altitude))));
             }
         }
     }
@@ -98,9 +98,7 @@ async fn adaptive_webgpu_counts_meet_their_accuracy() {
     let gpu = counter.upload(&scene).unwrap();
     let requests: Vec<ViewRequest> = (100..=260)
         .step_by(40)
-        .flat_map(|azimuth| {
-            (10..=70).step_by(20).map(move |altitude| ViewRequest { receiver: 0, sun: sun(f64::from(azimuth), f64::from(altitude)) })
-        })
+        .flat_map(|azimuth| (10..=70).step_by(20).map(move |altitude| ViewRequest::new(0, sun(f64::from(azimuth), f64::from(altitude)))))
         .collect();
     let counted = counter.fractions(&gpu, &requests).await.unwrap();
     let reference = exact::sunlit_fractions(&scene, &requests);
@@ -145,7 +143,7 @@ async fn a_lost_webgpu_device_is_reported_and_a_new_one_counts() {
     let scene = scene();
     let counter = Counter::new(CounterOptions { resolution: 128, ..Default::default() }).await.unwrap();
     let gpu = counter.upload(&scene).unwrap();
-    let request = [ViewRequest { receiver: 0, sun: sun(180.0, 35.0) }];
+    let request = [ViewRequest::new(0, sun(180.0, 35.0))];
     let before = counter.fractions(&gpu, &request).await.unwrap()[0].fraction;
     counter.device_loss_trigger()();
     let error = counter.fractions(&gpu, &request).await.map(|c| c[0].fraction);

@@ -1,6 +1,34 @@
 // Types of sunlit's JavaScript API (sunlit.js). Axes are EnergyPlus's: x east, y north, z up,
 // metres. Fractions are sunlit area / area, 0..1, for each receiving surface.
 
+/** What every function here throws or rejects with, except cancellation (a DOMException named
+ * AbortError). The message names the file, object or option (as this API spells it, e.g.
+ * `timestepsPerHour`) and the reason, for people; programs switch on `code`, never on the
+ * message. */
+export interface SunlitError extends Error {
+  code:
+    | 'io'
+    | 'model'
+    | 'object'
+    | 'timestep-mismatch'
+    | 'duplicate-receiver'
+    | 'no-receivers'
+    | 'bad-option'
+    | 'gpu'
+    | 'device-lost'
+    | 'cancelled'
+    | 'no-webgpu';
+  /** The file the error is about (a model or EPW file name), where it is about one. */
+  file?: string;
+  /** The object in that file, e.g. "node 'Wall_S'" or "Timestep". */
+  object?: string;
+  /** The option the error is about, e.g. 'receivers' or 'timestepsPerHour'. */
+  option?: string;
+  /** With code 'gpu': what failed. A 'gpu' or 'device-lost' error leaves the engine unusable;
+   * a new engine (createEngine) may work. */
+  gpu?: 'no-adapter' | 'device' | 'out-of-memory' | 'over-limit' | 'validation' | 'readback';
+}
+
 /** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
 export function wasmMemoryBytes(): Promise<number>;
 
@@ -10,7 +38,7 @@ export function hasWebGPU(): boolean;
 /** Unit vector towards the sun from azimuth (degrees clockwise from north) and altitude (degrees). */
 export function sunDirection(azimuth: number, altitude: number): [number, number, number];
 
-/** Opens the GPU device. `resolution`: pixels along a view's side (default 512). `accuracy`: a
+/** Opens the GPU device (rejects with a SunlitError, code 'no-webgpu' where WebGPU is missing). `resolution`: pixels along a view's side (default 512). `accuracy`: a
  * target |error| per view (e.g. 0.002): each view is counted at 64² first and again, finer up to
  * `resolution`, only where its shadow edges make the estimated error larger; without it every
  * view is counted at `resolution`. */
@@ -122,9 +150,9 @@ export interface SunlitEngine {
   readonly adapter: string;
   /** Pixels along a view's side. */
   readonly resolution: number;
-  /** Reads model files; throws an Error naming the file, object and reason when one is bad. */
+  /** Reads model files; throws a SunlitError naming the file, object and reason when one is bad. */
   loadFiles(files: ModelFile[], options?: LoadOptions): Model;
-  /** Builds a model from typed arrays; throws an Error naming the array and element when bad. */
+  /** Builds a model from typed arrays; throws a SunlitError naming the array and element when bad. */
   fromArrays(input: ArraysInput): Model;
   /** Builds a model from meshes and placements; throws an Error naming the array and element when bad. */
   fromMeshes(input: MeshesInput): Model;

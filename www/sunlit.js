@@ -33,11 +33,16 @@ export function sunDirection(azimuth, altitude) {
   return [Math.sin(a) * Math.cos(h), Math.cos(a) * Math.cos(h), Math.sin(h)];
 }
 
+/** An Error with a `code` (and what it names), as the wasm side throws them (sunlit.d.ts). */
+function coded(message, code, names = {}) {
+  return Object.assign(new Error(message), { code }, names);
+}
+
 /** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps).
- * Rejects with a clear message where WebGPU is missing. */
+ * Rejects with code 'no-webgpu' where WebGPU is missing. */
 export async function createEngine({ resolution, accuracy, device } = {}) {
   if (!hasWebGPU()) {
-    throw new Error('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).');
+    throw coded('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).', 'no-webgpu');
   }
   await ready();
   const open = () => Engine.create(resolution, accuracy);
@@ -54,7 +59,7 @@ function toBytes(bytes, name) {
   if (bytes instanceof Uint8Array) return bytes;
   if (bytes instanceof ArrayBuffer) return new Uint8Array(bytes);
   if (ArrayBuffer.isView(bytes)) return new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength);
-  throw new TypeError(`${name}: bytes must be a Uint8Array or ArrayBuffer`);
+  throw coded(`${name}: bytes must be a Uint8Array or ArrayBuffer`, 'bad-option', { file: name, option: 'bytes' });
 }
 
 function abortError() {
@@ -123,7 +128,7 @@ class SunlitEngine {
     try {
       return await this.#engine.annual(model, settings, onProgress, signal);
     } catch (error) {
-      if (signal?.aborted && String(error?.message ?? error) === 'cancelled') throw abortError();
+      if (signal?.aborted && error?.code === 'cancelled') throw abortError();
       throw error;
     }
   }

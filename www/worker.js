@@ -1,6 +1,8 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
 // page stays responsive. Messages in: load, compute, cancel. Messages out: loaded, progress,
-// notice, result, error (with `gpu: true` when the device failed twice and a retry may help).
+// notice, result, error (with the error's `code`, and `gpu: true` when the device failed twice and
+// a retry may help). Errors are told apart by their `code` (sunlit.d.ts, SunlitError), never by
+// their message.
 import { createEngine } from './sunlit.js';
 
 let engine = null;
@@ -24,19 +26,22 @@ function modelOn(e) {
   return model;
 }
 
-function isGpuFailure(message) {
-  return /^GPU:|device (was )?lost|device went away/i.test(message);
+/** Codes after which the device cannot be trusted, but a new one may work. */
+const GPU_FAILURES = new Set(['gpu', 'device-lost']);
+
+function isGpuFailure(error) {
+  return GPU_FAILURES.has(error?.code);
 }
 
 function fail(error, request) {
   const message = String(error?.message ?? error);
-  const gpu = isGpuFailure(message);
+  const gpu = isGpuFailure(error);
   if (gpu) {
     // A lost or failed device cannot be reused; the next request makes a new one.
     engine = null;
     model = null;
   }
-  postMessage({ type: 'error', request, message, gpu, cancelled: error?.name === 'AbortError' });
+  postMessage({ type: 'error', request, message, code: error?.code, gpu, cancelled: error?.name === 'AbortError' });
 }
 
 async function load({ files: given, options, resolution }) {
@@ -72,7 +77,7 @@ async function compute(request) {
   try {
     return await computeOnce(request);
   } catch (error) {
-    if (error?.name === 'AbortError' || !isGpuFailure(String(error?.message ?? error))) throw error;
+    if (!isGpuFailure(error)) throw error;
     engine = null;
     model = null;
     postMessage({ type: 'notice', text: `The GPU device failed (${error.message}); counting again on a new one…` });
@@ -81,7 +86,7 @@ async function compute(request) {
 }
 
 async function computeOnce({ settings, resolution, csvName }) {
-  if (!files) throw new Error('load a model first');
+  if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
   const e = await engineFor(resolution);
   const m = modelOn(e);
   running = new AbortController();

@@ -10,9 +10,10 @@ use std::collections::BTreeMap;
 
 use glam::DVec3;
 
+use crate::count::ViewRequest;
+use crate::count::gpu::plan::planned_triangles;
 use crate::count::gpu::{Counted, Counter, GpuScene};
 use crate::count::lanes::{Lane, fractions_side_by_side};
-use crate::count::{ViewRequest, is_dark, view};
 use crate::error::Result;
 use crate::scene::{Scene, SceneBuilder, SourceMesh};
 
@@ -134,7 +135,7 @@ pub struct Timing {
 pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DVec3], now: impl Fn() -> f64) -> Result<Timing> {
     let gpu: GpuScene = counter.upload(scene)?;
     let requests: Vec<ViewRequest> =
-        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest { receiver, sun })).collect();
+        suns.iter().flat_map(|&sun| (0..scene.receivers.len() as u32).map(move |receiver| ViewRequest::new(receiver, sun))).collect();
     counter.fractions(&gpu, &requests[..requests.len().min(counter.tiles_per_batch())]).await?;
     let start = now();
     let counted = counter.fractions(&gpu, &requests).await?;
@@ -195,21 +196,21 @@ pub struct ViewTiming {
 }
 
 /// Times counting `requests` over the lanes (side by side); one warm-up batch a lane first.
-pub async fn time_requests(lanes: &[Lane<'_>], scene: &Scene, requests: &[ViewRequest], now: impl Fn() -> f64) -> Result<ViewTiming> {
+pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: impl Fn() -> f64) -> Result<ViewTiming> {
     let Some(&Lane { counter, gpu }) = lanes.first() else { return Err(crate::error::Error::argument("lanes", "none to count on")) };
     // Warm every lane (pipelines, first submission) outside the timing.
     let warm = requests.len().min(counter.tiles_per_batch() * lanes.len());
-    fractions_side_by_side(lanes, &requests[..warm], &[]).await?;
+    fractions_side_by_side(lanes, &requests[..warm]).await?;
     let start = now();
     let rendered_so_far = || lanes.iter().fold((0, 0), |(t, n), l| (t + l.counter.rendered().0, n + l.counter.rendered().1));
     let before = rendered_so_far();
-    let counted = fractions_side_by_side(lanes, requests, &[]).await?;
+    let counted = fractions_side_by_side(lanes, requests).await?;
     let seconds = now() - start;
     let after = rendered_so_far();
     let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);
     let rendered = counted.iter().filter(|c| c.covered > 0).count();
     let start = now();
-    let (drawn, planned) = plan_views(scene, gpu, requests, counter.resolution());
+    let (drawn, planned) = planned_triangles(gpu, requests, counter.resolution());
     let planning_seconds = now() - start;
     Ok(ViewTiming {
         views: requests.len(),
@@ -259,27 +260,6 @@ pub fn check_exact(scene: &Scene, requests: &[ViewRequest], counted: &[Counted],
         max: errors.iter().map(|e| e.0).fold(0.0, f64::max),
         above_estimate: errors.iter().filter(|(error, estimate)| error > estimate).count(),
     }
-}
-
-/// What [`Counter::fractions`] does on the CPU before drawing: fit each lit view and choose
-/// what it draws. Returns the triangles drawn over all views that need a render, and their count.
-fn plan_views(scene: &Scene, gpu: &GpuScene, requests: &[ViewRequest], resolution: u32) -> (usize, usize) {
-    let points: Vec<Vec<DVec3>> = scene.receivers.iter().map(|r| r.triangles.iter().flatten().copied().collect()).collect();
-    let (mut sum, mut n) = (0usize, 0usize);
-    for req in requests {
-        let r = &scene.receivers[req.receiver as usize];
-        if is_dark(r.normal, req.sun) {
-            continue;
-        }
-        let points = &points[req.receiver as usize];
-        let v = view::fit(points, req.sun, scene.bounds, scene.origin, resolution);
-        let target = crate::count::cull::Target { points, normal: r.normal, gpu_id: r.gpu_id };
-        if let Some(list) = gpu.culling().select(&v.view_proj, &target, req.sun) {
-            sum += list.triangles(gpu.culling());
-            n += 1;
-        }
-    }
-    (sum, n)
 }
 
 /// A small deterministic generator: benchmarks must not depend on a random crate's versions.

@@ -24,13 +24,16 @@
 //! Degenerate cases: an unknown receiver id, a non-finite sun vector or a receiver without area
 //! give 0 (nothing can be lit); a receiver that nothing shades gives exactly 1.
 
+use std::collections::HashMap;
+
 use glam::{DVec2, DVec3};
 use i_overlay::core::extract::BooleanExtractionBuffer;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::overlay::FloatOverlay;
 
-use super::{ViewRequest, is_dark};
+use super::{Engine, ViewAnswer, ViewRequest, check_receivers, cos_incidence, is_dark};
+use crate::error::Result;
 use crate::scene::{Receiver, Scene};
 
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).
@@ -43,20 +46,54 @@ const AREA_EPS: f64 = 1e-15;
 /// The box shadows are clipped to exceeds the receiver's by this part of its size.
 const WINDOW_MARGIN: f64 = 0.01;
 
-/// Sunlit fraction of one receiver for one sun direction, by exact polygon clipping.
+/// Sunlit fraction of one receiver for one sun direction (at the request's leaf fraction), by
+/// exact polygon clipping.
 pub fn sunlit_fraction(scene: &Scene, request: ViewRequest) -> f64 {
-    Casters::new(scene, 1.0).fraction(scene, request)
+    Casters::new(scene, request.leaves).fraction(scene, request)
 }
 
-/// Many at once (may share work, e.g. collect the world triangles once).
+/// Many at once, each at its own leaf fraction; the world triangles are collected once per
+/// distinct leaf fraction.
 pub fn sunlit_fractions(scene: &Scene, requests: &[ViewRequest]) -> Vec<f64> {
-    sunlit_fractions_with_leaves(scene, requests, 1.0)
+    let mut casters: HashMap<u32, Casters> = HashMap::new();
+    requests
+        .iter()
+        .map(|&request| {
+            casters.entry(request.leaves.to_bits()).or_insert_with(|| Casters::new(scene, request.leaves)).fraction(scene, request)
+        })
+        .collect()
 }
 
-/// Many at once with leaf fraction `leaves`: only the leaves whose rank is below it cast shadows.
-pub fn sunlit_fractions_with_leaves(scene: &Scene, requests: &[ViewRequest], leaves: f32) -> Vec<f64> {
-    let casters = Casters::new(scene, leaves);
-    requests.iter().map(|&request| casters.fraction(scene, request)).collect()
+/// The exact reference as an [`Engine`]: answers every view of its scene by polygon clipping.
+#[derive(Clone, Copy)]
+pub struct Exact<'a> {
+    /// The scene the views are of.
+    pub scene: &'a Scene,
+}
+
+/// Views the exact reference answers per call of [`Engine::answer`] when a caller chunks: a few
+/// seconds of clipping on a large scene, so progress and cancellation stay responsive.
+const EXACT_BATCH: usize = 64;
+
+impl Engine for Exact<'_> {
+    fn batch(&self) -> usize {
+        EXACT_BATCH
+    }
+
+    async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        check_receivers(self.scene.receivers.len(), requests)?;
+        let fractions = sunlit_fractions(self.scene, requests);
+        Ok(requests
+            .iter()
+            .zip(fractions)
+            .map(|(request, fraction)| ViewAnswer {
+                fraction,
+                cos_incidence: cos_incidence(self.scene.receivers[request.receiver as usize].normal, request.sun),
+                error_estimate: Some(0.0),
+                ..Default::default()
+            })
+            .collect())
+    }
 }
 
 /// The scene's world triangles, collected once, with the tolerances that fit the scene's size.
@@ -347,7 +384,7 @@ mod tests {
 
     fn fraction(scene: &Scene, name: &str, sun: DVec3) -> f64 {
         let (receiver, _) = scene.receiver(name).unwrap();
-        sunlit_fraction(scene, ViewRequest { receiver, sun })
+        sunlit_fraction(scene, ViewRequest::new(receiver, sun))
     }
 
     fn assert_close(got: f64, want: f64) {
@@ -371,7 +408,7 @@ mod tests {
         assert_eq!(fraction(&s, "Window", sun(180.0, 30.0)), 1.0);
         assert_eq!(fraction(&s, "Window", sun(0.0, 30.0)), 0.0, "sun in the north: back-facing");
         assert_eq!(fraction(&s, "Window", sun(180.0, -5.0)), 0.0, "sun below the horizon");
-        assert_eq!(sunlit_fraction(&s, ViewRequest { receiver: 7, sun: sun(180.0, 30.0) }), 0.0, "unknown receiver");
+        assert_eq!(sunlit_fraction(&s, ViewRequest::new(7, sun(180.0, 30.0))), 0.0, "unknown receiver");
         assert_eq!(fraction(&s, "Window", DVec3::NAN), 0.0);
     }
 
@@ -500,7 +537,7 @@ mod tests {
         let sun = DVec3::new(0.0, -1.0, 2.0).normalize();
         let (wall_id, _) = s.receiver("Wall").unwrap();
         let (window_id, _) = s.receiver("Window").unwrap();
-        let requests = [ViewRequest { receiver: wall_id, sun }, ViewRequest { receiver: window_id, sun }];
+        let requests = [ViewRequest::new(wall_id, sun), ViewRequest::new(window_id, sun)];
         let got = sunlit_fractions(&s, &requests);
         assert_close(got[0], 0.7);
         assert_close(got[1], 0.5);

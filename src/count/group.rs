@@ -23,6 +23,7 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
+use crate::geometry;
 use crate::scene::{COPLANAR_ANGLE, COPLANAR_DISTANCE, Receiver, Scene};
 
 /// Most receivers one tile counts (the count shader's `MAX_MEMBERS`). The count shader keeps
@@ -63,23 +64,24 @@ pub struct ViewGroups {
 
 /// A receiver's plane and in-plane frame.
 struct Plane {
-    normal: DVec3,
+    /// Through the receiver's first vertex; flat coordinates are relative to it.
+    plane: geometry::Plane,
     offset: f64,
-    u: DVec3,
-    v: DVec3,
 }
 
 impl Plane {
     fn of(r: &Receiver) -> Option<Self> {
         let p0 = *r.triangles.first()?.first()?;
         let normal = r.normal.try_normalize()?;
-        let helper = if normal.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
-        let u = (helper - normal * helper.dot(normal)).normalize();
-        Some(Self { normal, offset: normal.dot(p0), u, v: normal.cross(u) })
+        Some(Self { plane: geometry::Plane::through(p0, normal), offset: normal.dot(p0) })
+    }
+
+    fn normal(&self) -> DVec3 {
+        self.plane.normal
     }
 
     fn flat(&self, p: DVec3) -> DVec2 {
-        DVec2::new(p.dot(self.u), p.dot(self.v))
+        self.plane.project(p)
     }
 
     fn rectangle(&self, r: &Receiver) -> (DVec2, DVec2) {
@@ -92,8 +94,8 @@ impl Plane {
 
     /// Whether every vertex of `r` lies on this plane and `r` faces the same way.
     fn holds(&self, r: &Receiver) -> bool {
-        r.normal.dot(self.normal) >= COPLANAR_ANGLE.cos()
-            && r.triangles.iter().flatten().all(|p| (p.dot(self.normal) - self.offset).abs() <= COPLANAR_DISTANCE)
+        r.normal.dot(self.normal()) >= COPLANAR_ANGLE.cos()
+            && r.triangles.iter().flatten().all(|p| (p.dot(self.normal()) - self.offset).abs() <= COPLANAR_DISTANCE)
     }
 }
 
@@ -116,7 +118,7 @@ impl ViewGroups {
         let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
         for (i, plane) in planes.iter().enumerate() {
             if let Some(p) = plane {
-                cells.entry(cell(p.normal)).or_default().push(i as u32);
+                cells.entry(cell(p.normal())).or_default().push(i as u32);
             }
         }
         let outline: Vec<f64> = receivers
@@ -139,7 +141,7 @@ impl ViewGroups {
             }
             claimed[owner as usize] = true;
             let members = match &planes[owner as usize] {
-                Some(plane) => gather(receivers, plane, owner, &neighbours(&cells, plane.normal), min_share, &mut claimed),
+                Some(plane) => gather(receivers, plane, owner, &neighbours(&cells, plane.normal()), min_share, &mut claimed),
                 None => vec![owner],
             };
             let g = groups.members.len() as u32;

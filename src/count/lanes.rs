@@ -11,8 +11,8 @@
 //!
 //! On the web there is one GPU and one lane; lanes there would run one after the other.
 
-use super::ViewRequest;
 use super::gpu::{Counted, Counter, GpuScene};
+use super::{Engine, ViewAnswer, ViewRequest};
 use crate::error::Result;
 use crate::platform;
 
@@ -33,27 +33,43 @@ pub fn default_lanes(info: &wgpu::AdapterInfo) -> usize {
     if info.device_type == wgpu::DeviceType::Cpu && cores >= 2 { 2 } else { 1 }
 }
 
-/// Counts `requests` (with `leaves[i]` the leaf fraction of request `i`, or all leaves on when
-/// `leaves` is empty) over the lanes, each a contiguous share of whole atlas batches.
-pub async fn fractions_side_by_side(lanes: &[Lane<'_>], requests: &[ViewRequest], leaves: &[f32]) -> Result<Vec<Counted>> {
+/// Counts `requests` over the lanes, each a contiguous share of whole atlas batches.
+pub async fn fractions_side_by_side(lanes: &[Lane<'_>], requests: &[ViewRequest]) -> Result<Vec<Counted>> {
     let Some(first) = lanes.first() else { return Ok(Vec::new()) };
     let batch = first.counter.tiles_per_batch().max(1);
     // Whole batches per lane, so no lane submits a part-filled atlas it need not.
     let share = requests.len().div_ceil(lanes.len()).div_ceil(batch) * batch;
-    let parts: Vec<(Lane<'_>, &[ViewRequest], &[f32])> = lanes
-        .iter()
-        .zip(requests.chunks(share.max(1)))
-        .enumerate()
-        .map(|(k, (lane, part))| {
-            let from = k * share;
-            let leaves = if leaves.is_empty() { leaves } else { &leaves[from..from + part.len()] };
-            (*lane, part, leaves)
-        })
-        .collect();
-    let counted = platform::side_by_side(&parts, |(lane, part, leaves)| lane.counter.fractions_with_leaves(lane.gpu, part, leaves)).await;
+    let parts: Vec<(Lane<'_>, &[ViewRequest])> = lanes.iter().copied().zip(requests.chunks(share.max(1))).collect();
+    let counted = platform::side_by_side(&parts, |(lane, part)| lane.counter.fractions(lane.gpu, part)).await;
     let mut out = Vec::with_capacity(requests.len());
     for part in counted {
         out.extend(part?);
     }
     Ok(out)
+}
+
+/// One device as an [`Engine`].
+impl Engine for Lane<'_> {
+    fn batch(&self) -> usize {
+        self.counter.tiles_per_batch()
+    }
+
+    async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        self.counter.answer(self.gpu, requests).await
+    }
+}
+
+/// Several devices side by side as one [`Engine`].
+#[derive(Clone, Copy)]
+pub struct Lanes<'a>(pub &'a [Lane<'a>]);
+
+impl Engine for Lanes<'_> {
+    fn batch(&self) -> usize {
+        self.0.first().map_or(1, |l| l.counter.tiles_per_batch()) * self.0.len().max(1)
+    }
+
+    async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        let edges_counted = self.0.first().is_some_and(|l| l.counter.options().accuracy.is_some());
+        Ok(fractions_side_by_side(self.0, requests).await?.iter().map(|c| c.answer(edges_counted)).collect())
+    }
 }

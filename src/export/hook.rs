@@ -17,10 +17,11 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, Result};
+use crate::geometry::{self, Plane, is_convex};
 use crate::model::EnergyPlusInput;
 use crate::model::idf::IdfObject;
-use crate::samples::Timesteps;
 use crate::scene::Scene;
+use crate::year::samples::Timesteps;
 
 /// How EnergyPlus is told to use the CSV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,7 +38,7 @@ impl Hook {
         match text.to_ascii_lowercase().as_str() {
             "scheduled" => Ok(Hook::Scheduled),
             "imported" => Ok(Hook::Imported),
-            _ => Err(Error::argument("--hook", format!("'{text}': expected scheduled or imported"))),
+            _ => Err(Error::argument("hook", format!("'{text}': expected scheduled or imported"))),
         }
     }
 
@@ -158,36 +159,9 @@ fn convex_split(file: &str, o: &IdfObject) -> Result<Option<String>> {
     Ok(Some(out))
 }
 
-/// A polygon's normal × area (Newell), for its orientation.
-fn newell(v: &[glam::DVec3]) -> glam::DVec3 {
-    (0..v.len()).map(|i| v[i].cross(v[(i + 1) % v.len()])).sum::<glam::DVec3>() * 0.5
-}
-
-/// Whether every turn of the polygon goes the same way as its normal.
-fn is_convex(v: &[glam::DVec3]) -> bool {
-    let n = newell(v);
-    (0..v.len()).all(|i| {
-        let (a, b, c) = (v[i], v[(i + 1) % v.len()], v[(i + 2) % v.len()]);
-        (b - a).cross(c - b).dot(n) >= -1e-12 * n.length()
-    })
-}
-
 /// Ear-clipped triangles of a planar polygon, as vertex indices keeping its winding.
 fn triangles(v: &[glam::DVec3]) -> Vec<[usize; 3]> {
-    let n = newell(v).normalize_or_zero();
-    let helper = if n.x.abs() < 0.9 { glam::DVec3::X } else { glam::DVec3::Y };
-    let u = (helper - n * helper.dot(n)).normalize_or_zero();
-    let w = n.cross(u);
-    let flat: Vec<[f64; 2]> = v.iter().map(|p| [p.dot(u), p.dot(w)]).collect();
-    let mut indices: Vec<usize> = Vec::new();
-    earcut::Earcut::new().earcut(flat.iter().copied(), &[], &mut indices);
-    indices
-        .chunks_exact(3)
-        .map(|t| {
-            let facing = (v[t[1]] - v[t[0]]).cross(v[t[2]] - v[t[0]]).dot(n);
-            if facing < 0.0 { [t[0], t[2], t[1]] } else { [t[0], t[1], t[2]] }
-        })
-        .collect()
+    geometry::triangulate(&Plane::of_polygon(v), v, &[])
 }
 
 /// Whether another object starts or ends on one of `o`'s lines.
@@ -203,14 +177,7 @@ pub fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result
     if let Some(ts) = objects.iter().find(|o| o.is("Timestep")) {
         let n: u32 = ts.field(0).trim().parse().unwrap_or(1);
         if n != plan.timesteps.per_hour() {
-            return Err(Error::object(
-                file,
-                ts.label(),
-                format!(
-                    "the model runs {n} timesteps per hour but the CSV has {}: use --timesteps-per-hour {n}",
-                    plan.timesteps.per_hour()
-                ),
-            ));
+            return Err(Error::TimestepMismatch { file: file.into(), object: ts.label(), model: n, schedule: plan.timesteps.per_hour() });
         }
     }
     if plan.hook == Hook::Scheduled {
@@ -380,7 +347,7 @@ mod tests {
         let columns = vec!["WIN_S".to_string()];
         let objects = parse_idf("m.idf", "Version, 25.2;\nTimestep, 6;\n").unwrap();
         let e = patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string();
-        assert!(e.contains("Timestep") && e.contains("--timesteps-per-hour 6"), "{e}");
+        assert!(e.contains("Timestep") && e.contains("timesteps_per_hour 6"), "{e}");
         let objects = parse_idf("m.idf", "Version, 8.9;\n").unwrap();
         assert!(patch_idf("m.idf", "", &objects, &plan(&columns)).unwrap_err().to_string().contains("9.0"));
         let objects = parse_idf("m.idf", "Version, 25.2;\nSurfaceProperty:LocalEnvironment, E, win_s, S;\n").unwrap();

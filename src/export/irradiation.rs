@@ -23,10 +23,10 @@ use std::path::Path;
 
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::samples::{DAYS, Timesteps};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::samples::{DAYS, Timesteps};
 
 /// Lines before the first data record of an EPW (LOCATION … DATA PERIODS).
 const EPW_HEADER_LINES: usize = 8;
@@ -290,7 +290,7 @@ mod tests {
         text.push_str("COMMENTS 1,\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday,1/1,12/31\n");
         for h in 0..records {
             let (day, hour) = (h / 24 + 1, h % 24 + 1);
-            let (month, dom) = crate::samples::month_day(day as u32);
+            let (month, dom) = crate::year::samples::month_day(day as u32);
             let _ = writeln!(
                 text,
                 "1999,{month},{dom},{hour},60,x,10,5,50,80000,0,1000,300,400,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0"

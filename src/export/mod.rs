@@ -10,7 +10,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
-use crate::samples::Timesteps;
+use crate::year::samples::Timesteps;
 
 pub mod hook;
 pub mod irradiation;
@@ -143,7 +143,7 @@ impl Schedule {
 }
 
 /// Hours in EnergyPlus's schedule year.
-const DAYS_HOURS: u32 = crate::samples::DAYS * 24;
+const DAYS_HOURS: u32 = crate::year::samples::DAYS * 24;
 
 /// A CSV line's fields, without the one trailing comma EnergyPlus writes (and `\r`).
 fn csv_fields(line: &str) -> std::str::Split<'_, char> {

@@ -6,7 +6,7 @@
 
 use glam::DVec3;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, NoReceivers, Result};
 use crate::scene::{Scene, SceneBuilder, SourceMesh};
 
 /// The label errors and receiver origins carry for array input.
@@ -65,7 +65,7 @@ pub fn scene_from_arrays(arrays: &Arrays) -> Result<Scene> {
         builder.add_object(SOURCE, "context", context, false);
     }
     if arrays.names.is_empty() {
-        return Err(Error::NoReceivers("the arrays name no receiver".into()));
+        return Err(Error::NoReceivers(NoReceivers::Other("the arrays name no receiver".into())));
     }
     builder.build()
 }

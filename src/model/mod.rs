@@ -1,25 +1,30 @@
-//! Model readers and writers: glTF/glb and EnergyPlus IDF/epJSON in, glb and IDF out.
+//! Model readers: glTF/glb, EnergyPlus IDF/epJSON and typed arrays in, one [`Scene`] out (with
+//! the EnergyPlus model kept for the hook, [`crate::export::hook`]). With the `fixtures` feature,
+//! also the glb writer and the generated example office (`glb_write`, `office`, `office_idf`).
 //!
 //! Owns the choice of receivers across all input files. With an EnergyPlus model among the
 //! inputs, it gives the receivers (its outdoor surfaces and fenestration, by their EnergyPlus
-//! names) and glTF files are context that only casts shadows, unless `--receivers` picks glTF
-//! nodes too. Without one: `--receivers GLOB` (node names, case-insensitive) when given;
+//! names) and glTF files are context that only casts shadows, unless the `receivers` patterns pick
+//! glTF nodes too. Without one: the `receivers` globs (node names, case-insensitive) when given;
 //! otherwise the nodes marked `{"sunlit": {"receiver": true}}` in their extras, if any file marks
-//! one; otherwise every named node with a mesh. Foliage and see-through nodes (`--foliage`,
-//! `--transmittance`, or their extras marks) are never chosen by the marks-or-names default.
+//! one; otherwise every named node with a mesh. Foliage and see-through nodes (the `foliage` and
+//! `transmittance` patterns, or their extras marks) are never chosen by the marks-or-names default.
 pub mod arrays;
 pub mod building;
 pub mod epjson;
+#[cfg(feature = "fixtures")]
 pub mod glb_write;
 pub mod gltf_read;
 pub mod idf;
+#[cfg(feature = "fixtures")]
 pub mod office;
+#[cfg(feature = "fixtures")]
 pub mod office_idf;
 pub mod placed;
 
 use std::path::PathBuf;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, NoReceivers, Result};
 use crate::scene::{NodeVeil, Scene, SceneBuilder};
 use gltf_read::{GltfModel, GltfNode};
 
@@ -40,7 +45,7 @@ pub struct LoadOptions {
     pub transmittance: Vec<(String, f64)>,
 }
 
-/// The EnergyPlus model among the inputs, kept for `--idf-out`.
+/// The EnergyPlus model among the inputs, kept for hooking the schedule into a copy of it.
 #[derive(Debug, Clone)]
 pub struct EnergyPlusInput {
     /// File label.
@@ -109,10 +114,10 @@ fn energyplus_kind(name: &str) -> Option<bool> {
     }
 }
 
-/// Parses `GLOB=T` (a `--transmittance` option, or one item of the page's list): nodes matching
+/// Parses `GLOB=T` (one `transmittance` item): nodes matching
 /// GLOB let T (0 ≤ T < 1) of the beam through.
 pub fn parse_transmittance(text: &str) -> Result<(String, f64)> {
-    let bad = || Error::argument("--transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
+    let bad = || Error::argument("transmittance", format!("'{text}' is not GLOB=T with T a number in [0, 1)"));
     let (glob, t) = text.rsplit_once('=').ok_or_else(bad)?;
     let t: f64 = t.trim().parse().map_err(|_| bad())?;
     let glob = glob.trim();
@@ -173,7 +178,7 @@ fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusI
 
 fn check_options(options: &LoadOptions) -> Result<()> {
     if !options.north.is_finite() {
-        return Err(Error::argument("--north", format!("{} is not a finite angle", options.north)));
+        return Err(Error::argument("north", format!("{} is not a finite angle", options.north)));
     }
     Ok(())
 }
@@ -214,12 +219,15 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
     builder.build()
 }
 
+/// A node pattern as given: the parameter and its text (`("foliage", "pine*")`).
+type Label = (&'static str, String);
+
 /// The foliage and transmittance rules in force for one load.
 struct Veils {
-    foliage: Vec<(globset::GlobMatcher, String)>,
-    transmittance: Vec<(globset::GlobMatcher, String, f64)>,
+    foliage: Vec<(globset::GlobMatcher, Label)>,
+    transmittance: Vec<(globset::GlobMatcher, Label, f64)>,
     /// Patterns that matched some node, so a misspelt one is reported rather than ignored.
-    used: std::cell::RefCell<std::collections::HashSet<String>>,
+    used: std::cell::RefCell<std::collections::HashSet<Label>>,
 }
 
 impl Veils {
@@ -231,15 +239,15 @@ impl Veils {
                 .map(|g| g.compile_matcher())
                 .map_err(|e| Error::argument(flag.to_string(), format!("'{pattern}': {e}")))
         };
-        let foliage = options.foliage.iter().map(|p| Ok((glob("--foliage", p)?, format!("--foliage {p}")))).collect::<Result<_>>()?;
+        let foliage = options.foliage.iter().map(|p| Ok((glob("foliage", p)?, ("foliage", p.clone())))).collect::<Result<_>>()?;
         let transmittance = options
             .transmittance
             .iter()
             .map(|(p, t)| {
                 if !(0.0..1.0).contains(t) {
-                    return Err(Error::argument("--transmittance", format!("{p}={t}: the transmittance must be in [0, 1)")));
+                    return Err(Error::argument("transmittance", format!("{p}={t}: the transmittance must be in [0, 1)")));
                 }
-                Ok((glob("--transmittance", p)?, format!("--transmittance {p}={t}"), *t))
+                Ok((glob("transmittance", p)?, ("transmittance", format!("{p}={t}")), *t))
             })
             .collect::<Result<_>>()?;
         Ok(Self { foliage, transmittance, used: Default::default() })
@@ -268,7 +276,7 @@ impl Veils {
         let used = self.used.borrow();
         let labels = self.foliage.iter().map(|(_, l)| l).chain(self.transmittance.iter().map(|(_, l, _)| l));
         match labels.into_iter().find(|l| !used.contains(*l)) {
-            Some(label) => Err(Error::argument(label.clone(), "no glTF node name matches it")),
+            Some((what, pattern)) => Err(Error::Unmatched { what: what.to_string(), pattern: pattern.clone() }),
             None => Ok(()),
         }
     }
@@ -291,10 +299,10 @@ impl Selection {
                 let glob = globset::GlobBuilder::new(pattern)
                     .case_insensitive(true)
                     .build()
-                    .map_err(|e| Error::argument("--receivers", format!("'{pattern}': {e}")))?;
+                    .map_err(|e| Error::argument("receivers", format!("'{pattern}': {e}")))?;
                 set.add(glob);
             }
-            let set = set.build().map_err(|e| Error::argument("--receivers", e.to_string()))?;
+            let set = set.build().map_err(|e| Error::argument("receivers", e.to_string()))?;
             return Ok(Selection::Globs(set, options.receivers.clone()));
         }
         let any_marked = models.iter().any(|m| m.nodes.iter().any(|n| n.marked));
@@ -310,12 +318,12 @@ impl Selection {
         }
     }
 
-    fn explain(&self) -> String {
+    fn explain(&self) -> NoReceivers {
         match self {
-            Selection::Globs(_, p) => format!("no node name matches --receivers {}", p.join(", ")),
-            Selection::Marked => "no node is marked as a receiver".into(),
-            Selection::Named => "the models have no named node with a mesh (name nodes, mark them in extras, or use --receivers)".into(),
-            Selection::Context => "the EnergyPlus model has no outdoor surface or window".into(),
+            Selection::Globs(_, p) => NoReceivers::Unmatched(p.clone()),
+            Selection::Marked => NoReceivers::Other("no node is marked as a receiver".into()),
+            Selection::Named => NoReceivers::Unnamed,
+            Selection::Context => NoReceivers::Other("the EnergyPlus model has no outdoor surface or window".into()),
         }
     }
 }

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 use glam::{DMat4, DVec4};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, NoReceivers, Result};
 use crate::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
 
 /// The label errors and receiver origins carry for this input.
@@ -68,7 +68,7 @@ pub fn scene_from_placed(input: &Placed) -> Result<Scene> {
         });
     }
     if !input.receivers.iter().any(|r| *r != 0) {
-        return Err(Error::NoReceivers("no placement is marked as a receiver".into()));
+        return Err(Error::NoReceivers(NoReceivers::Other("no placement is marked as a receiver".into())));
     }
     builder.build()
 }

@@ -1,7 +1,7 @@
 //! The site the sun is seen from: latitude, longitude, time zone and elevation.
 //!
 //! Owns the ranges a site must satisfy and the two ways one comes in: the CLI's
-//! `--location LAT,LON,TZ` and the `LOCATION` record on the first line of an EnergyPlus
+//! `LAT,LON,TZ` text (the `location` parameter) and the `LOCATION` record on the first line of an EnergyPlus
 //! weather (EPW) file.
 
 use std::io::{BufRead, BufReader};
@@ -52,7 +52,7 @@ impl Location {
     pub fn parse(text: &str) -> Result<Self> {
         let bad = || {
             Error::argument(
-                "--location",
+                "location",
                 format!("expected LAT,LON,TZ (degrees north, degrees east, hours from UTC, e.g. 39.74,-105.18,-7), got '{text}'"),
             )
         };
@@ -60,7 +60,7 @@ impl Location {
         let [lat, lon, tz] = parts.as_slice() else { return Err(bad()) };
         let number = |part: &str| part.trim().parse::<f64>().map_err(|_| bad());
         let (latitude, longitude, time_zone) = (number(lat)?, number(lon)?, number(tz)?);
-        check_coordinates(latitude, longitude, time_zone).map_err(|reason| Error::argument("--location", reason))?;
+        check_coordinates(latitude, longitude, time_zone).map_err(|reason| Error::argument("location", reason))?;
         Ok(Self { latitude, longitude, time_zone, elevation: 0.0, name: String::new() })
     }
 
@@ -180,7 +180,7 @@ mod tests {
         assert_eq!((site.latitude, site.longitude, site.time_zone), (-33.87, 151.21, 10.0));
         for bad in ["", "40", "40,-105", "40,-105,-7,0", "a,-105,-7", "40,,-7", "95,-105,-7", "40,-105,15", "nan,0,0"] {
             let e = Location::parse(bad).unwrap_err().to_string();
-            assert!(e.contains("--location"), "{bad}: {e}");
+            assert!(e.contains("invalid location"), "{bad}: {e}");
         }
         assert!(Location::parse("40,-105,15").unwrap_err().to_string().contains("time zone 15"));
     }

@@ -35,12 +35,12 @@ impl SunPosition {
 
     /// Parses `AZ,ALT` (degrees).
     pub fn parse(text: &str) -> Result<Self> {
-        let bad = || Error::argument("--sun", format!("expected AZ,ALT in degrees (e.g. 180,45), got '{text}'"));
+        let bad = || Error::argument("sun", format!("expected AZ,ALT in degrees (e.g. 180,45), got '{text}'"));
         let (a, b) = text.split_once(',').ok_or_else(bad)?;
         let az: f64 = a.trim().parse().map_err(|_| bad())?;
         let alt: f64 = b.trim().parse().map_err(|_| bad())?;
         Self::new(az, alt).map_err(|e| match e {
-            Error::Argument { reason, .. } => Error::argument("--sun", reason),
+            Error::Argument { reason, .. } => Error::argument("sun", reason),
             other => other,
         })
     }
@@ -73,7 +73,7 @@ mod tests {
     fn malformed_sun_is_refused() {
         for bad in ["", "180", "a,b", "180,95", "nan,10", "180,inf"] {
             let e = SunPosition::parse(bad).unwrap_err().to_string();
-            assert!(e.contains("--sun"), "{bad}: {e}");
+            assert!(e.contains("invalid sun"), "{bad}: {e}");
         }
         assert_eq!(SunPosition::parse(" 190 , 30 ").unwrap().azimuth, 190.0);
     }

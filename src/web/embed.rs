@@ -10,10 +10,10 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::irradiation::{DirectNormal, SurfaceSummary, summarize};
 use crate::model::placed::{Placed, scene_from_placed};
-use crate::samples::DAYS;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::samples::DAYS;
 
 #[wasm_bindgen]
 impl Engine {

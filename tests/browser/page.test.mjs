@@ -166,7 +166,7 @@ test('bad files get a message naming the problem, and the page keeps working', {
   }
   await page.fill('#receivers', 'Nothing*');
   const none = await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/);
-  assert.match(none, /no receiving surface: no node name matches --receivers Nothing\*/);
+  assert.match(none, /no receiving surface: no node name matches receivers Nothing\*/);
   await page.fill('#receivers', '');
 
   const epw = join(WORK, 'nowhere.epw');
@@ -280,6 +280,49 @@ test('the API example runs', { timeout: 300_000 }, async () => {
   assert.match(out, /window: 0\.\d{3}/);
   assert.match(out, /8760 rows/);
   await example.close();
+});
+
+test('API errors carry a stable code and name what they are about as the API spells it', { timeout: 120_000 }, async () => {
+  const p = await page.context().newPage();
+  p.on('request', (r) => requests.push(r.url()));
+  p.on('pageerror', (e) => pageErrors.push(e.message));
+  await p.goto(`${origin}/`);
+  const errors = await p.evaluate(async () => {
+    const sunlit = await import('/sunlit.js');
+    const engine = await sunlit.createEngine({ resolution: 64 });
+    const shape = (e) => ({ code: e.code, file: e.file, object: e.object, option: e.option, message: e.message, isError: e instanceof Error });
+    const thrown = (f) => {
+      try {
+        f();
+      } catch (e) {
+        return shape(e);
+      }
+      return null;
+    };
+    const bytes = new Uint8Array(await (await fetch('/pkg/office.glb')).arrayBuffer());
+    const model = engine.loadFiles([{ name: 'office.glb', bytes }]);
+    let settings = null;
+    try {
+      await engine.annual(model, { latitude: 40, longitude: -105, timeZone: -7, timestepsPerHour: 7 });
+    } catch (e) {
+      settings = shape(e);
+    }
+    return {
+      file: thrown(() => engine.loadFiles([{ name: 'notes.glb', bytes: new TextEncoder().encode('hello') }])),
+      receivers: thrown(() => engine.loadFiles([{ name: 'office.glb', bytes }], { receivers: 'Nothing*' })),
+      settings,
+    };
+  });
+  await p.close();
+  assert.equal(errors.file.isError, true);
+  assert.equal(errors.file.code, 'model');
+  assert.equal(errors.file.file, 'notes.glb');
+  assert.equal(errors.receivers.code, 'no-receivers');
+  assert.equal(errors.receivers.option, 'receivers');
+  assert.match(errors.receivers.message, /no node name matches receivers Nothing\*/);
+  assert.equal(errors.settings.code, 'bad-option');
+  assert.equal(errors.settings.option, 'timestepsPerHour');
+  assert.match(errors.settings.message, /^invalid timestepsPerHour: 7 is not one EnergyPlus accepts/);
 });
 
 test('a browser without WebGPU is told so', async () => {

@@ -50,7 +50,7 @@ impl Timesteps {
         if VALID_TIMESTEPS.contains(&per_hour) {
             Ok(Self(per_hour))
         } else {
-            Err(Error::argument("--timesteps-per-hour", format!("{per_hour} is not one EnergyPlus accepts ({VALID_TIMESTEPS:?})")))
+            Err(Error::argument("timesteps_per_hour", format!("{per_hour} is not one EnergyPlus accepts ({VALID_TIMESTEPS:?})")))
         }
     }
 
@@ -120,10 +120,10 @@ impl SamplingPlan {
     /// Checks the ranges: 3..=365 days (a periodic quadratic needs three), 3..=240 per day.
     pub fn new(days: usize, per_day: usize) -> Result<Self> {
         if !(3..=DAYS as usize).contains(&days) {
-            return Err(Error::argument("--days-per-year", format!("{days} is outside 3..=365")));
+            return Err(Error::argument("days_per_year", format!("{days} is outside 3..=365")));
         }
         if !(3..=240).contains(&per_day) {
-            return Err(Error::argument("--samples-per-day", format!("{per_day} is outside 3..=240")));
+            return Err(Error::argument("samples_per_day", format!("{per_day} is outside 3..=240")));
         }
         Ok(Self { days, per_day })
     }
@@ -276,7 +276,7 @@ mod tests {
     #[test]
     fn bad_plans_and_timesteps_are_refused() {
         for n in [0, 7, 8, 9, 11, 120] {
-            assert!(Timesteps::new(n).unwrap_err().to_string().contains("--timesteps-per-hour"));
+            assert!(Timesteps::new(n).unwrap_err().to_string().contains("timesteps_per_hour"));
         }
         assert!(SamplingPlan::new(2, 19).is_err());
         assert!(SamplingPlan::new(27, 1).is_err());

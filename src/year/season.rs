@@ -3,10 +3,10 @@
 //! Owns the rule the foliage layer follows (see [`crate::scene::Veil`]): the leaf fraction is 0
 //! in winter, rises linearly over leaf-out, is 1 in summer and falls linearly over leaf fall, as
 //! the number of leaves was varied in the paper's Blaas case. The phases are the regimes the
-//! annual fit is split by (`crate::annual`): within each the fraction is smooth in the day.
+//! annual fit is split by (`crate::year::annual`): within each the fraction is smooth in the day.
 
 use crate::error::{Error, Result};
-use crate::samples::DAYS;
+use crate::year::samples::DAYS;
 
 const YEAR: f64 = DAYS as f64;
 
@@ -64,7 +64,7 @@ impl LeafCalendar {
         let ordered = out > 0.0 && full >= out && fall > full && fall < YEAR;
         if !leaf_out.0.is_finite() || !leaf_out.1.is_finite() || !leaf_fall.0.is_finite() || !leaf_fall.1.is_finite() || !ordered {
             return Err(Error::argument(
-                "--leaf-out/--leaf-fall",
+                "leaf_out/leaf_fall",
                 "leaf-out and leaf fall must each last at least a day, in the order leaf-out, summer, leaf fall, winter".to_string(),
             ));
         }

@@ -1,6 +1,7 @@
 //! The annual schedule: count at sparse sun samples, fit the B-spline surface, evaluate it at
 //! every EnergyPlus timestep ([`Method::Spline`]); or count every sun-up timestep ([`Method::Dense`],
-//! the reference the spline is tested against).
+//! the reference the spline is tested against). Any [`Engine`] answers the views
+//! ([`annual_with`]); the GPU lanes are the usual one ([`annual_on`], [`annual_recovering`]).
 //!
 //! Owns the handling of the terminator. A surface's fraction drops to exactly 0 where it turns
 //! away from the sun (cos θ ≤ 1e-5) or the sun sets; fitting through those zeros would make the
@@ -12,7 +13,7 @@
 //! the samples of the nearest day that has it, so the periodic fit stays defined. At evaluation
 //! the sun-up and facing tests are applied exactly per timestep; values are clamped to [0, 1].
 //!
-//! Foliage (a scene with leaves, [`crate::season`]): the fraction then changes with the leaf
+//! Foliage (a scene with leaves, [`crate::year::season`]): the fraction then changes with the leaf
 //! cover as well as with the sun, and the leaf fraction has corners where leaf-out and leaf fall
 //! begin and end, which a spline across them would round off. So the year is split into regimes
 //! with a fit each: bare (no leaves) and full leaf, each fitted periodically over the whole year
@@ -24,16 +25,16 @@
 use glam::DVec3;
 
 use crate::count::gpu::{Counter, GpuScene};
-use crate::count::lanes::{Lane, fractions_side_by_side};
-use crate::count::{MIN_COS_INCIDENCE, ViewRequest, is_dark};
+use crate::count::lanes::{Lane, Lanes};
+use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::scene::Scene;
-use crate::season::{LeafCalendar, Phase};
-use crate::spline::{AnnualGrid, AnnualSpline};
 use crate::sun::location::Location;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
+use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
+use crate::year::season::{LeafCalendar, Phase};
+use crate::year::spline::{AnnualGrid, AnnualSpline};
 
 /// How the year is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -115,9 +116,22 @@ pub async fn annual_on(
     calendar: &LeafCalendar,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
+    annual_with(&Lanes(lanes), scene, location, options, calendar, progress).await
+}
+
+/// The year's schedule with any [`Engine`] answering the views (the GPU lanes, the exact
+/// reference, or a mix).
+pub async fn annual_with<E: Engine>(
+    engine: &E,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Schedule> {
     let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
     let mut schedule = Schedule::zeros(names, options.timesteps);
-    let views = Views { lanes };
+    let views = Views { engine };
     let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
     match options.method {
         Method::Spline(plan) => spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?,
@@ -157,20 +171,19 @@ fn borrowed(lanes: &[(Counter, GpuScene)]) -> Vec<Lane<'_>> {
     lanes.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect()
 }
 
-/// The counters and their scenes: what turns view requests into fractions.
-struct Views<'a> {
-    lanes: &'a [Lane<'a>],
+/// The engine that turns view requests into fractions, with progress reports between chunks.
+struct Views<'a, E: Engine> {
+    engine: &'a E,
 }
 
-impl Views<'_> {
-    /// Counts many views (`leaves[i]`: the leaf fraction of view `i`), reporting progress as it goes.
-    async fn count(&self, requests: &[ViewRequest], leaves: &[f32], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
+impl<E: Engine> Views<'_, E> {
+    /// Counts many views (each at its own leaf fraction), reporting progress as it goes.
+    async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
         progress(Progress { done: 0, total: requests.len() })?;
-        let batch = self.lanes.first().map_or(1, |l| l.counter.tiles_per_batch());
-        let per_report = batch * BATCHES_PER_REPORT * self.lanes.len().max(1);
-        for (chunk, leaves) in requests.chunks(per_report).zip(leaves.chunks(per_report)) {
-            out.extend(fractions_side_by_side(self.lanes, chunk, leaves).await?.into_iter().map(|c| c.fraction));
+        let per_report = self.engine.batch().max(1) * BATCHES_PER_REPORT;
+        for chunk in requests.chunks(per_report) {
+            out.extend(self.engine.answer(chunk).await?.into_iter().map(|c| c.fraction));
             progress(Progress { done: out.len(), total: requests.len() })?;
         }
         Ok(out)
@@ -187,7 +200,7 @@ fn sun_is_up(sun: DVec3) -> bool {
 }
 
 async fn dense_year(
-    views: &Views<'_>,
+    views: &Views<'_, impl Engine>,
     scene: &Scene,
     location: &Location,
     calendar: &LeafCalendar,
@@ -195,7 +208,6 @@ async fn dense_year(
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
     let mut requests = Vec::new();
-    let mut leaves = Vec::new();
     let mut cells = Vec::new();
     for (row, instant) in schedule.timesteps.instants().enumerate() {
         let sun = sun_direction(location, instant.day as f64, instant.hour);
@@ -204,13 +216,12 @@ async fn dense_year(
         }
         for (column, r) in scene.receivers.iter().enumerate() {
             if !is_dark(r.normal, sun) {
-                requests.push(ViewRequest { receiver: column as u32, sun });
-                leaves.push(calendar.fraction(instant.day as f64) as f32);
+                requests.push(ViewRequest::new(column as u32, sun).with_leaves(calendar.fraction(instant.day as f64) as f32));
                 cells.push((row, column));
             }
         }
     }
-    let values = views.count(&requests, &leaves, progress).await?;
+    let values = views.count(&requests, progress).await?;
     for ((row, column), v) in cells.into_iter().zip(values) {
         schedule.set(row, column, v as f32);
     }
@@ -334,7 +345,7 @@ fn sun_day(day: f64) -> f64 {
 
 #[allow(clippy::too_many_arguments)] // The year's inputs and its two outputs; grouping them would hide nothing.
 async fn spline_year(
-    views: &Views<'_>,
+    views: &Views<'_, impl Engine>,
     scene: &Scene,
     location: &Location,
     plan: SamplingPlan,
@@ -345,10 +356,10 @@ async fn spline_year(
 ) -> Result<()> {
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
-    let SampleViews { requests, leaves, cells } = sample_views(scene, location, &regimes, &taus);
+    let SampleViews { requests, cells } = sample_views(scene, location, &regimes, &taus);
     // Progress counts the samples and then the refined timesteps, whose number is known later.
     let total = requests.len();
-    let counted = views.count(&requests, &leaves, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
+    let counted = views.count(&requests, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
     let mut samples: Vec<Vec<Option<f64>>> =
         regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
     for (request, g, cell) in cells {
@@ -360,9 +371,11 @@ async fn spline_year(
     }
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
     let rough = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
-    let requests: Vec<ViewRequest> = rough.iter().map(|(_, column, sun, _)| ViewRequest { receiver: *column as u32, sun: *sun }).collect();
-    let leaves: Vec<f32> = rough.iter().map(|(_, _, _, day)| calendar.fraction(*day) as f32).collect();
-    let refined = views.count(&requests, &leaves, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
+    let requests: Vec<ViewRequest> = rough
+        .iter()
+        .map(|(_, column, sun, day)| ViewRequest::new(*column as u32, *sun).with_leaves(calendar.fraction(*day) as f32))
+        .collect();
+    let refined = views.count(&requests, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
     for ((row, column, _, _), v) in rough.into_iter().zip(refined) {
         schedule.set(row, column, v as f32);
     }
@@ -371,9 +384,8 @@ async fn spline_year(
 
 /// The views the sample grids need, and where each count goes.
 struct SampleViews {
+    /// Each at its regime's leaf fraction.
     requests: Vec<ViewRequest>,
-    /// Leaf fraction of each request.
-    leaves: Vec<f32>,
     /// (request, regime, cell): the count of `request` fills `cell` of `regime`'s samples.
     cells: Vec<(usize, usize, usize)>,
 }
@@ -383,7 +395,7 @@ struct SampleViews {
 /// pieces are the twin's, shifted by the difference in solar noon, takes the twin's views: the
 /// sun directions are the same, so the counts would be.
 fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[f64]) -> SampleViews {
-    let mut out = SampleViews { requests: Vec::new(), leaves: Vec::new(), cells: Vec::new() };
+    let mut out = SampleViews { requests: Vec::new(), cells: Vec::new() };
     for (g, regime) in regimes.iter().enumerate() {
         let per_piece = regime.days.len() * taus.len();
         for (id, r) in scene.receivers.iter().enumerate() {
@@ -402,8 +414,7 @@ fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[
                     for (j, tau) in taus.iter().enumerate() {
                         if !shared {
                             let sun = sun_direction(location, day, start + tau * (end - start));
-                            out.requests.push(ViewRequest { receiver: id as u32, sun });
-                            out.leaves.push(regime.leaves[d]);
+                            out.requests.push(ViewRequest::new(id as u32, sun).with_leaves(regime.leaves[d]));
                         }
                         out.cells.push((base + j, g, (id * MAX_PIECES + p) * per_piece + d * taus.len() + j));
                     }
@@ -419,8 +430,8 @@ fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[
 /// the views are counted a batch at a time.
 fn by_sun(views: SampleViews) -> SampleViews {
     let key = |k: usize| {
-        let (r, leaves) = (views.requests[k], views.leaves[k]);
-        (r.sun.x.to_bits(), r.sun.y.to_bits(), r.sun.z.to_bits(), leaves.to_bits(), r.receiver)
+        let r = views.requests[k];
+        (r.sun.x.to_bits(), r.sun.y.to_bits(), r.sun.z.to_bits(), r.leaves.to_bits(), r.receiver)
     };
     let mut order: Vec<usize> = (0..views.requests.len()).collect();
     order.sort_by_key(|&k| key(k));
@@ -430,7 +441,6 @@ fn by_sun(views: SampleViews) -> SampleViews {
     }
     SampleViews {
         requests: order.iter().map(|&k| views.requests[k]).collect(),
-        leaves: order.iter().map(|&k| views.leaves[k]).collect(),
         cells: views.cells.into_iter().map(|(request, g, cell)| (new_index[request], g, cell)).collect(),
     }
 }

@@ -1,0 +1,279 @@
+//! The GPU pixel counter (wgpu; Vulkan/lavapipe natively, WebGPU in the browser).
+//!
+//! Owns the device, the pipelines and the atlas. For each (receiver, sun) view it renders, into
+//! one tile of an atlas, the receiver alone (coverage mask, no depth test) and then the scene
+//! (depth-tested receiver ids; only what lies in the prism in front of it, see [`super::cull`]);
+//! a compute pass counts per tile the pixels where the receiver is visible and where it is covered. The sunlit fraction is visible / covered: the covered
+//! count is the pixel estimate of the projected area A·cosθ/Ap of the paper's formula, measured
+//! with the same rasterisation rule, so edge aliasing on unshaded edges cancels and an unshaded
+//! surface gives exactly 1. Many views share one submission (tiles of the atlas).
+//!
+//! Requests for receivers of one view group ([`super::group`]: a wall and the windows in it) at
+//! the same sun and leaf fraction share a tile: the mask pass draws each requested member with its
+//! own id, the scene is drawn once, and the count pass counts each member apart.
+//!
+//! Foliage and see-through casters ([`crate::scene::Veil`]) are decided on the GPU, so one upload
+//! serves every day: each view carries its day's leaf fraction and the vertex shader drops the
+//! leaves whose rank is not below it; a see-through fragment is discarded (lets the sun through)
+//! where a per-pixel hash threshold falls below its transmittance.
+//!
+//! Adaptive resolution ([`CounterOptions::accuracy`]): every tile is first counted at a small
+//! side; the count pass also counts each member's shadow-edge pixel pairs, from which
+//! [`error_estimate`] predicts the count's error, and tiles predicted worse than the target are
+//! counted again at the side predicted to reach it (up to `resolution`). Fully lit and fully
+//! shaded views, most of a year, then cost a small tile; views crossed by many shadow edges get
+//! the full side.
+//!
+//! The parts, in the order a count goes through them:
+//! - `device`: opening the adapter and device within its limits; uncaptured errors and device
+//!   loss, surfaced as typed errors per stage;
+//! - `pipelines`: the WGSL programs, the structs they read, bind group layouts and pipelines;
+//! - `upload`: a scene's buffers (static mesh in chunks within the device's buffer limit);
+//! - [`plan`]: CPU only — which views need a render, tiles, their cameras, adaptive sides;
+//! - `encode`: the per-batch buffers, render and count passes, one submission per batch;
+//! - `readback`: mapping the counts and turning them into fractions.
+//!
+//! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
+//! `test-hooks` feature, which the crate's own tests enable.
+
+mod device;
+mod encode;
+#[cfg(feature = "test-hooks")]
+mod hooks;
+mod pipelines;
+pub mod plan;
+mod readback;
+mod upload;
+
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::DVec3;
+
+use self::device::Faults;
+use self::encode::BatchBuffers;
+use self::pipelines::Pipelines;
+pub use self::pipelines::SHADERS;
+use self::plan::{SceneLayout, Tile, finer_side, fit_tile, plan_tiles, sides, tiles_at};
+use self::upload::{GpuMesh, StaticChunk};
+use super::{ViewAnswer, ViewRequest};
+use crate::error::Result;
+
+/// The side adaptive counting starts at: ~2,000 pixels on the receiver, enough that a view
+/// without shadow edges is within 0.001 and the edge count is a fair guide for the others.
+pub const ADAPTIVE_FIRST_SIDE: u32 = 64;
+
+/// Settings of a [`Counter`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CounterOptions {
+    /// Tile size in pixels (square); 512 gives about three decimals. With `accuracy`, the
+    /// largest side a view gets.
+    pub resolution: u32,
+    /// Largest atlas side in pixels; tiles per submission = (atlas / resolution)².
+    pub max_atlas: u32,
+    /// Target |error| of each fraction: `Some` counts every view at
+    /// [`ADAPTIVE_FIRST_SIDE`] first and again, at a side up to `resolution`, only where the
+    /// estimated error is larger ([`error_estimate`]). `None`: every view at `resolution`.
+    pub accuracy: Option<f64>,
+}
+
+impl Default for CounterOptions {
+    fn default() -> Self {
+        Self { resolution: 512, max_atlas: 2048, accuracy: None }
+    }
+}
+
+/// Estimated |error| of a fraction counted from `covered` pixels with `edges` shadow-edge pixel
+/// pairs: each boundary pixel is decided by its centre and is off by up to half a pixel. Were
+/// these errors independent they would add like a random walk, sqrt(edges/12) pixels; along a
+/// straight edge they are not (a nearly axis-aligned edge repeats its sub-pixel offsets), and on
+/// louvre shadows, many parallel straight edges, the exact reference showed errors up to
+/// 2.6·sqrt(edges) pixels. The estimate takes 3·sqrt(edges), plus one pixel for the receiver's
+/// own outline, over the covered pixels.
+pub fn error_estimate(covered: u32, edges: u32) -> f64 {
+    if covered == 0 {
+        return f64::INFINITY;
+    }
+    (3.0 * (edges as f64).sqrt() + 1.0) / covered as f64
+}
+
+/// One counted view. A view that needed no render (sun down, facing away, or nothing in front
+/// of the receiver) has `covered == 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Counted {
+    /// Sunlit fraction in [0, 1].
+    pub fraction: f64,
+    /// Cosine of incidence (normal · sun).
+    pub cos_incidence: f64,
+    /// Pixels where the receiver is visible from the sun (0 when not rendered).
+    pub visible: u32,
+    /// Pixels the receiver covers in its tile (0 when not rendered).
+    pub covered: u32,
+    /// Area per pixel on the view plane (m²; 0 when not rendered).
+    pub pixel_area: f64,
+    /// Side of the tile it was counted in (0 when not rendered).
+    pub side: u32,
+    /// Shadow-edge pixel pairs on the receiver (counted only with an accuracy target).
+    pub edges: u32,
+}
+
+impl Counted {
+    /// [`error_estimate`] of this count (0 when not rendered: exact by construction).
+    pub fn error_estimate(&self) -> f64 {
+        if self.side == 0 { 0.0 } else { error_estimate(self.covered, self.edges) }
+    }
+
+    /// The common answer; `edges_counted`: whether the count pass counted shadow edges (only
+    /// with an accuracy target), without which a rendered view has no error estimate.
+    pub fn answer(&self, edges_counted: bool) -> ViewAnswer {
+        let rendered = self.side > 0;
+        ViewAnswer {
+            fraction: self.fraction,
+            cos_incidence: self.cos_incidence,
+            covered: rendered.then_some(self.covered),
+            side: rendered.then_some(self.side),
+            error_estimate: (!rendered || edges_counted).then(|| self.error_estimate()),
+        }
+    }
+}
+
+/// The device, pipelines and atlas; reusable across scenes.
+pub struct Counter {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    options: CounterOptions,
+    /// The atlas's side in pixels: a whole number of tiles at every side used.
+    atlas_side: u32,
+    pipelines: Pipelines,
+    batch: BatchBuffers,
+    /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
+    tiles_rendered: AtomicU64,
+    triangles_drawn: AtomicU64,
+    faults: Faults,
+}
+
+/// A scene uploaded to a [`Counter`]'s device.
+pub struct GpuScene {
+    meshes: Vec<GpuMesh>,
+    /// The static mesh's triangles in the culling's spatial order, in buffers within the device's
+    /// size limit, each indexed into its distinct vertices (the scene pass draws ranges of it).
+    static_chunks: Vec<StaticChunk>,
+    /// What planning reads: receivers' outlines and draws, view groups, the culling.
+    layout: SceneLayout,
+    render_bind: wgpu::BindGroup,
+    count_bind: wgpu::BindGroup,
+}
+
+impl Counter {
+    /// Opens a device and builds the pipelines and atlas.
+    pub async fn new(options: CounterOptions) -> Result<Self> {
+        let device::Opened { device, queue, info, tiles_per_side } = device::open(&options).await?;
+        let faults = Faults::watch(&device);
+        let pipelines = Pipelines::new(&device);
+        let atlas_side = tiles_per_side * options.resolution;
+        // Buffers hold a batch at the smallest side used.
+        let smallest = sides(&options).first().copied().unwrap_or(options.resolution);
+        let batch = BatchBuffers::new(&device, &pipelines, atlas_side, smallest);
+        let counter = Self {
+            device,
+            queue,
+            info,
+            options,
+            atlas_side,
+            pipelines,
+            batch,
+            tiles_rendered: AtomicU64::new(0),
+            triangles_drawn: AtomicU64::new(0),
+            faults,
+        };
+        counter.check_errors("setting up the GPU")?;
+        Ok(counter)
+    }
+
+    /// The adapter in use (name, backend, device type).
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.info
+    }
+
+    /// The options it was made with.
+    pub fn options(&self) -> CounterOptions {
+        self.options
+    }
+
+    /// Tile resolution in pixels.
+    pub fn resolution(&self) -> u32 {
+        self.options.resolution
+    }
+
+    /// Views rendered per submission at `resolution`.
+    pub fn tiles_per_batch(&self) -> usize {
+        tiles_at(self.atlas_side, self.options.resolution)
+    }
+
+    /// Tiles rendered since this counter was made (a tile counts one request, or several of one
+    /// view group), and the triangles drawn in them by the scene pass.
+    pub fn rendered(&self) -> (u64, u64) {
+        (self.tiles_rendered.load(Ordering::Relaxed), self.triangles_drawn.load(Ordering::Relaxed))
+    }
+
+    /// The first GPU failure since the last check, as the error of stage `doing`.
+    fn check_errors(&self, doing: &str) -> Result<()> {
+        self.faults.check(doing, self.options.resolution)
+    }
+
+    /// A new counter with the same options on a new device (after [`crate::Error::DeviceLost`]).
+    pub async fn recreate(&self) -> Result<Counter> {
+        Counter::new(self.options).await
+    }
+
+    /// Sunlit fractions for many views, each at its own leaf fraction (the leaves whose rank is
+    /// below it cast shadows); dark views (sun down, facing away) cost nothing, the others are
+    /// rendered in batches of atlas tiles.
+    pub async fn fractions(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<Counted>> {
+        let mut out = vec![Counted::default(); requests.len()];
+        let ladder = sides(&self.options);
+        let first = ladder.first().copied().unwrap_or(self.options.resolution);
+        let tiles = plan_tiles(&scene.layout, requests, first, &mut out)?;
+        // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
+        let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
+        while let Some((side, tiles)) = waiting.pop_first() {
+            self.count_tiles(scene, requests, &tiles, side, &mut out).await?;
+            let Some(target) = self.options.accuracy else { continue };
+            for tile in tiles {
+                let worst = tile.requests.iter().map(|&i| out[i].error_estimate()).fold(0.0, f64::max);
+                if let Some(next) = finer_side(&ladder, side, worst, target) {
+                    let view = fit_tile(&scene.layout, requests, &tile.requests, next);
+                    waiting.entry(next).or_default().push(Tile { view, ..tile });
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// [`Self::fractions`] as the common answer ([`ViewAnswer`]).
+    pub async fn answer(&self, scene: &GpuScene, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        let counted = self.fractions(scene, requests).await?;
+        let edges_counted = self.options.accuracy.is_some();
+        Ok(counted.iter().map(|c| c.answer(edges_counted)).collect())
+    }
+}
+
+impl GpuScene {
+    /// World origin the GPU coordinates are relative to.
+    pub fn origin(&self) -> DVec3 {
+        self.layout.origin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_error_estimate_falls_with_fewer_edges_and_more_pixels() {
+        assert_eq!(error_estimate(0, 0), f64::INFINITY);
+        assert_eq!(error_estimate(1000, 0), 0.001, "one pixel of outline");
+        assert!(error_estimate(4000, 200) < error_estimate(1000, 100));
+    }
+}

@@ -1,0 +1,276 @@
+//! The GPU programs and their interfaces: the WGSL sources (`shaders/`), the layouts of what
+//! they read (vertices, instances, per-tile views, counts), the bind group layouts and the
+//! render and compute pipelines. Nothing here touches a scene or a view: only shapes.
+//!
+//! The `Gpu*` structs mirror the shaders' structs byte for byte (`#[repr(C)]`, `Pod`); a field
+//! changed here must change in the WGSL too (tests/shaders.rs validates the WGSL on its own).
+
+pub(super) const SUN_VIEW_WGSL: &str = include_str!("../../../shaders/sun_view.wgsl");
+pub(super) const COUNT_PIXELS_WGSL: &str = include_str!("../../../shaders/count_pixels.wgsl");
+/// Rows of a tile per compute workgroup (the shader's `ROWS_PER_GROUP`).
+pub(super) const ROWS_PER_GROUP: u32 = 64;
+/// One target, two channels: red = the visible surface's id (scene pass), green = the target
+/// receiver's own coverage (mask pass). Per-channel write masks keep the passes apart, and the
+/// count reads one texel per pixel.
+pub(super) const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+pub(super) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Counts the count pass writes per member: visible, covered, edge pairs.
+pub(super) const COUNTS_PER_MEMBER: u64 = 3;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuInstance {
+    pub(super) transform: [[f32; 4]; 4],
+    pub(super) receiver_base: u32,
+    pub(super) leaf_shift: f32,
+    pub(super) _pad: [u32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuView {
+    pub(super) tile: [u32; 2],
+    pub(super) first_member: u32,
+    pub(super) member_count: u32,
+    pub(super) side: u32,
+    pub(super) _pad: u32,
+}
+
+/// A tile's view as the vertex shaders read it (`TileView` in sun_view.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuTileView {
+    pub(super) view_proj: [[f32; 4]; 4],
+    pub(super) leaves: f32,
+    pub(super) _pad: [u32; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuParams {
+    pub(super) count_edges: u32,
+    pub(super) static_slot: u32,
+    pub(super) _pad: [u32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuVertex {
+    pub(super) position: [f32; 3],
+    pub(super) surface: u32,
+    /// Leaf rank (negative: not a leaf) and transmittance.
+    pub(super) veil: [f32; 2],
+    pub(super) seed: u32,
+}
+
+/// Every layout and pipeline a counter uses, made once per device.
+pub(super) struct Pipelines {
+    /// Instances and parameters, for the vertex shaders.
+    pub(super) render_layout: wgpu::BindGroupLayout,
+    /// The tile's view, at a dynamic offset per tile.
+    pub(super) tile_layout: wgpu::BindGroupLayout,
+    /// The id atlas, tile views, parameters, counts and members, for the count pass.
+    pub(super) count_layout: wgpu::BindGroupLayout,
+    pub(super) view: ViewPipelines,
+    pub(super) count: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let render_layout = render_bind_layout(device);
+        let tile_layout = tile_bind_layout(device);
+        let count_layout = count_bind_layout(device);
+        let view = render_pipelines(device, &render_layout, &tile_layout);
+        let count = count_pipeline(device, &count_layout);
+        Self { render_layout, tile_layout, count_layout, view, count }
+    }
+}
+
+/// The sun-view pipelines: scene (depth-tested ids into red) and mask (coverage into green),
+/// each for placed meshes (`vs_main`) and for the static mesh (`vs_static`, no instance to read).
+/// Scene and mask differ only in depth state (the mask always passes and writes no depth) and
+/// the channel they write.
+pub(super) struct ViewPipelines {
+    pub(super) scene: wgpu::RenderPipeline,
+    pub(super) mask: wgpu::RenderPipeline,
+    pub(super) static_scene: wgpu::RenderPipeline,
+    pub(super) static_mask: wgpu::RenderPipeline,
+}
+
+fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_layout: &wgpu::BindGroupLayout) -> ViewPipelines {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("sun_view.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("sun view"),
+        bind_group_layouts: &[Some(layout), Some(tile_layout)],
+        immediate_size: 0,
+    });
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2, 3 => Uint32];
+    let make = |label: &str, vertex: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(vertex),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: size_of::<GpuVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(depth_write),
+                depth_compare: Some(compare),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: channels })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let scene = |label, vertex| make(label, vertex, true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED);
+    let mask = |label, vertex| make(label, vertex, false, wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN);
+    ViewPipelines {
+        scene: scene("scene", "vs_main"),
+        mask: mask("mask", "vs_main"),
+        static_scene: scene("scene, static mesh", "vs_static"),
+        static_mask: mask("mask, static mesh", "vs_static"),
+    }
+}
+
+fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("count_pixels.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(COUNT_PIXELS_WGSL.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("count"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("count"),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("count_main"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+fn render_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let vs = wgpu::ShaderStages::VERTEX;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("render"),
+        entries: &[storage_entry(0, vs, true), uniform_entry(2, vs)],
+    })
+}
+
+/// The tile's view, one uniform at a dynamic offset per tile.
+fn tile_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("tile view"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(size_of::<GpuTileView>() as u64),
+            },
+            count: None,
+        }],
+    })
+}
+
+fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let cs = wgpu::ShaderStages::COMPUTE;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("count"),
+        entries: &[
+            uint_texture_entry(0),
+            storage_entry(1, cs, true),
+            uniform_entry(2, cs),
+            storage_entry(3, cs, false),
+            storage_entry(4, cs, true),
+        ],
+    })
+}
+
+fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+fn uint_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Uint,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+pub(super) fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource }
+}
+
+pub(super) fn buffer(device: &wgpu::Device, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+}
+
+pub(super) fn attachment(device: &wgpu::Device, label: &str, side: u32, format: wgpu::TextureFormat, sampled: bool) -> wgpu::TextureView {
+    let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    if sampled {
+        usage |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    }
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+/// WGSL sources, for validation in tests.
+pub const SHADERS: [(&str, &str); 2] = [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL)];

@@ -1,0 +1,15 @@
+//! The year: from a handful of counted views to a sunlit fraction at every EnergyPlus timestep.
+//!
+//! Owns *when*: the timesteps EnergyPlus wants and the sparse samples that are counted instead
+//! ([`samples`]), the leaf calendar foliage follows through the seasons ([`season`]), the one
+//! resolver of a run's settings that the CLI and the web share ([`settings`]), the B-spline
+//! surface over (day, time of day) through the samples ([`spline`]), and the annual run that ties
+//! them to an [`Engine`](crate::count::Engine): what to count, fitting, refining where shadow
+//! edges sweep too fast, and surviving a lost GPU device ([`annual`]). It knows nothing of pixels
+//! (that is [`crate::count`]) or of files (that is [`crate::export`]).
+
+pub mod annual;
+pub mod samples;
+pub mod season;
+pub mod settings;
+pub mod spline;
