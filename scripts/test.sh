@@ -16,5 +16,7 @@ cargo test --no-fail-fast 2>&1 | tee target/test.log || status=1
 cargo test --target wasm32-unknown-unknown --no-default-features --test web 2>&1 | tee target/test-web.log || status=1
 # The page: builds www/pkg, then drives it; the 3D view lands in target/artifacts/page.png.
 scripts/build-web.sh
+# tests/browser/npm.test.mjs packs the npm package (scripts/pack-npm.sh, reusing www/pkg) and
+# builds a fresh Vite app with it (npm install of three + vite: needs the npm registry).
 node --test tests/browser/ 2>&1 | tee target/test-browser.log || status=1
 exit $status

@@ -21,6 +21,7 @@ use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
+use sunlit::export::irradiation;
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
@@ -97,6 +98,11 @@ struct AnnualArgs {
     /// Output CSV (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
+    /// Also write a per-surface summary (JSON or CSV, by extension; written atomically): area,
+    /// mean fraction over sun-up timesteps and, with --epw, annual direct irradiation (kWh/m²)
+    /// with and without shading, from the EPW's direct normal irradiance.
+    #[arg(long, value_name = "FILE.json|FILE.csv")]
+    summary: Option<PathBuf>,
     /// Also write a copy of the EnergyPlus model (IDF or epJSON, as given) that uses the CSV.
     #[arg(long, value_name = "FILE")]
     idf_out: Option<PathBuf>,
@@ -350,6 +356,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("jobs", "--jobs"),
     ("per_task", "--per-task"),
     ("index", "--index"),
+    ("summary", "--summary"),
 ];
 
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
@@ -456,6 +463,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
     check_writable(&args.output)?;
+    let summary = summary_plan(&args)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
     }
@@ -505,7 +513,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form)?)),
         _ => None,
     };
+    let summary_text = match &summary {
+        Some((_, to_text, dni)) => Some(to_text(&irradiation::summarize(&scene, &schedule, &settings.location, dni.as_ref())?)),
+        None => None,
+    };
     sunlit::export::write_atomic(&args.output, &bytes)?;
+    if let (Some((path, ..)), Some(text)) = (&summary, summary_text) {
+        sunlit::export::write_atomic(path, text.as_bytes())?;
+        eprintln!("wrote {}", path.display());
+    }
     if let Some((out, form, text)) = patched {
         sunlit::export::write_atomic(out, text.as_bytes())?;
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
@@ -526,6 +542,24 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.length().unwrap_or(0)
     );
     Ok(())
+}
+
+/// Writes a summary as JSON or CSV.
+type SummaryFormat = fn(&[irradiation::SurfaceSummary]) -> String;
+
+/// `--summary`'s file, its format by extension, and the EPW's direct normal irradiance (read
+/// now, so a bad weather file is refused before the counting).
+fn summary_plan(args: &AnnualArgs) -> Result<Option<(PathBuf, SummaryFormat, Option<irradiation::DirectNormal>)>> {
+    let Some(path) = &args.summary else { return Ok(None) };
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    let format: SummaryFormat = match extension.as_deref() {
+        Some("json") => irradiation::summary_json,
+        Some("csv") => irradiation::summary_csv,
+        _ => return Err(Error::argument("summary", format!("{}: give a .json or .csv file", path.display()))),
+    };
+    check_writable(path)?;
+    let dni = args.epw.as_deref().map(irradiation::DirectNormal::from_epw).transpose()?;
+    Ok(Some((path.clone(), format, dni)))
 }
 
 /// Without --epw or --location: the EnergyPlus model's own Site:Location, said so.

@@ -12,6 +12,8 @@
 
 use std::rc::Rc;
 
+mod embed;
+
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
@@ -182,7 +184,8 @@ impl Engine {
     pub fn annual(&self, model: &Model, settings: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
         let (counter, model) = (self.counter.clone(), model.inner.clone());
         future_to_promise(async move {
-            let settings = settings_from_js(&settings).and_then(|s| s.resolve()).map_err(js_error)?;
+            let given = settings_from_js(&settings).map_err(js_error)?;
+            let settings = given.resolve().map_err(js_error)?;
             let options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
             let (location, calendar) = (settings.location, settings.calendar);
             let hook = match &model.energyplus {
@@ -203,7 +206,9 @@ impl Engine {
                 .await
                 .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
-            Ok(Annual { schedule, means, hook, model }.into())
+            let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
+            let extra = embed::Extra::new(&model.scene, &schedule, &location, epw);
+            Ok(Annual { schedule, means, hook, model, extra }.into())
         })
     }
 }
@@ -340,6 +345,7 @@ pub struct Annual {
     means: Vec<f64>,
     hook: Option<Hook>,
     model: Rc<ModelInner>,
+    extra: embed::Extra,
 }
 
 #[wasm_bindgen]

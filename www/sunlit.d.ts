@@ -42,7 +42,41 @@ export function sunDirection(azimuth: number, altitude: number): [number, number
  * target |error| per view (e.g. 0.002): each view is counted at 64² first and again, finer up to
  * `resolution`, only where its shadow edges make the estimated error larger; without it every
  * view is counted at `resolution`. */
-export function createEngine(options?: { resolution?: number; accuracy?: number }): Promise<SunlitEngine>;
+export function createEngine(options?: {
+  resolution?: number;
+  accuracy?: number;
+  /** A GPUDevice the caller holds (e.g. its WebGPU renderer's): sunlit counts on it and never
+   * destroys it; its loss is reported as a "GPU device lost" error. */
+  device?: GPUDevice;
+}): Promise<SunlitEngine>;
+
+/** An EPW weather file's LOCATION record (throws naming `name` and the reason). */
+export function epwLocation(
+  text: string,
+  name?: string,
+): Promise<{ latitude: number; longitude: number; timeZone: number; elevation: number; name: string }>;
+
+/** Meshes and their placements (what sunlit/three's fromThree builds from a scene graph). */
+export interface MeshesInput {
+  /** x, y, z per vertex, every mesh's vertices one after another, each in its own coordinates. */
+  positions: ArrayLike<number>;
+  /** Mesh m's vertices are vertexStarts[m]..vertexStarts[m+1]; meshes + 1 entries. */
+  vertexStarts: ArrayLike<number>;
+  /** Triangle lists, relative to their mesh's first vertex, one after another. */
+  indices: ArrayLike<number>;
+  /** Mesh m's indices are indexStarts[m]..indexStarts[m+1]; meshes + 1 entries. */
+  indexStarts: ArrayLike<number>;
+  /** Per placement: its mesh. A mesh placed several times is drawn instanced. */
+  placementMeshes: ArrayLike<number>;
+  /** Per placement: 16 numbers, mesh → world, column-major (three.js Matrix4.elements). */
+  matrices: ArrayLike<number>;
+  /** Per placement: its name (receivers' names are the output columns, unique). */
+  names: string[];
+  /** Per placement: truthy when it receives. */
+  receivers: ArrayLike<number | boolean>;
+  /** World coordinates in glTF / three.js axes (+Y up, -Z north). */
+  yUp?: boolean;
+}
 
 export interface ModelFile {
   /** File name; its extension picks the reader (.glb, .gltf, .idf, .epJSON). */
@@ -120,6 +154,8 @@ export interface SunlitEngine {
   loadFiles(files: ModelFile[], options?: LoadOptions): Model;
   /** Builds a model from typed arrays; throws a SunlitError naming the array and element when bad. */
   fromArrays(input: ArraysInput): Model;
+  /** Builds a model from meshes and placements; throws an Error naming the array and element when bad. */
+  fromMeshes(input: MeshesInput): Model;
   /** Every receiver's fraction for one sun direction (unit vector towards the sun, or angles). */
   fractions(model: Model, sun: [number, number, number] | { azimuth: number; altitude: number }): Promise<Float64Array>;
   /** The year's sunlit fractions at every EnergyPlus timestep. */
@@ -160,6 +196,15 @@ export interface Annual {
   readonly means: Float64Array;
   /** One receiver's fraction at every timestep. */
   column(index: number): Float32Array;
+  /** Annual direct (beam) irradiation Σ DNI·cosθ·fraction·Δt per receiver, kWh/m², from the EPW's
+   * direct normal irradiance (each hour's value held over its timesteps); undefined without an
+   * EPW. Throws naming the file and line when the EPW's hourly records are unreadable. */
+  readonly irradiation: Float64Array | undefined;
+  /** The same with nothing in the way: Σ DNI·cosθ·Δt over timesteps with the sun in front. */
+  readonly unshadedIrradiation: Float64Array | undefined;
+  /** Every receiver's fraction at day of year `day` (1..365) and local standard `hour` (0..24),
+   * linear between the schedule's rows, 0 with the sun down. */
+  fractionsAt(day: number, hour?: number): Float64Array;
   /** The EnergyPlus CSV (eplusshading.csv layout). */
   csv(): string;
   /** With an IDF/epJSON loaded: the model text with the CSV (saved beside it as csvName) hooked in. */

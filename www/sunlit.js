@@ -3,7 +3,8 @@
 //
 // Wraps the wasm-bindgen bindings (pkg/sunlit_wasm.js, built by scripts/build-web.sh) so that
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
-import init, { Engine } from './pkg/sunlit_wasm.js';
+import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
+import { onDevice } from './device.js';
 
 let wasmReady;
 
@@ -37,13 +38,21 @@ function coded(message, code, names = {}) {
   return Object.assign(new Error(message), { code }, names);
 }
 
-/** Opens the GPU device. Rejects with code 'no-webgpu' where WebGPU is missing. */
-export async function createEngine({ resolution, accuracy } = {}) {
+/** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps).
+ * Rejects with code 'no-webgpu' where WebGPU is missing. */
+export async function createEngine({ resolution, accuracy, device } = {}) {
   if (!hasWebGPU()) {
     throw coded('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).', 'no-webgpu');
   }
   await ready();
-  return new SunlitEngine(await Engine.create(resolution, accuracy));
+  const open = () => Engine.create(resolution, accuracy);
+  return new SunlitEngine(device === undefined ? await open() : await onDevice(device, open));
+}
+
+/** An EPW's LOCATION record: { latitude, longitude, timeZone, elevation, name }. */
+export async function epwLocation(text, name = 'EPW') {
+  await ready();
+  return wasmEpwLocation(String(name), String(text));
 }
 
 function toBytes(bytes, name) {
@@ -88,6 +97,21 @@ class SunlitEngine {
       Uint32Array.from(indices),
       Int32Array.from(triangleReceivers),
       names.map(String),
+      !!yUp,
+    );
+  }
+
+  /** A model from meshes and their placements (instancing kept; see sunlit.d.ts, and three.js). */
+  fromMeshes({ positions, vertexStarts, indices, indexStarts, placementMeshes, matrices, names, receivers, yUp = false }) {
+    return this.#engine.fromMeshes(
+      Float32Array.from(positions),
+      Uint32Array.from(vertexStarts),
+      Uint32Array.from(indices),
+      Uint32Array.from(indexStarts),
+      Uint32Array.from(placementMeshes),
+      Float64Array.from(matrices),
+      names.map(String),
+      Uint8Array.from(receivers, (r) => (r ? 1 : 0)),
       !!yUp,
     );
   }

@@ -13,6 +13,7 @@ use crate::error::{Error, Result};
 use crate::year::samples::Timesteps;
 
 pub mod hook;
+pub mod irradiation;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]

@@ -25,6 +25,7 @@ pub mod idf;
 pub mod office;
 #[cfg(feature = "fixtures")]
 pub mod office_idf;
+pub mod placed;
 pub mod reveal;
 pub mod run_year;
 pub mod site;

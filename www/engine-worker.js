@@ -1,0 +1,57 @@
+// sunlit/worker: the engine in a module Web Worker, so a viewer's main thread stays free.
+// Start it with `new Worker(new URL('sunlit/worker', import.meta.url), { type: 'module' })` (or a
+// bundler's worker import) and post requests; each gets one reply with the same `id`:
+//   { id, op: 'create', options }                  → { id, result: { adapter, resolution } }
+//   { id, op: 'fromMeshes', input }                → { id, result: { names, areas } }   (fromThree's arrays)
+//   { id, op: 'loadFiles', files, options }        → { id, result: { names, areas } }
+//   { id, op: 'fractions', sun }                   → { id, result: Float64Array }
+//   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
+//   { id, op: 'cancel' }                           → aborts a running annual
+// Errors come back as { id, error: message }; progress of an annual as { id, progress: [done, total] }.
+import { createEngine } from './sunlit.js';
+
+let engine = null;
+let model = null;
+let running = null;
+
+function replaceModel(next) {
+  model?.free();
+  model = next;
+  return { names: next.receiverNames, areas: next.receiverAreas };
+}
+
+const ops = {
+  async create({ options }) {
+    engine = await createEngine(options ?? {});
+    return { adapter: engine.adapter, resolution: engine.resolution };
+  },
+  fromMeshes: ({ input }) => replaceModel(need(engine, 'create').fromMeshes(input)),
+  loadFiles: ({ files, options }) => replaceModel(need(engine, 'create').loadFiles(files, options)),
+  fractions: ({ sun }) => need(engine, 'create').fractions(need(model, 'fromMeshes or loadFiles'), sun),
+  async annual({ id, settings }) {
+    running = new AbortController();
+    const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
+    const year = await need(engine, 'create').annual(need(model, 'fromMeshes or loadFiles'), settings, { onProgress, signal: running.signal });
+    try {
+      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv() };
+    } finally {
+      year.free();
+    }
+  },
+};
+
+function need(value, step) {
+  if (!value) throw new Error(`sunlit worker: call '${step}' first`);
+  return value;
+}
+
+onmessage = async ({ data }) => {
+  if (data?.op === 'cancel') return running?.abort();
+  const op = ops[data?.op];
+  try {
+    if (!op) throw new Error(`sunlit worker: unknown op '${data?.op}' (create, fromMeshes, loadFiles, fractions, annual, cancel)`);
+    postMessage({ id: data.id, result: await op(data) });
+  } catch (error) {
+    postMessage({ id: data?.id, error: String(error?.message ?? error) });
+  }
+};
