@@ -92,7 +92,7 @@ fn flipped(mesh: &SourceMesh) -> SourceMesh {
 
 /// Each mesh's vertices and local triangle list, checked.
 fn meshes(input: &Placed) -> Result<Vec<SourceMesh>> {
-    if input.positions.len() % 3 != 0 {
+    if !input.positions.len().is_multiple_of(3) {
         return Err(Error::object(SOURCE, "positions", format!("length {} is not a multiple of 3", input.positions.len())));
     }
     if let Some(i) = input.positions.iter().position(|v| !v.is_finite()) {
