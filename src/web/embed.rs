@@ -35,7 +35,7 @@ impl Engine {
         y_up: bool,
     ) -> Result<Model, JsValue> {
         let input = Placed { positions, vertex_starts, indices, index_starts, placement_meshes, matrices, names: &names, receivers, y_up };
-        self.model(scene_from_placed(&input).map_err(js_error)?, None)
+        self.model(scene_from_placed(&input).map_err(js_error)?, None, Vec::new())
     }
 }
 
