@@ -1024,12 +1024,18 @@ fn sweep(args: SweepArgs) -> Result<()> {
             eprintln!("every variant is finished; nothing submitted");
             return sweep_merge(&manifest, &dir);
         }
+        // The tasks and the merge job run this same program on the same manifest and folder.
+        let sweep = |more: &[&str]| -> Vec<String> {
+            let mut words = vec![exe.display().to_string(), "sweep".into(), manifest.path.display().to_string(), "-o".into()];
+            words.push(dir.display().to_string());
+            words.extend(more.iter().map(|w| w.to_string()));
+            words
+        };
+        let (per_task, jobs) = (args.per_task.to_string(), args.jobs.to_string());
         let options = slurm::SlurmOptions {
-            exe,
-            manifest: manifest.path.clone(),
             dir: dir.clone(),
-            per_task: args.per_task,
-            jobs: args.jobs,
+            task_command: sweep(&["--per-task", &per_task, "--jobs", &jobs, "--index"]),
+            merge_command: sweep(&["--merge"]),
             array_max: args.array_max,
             sbatch: args.sbatch.as_deref().unwrap_or("").split_whitespace().map(String::from).collect(),
         };

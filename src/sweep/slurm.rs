@@ -1,6 +1,7 @@
-//! A sweep as a Slurm job array: one task per `per_task` variants, each running
-//! `sunlit sweep MANIFEST -o DIR --per-task M --index $SLURM_ARRAY_TASK_ID`, and a merge job
-//! after the array (`afterany`) that writes the summary and lists what failed.
+//! A sweep as a Slurm job array: one task per `per_task` variants, each running the caller's task
+//! command with the task's index appended (the CLI gives `sunlit sweep … --index`), and a merge job
+//! after the array (`afterany`) that writes the summary and lists what failed. The commands are
+//! the edge's: this module quotes them for the shell, writes the scripts and calls `sbatch`.
 //!
 //! Only tasks with unfinished variants are submitted, so resubmitting after a failure or a
 //! cancellation runs just what is missing. The scripts and logs live in `DIR/.slurm/`; the
@@ -23,16 +24,13 @@ const MAX_ARRAY_INDEX: usize = 1000;
 /// What to submit.
 #[derive(Debug, Clone)]
 pub struct SlurmOptions {
-    /// The sunlit executable the tasks run (its path as the nodes see it).
-    pub exe: PathBuf,
-    /// The manifest (absolute).
-    pub manifest: PathBuf,
-    /// The output folder (absolute, shared by the nodes).
+    /// The output folder (absolute, shared by the nodes): scripts and logs go in `DIR/.slurm/`.
     pub dir: PathBuf,
-    /// Variants a task.
-    pub per_task: usize,
-    /// Variants a task counts side by side.
-    pub jobs: usize,
+    /// What an array task runs (program and arguments, paths as the nodes see them); the task's
+    /// index follows as one more argument.
+    pub task_command: Vec<String>,
+    /// What the merge job runs.
+    pub merge_command: Vec<String>,
     /// At most this many tasks at once (`%K` of `--array`).
     pub array_max: Option<usize>,
     /// Further sbatch arguments for both jobs (partition, account, time, …).
@@ -85,31 +83,24 @@ fn quote(text: &str) -> String {
     format!("'{}'", text.replace('\'', r"'\''"))
 }
 
-/// The command line every script runs: `sunlit sweep MANIFEST -o DIR`.
-fn sweep_command(options: &SlurmOptions) -> String {
-    format!(
-        "{} sweep {} -o {}",
-        quote(&options.exe.display().to_string()),
-        quote(&options.manifest.display().to_string()),
-        quote(&options.dir.display().to_string())
-    )
+/// A command line quoted word by word for a POSIX shell.
+fn shell_command(words: &[String]) -> String {
+    words.iter().map(|w| quote(w)).collect::<Vec<_>>().join(" ")
 }
 
 /// The array task's script.
 pub fn task_script(options: &SlurmOptions) -> String {
     format!(
-        "#!/bin/sh\n# A task of a sunlit sweep's job array (written by `sunlit sweep --slurm`): counts the\n# unfinished variants of task $SLURM_ARRAY_TASK_ID.\nexec {} --per-task {} --jobs {} --index \"$SLURM_ARRAY_TASK_ID\"\n",
-        sweep_command(options),
-        options.per_task,
-        options.jobs
+        "#!/bin/sh\n# A task of a sunlit sweep's job array: counts the unfinished variants of task\n# $SLURM_ARRAY_TASK_ID.\nexec {} \"$SLURM_ARRAY_TASK_ID\"\n",
+        shell_command(&options.task_command)
     )
 }
 
 /// The merge job's script.
 pub fn merge_script(options: &SlurmOptions) -> String {
     format!(
-        "#!/bin/sh\n# The merge job of a sunlit sweep (written by `sunlit sweep --slurm`): summary.csv, and\n# failed.csv listing unfinished variants with their exit codes.\nexec {} --merge\n",
-        sweep_command(options)
+        "#!/bin/sh\n# The merge job of a sunlit sweep: summary.csv, and failed.csv listing unfinished\n# variants with their exit codes.\nexec {}\n",
+        shell_command(&options.merge_command)
     )
 }
 
@@ -117,7 +108,7 @@ pub fn merge_script(options: &SlurmOptions) -> String {
 pub fn submit(options: &SlurmOptions, tasks: &[usize]) -> Result<Submitted> {
     if let Some(&last) = tasks.last().filter(|&&t| t > MAX_ARRAY_INDEX) {
         return Err(Error::argument(
-            "per-task",
+            "per_task",
             format!("task index {last} is past Slurm's usual array limit ({MAX_ARRAY_INDEX}); put more variants in a task"),
         ));
     }
@@ -187,23 +178,20 @@ mod tests {
 
     #[test]
     fn scripts_quote_paths_for_the_shell() {
+        let words = |w: &[&str]| w.iter().map(|w| w.to_string()).collect::<Vec<_>>();
         let options = SlurmOptions {
-            exe: "/opt/sun lit/sunlit".into(),
-            manifest: "/d/it's.jsonl".into(),
             dir: "/d/out".into(),
-            per_task: 2,
-            jobs: 1,
+            task_command: words(&["/opt/sun lit/sunlit", "sweep", "/d/it's.jsonl", "-o", "/d/out", "-x", "2"]),
+            merge_command: words(&["/opt/sun lit/sunlit", "sweep", "/d/it's.jsonl", "-m"]),
             array_max: None,
             sbatch: vec![],
         };
         let s = task_script(&options);
         assert!(s.starts_with("#!/bin/sh\n"));
         assert!(
-            s.contains(
-                r#"exec '/opt/sun lit/sunlit' sweep '/d/it'\''s.jsonl' -o '/d/out' --per-task 2 --jobs 1 --index "$SLURM_ARRAY_TASK_ID""#
-            ),
+            s.contains(r#"exec '/opt/sun lit/sunlit' 'sweep' '/d/it'\''s.jsonl' '-o' '/d/out' '-x' '2' "$SLURM_ARRAY_TASK_ID""#),
             "{s}"
         );
-        assert!(merge_script(&options).contains("-o '/d/out' --merge\n"));
+        assert!(merge_script(&options).ends_with("'/d/it'\\''s.jsonl' '-m'\n"));
     }
 }
