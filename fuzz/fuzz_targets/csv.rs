@@ -4,7 +4,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use sunlit::export::Schedule;
-use sunlit::samples::Timesteps;
+use sunlit::year::samples::Timesteps;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(schedule) = Schedule::from_csv("fuzz.csv", &String::from_utf8_lossy(data)) {
