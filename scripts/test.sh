@@ -9,6 +9,9 @@ SUNLIT_ENERGYPLUS=1 SUNLIT_WEB=1 SUNLIT_BROWSER=1 . scripts/setup.sh
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings
 cargo clippy --lib --quiet --target wasm32-unknown-unknown -- -D warnings
+# The fuzz targets are their own workspace (no build of the crate compiles them): check they still
+# build against the library's API, so a move in the library cannot silently break them.
+cargo check --quiet --manifest-path fuzz/Cargo.toml --target-dir target/fuzz-check
 mkdir -p target
 status=0
 cargo test --no-fail-fast 2>&1 | tee target/test.log || status=1
