@@ -202,9 +202,8 @@ impl Engine {
                 }
                 Ok(())
             };
-            let (schedule, fitted) = annual_fitted(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report)
-                .await
-                .map_err(js_error)?;
+            let (schedule, fitted) =
+                annual_fitted(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report).await.map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
             let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
             let extra = embed::Extra::new(&model.scene, &schedule, &location, epw, fitted);

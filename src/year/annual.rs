@@ -161,9 +161,7 @@ pub async fn annual_fitted_with<E: Engine>(
     let views = Views { engine };
     let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
     let fitted = match options.method {
-        Method::Spline(plan) => {
-            Some(spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?)
-        }
+        Method::Spline(plan) => Some(spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?),
         Method::Dense => {
             dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?;
             None

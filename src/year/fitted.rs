@@ -78,7 +78,12 @@ impl FittedYear {
         }
         let regime = &self.regimes[(self.regime_of)(self.calendar.phase(day))];
         let grid_day = regime.map.grid_day(day);
-        Ok(self.normals.iter().enumerate().map(|(column, &normal)| self.value(regime, grid_day, column, normal, sun_day, hour, sun)).collect())
+        Ok(self
+            .normals
+            .iter()
+            .enumerate()
+            .map(|(column, &normal)| self.value(regime, grid_day, column, normal, sun_day, hour, sun))
+            .collect())
     }
 
     /// One receiver's value (see [`Self::fractions_at`]).
