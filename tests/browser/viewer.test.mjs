@@ -148,6 +148,22 @@ test('the example viewer: glTF in, the year computed, the slider recolours by th
     console.log(`day ${s.day} hour ${s.hour}: spline ${s.api.map((v) => v.toFixed(3))} vs rows ${s.linear.map((v) => v.toFixed(3))}`);
     assert.ok(same >= s.api.length / 2 && mean < 0.05, `day ${s.day} hour ${s.hour}: ${same} equal to the row, mean |Δ| ${mean}`);
   }
+  // Instants outside the year are refused naming the argument, as every JS API error.
+  const refused = await page.evaluate(() => {
+    const attempt = (f) => {
+      try {
+        f();
+        return null;
+      } catch (e) {
+        return { code: e.code, option: e.option, message: e.message };
+      }
+    };
+    const { year } = window.sunlitViewer;
+    return { day: attempt(() => year.splineFractionsAt(400, 1)), hour: attempt(() => year.splineFractionsAt(100, 30)) };
+  });
+  assert.deepEqual([refused.day.code, refused.day.option], ['bad-option', 'day']);
+  assert.match(refused.day.message, /400 is outside/);
+  assert.deepEqual([refused.hour.code, refused.hour.option], ['bad-option', 'hour']);
   await page.screenshot({ path: join(ROOT, 'target/artifacts/viewer.png') });
   await slide(172, 2);
   const night = await shown();
