@@ -45,19 +45,21 @@ function staticServer(dir) {
 }
 
 before(async () => {
-  const env = { ...process.env, SUNLIT_PACK_SKIP_BUILD: existsSync(join(ROOT, 'www/pkg/sunlit_wasm_bg.wasm')) ? '1' : '0' };
+  // Packed into this test's own folder, so that the npm package test may pack beside it.
+  base = mkdtempSync(join(tmpdir(), 'sunlit-viewer-'));
+  const packed = join(base, 'npm');
+  const env = { ...process.env, SUNLIT_PACK_DIR: packed, SUNLIT_PACK_SKIP_BUILD: existsSync(join(ROOT, 'www/pkg/sunlit_wasm_bg.wasm')) ? '1' : '0' };
   sh('bash', ['scripts/pack-npm.sh'], { cwd: ROOT, env });
-  const tgz = readdirSync(join(ROOT, 'target/npm')).filter((f) => f.endsWith('.tgz'));
+  const tgz = readdirSync(packed).filter((f) => f.endsWith('.tgz'));
   assert.equal(tgz.length, 1);
   // The example as it sits in the repository (examples/three-viewer beside examples/office.glb),
   // its sunlit dependency pointed at the tarball by absolute path.
-  base = mkdtempSync(join(tmpdir(), 'sunlit-viewer-'));
   const app = join(base, 'three-viewer');
   cpSync(join(ROOT, 'examples/three-viewer'), app, { recursive: true, filter: (p) => !/node_modules|dist$/.test(p) });
   cpSync(join(ROOT, 'examples/office.glb'), join(base, 'office.glb'));
   const manifest = JSON.parse(readFileSync(join(app, 'package.json'), 'utf8'));
   assert.match(manifest.dependencies.sunlit, /^file:\.\.\/\.\.\/target\/npm\/sunlit-.*\.tgz$/, 'the example installs the packed tarball');
-  manifest.dependencies.sunlit = `file:${join(ROOT, 'target/npm', tgz[0])}`;
+  manifest.dependencies.sunlit = `file:${join(packed, tgz[0])}`;
   writeFileSync(join(app, 'package.json'), JSON.stringify(manifest));
   sh('npm', ['install', '--no-audit', '--no-fund', '--loglevel=error'], { cwd: app });
   sh('npx', ['vite', 'build', '--logLevel', 'warn'], { cwd: app });
