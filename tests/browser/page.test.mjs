@@ -352,6 +352,30 @@ test('API errors carry a stable code and name what they are about as the API spe
   assert.match(errors.settings.message, /^invalid timestepsPerHour: 7 is not one EnergyPlus accepts/);
 });
 
+test('a dense year has no fitted surfaces: splineFractionsAt is refused naming dense', { timeout: 300_000 }, async () => {
+  const p = await page.context().newPage();
+  p.on('request', (r) => requests.push(r.url()));
+  p.on('pageerror', (e) => pageErrors.push(e.message));
+  await p.goto(`${origin}/`);
+  const r = await p.evaluate(async () => {
+    const sunlit = await import('/sunlit.js');
+    const engine = await sunlit.createEngine({ resolution: 32 });
+    const model = engine.fromArrays({ positions: [0, 0, 0, 1, 0, 0, 0, 1, 0], indices: [0, 1, 2], triangleReceivers: [0], names: ['ROOF'] });
+    const year = await engine.annual(model, { latitude: 40, longitude: -105, timeZone: -7, timestepsPerHour: 1, dense: true });
+    let refused = null;
+    try {
+      year.splineFractionsAt(172, 12);
+    } catch (e) {
+      refused = { code: e.code, option: e.option, message: e.message };
+    }
+    return { refused, linear: Array.from(year.fractionsAt(172, 12)) };
+  });
+  await p.close();
+  assert.deepEqual([r.refused?.code, r.refused?.option], ['bad-option', 'dense']);
+  assert.match(r.refused.message, /no fitted surfaces; use fractionsAt/);
+  assert.deepEqual(r.linear, [1], 'fractionsAt still answers');
+});
+
 test('a browser without WebGPU is told so', async () => {
   const plain = await launch({ webgpu: false });
   try {
