@@ -2,15 +2,17 @@
 # `npm run pack`: the npm package `sunlit` as exactly one tarball in target/npm/. Builds the wasm
 # bundle (scripts/build-web.sh), stages what ships in target/npm/pkg (the ES modules, the wasm
 # and its glue, the types; no tests, fixtures, source maps or install scripts), then npm pack.
+# SUNLIT_PACK_DIR puts the staging folder and the tarball elsewhere (a test packing beside another).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ "${SUNLIT_PACK_SKIP_BUILD:-0}" = 1 ] || bash scripts/build-web.sh
+out="${SUNLIT_PACK_DIR:-target/npm}"
 version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -n1)
-rm -rf target/npm && mkdir -p target/npm/pkg/pkg
-cp www/sunlit.js www/device.js www/colour.js www/three.js www/engine-worker.js www/sunlit.d.ts www/three.d.ts target/npm/pkg/
-cp www/pkg/sunlit_wasm.js www/pkg/sunlit_wasm_bg.wasm target/npm/pkg/pkg/
-cp www/npm-readme.md target/npm/pkg/README.md
-cat > target/npm/pkg/package.json <<JSON
+rm -rf "$out" && mkdir -p "$out/pkg/pkg"
+cp www/sunlit.js www/device.js www/colour.js www/three.js www/engine-worker.js www/sunlit.d.ts www/three.d.ts "$out/pkg/"
+cp www/pkg/sunlit_wasm.js www/pkg/sunlit_wasm_bg.wasm "$out/pkg/pkg/"
+cp www/npm-readme.md "$out/pkg/README.md"
+cat > "$out/pkg/package.json" <<JSON
 {
   "name": "sunlit",
   "version": "$version",
@@ -31,6 +33,6 @@ cat > target/npm/pkg/package.json <<JSON
   "peerDependenciesMeta": { "three": { "optional": true } }
 }
 JSON
-(cd target/npm && npm pack ./pkg --pack-destination . --silent >/dev/null)
-ls target/npm/*.tgz
-echo "packed $(ls target/npm/*.tgz) ($(du -k target/npm/*.tgz | cut -f1) KiB)"
+(cd "$out" && npm pack ./pkg --pack-destination . --silent >/dev/null)
+ls "$out"/*.tgz
+echo "packed $(ls "$out"/*.tgz) ($(du -k "$out"/*.tgz | cut -f1) KiB)"

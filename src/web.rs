@@ -29,7 +29,7 @@ use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmitt
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
-use crate::year::annual::{Progress, annual_with_leaves};
+use crate::year::annual::{Progress, annual_fitted};
 use crate::year::settings::AnnualSettings;
 
 /// A library error as a JS `Error` whose message names the file, object or option (as the JS API
@@ -202,12 +202,11 @@ impl Engine {
                 }
                 Ok(())
             };
-            let schedule = annual_with_leaves(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report)
-                .await
-                .map_err(js_error)?;
+            let (schedule, fitted) =
+                annual_fitted(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report).await.map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
             let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
-            let extra = embed::Extra::new(&model.scene, &schedule, &location, epw);
+            let extra = embed::Extra::new(&model.scene, &schedule, &location, epw, fitted);
             Ok(Annual { schedule, means, hook, model, extra }.into())
         })
     }

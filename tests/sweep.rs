@@ -111,6 +111,102 @@ fn sweep_equals_separate_runs_resumes_and_recounts_a_changed_line() {
     assert!(partial_files(&dir).is_empty());
 }
 
+/// An EPW at 46.5 N with a direct normal irradiance that varies by the hour.
+fn varying_epw() -> String {
+    let mut text = String::from("LOCATION,Bolzano,BZ,ITA,test,0,46.5,11.35,1.0,262\n");
+    text.push_str("DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n");
+    text.push_str("COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n");
+    let month_days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let mut n = 0u32;
+    for (m, days) in month_days.iter().enumerate() {
+        for d in 1..=*days {
+            for h in 1..=24 {
+                let dni = 200 + (n * 37) % 600;
+                n += 1;
+                text.push_str(&format!(
+                    "1999,{},{d},{h},60,x,10,5,50,80000,0,1300,300,500,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0\n",
+                    m + 1
+                ));
+            }
+        }
+    }
+    text
+}
+
+/// A variant with an EPW gets irradiation columns in summary.csv: its annual run writes
+/// `<id>.summary.json`, whose values are those of a separate `annual --summary` run; a variant
+/// without weather leaves them empty; a line may not set `summary` itself.
+#[test]
+fn summary_has_irradiation_for_variants_with_an_epw() {
+    let dir = scratch("sweep-irradiation");
+    let lines = variants(&dir);
+    std::fs::write(dir.join("site.epw"), varying_epw()).unwrap();
+    let with_epw = lines[0].replace("\"location\": \"46.5,11.35,1\"", "\"epw\": \"site.epw\"").replace("d20_n0", "d20_n0_epw");
+    let manifest = write_manifest(&dir, "sweep.jsonl", &[with_epw.clone(), lines[3].clone()]);
+    let out = dir.join("out");
+    let run = sunlit(&["sweep", &manifest.display().to_string(), "-o", &out.display().to_string()]);
+    assert!(run.status.success(), "{}", stderr(&run));
+
+    let summary = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = summary.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        rows[0][..6],
+        ["id", "surface", "mean_sunlit_fraction", "sunup_timesteps", "irradiation_kwh_m2", "unshaded_irradiation_kwh_m2"]
+    );
+    assert_eq!(rows.len(), 1 + 2 * 10);
+
+    // The same run by hand, with its own summary.
+    let separate = dir.join("separate.json");
+    let csv = dir.join("separate.csv");
+    let (office, louvres, epw) = (dir.join("office.glb"), dir.join("louvres-20.glb"), dir.join("site.epw"));
+    let args = [
+        "annual",
+        &office.display().to_string(),
+        &louvres.display().to_string(),
+        "--north",
+        "0",
+        "--epw",
+        &epw.display().to_string(),
+        "--days-per-year",
+        "3",
+        "--samples-per-day",
+        "5",
+        "--resolution",
+        "64",
+        "--timesteps-per-hour",
+        "1",
+        "-o",
+        &csv.display().to_string(),
+        "--summary",
+        &separate.display().to_string(),
+    ];
+    let annual = sunlit(&args);
+    assert!(annual.status.success(), "{}", stderr(&annual));
+    let by_hand: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&separate).unwrap()).unwrap();
+    let mut shaded = 0;
+    for s in by_hand["surfaces"].as_array().unwrap() {
+        let name = s["name"].as_str().unwrap();
+        let row = rows.iter().find(|r| r[0] == "d20_n0_epw" && r[1] == name).unwrap_or_else(|| panic!("{name} in {summary}"));
+        let (irradiation, unshaded) = (s["irradiation"].as_f64().unwrap(), s["unshaded_irradiation"].as_f64().unwrap());
+        assert!((row[4].parse::<f64>().unwrap() - irradiation).abs() < 1e-4, "{name}: {} vs {irradiation}", row[4]);
+        assert!((row[5].parse::<f64>().unwrap() - unshaded).abs() < 1e-4, "{name}: {} vs {unshaded}", row[5]);
+        shaded += usize::from(irradiation < unshaded - 1.0);
+    }
+    assert!(shaded >= 2, "the louvres shade some surfaces: {summary}");
+    // The variant with a location only: empty irradiation cells.
+    assert!(rows.iter().filter(|r| r[0] == "d50_n0").all(|r| r[4].is_empty() && r[5].is_empty()), "{summary}");
+    assert!(out.join("d20_n0_epw.summary.json").is_file());
+
+    // A second run finds both finished (the summary JSON is one of the outputs it checks).
+    let again = sunlit(&["sweep", &manifest.display().to_string(), "-o", &out.display().to_string()]);
+    assert!(stderr(&again).contains("counted 0, finished before 2, failed 0"), "{}", stderr(&again));
+
+    let bad = write_manifest(&dir, "bad.jsonl", &[with_epw.replace("\"north\": 0", "\"north\": 0, \"summary\": \"x.json\"")]);
+    let refused = sunlit(&["sweep", &bad.display().to_string(), "-o", &dir.join("out2").display().to_string()]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(stderr(&refused).contains("line 1: summary is set by the sweep"), "{}", stderr(&refused));
+}
+
 #[test]
 fn every_bad_line_is_reported_with_its_number_before_counting() {
     let dir = scratch("sweep-bad");

@@ -5,7 +5,7 @@ import { drawHeatmap } from './heatmap.js';
 import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
-const state = { files: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '' };
+const state = { files: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '', colourBy: 'mean' };
 const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
 
 function status(text, { error = false } = {}) {
@@ -76,15 +76,42 @@ function showModel(msg) {
  * after the model arrives, so it is also called once the viewer exists. */
 function showInViewer() {
   const { viewer, model, result } = state;
+  const scale = colourScale();
+  showLegend(scale);
   if (!viewer || !model) return;
   if (viewer.positions !== model.positions) viewer.setModel(model.positions, model.receivers);
-  viewer.setColours(result ? (r) => colourOf(result.means[r]) : () => UNCOMPUTED);
+  viewer.setColours(result ? (r) => colourOf(scale.values[r] / scale.max) : () => UNCOMPUTED);
 }
 
-function fillTable(means) {
+/** What the view is coloured by: the result's values per receiver, the top of the scale, and
+ * the legend's title and tick format. Irradiation only when the year had an EPW. */
+function colourScale() {
+  const { result } = state;
+  if (state.colourBy === 'irradiation' && result?.irradiation) {
+    // The palette's top is the most irradiated surface (at least 1 kWh/m², so a dark year draws).
+    const max = Math.max(1, ...result.irradiation);
+    return { values: result.irradiation, max, title: 'Annual direct irradiation, kWh/m² (beam, shaded)', tick: (v) => v.toFixed(0) };
+  }
+  return { values: result?.means ?? [], max: 1, title: 'Annual mean sunlit fraction (sun-up hours)', tick: (v) => String(v) };
+}
+
+function showLegend({ max, title, tick }) {
+  $('legendtitle').textContent = title;
+  const ticks = [0, 0.25, 0.5, 0.75, 1].map((t) => {
+    const span = document.createElement('span');
+    span.textContent = tick(t * max);
+    return span;
+  });
+  $('legendticks').replaceChildren(...ticks);
+}
+
+function fillTable(result) {
   const body = $('table').tBodies[0];
   body.replaceChildren();
   const { names, areas } = state.model;
+  const means = result?.means;
+  const irradiation = result?.irradiation;
+  for (const th of $('table').tHead.querySelectorAll('.irr')) th.hidden = !irradiation;
   names.forEach((name, i) => {
     const row = body.insertRow();
     row.tabIndex = 0;
@@ -97,6 +124,13 @@ function fillTable(means) {
     const mean = row.insertCell();
     mean.textContent = means ? means[i].toFixed(3) : '–';
     mean.className = 'num';
+    if (irradiation) {
+      for (const values of [irradiation, result.unshaded]) {
+        const cell = row.insertCell();
+        cell.textContent = values[i].toFixed(1);
+        cell.className = 'num';
+      }
+    }
     if (i === state.selected) row.classList.add('selected');
   });
 }
@@ -115,12 +149,17 @@ function showResult(msg) {
   state.result = msg;
   setBusy(false);
   $('progress').value = 1;
-  fillTable(msg.means);
+  fillTable(msg);
+  const irradiation = $('colourby').querySelector('[value=irradiation]');
+  irradiation.disabled = !msg.irradiation;
+  if (!msg.irradiation) $('colourby').value = state.colourBy = 'mean';
   showInViewer();
   $('download').disabled = false;
   $('downloadidf').disabled = !msg.hooked;
   selectReceiver(state.selected >= 0 ? state.selected : 0);
-  status(`Done in ${msg.seconds.toFixed(1)} s: ${msg.names.length} surfaces × ${msg.rows.toLocaleString()} timesteps.`);
+  // An EPW whose hourly records cannot be read still gives fractions; say why there is no energy.
+  const weather = msg.irradiationError ? ` No irradiation: ${msg.irradiationError}.` : '';
+  status(`Done in ${msg.seconds.toFixed(1)} s: ${msg.names.length} surfaces × ${msg.rows.toLocaleString()} timesteps.${weather}`, { error: !!weather });
 }
 
 function showError(msg) {
@@ -149,11 +188,38 @@ worker.onmessage = ({ data: msg }) => {
     status(msg.text);
   } else if (msg.type === 'result') {
     showResult(msg);
+  } else if (msg.type === 'epwLocation') {
+    showEpwLocation(msg);
   } else if (msg.type === 'error') {
     showError(msg);
   }
 };
 worker.onerror = (e) => showError({ message: e.message || 'the worker failed to start', request: 'start' });
+
+/** The EPW's own location in the form (the EPW is what the year uses); the fields are read-only
+ * while it is chosen. A bad LOCATION record is said under the fields (Compute says it again in
+ * the status line, which this leaves alone). */
+function showEpwLocation({ name, location, message }) {
+  if ($('epw').files[0]?.name !== name) return;
+  $('locationnote').classList.toggle('error', !location);
+  if (!location) {
+    $('locationnote').textContent = `${name}: ${message}.`;
+    return;
+  }
+  [$('latitude').value, $('longitude').value, $('timezone').value] = [location.latitude, location.longitude, location.timeZone].map(String);
+  $('locationnote').textContent = `From ${name}: ${location.name || 'its LOCATION record'}. Clear the EPW to edit.`;
+}
+
+function epwChosen() {
+  const file = $('epw').files[0];
+  for (const id of ['latitude', 'longitude', 'timezone']) $(id).readOnly = !!file;
+  if (!file) {
+    $('locationnote').classList.remove('error');
+    $('locationnote').textContent = 'An EPW, when given, sets all three.';
+    return;
+  }
+  file.text().then((text) => worker.postMessage({ type: 'epw', name: file.name, text }));
+}
 
 function noWebGPU() {
   const box = $('nowebgpu');
@@ -227,6 +293,11 @@ function wire() {
     worker.postMessage({ type: 'compute', settings: await settings(), resolution: resolution(), csvName: state.csvName });
   });
   $('cancel').addEventListener('click', () => worker.postMessage({ type: 'cancel' }));
+  $('epw').addEventListener('change', epwChosen);
+  $('colourby').addEventListener('change', () => {
+    state.colourBy = $('colourby').value;
+    showInViewer();
+  });
   $('retry').addEventListener('click', () => $('settings').requestSubmit());
   $('download').addEventListener('click', () => state.result && download(state.csvName, state.result.csv, 'text/csv'));
   $('downloadidf').addEventListener('click', () => {

@@ -205,6 +205,13 @@ export interface Annual {
   /** Every receiver's fraction at day of year `day` (1..365) and local standard `hour` (0..24),
    * linear between the schedule's rows, 0 with the sun down. */
   fractionsAt(day: number, hour?: number): Float64Array;
+  /** Every receiver's fraction at day of year `day` (1..365, fractional allowed) and local standard
+   * `hour` (0..24) from the year's fitted annual spline surfaces, evaluated in wasm (cheap enough
+   * for a time slider): smooth between timesteps; at a timestep's instant the CSV's value, except
+   * where the run counted that timestep directly (refinement); 0 with the sun down or behind the
+   * surface. Throws a SunlitError naming `day` or `hour` when outside, or `dense` for a dense year
+   * (which has no surfaces: use fractionsAt). */
+  splineFractionsAt(day: number, hour: number): Float64Array;
   /** The EnergyPlus CSV (eplusshading.csv layout). */
   csv(): string;
   /** With an IDF/epJSON loaded: the model text with the CSV (saved beside it as csvName) hooked in. */

@@ -48,6 +48,10 @@ function multiply(a, b) {
 
 const links = new WeakMap();
 
+/** The palette is in sRGB, as the legend's CSS is; three.js (r152+) converts from it to its linear
+ * working space, so a surface shows the legend's colour. (three's SRGBColorSpace, by value.) */
+const SRGB = 'srgb';
+
 /**
  * A Model from every Mesh under `object` (world matrices applied; InstancedMesh kept instanced,
  * instance i named `NAME[i]`), in three.js's Y-up axes. `receivers`: comma-separated globs over
@@ -155,14 +159,14 @@ export function colourByValues(model, values, { min = 0, max, label = '' } = {})
     const [r, g, b] = colourOf((s.v / s.a - min) / (top - min));
     if (instance >= 0) {
       const colour = mesh.material.color?.clone?.() ?? null;
-      if (colour) mesh.setColorAt(instance, colour.setRGB(r, g, b));
+      if (colour) mesh.setColorAt(instance, colour.setRGB(r, g, b, SRGB));
       if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
     } else {
       if (!mesh.userData.sunlitMaterial) {
         mesh.material = mesh.material.clone();
         mesh.userData.sunlitMaterial = true;
       }
-      mesh.material.color.setRGB(r, g, b);
+      mesh.material.color.setRGB(r, g, b, SRGB);
     }
   }
   return { min, max: top, legend: typeof document === 'undefined' ? null : legend(min, top, label) };

@@ -1,9 +1,9 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: load, compute, cancel. Messages out: loaded, progress,
-// notice, result, error (with the error's `code`, and `gpu: true` when the device failed twice and
-// a retry may help). Errors are told apart by their `code` (sunlit.d.ts, SunlitError), never by
-// their message.
-import { createEngine } from './sunlit.js';
+// page stays responsive. Messages in: load, compute, cancel, epw. Messages out: loaded, progress,
+// notice, result, epwLocation, error (with the error's `code`, and `gpu: true` when the device
+// failed twice and a retry may help). Errors are told apart by their `code` (sunlit.d.ts,
+// SunlitError), never by their message.
+import { createEngine, epwLocation } from './sunlit.js';
 
 let engine = null;
 let model = null;
@@ -106,10 +106,14 @@ async function computeOnce({ settings, resolution, csvName }) {
     const columns = annual.names.length;
     const values = new Float32Array(annual.rows * columns);
     for (let c = 0; c < columns; c++) values.set(annual.column(c), c * annual.rows);
+    const { irradiation, unshaded, irradiationError } = energy(annual);
     const result = {
       type: 'result',
       names: annual.names,
       means: annual.means,
+      irradiation,
+      unshaded,
+      irradiationError,
       rows: annual.rows,
       timestepsPerHour: annual.timestepsPerHour,
       values,
@@ -123,6 +127,25 @@ async function computeOnce({ settings, resolution, csvName }) {
   }
 }
 
+/** The year's direct irradiation and its unshaded twin (kWh/m²), both undefined without an EPW;
+ * an EPW whose hourly records are unreadable gives the reason instead. */
+function energy(annual) {
+  try {
+    return { irradiation: annual.irradiation, unshaded: annual.unshadedIrradiation, irradiationError: undefined };
+  } catch (error) {
+    return { irradiation: undefined, unshaded: undefined, irradiationError: String(error?.message ?? error) };
+  }
+}
+
+/** An EPW's LOCATION, for the page's form. */
+async function epw({ name, text }) {
+  try {
+    postMessage({ type: 'epwLocation', name, location: await epwLocation(text, name) });
+  } catch (error) {
+    postMessage({ type: 'epwLocation', name, location: null, message: String(error?.message ?? error) });
+  }
+}
+
 onmessage = async ({ data }) => {
   if (data.type === 'cancel') {
     running?.abort();
@@ -131,6 +154,7 @@ onmessage = async ({ data }) => {
   try {
     if (data.type === 'load') await load(data);
     else if (data.type === 'compute') await compute(data);
+    else if (data.type === 'epw') await epw(data);
   } catch (error) {
     fail(error, data.type);
   } finally {

@@ -23,6 +23,11 @@ pub const MODELS: &str = "models";
 pub const IDF_OUT: &str = "idf-out";
 /// The key of the output CSV, which the sweep sets (`<id>.csv`) and a line may not.
 pub const OUTPUT: &str = "output";
+/// The key of the annual run's per-surface summary, which the sweep sets for a variant with an
+/// `epw` (`<id>.summary.json`, read back for summary.csv's irradiation) and a line may not.
+pub const SUMMARY: &str = "summary";
+/// The key of the weather file: with it, a variant has annual irradiation.
+const EPW: &str = "epw";
 /// Ids a variant may not take: its CSV would overwrite the sweep's own outputs.
 const RESERVED_IDS: [&str; 2] = ["summary", "failed"];
 /// Longest id (file systems allow 255 bytes a name; the id gets suffixes).
@@ -65,7 +70,7 @@ impl Schema {
     /// Every key a line may use, for the unknown-key message.
     fn keys(&self) -> String {
         let mut keys = vec!["id", MODELS];
-        keys.extend(self.options.iter().map(|o| o.key.as_str()).filter(|k| *k != OUTPUT));
+        keys.extend(self.options.iter().map(|o| o.key.as_str()).filter(|k| *k != OUTPUT && *k != SUMMARY));
         keys.join(", ")
     }
 }
@@ -101,9 +106,15 @@ impl Variant {
         self.idf_out.as_ref().map(|ext| dir.join(format!("{}.{ext}", self.id)))
     }
 
+    /// The per-surface summary in `dir` (mean fraction, irradiation, unshaded irradiation),
+    /// written for a variant with an `epw`, whose weather gives the irradiation.
+    pub fn surface_summary(&self, dir: &Path) -> Option<PathBuf> {
+        self.arg(EPW).map(|_| dir.join(format!("{}.summary.json", self.id)))
+    }
+
     /// Every file the run writes in `dir`.
     pub fn outputs(&self, dir: &Path) -> Vec<PathBuf> {
-        std::iter::once(self.csv(dir)).chain(self.model_copy(dir)).collect()
+        std::iter::once(self.csv(dir)).chain(self.model_copy(dir)).chain(self.surface_summary(dir)).collect()
     }
 
     /// The whole argument list of the annual run writing into `dir` (after the program name and
@@ -114,6 +125,9 @@ impl Variant {
         args.push(format!("--{OUTPUT}={}", self.csv(dir).display()));
         if let Some(copy) = self.model_copy(dir) {
             args.push(format!("--{IDF_OUT}={}", copy.display()));
+        }
+        if let Some(summary) = self.surface_summary(dir) {
+            args.push(format!("--{SUMMARY}={}", summary.display()));
         }
         args.extend_from_slice(&self.args[split..]);
         args
@@ -264,6 +278,10 @@ fn parse_line(raw: &str, line: usize, index: usize, base: &Path, schema: &Schema
         }
         if key == OUTPUT {
             problems.push(format!("{OUTPUT} is set by the sweep (<id>.csv in the output folder); leave it out"));
+            continue;
+        }
+        if key == SUMMARY {
+            problems.push(format!("{SUMMARY} is set by the sweep (<id>.summary.json, with an {EPW}); leave it out"));
             continue;
         }
         if key == IDF_OUT {

@@ -69,6 +69,12 @@ pub struct SurfaceMean {
     pub mean_fraction: f64,
     /// Sun-up timesteps of the year.
     pub sunup_timesteps: usize,
+    /// Annual direct irradiation Σ DNI·cos θ·fraction·Δt, kWh/m² (a variant with an EPW).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub irradiation: Option<f64>,
+    /// The same unshaded, kWh/m².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unshaded_irradiation: Option<f64>,
 }
 
 /// The record of a finished variant.

@@ -3,8 +3,10 @@
 //!
 //! The means are taken once, when a variant finishes, from its CSV (read back with
 //! [`Schedule::from_csv`]) and the sun at each timestep, and kept in its done record; the summary
-//! is assembled from the records. Annual irradiation (where an EPW gives the weather) belongs
-//! beside the mean as further [`SurfaceMean`] fields and columns here.
+//! is assembled from the records. A variant with an EPW also has annual direct irradiation and
+//! its unshaded twin (kWh/m²): its annual run writes them per surface
+//! ([`Variant::surface_summary`], the scene's normals and the weather are the run's), read back
+//! here beside the means; summary.csv has their columns when any finished variant has them.
 
 use std::path::Path;
 
@@ -47,7 +49,13 @@ pub fn means(schedule: &Schedule, location: &Location) -> Vec<SurfaceMean> {
         .names
         .iter()
         .zip(sums)
-        .map(|(name, sum)| SurfaceMean { surface: name.clone(), mean_fraction: sum / up.max(1) as f64, sunup_timesteps: up })
+        .map(|(name, sum)| SurfaceMean {
+            surface: name.clone(),
+            mean_fraction: sum / up.max(1) as f64,
+            sunup_timesteps: up,
+            irradiation: None,
+            unshaded_irradiation: None,
+        })
         .collect()
 }
 
@@ -56,7 +64,28 @@ pub fn means_of(dir: &Path, variant: &Variant) -> Result<Vec<SurfaceMean>> {
     let path = variant.csv(dir);
     let text = std::fs::read_to_string(&path).map_err(|source| Error::Io { path: path.clone(), source })?;
     let schedule = Schedule::from_csv(&path.display().to_string(), &text)?;
-    Ok(means(&schedule, &location(variant)?))
+    let mut surfaces = means(&schedule, &location(variant)?);
+    if let Some(summary) = variant.surface_summary(dir) {
+        add_irradiation(&mut surfaces, &summary)?;
+    }
+    Ok(surfaces)
+}
+
+/// Fills each surface's irradiation from the annual run's summary JSON (`surfaces[]` with
+/// `name`, `irradiation`, `unshaded_irradiation`; see `export::irradiation::summary_json`).
+fn add_irradiation(surfaces: &mut [SurfaceMean], path: &Path) -> Result<()> {
+    let label = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::model(&label, e.to_string()))?;
+    let listed = json["surfaces"].as_array().ok_or_else(|| Error::model(&label, "no surfaces array"))?;
+    for s in surfaces.iter_mut() {
+        let Some(entry) = listed.iter().find(|e| e["name"].as_str() == Some(s.surface.as_str())) else {
+            return Err(Error::model(&label, format!("no surface '{}' (a column of the CSV)", s.surface)));
+        };
+        s.irradiation = entry["irradiation"].as_f64();
+        s.unshaded_irradiation = entry["unshaded_irradiation"].as_f64();
+    }
+    Ok(())
 }
 
 /// The summary's text: a header, then a row per finished variant and surface, in manifest order.
@@ -65,7 +94,12 @@ pub fn summary_csv(finished: &[(&Variant, &Done)]) -> String {
     let mut keys: Vec<&str> = finished.iter().flat_map(|(v, _)| v.settings.iter().map(|(k, _)| k.as_str())).collect();
     keys.sort_unstable();
     keys.dedup();
+    // Irradiation columns only where some variant has weather: a sweep of locations keeps its shape.
+    let energy = finished.iter().any(|(_, d)| d.surfaces.iter().any(|s| s.irradiation.is_some()));
     let mut header = vec!["id", "surface", "mean_sunlit_fraction", "sunup_timesteps"];
+    if energy {
+        header.extend(["irradiation_kwh_m2", "unshaded_irradiation_kwh_m2"]);
+    }
     header.extend(&keys);
     let mut out = header.iter().map(|h| field(h)).collect::<Vec<_>>().join(",");
     out.push('\n');
@@ -73,6 +107,10 @@ pub fn summary_csv(finished: &[(&Variant, &Done)]) -> String {
         let settings: Vec<String> = keys.iter().map(|k| field(variant.setting(k).unwrap_or(""))).collect();
         for s in &done.surfaces {
             let mut row = vec![field(&variant.id), field(&s.surface), format!("{:.6}", s.mean_fraction), s.sunup_timesteps.to_string()];
+            if energy {
+                let optional = |v: Option<f64>| v.map(|v| format!("{v:.4}")).unwrap_or_default();
+                row.extend([optional(s.irradiation), optional(s.unshaded_irradiation)]);
+            }
             row.extend(settings.iter().cloned());
             out.push_str(&row.join(","));
             out.push('\n');

@@ -1,6 +1,7 @@
 //! The bindings for embedding sunlit in a web viewer: scenes from meshes and placements (a
 //! three.js scene graph, instancing kept), a year's direct irradiation on [`Annual`], its
-//! fractions at any instant (for a time slider), and an EPW's location for a form.
+//! fractions at any instant (for a time slider: the fitted surfaces, or the schedule's rows
+//! interpolated), and an EPW's location for a form.
 
 use js_sys::{Float64Array, Object, Reflect};
 use wasm_bindgen::prelude::*;
@@ -13,6 +14,7 @@ use crate::model::placed::{Placed, scene_from_placed};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::fitted::FittedYear;
 use crate::year::samples::DAYS;
 
 #[wasm_bindgen]
@@ -39,22 +41,29 @@ impl Engine {
     }
 }
 
-/// What a year adds for viewers: the site, and the per-surface summary (or why the weather's
-/// irradiance could not be read).
+/// What a year adds for viewers: the site, the per-surface summary (or why the weather's
+/// irradiance could not be read) and the fitted surfaces (None for a dense year).
 pub(super) struct Extra {
     location: Location,
     summary: std::result::Result<Vec<SurfaceSummary>, String>,
+    fitted: Option<FittedYear>,
 }
 
 impl Extra {
     /// The summary of `schedule`, with irradiation when `epw` (its text, labelled `epw_name`) is given.
-    pub(super) fn new(scene: &Scene, schedule: &Schedule, location: &Location, epw: Option<(&str, &str)>) -> Self {
+    pub(super) fn new(
+        scene: &Scene,
+        schedule: &Schedule,
+        location: &Location,
+        epw: Option<(&str, &str)>,
+        fitted: Option<FittedYear>,
+    ) -> Self {
         let summary = (|| -> Result<Vec<SurfaceSummary>> {
             let dni = epw.map(|(name, text)| DirectNormal::from_epw_text(name, text)).transpose()?;
             summarize(scene, schedule, location, dni.as_ref())
         })()
         .map_err(|e| e.to_string());
-        Self { location: location.clone(), summary }
+        Self { location: location.clone(), summary, fitted }
     }
 }
 
@@ -100,6 +109,23 @@ impl Annual {
             return Ok(Float64Array::from(vec![0.0; columns].as_slice()));
         }
         Ok(Float64Array::from(interpolated_row(&self.schedule, (day.floor() - 1.0) * 24.0 + hour).as_slice()))
+    }
+}
+
+#[wasm_bindgen]
+impl Annual {
+    /// Every receiver's fraction at day of year `day` (1..=365, fractional allowed) and local
+    /// standard `hour` (0..=24) from the year's fitted spline surfaces, evaluated here: smooth
+    /// between timesteps, the schedule's value at a timestep's instant except where the run
+    /// counted that timestep directly (refinement), exactly 0 with the sun down or behind the
+    /// surface. A dense year (`dense: true`) has no surfaces: an error naming `dense`.
+    #[wasm_bindgen(js_name = splineFractionsAt)]
+    pub fn spline_fractions_at(&self, day: f64, hour: f64) -> Result<Float64Array, JsValue> {
+        let Some(fitted) = &self.extra.fitted else {
+            return Err(js_error(Error::argument("dense", "a dense year has no fitted surfaces; use fractionsAt")));
+        };
+        let values = fitted.fractions_at(day, hour).map_err(js_error)?;
+        Ok(Float64Array::from(values.as_slice()))
     }
 }
 

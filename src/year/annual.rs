@@ -32,6 +32,7 @@ use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
+use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::year::season::{LeafCalendar, Phase};
 use crate::year::spline::{AnnualGrid, AnnualSpline};
@@ -129,16 +130,45 @@ pub async fn annual_with<E: Engine>(
     calendar: &LeafCalendar,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Schedule> {
+    Ok(annual_fitted_with(engine, scene, location, options, calendar, progress).await?.0)
+}
+
+/// As [`annual_with_leaves`], keeping the fitted surfaces too (None for [`Method::Dense`]), to
+/// evaluate at any instant ([`FittedYear::fractions_at`], a viewer's time slider).
+pub async fn annual_fitted(
+    counter: &Counter,
+    gpu: &GpuScene,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<(Schedule, Option<FittedYear>)> {
+    annual_fitted_with(&Lanes(&[Lane { counter, gpu }]), scene, location, options, calendar, progress).await
+}
+
+/// As [`annual_with`], keeping the fitted surfaces too (None for [`Method::Dense`]).
+pub async fn annual_fitted_with<E: Engine>(
+    engine: &E,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<(Schedule, Option<FittedYear>)> {
     let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
     let mut schedule = Schedule::zeros(names, options.timesteps);
     let views = Views { engine };
     let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
-    match options.method {
-        Method::Spline(plan) => spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?,
-        Method::Dense => dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?,
-    }
+    let fitted = match options.method {
+        Method::Spline(plan) => Some(spline_year(&views, scene, location, plan, &calendar, options.refine, &mut schedule, progress).await?),
+        Method::Dense => {
+            dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?;
+            None
+        }
+    };
     schedule.validate()?;
-    Ok(schedule)
+    Ok((schedule, fitted))
 }
 
 /// [`annual_on`] the lanes' counters, surviving one loss of a GPU device (a driver reset, a GPU
@@ -192,7 +222,7 @@ impl<E: Engine> Views<'_, E> {
 
 /// A surface has at most this many lit pieces a day that get a fitted surface each: a north
 /// wall in summer is lit in the morning and again in the evening.
-const MAX_PIECES: usize = 2;
+pub(super) const MAX_PIECES: usize = 2;
 
 /// The day of the sun model whose sun EnergyPlus's shading uses on calendar day `day`: the day
 /// before. Measured against EnergyPlus 25.2's eplusshading.csv (Golden, annual, Timestep 4): with
@@ -205,7 +235,7 @@ pub fn shading_sun_day(day: u32) -> f64 {
 }
 
 /// Whether the sun counts as up (EnergyPlus's SunIsUp threshold on cos zenith).
-fn sun_is_up(sun: DVec3) -> bool {
+pub(super) fn sun_is_up(sun: DVec3) -> bool {
     sun.z >= MIN_COS_INCIDENCE
 }
 
@@ -256,7 +286,7 @@ struct Regime {
 
 /// How a regime's grid coordinate follows the day of year.
 #[derive(Debug, Clone, Copy)]
-enum DayMap {
+pub(super) enum DayMap {
     /// The season axis's coordinate (periodic over the year; see [`SeasonAxis`]).
     Year(SeasonAxis),
     /// A ramp of `length` days from `start`, in u ∈ [0, 1] with leaf fraction u² (leaf-out) or
@@ -268,6 +298,15 @@ enum DayMap {
 }
 
 impl DayMap {
+    /// The grid coordinate of calendar day `day` (fractional allowed): the year's fit is over
+    /// the sun's day ([`shading_sun_day`]), a foliage ramp's over the leaves' (calendar) day.
+    pub(super) fn grid_day(self, day: f64) -> f64 {
+        match self {
+            DayMap::Year(_) => self.grid_coordinate(day - 1.0),
+            DayMap::Ramp { .. } => self.grid_coordinate(day),
+        }
+    }
+
     fn grid_coordinate(self, day: f64) -> f64 {
         match self {
             DayMap::Year(axis) => axis.coordinate(day),
@@ -325,7 +364,7 @@ impl Regime {
 }
 
 /// Which regime serves a leaf phase.
-type RegimeOf = fn(Phase) -> usize;
+pub(super) type RegimeOf = fn(Phase) -> usize;
 
 /// The regimes of a year and which one serves each phase: one for every phase without foliage,
 /// else bare, full leaf, leaf-out and leaf fall.
@@ -363,7 +402,7 @@ async fn spline_year(
     refine: f64,
     schedule: &mut Schedule,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
-) -> Result<()> {
+) -> Result<FittedYear> {
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
     let SampleViews { requests, cells } = sample_views(scene, location, &regimes, &taus);
@@ -389,7 +428,12 @@ async fn spline_year(
     for ((row, column, _, _), v) in rough.into_iter().zip(refined) {
         schedule.set(row, column, v as f32);
     }
-    Ok(())
+    let surfaces = regimes
+        .iter()
+        .zip(fits)
+        .map(|(g, f)| FittedSurfaces { map: g.map, splines: f.into_iter().map(|p| p.map(|p| p.spline)).collect() })
+        .collect();
+    Ok(FittedYear::new(scene, location, *calendar, surfaces, regime_of, schedule.timesteps.days()))
 }
 
 /// The views the sample grids need, and where each count goes.
@@ -543,11 +587,7 @@ fn evaluate(
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
         let regime = &regimes[regime_of(day as f64)];
-        // The year's fit is over the sun's day; a foliage ramp's over the leaves' (calendar) day.
-        let grid_day = match regime.map {
-            DayMap::Year(_) => regime.map.grid_coordinate(shading_sun_day(day)),
-            DayMap::Ramp { .. } => regime.map.grid_coordinate(day as f64),
-        };
+        let grid_day = regime.map.grid_day(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
             let sun = sun_direction(location, shading_sun_day(day), instant.hour);
@@ -558,8 +598,8 @@ fn evaluate(
                 if is_dark(r.normal, sun) {
                     continue;
                 }
-                let Some((p, tau)) = piece_at(&pieces[column], instant.hour) else { continue };
-                if let Some(fit) = &regime.fits[column * MAX_PIECES + p.min(MAX_PIECES - 1)] {
+                let Some((fit, tau)) = fit_at(&pieces[column], column, instant.hour) else { continue };
+                if let Some(fit) = &regime.fits[fit] {
                     schedule.set(row, column, fit.spline.eval(grid_day, tau).clamp(0.0, 1.0) as f32);
                     if regime.cells.spread(&fit.samples, grid_day, tau) > refine {
                         rough.push((row, column, sun, day as f64));
@@ -569,6 +609,13 @@ fn evaluate(
         }
     }
     rough
+}
+
+/// Which of a regime's fits (by receiver and piece) serves receiver `column` at time `t`, given
+/// its lit pieces that day, and the normalised time within the piece.
+pub(super) fn fit_at(pieces: &[(f64, f64)], column: usize, t: f64) -> Option<(usize, f64)> {
+    let (p, tau) = piece_at(pieces, t)?;
+    Some((column * MAX_PIECES + p.min(MAX_PIECES - 1), tau))
 }
 
 /// The lit piece holding time `t` (or the nearest one, for rounding at its ends) and the

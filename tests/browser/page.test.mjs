@@ -352,6 +352,30 @@ test('API errors carry a stable code and name what they are about as the API spe
   assert.match(errors.settings.message, /^invalid timestepsPerHour: 7 is not one EnergyPlus accepts/);
 });
 
+test('a dense year has no fitted surfaces: splineFractionsAt is refused naming dense', { timeout: 300_000 }, async () => {
+  const p = await page.context().newPage();
+  p.on('request', (r) => requests.push(r.url()));
+  p.on('pageerror', (e) => pageErrors.push(e.message));
+  await p.goto(`${origin}/`);
+  const r = await p.evaluate(async () => {
+    const sunlit = await import('/sunlit.js');
+    const engine = await sunlit.createEngine({ resolution: 32 });
+    const model = engine.fromArrays({ positions: [0, 0, 0, 1, 0, 0, 0, 1, 0], indices: [0, 1, 2], triangleReceivers: [0], names: ['ROOF'] });
+    const year = await engine.annual(model, { latitude: 40, longitude: -105, timeZone: -7, timestepsPerHour: 1, dense: true });
+    let refused = null;
+    try {
+      year.splineFractionsAt(172, 12);
+    } catch (e) {
+      refused = { code: e.code, option: e.option, message: e.message };
+    }
+    return { refused, linear: Array.from(year.fractionsAt(172, 12)) };
+  });
+  await p.close();
+  assert.deepEqual([r.refused?.code, r.refused?.option], ['bad-option', 'dense']);
+  assert.match(r.refused.message, /no fitted surfaces; use fractionsAt/);
+  assert.deepEqual(r.linear, [1], 'fractionsAt still answers');
+});
+
 test('a browser without WebGPU is told so', async () => {
   const plain = await launch({ webgpu: false });
   try {
@@ -363,6 +387,149 @@ test('a browser without WebGPU is told so', async () => {
   } finally {
     await plain.close();
   }
+});
+
+/** An EPW for Sydney (LOCATION differs from the form's Golden) whose direct normal irradiance
+ * varies from hour to hour. */
+function sydneyEpw() {
+  const lines = ['LOCATION,Sydney,NSW,AUS,test,947670,-33.87,151.21,10.0,39', 'DESIGN CONDITIONS,0', 'TYPICAL/EXTREME PERIODS,0',
+    'GROUND TEMPERATURES,0', 'HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0', 'COMMENTS 1,', 'COMMENTS 2,', 'DATA PERIODS,1,1,Data,Sunday,1/1,12/31'];
+  const days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+  let n = 0;
+  days.forEach((count, m) => {
+    for (let d = 1; d <= count; d++) {
+      for (let h = 1; h <= 24; h++) {
+        const dni = 200 + ((n++ * 37) % 600);
+        lines.push(`1999,${m + 1},${d},${h},60,x,20,10,50,101000,0,1300,300,500,${dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0`);
+      }
+    }
+  });
+  return `${lines.join('\n')}\n`;
+}
+
+test('with an EPW: its location in the form, irradiation columns and colours, equal to the API', { timeout: 600_000 }, async () => {
+  assert.match(await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb/);
+  const epwText = sydneyEpw();
+  const epwPath = join(WORK, 'sydney.epw');
+  writeFileSync(epwPath, epwText);
+  await page.setInputFiles('#epw', epwPath);
+  await page.waitForFunction(() => document.getElementById('latitude').value === '-33.87', null, { timeout: 60_000 });
+  const fields = await page.evaluate(() => ['latitude', 'longitude', 'timezone'].map((id) => [document.getElementById(id).value, document.getElementById(id).readOnly]));
+  assert.deepEqual(fields, [['-33.87', true], ['151.21', true], ['10', true]]);
+  assert.match(await page.textContent('#locationnote'), /From sydney\.epw: Sydney, NSW, AUS/);
+  await page.fill('#days', '6');
+  await page.fill('#perday', '5');
+  await page.fill('#resolution', '64');
+  await page.selectOption('#timesteps', '1');
+  assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done in [\d.]+ s: 10 surfaces/);
+
+  const table = await page.evaluate(() => ({
+    head: [...document.querySelectorAll('#table thead th')].filter((th) => !th.hidden).map((th) => th.textContent),
+    rows: [...document.querySelectorAll('#table tbody tr')].map((tr) => [...tr.cells].map((td) => td.textContent)),
+  }));
+  assert.deepEqual(table.head, ['Surface', 'Area m²', 'Mean fraction', 'Irradiation kWh/m²', 'Unshaded kWh/m²']);
+  // The same year through the JS API (its own engine, on the page's thread).
+  const api = await page.evaluate(async (text) => {
+    const sunlit = await import('/sunlit.js');
+    const engine = await sunlit.createEngine({ resolution: 64 });
+    const bytes = new Uint8Array(await (await fetch('/pkg/office.glb')).arrayBuffer());
+    const model = engine.loadFiles([{ name: 'office.glb', bytes }]);
+    const year = await engine.annual(model, { epw: text, epwName: 'sydney.epw', daysPerYear: 6, samplesPerDay: 5, timestepsPerHour: 1 });
+    const out = { names: year.names, means: Array.from(year.means), irradiation: Array.from(year.irradiation), unshaded: Array.from(year.unshadedIrradiation) };
+    year.free();
+    model.free();
+    return out;
+  }, epwText);
+  assert.equal(table.rows.length, api.names.length);
+  table.rows.forEach(([name, , mean, irradiation, unshaded], i) => {
+    assert.equal(name, api.names[i]);
+    assert.ok(Math.abs(Number(mean) - api.means[i]) <= 0.0015, `${name}: mean ${mean} vs API ${api.means[i]}`);
+    assert.ok(Math.abs(Number(irradiation) - api.irradiation[i]) <= 0.05 + 0.002 * api.irradiation[i], `${name}: ${irradiation} vs API ${api.irradiation[i]}`);
+    assert.ok(Math.abs(Number(unshaded) - api.unshaded[i]) <= 0.051, `${name}: unshaded ${unshaded} vs API ${api.unshaded[i]}`);
+  });
+  assert.ok(api.irradiation.some((v) => v > 100), 'the year has sun on it');
+
+  // Colour by irradiation: the legend's title and top tick (the most irradiated surface), and
+  // the view changes.
+  const byMean = await page.locator('#view').screenshot();
+  assert.match(await page.textContent('#legendtitle'), /mean sunlit fraction/);
+  assert.deepEqual(await page.$$eval('#legendticks span', (s) => s.map((x) => x.textContent)), ['0', '0.25', '0.5', '0.75', '1']);
+  await page.selectOption('#colourby', 'irradiation');
+  assert.match(await page.textContent('#legendtitle'), /irradiation, kWh\/m²/);
+  const ticks = await page.$$eval('#legendticks span', (s) => s.map((x) => Number(x.textContent)));
+  const top = Math.max(...api.irradiation);
+  assert.ok(Math.abs(ticks[4] - top) <= 1 + 0.002 * top, `legend top ${ticks[4]} vs the largest irradiation ${top}`);
+  assert.ok(Math.abs(ticks[2] - top / 2) <= 1 + 0.002 * top);
+  const byIrradiation = await page.locator('#view').screenshot();
+  assert.notDeepEqual(byIrradiation, byMean, 'the 3D view is recoloured');
+  await page.locator('.results').screenshot({ path: join(ARTIFACTS, 'page-irradiation.png') });
+  await page.selectOption('#colourby', 'mean');
+
+  // Without the EPW the fields are the user's again, and a year without one has no columns.
+  await page.setInputFiles('#epw', []);
+  assert.equal(await page.evaluate(() => document.getElementById('latitude').readOnly), false);
+  await page.fill('#latitude', SETTINGS.latitude);
+  await page.fill('#longitude', SETTINGS.longitude);
+  await page.fill('#timezone', SETTINGS.timezone);
+  assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done/);
+  assert.equal(await page.locator('#table thead th:not([hidden])').count(), 3);
+  assert.equal(await page.isDisabled('#colourby option[value=irradiation]'), true);
+});
+
+test('a GPU device lost during a computation: the worker counts again on a new one, with the same result', { timeout: 600_000 }, async () => {
+  assert.match(await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb/);
+  await page.fill('#days', '14');
+  await page.fill('#perday', '9');
+  await page.selectOption('#timesteps', '1');
+  const csv = async (name) => {
+    const download = page.waitForEvent('download');
+    await page.click('#download');
+    const file = join(WORK, name);
+    await (await download).saveAs(file);
+    return parseCsv(readFileSync(file, 'utf8'));
+  };
+  // The worker's devices, as wgpu opens them (the engine is made again for a new resolution).
+  const [worker] = page.workers();
+  assert.ok(worker, 'the page runs its engine in a worker');
+  await worker.evaluate(() => {
+    self.devices = [];
+    const request = GPUAdapter.prototype.requestDevice;
+    GPUAdapter.prototype.requestDevice = async function (...args) {
+      const device = await request.apply(this, args);
+      self.devices.push(device);
+      return device;
+    };
+  });
+  await page.fill('#resolution', '80');
+  assert.match(await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000), /^Done/);
+  const clean = await csv('clean.csv');
+  assert.equal(await worker.evaluate(() => self.devices.length), 1, 'one device for the new resolution');
+
+  // Every status line, to see the notice the retry gives.
+  await page.evaluate(() => {
+    window.statuses = [];
+    new MutationObserver(() => window.statuses.push(document.getElementById('status').textContent)).observe(document.getElementById('status'), {
+      childList: true,
+      characterData: true,
+      subtree: true,
+    });
+  });
+  const done = await statusAfter(async () => {
+    await page.click('#compute');
+    await waitForStatus(/^Counting views: [1-9]/);
+    await worker.evaluate(() => self.devices.at(-1).destroy());
+  }, /^Done|^Could not/, 300_000);
+  assert.match(done, /^Done/);
+  const statuses = await page.evaluate(() => window.statuses);
+  assert.ok(statuses.some((t) => /^The GPU device failed \(.*\); counting again on a new one/.test(t)), `the retry is told: ${statuses.filter((t) => !/^Counting/.test(t))}`);
+  assert.equal(await worker.evaluate(() => self.devices.length), 2, 'a second device was opened');
+  assert.equal(await page.isHidden('#retry'), true);
+  const recovered = await csv('recovered.csv');
+  assert.deepEqual(recovered.header, clean.header);
+  let worst = 0;
+  recovered.rows.forEach((row, r) => row.slice(1).forEach((v, c) => (worst = Math.max(worst, Math.abs(Number(v) - Number(clean.rows[r][c + 1]))))));
+  console.log(`after a device loss: max |Δ| ${worst} against the uninterrupted year`);
+  assert.ok(worst <= 1e-6, `the recovered year equals the uninterrupted one (max |Δ| ${worst})`);
 });
 
 test('no request left the origin and no script error happened', () => {
