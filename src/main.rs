@@ -532,9 +532,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         if form == Hook::Scheduled {
             // EnergyPlus's own share: the Scheduled method moves annual site energy even when fed
             // EnergyPlus's own clipped fractions (README, "EnergyPlus").
-            eprintln!(
-                "note: EnergyPlus's Scheduled method itself shifts annual site energy by +0.2 to +0.5% on EnergyPlus's test files against its own clipping, with the same fractions"
-            );
+            eprintln!("note: {}", sunlit::export::hook::SCHEDULED_METHOD_NOTE);
         }
     }
     eprintln!(

@@ -529,7 +529,12 @@ fn planar_parts(tris: &[[DVec3; 3]]) -> Option<Vec<Part>> {
     for i in order {
         let t = &tris[i];
         let n = triangle_normal(t);
-        let fits = |p: &Part| n.dot(p.normal) >= cos_tol && t.iter().all(|v| (v.dot(p.normal) - p.offset).abs() <= COPLANAR_DISTANCE);
+        // A sliver (thinner than the coplanar distance) has a normal rounding decides: e.g. where a
+        // door's edge meets its wall's edge, exactly in line in world coordinates but a few µm apart
+        // once a north axis turns them. It belongs to the part its vertices lie on.
+        let sliver = is_sliver(t);
+        let on_plane = |p: &Part| t.iter().all(|v| (v.dot(p.normal) - p.offset).abs() <= COPLANAR_DISTANCE);
+        let fits = |p: &Part| (sliver || n.dot(p.normal) >= cos_tol) && on_plane(p);
         match parts.iter().position(fits) {
             Some(k) => parts[k].triangles.push(i),
             None if parts.len() == MAX_PARTS => return None,
@@ -542,6 +547,12 @@ fn planar_parts(tris: &[[DVec3; 3]]) -> Option<Vec<Part>> {
     }
     parts.sort_by_key(|p| p.triangles[0]);
     Some(parts)
+}
+
+/// Whether a triangle is thinner than [`COPLANAR_DISTANCE`] (its height over its longest side).
+fn is_sliver(t: &[DVec3; 3]) -> bool {
+    let longest = (t[1] - t[0]).length().max((t[2] - t[1]).length()).max((t[0] - t[2]).length());
+    longest > 0.0 && 2.0 * triangle_area(t) / longest < COPLANAR_DISTANCE
 }
 
 fn part_name(node: &str, k: usize, count: usize) -> String {
@@ -742,6 +753,33 @@ mod tests {
         let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
         assert_eq!(names, ["Box#1", "Box#2"]);
         assert!((s.receivers[1].area - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_sliver_belongs_to_the_plane_its_vertices_lie_on() {
+        let mut b = SceneBuilder::new();
+        // A 3 m × 1 m wall in z = 0 and a sliver 2 µm wide along its bottom edge whose middle
+        // vertex is 1 µm off the plane: its own normal is far from the wall's (rounding decides
+        // it), but it is thinner than the coplanar distance, so it is part of the wall.
+        let m = b.add_mesh(
+            "wall",
+            SourceMesh {
+                positions: vec![[0., 0., 0.], [3., 0., 0.], [3., 1., 0.], [0., 1., 0.], [1.5, -2e-6, 1e-6]],
+                indices: vec![0, 1, 2, 0, 2, 3, 0, 4, 1],
+            },
+        );
+        b.add_node(node("Wall", m, true, DMat4::IDENTITY));
+        let s = b.build().unwrap();
+        let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(names, ["Wall"]);
+        // A genuine second face (a 1 m² triangle at right angles) still splits.
+        let mut b = SceneBuilder::new();
+        let m = b.add_mesh(
+            "corner",
+            SourceMesh { positions: vec![[0., 0., 0.], [3., 0., 0.], [3., 1., 0.], [0., 0., 1.]], indices: vec![0, 1, 2, 0, 3, 1] },
+        );
+        b.add_node(node("Corner", m, true, DMat4::IDENTITY));
+        assert_eq!(b.build().unwrap().receivers.len(), 2);
     }
 
     #[test]

