@@ -188,10 +188,9 @@ impl Engine {
             let settings = given.resolve().map_err(js_error)?;
             let options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
             let (location, calendar) = (settings.location, settings.calendar);
-            let hook = match &model.energyplus {
-                Some(ep) => Some(hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error)?),
-                None => None,
-            };
+            // A model that cannot be hooked (e.g. a Version before 9.3) still has its year
+            // counted: the refusal is kept for `hookedModel`, the only call that needs the hook.
+            let hook = model.energyplus.as_ref().map(|ep| hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error));
             let mut report = |p: Progress| {
                 if signal.as_ref().is_some_and(|s| s.aborted()) {
                     return Err(Error::Cancelled);
@@ -342,7 +341,8 @@ fn daylight_means(schedule: &Schedule, location: &Location) -> Vec<f64> {
 pub struct Annual {
     schedule: Schedule,
     means: Vec<f64>,
-    hook: Option<Hook>,
+    /// The hook form, or why this model cannot be hooked (None: no EnergyPlus model).
+    hook: Option<Result<Hook, JsValue>>,
     model: Rc<ModelInner>,
     extra: embed::Extra,
 }
@@ -392,9 +392,10 @@ impl Annual {
     /// the CSV beside it as `csv_name`.
     #[wasm_bindgen(js_name = hookedModel)]
     pub fn hooked_model(&self, csv_name: &str) -> Result<String, JsValue> {
-        let (Some(ep), Some(hook)) = (&self.model.energyplus, self.hook) else {
+        let (Some(ep), Some(hook)) = (&self.model.energyplus, &self.hook) else {
             return Err(js_error(Error::argument("hookedModel", "no EnergyPlus model (.idf or .epJSON) was loaded")));
         };
+        let hook = hook.clone()?;
         let plan = HookPlan { csv: csv_name, columns: &self.schedule.names, timesteps: self.schedule.timesteps, hook };
         patch_model(ep, &plan).map_err(js_error)
     }

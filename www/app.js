@@ -156,10 +156,13 @@ function showResult(msg) {
   showInViewer();
   $('download').disabled = false;
   $('downloadidf').disabled = !msg.hooked;
+  $('downloadidf').title = msg.hookError ?? '';
   selectReceiver(state.selected >= 0 ? state.selected : 0);
   // An EPW whose hourly records cannot be read still gives fractions; say why there is no energy.
   const weather = msg.irradiationError ? ` No irradiation: ${msg.irradiationError}.` : '';
-  status(`Done in ${msg.seconds.toFixed(1)} s: ${msg.names.length} surfaces × ${msg.rows.toLocaleString()} timesteps.${weather}`, { error: !!weather });
+  // A model that cannot be hooked (e.g. too old a Version) still gets its CSV; say why no IDF.
+  const hook = msg.hookError ? ` No hooked model: ${msg.hookError}.` : '';
+  status(`Done in ${msg.seconds.toFixed(1)} s: ${msg.names.length} surfaces × ${msg.rows.toLocaleString()} timesteps.${weather}${hook}`, { error: !!(weather || hook) });
 }
 
 function showError(msg) {

@@ -118,12 +118,23 @@ async function computeOnce({ settings, resolution, csvName }) {
       timestepsPerHour: annual.timestepsPerHour,
       values,
       csv: annual.csv(),
-      hooked: m.hasEnergyPlus ? annual.hookedModel(csvName) : null,
+      ...hooked(annual, m.hasEnergyPlus, csvName),
       seconds: (performance.now() - started) / 1000,
     };
     postMessage(result, [values.buffer]);
   } finally {
     annual.free();
+  }
+}
+
+/** The EnergyPlus model with the CSV hooked in, or why it cannot be hooked (e.g. its Version is
+ * too old): the year is counted either way, only the model's download needs the hook. */
+function hooked(annual, hasEnergyPlus, csvName) {
+  if (!hasEnergyPlus) return { hooked: null, hookError: undefined };
+  try {
+    return { hooked: annual.hookedModel(csvName), hookError: undefined };
+  } catch (error) {
+    return { hooked: null, hookError: String(error?.message ?? error) };
   }
 }
 

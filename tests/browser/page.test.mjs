@@ -216,6 +216,19 @@ test('an EnergyPlus IDF loads, and the hooked IDF downloads with its CSV named',
   assert.match(text, /Scheduled/);
 });
 
+test('an EnergyPlus model too old to hook still gets its year, and the page says why there is no hooked IDF', { timeout: 300_000 }, async () => {
+  const old = join(ROOT, 'tests', 'energyplus_testfiles', '4ZoneWithShading_Simple_1_V8-4.idf');
+  const loaded = await statusAfter(() => page.setInputFiles('#model', old), /^Loaded|^Could not/);
+  assert.match(loaded, /^Loaded 4ZoneWithShading_Simple_1_V8-4\.idf \(\d+ receivers\)/);
+  await page.fill('#days', '6');
+  await page.fill('#perday', '5');
+  await page.fill('#resolution', '64');
+  const done = await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000);
+  assert.match(done, /^Done in .* No hooked model: .*Version 8\.4.*9\.3/);
+  assert.equal(await page.locator('#downloadidf').isDisabled(), true);
+  assert.equal(await page.locator('#download').isDisabled(), false);
+});
+
 test('trees shade by season: bare in winter, and evergreen keeps them', { timeout: 600_000 }, async () => {
   const trees = join(WORK, 'trees.glb');
   execFileSync('cargo', ['run', '--quiet', '--example', 'make_trees', '--', '3000', trees], { cwd: ROOT, stdio: 'inherit' });
