@@ -190,6 +190,8 @@ impl Boundary {
             if !poly.receiver && !boxes_overlap(poly.lo, poly.hi, receivers.0, receivers.1) {
                 continue;
             }
+            // The polygons near this one, once for all its edges.
+            self.collect_candidates(poly.lo, poly.hi);
             for k in poly.start..poly.end {
                 let a = self.points[k as usize];
                 let b = self.points[if k + 1 == poly.end { poly.start } else { k + 1 } as usize];
@@ -200,19 +202,18 @@ impl Boundary {
     }
 
     /// `∫ x dy` over the parts of polygon `p`'s edge `a → b` that bound the region, signed by
-    /// which side the region is on.
+    /// which side the region is on; `self.candidates` holds the polygons near `p`.
     fn edge_integral(&mut self, p: usize, a: Point, b: Point) -> f64 {
         let own = self.polys[p];
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
-        self.collect_candidates(lo, hi);
         self.events.clear();
         for c in 0..self.candidates.len() {
             let q = self.candidates[c] as usize;
-            if q == p {
+            let other = self.polys[q];
+            if q == p || !boxes_overlap(lo, hi, other.lo, other.hi) {
                 continue;
             }
-            let other = self.polys[q];
             let Some((t0, t1, side)) = cover(&self.points[other.start as usize..other.end as usize], a, b) else { continue };
             let (left, right) = if other.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
             let mut counters = match side {
@@ -295,9 +296,7 @@ impl Boundary {
                 }
             }
         }
-        // Bucket order is not push order; the counters do not depend on order, but keep it
-        // deterministic and cheap to reason about.
-        self.candidates.sort_unstable();
+        // Not in push order, but the sums do not depend on the order the counters move in.
     }
 
     /// Buckets the polygons by their boxes when there are many (else `buckets.n = 0`).
