@@ -37,7 +37,7 @@ const PROBE_EXACT_VIEWS: usize = 48;
 /// Most time the exact probe may take (s); it stops early past it.
 const PROBE_EXACT_SECONDS: f64 = 0.15;
 /// Views per GPU probe batch (a light and a heavy batch).
-const PROBE_GPU_VIEWS: usize = 32;
+const PROBE_GPU_VIEWS: usize = 16;
 /// Start-up a GPU is assumed to cost (s) before one has been measured: below this much work
 /// in total, `auto` answers everything exactly without making a device.
 const ASSUMED_GPU_STARTUP: f64 = 0.5;
@@ -143,11 +143,6 @@ impl Profile {
             Some(gpu) if gpu.of(load) < self.exact.of(load) => Route::Gpu,
             _ => Route::Exact,
         }
-    }
-
-    /// Modelled µs of all these views on the exact engine alone.
-    pub fn exact_total_us(&self, loads: &[ViewLoad]) -> f64 {
-        loads.iter().filter(|l| l.triangles > 0).map(|&l| self.exact.of(l)).sum()
     }
 }
 
@@ -416,10 +411,14 @@ impl<'a> HybridEngine<'a> {
     async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], key: String) -> Result<Profile> {
         let start = now();
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
-        let exact_cost = probe_exact(exact, requests, loads, &probe);
+        let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe);
         let mut profile = Profile { device: key, exact: exact_cost, gpu: None, gpu_startup_seconds: None };
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
-        if profile.exact_total_us(loads) / threads > 1e6 * ASSUMED_GPU_STARTUP {
+        // The probe's views are spread evenly over the sorted loads, so their mean time is the
+        // loaded views' mean (a line through them extrapolates worse: most of a view's time is
+        // its objects' shadows, not its triangles). Below a GPU's start-up for all of them, no
+        // GPU can pay for itself here: it is neither made nor probed.
+        let loaded = loads.iter().filter(|l| l.triangles > 0).count() as f64;
+        if mean_us * loaded > 1e6 * ASSUMED_GPU_STARTUP {
             let before = self.stats().gpu_startup_seconds;
             let lanes = self.gpu_lanes().await?;
             profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
@@ -450,8 +449,9 @@ fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
     loaded.into_iter().step_by(stride).collect()
 }
 
-/// Times the exact engine view by view on one thread and fits its cost line.
-fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize]) -> Cost {
+/// Times the exact engine view by view on one thread and fits its cost line; also the mean µs
+/// of a probed view (both per thread: a view costs the machine its time over the threads).
+fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize]) -> (Cost, f64) {
     let mut scratch = exact.scratch();
     let leaves_of = |i: usize| requests[i].leaves;
     // Warm caches and the scratch memory first.
@@ -471,7 +471,8 @@ fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]
     // Work spreads over every core: a view costs the machine its time over the threads.
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
     let line = fit_line(&samples);
-    Cost { per_view_us: line.per_view_us / threads, per_triangle_us: line.per_triangle_us / threads }
+    let mean_us = samples.iter().map(|(_, us)| us).sum::<f64>() / samples.len().max(1) as f64;
+    (Cost { per_view_us: line.per_view_us / threads, per_triangle_us: line.per_triangle_us / threads }, mean_us / threads)
 }
 
 /// Times a light and a heavy batch of views on the GPU lanes and fits its cost line.
