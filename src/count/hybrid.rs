@@ -146,6 +146,18 @@ impl Profile {
     }
 }
 
+/// Prism triangles up to which [`simple_route`] clips a view rather than counting its pixels.
+pub const SIMPLE_EXACT_TRIANGLES: usize = 2_000;
+
+/// `auto` without a measured profile (the web, where no probe runs): a view is clipped exactly
+/// when nothing see-through is in its prism and the prism holds at most
+/// [`SIMPLE_EXACT_TRIANGLES`] triangles (natively the exact engine answers such a view in well
+/// under a millisecond on one thread, about what one view costs a browser's GPU with its
+/// read-back); heavier views go to the GPU. A pure function of the load, so reproducible.
+pub fn simple_route(load: ViewLoad) -> Route {
+    if load.triangles == 0 || (load.see_through == 0 && load.triangles <= SIMPLE_EXACT_TRIANGLES) { Route::Exact } else { Route::Gpu }
+}
+
 /// Where the profile comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ProfileSource {
