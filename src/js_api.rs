@@ -124,8 +124,10 @@ fn literals_after(marker: &str) -> BTreeSet<String> {
 
 #[test]
 fn the_engine_names_are_the_same_on_both_sides() {
-    let rust: BTreeSet<String> =
-        [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact].iter().map(|k| EngineKind::parse(k.name()).unwrap().name().to_string()).collect();
+    let rust: BTreeSet<String> = [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact]
+        .iter()
+        .map(|k| EngineKind::parse(k.name()).unwrap().name().to_string())
+        .collect();
     assert_eq!(literals_after("  engine?: "), rust, "createEngine's option");
     assert_eq!(literals_after("  readonly engine: "), rust, "SunlitEngine.engine");
     let error = EngineKind::parse("fast").unwrap_err();

@@ -13,11 +13,12 @@
 //!   device is made;
 //! - routing depends only on the loads and the profile, never on timing during the run, so the
 //!   same inputs with the same profile give the same answers byte for byte. The profile is
-//!   measured once per device (a probe of both engines on the model's own views, a few hundred
-//!   ms), kept in a cache file keyed by adapter, driver, resolution, cores and the scene's size, and can be pinned
+//!   measured once per device (a probe of the exact engine on the model's own views, a few ms,
+//!   and of the GPU only where the exact engine's estimate exceeds a GPU's start-up), kept in a cache file keyed by adapter, driver, resolution, cores and the scene's size, and can be pinned
 //!   with a profile file of its own;
 //! - both engines run at once: natively the exact views on every core's threads while the GPU
-//!   lanes count theirs; on the web one after the other (one thread).
+//!   lanes count theirs; on the web one after the other (one thread), routed by
+//!   [`simple_route`] since no probe runs there.
 
 use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
