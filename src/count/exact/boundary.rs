@@ -35,6 +35,9 @@ const HALF: f64 = (1u64 << 29) as f64;
 const SCAN_ALL: usize = 48;
 /// Most buckets along one side of the grid.
 const MAX_BUCKETS: usize = 64;
+/// A polygon over more buckets than this (a receiver triangle, a wall's shadow) is kept out of
+/// them and tested by its box alone: in every bucket it would be met again by every query.
+const BIG_SPAN: usize = 16;
 
 type Point = [i64; 2];
 
@@ -113,14 +116,16 @@ pub(super) struct Boundary {
     /// Candidates of the current edge.
     candidates: Vec<u32>,
     buckets: Buckets,
+    /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
+    big: Vec<u32>,
 }
 
-/// The bucket grid: `n × n` cells of `size` grid units from `origin`.
+/// The bucket grid: `n × n` cells of `size` grid units (per axis) from `origin`.
 #[derive(Debug, Default, Clone, Copy)]
 struct Buckets {
     n: usize,
     origin: Point,
-    size: i64,
+    size: Point,
 }
 
 impl Boundary {
@@ -280,6 +285,13 @@ impl Boundary {
             self.stamp.fill(0);
             self.epoch = 1;
         }
+        for k in 0..self.big.len() {
+            let q = self.big[k];
+            let poly = &self.polys[q as usize];
+            if boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                self.candidates.push(q);
+            }
+        }
         let (c0, c1) = (b.cell(lo), b.cell(hi));
         for cy in c0[1]..=c1[1] {
             for cx in c0[0]..=c1[0] {
@@ -309,13 +321,18 @@ impl Boundary {
         let lo = self.polys.iter().fold([i64::MAX; 2], |m, p| [m[0].min(p.lo[0]), m[1].min(p.lo[1])]);
         let hi = self.polys.iter().fold([i64::MIN; 2], |m, p| [m[0].max(p.hi[0]), m[1].max(p.hi[1])]);
         let side = ((n as f64).sqrt().ceil() as usize).clamp(1, MAX_BUCKETS);
-        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(1);
-        let buckets = Buckets { n: side, origin: lo, size: extent / side as i64 + 1 };
+        let size = |k: usize| (hi[k] - lo[k]).max(1) / side as i64 + 1;
+        let buckets = Buckets { n: side, origin: lo, size: [size(0), size(1)] };
         self.buckets = buckets;
         self.cell_start.clear();
         self.cell_start.resize(side * side + 1, 0);
-        for p in &self.polys {
+        self.big.clear();
+        for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+                self.big.push(i as u32);
+                continue;
+            }
             for cy in c0[1]..=c1[1] {
                 for cx in c0[0]..=c1[0] {
                     self.cell_start[cy * side + cx + 1] += 1;
@@ -333,6 +350,9 @@ impl Boundary {
         next.extend_from_slice(&self.cell_start[..side * side]);
         for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+                continue;
+            }
             for cy in c0[1]..=c1[1] {
                 for cx in c0[0]..=c1[0] {
                     let cell = cy * side + cx;
@@ -348,7 +368,7 @@ impl Boundary {
 impl Buckets {
     /// The cell holding grid point `p` (clamped to the grid of cells).
     fn cell(&self, p: Point) -> [usize; 2] {
-        let c = |k: usize| (((p[k] - self.origin[k]) / self.size).max(0) as usize).min(self.n - 1);
+        let c = |k: usize| (((p[k] - self.origin[k]) / self.size[k]).max(0) as usize).min(self.n - 1);
         [c(0), c(1)]
     }
 }
@@ -593,7 +613,7 @@ mod tests {
 
     #[test]
     fn many_shadows_use_buckets_and_agree() {
-        // Leaves: 600 small shadows, some overlapping, some identical.
+        // Leaves: 600 small shadows, some overlapping, some identical, and two wide ones.
         let mut rng = Rng(7);
         let mut shadows = Vec::new();
         for _ in 0..600 {
@@ -601,6 +621,9 @@ mod tests {
             let r = 0.125 * (1 + rng.below(3)) as f64;
             shadows.push(vec![c + DVec2::new(-r, 0.), c + DVec2::new(0., -r), c + DVec2::new(r, 0.), c + DVec2::new(0., r)]);
         }
+        // A few wide shadows among them (a branch, a wall's): kept out of the buckets.
+        shadows.insert(100, square(-0.5, 0.25, 4.5, 0.5));
+        shadows.push(tri([[-1., 1.0], [5., 1.2], [-1., 1.4]]));
         let receiver = holed_wall();
         let got = assert_agrees(&receiver, &shadows, "leaves");
         assert!(got > 0.0 && got < 1.0, "{got}");
