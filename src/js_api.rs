@@ -5,6 +5,7 @@
 
 use std::collections::BTreeSet;
 
+use crate::count::hybrid::EngineKind;
 use crate::error::{Error, GpuError, NoReceivers};
 use crate::year::settings::AnnualSettings;
 
@@ -112,4 +113,23 @@ fn the_error_codes_are_the_same_on_both_sides() {
     let gpu: BTreeSet<String> = every_gpu_error().iter().map(|e| e.code().to_string()).collect();
     assert_eq!(union(body, "gpu"), gpu);
     assert_eq!(fields(body), ["code", "file", "gpu", "object", "option"].map(String::from).into());
+}
+
+/// The string literals after the first `marker` in the file, up to its `;`.
+fn literals_after(marker: &str) -> BTreeSet<String> {
+    let start = DTS.find(marker).unwrap_or_else(|| panic!("no {marker} in sunlit.d.ts"));
+    let rest = &DTS[start..];
+    rest[..rest.find(';').unwrap()].split('\'').skip(1).step_by(2).map(str::to_string).collect()
+}
+
+#[test]
+fn the_engine_names_are_the_same_on_both_sides() {
+    let rust: BTreeSet<String> = [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact]
+        .iter()
+        .map(|k| EngineKind::parse(k.name()).unwrap().name().to_string())
+        .collect();
+    assert_eq!(literals_after("  engine?: "), rust, "createEngine's option");
+    assert_eq!(literals_after("  readonly engine: "), rust, "SunlitEngine.engine");
+    let error = EngineKind::parse("fast").unwrap_err();
+    assert_eq!((error.code(), error.parameter()), ("bad-option", Some("engine")));
 }

@@ -12,13 +12,16 @@
 
 use std::rc::Rc;
 
+mod choice;
 mod embed;
 
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
+use crate::count::exact::engine::ExactEngine;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::count::hybrid::EngineKind;
 use crate::count::lanes::Lane;
 use crate::count::{Engine as _, ViewRequest};
 use crate::error::{Error, Result};
@@ -29,7 +32,7 @@ use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmitt
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
-use crate::year::annual::{Progress, annual_fitted};
+use crate::year::annual::{Progress, annual_fitted_with};
 use crate::year::settings::AnnualSettings;
 
 /// A library error as a JS `Error` whose message names the file, object or option (as the JS API
@@ -80,18 +83,28 @@ pub fn js_option(param: &str) -> String {
 #[wasm_bindgen]
 pub struct Engine {
     counter: Rc<Counter>,
+    /// Which engine answers views (`auto`, `gpu`, `exact`; see [`choice`]).
+    kind: EngineKind,
 }
 
 #[wasm_bindgen]
 impl Engine {
     /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512);
     /// `accuracy`: a target |error| per view, counting each at 64² first and finer, up to
-    /// `resolution`, only where its shadow edges need it (default: every view at `resolution`).
-    pub async fn create(resolution: Option<u32>, accuracy: Option<f64>) -> Result<Engine, JsValue> {
+    /// `resolution`, only where its shadow edges need it (default: every view at `resolution`);
+    /// `engine`: `auto` (default), `gpu` or `exact` ([`choice`]).
+    pub async fn create(resolution: Option<u32>, accuracy: Option<f64>, engine: Option<String>) -> Result<Engine, JsValue> {
+        let kind = engine.as_deref().map_or(Ok(EngineKind::Auto), EngineKind::parse).map_err(js_error)?;
         let options =
             CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), accuracy, ..Default::default() };
         let counter = Counter::new(options).await.map_err(js_error)?;
-        Ok(Engine { counter: Rc::new(counter) })
+        Ok(Engine { counter: Rc::new(counter), kind })
+    }
+
+    /// Which engine answers views: `auto`, `gpu` or `exact`.
+    #[wasm_bindgen(getter)]
+    pub fn engine(&self) -> String {
+        self.kind.name().into()
     }
 
     /// The adapter's name and backend, for the page's status line.
@@ -157,13 +170,13 @@ impl Engine {
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
         let gpu = self.counter.upload(&scene).map_err(js_error)?;
-        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes }) })
+        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default() }) })
     }
 
     /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
     /// direction: a unit vector towards the sun, x east, y north, z up.
     pub fn fractions(&self, model: &Model, sun_x: f64, sun_y: f64, sun_z: f64) -> Promise {
-        let (counter, model) = (self.counter.clone(), model.inner.clone());
+        let (counter, model, kind) = (self.counter.clone(), model.inner.clone(), self.kind);
         future_to_promise(async move {
             let sun = glam::DVec3::new(sun_x, sun_y, sun_z);
             if !sun.is_finite() || sun.length() < 1e-9 {
@@ -172,7 +185,7 @@ impl Engine {
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
                 (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
-            let answers = Lane { counter: &counter, gpu: &model.gpu }.answer(&requests).await.map_err(js_error)?;
+            let answers = model.chosen(kind, &counter).answer(&requests).await.map_err(js_error)?;
             let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
         })
@@ -182,7 +195,7 @@ impl Engine {
     /// [`AnnualSettings`]); `progress(done, total)` is called as views are counted; an aborted
     /// `signal` rejects the promise with an `Error` whose `code` is `cancelled`.
     pub fn annual(&self, model: &Model, settings: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
-        let (counter, model) = (self.counter.clone(), model.inner.clone());
+        let (counter, model, kind) = (self.counter.clone(), model.inner.clone(), self.kind);
         future_to_promise(async move {
             let given = settings_from_js(&settings).map_err(js_error)?;
             let settings = given.resolve().map_err(js_error)?;
@@ -202,7 +215,9 @@ impl Engine {
                 Ok(())
             };
             let (schedule, fitted) =
-                annual_fitted(&counter, &model.gpu, &model.scene, &location, &options, &calendar, &mut report).await.map_err(js_error)?;
+                annual_fitted_with(&model.chosen(kind, &counter), &model.scene, &location, &options, &calendar, &mut report)
+                    .await
+                    .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
             let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
             let extra = embed::Extra::new(&model.scene, &schedule, &location, epw, fitted);
@@ -228,6 +243,15 @@ struct ModelInner {
     energyplus: Option<EnergyPlusInput>,
     /// What loading chose that the user should hear (e.g. many default receivers).
     notes: Vec<String>,
+    /// The exact engine over `scene`, made when a view is first routed to it.
+    exact: std::cell::OnceCell<ExactEngine>,
+}
+
+impl ModelInner {
+    /// The engine `kind` over this model, on `counter`'s device.
+    fn chosen<'a>(&'a self, kind: EngineKind, counter: &'a Counter) -> choice::Chosen<'a> {
+        choice::Chosen { kind, scene: &self.scene, exact: &self.exact, lane: Lane { counter, gpu: &self.gpu } }
+    }
 }
 
 #[wasm_bindgen]

@@ -114,7 +114,7 @@ async fn adaptive_webgpu_counts_meet_their_accuracy() {
 
 #[wasm_bindgen_test]
 async fn the_page_bindings_give_the_analytic_overhang_shadow() {
-    let engine = Engine::create(Some(512), None).await.map_err(|e| format!("{e:?}")).unwrap();
+    let engine = Engine::create(Some(512), None, Some("gpu".into())).await.map_err(|e| format!("{e:?}")).unwrap();
     let (positions, indices, receivers, names) = arrays();
     let model = engine.from_arrays(&positions, &indices, &receivers, names, false).map_err(|e| format!("{e:?}")).unwrap();
     for altitude in [20.0f64, 35.0, 50.0] {
@@ -125,6 +125,44 @@ async fn the_page_bindings_give_the_analytic_overhang_shadow() {
         let analytic = (1.0 - DEPTH * altitude.to_radians().tan() / HEIGHT).clamp(0.0, 1.0);
         assert!((fractions[0] - analytic).abs() < 0.005, "altitude {altitude}: {:.4} vs analytic {analytic:.4}", fractions[0]);
     }
+}
+
+/// `createEngine({ engine })`: the exact engine (one thread in the wasm), the GPU and `auto`
+/// give the same fractions (the GPU within its pixels' tolerance), the exact one the reference's;
+/// another name is refused naming the option.
+#[wasm_bindgen_test]
+async fn the_engine_option_picks_exact_gpu_or_auto_and_they_agree() {
+    let (positions, indices, receivers, names) = arrays();
+    let scene = scene();
+    let suns = [sun(180.0, 35.0), sun(120.0, 20.0), sun(240.0, 50.0)];
+    let mut answers = Vec::new();
+    for kind in ["exact", "gpu", "auto"] {
+        let engine = Engine::create(Some(512), None, Some(kind.into())).await.map_err(|e| format!("{e:?}")).unwrap();
+        assert_eq!(engine.engine(), kind);
+        let model = engine.from_arrays(&positions, &indices, &receivers, names.clone(), false).map_err(|e| format!("{e:?}")).unwrap();
+        let mut fractions = Vec::new();
+        for s in suns {
+            let promise = engine.fractions(&model, s.x, s.y, s.z);
+            fractions.extend(js_sys::Float64Array::new(&JsFuture::from(promise).await.unwrap()).to_vec());
+        }
+        answers.push(fractions);
+    }
+    let requests: Vec<ViewRequest> = suns.iter().flat_map(|&s| (0..2).map(move |r| ViewRequest::new(r, s))).collect();
+    let reference = exact::sunlit_fractions(&scene, &requests);
+    for (i, r) in reference.iter().enumerate() {
+        assert!((answers[0][i] - r).abs() < 1e-6, "exact {i}: {} vs reference {r}", answers[0][i]);
+        assert!((answers[1][i] - r).abs() < 0.005, "gpu {i}: {} vs reference {r}", answers[1][i]);
+        // The light views of this small scene are all clipped under `auto`'s rule.
+        assert!((answers[2][i] - r).abs() < 1e-6, "auto {i}: {} vs reference {r}", answers[2][i]);
+    }
+    let error = match Engine::create(Some(512), None, Some("fastest".into())).await {
+        Ok(_) => panic!("an unknown engine was accepted"),
+        Err(e) => e,
+    };
+    let get = |key: &str| js_sys::Reflect::get(&error, &key.into()).unwrap().as_string();
+    assert_eq!(get("code").as_deref(), Some("bad-option"));
+    assert_eq!(get("option").as_deref(), Some("engine"));
+    assert!(get("message").unwrap().contains("fastest"), "{:?}", get("message"));
 }
 
 #[wasm_bindgen_test]

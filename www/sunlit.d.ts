@@ -48,6 +48,12 @@ export function createEngine(options?: {
   /** A GPUDevice the caller holds (e.g. its WebGPU renderer's): sunlit counts on it and never
    * destroys it; its loss is reported as a "GPU device lost" error. */
   device?: GPUDevice;
+  /** Which engine answers views (default 'auto'). 'gpu': pixels on WebGPU. 'exact': polygon
+   * clipping in the wasm, on one thread, no resolution error (see-through geometry counts as
+   * opaque). 'auto': per view, clipping when the view's prism holds nothing see-through and at
+   * most 2,000 triangles, else pixels; a fixed rule (no timing), so answers are reproducible.
+   * Another value rejects with code 'bad-option', option 'engine'. */
+  engine?: 'auto' | 'gpu' | 'exact';
 }): Promise<SunlitEngine>;
 
 /** An EPW weather file's LOCATION record (throws naming `name` and the reason). */
@@ -150,6 +156,8 @@ export interface SunlitEngine {
   readonly adapter: string;
   /** Pixels along a view's side. */
   readonly resolution: number;
+  /** Which engine answers views (createEngine's `engine`). */
+  readonly engine: 'auto' | 'gpu' | 'exact';
   /** Reads model files; throws a SunlitError naming the file, object and reason when one is bad. */
   loadFiles(files: ModelFile[], options?: LoadOptions): Model;
   /** Builds a model from typed arrays; throws a SunlitError naming the array and element when bad. */

@@ -39,13 +39,14 @@ function coded(message, code, names = {}) {
 }
 
 /** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps).
- * Rejects with code 'no-webgpu' where WebGPU is missing. */
-export async function createEngine({ resolution, accuracy, device } = {}) {
+ * `engine`: 'auto' (default), 'gpu' or 'exact' (sunlit.d.ts). Rejects with code 'no-webgpu'
+ * where WebGPU is missing, 'bad-option' (option 'engine') for another engine name. */
+export async function createEngine({ resolution, accuracy, device, engine } = {}) {
   if (!hasWebGPU()) {
     throw coded('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).', 'no-webgpu');
   }
   await ready();
-  const open = () => Engine.create(resolution, accuracy);
+  const open = () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine));
   return new SunlitEngine(device === undefined ? await open() : await onDevice(device, open));
 }
 
@@ -81,6 +82,11 @@ class SunlitEngine {
   /** Pixels along a view's side. */
   get resolution() {
     return this.#engine.resolution;
+  }
+
+  /** Which engine answers views: 'auto', 'gpu' or 'exact'. */
+  get engine() {
+    return this.#engine.engine;
   }
 
   /** A model from files: [{ name, bytes }]; glb, gltf (+ its .bin files), IDF or epJSON. */

@@ -12,21 +12,19 @@
 //! - natively, views are spread over every core (threads take chunks of views in turn); a view's
 //!   answer depends only on the view, never on the thread that computed it.
 //!
-//! The boolean step is the reference's: one i_overlay graph on an integer grid fitted to the
-//! view's own polygons (32-bit here, see [`Grid`]), receiver minus the union of the shadows,
-//! areas from that graph.
+//! The boolean step is not the reference's overlay graph: every polygon here is convex (receiver
+//! triangles, clipped triangles, hulls), so [`super::boundary`] integrates `x dy` along the parts of
+//! their edges that bound `receiver − ∪ shadows`, on a 2^30 integer grid fitted to the
+//! receiver's window with exact orientation tests. It needs no graph, no sorting of segments
+//! and no allocation, and it stays within ~1e-9 of the reference.
 
 use std::ops::Range;
 
 use glam::{DVec2, DVec3};
-use i_overlay::core::extract::BooleanExtractionBuffer;
-use i_overlay::core::fill_rule::FillRule;
-use i_overlay::core::overlay_rule::OverlayRule;
-use i_overlay::core::solver::Solver;
-use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
 
+use super::boundary::{Boundary, Snap};
 use super::objects::{self, MeshObjects};
-use super::{AREA_EPS, Contour, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN, shapes_area};
+use super::{AREA_EPS, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN};
 use crate::count::cull::{CPU_LEAF_TRIANGLES, Culling};
 use crate::count::{ViewRequest, is_dark, view};
 use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
@@ -36,19 +34,17 @@ use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
 const PRISM_SIDE: u32 = 512;
 /// Views a thread takes at a time.
 const CHUNK: usize = 16;
-/// The overlay's integer grid. The reference's 64-bit grid spends most of its time in 128-bit
-/// products (a profile of `blaas-louvres`: a quarter of all samples in one wide division); 32
-/// bits over a receiver's window still resolve a part in 10⁹ of its size; fractions stay within
-/// ~1e-7 of the reference (7e-8 at most over 299 `blaas-louvres` views), far below any
-/// tolerance they are held to, at a fifth of the cost.
-type Grid = i32;
 /// No object: the triangle casts its own shadow.
 const NO_OBJECT: u32 = u32::MAX;
 
 /// A receiver as the engine needs it, made once: its plane frame's axes and its 2D outline.
 struct Outline {
-    /// The receiver's triangles as counter-clockwise contours in its plane frame.
-    lit: Vec<Contour>,
+    /// The receiver's triangles in its plane frame, snapped to its grid.
+    lit: Vec<[[i64; 2]; 3]>,
+    /// The grid over its window (a receiver's window does not depend on the sun).
+    snap: Snap,
+    /// Area of the union of its triangles, grid units².
+    whole: f64,
     bounds: Rect,
     window: Rect,
     /// Its vertices (world), for the view's clip volume.
@@ -91,11 +87,10 @@ pub struct Scratch {
     hull: Vec<DVec2>,
     window_a: Vec<DVec2>,
     window_b: Vec<DVec2>,
-    /// The view's shadows, flattened, and each one's range.
-    shadow_points: Vec<[f64; 2]>,
-    shadows: Vec<Range<usize>>,
-    overlay: FloatOverlay<[f64; 2], Grid>,
-    buffer: BooleanExtractionBuffer<Grid>,
+    /// Shadows cast in this view.
+    shadows: usize,
+    /// The receiver's triangles and the view's shadows on the grid.
+    boundary: Boundary,
 }
 
 /// What a view costs the exact engine, known before clipping: from the BVH walk alone.
@@ -173,7 +168,6 @@ impl ExactEngine {
 
     /// Fresh scratch memory for one thread.
     pub fn scratch(&self) -> Scratch {
-        let options: OverlayOptions<f64, Grid> = OverlayOptions::default();
         Scratch {
             stamp: vec![0; self.objects.len()],
             epoch: 0,
@@ -183,10 +177,8 @@ impl ExactEngine {
             hull: Vec::new(),
             window_a: Vec::new(),
             window_b: Vec::new(),
-            shadow_points: Vec::new(),
-            shadows: Vec::new(),
-            overlay: FloatOverlay::new_empty(options, Solver::default(), 64),
-            buffer: BooleanExtractionBuffer::default(),
+            shadows: 0,
+            boundary: Boundary::default(),
         }
     }
 
@@ -250,8 +242,11 @@ impl ExactEngine {
             scratch.stamp.fill(0);
             scratch.epoch = 1;
         }
-        scratch.shadow_points.clear();
-        scratch.shadows.clear();
+        scratch.shadows = 0;
+        scratch.boundary.clear();
+        for t in &outline.lit {
+            scratch.boundary.push_points(t, true);
+        }
         self.culling.visit_triangles(&view.view_proj, |range| {
             for p in range {
                 if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
@@ -311,35 +306,25 @@ impl ExactEngine {
         if area.abs() <= self.area_eps {
             return;
         }
-        let start = s.shadow_points.len();
-        if area > 0.0 {
-            s.shadow_points.extend(polygon.iter().map(|p| p.to_array()));
-        } else {
-            s.shadow_points.extend(polygon.iter().rev().map(|p| p.to_array()));
-        }
-        s.shadows.push(start..s.shadow_points.len());
+        s.boundary.push(&outline.snap, polygon, false);
+        s.shadows += 1;
     }
 
     /// `area(receiver − ∪ shadows) / area(∪ receiver)`, as the reference computes it.
     fn sunlit_ratio(&self, outline: &Outline, s: &mut Scratch) -> f64 {
-        if outline.lit.is_empty() {
+        let area_eps = self.area_eps * outline.snap.area_scale();
+        if outline.whole <= area_eps {
             return 0.0;
         }
-        if s.shadows.is_empty() {
+        if s.shadows == 0 {
             return 1.0;
         }
-        let shadows: Vec<&[[f64; 2]]> = s.shadows.iter().map(|r| &s.shadow_points[r.clone()]).collect();
-        s.overlay.reinit_with_subj_and_clip(outline.lit.as_slice(), shadows.as_slice());
-        let Some(graph) = s.overlay.build_graph_view(FillRule::NonZero) else { return 0.0 };
-        let whole = shapes_area(&graph.extract_shapes(OverlayRule::Subject, &mut s.buffer));
-        if whole <= self.area_eps {
+        let lit = s.boundary.uncovered_area();
+        // A lit area below the noise level is none (as in the reference).
+        if lit <= area_eps {
             return 0.0;
         }
-        let lit = shapes_area(&graph.extract_shapes(OverlayRule::Difference, &mut s.buffer));
-        if lit <= self.area_eps {
-            return 0.0;
-        }
-        (lit / whole).clamp(0.0, 1.0)
+        (lit / outline.whole).clamp(0.0, 1.0)
     }
 }
 
@@ -387,13 +372,30 @@ fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>
     (ranges, out)
 }
 
-/// The receiver's outline in its frame: counter-clockwise triangles, bounds and the window
-/// shadows are clipped to (as in the reference).
+/// The receiver's outline in its frame: its triangles on the grid of its window, their union's
+/// area, bounds and the window shadows are clipped to (as in the reference).
 fn outline(r: &crate::scene::Receiver, frame: &PlaneFrame, eps: f64) -> Option<Outline> {
-    let lit: Vec<Contour> = r.triangles.iter().filter_map(|t| frame.receiver_contour(t)).collect();
-    let bounds = Rect::around(lit.iter().flatten().map(|&[x, y]| DVec2::new(x, y)))?;
+    let flat: Vec<Vec<DVec2>> =
+        r.triangles.iter().filter_map(|t| frame.receiver_contour(t)).map(|c| c.iter().map(|&p| DVec2::from(p)).collect()).collect();
+    let bounds = Rect::around(flat.iter().flatten().copied())?;
     let window = bounds.expanded(WINDOW_MARGIN * bounds.size().length() + eps);
-    Some(Outline { lit, bounds, window, points: r.triangles.iter().flatten().copied().collect(), normal: r.normal, gpu_id: r.gpu_id })
+    let snap = Snap::new(window.min, window.max)?;
+    let lit: Vec<[[i64; 2]; 3]> = flat.iter().filter_map(|t| Boundary::snapped(&snap, t).try_into().ok()).collect();
+    let mut whole = Boundary::default();
+    for t in &lit {
+        whole.push_points(t, true);
+    }
+    let whole = whole.uncovered_area();
+    Some(Outline {
+        lit,
+        snap,
+        whole,
+        bounds,
+        window,
+        points: r.triangles.iter().flatten().copied().collect(),
+        normal: r.normal,
+        gpu_id: r.gpu_id,
+    })
 }
 
 /// Appends the projections of the part of `tri` in front of the plane to `flat` (nothing when

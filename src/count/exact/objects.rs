@@ -23,8 +23,15 @@ use glam::{DVec2, DVec3};
 pub(super) const MAX_CONVEX_TRIANGLES: usize = 64;
 /// Relative tolerance (of the object's size) of the convexity and flatness tests.
 const CONVEX_TOLERANCE: f64 = 1e-9;
+/// Tolerance of the same tests relative to the object's largest coordinate: positions are `f32`,
+/// and a box whose faces were written each with its own corners (`lo + x + y` on one face,
+/// `lo + y + x − …` on another) has corners that differ in the last bits. Within this many
+/// `f32` roundings two corners are one, and a face may bend that much and still count as flat:
+/// the hull's shadow then differs from the triangles' by slivers far thinner than the model's
+/// own precision.
+const F32_ROUNDINGS: f64 = 16.0 * f32::EPSILON as f64;
 /// Relative difference allowed between a flat object's area and its hull's.
-const FLAT_AREA_TOLERANCE: f64 = 1e-9;
+const FLAT_AREA_TOLERANCE: f64 = 1e-6;
 
 /// A mesh's triangles grouped into objects.
 #[derive(Debug, Default)]
@@ -96,13 +103,26 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
 pub(super) fn is_convex(tris: &[[DVec3; 3]]) -> bool {
     let points: Vec<DVec3> = tris.iter().flatten().copied().collect();
     let Some(size) = extent(&points) else { return false };
-    let tol = CONVEX_TOLERANCE * size.max(f64::MIN_POSITIVE);
-    // Edges by their endpoints' bits, undirected: how many triangles use each.
-    let mut uses: HashMap<([u64; 3], [u64; 3]), u32> = HashMap::new();
+    let magnitude = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let tol = (CONVEX_TOLERANCE * size).max(F32_ROUNDINGS * magnitude).max(f64::MIN_POSITIVE);
+    // Corners within `tol` of each other are one (welded to the first seen).
+    let mut corners: Vec<DVec3> = Vec::new();
+    let mut corner = |p: DVec3| -> usize {
+        corners.iter().position(|c| (*c - p).abs().max_element() <= tol).unwrap_or_else(|| {
+            corners.push(p);
+            corners.len() - 1
+        })
+    };
+    // Edges by their welded corners, undirected: how many triangles use each.
+    let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
     for t in tris {
+        let c = t.map(&mut corner);
         for k in 0..3 {
-            let (a, b) = (t[k].to_array().map(f64::to_bits), t[(k + 1) % 3].to_array().map(f64::to_bits));
-            *uses.entry(if a < b { (a, b) } else { (b, a) }).or_insert(0) += 1;
+            let (a, b) = (c[k], c[(k + 1) % 3]);
+            if a == b {
+                return false;
+            }
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
         }
     }
     if uses.values().any(|&u| u > 2) {
@@ -213,6 +233,35 @@ mod tests {
         // the shared face left inside, edges are used more than twice.
         let shifted: Vec<[DVec3; 3]> = cube.iter().map(|t| t.map(|p| p + DVec3::X)).collect();
         assert!(!is_convex(&[cube.clone(), shifted].concat()));
+    }
+
+    #[test]
+    fn a_box_whose_faces_round_their_corners_apart_is_still_convex() {
+        // A slat written face by face in f32 (as the bench's generator does): corners reached
+        // along different sums differ in their last bits, so no edge matches bit for bit.
+        let (lo, size) = ([-0.1f32, -0.45, 0.0], [6.2f32, 0.25, 0.02]);
+        let mut tris: Vec<[DVec3; 3]> = Vec::new();
+        for (k, t) in cube().iter().enumerate() {
+            tris.push(t.map(|p| {
+                let q: [f32; 3] = std::array::from_fn(|i| {
+                    let v = lo[i] + size[i] * p[i] as f32;
+                    // Every other face nudges its corners by one f32 step.
+                    if k % 4 < 2 { v } else { f32::from_bits(v.to_bits() + 1) }
+                });
+                DVec3::from_array(q.map(f64::from))
+            }));
+        }
+        assert!(is_convex(&tris));
+        // A real dent is still seen: one corner pushed 1 mm into the slat.
+        let mut dented = tris.clone();
+        for t in &mut dented {
+            for p in t.iter_mut() {
+                if p.z > 0.01 && p.x > 6.0 && p.y > -0.25 {
+                    p.z -= 0.001;
+                }
+            }
+        }
+        assert!(!is_convex(&dented));
     }
 
     #[test]

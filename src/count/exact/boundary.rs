@@ -1,0 +1,636 @@
+//! The fast exact engine's boolean step: `area(receiver − ∪ shadows)` when every polygon is
+//! convex, by integrating along the boundary instead of building an overlay graph.
+//!
+//! Owns the integer grid a receiver's polygons are snapped to ([`Snap`]) and the area of the
+//! region that is inside some *receiver* polygon and inside no *shadow* polygon. It is not a
+//! general polygon boolean: it returns an area, never a shape, and needs convex polygons (the
+//! engine's shadows are convex hulls, clipped triangles and receiver triangles).
+//!
+//! How: by Green's theorem the area of a region is `∮ x dy` over its boundary, and every piece of
+//! that boundary lies on some polygon's edge. So for every edge of every polygon the parameter
+//! interval where each other (convex) polygon covers it is found by clipping the segment against
+//! that polygon's half-planes; between those intervals' ends, whether the region lies on the
+//! edge's left and on its right is known, and `(left − right) · ∫ x dy` is added. A segment
+//! where several edges lie on one line (shared or overlapping edges) is counted once, for the
+//! polygon pushed first: a polygon with an edge on the same line covers only that edge's left
+//! or right side there, and a segment lying on an earlier polygon's edge is that edge's to count.
+//!
+//! Robustness is the integer grid's, as in the reference: vertices are snapped to integers (a
+//! 2^30 grid over the receiver's window), each snapped polygon is made convex again (an exact
+//! hull), and every inside, outside or on-the-line decision is an exact `i64` orientation test.
+//! Only where a segment crosses a line is computed in `f64`, so rounding can move a crossing
+//! along its segment by an ulp, never change which polygons cover which side of it.
+//!
+//! Cost: each edge is tested only against polygons whose bounding boxes overlap its own (all of
+//! them when there are few, a uniform grid of buckets when there are many, as leaves give), so a
+//! view with `n` shadows of bounded overlap costs about `n` times their edges.
+
+use glam::DVec2;
+
+/// Half the grid's side: snapped coordinates lie in `[−HALF, HALF]`, so differences stay below
+/// 2^30, products below 2^60 and orientation determinants below 2^61, inside `i64`.
+const HALF: f64 = (1u64 << 29) as f64;
+/// Up to this many polygons every edge is tested against all of them (a bounding-box check is
+/// cheaper than building buckets); above, a grid of buckets.
+const SCAN_ALL: usize = 48;
+/// Most buckets along one side of the grid.
+const MAX_BUCKETS: usize = 64;
+/// A polygon over more buckets than this (a receiver triangle, a wall's shadow) is kept out of
+/// them and tested by its box alone: in every bucket it would be met again by every query.
+const BIG_SPAN: usize = 16;
+
+type Point = [i64; 2];
+
+/// Maps a receiver's window onto the integer grid: its centre to 0, its longer half-side to
+/// [`HALF`].
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Snap {
+    center: DVec2,
+    scale: f64,
+}
+
+impl Snap {
+    /// `None` for an empty or non-finite window.
+    pub(super) fn new(min: DVec2, max: DVec2) -> Option<Self> {
+        let half = 0.5 * (max - min).max_element();
+        let scale = HALF / half;
+        (half > 0.0 && scale.is_finite() && min.is_finite() && max.is_finite()).then_some(Self { center: 0.5 * (min + max), scale })
+    }
+
+    /// Grid units² per unit² of the plane.
+    pub(super) fn area_scale(&self) -> f64 {
+        self.scale * self.scale
+    }
+
+    /// The nearest grid point (clamped to the grid: polygons are clipped to the window first, so
+    /// only rounding reaches past it).
+    fn point(&self, p: DVec2) -> Point {
+        let q = ((p - self.center) * self.scale).clamp(DVec2::splat(-HALF), DVec2::splat(HALF)).round();
+        [q.x as i64, q.y as i64]
+    }
+}
+
+/// A polygon's vertices (a range of [`Boundary::points`]), bounding box and role.
+#[derive(Debug, Clone, Copy)]
+struct Poly {
+    start: u32,
+    end: u32,
+    lo: Point,
+    hi: Point,
+    receiver: bool,
+}
+
+/// How a convex polygon covers an edge over a parameter interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Side {
+    /// Both sides: the interval runs through the polygon's interior.
+    Both,
+    /// Only the edge's left (the polygon has an edge on the same line, in the same direction).
+    Left,
+    /// Only the edge's right (an edge on the same line, in the opposite direction).
+    Right,
+}
+
+/// Counters an interval moves while sweeping one edge.
+const RECEIVER_LEFT: u8 = 1;
+const RECEIVER_RIGHT: u8 = 2;
+const SHADOW_LEFT: u8 = 4;
+const SHADOW_RIGHT: u8 = 8;
+const EARLIER_EDGE: u8 = 16;
+
+/// The polygons of one view and the memory to integrate them, reused from view to view.
+#[derive(Debug, Default)]
+pub(super) struct Boundary {
+    points: Vec<Point>,
+    polys: Vec<Poly>,
+    /// Scratch for snapping one polygon and taking its hull.
+    snapped: Vec<Point>,
+    /// One edge's interval ends: parameter, counters, +1 or −1.
+    events: Vec<(f64, u8, i8)>,
+    /// Buckets: per cell its range of `cell_items` (prefix sums), the polygons in each cell.
+    cell_start: Vec<u32>,
+    cell_items: Vec<u32>,
+    /// Per polygon: the edge that last tested it (so a polygon in several cells is tested once).
+    stamp: Vec<u32>,
+    epoch: u32,
+    /// Candidates of the current edge.
+    candidates: Vec<u32>,
+    buckets: Buckets,
+    /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
+    big: Vec<u32>,
+}
+
+/// The bucket grid: `n × n` cells of `size` grid units (per axis) from `origin`.
+#[derive(Debug, Default, Clone, Copy)]
+struct Buckets {
+    n: usize,
+    origin: Point,
+    size: Point,
+}
+
+impl Boundary {
+    /// Forgets the polygons (keeps the memory).
+    pub(super) fn clear(&mut self) {
+        self.points.clear();
+        self.polys.clear();
+    }
+
+    /// Polygons pushed.
+    #[cfg(test)]
+    pub(super) fn len(&self) -> usize {
+        self.polys.len()
+    }
+
+    /// Snaps a polygon's vertices to the grid and pushes their convex hull; a receiver polygon
+    /// (part of the region) or a shadow (taken away from it). Nothing is pushed when the snapped
+    /// hull has no area. Polygons are counted in the order they are pushed (the order decides
+    /// which of two edges on one line counts the segment they share, not the result).
+    pub(super) fn push(&mut self, snap: &Snap, polygon: &[DVec2], receiver: bool) {
+        self.snapped.clear();
+        self.snapped.extend(polygon.iter().map(|&p| snap.point(p)));
+        self.push_snapped(receiver);
+    }
+
+    /// Pushes already snapped points (their hull).
+    pub(super) fn push_points(&mut self, points: &[Point], receiver: bool) {
+        self.snapped.clear();
+        self.snapped.extend_from_slice(points);
+        self.push_snapped(receiver);
+    }
+
+    fn push_snapped(&mut self, receiver: bool) {
+        let start = self.points.len();
+        hull(&mut self.snapped, &mut self.points);
+        if self.points.len() - start < 3 {
+            self.points.truncate(start);
+            return;
+        }
+        let vertices = &self.points[start..];
+        let lo = vertices.iter().fold([i64::MAX; 2], |m, p| [m[0].min(p[0]), m[1].min(p[1])]);
+        let hi = vertices.iter().fold([i64::MIN; 2], |m, p| [m[0].max(p[0]), m[1].max(p[1])]);
+        self.polys.push(Poly { start: start as u32, end: self.points.len() as u32, lo, hi, receiver });
+    }
+
+    /// Snapped points of a polygon as pushed (for outlines made once).
+    pub(super) fn snapped(snap: &Snap, polygon: &[DVec2]) -> Vec<Point> {
+        polygon.iter().map(|&p| snap.point(p)).collect()
+    }
+
+    /// Area (grid units²) of what lies inside some receiver polygon and inside no shadow.
+    pub(super) fn uncovered_area(&mut self) -> f64 {
+        if !self.polys.iter().any(|p| p.receiver) {
+            return 0.0;
+        }
+        let receivers = self.polys.iter().filter(|p| p.receiver).fold(([i64::MAX; 2], [i64::MIN; 2]), |(lo, hi), p| {
+            ([lo[0].min(p.lo[0]), lo[1].min(p.lo[1])], [hi[0].max(p.hi[0]), hi[1].max(p.hi[1])])
+        });
+        self.build_buckets();
+        if self.stamp.len() < self.polys.len() {
+            self.stamp.resize(self.polys.len(), 0);
+        }
+        let mut total = 0.0;
+        for p in 0..self.polys.len() {
+            let poly = self.polys[p];
+            // A shadow counts only where a receiver lies on its outer side.
+            if !poly.receiver && !boxes_overlap(poly.lo, poly.hi, receivers.0, receivers.1) {
+                continue;
+            }
+            // The polygons near this one, once for all its edges.
+            self.collect_candidates(poly.lo, poly.hi);
+            for k in poly.start..poly.end {
+                let a = self.points[k as usize];
+                let b = self.points[if k + 1 == poly.end { poly.start } else { k + 1 } as usize];
+                total += self.edge_integral(p, a, b);
+            }
+        }
+        total
+    }
+
+    /// `∫ x dy` over the parts of polygon `p`'s edge `a → b` that bound the region, signed by
+    /// which side the region is on; `self.candidates` holds the polygons near `p`.
+    fn edge_integral(&mut self, p: usize, a: Point, b: Point) -> f64 {
+        let own = self.polys[p];
+        let lo = [a[0].min(b[0]), a[1].min(b[1])];
+        let hi = [a[0].max(b[0]), a[1].max(b[1])];
+        self.events.clear();
+        for c in 0..self.candidates.len() {
+            let q = self.candidates[c] as usize;
+            let other = self.polys[q];
+            if q == p || !boxes_overlap(lo, hi, other.lo, other.hi) {
+                continue;
+            }
+            let Some((t0, t1, side)) = cover(&self.points[other.start as usize..other.end as usize], a, b) else { continue };
+            let (left, right) = if other.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
+            let mut counters = match side {
+                Side::Both => left | right,
+                Side::Left => left,
+                Side::Right => right,
+            };
+            if side != Side::Both && q < p {
+                counters |= EARLIER_EDGE;
+                if t0 <= 0.0 && t1 >= 1.0 {
+                    return 0.0;
+                }
+            }
+            // A shadow over the whole edge on the side the region could lie (both sides for a
+            // receiver's edge, the outer side for a shadow's): nothing of it bounds the region.
+            if !other.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
+                return 0.0;
+            }
+            self.events.push((t0, counters, 1));
+            self.events.push((t1, counters, -1));
+        }
+        self.events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        // The polygon itself covers its edge's left side.
+        let mut count = [0i32; 5];
+        count[if own.receiver { 0 } else { 2 }] = 1;
+        let (ax, dx, dy) = (a[0] as f64, (b[0] - a[0]) as f64, (b[1] - a[1]) as f64);
+        let piece = |count: &[i32; 5], t0: f64, t1: f64| -> f64 {
+            if t1 <= t0 || count[4] > 0 {
+                return 0.0;
+            }
+            let inside_left = count[0] > 0 && count[2] == 0;
+            let inside_right = count[1] > 0 && count[3] == 0;
+            let sign = f64::from(i8::from(inside_left) - i8::from(inside_right));
+            if sign == 0.0 {
+                return 0.0;
+            }
+            sign * (ax + 0.5 * (t0 + t1) * dx) * (t1 - t0) * dy
+        };
+        let mut total = 0.0;
+        let mut at = 0.0;
+        for &(t, counters, step) in &self.events {
+            total += piece(&count, at, t);
+            for (bit, c) in count.iter_mut().enumerate() {
+                if counters & (1 << bit) != 0 {
+                    *c += i32::from(step);
+                }
+            }
+            at = at.max(t);
+        }
+        total + piece(&count, at, 1.0)
+    }
+
+    /// Polygons whose boxes overlap `[lo, hi]` into `self.candidates`.
+    fn collect_candidates(&mut self, lo: Point, hi: Point) {
+        self.candidates.clear();
+        let b = self.buckets;
+        if b.n == 0 {
+            let hits = self.polys.iter().enumerate().filter(|(_, q)| boxes_overlap(lo, hi, q.lo, q.hi));
+            self.candidates.extend(hits.map(|(i, _)| i as u32));
+            return;
+        }
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.stamp.fill(0);
+            self.epoch = 1;
+        }
+        for k in 0..self.big.len() {
+            let q = self.big[k];
+            let poly = &self.polys[q as usize];
+            if boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                self.candidates.push(q);
+            }
+        }
+        let (c0, c1) = (b.cell(lo), b.cell(hi));
+        for cy in c0[1]..=c1[1] {
+            for cx in c0[0]..=c1[0] {
+                let cell = cy * b.n + cx;
+                for k in self.cell_start[cell]..self.cell_start[cell + 1] {
+                    let q = self.cell_items[k as usize];
+                    if self.stamp[q as usize] != self.epoch {
+                        self.stamp[q as usize] = self.epoch;
+                        let poly = &self.polys[q as usize];
+                        if boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                            self.candidates.push(q);
+                        }
+                    }
+                }
+            }
+        }
+        // Not in push order, but the sums do not depend on the order the counters move in.
+    }
+
+    /// Buckets the polygons by their boxes when there are many (else `buckets.n = 0`).
+    fn build_buckets(&mut self) {
+        let n = self.polys.len();
+        if n <= SCAN_ALL {
+            self.buckets = Buckets::default();
+            return;
+        }
+        let lo = self.polys.iter().fold([i64::MAX; 2], |m, p| [m[0].min(p.lo[0]), m[1].min(p.lo[1])]);
+        let hi = self.polys.iter().fold([i64::MIN; 2], |m, p| [m[0].max(p.hi[0]), m[1].max(p.hi[1])]);
+        let side = ((n as f64).sqrt().ceil() as usize).clamp(1, MAX_BUCKETS);
+        let size = |k: usize| (hi[k] - lo[k]).max(1) / side as i64 + 1;
+        let buckets = Buckets { n: side, origin: lo, size: [size(0), size(1)] };
+        self.buckets = buckets;
+        self.cell_start.clear();
+        self.cell_start.resize(side * side + 1, 0);
+        self.big.clear();
+        for (i, p) in self.polys.iter().enumerate() {
+            let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+                self.big.push(i as u32);
+                continue;
+            }
+            for cy in c0[1]..=c1[1] {
+                for cx in c0[0]..=c1[0] {
+                    self.cell_start[cy * side + cx + 1] += 1;
+                }
+            }
+        }
+        for c in 0..side * side {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.cell_items.clear();
+        self.cell_items.resize(self.cell_start[side * side] as usize, 0);
+        // Fill each cell from its start, in push order.
+        let mut next: Vec<u32> = std::mem::take(&mut self.candidates);
+        next.clear();
+        next.extend_from_slice(&self.cell_start[..side * side]);
+        for (i, p) in self.polys.iter().enumerate() {
+            let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+                continue;
+            }
+            for cy in c0[1]..=c1[1] {
+                for cx in c0[0]..=c1[0] {
+                    let cell = cy * side + cx;
+                    self.cell_items[next[cell] as usize] = i as u32;
+                    next[cell] += 1;
+                }
+            }
+        }
+        self.candidates = next;
+    }
+}
+
+impl Buckets {
+    /// The cell holding grid point `p` (clamped to the grid of cells).
+    fn cell(&self, p: Point) -> [usize; 2] {
+        let c = |k: usize| (((p[k] - self.origin[k]) / self.size[k]).max(0) as usize).min(self.n - 1);
+        [c(0), c(1)]
+    }
+}
+
+fn boxes_overlap(lo: Point, hi: Point, lo2: Point, hi2: Point) -> bool {
+    lo[0] <= hi2[0] && lo2[0] <= hi[0] && lo[1] <= hi2[1] && lo2[1] <= hi[1]
+}
+
+/// Twice the signed area of `o, a, b` (positive when `b` lies left of `o → a`); exact.
+fn orient(o: Point, a: Point, b: Point) -> i64 {
+    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+}
+
+/// Where the convex counter-clockwise polygon `q` covers the segment `a → b`: the parameter
+/// interval (`0` at `a`, `1` at `b`) and which sides, or `None` when it covers at most a point.
+fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    let mut side = Side::Both;
+    for k in 0..q.len() {
+        let (q0, q1) = (q[k], q[(k + 1) % q.len()]);
+        let (oa, ob) = (orient(q0, q1, a), orient(q0, q1, b));
+        if oa > 0 && ob > 0 {
+            continue;
+        }
+        if oa <= 0 && ob <= 0 {
+            if oa == 0 && ob == 0 {
+                // On this edge's line: the polygon lies on the edge's left, so on the segment's
+                // left when both run the same way.
+                let same = (b[0] - a[0]) * (q1[0] - q0[0]) + (b[1] - a[1]) * (q1[1] - q0[1]) > 0;
+                side = if same { Side::Left } else { Side::Right };
+                continue;
+            }
+            return None;
+        }
+        // Signs differ: the segment crosses this edge's line once.
+        let t = oa as f64 / (oa - ob) as f64;
+        if oa > 0 {
+            t1 = t1.min(t);
+        } else {
+            t0 = t0.max(t);
+        }
+        if t0 >= t1 {
+            return None;
+        }
+    }
+    Some((t0, t1, side))
+}
+
+/// Andrew's monotone chain on grid points (exact): the hull of `points` (sorted in place)
+/// appended to `out`, counter-clockwise, without collinear or repeated points.
+fn hull(points: &mut [Point], out: &mut Vec<Point>) {
+    let base = out.len();
+    if points.is_empty() {
+        return;
+    }
+    points.sort_unstable();
+    let push = |out: &mut Vec<Point>, q: Point, floor: usize| {
+        while out.len() >= floor + 2 && orient(out[out.len() - 2], out[out.len() - 1], q) <= 0 {
+            out.pop();
+        }
+        out.push(q);
+    };
+    for &q in points.iter() {
+        push(out, q, base);
+    }
+    let lower = out.len() - 1;
+    for &q in points.iter().rev().skip(1) {
+        push(out, q, lower);
+    }
+    out.pop();
+    // Fewer than three distinct points: whatever is left has no area, the caller drops it.
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::count::exact::{Contour, sunlit_ratio};
+
+    /// A grid where multiples of 1/4 in [−8, 8] land exactly on grid points (scale 2^26), so
+    /// shared and collinear edges stay exactly so after snapping.
+    fn snap() -> Snap {
+        Snap::new(DVec2::splat(-8.0), DVec2::splat(8.0)).unwrap()
+    }
+
+    fn ratio(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>]) -> f64 {
+        let s = snap();
+        let mut b = Boundary::default();
+        for r in receiver {
+            b.push(&s, r, true);
+        }
+        let whole = b.uncovered_area();
+        for sh in shadows {
+            b.push(&s, sh, false);
+        }
+        let lit = b.uncovered_area();
+        if whole <= 0.0 { 0.0 } else { (lit / whole).clamp(0.0, 1.0) }
+    }
+
+    fn contour(p: &[DVec2]) -> Contour {
+        let area: f64 = (0..p.len()).map(|i| p[i].perp_dot(p[(i + 1) % p.len()])).sum();
+        let mut c: Contour = p.iter().map(|q| q.to_array()).collect();
+        if area < 0.0 {
+            c.reverse();
+        }
+        c
+    }
+
+    fn reference(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>]) -> f64 {
+        let r: Vec<Contour> = receiver.iter().map(|p| contour(p)).collect();
+        let s: Vec<Contour> = shadows.iter().map(|p| contour(p)).collect();
+        sunlit_ratio(&r, &s, 0.0)
+    }
+
+    fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<DVec2> {
+        vec![DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x1, y1), DVec2::new(x0, y1)]
+    }
+
+    fn tri(p: [[f64; 2]; 3]) -> Vec<DVec2> {
+        p.iter().map(|&[x, y]| DVec2::new(x, y)).collect()
+    }
+
+    /// A 4 × 3 wall as two triangles.
+    fn wall() -> Vec<Vec<DVec2>> {
+        vec![tri([[0., 0.], [4., 0.], [4., 3.]]), tri([[0., 0.], [4., 3.], [0., 3.]])]
+    }
+
+    /// The wall with a 2 × 1 hole at [1, 3] × [1, 2], as eight triangles.
+    fn holed_wall() -> Vec<Vec<DVec2>> {
+        let t = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| tri([a, b, c]);
+        vec![
+            t([0., 0.], [4., 0.], [3., 1.]),
+            t([0., 0.], [3., 1.], [1., 1.]),
+            t([4., 0.], [4., 3.], [3., 2.]),
+            t([4., 0.], [3., 2.], [3., 1.]),
+            t([4., 3.], [0., 3.], [1., 2.]),
+            t([4., 3.], [1., 2.], [3., 2.]),
+            t([0., 3.], [0., 0.], [1., 1.]),
+            t([0., 3.], [1., 1.], [1., 2.]),
+        ]
+    }
+
+    fn assert_agrees(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>], what: &str) -> f64 {
+        let (got, want) = (ratio(receiver, shadows), reference(receiver, shadows));
+        assert!((got - want).abs() < 1e-6, "{what}: boundary {got}, reference {want}");
+        got
+    }
+
+    #[test]
+    fn degenerate_arrangements_match_closed_forms_and_the_reference() {
+        let w = wall();
+        let a = square(1., 1., 2., 2.);
+        // Identical shadows, each alone and both: one square metre of twelve.
+        assert!((assert_agrees(&w, &[a.clone(), a.clone(), a.clone()], "identical") - 11. / 12.).abs() < 1e-12);
+        // Sharing an edge (opposite directions), and overlapping along a collinear edge (same direction).
+        assert!((assert_agrees(&w, &[a.clone(), square(2., 1., 3., 2.)], "shared edge") - 10. / 12.).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[a.clone(), square(1.5, 1., 3., 1.5)], "collinear overlap") - (12. - 1.5) / 12.).abs() < 1e-12);
+        // Touching at a vertex; nested; along the wall's own edge and its diagonal; beyond it.
+        assert!((assert_agrees(&w, &[a.clone(), square(2., 2., 3., 3.)], "vertex") - 10. / 12.).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[square(0.5, 0.5, 3., 2.5), a.clone()], "nested") - 7. / 12.).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[square(0., 0., 4., 1.)], "on the wall's edge") - 8. / 12.).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[tri([[0., 0.], [4., 3.], [0., 3.]])], "the upper triangle itself") - 0.5).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[square(-1., -1., 5., 4.)], "all of it")).abs() < 1e-12);
+        assert!((assert_agrees(&w, &[square(-2., 1., 6., 2.)], "beyond both sides") - 8. / 12.).abs() < 1e-12);
+        assert_eq!(assert_agrees(&w, &[square(5., 0., 6., 3.)], "beside it"), 1.0);
+        // The holed wall (10 m²): a shadow over the hole shades only its frame.
+        let h = holed_wall();
+        assert!((assert_agrees(&h, &[square(0.5, 0.5, 3.5, 2.5)], "over the hole") - 6. / 10.).abs() < 1e-12);
+        assert!((assert_agrees(&h, &[square(1., 1., 3., 2.)], "the hole itself") - 1.0).abs() < 1e-12);
+        assert!((assert_agrees(&h, &[square(1., 1., 3., 2.5)], "the hole's top edge and above") - 9. / 10.).abs() < 1e-12);
+    }
+
+    /// Deterministic pseudo-random numbers (xorshift).
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+        fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+        fn unit(&mut self) -> f64 {
+            (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The hull of a few random points: on a coarse lattice (so edges coincide, overlap, touch)
+    /// or anywhere.
+    fn random_convex(rng: &mut Rng, lattice: bool) -> Vec<DVec2> {
+        let mut pts: Vec<DVec2> = (0..3 + rng.below(6))
+            .map(|_| {
+                if lattice {
+                    DVec2::new(rng.below(25) as f64 * 0.25 - 1.0, rng.below(19) as f64 * 0.25 - 1.0)
+                } else {
+                    DVec2::new(rng.unit() * 6.0 - 1.0, rng.unit() * 5.0 - 1.0)
+                }
+            })
+            .collect();
+        let mut h = Vec::new();
+        super::super::objects::convex_hull(&mut pts, &mut h);
+        h
+    }
+
+    #[test]
+    fn random_convex_shadows_agree_with_the_reference() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut partly = 0;
+        for case in 0..400 {
+            let receiver = if case % 2 == 0 { wall() } else { holed_wall() };
+            let lattice = case % 3 != 0;
+            let count = 1 + rng.below(if case % 5 == 0 { 80 } else { 12 }) as usize;
+            let mut shadows: Vec<Vec<DVec2>> = Vec::new();
+            for _ in 0..count {
+                let s = random_convex(&mut rng, lattice);
+                if s.len() < 3 {
+                    continue;
+                }
+                match rng.below(6) {
+                    // A copy of an earlier shadow, or one reversed (same polygon, other start).
+                    0 if !shadows.is_empty() => {
+                        let k = rng.below(shadows.len() as u64) as usize;
+                        let mut copy = shadows[k].clone();
+                        copy.rotate_left(1);
+                        shadows.push(copy);
+                    }
+                    // One nested in an earlier one: shrunk about its centre.
+                    1 if !shadows.is_empty() => {
+                        let k = rng.below(shadows.len() as u64) as usize;
+                        let c = shadows[k].iter().copied().sum::<DVec2>() / shadows[k].len() as f64;
+                        shadows.push(shadows[k].iter().map(|&p| c + (p - c) * 0.5).collect());
+                    }
+                    _ => shadows.push(s),
+                }
+            }
+            let got = assert_agrees(&receiver, &shadows, &format!("case {case}"));
+            partly += usize::from(got > 0.01 && got < 0.99);
+        }
+        assert!(partly > 200, "only {partly} cases partly shaded");
+    }
+
+    #[test]
+    fn many_shadows_use_buckets_and_agree() {
+        // Leaves: 600 small shadows, some overlapping, some identical, and two wide ones.
+        let mut rng = Rng(7);
+        let mut shadows = Vec::new();
+        for _ in 0..600 {
+            let c = DVec2::new(rng.below(33) as f64 * 0.125, rng.below(25) as f64 * 0.125);
+            let r = 0.125 * (1 + rng.below(3)) as f64;
+            shadows.push(vec![c + DVec2::new(-r, 0.), c + DVec2::new(0., -r), c + DVec2::new(r, 0.), c + DVec2::new(0., r)]);
+        }
+        // A few wide shadows among them (a branch, a wall's): kept out of the buckets.
+        shadows.insert(100, square(-0.5, 0.25, 4.5, 0.5));
+        shadows.push(tri([[-1., 1.0], [5., 1.2], [-1., 1.4]]));
+        let receiver = holed_wall();
+        let got = assert_agrees(&receiver, &shadows, "leaves");
+        assert!(got > 0.0 && got < 1.0, "{got}");
+        let mut b = Boundary::default();
+        for sh in &shadows {
+            b.push(&snap(), sh, false);
+        }
+        assert!(b.len() > SCAN_ALL);
+    }
+}
