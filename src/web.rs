@@ -28,6 +28,7 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
+use crate::model::run_year::{choose, is_leap};
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::scene::Scene;
 use crate::sun::location::Location;
@@ -199,7 +200,8 @@ impl Engine {
         future_to_promise(async move {
             let given = settings_from_js(&settings).map_err(js_error)?;
             let settings = given.resolve().map_err(js_error)?;
-            let options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
+            let mut options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
+            options.timesteps = options.timesteps.leap_year(is_leap_run(&given, model.energyplus.as_ref()));
             let (location, calendar) = (settings.location, settings.calendar);
             // A model that cannot be hooked (e.g. a Version before 9.3) still has its year
             // counted: the refusal is kept for `hookedModel`, the only call that needs the hook.
@@ -341,6 +343,13 @@ fn settings_from_js(value: &JsValue) -> Result<AnnualSettings> {
     }
     let text = js_sys::JSON::stringify(value).map_err(|_| Error::argument("settings", "not a plain object"))?;
     serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("settings", e.to_string()))
+}
+
+/// Whether the year is a leap year, as the CLI chooses it: the `year` setting, else the
+/// EnergyPlus model's RunPeriod, else the EPW's Feb 29 record.
+fn is_leap_run(given: &AnnualSettings, energyplus: Option<&EnergyPlusInput>) -> bool {
+    let objects = energyplus.map(|ep| ep.objects.as_slice());
+    choose(given.year, objects, given.epw.as_deref()).is_some_and(|(year, _)| is_leap(year))
 }
 
 /// Each column's mean over the year's sun-up timesteps: the page's colour per surface.

@@ -142,6 +142,9 @@ export interface AnnualSettings {
   leafOut?: string;
   /** Leaf-fall period "MM-DD,MM-DD" (default "10-01,11-15"). */
   leafFall?: string;
+  /** The calendar year: a leap year gives 366 days (8784 × timestepsPerHour rows). Default: the
+   * EnergyPlus model's RunPeriod year, else the EPW's Feb 29 record, else a non-leap year. */
+  year?: number;
 }
 
 export interface AnnualRunOptions {

@@ -57,6 +57,10 @@ pub struct AnnualSettings {
     pub leaf_out: Option<String>,
     /// Leaf-fall period (default 10-01,11-15, likewise).
     pub leaf_fall: Option<String>,
+    /// The calendar year (a leap year gives 366 days, 8784 rows per timestep per hour); default:
+    /// the EnergyPlus model's RunPeriod year, else the EPW's Feb 29, else a non-leap year
+    /// ([`crate::model::run_year::choose`]).
+    pub year: Option<i32>,
 }
 
 /// Settings with their defaults applied and every value checked.

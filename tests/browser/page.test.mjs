@@ -5,7 +5,7 @@
 // render as text. The 3D view is saved to target/artifacts/page.png for a person to look at.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
@@ -214,6 +214,33 @@ test('an EnergyPlus IDF loads, and the hooked IDF downloads with its CSV named',
   assert.match(text, /office-shading\.csv/);
   assert.match(text, /SurfaceProperty:LocalEnvironment,/);
   assert.match(text, /Scheduled/);
+});
+
+test('a model whose RunPeriod is a leap year gets 366 days of rows, as the CLI', { timeout: 300_000 }, async () => {
+  const plain = join(WORK, 'office.idf');
+  if (!existsSync(plain)) {
+    execFileSync('cargo', ['run', '--quiet', '--example', 'make_office_idf', '--', plain, '--louvres', '2'], { cwd: ROOT, stdio: 'inherit' });
+  }
+  const text = readFileSync(plain, 'utf8');
+  const leap = text.replace(/RunPeriod, YEAR, 1, 1, , 12, 31, ,/, 'RunPeriod, YEAR, 1, 1, 2020, 12, 31, 2020,');
+  assert.notEqual(leap, text, 'the generated model has the RunPeriod this test edits');
+  const idf = join(WORK, 'office-2020.idf');
+  writeFileSync(idf, leap);
+  assert.match(await statusAfter(() => page.setInputFiles('#model', idf), /^Loaded|^Could not/), /^Loaded office-2020\.idf/);
+  await page.fill('#days', '6');
+  await page.fill('#perday', '5');
+  await page.fill('#resolution', '64');
+  const done = await statusAfter(() => page.click('#compute'), /^Done|^Could not/, 300_000);
+  const rows = Number(/× ([\d,]+) timesteps/.exec(done)?.[1].replace(/,/g, ''));
+  assert.ok(rows > 0 && rows % 8784 === 0, `${rows} rows are whole leap-year days (${done})`);
+  const download = page.waitForEvent('download');
+  await page.click('#download');
+  const csv = join(WORK, 'office-2020.csv');
+  await (await download).saveAs(csv);
+  const lines = readFileSync(csv, 'utf8').trimEnd().split('\n');
+  assert.equal(lines.length, rows + 1);
+  assert.ok(lines.some((l) => l.startsWith(' 02/29 ')), 'Feb 29 is in the CSV');
+  assert.match(lines.at(-1), /^ 12\/31 24:00,/);
 });
 
 test('an EnergyPlus model too old to hook still gets its year, and the page says why there is no hooked IDF', { timeout: 300_000 }, async () => {
