@@ -20,9 +20,10 @@ function setBusy(busy) {
   for (const id of ['model', 'example', 'epw']) $(id).disabled = busy;
 }
 
-function resolution() {
+/** What the worker's engine is made with: a change of either makes a new engine. */
+function engineOptions() {
   const r = Number($('resolution').value);
-  return Number.isInteger(r) && r >= 16 && r <= 2048 ? r : 512;
+  return { resolution: Number.isInteger(r) && r >= 16 && r <= 2048 ? r : 512, engine: $('engine').value };
 }
 
 async function readFiles(list) {
@@ -40,7 +41,7 @@ async function loadFiles(files) {
   status(`Reading ${state.modelName}…`);
   $('compute').disabled = true;
   const options = { receivers: $('receivers').value, north: 0, foliage: $('foliage').value, transmittance: $('transmittance').value };
-  worker.postMessage({ type: 'load', files, options, resolution: resolution() });
+  worker.postMessage({ type: 'load', files, options, engine: engineOptions() });
 }
 
 function showModel(msg) {
@@ -293,7 +294,7 @@ function wire() {
     setBusy(true);
     $('progress').value = 0;
     status('Sampling the sun…');
-    worker.postMessage({ type: 'compute', settings: await settings(), resolution: resolution(), csvName: state.csvName });
+    worker.postMessage({ type: 'compute', settings: await settings(), engine: engineOptions(), csvName: state.csvName });
   });
   $('cancel').addEventListener('click', () => worker.postMessage({ type: 'cancel' }));
   $('epw').addEventListener('change', epwChosen);

@@ -11,12 +11,13 @@ let files = null;
 let loadOptions = null;
 let running = null;
 
-async function engineFor(resolution) {
-  if (!engine || engine.resolution !== resolution) {
+/** The engine for these options ({ resolution, engine }), made again when either changes. */
+async function engineFor(options) {
+  if (!engine || engine.resolution !== options.resolution || engine.engine !== options.engine) {
     engine = null;
     model?.free();
     model = null;
-    engine = await createEngine({ resolution });
+    engine = await createEngine(options);
   }
   return engine;
 }
@@ -44,8 +45,8 @@ function fail(error, request) {
   postMessage({ type: 'error', request, message, code: error?.code, gpu, cancelled: error?.name === 'AbortError' });
 }
 
-async function load({ files: given, options, resolution }) {
-  const e = await engineFor(resolution);
+async function load({ files: given, options, engine: made }) {
+  const e = await engineFor(made);
   // Read first: a bad file leaves the last good model in place.
   const m = e.loadFiles(given, options);
   model?.free();
@@ -87,9 +88,9 @@ async function compute(request) {
   }
 }
 
-async function computeOnce({ settings, resolution, csvName }) {
+async function computeOnce({ settings, engine: made, csvName }) {
   if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
-  const e = await engineFor(resolution);
+  const e = await engineFor(made);
   const m = modelOn(e);
   running = new AbortController();
   const started = performance.now();

@@ -216,7 +216,8 @@ test('createEngine({ device }) counts on the caller\'s GPUDevice and leaves it a
     const device = await adapter.requestDevice();
     let lost = false;
     device.lost.then(() => (lost = true));
-    const shared = await createEngine({ device });
+    // The pixel engine, which counts on the device (auto would clip this light scene exactly).
+    const shared = await createEngine({ device, engine: 'gpu' });
     const model = fromThree(shared, buildScene(), { receivers: 'WALL*,ROOF' });
     const onDevice = Array.from(await shared.fractions(model, sun));
     const names = model.receiverNames;
