@@ -210,7 +210,7 @@ test('sunlit/three in a Vite app: fractions equal the native CLI on the same sce
 test('createEngine({ device }) counts on the caller\'s GPUDevice and leaves it alive; the worker entry counts the same', async () => {
   const r = await page.evaluate(async (sun) => {
     const { createEngine, fromThree, buildScene, exportGlb, SunlitWorker } = window.sunlitApp;
-    const own = await createEngine();
+    const own = await createEngine({ engine: 'gpu' });
     const base = Array.from(await own.fractions(fromThree(own, buildScene(), { receivers: 'WALL*,ROOF' }), sun));
     const adapter = await navigator.gpu.requestAdapter();
     const device = await adapter.requestDevice();
