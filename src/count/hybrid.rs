@@ -163,6 +163,14 @@ pub fn simple_route(load: ViewLoad) -> Route {
     if load.triangles == 0 || (load.see_through == 0 && load.triangles <= SIMPLE_EXACT_TRIANGLES) { Route::Exact } else { Route::Gpu }
 }
 
+/// The requests `routes` sends to `route`, with their indices in `requests` (to put the answers
+/// back in order).
+pub fn routed_to(requests: &[ViewRequest], routes: &[Route], route: Route) -> (Vec<usize>, Vec<ViewRequest>) {
+    let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
+    let reqs = idx.iter().map(|&i| requests[i]).collect();
+    (idx, reqs)
+}
+
 /// Where the profile comes from.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ProfileSource {
@@ -313,13 +321,8 @@ impl<'a> HybridEngine<'a> {
 
     /// Counts each request on the engine `routes` names, both engines at once.
     pub async fn count_routed(&self, requests: &[ViewRequest], routes: &[Route]) -> Result<Vec<ViewAnswer>> {
-        let pick = |route: Route| -> (Vec<usize>, Vec<ViewRequest>) {
-            let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
-            let reqs = idx.iter().map(|&i| requests[i]).collect();
-            (idx, reqs)
-        };
-        let (exact_idx, exact_reqs) = pick(Route::Exact);
-        let (gpu_idx, gpu_reqs) = pick(Route::Gpu);
+        let (exact_idx, exact_reqs) = routed_to(requests, routes, Route::Exact);
+        let (gpu_idx, gpu_reqs) = routed_to(requests, routes, Route::Gpu);
         let lanes: Vec<Lane<'_>> = if gpu_reqs.is_empty() {
             Vec::new()
         } else {

@@ -6,7 +6,7 @@
 //! ones counted on the GPU), never by timing, so a page's answers do not depend on its load.
 
 use crate::count::exact::engine::ExactEngine;
-use crate::count::hybrid::{EngineKind, Route, simple_route};
+use crate::count::hybrid::{EngineKind, Route, routed_to, simple_route};
 use crate::count::lanes::Lane;
 use crate::count::{Engine, ViewAnswer, ViewRequest, cos_incidence};
 use crate::error::Result;
@@ -37,13 +37,8 @@ impl Engine for Chosen<'_> {
             EngineKind::Exact => vec![Route::Exact; requests.len()],
             EngineKind::Auto => self.exact().loads(requests).into_iter().map(simple_route).collect(),
         };
-        let pick = |route: Route| -> (Vec<usize>, Vec<ViewRequest>) {
-            let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
-            let reqs = idx.iter().map(|&i| requests[i]).collect();
-            (idx, reqs)
-        };
-        let (gpu_idx, gpu_reqs) = pick(Route::Gpu);
-        let (exact_idx, exact_reqs) = pick(Route::Exact);
+        let (gpu_idx, gpu_reqs) = routed_to(requests, &routes, Route::Gpu);
+        let (exact_idx, exact_reqs) = routed_to(requests, &routes, Route::Exact);
         let mut out: Vec<ViewAnswer> = requests
             .iter()
             .map(|r| ViewAnswer {
