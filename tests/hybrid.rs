@@ -147,6 +147,29 @@ fn the_same_profile_gives_the_same_csv_byte_for_byte() {
     assert!(csvs[0] == csvs[1], "two runs with one profile differ");
 }
 
+/// A model no GPU is worth its start-up for gets a profile kept without an adapter (finding it
+/// again asks for none), and the run that finds it writes the same CSV.
+#[test]
+fn an_exact_only_profile_is_cached_without_the_adapter() {
+    let dir = temp_dir();
+    let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
+    let mut csvs = Vec::new();
+    for run in 0..2 {
+        let csv = dir.join(format!("cached{run}.csv"));
+        let args =
+            ["annual", glb, "--location", "40,-105,-7", "--days-per-year", "6", "--samples-per-day", "7", "-o", csv.to_str().unwrap()];
+        let out = sunlit(&args, &dir);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        csvs.push(std::fs::read(&csv).unwrap());
+    }
+    let cache = std::fs::read_to_string(dir.join("sunlit/engine-profiles.json")).expect("the first run cached its profile");
+    let keys: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&cache).unwrap();
+    assert_eq!(keys.len(), 1, "one profile, found again by the second run: {cache}");
+    let (key, profile) = keys.iter().next().unwrap();
+    assert!(key.starts_with("exact only; ") && profile["gpu"].is_null(), "{cache}");
+    assert!(csvs[0] == csvs[1], "the probing run and the cached run differ");
+}
+
 #[test]
 fn the_gpu_engine_answers_alone() {
     let dir = temp_dir();

@@ -100,7 +100,8 @@ impl Cost {
 /// A device's cost model: what `auto` routes by.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Profile {
-    /// The device it was measured on (adapter, driver, CPU threads, tile side).
+    /// The device it was measured on (adapter, driver, CPU threads, tile side; "exact only" and
+    /// no adapter where no GPU was worth probing) and the scene's size.
     pub device: String,
     /// The exact engine on this machine's threads.
     pub exact: Cost,
@@ -401,24 +402,32 @@ impl<'a> HybridEngine<'a> {
         }
         // A profile is measured on the model's own views: its loads cost differently per model (leaves
         // overlap far more than slats), so the key names the scene's size too.
-        let key = format!(
-            "{}; scene {} triangles, {} receivers",
-            device_key(&self.options).await?,
-            self.scene.triangle_count(),
-            self.scene.receivers.len()
-        );
+        let scene = format!("scene {} triangles, {} receivers", self.scene.triangle_count(), self.scene.receivers.len());
         let (profile, from) = match &self.source {
             ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
-            ProfileSource::Cache => match cached(&key) {
-                Some(p) => (p, "cache"),
-                None => (self.calibrate(exact, requests, loads, key.clone()).await?, "probe"),
-            },
-            _ => (self.calibrate(exact, requests, loads, key.clone()).await?, "probe"),
+            ProfileSource::Cache => {
+                // An exact-only profile is kept under the CPU's key: finding it asks no adapter.
+                let cpu = cpu_key(&self.options).map(|k| format!("{k}; {scene}"));
+                match cpu.as_deref().and_then(cached) {
+                    Some(p) => (p, "cache"),
+                    None => match cached(&format!("{}; {scene}", device_key(&self.options).await?)) {
+                        Some(p) => {
+                            // Kept by an older sunlit under its adapter's key: found without one next time.
+                            if let (None, Some(cpu)) = (&p.gpu, &cpu) {
+                                store_cached(cpu, &p);
+                            }
+                            (p, "cache")
+                        }
+                        None => (self.calibrate(exact, requests, loads, &scene).await?, "probe"),
+                    },
+                }
+            }
+            _ => (self.calibrate(exact, requests, loads, &scene).await?, "probe"),
         };
         if from == "probe" {
             match &self.source {
                 ProfileSource::File(path) => write_profile(path, &profile)?,
-                ProfileSource::Cache => store_cached(&key, &profile),
+                ProfileSource::Cache => store_cached(&profile.device, &profile),
                 ProfileSource::Probe => {}
             }
         }
@@ -428,11 +437,12 @@ impl<'a> HybridEngine<'a> {
 
     /// Measures both engines on a spread of these views (the GPU only if the exact engine alone
     /// would take longer than a GPU's start-up).
-    async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], key: String) -> Result<Profile> {
+    /// `scene` names the scene's size, for the profile's key.
+    async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], scene: &str) -> Result<Profile> {
         let start = now();
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe);
-        let mut profile = Profile { device: key, exact: exact_cost, gpu: None, gpu_startup_seconds: None };
+        let mut profile = Profile { device: String::new(), exact: exact_cost, gpu: None, gpu_startup_seconds: None };
         // The probe's views are spread evenly over the sorted loads, so their mean time is the
         // loaded views' mean (a line through them extrapolates worse: most of a view's time is
         // its objects' shadows, not its triangles). Below a GPU's start-up for all of them, no
@@ -444,6 +454,11 @@ impl<'a> HybridEngine<'a> {
             profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
             profile.gpu = Some(probe_gpu(lanes, requests, loads).await?);
         }
+        let device = match (&profile.gpu, cpu_key(&self.options)) {
+            (None, Some(cpu)) => cpu,
+            _ => device_key(&self.options).await?,
+        };
+        profile.device = format!("{device}; {scene}");
         let seconds = now() - start;
         self.add_stats(|s| s.calibration_seconds += seconds);
         Ok(profile)
@@ -554,10 +569,25 @@ fn fit_line(samples: &[(f64, f64)]) -> Cost {
     Cost { per_view_us: intercept, per_triangle_us: slope.max(0.0) }
 }
 
+/// The CPU threads and tile side (with the accuracy, if any) of a profile's key.
+fn threads_and_side(options: &CounterOptions) -> String {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let accuracy = options.accuracy.map_or(String::new(), |a| format!(" ±{a}"));
+    format!("{threads} CPU threads; {}²{accuracy}", options.resolution)
+}
+
+/// The key of a profile that never needs the GPU (no view was worth its start-up): the CPU's
+/// threads and the tile side, without the adapter, since asking for one costs a small model a
+/// third of its run (on lavapipe: loading the driver). `None` for a side outside what every
+/// adapter renders (wgpu's downlevel minimum), which only the adapter can check.
+fn cpu_key(options: &CounterOptions) -> Option<String> {
+    let every_adapter = 16..=wgpu::Limits::downlevel_defaults().max_texture_dimension_2d;
+    every_adapter.contains(&options.resolution).then(|| format!("exact only; {}", threads_and_side(options)))
+}
+
 /// What identifies the device a profile belongs to: adapter, driver, CPU threads and tile side.
 /// Refuses a side the adapter cannot render, as the GPU would (without making a device).
 pub async fn device_key(options: &CounterOptions) -> Result<String> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let resolution = options.resolution;
     let adapter = match platform::instance().request_adapter(&wgpu::RequestAdapterOptions::default()).await {
         Ok(a) => {
@@ -573,8 +603,7 @@ pub async fn device_key(options: &CounterOptions) -> Result<String> {
         }
         Err(_) => "no GPU adapter".to_string(),
     };
-    let accuracy = options.accuracy.map_or(String::new(), |a| format!(" ±{a}"));
-    Ok(format!("{adapter}; {threads} CPU threads; {resolution}²{accuracy}"))
+    Ok(format!("{adapter}; {}", threads_and_side(options)))
 }
 
 /// Reads a profile file.
