@@ -314,7 +314,8 @@ impl<'a> HybridEngine<'a> {
             (EngineKind::Auto, Some(exact)) => {
                 let loads = exact.loads(requests);
                 let profile = self.ensure_profile(exact, requests, &loads).await?;
-                profile.route(&loads)
+                let routes = profile.route(&loads);
+                return self.count_routed_loaded(requests, &routes, Some(&loads)).await;
             }
         };
         self.count_routed(requests, &routes).await
@@ -322,7 +323,14 @@ impl<'a> HybridEngine<'a> {
 
     /// Counts each request on the engine `routes` names, both engines at once.
     pub async fn count_routed(&self, requests: &[ViewRequest], routes: &[Route]) -> Result<Vec<ViewAnswer>> {
+        self.count_routed_loaded(requests, routes, None).await
+    }
+
+    /// As [`Self::count_routed`], with the requests' loads when routing has walked them already
+    /// (the exact engine then does not walk again where nothing was in front).
+    async fn count_routed_loaded(&self, requests: &[ViewRequest], routes: &[Route], loads: Option<&[ViewLoad]>) -> Result<Vec<ViewAnswer>> {
         let (exact_idx, exact_reqs) = routed_to(requests, routes, Route::Exact);
+        let exact_loads: Option<Vec<ViewLoad>> = loads.map(|l| exact_idx.iter().map(|&i| l[i]).collect());
         let (gpu_idx, gpu_reqs) = routed_to(requests, routes, Route::Gpu);
         let lanes: Vec<Lane<'_>> = if gpu_reqs.is_empty() {
             Vec::new()
@@ -347,12 +355,16 @@ impl<'a> HybridEngine<'a> {
             parts.push(Part::Gpu);
         }
         let results = platform::side_by_side(&parts, |part| {
-            let (part, lanes, exact_reqs, gpu_reqs) = (*part, &lanes, &exact_reqs, &gpu_reqs);
+            let (part, lanes, exact_reqs, gpu_reqs, exact_loads) = (*part, &lanes, &exact_reqs, &gpu_reqs, &exact_loads);
             async move {
                 let start = now();
                 let counted = match part {
                     Part::Exact(e) => {
-                        Ok(e.fractions(exact_reqs).into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect())
+                        let fractions = match exact_loads {
+                            Some(loads) => e.fractions_loaded(exact_reqs, loads),
+                            None => e.fractions(exact_reqs),
+                        };
+                        Ok(fractions.into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect())
                     }
                     Part::Gpu => Lanes(lanes).answer(gpu_reqs).await,
                 };
@@ -491,7 +503,7 @@ fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]
     let leaves_of = |i: usize| requests[i].leaves;
     // Warm caches and the scratch memory first.
     for &i in probe.iter().take(4) {
-        exact.fraction(requests[i], leaves_of(i), &mut scratch);
+        exact.fraction(requests[i], leaves_of(i), true, &mut scratch);
     }
     let started = now();
     let mut samples = Vec::new();
@@ -501,7 +513,7 @@ fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]
         let mut best = f64::INFINITY;
         for _ in 0..PROBE_EXACT_REPEATS {
             let t0 = now();
-            exact.fraction(requests[i], leaves_of(i), &mut scratch);
+            exact.fraction(requests[i], leaves_of(i), true, &mut scratch);
             best = best.min(now() - t0);
             if best > PROBE_REPEAT_BELOW {
                 break;

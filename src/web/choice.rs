@@ -5,7 +5,7 @@
 //! in a page, so `auto` routes by [`simple_route`] (light views clipped, heavy or see-through
 //! ones counted on the GPU), never by timing, so a page's answers do not depend on its load.
 
-use crate::count::exact::engine::ExactEngine;
+use crate::count::exact::engine::{ExactEngine, ViewLoad};
 use crate::count::hybrid::{EngineKind, Route, routed_to, simple_route};
 use crate::count::lanes::Lane;
 use crate::count::{Engine, ViewAnswer, ViewRequest, cos_incidence};
@@ -32,10 +32,13 @@ impl Engine for Chosen<'_> {
     }
 
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
-        let routes: Vec<Route> = match self.kind {
+        let (routes, loads): (Vec<Route>, Option<Vec<ViewLoad>>) = match self.kind {
             EngineKind::Gpu => return self.lane.answer(requests).await,
-            EngineKind::Exact => vec![Route::Exact; requests.len()],
-            EngineKind::Auto => self.exact().loads(requests).into_iter().map(simple_route).collect(),
+            EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
+            EngineKind::Auto => {
+                let loads = self.exact().loads(requests);
+                (loads.iter().copied().map(simple_route).collect(), Some(loads))
+            }
         };
         let (gpu_idx, gpu_reqs) = routed_to(requests, &routes, Route::Gpu);
         let (exact_idx, exact_reqs) = routed_to(requests, &routes, Route::Exact);
@@ -47,7 +50,12 @@ impl Engine for Chosen<'_> {
             })
             .collect();
         if !exact_reqs.is_empty() {
-            for (&i, fraction) in exact_idx.iter().zip(self.exact().fractions(&exact_reqs)) {
+            let fractions = match &loads {
+                // Routing walked every view already: the exact engine skips those that reached nothing.
+                Some(loads) => self.exact().fractions_loaded(&exact_reqs, &exact_idx.iter().map(|&i| loads[i]).collect::<Vec<_>>()),
+                None => self.exact().fractions(&exact_reqs),
+            };
+            for (&i, fraction) in exact_idx.iter().zip(fractions) {
                 out[i].fraction = fraction;
                 out[i].error_estimate = Some(0.0);
             }

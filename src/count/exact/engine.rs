@@ -194,13 +194,25 @@ impl ExactEngine {
 
     /// Sunlit fractions of `requests`, each at its leaf fraction. Natively over every core.
     pub fn fractions(&self, requests: &[ViewRequest]) -> Vec<f64> {
-        let leaves_of = |i: usize| requests[i].leaves;
+        self.fractions_walking(requests, |_| true)
+    }
+
+    /// As [`Self::fractions`], for views whose [`Self::load`]s are known: a view whose walk
+    /// reaches no triangle is not walked again (most of a light model's views; the answer is the
+    /// same, since that walk would visit nothing).
+    pub fn fractions_loaded(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Vec<f64> {
+        self.fractions_walking(requests, |i| loads.get(i).is_none_or(|l| l.triangles > 0))
+    }
+
+    /// The views' fractions, walking the BVH for those `walk` says.
+    fn fractions_walking(&self, requests: &[ViewRequest], walk: impl Fn(usize) -> bool + Sync) -> Vec<f64> {
+        let one = |i: usize, scratch: &mut Scratch| self.fraction(requests[i], requests[i].leaves, walk(i), scratch);
         let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
         if threads == 1 {
             let mut scratch = self.scratch();
-            return requests.iter().enumerate().map(|(i, &r)| self.fraction(r, leaves_of(i), &mut scratch)).collect();
+            return (0..requests.len()).map(|i| one(i, &mut scratch)).collect();
         }
-        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), |i, scratch| self.fraction(requests[i], leaves_of(i), scratch))
+        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), one)
     }
 
     /// [`Self::load`] of every request, natively over every core.
@@ -224,8 +236,9 @@ impl ExactEngine {
         load
     }
 
-    /// Sunlit fraction of one view with leaf fraction `leaves`.
-    pub fn fraction(&self, request: ViewRequest, leaves: f32, scratch: &mut Scratch) -> f64 {
+    /// Sunlit fraction of one view with leaf fraction `leaves`; `walk` false skips the BVH walk
+    /// (for a view known to reach no triangle).
+    pub fn fraction(&self, request: ViewRequest, leaves: f32, walk: bool, scratch: &mut Scratch) -> f64 {
         let sun = request.sun;
         let (Some(Some(outline)), Some(Some(frame))) =
             (self.outlines.get(request.receiver as usize), self.frames.get(request.receiver as usize))
@@ -246,6 +259,9 @@ impl ExactEngine {
         scratch.boundary.clear();
         for t in &outline.lit {
             scratch.boundary.push_points(t, true);
+        }
+        if !walk {
+            return self.sunlit_ratio(outline, scratch);
         }
         self.culling.visit_triangles(&view.view_proj, |range| {
             for p in range {
