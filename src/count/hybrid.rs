@@ -166,10 +166,67 @@ pub fn simple_route(load: ViewLoad) -> Route {
 
 /// The requests `routes` sends to `route`, with their indices in `requests` (to put the answers
 /// back in order).
-pub fn routed_to(requests: &[ViewRequest], routes: &[Route], route: Route) -> (Vec<usize>, Vec<ViewRequest>) {
+fn routed_to(requests: &[ViewRequest], routes: &[Route], route: Route) -> (Vec<usize>, Vec<ViewRequest>) {
     let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
     let reqs = idx.iter().map(|&i| requests[i]).collect();
     (idx, reqs)
+}
+
+/// One engine's part of a routed batch.
+enum Counted {
+    Exact(Vec<f64>),
+    Gpu(Vec<ViewAnswer>),
+}
+
+/// Requests split by route, natively and on the web alike: each part with its indices in the
+/// original order, and the exact part's loads when routing walked them (so the exact engine does
+/// not walk again where nothing was in front).
+pub struct Split {
+    /// Where the exact part's requests sit in the original order.
+    pub exact_idx: Vec<usize>,
+    /// The requests routed to the exact engine.
+    pub exact_reqs: Vec<ViewRequest>,
+    /// Empty when routing did not walk the views.
+    exact_loads: Vec<ViewLoad>,
+    /// Where the GPU part's requests sit in the original order.
+    pub gpu_idx: Vec<usize>,
+    /// The requests routed to the GPU.
+    pub gpu_reqs: Vec<ViewRequest>,
+}
+
+impl Split {
+    /// Splits `requests` by `routes`; `loads` are the requests' own, if routing walked them.
+    pub fn new(requests: &[ViewRequest], routes: &[Route], loads: Option<&[ViewLoad]>) -> Self {
+        let (exact_idx, exact_reqs) = routed_to(requests, routes, Route::Exact);
+        let exact_loads = loads.map_or_else(Vec::new, |l| exact_idx.iter().map(|&i| l[i]).collect());
+        let (gpu_idx, gpu_reqs) = routed_to(requests, routes, Route::Gpu);
+        Self { exact_idx, exact_reqs, exact_loads, gpu_idx, gpu_reqs }
+    }
+
+    /// The exact part's fractions.
+    pub fn exact_fractions(&self, exact: &ExactEngine) -> Vec<f64> {
+        exact.fractions_loaded(&self.exact_reqs, &self.exact_loads)
+    }
+
+    /// The answers in the requests' order: exact ones carry their fraction and cosine (error 0),
+    /// the GPU's their pixel counts too.
+    pub fn merge(&self, scene: &Scene, requests: &[ViewRequest], exact: Vec<f64>, gpu: Vec<ViewAnswer>) -> Vec<ViewAnswer> {
+        let mut out: Vec<ViewAnswer> = requests
+            .iter()
+            .map(|r| ViewAnswer {
+                cos_incidence: scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
+                ..Default::default()
+            })
+            .collect();
+        for (&i, fraction) in self.exact_idx.iter().zip(exact) {
+            out[i].fraction = fraction;
+            out[i].error_estimate = Some(0.0);
+        }
+        for (&i, answer) in self.gpu_idx.iter().zip(gpu) {
+            out[i] = answer;
+        }
+        out
+    }
 }
 
 /// Where the profile comes from.
@@ -329,15 +386,13 @@ impl<'a> HybridEngine<'a> {
     /// As [`Self::count_routed`], with the requests' loads when routing has walked them already
     /// (the exact engine then does not walk again where nothing was in front).
     async fn count_routed_loaded(&self, requests: &[ViewRequest], routes: &[Route], loads: Option<&[ViewLoad]>) -> Result<Vec<ViewAnswer>> {
-        let (exact_idx, exact_reqs) = routed_to(requests, routes, Route::Exact);
-        let exact_loads: Option<Vec<ViewLoad>> = loads.map(|l| exact_idx.iter().map(|&i| l[i]).collect());
-        let (gpu_idx, gpu_reqs) = routed_to(requests, routes, Route::Gpu);
-        let lanes: Vec<Lane<'_>> = if gpu_reqs.is_empty() {
+        let split = Split::new(requests, routes, loads);
+        let lanes: Vec<Lane<'_>> = if split.gpu_reqs.is_empty() {
             Vec::new()
         } else {
             self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect()
         };
-        let exact = match (&self.exact, exact_reqs.is_empty()) {
+        let exact = match (&self.exact, split.exact_reqs.is_empty()) {
             (_, true) => None,
             (Some(e), false) => Some(e),
             (None, false) => return Err(Error::argument("engine", "views routed to the exact engine of a GPU-only engine")),
@@ -351,60 +406,41 @@ impl<'a> HybridEngine<'a> {
         if let Some(e) = exact {
             parts.push(Part::Exact(e));
         }
-        if !gpu_reqs.is_empty() {
+        if !split.gpu_reqs.is_empty() {
             parts.push(Part::Gpu);
         }
         let results = platform::side_by_side(&parts, |part| {
-            let (part, lanes, exact_reqs, gpu_reqs, exact_loads) = (*part, &lanes, &exact_reqs, &gpu_reqs, &exact_loads);
+            let (part, lanes, split) = (*part, &lanes, &split);
             async move {
                 let start = now();
                 let counted = match part {
-                    Part::Exact(e) => {
-                        let fractions = match exact_loads {
-                            Some(loads) => e.fractions_loaded(exact_reqs, loads),
-                            None => e.fractions(exact_reqs),
-                        };
-                        Ok(fractions.into_iter().map(|fraction| ViewAnswer { fraction, ..Default::default() }).collect())
-                    }
-                    Part::Gpu => Lanes(lanes).answer(gpu_reqs).await,
+                    Part::Exact(e) => Ok(Counted::Exact(split.exact_fractions(e))),
+                    Part::Gpu => Lanes(lanes).answer(&split.gpu_reqs).await.map(Counted::Gpu),
                 };
                 (counted, now() - start)
             }
         })
         .await;
-        // Exact answers carry their fraction and cosine; the GPU's their pixel counts too.
-        let mut out: Vec<ViewAnswer> = requests
-            .iter()
-            .map(|r| ViewAnswer {
-                cos_incidence: self.scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
-                ..Default::default()
-            })
-            .collect();
-        for (part, (counted, seconds)) in parts.iter().zip(results) {
-            let counted: Vec<ViewAnswer> = counted?;
-            match part {
-                Part::Exact(_) => {
-                    for (&i, c) in exact_idx.iter().zip(counted) {
-                        out[i].fraction = c.fraction;
-                        out[i].error_estimate = Some(0.0);
-                    }
+        let (mut exact_fractions, mut gpu_answers) = (Vec::new(), Vec::new());
+        for (counted, seconds) in results {
+            match counted? {
+                Counted::Exact(fractions) => {
+                    exact_fractions = fractions;
                     self.add_stats(|s| {
-                        s.exact_views += exact_idx.len();
+                        s.exact_views += split.exact_idx.len();
                         s.exact_seconds += seconds;
                     });
                 }
-                Part::Gpu => {
-                    for (&i, c) in gpu_idx.iter().zip(counted) {
-                        out[i] = c;
-                    }
+                Counted::Gpu(answers) => {
+                    gpu_answers = answers;
                     self.add_stats(|s| {
-                        s.gpu_views += gpu_idx.len();
+                        s.gpu_views += split.gpu_idx.len();
                         s.gpu_seconds += seconds;
                     });
                 }
             }
         }
-        Ok(out)
+        Ok(split.merge(self.scene, requests, exact_fractions, gpu_answers))
     }
 
     /// The profile to route by: pinned, cached or measured now (see [`ProfileSource`]).

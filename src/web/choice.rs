@@ -6,9 +6,9 @@
 //! ones counted on the GPU), never by timing, so a page's answers do not depend on its load.
 
 use crate::count::exact::engine::{ExactEngine, ViewLoad};
-use crate::count::hybrid::{EngineKind, Route, routed_to, simple_route};
+use crate::count::hybrid::{EngineKind, Route, Split, simple_route};
 use crate::count::lanes::Lane;
-use crate::count::{Engine, ViewAnswer, ViewRequest, cos_incidence};
+use crate::count::{Engine, ViewAnswer, ViewRequest};
 use crate::error::Result;
 use crate::scene::Scene;
 
@@ -40,31 +40,9 @@ impl Engine for Chosen<'_> {
                 (loads.iter().copied().map(simple_route).collect(), Some(loads))
             }
         };
-        let (gpu_idx, gpu_reqs) = routed_to(requests, &routes, Route::Gpu);
-        let (exact_idx, exact_reqs) = routed_to(requests, &routes, Route::Exact);
-        let mut out: Vec<ViewAnswer> = requests
-            .iter()
-            .map(|r| ViewAnswer {
-                cos_incidence: self.scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
-                ..Default::default()
-            })
-            .collect();
-        if !exact_reqs.is_empty() {
-            let fractions = match &loads {
-                // Routing walked every view already: the exact engine skips those that reached nothing.
-                Some(loads) => self.exact().fractions_loaded(&exact_reqs, &exact_idx.iter().map(|&i| loads[i]).collect::<Vec<_>>()),
-                None => self.exact().fractions(&exact_reqs),
-            };
-            for (&i, fraction) in exact_idx.iter().zip(fractions) {
-                out[i].fraction = fraction;
-                out[i].error_estimate = Some(0.0);
-            }
-        }
-        if !gpu_reqs.is_empty() {
-            for (&i, answer) in gpu_idx.iter().zip(self.lane.answer(&gpu_reqs).await?) {
-                out[i] = answer;
-            }
-        }
-        Ok(out)
+        let split = Split::new(requests, &routes, loads.as_deref());
+        let exact = if split.exact_reqs.is_empty() { Vec::new() } else { split.exact_fractions(self.exact()) };
+        let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane.answer(&split.gpu_reqs).await? };
+        Ok(split.merge(self.scene, requests, exact, gpu))
     }
 }
