@@ -19,5 +19,5 @@ for n in ${LOUVRES:-10 100}; do
   ours=$(seconds ./target/release/sunlit annual "$d/model.idf" --epw "$epw" -o "$d/shading.csv" --idf-out "$d/hooked.idf")
   hooked=$(seconds "$ENERGYPLUS" -w "$epw" -d "$d/hooked" "$d/hooked.idf")
   total=$(echo "$ours + $hooked" | bc)
-  printf '%-9s %12.1f s %10.1f s %12.1f s %10.1f s %7.1fx\n' "$n" "$clip" "$ours" "$hooked" "$total" "$(echo "$clip / $total" | bc -l)"
+  printf '%-9s %12.1f s %10.2f s %12.1f s %10.1f s %7.1fx\n' "$n" "$clip" "$ours" "$hooked" "$total" "$(echo "$clip / $total" | bc -l)"
 done

@@ -708,13 +708,15 @@ fn run_bench(args: BenchArgs) -> Result<()> {
         let start = Instant::now();
         return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
     }
+    let made = Instant::now();
     let counter = pollster::block_on(Counter::new(CounterOptions { max_atlas: args.atlas, ..args.pixels.options() }))?;
+    let startup = made.elapsed().as_secs_f64();
     let info = counter.adapter_info();
     eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
     let start = Instant::now();
     let now = move || start.elapsed().as_secs_f64();
     if !args.models.is_empty() {
-        return bench_models(&args, &counter, now);
+        return bench_models(&args, &counter, startup, now);
     }
     let suns = bench::suns(args.suns, 7);
     let mut cases: Vec<(String, Scene)> = Vec::new();
@@ -734,8 +736,10 @@ fn run_bench(args: BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// Times each model over its sampling plan's views; one JSON line each.
-fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Copy) -> Result<()> {
+/// Times each model over its sampling plan's views on the GPU alone (`--engine gpu`); one JSON line
+/// each. `startup` is what making `counter` took: with the other lanes' devices and the model's
+/// upload it is reported as `gpu_startup_seconds`, as the hybrid engine reports its own.
+fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn() -> f64 + Copy) -> Result<()> {
     let (days, per_day) = args
         .samples
         .split_once(['x', 'X'])
@@ -746,10 +750,12 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
     if lane_count == 0 {
         return Err(Error::argument("--lanes", "must be at least 1"));
     }
+    let lanes_made = now();
     let mut counters = vec![];
     for _ in 1..lane_count {
         counters.push(pollster::block_on(Counter::new(counter.options()))?);
     }
+    let startup = startup + now() - lanes_made;
     let counters: Vec<&Counter> = std::iter::once(counter).chain(&counters).collect();
     for name in &args.models {
         let t0 = now();
@@ -762,7 +768,9 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         } else {
             (model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(&args.location)?, None)
         };
+        let uploading = now();
         let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
+        let upload_seconds = now() - uploading;
         let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
         let load_seconds = now() - t0;
         let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
@@ -778,6 +786,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, now: impl Fn() -> f64 + Cop
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
+            "engine": EngineKind::Gpu.name(),
+            "gpu_startup_seconds": startup + upload_seconds,
             "receivers": scene.receivers.len(),
             "shading_polygons": shading,
             "triangles": scene.triangle_count(),
