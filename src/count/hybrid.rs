@@ -138,7 +138,8 @@ impl Profile {
         routes
     }
 
-    fn route_one(&self, load: ViewLoad) -> Route {
+    /// Where one view goes on its own load (before [`Self::route`]'s rule for the whole batch).
+    pub fn route_one(&self, load: ViewLoad) -> Route {
         if load.triangles == 0 {
             return Route::Exact;
         }
@@ -170,6 +171,17 @@ fn routed_to(requests: &[ViewRequest], routes: &[Route], route: Route) -> (Vec<u
     let idx: Vec<usize> = (0..requests.len()).filter(|&i| routes[i] == route).collect();
     let reqs = idx.iter().map(|&i| requests[i]).collect();
     (idx, reqs)
+}
+
+/// Answers holding only each view's cosine of incidence, for the engines' counts to fill in.
+fn unanswered(scene: &Scene, requests: &[ViewRequest]) -> Vec<ViewAnswer> {
+    requests
+        .iter()
+        .map(|r| ViewAnswer {
+            cos_incidence: scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
+            ..Default::default()
+        })
+        .collect()
 }
 
 /// One engine's part of a routed batch.
@@ -211,13 +223,7 @@ impl Split {
     /// The answers in the requests' order: exact ones carry their fraction and cosine (error 0),
     /// the GPU's their pixel counts too.
     pub fn merge(&self, scene: &Scene, requests: &[ViewRequest], exact: Vec<f64>, gpu: Vec<ViewAnswer>) -> Vec<ViewAnswer> {
-        let mut out: Vec<ViewAnswer> = requests
-            .iter()
-            .map(|r| ViewAnswer {
-                cos_incidence: scene.receivers.get(r.receiver as usize).map_or(0.0, |s| cos_incidence(s.normal, r.sun)),
-                ..Default::default()
-            })
-            .collect();
+        let mut out = unanswered(scene, requests);
         for (&i, fraction) in self.exact_idx.iter().zip(exact) {
             out[i].fraction = fraction;
             out[i].error_estimate = Some(0.0);
@@ -369,13 +375,48 @@ impl<'a> HybridEngine<'a> {
             (EngineKind::Gpu, _) | (_, None) => vec![Route::Gpu; requests.len()],
             (EngineKind::Exact, Some(_)) => vec![Route::Exact; requests.len()],
             (EngineKind::Auto, Some(exact)) => {
+                if let Some(profile) = self.stored_profile().await? {
+                    return self.count_in_one_walk(exact, profile, requests).await;
+                }
                 let loads = exact.loads(requests);
-                let profile = self.ensure_profile(exact, requests, &loads).await?;
+                let profile = self.measure_profile(exact, requests, &loads).await?;
                 let routes = profile.route(&loads);
                 return self.count_routed_loaded(requests, &routes, Some(&loads)).await;
             }
         };
         self.count_routed(requests, &routes).await
+    }
+
+    /// `auto` with a known profile, one BVH walk for most views: each view's walk gives its load,
+    /// and a view the profile clips whatever the others do ([`Profile::route_one`]) is clipped at
+    /// once from that walk. The rest follow [`Profile::route`] on all the loads, which only ever
+    /// moves views from the GPU to the exact engine, so every view goes where routing by loads
+    /// first would send it, with the same answer.
+    async fn count_in_one_walk(&self, exact: &ExactEngine, profile: &Profile, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
+        let start = now();
+        let walked = exact.fractions_unless(requests, |load| profile.route_one(load) == Route::Gpu);
+        let seconds = now() - start;
+        let loads: Vec<ViewLoad> = walked.iter().map(|(load, _)| *load).collect();
+        let routes = profile.route(&loads);
+        let clipped: Vec<usize> = (0..requests.len()).filter(|&i| walked[i].1.is_some()).collect();
+        self.add_stats(|s| {
+            s.exact_views += clipped.len();
+            s.exact_seconds += seconds;
+        });
+        let rest: Vec<usize> = (0..requests.len()).filter(|&i| walked[i].1.is_none()).collect();
+        let pick = |idx: &[usize]| -> Vec<ViewRequest> { idx.iter().map(|&i| requests[i]).collect() };
+        let rest_routes: Vec<Route> = rest.iter().map(|&i| routes[i]).collect();
+        let rest_loads: Vec<ViewLoad> = rest.iter().map(|&i| loads[i]).collect();
+        let rest_answers = self.count_routed_loaded(&pick(&rest), &rest_routes, Some(&rest_loads)).await?;
+        let mut out = unanswered(self.scene, requests);
+        for &i in &clipped {
+            out[i].fraction = walked[i].1.unwrap_or(0.0);
+            out[i].error_estimate = Some(0.0);
+        }
+        for (&i, answer) in rest.iter().zip(rest_answers) {
+            out[i] = answer;
+        }
+        Ok(out)
     }
 
     /// Counts each request on the engine `routes` names, both engines at once.
@@ -443,43 +484,53 @@ impl<'a> HybridEngine<'a> {
         Ok(split.merge(self.scene, requests, exact_fractions, gpu_answers))
     }
 
-    /// The profile to route by: pinned, cached or measured now (see [`ProfileSource`]).
-    async fn ensure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
+    /// The scene's size, as the profile's key names it: a profile is measured on the model's own
+    /// views, and its loads cost differently per model (leaves overlap far more than slats).
+    fn scene_key(&self) -> String {
+        format!("scene {} triangles, {} receivers", self.scene.triangle_count(), self.scene.receivers.len())
+    }
+
+    /// The profile to route by when one is known without measuring: already in use, pinned in a
+    /// file that exists, or cached for this device (see [`ProfileSource`]).
+    async fn stored_profile(&self) -> Result<Option<&Profile>> {
         if let Some((p, _)) = self.profile.get() {
-            return Ok(p);
+            return Ok(Some(p));
         }
-        // A profile is measured on the model's own views: its loads cost differently per model (leaves
-        // overlap far more than slats), so the key names the scene's size too.
-        let scene = format!("scene {} triangles, {} receivers", self.scene.triangle_count(), self.scene.receivers.len());
-        let (profile, from) = match &self.source {
-            ProfileSource::File(path) if path.exists() => (read_profile(path)?, "file"),
+        let scene = self.scene_key();
+        let found = match &self.source {
+            ProfileSource::File(path) if path.exists() => Some((read_profile(path)?, "file")),
             ProfileSource::Cache => {
                 // An exact-only profile is kept under the CPU's key: finding it asks no adapter.
                 let cpu = cpu_key(&self.options).map(|k| format!("{k}; {scene}"));
                 match cpu.as_deref().and_then(cached) {
-                    Some(p) => (p, "cache"),
-                    None => match cached(&format!("{}; {scene}", device_key(&self.options).await?)) {
-                        Some(p) => {
-                            // Kept by an older sunlit under its adapter's key: found without one next time.
-                            if let (None, Some(cpu)) = (&p.gpu, &cpu) {
-                                store_cached(cpu, &p);
-                            }
-                            (p, "cache")
+                    Some(p) => Some((p, "cache")),
+                    None => cached(&format!("{}; {scene}", device_key(&self.options).await?)).map(|p| {
+                        // Kept by an older sunlit under its adapter's key: found without one next time.
+                        if let (None, Some(cpu)) = (&p.gpu, &cpu) {
+                            store_cached(cpu, &p);
                         }
-                        None => (self.calibrate(exact, requests, loads, &scene).await?, "probe"),
-                    },
+                        (p, "cache")
+                    }),
                 }
             }
-            _ => (self.calibrate(exact, requests, loads, &scene).await?, "probe"),
+            _ => None,
         };
-        if from == "probe" {
-            match &self.source {
-                ProfileSource::File(path) => write_profile(path, &profile)?,
-                ProfileSource::Cache => store_cached(&profile.device, &profile),
-                ProfileSource::Probe => {}
-            }
+        Ok(found.and_then(|found| {
+            let _ = self.profile.set(found);
+            self.profile.get().map(|(p, _)| p)
+        }))
+    }
+
+    /// The profile measured now on these views (none being known: [`Self::stored_profile`]),
+    /// written where the source keeps it.
+    async fn measure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
+        let profile = self.calibrate(exact, requests, loads, &self.scene_key()).await?;
+        match &self.source {
+            ProfileSource::File(path) => write_profile(path, &profile)?,
+            ProfileSource::Cache => store_cached(&profile.device, &profile),
+            ProfileSource::Probe => {}
         }
-        let _ = self.profile.set((profile, from));
+        let _ = self.profile.set((profile, "probe"));
         self.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
     }
 

@@ -5,7 +5,7 @@
 //! in a page, so `auto` routes by [`simple_route`] (light views clipped, heavy or see-through
 //! ones counted on the GPU), never by timing, so a page's answers do not depend on its load.
 
-use crate::count::exact::engine::{ExactEngine, ViewLoad};
+use crate::count::exact::engine::ExactEngine;
 use crate::count::hybrid::{EngineKind, Route, Split, simple_route};
 use crate::count::lanes::Lane;
 use crate::count::{Engine, ViewAnswer, ViewRequest};
@@ -32,16 +32,22 @@ impl Engine for Chosen<'_> {
     }
 
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
-        let (routes, loads): (Vec<Route>, Option<Vec<ViewLoad>>) = match self.kind {
+        let (routes, clipped): (Vec<Route>, Option<Vec<f64>>) = match self.kind {
             EngineKind::Gpu => return self.lane.answer(requests).await,
             EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto => {
-                let loads = self.exact().loads(requests);
-                (loads.iter().copied().map(simple_route).collect(), Some(loads))
+                // One walk a view: its load routes it, and a view routed exact is clipped from it.
+                let walked = self.exact().fractions_unless(requests, |load| simple_route(load) == Route::Gpu);
+                let routes = walked.iter().map(|(_, f)| if f.is_some() { Route::Exact } else { Route::Gpu }).collect();
+                (routes, Some(walked.into_iter().filter_map(|(_, f)| f).collect()))
             }
         };
-        let split = Split::new(requests, &routes, loads.as_deref());
-        let exact = if split.exact_reqs.is_empty() { Vec::new() } else { split.exact_fractions(self.exact()) };
+        let split = Split::new(requests, &routes, None);
+        let exact = match clipped {
+            Some(clipped) => clipped,
+            None if split.exact_reqs.is_empty() => Vec::new(),
+            None => split.exact_fractions(self.exact()),
+        };
         let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane.answer(&split.gpu_reqs).await? };
         Ok(split.merge(self.scene, requests, exact, gpu))
     }

@@ -87,6 +87,8 @@ pub struct Scratch {
     hull: Vec<DVec2>,
     window_a: Vec<DVec2>,
     window_b: Vec<DVec2>,
+    /// The view's BVH walk: the triangle ranges it reached, clipped after the load is known.
+    reached: Vec<Range<usize>>,
     /// Shadows cast in this view.
     shadows: usize,
     /// The receiver's triangles and the view's shadows on the grid.
@@ -177,6 +179,7 @@ impl ExactEngine {
             hull: Vec::new(),
             window_a: Vec::new(),
             window_b: Vec::new(),
+            reached: Vec::new(),
             shadows: 0,
             boundary: Boundary::default(),
         }
@@ -215,6 +218,19 @@ impl ExactEngine {
         parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), one)
     }
 
+    /// Every view's [`Self::load`] and, unless `defer` claims that load, its fraction: one BVH
+    /// walk a view, for routing that clips most views and leaves the rest to be decided by
+    /// load. Natively over every core.
+    pub fn fractions_unless(&self, requests: &[ViewRequest], defer: impl Fn(ViewLoad) -> bool + Sync) -> Vec<(ViewLoad, Option<f64>)> {
+        let one = |i: usize, scratch: &mut Scratch| self.clip(requests[i], requests[i].leaves, true, &defer, scratch);
+        let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
+        if threads == 1 {
+            let mut scratch = self.scratch();
+            return (0..requests.len()).map(|i| one(i, &mut scratch)).collect();
+        }
+        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), one)
+    }
+
     /// [`Self::load`] of every request, natively over every core.
     pub fn loads(&self, requests: &[ViewRequest]) -> Vec<ViewLoad> {
         let threads = worker_threads().min(requests.len().div_ceil(4 * CHUNK)).max(1);
@@ -239,17 +255,46 @@ impl ExactEngine {
     /// Sunlit fraction of one view with leaf fraction `leaves`; `walk` false skips the BVH walk
     /// (for a view known to reach no triangle).
     pub fn fraction(&self, request: ViewRequest, leaves: f32, walk: bool, scratch: &mut Scratch) -> f64 {
+        self.clip(request, leaves, walk, |_| false, scratch).1.unwrap_or(0.0)
+    }
+
+    /// One view: its load (what its walk reached; none when `walk` is false or the view is dark)
+    /// and, unless `defer` claims that load, its sunlit fraction.
+    fn clip(
+        &self,
+        request: ViewRequest,
+        leaves: f32,
+        walk: bool,
+        defer: impl Fn(ViewLoad) -> bool,
+        scratch: &mut Scratch,
+    ) -> (ViewLoad, Option<f64>) {
         let sun = request.sun;
         let (Some(Some(outline)), Some(Some(frame))) =
             (self.outlines.get(request.receiver as usize), self.frames.get(request.receiver as usize))
         else {
-            return 0.0;
+            return (ViewLoad::default(), Some(0.0));
         };
         if !sun.is_finite() || is_dark(outline.normal, sun) {
-            return 0.0;
+            return (ViewLoad::default(), Some(0.0));
         }
-        let frame = frame.towards(sun);
         let view = view::fit(&outline.points, sun, self.bounds, self.origin, PRISM_SIDE);
+        let mut load = ViewLoad::default();
+        scratch.reached.clear();
+        if walk {
+            self.culling.visit_triangles(&view.view_proj, |r| {
+                load.triangles += r.len();
+                load.see_through += (self.see_through_before[r.end] - self.see_through_before[r.start]) as usize;
+                scratch.reached.push(r);
+            });
+        }
+        if defer(load) {
+            return (load, None);
+        }
+        (load, Some(self.clip_reached(outline, &frame.towards(sun), leaves, scratch)))
+    }
+
+    /// The sunlit fraction of `outline` under the shadows of the triangles in `s.reached`.
+    fn clip_reached(&self, outline: &Outline, frame: &PlaneFrame, leaves: f32, scratch: &mut Scratch) -> f64 {
         scratch.epoch = scratch.epoch.wrapping_add(1);
         if scratch.epoch == 0 {
             scratch.stamp.fill(0);
@@ -260,25 +305,23 @@ impl ExactEngine {
         for t in &outline.lit {
             scratch.boundary.push_points(t, true);
         }
-        if !walk {
-            return self.sunlit_ratio(outline, scratch);
-        }
-        self.culling.visit_triangles(&view.view_proj, |range| {
-            for p in range {
-                if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
-                    continue;
-                }
-                match self.object[p] {
-                    NO_OBJECT => self.triangle_shadow(&frame, outline, p, scratch),
-                    o => {
-                        if scratch.stamp[o as usize] != scratch.epoch {
-                            scratch.stamp[o as usize] = scratch.epoch;
-                            self.object_shadow(&frame, outline, o, scratch);
-                        }
+        // Taken out for the walk over it, which needs the rest of the scratch mutably.
+        let reached = std::mem::take(&mut scratch.reached);
+        for p in reached.iter().flat_map(|r| r.clone()) {
+            if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
+                continue;
+            }
+            match self.object[p] {
+                NO_OBJECT => self.triangle_shadow(frame, outline, p, scratch),
+                o => {
+                    if scratch.stamp[o as usize] != scratch.epoch {
+                        scratch.stamp[o as usize] = scratch.epoch;
+                        self.object_shadow(frame, outline, o, scratch);
                     }
                 }
             }
-        });
+        }
+        scratch.reached = reached;
         self.sunlit_ratio(outline, scratch)
     }
 
