@@ -42,7 +42,7 @@ const PROBE_EXACT_REPEATS: usize = 3;
 /// ... unless one run already took this long (s): then a preemption is a small part of it.
 const PROBE_REPEAT_BELOW: f64 = 0.002;
 /// Views per GPU probe batch (a light and a heavy batch).
-const PROBE_GPU_VIEWS: usize = 16;
+const PROBE_GPU_VIEWS: usize = 64;
 /// Start-up a GPU is assumed to cost (s) before one has been measured: below this much work
 /// in total, `auto` answers everything exactly without making a device.
 const ASSUMED_GPU_STARTUP: f64 = 0.5;
@@ -121,8 +121,10 @@ pub enum Route {
 }
 
 impl Profile {
-    /// Routes views with these loads: see the module doc. A pure function of its inputs.
-    pub fn route(&self, loads: &[ViewLoad]) -> Vec<Route> {
+    /// Routes views with these loads, a batch of a run of `run_views` views in all (the GPU's
+    /// start-up is paid once a run, so this batch's saving is weighed as the run's: scaled by
+    /// `run_views` over the batch's views): see the module doc. A pure function of its inputs.
+    pub fn route(&self, loads: &[ViewLoad], run_views: usize) -> Vec<Route> {
         let mut routes: Vec<Route> = loads.iter().map(|&l| self.route_one(l)).collect();
         let needed = loads.iter().any(|l| l.see_through > 0);
         let saving_us: f64 = loads
@@ -131,8 +133,9 @@ impl Profile {
             .filter(|(_, r)| **r == Route::Gpu)
             .map(|(&l, _)| self.exact.of(l) - self.gpu.map_or(0.0, |g| g.of(l)))
             .sum();
+        let runs_per_batch = (run_views as f64 / loads.len().max(1) as f64).max(1.0);
         let startup_us = 1e6 * self.gpu_startup_seconds.unwrap_or(ASSUMED_GPU_STARTUP);
-        if !needed && saving_us < startup_us {
+        if !needed && saving_us * runs_per_batch < startup_us {
             routes.iter_mut().for_each(|r| *r = Route::Exact);
         }
         routes
@@ -274,6 +277,8 @@ pub struct HybridEngine<'a> {
     gpu: OnceCell<Vec<(Counter, GpuScene)>>,
     profile: OnceCell<(Profile, &'static str)>,
     stats: std::cell::Cell<EngineStats>,
+    /// Views the caller expects to ask for in all ([`Engine::expect`]; 0: each batch alone).
+    run_views: std::cell::Cell<usize>,
 }
 
 impl<'a> HybridEngine<'a> {
@@ -299,6 +304,7 @@ impl<'a> HybridEngine<'a> {
             gpu: OnceCell::new(),
             profile: OnceCell::new(),
             stats: Default::default(),
+            run_views: Default::default(),
         })
     }
 
@@ -380,7 +386,7 @@ impl<'a> HybridEngine<'a> {
                 }
                 let loads = exact.loads(requests);
                 let profile = self.measure_profile(exact, requests, &loads).await?;
-                let routes = profile.route(&loads);
+                let routes = profile.route(&loads, self.run_views.get());
                 return self.count_routed_loaded(requests, &routes, Some(&loads)).await;
             }
         };
@@ -397,7 +403,7 @@ impl<'a> HybridEngine<'a> {
         let walked = exact.fractions_unless(requests, |load| profile.route_one(load) == Route::Gpu);
         let seconds = now() - start;
         let loads: Vec<ViewLoad> = walked.iter().map(|(load, _)| *load).collect();
-        let routes = profile.route(&loads);
+        let routes = profile.route(&loads, self.run_views.get());
         let clipped: Vec<usize> = (0..requests.len()).filter(|&i| walked[i].1.is_some()).collect();
         self.add_stats(|s| {
             s.exact_views += clipped.len();
@@ -558,7 +564,8 @@ impl<'a> HybridEngine<'a> {
             _ => device_key(&self.options).await?,
         };
         profile.device = format!("{device}; {scene}");
-        let seconds = now() - start;
+        // The GPU's start-up is reported on its own (`gpu_startup_seconds`), not twice.
+        let seconds = now() - start - profile.gpu_startup_seconds.unwrap_or(0.0);
         self.add_stats(|s| s.calibration_seconds += seconds);
         Ok(profile)
     }
@@ -573,6 +580,10 @@ impl Engine for HybridEngine<'_> {
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         self.count(requests).await
     }
+
+    fn expect(&self, views: usize) {
+        self.run_views.set(views);
+    }
 }
 
 /// Indices of up to `n` views with something in their prism, spread evenly over their loads.
@@ -583,18 +594,34 @@ fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
     loaded.into_iter().step_by(stride).collect()
 }
 
+/// `items` in an order that covers their range at ever finer steps: the first, the last, the
+/// middle, the quarters, … (positions in bit-reversed order), each once.
+fn coarse_to_fine<T: Copy>(items: &[T]) -> Vec<T> {
+    let n = items.len();
+    if n < 3 {
+        return items.to_vec();
+    }
+    let bits = usize::BITS - (n - 1).leading_zeros();
+    let mut order: Vec<usize> = vec![0, n - 1];
+    order.extend((1..1usize << bits).map(|k| k.reverse_bits() >> (usize::BITS - bits)).filter(|&p| p > 0 && p < n - 1));
+    order.into_iter().map(|p| items[p]).collect()
+}
+
 /// Times the exact engine view by view on one thread and fits its cost line; also the mean µs
 /// of a probed view (both per thread: a view costs the machine its time over the threads).
 fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize]) -> (Cost, f64) {
     let mut scratch = exact.scratch();
     let leaves_of = |i: usize| requests[i].leaves;
-    // Warm caches and the scratch memory first.
+    // Warm caches and the scratch memory first, on the lightest views.
     for &i in probe.iter().take(4) {
         exact.fraction(requests[i], leaves_of(i), true, &mut scratch);
     }
     let started = now();
     let mut samples = Vec::new();
-    for &i in probe {
+    // Coarse to fine over the sorted loads, so that a probe the time limit cuts short still
+    // spans the light and the heavy views (in load order it timed only the light ones, and on a
+    // dense model priced its heavy views at a tenth of what they cost).
+    for i in coarse_to_fine(probe) {
         // The fastest of a few runs: a light view takes tens of µs, and one preemption by
         // another process would otherwise count as milliseconds of clipping.
         let mut best = f64::INFINITY;
@@ -772,6 +799,21 @@ mod tests {
     }
 
     #[test]
+    fn coarse_to_fine_visits_each_once_ends_first_then_halves() {
+        let items: Vec<usize> = (0..10).collect();
+        let order = coarse_to_fine(&items);
+        assert_eq!(&order[..4], &[0, 9, 8, 4], "ends, then the middle of 16 positions (8), then a quarter (4)");
+        let mut sorted = order.clone();
+        sorted.sort();
+        assert_eq!(sorted, items, "each item once");
+        assert_eq!(coarse_to_fine(&[7, 8]), vec![7, 8]);
+        assert!(coarse_to_fine::<u8>(&[]).is_empty());
+        // After the ends, every prefix of a power-of-two length's order halves the largest gap.
+        let order = coarse_to_fine(&(0..17).collect::<Vec<usize>>());
+        assert_eq!(&order[..5], &[0, 16, 8, 4, 12]);
+    }
+
+    #[test]
     fn routing_follows_the_cheaper_modelled_cost() {
         let profile = Profile {
             device: "test".into(),
@@ -781,15 +823,19 @@ mod tests {
         };
         // Break-even at 10 + n = 500 + 0.1 n, n ≈ 544.
         let loads = [load(0), load(100), load(544), load(545), load(5_000), ViewLoad { triangles: 3, see_through: 1 }];
-        let routes = profile.route(&loads);
+        let routes = profile.route(&loads, 0);
         assert_eq!(routes, vec![Route::Exact, Route::Exact, Route::Exact, Route::Gpu, Route::Gpu, Route::Gpu]);
         // A GPU start-up the saving does not pay: all exact, but see-through views need the GPU.
         let slow_start = Profile { gpu_startup_seconds: Some(10.0), ..profile.clone() };
-        assert_eq!(slow_start.route(&loads[..5]), vec![Route::Exact; 5]);
-        assert_eq!(slow_start.route(&loads)[5], Route::Gpu);
+        assert_eq!(slow_start.route(&loads[..5], 0), vec![Route::Exact; 5]);
+        assert_eq!(slow_start.route(&loads, 0)[5], Route::Gpu);
+        // The same batch in a run long enough that its saving, run-wide, pays the start-up:
+        // 4,010.5 µs saved a batch (4,010 on the heaviest view, 0.5 at 545), × 20,000/5 ≥ 10 s.
+        assert_eq!(slow_start.route(&loads[..5], 20_000), vec![Route::Exact, Route::Exact, Route::Exact, Route::Gpu, Route::Gpu]);
+        assert_eq!(slow_start.route(&loads[..5], 10_000), vec![Route::Exact; 5], "4,010.5 µs × 2,000 < 10 s");
         // No GPU measured: all exact.
         let exact_only = Profile { gpu: None, ..profile };
-        assert!(exact_only.route(&loads[..5]).iter().all(|r| *r == Route::Exact));
+        assert!(exact_only.route(&loads[..5], 1_000_000).iter().all(|r| *r == Route::Exact));
     }
 
     #[test]

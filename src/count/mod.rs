@@ -79,6 +79,10 @@ pub trait Engine {
 
     /// One answer per request, in request order.
     fn answer(&self, requests: &[ViewRequest]) -> impl Future<Output = Result<Vec<ViewAnswer>>>;
+
+    /// Told that about `views` views will be asked for in all, batch by batch: an engine with a
+    /// once-a-run cost (a GPU's start-up) weighs it against the run, not one batch.
+    fn expect(&self, _views: usize) {}
 }
 
 /// A leaf fraction as a [`ViewRequest`] takes it, refused outside 0 (bare) ..= 1 (full leaf).

@@ -211,6 +211,7 @@ impl<E: Engine> Views<'_, E> {
     async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
         progress(Progress { done: 0, total: requests.len() })?;
+        self.engine.expect(requests.len());
         let per_report = self.engine.batch().max(1) * BATCHES_PER_REPORT;
         for chunk in requests.chunks(per_report) {
             out.extend(self.engine.answer(chunk).await?.into_iter().map(|c| c.fraction));
