@@ -11,7 +11,7 @@ use std::process::Command;
 use sunlit::model::office_idf::{Shading, office_idf};
 
 mod common;
-use common::energyplus::energyplus;
+use common::energyplus::{columns, energyplus};
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")
@@ -55,22 +55,6 @@ fn sunlit_annual(idf: &Path, dir: &Path, extra: &[&str]) -> (PathBuf, PathBuf) {
     let out = command.output().unwrap();
     assert!(out.status.success(), "sunlit annual {}: {}", idf.display(), String::from_utf8_lossy(&out.stderr));
     (csv, hooked)
-}
-
-/// A CSV as columns by upper-cased header name (first column dropped).
-fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim().to_uppercase()).collect();
-    let mut cols: HashMap<String, Vec<f64>> = HashMap::new();
-    for line in lines {
-        for (name, field) in header.iter().zip(line.split(',')).skip(1) {
-            if let Ok(v) = field.trim().parse::<f64>() {
-                cols.entry(name.clone()).or_default().push(v);
-            }
-        }
-    }
-    cols
 }
 
 /// The column of eplusout.csv for `key:variable` (case-insensitive, frequency ignored).

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::energyplus::energyplus;
+use common::energyplus::{columns, energyplus};
 
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
@@ -130,22 +130,6 @@ fn sunlit_ok(idf: &Path, csv: &Path, extra: &[&str]) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(out.status.success(), "sunlit annual {}: {stderr}", idf.display());
     stderr
-}
-
-/// A CSV as columns by upper-cased header name (first column dropped, empty cells skipped).
-fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(|h| h.trim().to_uppercase()).collect();
-    let mut cols: HashMap<String, Vec<f64>> = HashMap::new();
-    for line in lines {
-        for (name, field) in header.iter().zip(line.split(',')).skip(1) {
-            if let Ok(v) = field.trim().parse::<f64>() {
-                cols.entry(name.clone()).or_default().push(v);
-            }
-        }
-    }
-    cols
 }
 
 /// "Total Site Energy" (GJ) from a run's eplustbl.csv.

@@ -1,5 +1,6 @@
 //! Where the round-trip tests find EnergyPlus 25.2.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The EnergyPlus binary: `ENERGYPLUS`, else the one `npm test` installs into .venv-ep. Panics
@@ -14,4 +15,21 @@ pub fn energyplus() -> PathBuf {
     });
     #[allow(clippy::expect_used)] // A test helper: no EnergyPlus is a failure that says how to get it.
     found.expect("EnergyPlus 25.2 not found: run `npm test` (installs it into .venv-ep) or set ENERGYPLUS to its binary")
+}
+
+/// A CSV as columns by upper-cased header name (first column dropped, empty cells skipped): a
+/// sunlit schedule, or an EnergyPlus eplusout.csv / eplusshading.csv.
+pub fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap_or_default().split(',').map(|h| h.trim().to_uppercase()).collect();
+    let mut cols: HashMap<String, Vec<f64>> = HashMap::new();
+    for line in lines {
+        for (name, field) in header.iter().zip(line.split(',')).skip(1) {
+            if let Ok(v) = field.trim().parse::<f64>() {
+                cols.entry(name.clone()).or_default().push(v);
+            }
+        }
+    }
+    cols
 }
