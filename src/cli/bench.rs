@@ -1,0 +1,276 @@
+//! `sunlit bench`, the CLI's edge of [`sunlit::bench`]: its flags, the generated or loaded models,
+//! timing them on the GPU alone or on the hybrid engine, and one JSON line a model. The library
+//! owns the models, the synthetic cases and the timing of views.
+
+use super::*;
+
+#[derive(Args)]
+pub(super) struct BenchArgs {
+    /// List the generated benchmark models and exit.
+    #[arg(long)]
+    list: bool,
+    /// Write the one generated model named as glb and exit.
+    #[arg(long, value_name = "FILE.glb")]
+    write: Option<PathBuf>,
+    /// Sampling plan for models: days per year × samples per day (the views `sunlit annual`
+    /// counts for its spline, before refinement).
+    #[arg(long, value_name = "DAYSxPER_DAY", default_value = "27x19")]
+    samples: String,
+    /// Time an even spread of at most this many of a model's views and extrapolate the total.
+    #[arg(long, value_name = "N")]
+    views: Option<usize>,
+    /// Also check this many of the rendered views against the exact CPU reference (not timed).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    check: usize,
+    /// Location of model files (generated models carry their own): latitude, longitude, time zone.
+    #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true, default_value = "39.74,-105.18,-7")]
+    location: String,
+    /// Occluder triangle counts for the synthetic cases.
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
+    triangles: Vec<usize>,
+    /// Leaf counts for street-tree cases (trees in full leaf in front of a facade), e.g.
+    /// 35905,233866 as in the paper's Blaas case; none by default.
+    #[arg(long, value_delimiter = ',')]
+    trees: Vec<usize>,
+    /// Sun directions per case.
+    #[arg(long, default_value_t = 64)]
+    suns: usize,
+    #[command(flatten)]
+    pixels: PixelArgs,
+    /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
+    #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
+    atlas: u32,
+    /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
+    /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
+    #[arg(long, value_name = "N")]
+    lanes: Option<usize>,
+    #[command(flatten)]
+    engine: EngineArgs,
+    /// Generated model names (see --list) or glTF/IDF model files.
+    models: Vec<String>,
+}
+
+pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
+    if args.list {
+        for (name, description) in bench::models::CATALOGUE {
+            println!("{name:<20} {description}");
+        }
+        return Ok(());
+    }
+    if let Some(path) = &args.write {
+        let [name] = args.models.as_slice() else {
+            return Err(Error::argument("--write", "name exactly one generated model (see --list)"));
+        };
+        let model = bench::models::generate(name)?;
+        std::fs::write(path, model.glb.to_glb()).map_err(|source| Error::Io { path: path.clone(), source })?;
+        eprintln!("wrote {} ({} receivers, {} shading polygons)", path.display(), model.receivers, model.shading_polygons);
+        return Ok(());
+    }
+    if args.suns == 0 {
+        return Err(Error::argument("--suns", "must be at least 1"));
+    }
+    if !args.models.is_empty() && args.engine.kind()? != EngineKind::Gpu {
+        let start = Instant::now();
+        return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
+    }
+    let made = Instant::now();
+    let counter = pollster::block_on(Counter::new(CounterOptions { max_atlas: args.atlas, ..args.pixels.options() }))?;
+    let startup = made.elapsed().as_secs_f64();
+    let info = counter.adapter_info();
+    eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
+    let start = Instant::now();
+    let now = move || start.elapsed().as_secs_f64();
+    if !args.models.is_empty() {
+        return bench_models(&args, &counter, startup, now);
+    }
+    let suns = bench::suns(args.suns, 7);
+    let mut cases: Vec<(String, Scene)> = Vec::new();
+    for &n in &args.triangles {
+        cases.push((format!("cloud {n}"), bench::occluder_cloud(n, 42)?));
+    }
+    for &n in &args.trees {
+        let glb = bench::street_trees_glb(n, 11);
+        cases.push((format!("street trees {n} leaves"), model::load_bytes(&[("trees.glb".into(), glb)], &LoadOptions::default())?));
+    }
+    let office = sunlit::model::office::office(6).to_glb();
+    cases.push(("example office".into(), model::load_bytes(&[("office.glb".into(), office)], &LoadOptions::default())?));
+    for (name, scene) in &cases {
+        let t = pollster::block_on(bench::time_views(&counter, name, scene, &suns, now))?;
+        println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
+    }
+    Ok(())
+}
+
+/// Times each model over its sampling plan's views on the GPU alone (`--engine gpu`); one JSON line
+/// each. `startup` is what making `counter` took: with the other lanes' devices and the model's
+/// upload it is reported as `gpu_startup_seconds`, as the hybrid engine reports its own.
+fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn() -> f64 + Copy) -> Result<()> {
+    let (days, per_day, plan) = bench_plan(&args.samples)?;
+    let lane_count = args.lanes.unwrap_or_else(|| default_lanes(counter.adapter_info()));
+    if lane_count == 0 {
+        return Err(Error::argument("--lanes", "must be at least 1"));
+    }
+    let lanes_made = now();
+    let mut counters = vec![];
+    for _ in 1..lane_count {
+        counters.push(pollster::block_on(Counter::new(counter.options()))?);
+    }
+    let startup = startup + now() - lanes_made;
+    let counters: Vec<&Counter> = std::iter::once(counter).chain(&counters).collect();
+    for name in &args.models {
+        let t0 = now();
+        let (scene, location, shading) = bench_model(name, &args.location)?;
+        let uploading = now();
+        let gpus = counters.iter().map(|c| c.upload(&scene)).collect::<Result<Vec<_>>>()?;
+        let upload_seconds = now() - uploading;
+        let lanes: Vec<Lane<'_>> = counters.iter().zip(&gpus).map(|(counter, gpu)| Lane { counter, gpu }).collect();
+        let load_seconds = now() - t0;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
+        let spread;
+        let requests = match args.views {
+            Some(n) => {
+                spread = bench::spread(&all, n);
+                &spread
+            }
+            None => &all,
+        };
+        let t = pollster::block_on(bench::time_requests(&lanes, requests, now))?;
+        let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
+        let mut line = json!({
+            "model": name,
+            "engine": EngineKind::Gpu.name(),
+            "gpu_startup_seconds": startup + upload_seconds,
+            "receivers": scene.receivers.len(),
+            "shading_polygons": shading,
+            "triangles": scene.triangle_count(),
+            "samples": format!("{days}x{per_day}"),
+            "resolution": counter.resolution(),
+            "accuracy": counter.options().accuracy,
+            "sides": t.sides,
+            "lanes": lanes.len(),
+            "views": all.len(),
+            "views_timed": t.views,
+            "views_rendered": t.rendered,
+            "views_skipped": t.skipped,
+            "seconds": t.seconds,
+            "estimated_seconds_all_views": estimated,
+            "views_per_second": t.views_per_second,
+            "planning_seconds": t.planning_seconds,
+            "mean_triangles_drawn": t.mean_triangles_drawn.round(),
+            "tiles_rendered": t.tiles_rendered,
+            "mean_triangles_per_tile": t.mean_triangles_per_tile.round(),
+            "load_seconds": load_seconds,
+            "peak_memory_mib": peak_memory_mib(),
+        });
+        if args.check > 0 {
+            let check = bench::check_exact(&scene, requests, &t.counted, args.check);
+            line["exact_views_checked"] = json!(check.views);
+            line["mean_abs_error"] = json!(check.mean);
+            line["max_abs_error"] = json!(check.max);
+            if counter.options().accuracy.is_some() {
+                line["views_above_their_error_estimate"] = json!(check.above_estimate);
+            }
+        }
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// A bench model: generated by name (with its own location and shading polygon count), else
+/// read from a file at `location`. A name that is neither gets the list of generated names.
+fn bench_model(name: &str, location: &str) -> Result<(Scene, Location, Option<usize>)> {
+    let generated = bench::models::CATALOGUE.iter().any(|(n, _)| *n == name) || !std::path::Path::new(name).exists();
+    if generated {
+        let m = bench::models::generate(name)?;
+        let scene = model::load_bytes(&[(format!("{name}.glb"), m.glb.to_glb())], &LoadOptions::default())?;
+        return Ok((scene, m.location, Some(m.shading_polygons)));
+    }
+    Ok((model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(location)?, None))
+}
+
+/// The sampling plan `--samples` names.
+fn bench_plan(samples: &str) -> Result<(usize, usize, SamplingPlan)> {
+    let (days, per_day) = samples
+        .split_once(['x', 'X'])
+        .and_then(|(d, s)| Some((d.trim().parse().ok()?, s.trim().parse().ok()?)))
+        .ok_or_else(|| Error::argument("--samples", format!("'{samples}' is not DAYSxPER_DAY (e.g. 27x19)")))?;
+    Ok((days, per_day, SamplingPlan::new(days, per_day)?))
+}
+
+/// [`bench_models`] with `--engine auto` or `exact`: times the hybrid engine over each model's
+/// views (calibration and GPU start-up included, and reported apart); `--check` compares the
+/// GPU-routed views, and as many exactly-clipped ones, with the exact reference.
+fn bench_hybrid(args: &BenchArgs, now: impl Fn() -> f64 + Copy) -> Result<()> {
+    let (days, per_day, plan) = bench_plan(&args.samples)?;
+    let kind = args.engine.kind()?;
+    let options = CounterOptions { max_atlas: args.atlas, ..args.pixels.options() };
+    for name in &args.models {
+        let t0 = now();
+        let (scene, location, shading) = bench_model(name, &args.location)?;
+        let engine = HybridEngine::new(&scene, kind, options, args.lanes, args.engine.source())?;
+        let load_seconds = now() - t0;
+        let all = sunlit::year::annual::sample_requests(&scene, &location, plan)?;
+        let requests = match args.views {
+            Some(n) => bench::spread(&all, n),
+            None => all.clone(),
+        };
+        // Routed as the whole plan would be: the GPU's start-up is weighed against all its views.
+        engine.expect(all.len());
+        let t1 = now();
+        let answers = pollster::block_on(engine.answer(&requests))?;
+        let seconds = now() - t1;
+        let stats = engine.stats();
+        // Once-a-run costs are not scaled with the views; they are reported apart.
+        let once = stats.calibration_seconds + stats.gpu_startup_seconds;
+        let estimated = (seconds - once).max(0.0) * all.len() as f64 / requests.len().max(1) as f64;
+        let rendered = answers.iter().filter(|a| a.side.is_some()).count();
+        let mut sides: std::collections::BTreeMap<u32, usize> = Default::default();
+        answers.iter().filter_map(|a| a.side).for_each(|s| *sides.entry(s).or_default() += 1);
+        let mut line = json!({
+            "model": name,
+            "engine": kind.name(),
+            "receivers": scene.receivers.len(),
+            "shading_polygons": shading,
+            "triangles": scene.triangle_count(),
+            "samples": format!("{days}x{per_day}"),
+            "resolution": options.resolution,
+            "accuracy": options.accuracy,
+            "sides": sides,
+            "lanes": engine.lanes().map_or(0, |l| l.len()),
+            "views": all.len(),
+            "views_timed": requests.len(),
+            "views_rendered": rendered,
+            "views_skipped": requests.len() - rendered,
+            "seconds": seconds,
+            "estimated_seconds_all_views": estimated,
+            "views_per_second": requests.len() as f64 / seconds.max(1e-9),
+            "exact_views": stats.exact_views,
+            "gpu_views": stats.gpu_views,
+            "exact_seconds": stats.exact_seconds,
+            "gpu_seconds": stats.gpu_seconds,
+            "calibration_seconds": stats.calibration_seconds,
+            "gpu_startup_seconds": stats.gpu_startup_seconds,
+            "convex_objects": engine.exact().map(|e| e.convex_objects()),
+            "calibration": engine.profile().map(|(p, from)| json!({"from": from, "profile": p})),
+            "load_seconds": load_seconds,
+            "peak_memory_mib": peak_memory_mib(),
+        });
+        if args.check > 0 {
+            let (gpu_check, exact_check) = bench::check_answers(&scene, &requests, &answers, args.check);
+            line["exact_views_checked"] = json!(gpu_check.views);
+            line["mean_abs_error"] = json!(gpu_check.mean);
+            line["max_abs_error"] = json!(gpu_check.max);
+            line["exact_engine_views_checked"] = json!(exact_check.views);
+            line["exact_engine_max_abs_difference"] = json!(exact_check.max);
+        }
+        println!("{line}");
+    }
+    Ok(())
+}
+
+/// Peak resident memory of this process (VmHWM), where the OS reports it.
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib: f64 = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?.trim().trim_end_matches("kB").trim().parse().ok()?;
+    Some(kib / 1024.0)
+}
