@@ -243,11 +243,17 @@ impl ExactEngine {
         if !request.sun.is_finite() || is_dark(outline.normal, request.sun) {
             return ViewLoad::default();
         }
-        let view = view::fit(&outline.points, request.sun, self.bounds, self.origin, PRISM_SIDE);
+        self.walk(outline, request.sun, |_| {})
+    }
+
+    /// The BVH walk of one view's prism: what it reaches, each range handed to `reached`.
+    fn walk(&self, outline: &Outline, sun: DVec3, mut reached: impl FnMut(Range<usize>)) -> ViewLoad {
+        let view = view::fit(&outline.points, sun, self.bounds, self.origin, PRISM_SIDE);
         let mut load = ViewLoad::default();
         self.culling.visit_triangles(&view.view_proj, |r| {
             load.triangles += r.len();
             load.see_through += (self.see_through_before[r.end] - self.see_through_before[r.start]) as usize;
+            reached(r);
         });
         load
     }
@@ -277,16 +283,8 @@ impl ExactEngine {
         if !sun.is_finite() || is_dark(outline.normal, sun) {
             return (ViewLoad::default(), Some(0.0));
         }
-        let view = view::fit(&outline.points, sun, self.bounds, self.origin, PRISM_SIDE);
-        let mut load = ViewLoad::default();
         scratch.reached.clear();
-        if walk {
-            self.culling.visit_triangles(&view.view_proj, |r| {
-                load.triangles += r.len();
-                load.see_through += (self.see_through_before[r.end] - self.see_through_before[r.start]) as usize;
-                scratch.reached.push(r);
-            });
-        }
+        let load = if walk { self.walk(outline, sun, |r| scratch.reached.push(r)) } else { ViewLoad::default() };
         if defer(load) {
             return (load, None);
         }
