@@ -1,6 +1,6 @@
 // Headless Debian Chromium with WebGPU on its bundled SwiftShader (../shared/notes/gpu.md), and a
-// static server for the apps it loads, for
-// the page tests. The same flags are in webdriver.json for wasm-bindgen-test-runner.
+// static server for the apps it loads, for the page tests. The same flags are in webdriver.json
+// for wasm-bindgen-test-runner.
 import { readFileSync } from 'node:fs';
 import { readFile } from 'node:fs/promises';
 import { createServer } from 'node:http';
