@@ -381,11 +381,20 @@ impl<'a> HybridEngine<'a> {
             (EngineKind::Gpu, _) | (_, None) => vec![Route::Gpu; requests.len()],
             (EngineKind::Exact, Some(_)) => vec![Route::Exact; requests.len()],
             (EngineKind::Auto, Some(exact)) => {
-                if let Some(profile) = self.stored_profile().await? {
+                let stored = self.stored_profile().await?;
+                // One walk a view learns the GPU's views only once every view is walked, so the
+                // engines then run one after the other: taken only while no view of this run has
+                // gone to the GPU (an exact-only profile, or a model clipped throughout so far).
+                if let Some(profile) = stored
+                    && self.stats().gpu_views == 0
+                {
                     return self.count_in_one_walk(exact, profile, requests).await;
                 }
                 let loads = exact.loads(requests);
-                let profile = self.measure_profile(exact, requests, &loads).await?;
+                let profile = match stored {
+                    Some(p) => p,
+                    None => self.measure_profile(exact, requests, &loads).await?,
+                };
                 let routes = profile.route(&loads, self.run_views.get());
                 return self.count_routed_loaded(requests, &routes, Some(&loads)).await;
             }
@@ -397,7 +406,7 @@ impl<'a> HybridEngine<'a> {
     /// and a view the profile clips whatever the others do ([`Profile::route_one`]) is clipped at
     /// once from that walk. The rest follow [`Profile::route`] on all the loads, which only ever
     /// moves views from the GPU to the exact engine, so every view goes where routing by loads
-    /// first would send it, with the same answer.
+    /// first would send it, with the same answer. The GPU's views wait for the whole walk.
     async fn count_in_one_walk(&self, exact: &ExactEngine, profile: &Profile, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         let start = now();
         let walked = exact.fractions_unless(requests, |load| profile.route_one(load) == Route::Gpu);
