@@ -1,0 +1,137 @@
+//! A read [`Building`] into the scene: each surface triangulated in world coordinates with its
+//! windows and doors cut out, set-back windows' reveals, and `Mir-` back faces where asked.
+
+use super::*;
+
+/// Why a subsurface cannot be a hole in `base`, if it cannot.
+pub(super) fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String> {
+    let plane = Plane::of_polygon(&base.vertices);
+    let outline: Vec<DVec2> = base.vertices.iter().map(|p| plane.project(*p)).collect();
+    // Off the plane is no problem: EnergyPlus cuts a sub-surface's projection out of its base
+    // surface at any offset (see `super::reveal`).
+    if hole.vertices.iter().any(|p| !inside_or_on(plane.project(*p), &outline, EDGE_TOLERANCE)) {
+        return Some(format!("is not within its base surface '{}'", base.name));
+    }
+    None
+}
+
+/// A surface's triangles in world coordinates, holes cut out, wound counter-clockwise seen from
+/// outside. Receivers are flattened onto their best-fit plane (a scene receiver must be planar).
+pub(super) fn triangulate(surface: &EpSurface, holes: &[&EpSurface]) -> Vec<[DVec3; 3]> {
+    let plane = Plane::of_polygon(&surface.vertices);
+    let mut points: Vec<DVec3> = surface.vertices.iter().map(|p| if surface.receiver { plane.flatten(*p) } else { *p }).collect();
+    let mut starts: Vec<usize> = Vec::new();
+    for hole in holes {
+        starts.push(points.len());
+        points.extend(hole.vertices.iter().map(|p| plane.flatten(*p)));
+    }
+    let mut triangles = geometry::triangulate(&plane, &points, &starts);
+    if triangles.is_empty() {
+        // Self-intersecting outlines defeat ear clipping; a fan over the outline still casts.
+        triangles = (1..surface.vertices.len().saturating_sub(1)).map(|i| geometry::wind(&points, [0, i, i + 1], plane.normal)).collect();
+    }
+    triangles.iter().map(|t| t.map(|i| points[i])).collect()
+}
+
+impl Building {
+    /// Adds every surface as shadow-casting geometry; receivers are the surfaces whose Outside
+    /// Boundary Condition is Outdoors plus all fenestration (windows, glass doors, doors). A
+    /// window or door is a hole in its base surface, so a wall's receiver is its net area, as
+    /// EnergyPlus's sunlit fraction of the wall is; polygons with holes are triangulated by ear
+    /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
+    /// written in the file (EnergyPlus itself reports them upper-cased).
+    pub fn add_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_surfaces(builder, false)
+    }
+
+    /// As [`Building::add_to`], but every surface receives, and every shading surface also gets
+    /// its back face `Mir-NAME` as EnergyPlus makes it: the columns EnergyPlus's `Imported`
+    /// method looks up (those of its own eplusshading.csv).
+    pub fn add_all_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_surfaces(builder, true)?;
+        for s in self.surfaces.iter().filter(|s| s.is_shading()) {
+            builder.add_mirror(&s.name, &format!("Mir-{}", s.name));
+        }
+        Ok(())
+    }
+
+    fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool) -> Result<()> {
+        let holes = self.holes();
+        for (i, surface) in self.surfaces.iter().enumerate() {
+            let placed = self.placed(surface);
+            let surface = match &placed {
+                Some(SubPlacement::InPlane(vertices)) => &EpSurface { vertices: vertices.clone(), ..surface.clone() },
+                _ => surface,
+            };
+            if let Some(SubPlacement::SetBack { sides, .. }) = &placed {
+                self.add_reveal(builder, surface, sides);
+            }
+            let triangles = triangulate(surface, holes.get(&i).map_or(&[][..], Vec::as_slice));
+            let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
+            let mesh = builder.add_mesh(format!("{}: {}", self.file, surface.label()), relative_mesh(&triangles, anchor));
+            builder.add_node(SourceNode {
+                name: surface.name.clone(),
+                origin: format!("{}: {}", self.file, surface.label()),
+                mesh,
+                transform: DMat4::from_translation(anchor),
+                receiver: all || surface.receiver,
+            });
+        }
+        Ok(())
+    }
+
+    /// Where EnergyPlus puts a window or door against its base surface (None for other surfaces).
+    fn placed(&self, surface: &EpSurface) -> Option<SubPlacement> {
+        let base = surface.base.as_deref().filter(|_| surface.is_fenestration()).and_then(|b| self.surface(b))?;
+        if base.is_fenestration() || base.is_shading() {
+            return None;
+        }
+        reveal::place(&base.vertices, &surface.vertices)
+    }
+
+    /// The sides of a set-back window's reveal: casters only, never receivers (not EnergyPlus
+    /// surfaces), named `<window> reveal`.
+    fn add_reveal(&self, builder: &mut SceneBuilder, surface: &EpSurface, sides: &[[DVec3; 3]]) {
+        let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
+        let origin = format!("{}: the reveal of {}", self.file, surface.label());
+        let mesh = builder.add_mesh(origin.clone(), relative_mesh(sides, anchor));
+        builder.add_node(SourceNode {
+            name: format!("{} reveal", surface.name),
+            origin,
+            mesh,
+            transform: DMat4::from_translation(anchor),
+            receiver: false,
+        });
+    }
+
+    /// Names of the receivers in the order [`Building::add_to`] adds them.
+    pub fn receiver_names(&self) -> Vec<String> {
+        self.surfaces.iter().filter(|s| s.receiver).map(|s| s.name.clone()).collect()
+    }
+
+    /// A surface by name (case-insensitive, as EnergyPlus).
+    pub fn surface(&self, name: &str) -> Option<&EpSurface> {
+        self.surfaces.iter().find(|s| s.name.eq_ignore_ascii_case(name))
+    }
+
+    /// Surface index → the windows and doors cut out of it (those that fit in it; the others
+    /// were warned about when reading).
+    pub(super) fn holes(&self) -> HashMap<usize, Vec<&EpSurface>> {
+        let index: HashMap<String, usize> = self.surfaces.iter().enumerate().map(|(i, s)| (key(&s.name), i)).collect();
+        let mut holes: HashMap<usize, Vec<&EpSurface>> = HashMap::new();
+        for hole in self.surfaces.iter().filter(|s| s.is_fenestration()) {
+            let Some(&b) = hole.base.as_deref().and_then(|b| index.get(&key(b))) else { continue };
+            let base = &self.surfaces[b];
+            if !base.is_fenestration() && !base.is_shading() && hole_problem(base, hole).is_none() {
+                holes.entry(b).or_default().push(hole);
+            }
+        }
+        holes
+    }
+}
+
+/// Triangles as a mesh relative to `anchor`, so f32 positions keep millimetres far from the origin.
+fn relative_mesh(triangles: &[[DVec3; 3]], anchor: DVec3) -> SourceMesh {
+    let positions: Vec<[f32; 3]> = triangles.iter().flatten().map(|p| (*p - anchor).as_vec3().to_array()).collect();
+    SourceMesh { indices: (0..positions.len() as u32).collect(), positions }
+}
