@@ -16,7 +16,8 @@ profiles=$(mktemp -d)
 trap 'rm -rf "$profiles"' EXIT
 total='.estimated_seconds_all_views + (.gpu_startup_seconds // 0) + (.calibration_seconds // 0)'
 runs=${RUNS:-3}
-bench() { ./target/release/sunlit bench "$1" --views "$views" --resolution "$resolution" "${@:2}" 2>/dev/null; }
+# sunlit's stderr (the adapter line) is shown only when it fails.
+bench() { ./target/release/sunlit bench "$1" --views "$views" --resolution "$resolution" "${@:2}" 2>"$profiles/stderr" || { cat "$profiles/stderr" >&2; return 1; }; }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 printf '%-20s %10s %10s %10s %12s %s\n' model exact gpu auto auto/best "auto's split (exact/gpu views)"
 for m in $models; do
