@@ -4,9 +4,11 @@
 //! Owns the per-view work and its scheduling over threads. What differs from the reference:
 //! - a view clips only the triangles of the BVH leaves in its prism ([`Culling::visit_triangles`],
 //!   the walk the GPU path draws from), not every triangle of the scene;
-//! - the triangles of one convex object ([`super::objects`]: a box, a slat, a rod, a leaf) cast
-//!   one shadow, the hull of their clipped vertices' projections, so the union sees a few dozen
-//!   convex polygons instead of hundreds of triangles;
+//! - the triangles of one convex object ([`super::objects`]: a box, a slat, a rod or tube even
+//!   without its ends, a leaf) cast one shadow, the hull of their clipped vertices' projections,
+//!   so the union sees a few dozen convex polygons instead of hundreds of triangles (an object
+//!   with open ends casts its triangles one by one in the views where the sun may pass through
+//!   it: its ends' projections overlap, or the receiver's plane cuts it);
 //! - each receiver's 2D outline is made once, the scratch memory (polygon buffers, the overlay's
 //!   graph) is per thread and reused, so no triangle allocates;
 //! - natively, views are spread over every core (threads take chunks of views in turn); a view's
@@ -69,6 +71,13 @@ pub struct ExactEngine {
     /// Per convex object: its triangle positions, a range of `object_triangles`.
     objects: Vec<Range<u32>>,
     object_triangles: Vec<u32>,
+    /// Per object: its open caps, a range of `caps` (empty for a closed one; see
+    /// [`objects::Convexity`]).
+    object_caps: Vec<Range<u32>>,
+    /// Per cap: its corners in order, a range of `cap_corners`.
+    caps: Vec<Range<u32>>,
+    /// A cap's corners: `3 · position + corner` of a triangle holding each.
+    cap_corners: Vec<u32>,
     /// Prefix counts of see-through triangles by position (the exact engine counts them as opaque).
     see_through_before: Vec<u32>,
     bounds: (DVec3, DVec3),
@@ -89,6 +98,9 @@ pub struct Scratch {
     window_b: Vec<DVec2>,
     /// The view's BVH walk: the triangle ranges it reached, clipped after the load is known.
     reached: Vec<Range<usize>>,
+    /// One object's caps projected along the sun, and each cap's range of them.
+    cap_points: Vec<DVec2>,
+    cap_ranges: Vec<Range<usize>>,
     /// Shadows cast in this view.
     shadows: usize,
     /// The receiver's triangles and the view's shadows on the grid.
@@ -120,6 +132,7 @@ impl ExactEngine {
             object_base.push(total);
             total += mesh_objects[inst.mesh].convex.len() as u32;
         }
+        let (object_caps, caps, cap_corners) = object_caps(scene, &mesh_objects, &sources);
         let n = sources.len();
         let (mut triangles, mut owner, mut veils, mut object) =
             (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
@@ -146,7 +159,9 @@ impl ExactEngine {
             veils.push(veil);
             let objs = &mesh_objects[inst.mesh];
             let local = objs.object_of[t as usize];
-            object.push(if objs.convex[local as usize] { object_base[i] + local } else { NO_OBJECT });
+            let global = object_base[i] + local;
+            let caps_known = object_caps[global as usize].start != UNKNOWN_CAPS;
+            object.push(if objs.convex[local as usize] && caps_known { global } else { NO_OBJECT });
         }
         let (objects, object_triangles) = group_positions(&object, total as usize);
         let frames: Vec<Option<PlaneFrame>> = scene.receivers.iter().map(|r| PlaneFrame::new(r, DVec3::Z, eps)).collect();
@@ -161,6 +176,9 @@ impl ExactEngine {
             object,
             objects,
             object_triangles,
+            object_caps,
+            caps,
+            cap_corners,
             see_through_before,
             bounds: scene.bounds,
             origin: scene.origin,
@@ -180,6 +198,8 @@ impl ExactEngine {
             window_a: Vec::new(),
             window_b: Vec::new(),
             reached: Vec::new(),
+            cap_points: Vec::new(),
+            cap_ranges: Vec::new(),
             shadows: 0,
             boundary: Boundary::default(),
         }
@@ -187,7 +207,7 @@ impl ExactEngine {
 
     /// Convex objects found (shadows merged per object).
     pub fn convex_objects(&self) -> usize {
-        self.objects.len()
+        self.objects.iter().filter(|r| !r.is_empty()).count()
     }
 
     /// Triangles indexed.
@@ -330,14 +350,41 @@ impl ExactEngine {
         self.push_shadow(outline, false, s);
     }
 
-    /// The shadow of a convex object: the hull of its in-front vertices' projections.
+    /// The shadow of a convex object: the hull of its in-front vertices' projections, or, when the
+    /// sun may pass through its open caps, its triangles' shadows one by one.
     fn object_shadow(&self, frame: &PlaneFrame, outline: &Outline, o: u32, s: &mut Scratch) {
         s.flat.clear();
         let range = &self.objects[o as usize];
-        for &p in &self.object_triangles[range.start as usize..range.end as usize] {
-            push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
+        let triangles = &self.object_triangles[range.start as usize..range.end as usize];
+        let mut cut = false;
+        for &p in triangles {
+            cut |= push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
+        }
+        let caps = self.object_caps[o as usize].clone();
+        // The plane's cut is an opening too, so an object with caps that crosses it goes triangle
+        // by triangle.
+        if !caps.is_empty() && (cut || self.caps_overlap(frame, caps, s)) {
+            for &p in triangles {
+                self.triangle_shadow(frame, outline, p as usize, s);
+            }
+            return;
         }
         self.push_shadow(outline, true, s);
+    }
+
+    /// Whether the projections along the sun of two of these caps overlap (so some ray through
+    /// the object may meet none of its triangles). Separated or touching caps do not overlap.
+    fn caps_overlap(&self, frame: &PlaneFrame, caps: Range<u32>, s: &mut Scratch) -> bool {
+        s.cap_points.clear();
+        s.cap_ranges.clear();
+        for c in caps {
+            let corners = &self.cap_corners[self.caps[c as usize].start as usize..self.caps[c as usize].end as usize];
+            let start = s.cap_points.len();
+            s.cap_points.extend(corners.iter().map(|&k| frame.project_along_sun(self.triangles[k as usize / 3][k as usize % 3])));
+            s.cap_ranges.push(start..s.cap_points.len());
+        }
+        let n = s.cap_ranges.len();
+        (0..n).any(|a| (a + 1..n).any(|b| convex_overlap(&s.cap_points[s.cap_ranges[a].clone()], &s.cap_points[s.cap_ranges[b].clone()])))
     }
 
     /// Adds the polygon in `s.flat` (a projected triangle, or an object's projected points to
@@ -410,6 +457,49 @@ fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
     objects::group(&tris, &keys)
 }
 
+/// Marks an object whose caps could not be placed (a cap corner's triangle is not indexed): it
+/// is not used as convex.
+const UNKNOWN_CAPS: u32 = u32::MAX;
+
+/// Per object of every placement (in [`ExactEngine`]'s object order): its caps as a range of
+/// the second list, each cap a range of the third, each corner `3 · position + corner` of a
+/// triangle at that position of `sources`.
+fn object_caps(scene: &Scene, mesh_objects: &[MeshObjects], sources: &[(usize, u32)]) -> (Vec<Range<u32>>, Vec<Range<u32>>, Vec<u32>) {
+    // Where each placement's mesh triangles went.
+    let mut first_of_instance = Vec::with_capacity(scene.instances.len() + 1);
+    first_of_instance.push(0usize);
+    for inst in &scene.instances {
+        let last = first_of_instance.last().copied().unwrap_or(0);
+        first_of_instance.push(last + scene.meshes[inst.mesh].indices.len() / 3);
+    }
+    let mut position = vec![u32::MAX; first_of_instance.last().copied().unwrap_or(0)];
+    for (p, &(i, t)) in sources.iter().enumerate() {
+        position[first_of_instance[i] + t as usize] = p as u32;
+    }
+    let (mut object_caps, mut caps, mut corners) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, inst) in scene.instances.iter().enumerate() {
+        let objs = &mesh_objects[inst.mesh];
+        for range in &objs.cap_ranges {
+            let (first_cap, first_corner) = (caps.len(), corners.len());
+            for cap in &objs.caps[range.start as usize..range.end as usize] {
+                let start = corners.len() as u32;
+                for &(t, k) in &objs.cap_corners[cap.start as usize..cap.end as usize] {
+                    corners.push(position[first_of_instance[i] + t as usize].saturating_mul(3).saturating_add(u32::from(k)));
+                }
+                caps.push(start..corners.len() as u32);
+            }
+            if corners[first_corner..].iter().any(|&c| c >= u32::MAX - 2) {
+                caps.truncate(first_cap);
+                corners.truncate(first_corner);
+                object_caps.push(UNKNOWN_CAPS..UNKNOWN_CAPS);
+            } else {
+                object_caps.push(first_cap as u32..caps.len() as u32);
+            }
+        }
+    }
+    (object_caps, caps, corners)
+}
+
 /// Per convex object its triangle positions (counting sort by object).
 fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>) {
     let mut count = vec![0u32; objects + 1];
@@ -456,20 +546,43 @@ fn outline(r: &crate::scene::Receiver, frame: &PlaneFrame, eps: f64) -> Option<O
 }
 
 /// Appends the projections of the part of `tri` in front of the plane to `flat` (nothing when
-/// none of it is in front), clipping as the reference does.
-fn push_projected(frame: &PlaneFrame, tri: &[DVec3; 3], in_front: &mut Vec<DVec3>, clipped: &mut Vec<DVec3>, flat: &mut Vec<DVec2>) {
+/// none of it is in front), clipping as the reference does; `true` when a part lies behind it.
+fn push_projected(
+    frame: &PlaneFrame,
+    tri: &[DVec3; 3],
+    in_front: &mut Vec<DVec3>,
+    clipped: &mut Vec<DVec3>,
+    flat: &mut Vec<DVec2>,
+) -> bool {
     let h = tri.map(|p| frame.height(p));
     if h.iter().all(|&h| h <= 0.0) {
-        return;
+        return h.iter().any(|&h| h < 0.0);
     }
     if h.iter().all(|&h| h >= 0.0) {
         flat.extend(tri.iter().zip(h).map(|(&p, h)| frame.to_2d(p) + frame.shift_per_height * h));
-        return;
+        return false;
     }
     in_front.clear();
     in_front.extend_from_slice(tri);
     clip_into(in_front, clipped, |p| frame.height(*p));
     flat.extend(clipped.iter().map(|&p| frame.project_along_sun(p)));
+    true
+}
+
+/// Whether two convex polygons (either orientation, possibly flat) share interior points: no
+/// edge of either separates them. Touching polygons do not overlap; the test errs towards
+/// overlap (a flattened polygon across the other is reported), which only costs time.
+fn convex_overlap(a: &[DVec2], b: &[DVec2]) -> bool {
+    let separates = |edges: &[DVec2]| {
+        (0..edges.len()).any(|i| {
+            let axis = (edges[(i + 1) % edges.len()] - edges[i]).perp();
+            let span =
+                |p: &[DVec2]| p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(axis.dot(*q)), hi.max(axis.dot(*q))));
+            let ((a0, a1), (b0, b1)) = (span(a), span(b));
+            axis != DVec2::ZERO && (a1 <= b0 || b1 <= a0)
+        })
+    };
+    !(separates(a) || separates(b))
 }
 
 /// A convex polygon clipped to the window box, into `a` (`b` is scratch).
@@ -567,13 +680,20 @@ mod tests {
 
     /// A box [lo, hi] as 12 triangles, outward.
     fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+        open_cuboid(lo, hi, &[])
+    }
+
+    /// A box [lo, hi] without the faces whose outward normal is in `open` (±1, ±2, ±3 for ±x,
+    /// ±y, ±z): a tube when two opposite faces are left out.
+    fn open_cuboid(lo: [f32; 3], hi: [f32; 3], open: &[i32]) -> SourceMesh {
         let c = |i: u32| {
             [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }]
         };
-        let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let quads: [([u32; 4], i32); 6] =
+            [([0, 2, 3, 1], -3), ([4, 5, 7, 6], 3), ([0, 1, 5, 4], -2), ([2, 6, 7, 3], 2), ([0, 4, 6, 2], -1), ([1, 3, 7, 5], 1)];
         SourceMesh {
             positions: (0..8).map(c).collect(),
-            indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect(),
+            indices: quads.iter().filter(|(_, n)| !open.contains(n)).flat_map(|(q, _)| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect(),
         }
     }
 
@@ -616,5 +736,64 @@ mod tests {
             partly += usize::from(*r > 0.01 && *r < 0.99);
         }
         assert!(partly >= 10, "only {partly} views partly shaded");
+    }
+
+    /// A roof under upright square tubes (both ends open), one of them through the roof's plane,
+    /// and a cup (a box open at the bottom).
+    fn tubes_over_a_roof() -> Scene {
+        let roof = SourceMesh { positions: vec![[0., 0., 0.], [4., 0., 0.], [4., 3., 0.], [0., 3., 0.]], indices: vec![0, 1, 2, 0, 2, 3] };
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "ROOF", roof, true);
+        b.add_object("test", "TUBE", open_cuboid([0.5, 1.0, 0.5], [1.1, 1.6, 2.0], &[-3, 3]), false);
+        b.add_object("test", "THROUGH", open_cuboid([2.0, 0.5, -0.5], [2.4, 0.9, 1.0], &[-3, 3]), false);
+        b.add_object("test", "CUP", open_cuboid([2.8, 1.8, 0.9], [3.4, 2.4, 1.5], &[-3]), false);
+        b.build().unwrap()
+    }
+
+    #[test]
+    fn open_tubes_cast_their_hull_unless_the_sun_looks_down_their_bore() {
+        let scene = tubes_over_a_roof();
+        let engine = ExactEngine::new(&scene);
+        assert_eq!(engine.convex_objects(), 4, "the roof, the tubes and the cup are each one object");
+        let sun = |az: f64, alt: f64| {
+            let (a, h) = (az.to_radians(), alt.to_radians());
+            DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin())
+        };
+        // Straight down the bores (the tubes' sides are edge-on: only the cup shades), just off
+        // them (light through part of each bore) and well off them (the hull is the shadow).
+        let mut suns = vec![DVec3::Z];
+        for az in [0.0f64, 45.0, 100.0, 180.0, 250.0] {
+            for alt in [89.5f64, 87.0, 80.0, 72.0, 70.0, 60.0, 30.0] {
+                suns.push(sun(az, alt));
+            }
+        }
+        let requests: Vec<ViewRequest> = suns.iter().map(|&s| ViewRequest::new(0, s)).collect();
+        let fast = engine.fractions(&requests);
+        let reference = super::super::sunlit_fractions(&scene, &requests);
+        for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+            assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+        }
+        let cup = 0.6 * 0.6 / 12.0;
+        assert!((fast[0] - (1.0 - cup)).abs() < 1e-6, "overhead only the cup shades: {}", fast[0]);
+        let partly = reference.iter().filter(|r| **r > 0.01 && **r < 0.99).count();
+        assert!(partly >= 20, "only {partly} views partly shaded");
+    }
+
+    #[test]
+    fn convex_polygons_overlap_unless_an_edge_separates_them() {
+        let square = |x: f64, y: f64| [DVec2::new(x, y), DVec2::new(x + 1.0, y), DVec2::new(x + 1.0, y + 1.0), DVec2::new(x, y + 1.0)];
+        let mut clockwise = square(0.5, 0.5);
+        clockwise.reverse();
+        assert!(convex_overlap(&square(0.0, 0.0), &clockwise));
+        assert!(!convex_overlap(&square(0.0, 0.0), &square(1.0, 0.0)), "touching along an edge");
+        assert!(!convex_overlap(&square(0.0, 0.0), &square(1.0, 1.0)), "touching at a corner");
+        // Separated only by a diagonal: an edge of the triangle.
+        let triangle = [DVec2::new(1.2, 0.0), DVec2::new(0.0, 1.2), DVec2::new(1.2, 1.2)];
+        assert!(convex_overlap(&square(0.0, 0.0), &triangle));
+        let far = [DVec2::new(2.05, 0.0), DVec2::new(0.0, 2.05), DVec2::new(2.05, 2.05)];
+        assert!(!convex_overlap(&square(0.0, 0.0), &far));
+        // A flattened cap (the sun in its plane) across the other is reported as overlapping.
+        let flat = [DVec2::new(-1.0, 0.5), DVec2::new(2.0, 0.5), DVec2::new(2.0, 0.5)];
+        assert!(convex_overlap(&square(0.0, 0.0), &flat));
     }
 }

@@ -6,16 +6,24 @@
 //! so an object never mixes a receiver with other geometry, nor leaves of different ranks. An
 //! object is *convex* when it is
 //! - a closed convex polyhedron: every edge is used by exactly two of its triangles and every
-//!   triangle's plane has all the object's vertices on one side (boxes, slats, hexagonal rods); or
+//!   triangle's plane has all the object's vertices on one side (boxes, slats); or
+//! - a convex polyhedron with open *caps*: the same, except that the edges used once form closed
+//!   loops, each a convex polygon in a plane with all the object's vertices on one side (an
+//!   extruded rod or tube exported without its ends, a box without its bottom); or
 //! - a flat convex polygon: all vertices in one plane, no edge used more than twice, and its
 //!   triangles' areas add up to the area of their convex hull (quads, leaves).
 //!
-//! The shadow of a convex object's part in front of a plane is the convex hull of its clipped
-//! vertices' projections, exactly the union of its triangles' shadows: a sun ray through the
-//! solid crosses its surface, and at most one of those crossings lies on the cutting plane.
+//! The shadow of a closed convex object's part in front of a plane is the convex hull of its
+//! clipped vertices' projections, exactly the union of its triangles' shadows: a sun ray through
+//! the solid crosses its surface, and at most one of those crossings lies on the cutting plane.
+//! With caps the surface and the caps together bound the solid, and a ray through it that meets
+//! no triangle enters through one cap and leaves through another: so the hull is still the
+//! shadow in every view where no two caps' projections overlap and no part of the object lies
+//! behind the plane (whose cut would be one more opening). The engine checks that per view
+//! ([`caps_overlap`]) and otherwise casts the object's triangles one by one.
 //! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) are not tested and stay per-triangle.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glam::{DVec2, DVec3};
 
@@ -44,6 +52,24 @@ pub(super) struct MeshObjects {
     pub triangles: Vec<u32>,
     /// Per object: its range in `triangles`.
     pub ranges: Vec<std::ops::Range<u32>>,
+    /// Per object: its caps, a range of `caps` (empty unless convex with open caps).
+    pub cap_ranges: Vec<std::ops::Range<u32>>,
+    /// Per cap: its corners in order, a range of `cap_corners`.
+    pub caps: Vec<std::ops::Range<u32>>,
+    /// A cap's corners: the mesh triangle holding one and which of its corners (0–2).
+    pub cap_corners: Vec<(u32, u8)>,
+}
+
+/// How an object's triangles bound a convex set, if they do (see the module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Convexity {
+    /// Neither a convex polyhedron, with or without caps, nor a flat convex polygon.
+    No,
+    /// A closed convex polyhedron or a flat convex polygon.
+    Closed,
+    /// A convex polyhedron with open caps: per cap its corners in order, each an index into the
+    /// object's corners taken triangle by triangle (`3 · triangle + corner`).
+    Caps(Vec<Vec<usize>>),
 }
 
 /// Groups `triangles` (mesh coordinates, with a key per triangle that objects must share: surface
@@ -76,7 +102,17 @@ pub(super) fn group(triangles: &[[[f32; 3]; 3]], keys: &[u64]) -> MeshObjects {
     let mut out = MeshObjects { object_of, ..Default::default() };
     for m in &members {
         let tris: Vec<[DVec3; 3]> = m.iter().map(|&t| triangles[t as usize].map(|p| DVec3::from_array(p.map(f64::from)))).collect();
-        out.convex.push(tris.len() <= MAX_CONVEX_TRIANGLES && is_convex(&tris));
+        let convexity = if tris.len() <= MAX_CONVEX_TRIANGLES { convexity(&tris) } else { Convexity::No };
+        out.convex.push(convexity != Convexity::No);
+        let first_cap = out.caps.len() as u32;
+        if let Convexity::Caps(caps) = convexity {
+            for cap in caps {
+                let start = out.cap_corners.len() as u32;
+                out.cap_corners.extend(cap.iter().map(|&c| (m[c / 3], (c % 3) as u8)));
+                out.caps.push(start..out.cap_corners.len() as u32);
+            }
+        }
+        out.cap_ranges.push(first_cap..out.caps.len() as u32);
         let start = out.triangles.len() as u32;
         out.triangles.extend(m);
         out.ranges.push(start..out.triangles.len() as u32);
@@ -99,41 +135,51 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
     }
 }
 
-/// Whether the triangles form a closed convex polyhedron or a flat convex polygon.
+/// Whether the triangles form a convex polyhedron (closed or with caps) or a flat convex polygon.
+#[cfg(test)]
 pub(super) fn is_convex(tris: &[[DVec3; 3]]) -> bool {
+    convexity(tris) != Convexity::No
+}
+
+/// How the triangles bound a convex set (see the module doc).
+pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
     let points: Vec<DVec3> = tris.iter().flatten().copied().collect();
-    let Some(size) = extent(&points) else { return false };
+    let Some(size) = extent(&points) else { return Convexity::No };
     let magnitude = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let tol = (CONVEX_TOLERANCE * size).max(F32_ROUNDINGS * magnitude).max(f64::MIN_POSITIVE);
-    // Corners within `tol` of each other are one (welded to the first seen).
+    // Corners within `tol` of each other are one (welded to the first seen); `first` holds the
+    // index in `points` of each welded corner's first point.
     let mut corners: Vec<DVec3> = Vec::new();
-    let mut corner = |p: DVec3| -> usize {
-        corners.iter().position(|c| (*c - p).abs().max_element() <= tol).unwrap_or_else(|| {
+    let mut first: Vec<usize> = Vec::new();
+    let mut welded = Vec::with_capacity(points.len());
+    for (i, &p) in points.iter().enumerate() {
+        let c = corners.iter().position(|c| (*c - p).abs().max_element() <= tol).unwrap_or_else(|| {
             corners.push(p);
+            first.push(i);
             corners.len() - 1
-        })
-    };
+        });
+        welded.push(c);
+    }
     // Edges by their welded corners, undirected: how many triangles use each.
     let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
-    for t in tris {
-        let c = t.map(&mut corner);
+    for c in welded.chunks_exact(3) {
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
             if a == b {
-                return false;
+                return Convexity::No;
             }
             *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
         }
     }
     if uses.values().any(|&u| u > 2) {
-        return false;
+        return Convexity::No;
     }
     let mut flat = true;
     for t in tris {
         let normal = (t[1] - t[0]).cross(t[2] - t[0]);
         let length = normal.length();
         if length <= tol * size {
-            return false;
+            return Convexity::No;
         }
         let normal = normal / length;
         let (mut below, mut above) = (false, false);
@@ -143,14 +189,98 @@ pub(super) fn is_convex(tris: &[[DVec3; 3]]) -> bool {
             above |= h > tol;
         }
         if below && above {
-            return false;
+            return Convexity::No;
         }
         flat &= !below && !above;
     }
     if flat {
-        return flat_polygon_is_covered(tris, &points);
+        return if flat_polygon_is_covered(tris, &points) { Convexity::Closed } else { Convexity::No };
     }
-    uses.values().all(|&u| u == 2)
+    let open: Vec<(usize, usize)> = uses.iter().filter(|(_, u)| **u == 1).map(|(e, _)| *e).collect();
+    if open.is_empty() {
+        return Convexity::Closed;
+    }
+    let Some(loops) = edge_loops(&open) else { return Convexity::No };
+    let caps_are_faces = loops.iter().all(|l| {
+        let loop_points: Vec<DVec3> = l.iter().map(|&c| corners[c]).collect();
+        is_convex_face(&loop_points, &points, tol)
+    });
+    if !caps_are_faces {
+        return Convexity::No;
+    }
+    Convexity::Caps(loops.iter().map(|l| l.iter().map(|&c| first[c]).collect()).collect())
+}
+
+/// The closed loops formed by `edges` (undirected, between welded corners), each in order;
+/// `None` unless every corner on them has exactly two (loops touching at a corner are refused).
+fn edge_loops(edges: &[(usize, usize)]) -> Option<Vec<Vec<usize>>> {
+    let mut next: HashMap<usize, Vec<usize>> = HashMap::new();
+    for &(a, b) in edges {
+        next.entry(a).or_default().push(b);
+        next.entry(b).or_default().push(a);
+    }
+    if next.values().any(|n| n.len() != 2) {
+        return None;
+    }
+    let mut corners: Vec<usize> = next.keys().copied().collect();
+    corners.sort_unstable();
+    let mut seen: HashSet<usize> = HashSet::new();
+    let mut loops = Vec::new();
+    for &start in &corners {
+        if seen.contains(&start) {
+            continue;
+        }
+        let (mut before, mut at) = (usize::MAX, start);
+        let mut cycle = Vec::new();
+        loop {
+            seen.insert(at);
+            cycle.push(at);
+            let n = &next[&at];
+            let step = if n[0] != before { n[0] } else { n[1] };
+            (before, at) = (at, step);
+            if at == start {
+                break;
+            }
+            if cycle.len() > corners.len() {
+                return None;
+            }
+        }
+        loops.push(cycle);
+    }
+    Some(loops)
+}
+
+/// Whether the loop `cap` (in order) is a convex polygon in a plane with every point of `all` on
+/// one side: then it is a face of their convex hull.
+fn is_convex_face(cap: &[DVec3], all: &[DVec3], tol: f64) -> bool {
+    if cap.len() < 3 {
+        return false;
+    }
+    // Newell's normal: its length is twice the loop's area.
+    let newell = (0..cap.len()).fold(DVec3::ZERO, |n, i| n + cap[i].cross(cap[(i + 1) % cap.len()]));
+    let length = newell.length();
+    if length.is_nan() || length <= 0.0 {
+        return false;
+    }
+    let normal = newell / length;
+    let (mut below, mut above) = (false, false);
+    for p in all {
+        let h = normal.dot(*p - cap[0]);
+        if h.abs() <= tol {
+            continue;
+        }
+        below |= h < 0.0;
+        above |= h > 0.0;
+    }
+    let in_plane = cap.iter().all(|p| normal.dot(*p - cap[0]).abs() <= tol);
+    if !in_plane || (below && above) {
+        return false;
+    }
+    // Convex: every turn the same way round the normal.
+    (0..cap.len()).all(|i| {
+        let (a, b, c) = (cap[i], cap[(i + 1) % cap.len()], cap[(i + 2) % cap.len()]);
+        (b - a).cross(c - b).dot(normal) >= -tol * (b - a).length().max((c - b).length())
+    })
 }
 
 /// A flat object is its convex hull when its triangles' areas add up to the hull's area (and no
@@ -273,11 +403,58 @@ mod tests {
         let objects = group(&tris, &keys);
         assert_eq!(objects.ranges.len(), 2);
         assert_eq!(objects.convex, vec![true, true]);
-        // A different key on one face splits it off: the rest is no longer closed.
+        // A different key on one face splits it off: the rest is a box open on one side (a cup,
+        // convex with one cap), the face a flat square.
         keys[0] = 1;
         keys[1] = 1;
         let objects = group(&tris, &keys);
         assert_eq!(objects.ranges.len(), 3);
-        assert_eq!(objects.convex.iter().filter(|c| **c).count(), 2, "the face and the other cube");
+        assert_eq!(objects.convex, vec![true, true, true]);
+        assert_eq!(objects.cap_ranges.iter().map(|r| r.len()).collect::<Vec<_>>(), vec![0, 1, 0], "the cup's cap");
+        assert_eq!(objects.caps.len(), 1);
+        assert_eq!(objects.cap_corners.len(), 4);
+        // Two adjacent faces split off: the four left of the cube leave one loop that is not
+        // flat, so they are not convex.
+        keys[4] = 2;
+        keys[5] = 2;
+        let objects = group(&tris, &keys);
+        assert_eq!(objects.convex.iter().filter(|c| **c).count(), 3, "two squares and the other cube");
+    }
+
+    #[test]
+    fn tubes_and_cups_are_convex_with_caps_open_shells_are_not() {
+        let cube = cube();
+        // Faces 2 and 3 are y = 0 and y = 1: without them a square tube along y.
+        let tube: Vec<[DVec3; 3]> = [&cube[..4], &cube[8..]].concat();
+        let Convexity::Caps(caps) = convexity(&tube) else { panic!("a tube has two caps") };
+        assert_eq!(caps.len(), 2);
+        let points: Vec<DVec3> = tube.iter().flatten().copied().collect();
+        let mut ends: Vec<f64> = caps
+            .iter()
+            .map(|cap| {
+                assert_eq!(cap.len(), 4, "a square end");
+                let y = points[cap[0]].y;
+                assert!(cap.iter().all(|&c| points[c].y == y), "a cap's corners lie in its plane");
+                y
+            })
+            .collect();
+        ends.sort_by(f64::total_cmp);
+        assert_eq!(ends, vec![0.0, 1.0]);
+        // Without its top (face 1): a cup, one cap.
+        let cup: Vec<[DVec3; 3]> = [&cube[..2], &cube[4..]].concat();
+        assert!(matches!(convexity(&cup), Convexity::Caps(c) if c.len() == 1));
+        assert_eq!(convexity(&cube), Convexity::Closed);
+        // Three faces meeting at a corner leave one loop that is not flat.
+        assert_eq!(convexity(&cube[..6]), Convexity::No);
+        // A tube with one side dented inwards is not convex, caps or not.
+        let mut dented = tube.clone();
+        for t in &mut dented {
+            for p in t.iter_mut() {
+                if p.x == 1.0 && p.y == 1.0 && p.z == 1.0 {
+                    p.x = 0.8;
+                }
+            }
+        }
+        assert_eq!(convexity(&dented), Convexity::No);
     }
 }
