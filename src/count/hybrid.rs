@@ -383,10 +383,13 @@ impl<'a> HybridEngine<'a> {
             (EngineKind::Auto, Some(exact)) => {
                 let stored = self.stored_profile().await?;
                 // One walk a view learns the GPU's views only once every view is walked, so the
-                // engines then run one after the other: taken only while no view of this run has
-                // gone to the GPU (an exact-only profile, or a model clipped throughout so far).
+                // engines then run one after the other: taken only where no view is expected to
+                // go to the GPU (an exact-only profile, or a run whose earlier batches were all
+                // clipped). A first batch under a profile with a GPU walks its loads first, so
+                // that both engines start at once if some views do go to the GPU.
+                let stats = self.stats();
                 if let Some(profile) = stored
-                    && self.stats().gpu_views == 0
+                    && (profile.gpu.is_none() || (stats.gpu_views == 0 && stats.exact_views > 0))
                 {
                     return self.count_in_one_walk(exact, profile, requests).await;
                 }
