@@ -23,7 +23,7 @@
 //! ([`caps_overlap`]) and otherwise casts the object's triangles one by one.
 //! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) are not tested and stay per-triangle.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
@@ -196,11 +196,13 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
     if flat {
         return if flat_polygon_is_covered(tris, &points) { Convexity::Closed } else { Convexity::No };
     }
-    let open: Vec<(usize, usize)> = uses.iter().filter(|(_, u)| **u == 1).map(|(e, _)| *e).collect();
+    let mut open: Vec<(usize, usize)> = uses.iter().filter(|(_, u)| **u == 1).map(|(e, _)| *e).collect();
+    // In a fixed order, so every run finds the same loops.
+    open.sort_unstable();
     if open.is_empty() {
         return Convexity::Closed;
     }
-    let Some(loops) = edge_loops(&open) else { return Convexity::No };
+    let Some(loops) = edge_loops(&open, corners.len()) else { return Convexity::No };
     let caps_are_faces = loops.iter().all(|l| {
         let loop_points: Vec<DVec3> = l.iter().map(|&c| corners[c]).collect();
         is_convex_face(&loop_points, &points, tol)
@@ -211,38 +213,37 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
     Convexity::Caps(loops.iter().map(|l| l.iter().map(|&c| first[c]).collect()).collect())
 }
 
-/// The closed loops formed by `edges` (undirected, between welded corners), each in order;
-/// `None` unless every corner on them has exactly two (loops touching at a corner are refused).
-fn edge_loops(edges: &[(usize, usize)]) -> Option<Vec<Vec<usize>>> {
-    let mut next: HashMap<usize, Vec<usize>> = HashMap::new();
+/// The closed loops formed by `edges` (undirected, between welded corners below `corners`),
+/// each in order from its lowest corner; `None` unless every corner on them has exactly two
+/// (loops touching at a corner are refused).
+fn edge_loops(edges: &[(usize, usize)], corners: usize) -> Option<Vec<Vec<usize>>> {
+    const NONE: usize = usize::MAX;
+    let mut next = vec![[NONE; 2]; corners];
     for &(a, b) in edges {
-        next.entry(a).or_default().push(b);
-        next.entry(b).or_default().push(a);
+        for (from, to) in [(a, b), (b, a)] {
+            let slot = next[from].iter_mut().find(|n| **n == NONE)?;
+            *slot = to;
+        }
     }
-    if next.values().any(|n| n.len() != 2) {
-        return None;
-    }
-    let mut corners: Vec<usize> = next.keys().copied().collect();
-    corners.sort_unstable();
-    let mut seen: HashSet<usize> = HashSet::new();
+    let mut seen = vec![false; corners];
     let mut loops = Vec::new();
-    for &start in &corners {
-        if seen.contains(&start) {
+    for start in 0..corners {
+        if seen[start] || next[start][0] == NONE {
             continue;
         }
-        let (mut before, mut at) = (usize::MAX, start);
+        let (mut before, mut at) = (NONE, start);
         let mut cycle = Vec::new();
         loop {
-            seen.insert(at);
+            let n = next[at];
+            if n[1] == NONE || seen[at] {
+                return None;
+            }
+            seen[at] = true;
             cycle.push(at);
-            let n = &next[&at];
             let step = if n[0] != before { n[0] } else { n[1] };
             (before, at) = (at, step);
             if at == start {
                 break;
-            }
-            if cycle.len() > corners.len() {
-                return None;
             }
         }
         loops.push(cycle);
