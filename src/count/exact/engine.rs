@@ -779,6 +779,69 @@ mod tests {
         assert!(partly >= 20, "only {partly} views partly shaded");
     }
 
+    /// An open prism of `sides` faces around `axis` (no end faces), centred at `centre`.
+    fn open_prism(centre: DVec3, axis: DVec3, length: f64, radius: f64, sides: usize) -> SourceMesh {
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        let ring = |k: usize, end: f64| {
+            let a = std::f64::consts::TAU * k as f64 / sides as f64;
+            let p = centre + (u * a.cos() + v * a.sin()) * radius + axis * (end * 0.5 * length);
+            p.as_vec3().to_array()
+        };
+        let positions: Vec<[f32; 3]> = (0..sides).flat_map(|k| [ring(k, -1.0), ring(k, 1.0)]).collect();
+        let indices = (0..sides as u32)
+            .flat_map(|k| {
+                let (a0, a1, b0, b1) = (2 * k, 2 * k + 1, 2 * ((k + 1) % sides as u32), 2 * ((k + 1) % sides as u32) + 1);
+                [a0, b0, b1, a0, b1, a1]
+            })
+            .collect();
+        SourceMesh { positions, indices }
+    }
+
+    #[test]
+    fn random_open_prisms_agree_with_the_reference() {
+        // A small deterministic generator (SplitMix64), so a failure can be replayed.
+        let mut state = 0x5eed_u64;
+        let mut random = move || {
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "WALL", wall(), true);
+        for k in 0..40 {
+            // Axes from any direction, a third of them nearly along the wall's normal (so some
+            // suns look down their bores); a few reach through the wall's plane.
+            let mut axis = DVec3::new(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+            if k % 3 == 0 {
+                axis = (DVec3::new(0.0, -1.0, 0.0) + 0.2 * axis).normalize();
+            }
+            let centre = DVec3::new(4.0 * random(), -0.1 - 1.5 * random(), 3.0 * random());
+            let sides = [3, 4, 6][k % 3];
+            let mesh = open_prism(centre, axis, 0.3 + 1.2 * random(), 0.05 + 0.2 * random(), sides);
+            b.add_object("test", &format!("PRISM{k}"), mesh, false);
+        }
+        let scene = b.build().unwrap();
+        let engine = ExactEngine::new(&scene);
+        assert_eq!(engine.convex_objects(), 41, "every prism is one object");
+        let mut requests = Vec::new();
+        for _ in 0..60 {
+            let (az, alt) = ((100.0 + 160.0 * random()).to_radians(), (2.0 + 80.0 * random()).to_radians());
+            requests.push(ViewRequest::new(0, DVec3::new(alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin())));
+        }
+        // And straight along the wall's normal, down the near-normal bores.
+        requests.push(ViewRequest::new(0, DVec3::new(0.0, -1.0, 0.02).normalize()));
+        let fast = engine.fractions(&requests);
+        let reference = super::super::sunlit_fractions(&scene, &requests);
+        for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+            assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+        }
+        let partly = reference.iter().filter(|r| **r > 0.01 && **r < 0.99).count();
+        assert!(partly >= 40, "only {partly} views partly shaded");
+    }
+
     #[test]
     fn convex_polygons_overlap_unless_an_edge_separates_them() {
         let square = |x: f64, y: f64| [DVec2::new(x, y), DVec2::new(x + 1.0, y), DVec2::new(x + 1.0, y + 1.0), DVec2::new(x, y + 1.0)];
