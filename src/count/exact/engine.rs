@@ -78,6 +78,10 @@ pub struct ExactEngine {
     caps: Vec<Range<u32>>,
     /// A cap's corners: `3 · position + corner` of a triangle holding each.
     cap_corners: Vec<u32>,
+    /// Per convex object: its distinct corners (bit for bit), a range of `corners`.
+    object_corners: Vec<Range<u32>>,
+    /// A corner as `3 · position + corner` of a triangle holding it.
+    corners: Vec<u32>,
     /// Prefix counts of see-through triangles by position (the exact engine counts them as opaque).
     see_through_before: Vec<u32>,
     bounds: (DVec3, DVec3),
@@ -164,6 +168,7 @@ impl ExactEngine {
             object.push(if objs.convex[local as usize] && caps_known { global } else { NO_OBJECT });
         }
         let (objects, object_triangles) = group_positions(&object, total as usize);
+        let (object_corners, corners) = distinct_corners(&objects, &object_triangles, &triangles);
         let frames: Vec<Option<PlaneFrame>> = scene.receivers.iter().map(|r| PlaneFrame::new(r, DVec3::Z, eps)).collect();
         let outlines = scene.receivers.iter().zip(&frames).map(|(r, f)| f.as_ref().and_then(|f| outline(r, f, eps))).collect();
         Self {
@@ -179,6 +184,8 @@ impl ExactEngine {
             object_caps,
             caps,
             cap_corners,
+            object_corners,
+            corners,
             see_through_before,
             bounds: scene.bounds,
             origin: scene.origin,
@@ -356,9 +363,12 @@ impl ExactEngine {
         s.flat.clear();
         let range = &self.objects[o as usize];
         let triangles = &self.object_triangles[range.start as usize..range.end as usize];
-        let mut cut = false;
-        for &p in triangles {
-            cut |= push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
+        let cut = !self.project_corners(frame, o, s);
+        if cut {
+            s.flat.clear();
+            for &p in triangles {
+                push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
+            }
         }
         let caps = self.object_caps[o as usize].clone();
         // The plane's cut is an opening too, so an object with caps that crosses it goes triangle
@@ -370,6 +380,28 @@ impl ExactEngine {
             return;
         }
         self.push_shadow(outline, true, s);
+    }
+
+    /// Projects object `o`'s distinct corners into `s.flat` when none lies behind the plane (the
+    /// points its triangles would give, each once: a rod's 12 instead of 36), leaving `s.flat`
+    /// empty when all lie on it (the triangles would cast nothing); `false`, with `s.flat`
+    /// unusable, when some corner lies behind (its triangles must be clipped).
+    fn project_corners(&self, frame: &PlaneFrame, o: u32, s: &mut Scratch) -> bool {
+        let range = &self.object_corners[o as usize];
+        let mut above = false;
+        for &c in &self.corners[range.start as usize..range.end as usize] {
+            let p = self.triangles[c as usize / 3][c as usize % 3];
+            let h = frame.height(p);
+            if h < 0.0 {
+                return false;
+            }
+            above |= h > 0.0;
+            s.flat.push(frame.to_2d(p) + frame.shift_per_height * h);
+        }
+        if !above {
+            s.flat.clear();
+        }
+        true
     }
 
     /// Whether the projections along the sun of two of these caps overlap (so some ray through
@@ -498,6 +530,28 @@ fn object_caps(scene: &Scene, mesh_objects: &[MeshObjects], sources: &[(usize, u
         }
     }
     (object_caps, caps, corners)
+}
+
+/// Per convex object its distinct corners (world positions equal bit for bit are one), as a
+/// range of the second list, each `3 · position + corner` of a triangle holding it.
+fn distinct_corners(objects: &[Range<u32>], object_triangles: &[u32], triangles: &[[DVec3; 3]]) -> (Vec<Range<u32>>, Vec<u32>) {
+    let mut ranges = Vec::with_capacity(objects.len());
+    let mut corners = Vec::new();
+    let mut keyed: Vec<([u64; 3], u32)> = Vec::new();
+    for range in objects {
+        keyed.clear();
+        for &p in &object_triangles[range.start as usize..range.end as usize] {
+            for (k, q) in triangles[p as usize].iter().enumerate() {
+                keyed.push((q.to_array().map(f64::to_bits), 3 * p + k as u32));
+            }
+        }
+        keyed.sort_unstable();
+        keyed.dedup_by_key(|(bits, _)| *bits);
+        let start = corners.len() as u32;
+        corners.extend(keyed.iter().map(|(_, c)| *c));
+        ranges.push(start..corners.len() as u32);
+    }
+    (ranges, corners)
 }
 
 /// Per convex object its triangle positions (counting sort by object).
