@@ -384,12 +384,14 @@ impl<'a> HybridEngine<'a> {
                 let stored = self.stored_profile().await?;
                 // One walk a view learns the GPU's views only once every view is walked, so the
                 // engines then run one after the other: taken only where no view is expected to
-                // go to the GPU (an exact-only profile, or a run whose earlier batches were all
-                // clipped). A first batch under a profile with a GPU walks its loads first, so
-                // that both engines start at once if some views do go to the GPU.
+                // go to the GPU (an exact-only profile, a run whose earlier batches were all
+                // clipped, or a first batch none of whose sampled views the profile would send
+                // there). Otherwise the loads are walked first, so both engines start at once.
+                // Either path routes every view the same way.
                 let stats = self.stats();
                 if let Some(profile) = stored
-                    && (profile.gpu.is_none() || (stats.gpu_views == 0 && stats.exact_views > 0))
+                    && (profile.gpu.is_none()
+                        || (stats.gpu_views == 0 && (stats.exact_views > 0 || !sample_may_go_to_gpu(exact, profile, requests))))
                 {
                     return self.count_in_one_walk(exact, profile, requests).await;
                 }
@@ -596,6 +598,16 @@ impl Engine for HybridEngine<'_> {
     fn expect(&self, views: usize) {
         self.run_views.set(views);
     }
+}
+
+/// Views of a batch whose loads are sampled to guess whether any goes to the GPU.
+const GPU_SAMPLE_VIEWS: usize = 64;
+
+/// Whether any of an even spread of [`GPU_SAMPLE_VIEWS`] of `requests` would go to the GPU on its
+/// own load ([`Profile::route_one`]). A guess that only picks how the batch is walked.
+fn sample_may_go_to_gpu(exact: &ExactEngine, profile: &Profile, requests: &[ViewRequest]) -> bool {
+    let step = (requests.len() / GPU_SAMPLE_VIEWS).max(1);
+    requests.iter().step_by(step).any(|&r| profile.route_one(exact.load(r)) == Route::Gpu)
 }
 
 /// Indices of up to `n` views with something in their prism, spread evenly over their loads.
