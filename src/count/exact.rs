@@ -39,6 +39,7 @@ use crate::scene::{Receiver, Scene};
 mod boundary;
 pub mod engine;
 mod objects;
+mod placed;
 
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).
 type Contour = Vec<[f64; 2]>;

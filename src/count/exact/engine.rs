@@ -25,7 +25,8 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 
 use super::boundary::{Boundary, Snap};
-use super::objects::{self, MeshObjects};
+use super::objects;
+use super::placed::PlacedObjects;
 use super::{AREA_EPS, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN};
 use crate::count::cull::{CPU_LEAF_TRIANGLES, Culling};
 use crate::count::{ViewRequest, is_dark, view};
@@ -36,8 +37,6 @@ use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
 const PRISM_SIDE: u32 = 512;
 /// Views a thread takes at a time.
 const CHUNK: usize = 16;
-/// No object: the triangle casts its own shadow.
-const NO_OBJECT: u32 = u32::MAX;
 
 /// A receiver as the engine needs it, made once: its plane frame's axes and its 2D outline.
 struct Outline {
@@ -66,22 +65,8 @@ pub struct ExactEngine {
     owner: Vec<u32>,
     /// Per position: its veil (leaf rank already shifted by its instance).
     veils: Vec<Veil>,
-    /// Per position: its convex object, or [`NO_OBJECT`].
-    object: Vec<u32>,
-    /// Per convex object: its triangle positions, a range of `object_triangles`.
-    objects: Vec<Range<u32>>,
-    object_triangles: Vec<u32>,
-    /// Per object: its open caps, a range of `caps` (empty for a closed one; see
-    /// [`objects::Convexity`]).
-    object_caps: Vec<Range<u32>>,
-    /// Per cap: its corners in order, a range of `cap_corners`.
-    caps: Vec<Range<u32>>,
-    /// A cap's corners: `3 · position + corner` of a triangle holding each.
-    cap_corners: Vec<u32>,
-    /// Per convex object: its distinct corners (bit for bit), a range of `corners`.
-    object_corners: Vec<Range<u32>>,
-    /// A corner as `3 · position + corner` of a triangle holding it.
-    corners: Vec<u32>,
+    /// The convex objects among those triangles.
+    objects: PlacedObjects,
     /// Prefix counts of see-through triangles by position (the exact engine counts them as opaque).
     see_through_before: Vec<u32>,
     bounds: (DVec3, DVec3),
@@ -128,18 +113,8 @@ impl ExactEngine {
         let extent = (scene.bounds.1 - scene.bounds.0).length();
         let scale = if extent.is_finite() { 1.0 + extent } else { 1.0 };
         let eps = PLANE_EPS * scale;
-        // Objects of each mesh, in mesh coordinates; every placement has its own copies.
-        let mesh_objects: Vec<MeshObjects> = scene.meshes.iter().map(mesh_objects).collect();
-        let mut object_base = Vec::with_capacity(scene.instances.len());
-        let mut total = 0u32;
-        for inst in &scene.instances {
-            object_base.push(total);
-            total += mesh_objects[inst.mesh].convex.len() as u32;
-        }
-        let (object_caps, caps, cap_corners) = object_caps(scene, &mesh_objects, &sources);
         let n = sources.len();
-        let (mut triangles, mut owner, mut veils, mut object) =
-            (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+        let (mut triangles, mut owner, mut veils) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
         let mut see_through_before = Vec::with_capacity(n + 1);
         see_through_before.push(0u32);
         for &(i, t) in &sources {
@@ -161,14 +136,8 @@ impl ExactEngine {
             let last = *see_through_before.last().unwrap_or(&0);
             see_through_before.push(last + u32::from(veil.transmittance > 0.0));
             veils.push(veil);
-            let objs = &mesh_objects[inst.mesh];
-            let local = objs.object_of[t as usize];
-            let global = object_base[i] + local;
-            let caps_known = object_caps[global as usize].start != UNKNOWN_CAPS;
-            object.push(if objs.convex[local as usize] && caps_known { global } else { NO_OBJECT });
         }
-        let (objects, object_triangles) = group_positions(&object, total as usize);
-        let (object_corners, corners) = distinct_corners(&objects, &object_triangles, &triangles);
+        let objects = PlacedObjects::new(scene, &sources, &triangles);
         let frames: Vec<Option<PlaneFrame>> = scene.receivers.iter().map(|r| PlaneFrame::new(r, DVec3::Z, eps)).collect();
         let outlines = scene.receivers.iter().zip(&frames).map(|(r, f)| f.as_ref().and_then(|f| outline(r, f, eps))).collect();
         Self {
@@ -178,14 +147,7 @@ impl ExactEngine {
             triangles,
             owner,
             veils,
-            object,
             objects,
-            object_triangles,
-            object_caps,
-            caps,
-            cap_corners,
-            object_corners,
-            corners,
             see_through_before,
             bounds: scene.bounds,
             origin: scene.origin,
@@ -214,7 +176,7 @@ impl ExactEngine {
 
     /// Convex objects found (shadows merged per object).
     pub fn convex_objects(&self) -> usize {
-        self.objects.iter().filter(|r| !r.is_empty()).count()
+        self.objects.convex()
     }
 
     /// Triangles indexed.
@@ -336,9 +298,9 @@ impl ExactEngine {
             if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
                 continue;
             }
-            match self.object[p] {
-                NO_OBJECT => self.triangle_shadow(frame, outline, p, scratch),
-                o => {
+            match self.objects.of(p) {
+                None => self.triangle_shadow(frame, outline, p, scratch),
+                Some(o) => {
                     if scratch.stamp[o as usize] != scratch.epoch {
                         scratch.stamp[o as usize] = scratch.epoch;
                         self.object_shadow(frame, outline, o, scratch);
@@ -361,8 +323,7 @@ impl ExactEngine {
     /// sun may pass through its open caps, its triangles' shadows one by one.
     fn object_shadow(&self, frame: &PlaneFrame, outline: &Outline, o: u32, s: &mut Scratch) {
         s.flat.clear();
-        let range = &self.objects[o as usize];
-        let triangles = &self.object_triangles[range.start as usize..range.end as usize];
+        let triangles = self.objects.triangles(o);
         let cut = !self.project_corners(frame, o, s);
         if cut {
             s.flat.clear();
@@ -370,10 +331,9 @@ impl ExactEngine {
                 push_projected(frame, &self.triangles[p as usize], &mut s.in_front, &mut s.clipped, &mut s.flat);
             }
         }
-        let caps = self.object_caps[o as usize].clone();
         // The plane's cut is an opening too, so an object with caps that crosses it goes triangle
         // by triangle.
-        if !caps.is_empty() && (cut || self.caps_overlap(frame, caps, s)) {
+        if self.objects.has_caps(o) && (cut || self.caps_overlap(frame, o, s)) {
             for &p in triangles {
                 self.triangle_shadow(frame, outline, p as usize, s);
             }
@@ -387,10 +347,9 @@ impl ExactEngine {
     /// empty when all lie on it (the triangles would cast nothing); `false`, with `s.flat`
     /// unusable, when some corner lies behind (its triangles must be clipped).
     fn project_corners(&self, frame: &PlaneFrame, o: u32, s: &mut Scratch) -> bool {
-        let range = &self.object_corners[o as usize];
         let mut above = false;
-        for &c in &self.corners[range.start as usize..range.end as usize] {
-            let p = self.triangles[c as usize / 3][c as usize % 3];
+        for &c in self.objects.corners(o) {
+            let p = self.corner(c);
             let h = frame.height(p);
             if h < 0.0 {
                 return false;
@@ -404,19 +363,23 @@ impl ExactEngine {
         true
     }
 
-    /// Whether the projections along the sun of two of these caps overlap (so some ray through
-    /// the object may meet none of its triangles). Separated or touching caps do not overlap.
-    fn caps_overlap(&self, frame: &PlaneFrame, caps: Range<u32>, s: &mut Scratch) -> bool {
+    /// Whether the projections along the sun of two of object `o`'s caps overlap (so some ray
+    /// through the object may meet none of its triangles). Separated or touching caps do not.
+    fn caps_overlap(&self, frame: &PlaneFrame, o: u32, s: &mut Scratch) -> bool {
         s.cap_points.clear();
         s.cap_ranges.clear();
-        for c in caps {
-            let corners = &self.cap_corners[self.caps[c as usize].start as usize..self.caps[c as usize].end as usize];
+        for corners in self.objects.caps(o) {
             let start = s.cap_points.len();
-            s.cap_points.extend(corners.iter().map(|&k| frame.project_along_sun(self.triangles[k as usize / 3][k as usize % 3])));
+            s.cap_points.extend(corners.iter().map(|&c| frame.project_along_sun(self.corner(c))));
             s.cap_ranges.push(start..s.cap_points.len());
         }
         let n = s.cap_ranges.len();
         (0..n).any(|a| (a + 1..n).any(|b| convex_overlap(&s.cap_points[s.cap_ranges[a].clone()], &s.cap_points[s.cap_ranges[b].clone()])))
+    }
+
+    /// A corner `3 · position + k`: corner `k` of the triangle at that position.
+    fn corner(&self, c: u32) -> DVec3 {
+        self.triangles[c as usize / 3][c as usize % 3]
     }
 
     /// Adds the polygon in `s.flat` (a projected triangle, or an object's projected points to
@@ -470,107 +433,6 @@ impl PlaneFrame {
         let shift_per_height = -DVec2::new(sun.dot(self.e1), sun.dot(self.e2)) / self.normal.dot(sun);
         PlaneFrame { shift_per_height, ..*self }
     }
-}
-
-/// Objects of one mesh: triangles grouped by shared positions, surface value and veil.
-fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
-    let tris: Vec<[[f32; 3]; 3]> = mesh.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| mesh.positions[t[k] as usize])).collect();
-    let keys: Vec<u64> = mesh
-        .indices
-        .chunks_exact(3)
-        .map(|t| {
-            let v = t[0] as usize;
-            let veil = mesh.veils.get(v).copied().unwrap_or_default();
-            let surface = mesh.surfaces[v] as u64;
-            // Surface, leaf rank and whether see-through: an object shares all three.
-            (surface << 32) ^ (veil.rank.to_bits() as u64).rotate_left(7) ^ ((veil.transmittance > 0.0) as u64) << 63
-        })
-        .collect();
-    objects::group(&tris, &keys)
-}
-
-/// Marks an object whose caps could not be placed (a cap corner's triangle is not indexed): it
-/// is not used as convex.
-const UNKNOWN_CAPS: u32 = u32::MAX;
-
-/// Per object of every placement (in [`ExactEngine`]'s object order): its caps as a range of
-/// the second list, each cap a range of the third, each corner `3 · position + corner` of a
-/// triangle at that position of `sources`.
-fn object_caps(scene: &Scene, mesh_objects: &[MeshObjects], sources: &[(usize, u32)]) -> (Vec<Range<u32>>, Vec<Range<u32>>, Vec<u32>) {
-    // Where each placement's mesh triangles went.
-    let mut first_of_instance = Vec::with_capacity(scene.instances.len() + 1);
-    first_of_instance.push(0usize);
-    for inst in &scene.instances {
-        let last = first_of_instance.last().copied().unwrap_or(0);
-        first_of_instance.push(last + scene.meshes[inst.mesh].indices.len() / 3);
-    }
-    let mut position = vec![u32::MAX; first_of_instance.last().copied().unwrap_or(0)];
-    for (p, &(i, t)) in sources.iter().enumerate() {
-        position[first_of_instance[i] + t as usize] = p as u32;
-    }
-    let (mut object_caps, mut caps, mut corners) = (Vec::new(), Vec::new(), Vec::new());
-    for (i, inst) in scene.instances.iter().enumerate() {
-        let objs = &mesh_objects[inst.mesh];
-        for range in &objs.cap_ranges {
-            let (first_cap, first_corner) = (caps.len(), corners.len());
-            for cap in &objs.caps[range.start as usize..range.end as usize] {
-                let start = corners.len() as u32;
-                for &(t, k) in &objs.cap_corners[cap.start as usize..cap.end as usize] {
-                    corners.push(position[first_of_instance[i] + t as usize].saturating_mul(3).saturating_add(u32::from(k)));
-                }
-                caps.push(start..corners.len() as u32);
-            }
-            if corners[first_corner..].iter().any(|&c| c >= u32::MAX - 2) {
-                caps.truncate(first_cap);
-                corners.truncate(first_corner);
-                object_caps.push(UNKNOWN_CAPS..UNKNOWN_CAPS);
-            } else {
-                object_caps.push(first_cap as u32..caps.len() as u32);
-            }
-        }
-    }
-    (object_caps, caps, corners)
-}
-
-/// Per convex object its distinct corners (world positions equal bit for bit are one), as a
-/// range of the second list, each `3 · position + corner` of a triangle holding it.
-fn distinct_corners(objects: &[Range<u32>], object_triangles: &[u32], triangles: &[[DVec3; 3]]) -> (Vec<Range<u32>>, Vec<u32>) {
-    let mut ranges = Vec::with_capacity(objects.len());
-    let mut corners = Vec::new();
-    let mut keyed: Vec<([u64; 3], u32)> = Vec::new();
-    for range in objects {
-        keyed.clear();
-        for &p in &object_triangles[range.start as usize..range.end as usize] {
-            for (k, q) in triangles[p as usize].iter().enumerate() {
-                keyed.push((q.to_array().map(f64::to_bits), 3 * p + k as u32));
-            }
-        }
-        keyed.sort_unstable();
-        keyed.dedup_by_key(|(bits, _)| *bits);
-        let start = corners.len() as u32;
-        corners.extend(keyed.iter().map(|(_, c)| *c));
-        ranges.push(start..corners.len() as u32);
-    }
-    (ranges, corners)
-}
-
-/// Per convex object its triangle positions (counting sort by object).
-fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>) {
-    let mut count = vec![0u32; objects + 1];
-    for &o in object.iter().filter(|&&o| o != NO_OBJECT) {
-        count[o as usize + 1] += 1;
-    }
-    for k in 0..objects {
-        count[k + 1] += count[k];
-    }
-    let ranges: Vec<Range<u32>> = (0..objects).map(|k| count[k]..count[k + 1]).collect();
-    let mut next: Vec<u32> = count[..objects].to_vec();
-    let mut out = vec![0u32; count[objects] as usize];
-    for (p, &o) in object.iter().enumerate().filter(|(_, o)| **o != NO_OBJECT) {
-        out[next[o as usize] as usize] = p as u32;
-        next[o as usize] += 1;
-    }
-    (ranges, out)
 }
 
 /// The receiver's outline in its frame: its triangles on the grid of its window, their union's

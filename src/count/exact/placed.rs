@@ -1,0 +1,208 @@
+//! The convex objects of a whole scene, for the fast exact engine: every placement's objects
+//! ([`super::objects`], found once per mesh) indexed by triangle *position* (the culling's
+//! order, in which the engine keeps its world triangles), with each object's triangles, its
+//! distinct corners and its open caps.
+//!
+//! Owns the numbering: objects of placement `i` follow those of placements before it; a corner is
+//! `3 · position + k`, corner `k` of the triangle at that position, so nothing here copies a
+//! point. Built once per scene; read per view.
+
+use std::ops::Range;
+
+use glam::DVec3;
+
+use super::objects::{self, MeshObjects};
+use crate::scene::Scene;
+
+/// No object: the triangle casts its own shadow.
+const NO_OBJECT: u32 = u32::MAX;
+
+/// Every placement's convex objects, by triangle position.
+#[derive(Debug, Default)]
+pub(super) struct PlacedObjects {
+    /// Per position: its convex object, or [`NO_OBJECT`].
+    of: Vec<u32>,
+    /// Per object (convex or not; a non-convex one has none): its triangle positions, a range of
+    /// `triangles`.
+    ranges: Vec<Range<u32>>,
+    triangles: Vec<u32>,
+    /// Per object: its distinct corners (bit for bit), a range of `corners`.
+    corner_ranges: Vec<Range<u32>>,
+    corners: Vec<u32>,
+    /// Per object: its open caps, a range of `caps` (empty for a closed one; see
+    /// [`objects::Convexity`]).
+    cap_ranges: Vec<Range<u32>>,
+    /// Per cap: its corners in order, a range of `cap_corners`.
+    caps: Vec<Range<u32>>,
+    cap_corners: Vec<u32>,
+}
+
+impl PlacedObjects {
+    /// The objects of `scene`'s placements; `sources` gives each position's placement and mesh
+    /// triangle, `triangles` its world triangle.
+    pub(super) fn new(scene: &Scene, sources: &[(usize, u32)], triangles: &[[DVec3; 3]]) -> Self {
+        // Objects of each mesh, in mesh coordinates; every placement has its own copies.
+        let mesh_objects: Vec<MeshObjects> = scene.meshes.iter().map(mesh_objects).collect();
+        let mut object_base = Vec::with_capacity(scene.instances.len());
+        let mut total = 0u32;
+        for inst in &scene.instances {
+            object_base.push(total);
+            total += mesh_objects[inst.mesh].convex.len() as u32;
+        }
+        let (cap_ranges, caps, cap_corners) = object_caps(scene, &mesh_objects, sources);
+        let of: Vec<u32> = sources
+            .iter()
+            .map(|&(i, t)| {
+                let objs = &mesh_objects[scene.instances[i].mesh];
+                let local = objs.object_of[t as usize];
+                let global = object_base[i] + local;
+                let caps_known = cap_ranges[global as usize].start != UNKNOWN_CAPS;
+                if objs.convex[local as usize] && caps_known { global } else { NO_OBJECT }
+            })
+            .collect();
+        let (ranges, object_triangles) = group_positions(&of, total as usize);
+        let (corner_ranges, corners) = distinct_corners(&ranges, &object_triangles, triangles);
+        Self { of, ranges, triangles: object_triangles, corner_ranges, corners, cap_ranges, caps, cap_corners }
+    }
+
+    /// Objects numbered (convex or not): the size of a per-object stamp.
+    pub(super) fn len(&self) -> usize {
+        self.ranges.len()
+    }
+
+    /// Convex objects (those whose shadows are merged).
+    pub(super) fn convex(&self) -> usize {
+        self.ranges.iter().filter(|r| !r.is_empty()).count()
+    }
+
+    /// The convex object of the triangle at `position`, if any.
+    pub(super) fn of(&self, position: usize) -> Option<u32> {
+        Some(self.of[position]).filter(|&o| o != NO_OBJECT)
+    }
+
+    /// Object `o`'s triangle positions.
+    pub(super) fn triangles(&self, o: u32) -> &[u32] {
+        slice(&self.triangles, &self.ranges[o as usize])
+    }
+
+    /// Object `o`'s distinct corners.
+    pub(super) fn corners(&self, o: u32) -> &[u32] {
+        slice(&self.corners, &self.corner_ranges[o as usize])
+    }
+
+    /// Whether object `o` has open caps.
+    pub(super) fn has_caps(&self, o: u32) -> bool {
+        !self.cap_ranges[o as usize].is_empty()
+    }
+
+    /// Object `o`'s caps, each its corners in order.
+    pub(super) fn caps(&self, o: u32) -> impl Iterator<Item = &[u32]> {
+        let range = &self.cap_ranges[o as usize];
+        self.caps[range.start as usize..range.end as usize].iter().map(|cap| slice(&self.cap_corners, cap))
+    }
+}
+
+fn slice<'a>(items: &'a [u32], range: &Range<u32>) -> &'a [u32] {
+    &items[range.start as usize..range.end as usize]
+}
+
+/// Objects of one mesh: triangles grouped by shared positions, surface value and veil.
+fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
+    let tris: Vec<[[f32; 3]; 3]> = mesh.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| mesh.positions[t[k] as usize])).collect();
+    let keys: Vec<u64> = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let v = t[0] as usize;
+            let veil = mesh.veils.get(v).copied().unwrap_or_default();
+            let surface = mesh.surfaces[v] as u64;
+            // Surface, leaf rank and whether see-through: an object shares all three.
+            (surface << 32) ^ (veil.rank.to_bits() as u64).rotate_left(7) ^ ((veil.transmittance > 0.0) as u64) << 63
+        })
+        .collect();
+    objects::group(&tris, &keys)
+}
+
+/// Marks an object whose caps could not be placed (a cap corner's triangle is not indexed): it
+/// is not used as convex.
+const UNKNOWN_CAPS: u32 = u32::MAX;
+
+/// Per object of every placement (in [`PlacedObjects`]' order): its caps as a range of
+/// the second list, each cap a range of the third, each corner `3 · position + corner` of a
+/// triangle at that position of `sources`.
+fn object_caps(scene: &Scene, mesh_objects: &[MeshObjects], sources: &[(usize, u32)]) -> (Vec<Range<u32>>, Vec<Range<u32>>, Vec<u32>) {
+    // Where each placement's mesh triangles went.
+    let mut first_of_instance = Vec::with_capacity(scene.instances.len() + 1);
+    first_of_instance.push(0usize);
+    for inst in &scene.instances {
+        let last = first_of_instance.last().copied().unwrap_or(0);
+        first_of_instance.push(last + scene.meshes[inst.mesh].indices.len() / 3);
+    }
+    let mut position = vec![u32::MAX; first_of_instance.last().copied().unwrap_or(0)];
+    for (p, &(i, t)) in sources.iter().enumerate() {
+        position[first_of_instance[i] + t as usize] = p as u32;
+    }
+    let (mut object_caps, mut caps, mut corners) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, inst) in scene.instances.iter().enumerate() {
+        let objs = &mesh_objects[inst.mesh];
+        for range in &objs.cap_ranges {
+            let (first_cap, first_corner) = (caps.len(), corners.len());
+            for cap in &objs.caps[range.start as usize..range.end as usize] {
+                let start = corners.len() as u32;
+                for &(t, k) in &objs.cap_corners[cap.start as usize..cap.end as usize] {
+                    corners.push(position[first_of_instance[i] + t as usize].saturating_mul(3).saturating_add(u32::from(k)));
+                }
+                caps.push(start..corners.len() as u32);
+            }
+            if corners[first_corner..].iter().any(|&c| c >= u32::MAX - 2) {
+                caps.truncate(first_cap);
+                corners.truncate(first_corner);
+                object_caps.push(UNKNOWN_CAPS..UNKNOWN_CAPS);
+            } else {
+                object_caps.push(first_cap as u32..caps.len() as u32);
+            }
+        }
+    }
+    (object_caps, caps, corners)
+}
+
+/// Per convex object its distinct corners (world positions equal bit for bit are one), as a
+/// range of the second list, each `3 · position + corner` of a triangle holding it.
+fn distinct_corners(objects: &[Range<u32>], object_triangles: &[u32], triangles: &[[DVec3; 3]]) -> (Vec<Range<u32>>, Vec<u32>) {
+    let mut ranges = Vec::with_capacity(objects.len());
+    let mut corners = Vec::new();
+    let mut keyed: Vec<([u64; 3], u32)> = Vec::new();
+    for range in objects {
+        keyed.clear();
+        for &p in &object_triangles[range.start as usize..range.end as usize] {
+            for (k, q) in triangles[p as usize].iter().enumerate() {
+                keyed.push((q.to_array().map(f64::to_bits), 3 * p + k as u32));
+            }
+        }
+        keyed.sort_unstable();
+        keyed.dedup_by_key(|(bits, _)| *bits);
+        let start = corners.len() as u32;
+        corners.extend(keyed.iter().map(|(_, c)| *c));
+        ranges.push(start..corners.len() as u32);
+    }
+    (ranges, corners)
+}
+
+/// Per convex object its triangle positions (counting sort by object).
+fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>) {
+    let mut count = vec![0u32; objects + 1];
+    for &o in object.iter().filter(|&&o| o != NO_OBJECT) {
+        count[o as usize + 1] += 1;
+    }
+    for k in 0..objects {
+        count[k + 1] += count[k];
+    }
+    let ranges: Vec<Range<u32>> = (0..objects).map(|k| count[k]..count[k + 1]).collect();
+    let mut next: Vec<u32> = count[..objects].to_vec();
+    let mut out = vec![0u32; count[objects] as usize];
+    for (p, &o) in object.iter().enumerate().filter(|(_, o)| **o != NO_OBJECT) {
+        out[next[o as usize] as usize] = p as u32;
+        next[o as usize] += 1;
+    }
+    (ranges, out)
+}
