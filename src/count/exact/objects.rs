@@ -20,7 +20,7 @@
 //! no triangle enters through one cap and leaves through another: so the hull is still the
 //! shadow in every view where no two caps' projections overlap and no part of the object lies
 //! behind the plane (whose cut would be one more opening). The engine checks that per view
-//! ([`caps_overlap`]) and otherwise casts the object's triangles one by one.
+//! (`ExactEngine::caps_overlap`) and otherwise casts the object's triangles one by one.
 //! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) are not tested and stay per-triangle.
 
 use std::collections::HashMap;
