@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# sunlit bench on a real GPU: every engine (exact, gpu, auto with a fresh and a cached profile) on
+# the generated bench models, one JSON line a run with its wall time, into OUT (default
+# target/bench-gpu). Needs a Vulkan driver for the GPU (NVIDIA's ICD); SUNLIT= names the binary
+# (default target/release/sunlit, built if missing). ATLAS= and LANES= pass --atlas/--lanes to the
+# GPU runs. BUDGET= seconds after which the remaining runs are skipped (default 480).
+# Used for docs/benchmarks-gpu.md (an H100 and an H200 lent for one session: see there).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+B=${SUNLIT:-target/release/sunlit}
+[ -x "$B" ] || cargo build --release --quiet --bin sunlit
+OUT=${OUT:-target/bench-gpu}; mkdir -p "$OUT"
+T0=$(date +%s)
+gpu_flags=(); [ -n "${ATLAS:-}" ] && gpu_flags+=(--atlas "$ATLAS"); [ -n "${LANES:-}" ] && gpu_flags+=(--lanes "$LANES")
+run() { # label timeout args...
+  local label=$1 t=$2; shift 2
+  if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-480}" ]; then echo "skip $label" >> "$OUT/stderr.txt"; return; fi
+  echo "== $label: $*" >> "$OUT/stderr.txt"
+  local s e rc; s=$(date +%s.%N)
+  timeout "$t" "$B" "$@" > "$OUT/last.json" 2>>"$OUT/stderr.txt"; rc=$?
+  e=$(date +%s.%N)
+  python3 - "$label" "$rc" "$s" "$e" "$OUT/last.json" <<'PY' >> "$OUT/bench.jsonl"
+import json, sys
+label, rc, s, e, path = sys.argv[1:]
+print(json.dumps({"label": label, "rc": int(rc), "wall": round(float(e) - float(s), 3), "out": open(path).read()}))
+PY
+}
+profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
+run synthetic 40 bench --suns 64 "${gpu_flags[@]}"
+for m in blaas-louvres blaas-trees-summer nyt-self nyt-flat; do
+  run "$m-gpu" 40 bench "$m" --engine gpu --check 50 "${gpu_flags[@]}"
+  run "$m-exact" 40 bench "$m" --engine exact
+  run "$m-auto-first" 40 bench "$m" --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
+  run "$m-auto" 40 bench "$m" --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
+done
+m=nyt-blocks
+run "$m-gpu-3000" 60 bench $m --engine gpu --views 3000 --check 30 "${gpu_flags[@]}"
+run "$m-exact-3000" 60 bench $m --engine exact --views 3000
+run "$m-auto-first-3000" 60 bench $m --views 3000 --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
+run "$m-auto-all" 150 bench $m --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
+echo "results: $OUT/bench.jsonl"
