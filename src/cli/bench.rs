@@ -19,20 +19,21 @@ pub(super) struct BenchArgs {
     /// Time an even spread of at most this many of a model's views and extrapolate the total.
     #[arg(long, value_name = "N")]
     views: Option<usize>,
-    /// Also check this many of the rendered views against the exact CPU reference (not timed).
+    /// Also check this many of the views counted on the GPU (and as many exactly clipped ones)
+    /// against the exact CPU reference (not timed).
     #[arg(long, value_name = "N", default_value_t = 0)]
     check: usize,
     /// Location of model files (generated models carry their own): latitude, longitude, time zone.
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true, default_value = "39.74,-105.18,-7")]
     location: String,
-    /// Occluder triangle counts for the synthetic cases.
+    /// Occluder triangle counts for the synthetic cases (without models).
     #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
     triangles: Vec<usize>,
     /// Leaf counts for street-tree cases (trees in full leaf in front of a facade), e.g.
-    /// 35905,233866 as in the paper's Blaas case; none by default.
+    /// 35905,233866 as in the paper's Blaas case; none by default (without models).
     #[arg(long, value_delimiter = ',')]
     trees: Vec<usize>,
-    /// Sun directions per case.
+    /// Sun directions per synthetic case (without models).
     #[arg(long, default_value_t = 64)]
     suns: usize,
     #[command(flatten)]
@@ -46,7 +47,8 @@ pub(super) struct BenchArgs {
     lanes: Option<usize>,
     #[command(flatten)]
     engine: EngineArgs,
-    /// Generated model names (see --list) or glTF/IDF model files.
+    /// Generated model names (see --list) or model files (glTF, IDF, epJSON); none: the synthetic
+    /// occluder clouds and the example office, at random suns.
     models: Vec<String>,
 }
 
