@@ -42,7 +42,7 @@ use bench_cli::{BenchArgs, run_bench};
 mod docs_check;
 
 #[derive(Parser)]
-#[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces (glTF or EnergyPlus models) for any sun and every EnergyPlus timestep of a year, by GPU pixel counting or exact polygon clipping")]
+#[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces, by GPU pixel counting or exact polygon clipping")]
 struct Cli {
     #[command(subcommand)]
     command: Command,

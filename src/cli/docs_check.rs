@@ -99,20 +99,30 @@ fn words(line: &str) -> Vec<Word> {
     out
 }
 
+/// A placeholder: a word in capitals (N, MODEL, FILE.csv is not one) or a `$VARIABLE`.
+fn is_placeholder(word: &str) -> bool {
+    word.starts_with('$')
+        || (word.chars().any(|c| c.is_ascii_uppercase()) && word.chars().all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_'))
+}
+
 /// The argument lists a command line stands for: with every `[optional]` part and with none.
-/// A word `…` (or `...`) stands for "as above" and is left out.
+/// A word `…` (or `...`) stands for "more options" and is left out; a placeholder given as an
+/// option's value becomes `1`, which every option's type accepts as text.
 fn variants(words: &[Word]) -> [Vec<String>; 2] {
     let (mut all, mut required) = (vec![], vec![]);
     let mut depth = 0usize;
+    let mut previous = "";
     for w in words {
         if w.opens {
             depth += 1;
         }
         if w.text != "…" && w.text != "..." && !w.text.is_empty() {
-            all.push(w.text.clone());
+            let text = if previous.starts_with('-') && is_placeholder(&w.text) { "1".to_string() } else { w.text.clone() };
+            all.push(text.clone());
             if depth == 0 {
-                required.push(w.text.clone());
+                required.push(text);
             }
+            previous = &w.text;
         }
         if w.closes {
             depth = depth.saturating_sub(1);
@@ -121,8 +131,55 @@ fn variants(words: &[Word]) -> [Vec<String>; 2] {
     [all, required]
 }
 
-/// Every `sunlit …` command in `sh` fences: (line number, the command with continuations joined).
+/// Every `sunlit …` command shown: in `sh` fences (continuations joined), and in inline code spans
+/// of prose (a span may wrap lines) unless the span holds `…`, which marks an excerpt. With the
+/// line number where each starts.
 fn commands(text: &str) -> Vec<(usize, String)> {
+    let mut out = fenced_commands(text);
+    out.extend(inline_commands(text));
+    out
+}
+
+/// The inline code spans of prose that are `sunlit` command lines (three words or more, no `…`),
+/// with their line numbers.
+fn inline_commands(text: &str) -> Vec<(usize, String)> {
+    let mut out = vec![];
+    let mut paragraph: Vec<(usize, &str)> = vec![];
+    let mut flush = |paragraph: &mut Vec<(usize, &str)>| {
+        let joined: String = paragraph.iter().map(|(_, l)| format!("{l}\n")).collect();
+        let starts: Vec<usize> = paragraph
+            .iter()
+            .scan(0, |at, (_, l)| {
+                let start = *at;
+                *at += l.len() + 1;
+                Some(start)
+            })
+            .collect();
+        let mut at = 0;
+        for (i, piece) in joined.split('`').enumerate() {
+            let span = piece.split_whitespace().collect::<Vec<_>>().join(" ");
+            // `sunlit annual` alone names a command; three words or more are a command line.
+            if i % 2 == 1 && span.starts_with("sunlit ") && !span.contains('…') && span.split(' ').count() >= 3 {
+                let line = starts.iter().rposition(|&s| s <= at).map_or(0, |k| paragraph[k].0);
+                out.push((line, span));
+            }
+            at += piece.len() + 1;
+        }
+        paragraph.clear();
+    };
+    for line in lines(text) {
+        if line.fence.is_some() || line.text.trim().is_empty() {
+            flush(&mut paragraph);
+        } else {
+            paragraph.push((line.number, line.text));
+        }
+    }
+    flush(&mut paragraph);
+    out
+}
+
+/// Every `sunlit …` line in `sh` fences, continuations joined.
+fn fenced_commands(text: &str) -> Vec<(usize, String)> {
     let mut out = vec![];
     let mut pending: Option<(usize, String)> = None;
     for line in lines(text).into_iter().filter(|l| matches!(l.fence, Some("sh" | "bash"))) {
@@ -272,12 +329,23 @@ fn the_check_itself_catches_what_it_should() {
     // Optional parts, quotes and comments; a continuation joins lines.
     let text = "```sh\nsunlit fraction M.glb --sun 200,35 [--json]   # one sun\nsunlit annual M.glb \\\n  --location 1,2,3 -o o.csv [--refine 0.3] …\nsunlit sweep v.jsonl -o d --slurm [--sbatch \"--partition=cpu --time=2:00:00\"]\n```\n```text\nsunlit nonsense\n```\n";
     assert_eq!(commands(text).len(), 3);
+    // Inline: a command line is checked (also wrapped), an excerpt (…) or a bare command name not.
+    let prose = "Run `sunlit fraction M.glb\n --sun 1,2` or `sunlit annual … -o o.csv` with `sunlit info`.";
+    assert_eq!(commands(prose), vec![(1, "sunlit fraction M.glb --sun 1,2".to_string())]);
+    assert!(!command_problems(Path::new("t.md"), "a\n\nsee `sunlit bench --lst` there").is_empty());
+    // Placeholders in capitals stand for an option's value.
+    assert!(command_problems(Path::new("t.md"), "`sunlit bench MODEL --views N --check N --engine-profile FILE`").is_empty());
     assert!(command_problems(Path::new("t.md"), text).is_empty(), "{:?}", command_problems(Path::new("t.md"), text));
     let [all, required] = variants(&words("sunlit fraction M.glb --sun 1,2 [--json] [--resolution 64]"));
     assert_eq!(all.len(), 8);
     assert_eq!(required.len(), 5);
     // A misspelt option, a value where a number goes, a missing required option: each is caught.
-    for bad in ["sunlit fraction M.glb --sun 1,2 --jsn", "sunlit annual M.glb -o o.csv [--refine lots]", "sunlit fraction M.glb", "sunlit anual M.glb"] {
+    for bad in [
+        "sunlit fraction M.glb --sun 1,2 --jsn",
+        "sunlit annual M.glb -o o.csv [--refine lots]",
+        "sunlit fraction M.glb",
+        "sunlit anual M.glb",
+    ] {
         assert!(!command_problems(Path::new("t.md"), &format!("```sh\n{bad}\n```\n")).is_empty(), "{bad}");
     }
     // Links: a missing file, a missing anchor; a good anchor and code spans pass.
@@ -285,4 +353,33 @@ fn the_check_itself_catches_what_it_should() {
     assert_eq!(link_problems(&here, "[a](docs/nope.md) [b](docs/design.md#nope) [c](#nope)").len(), 3);
     assert!(link_problems(&here, "[a](docs/design.md#culling) `[x](nope)` [w](https://example.org/x)").is_empty());
     assert_eq!(slug("Hybrid engine (`--engine auto|gpu|exact`)"), "hybrid-engine---engine-autogpuexact");
+}
+
+/// The lines of a text's first fence tagged `tag`.
+fn first_fence<'a>(text: &'a str, tag: &str) -> Vec<&'a str> {
+    let mut inside = false;
+    let mut out = vec![];
+    for line in text.lines() {
+        match (line.trim_start().strip_prefix("```"), inside) {
+            (Some(info), false) if info.trim() == tag => inside = true,
+            (Some(_), true) => break,
+            (None, true) => out.push(line),
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn the_readme_quick_start_is_the_npm_readme_example_the_browser_test_runs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let read = |file: &str| std::fs::read_to_string(root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let (readme, npm) = (read("README.md"), read("www/npm-readme.md"));
+    let example = first_fence(&npm, "js");
+    assert!(example.iter().any(|l| l.contains("fromThree")), "www/npm-readme.md's first js fence is the three.js example: {example:?}");
+    assert_eq!(
+        first_fence(&readme, "js"),
+        example,
+        "README.md's three.js quick start must be www/npm-readme.md's example (tests/browser/npm.test.mjs runs that one)"
+    );
 }
