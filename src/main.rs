@@ -58,7 +58,8 @@ enum Command {
     /// (and, with --idf-out, a copy of an EnergyPlus model that uses it).
     Annual(AnnualArgs),
     /// Time generated benchmark models (see --list) or model files over the views of an annual
-    /// sampling plan; without models, views per second on synthetic occluder clouds and the office.
+    /// sampling plan, one JSON line a model (fields in docs/benchmarks.md); without models, views
+    /// per second on synthetic occluder clouds and the office.
     Bench(BenchArgs),
     /// Many annual runs from a manifest (one JSON object a line: "id" plus annual's long
     /// options), counted here side by side or submitted as a Slurm job array; resumable.
@@ -79,7 +80,7 @@ struct AnnualArgs {
     location: Option<String>,
     /// Timesteps per hour (one EnergyPlus accepts: 1 2 3 4 5 6 10 12 15 20 30 60); default: the
     /// EnergyPlus model's Timestep, else 4.
-    #[arg(long)]
+    #[arg(long, value_name = "N")]
     timesteps_per_hour: Option<u32>,
     /// The calendar year (a leap year gives 366 days, 8784 rows per timestep per hour); default:
     /// the EnergyPlus model's RunPeriod Begin Year, else the EPW's year if it has a Feb 29, else
@@ -87,11 +88,11 @@ struct AnnualArgs {
     #[arg(long)]
     year: Option<i32>,
     /// Sampled days, evenly over the year.
-    #[arg(long, default_value_t = SamplingPlan::default().days)]
+    #[arg(long, value_name = "N", default_value_t = SamplingPlan::default().days)]
     days_per_year: usize,
     /// Samples per day and lit period of each surface (Chebyshev nodes: closer together towards
     /// sunrise and sunset, where shadows move fastest).
-    #[arg(long, default_value_t = SamplingPlan::default().per_day)]
+    #[arg(long, value_name = "N", default_value_t = SamplingPlan::default().per_day)]
     samples_per_day: usize,
     #[command(flatten)]
     pixels: PixelArgs,
@@ -106,9 +107,9 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
+    #[arg(long, value_name = "T", default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
-    /// Output CSV (written atomically).
+    /// Output CSV, EnergyPlus's eplusshading.csv layout (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
     /// Also write a per-surface summary (JSON or CSV, by extension; written atomically): area,
@@ -117,7 +118,7 @@ struct AnnualArgs {
     #[arg(long, value_name = "FILE.json|FILE.csv")]
     summary: Option<PathBuf>,
     /// Also write a copy of the EnergyPlus model given (IDF or epJSON, as given) that reads the
-    /// CSV, named by its absolute path; needs an .idf or .epJSON among the models.
+    /// CSV (by its absolute path); needs an .idf or .epJSON among the models.
     #[arg(long, value_name = "FILE")]
     idf_out: Option<PathBuf>,
     /// How the copy reads the CSV: scheduled (a Schedule:File per surface; what EnergyPlus 25.2
@@ -174,9 +175,10 @@ struct ModelArgs {
     receivers: Vec<String>,
     /// Degrees clockwise from true north of a glTF model's north (its −Z), as EnergyPlus's
     /// Building North Axis; an EnergyPlus model's own North Axis is read from it instead.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
     north: f64,
-    /// Foliage: glob over node names; each leaf casts a shadow only while in leaf. Repeatable.
+    /// Foliage (deciduous unless --evergreen): glob over node names; each leaf (a connected group
+    /// of the node's triangles) casts a shadow only while in leaf (--leaf-out, --leaf-fall). Repeatable.
     #[arg(long = "foliage", value_name = "GLOB")]
     foliage: Vec<String>,
     /// See-through nodes (e.g. perforated screens): GLOB=T lets T (0..1) of the beam through. Repeatable.
@@ -216,7 +218,7 @@ impl ModelArgs {
 struct PixelArgs {
     /// Side in pixels of the square tile each view is counted on by the GPU (the exact engine
     /// needs none).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, value_name = "PIXELS", default_value_t = 512)]
     resolution: u32,
     /// Target |error| per counted view: count each view at 64² first and again, up to
     /// --resolution, only where shadow edges make the estimated error larger (see
@@ -272,9 +274,9 @@ struct FractionArgs {
     #[command(flatten)]
     engine: EngineArgs,
     /// Leaf fraction of foliage, 0 (bare) to 1 (full leaf).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, value_name = "L", default_value_t = 1.0)]
     leaves: f64,
-    /// Print JSON.
+    /// Print JSON instead of a table (fields in docs/guide-cli.md).
     #[arg(long)]
     json: bool,
 }

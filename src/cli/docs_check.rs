@@ -215,7 +215,9 @@ fn parse_error(args: &[String]) -> Option<String> {
 fn command_problems(file: &Path, text: &str) -> Vec<String> {
     let mut problems = vec![];
     for (number, command) in commands(text) {
-        for args in variants(&words(&command)) {
+        let [all, required] = variants(&words(&command));
+        let distinct = if all == required { vec![all] } else { vec![all, required] };
+        for args in distinct {
             if let Some(error) = parse_error(&args) {
                 let first = error.lines().next().unwrap_or_default().to_string();
                 problems.push(format!("{}:{number}: `{}` does not parse: {first}", file.display(), args.join(" ")));
