@@ -504,7 +504,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
         if form == Hook::Scheduled {
             // EnergyPlus's own share: the Scheduled method moves annual site energy even when fed
-            // EnergyPlus's own clipped fractions (README, "EnergyPlus").
+            // EnergyPlus's own clipped fractions (docs/guide-energyplus.md).
             eprintln!("note: {}", sunlit::export::hook::SCHEDULED_METHOD_NOTE);
         }
     }

@@ -2,7 +2,7 @@
 //! of a facade (by leaf count), the example office, and models after the paper's case studies ([`models`]) timed over the views `sunlit annual`
 //! counts for its samples.
 //!
-//! Owns what `sunlit bench` measures, so the figures in the README come from one place.
+//! Owns what `sunlit bench` measures, so the figures in docs/benchmarks.md come from one place.
 
 pub mod models;
 
