@@ -54,14 +54,16 @@ struct Word {
     closes: bool,
 }
 
-/// Shell words of one command line up to a comment, a pipe, a redirection or a `&&`/`;`.
+/// Shell words of one command line up to a comment, a pipe, a redirection (`>`, `2>`, `<`) or a
+/// `&&`/`;`.
 fn words(line: &str) -> Vec<Word> {
     let mut out: Vec<Word> = vec![];
     let mut chars = line.chars().peekable();
     loop {
         while chars.next_if(|c| c.is_whitespace()).is_some() {}
         let Some(&first) = chars.peek() else { break };
-        if matches!(first, '#' | '|' | '>' | ';' | '&') {
+        let rest: String = chars.clone().take(2).collect();
+        if matches!(first, '#' | '|' | '>' | '<' | ';' | '&') || (first.is_ascii_digit() && rest.ends_with('>')) {
             break;
         }
         let mut word = Word { text: String::new(), opens: false, closes: false };
@@ -193,13 +195,29 @@ fn fenced_commands(text: &str) -> Vec<(usize, String)> {
             }
             None => {
                 joined.push_str(text);
-                if joined.starts_with("sunlit ") || joined == "sunlit" {
-                    out.push((number, joined));
-                }
+                out.extend(as_sunlit(&joined).map(|command| (number, command)));
             }
         }
     }
     out
+}
+
+/// A shell line as a `sunlit` command, if it runs one: `sunlit …`, `target/release/sunlit …` or
+/// `cargo run --release -- …` (not an example's), after any `NAME=value` words.
+fn as_sunlit(line: &str) -> Option<String> {
+    let mut rest = line.trim();
+    while let Some((word, after)) = rest.split_once(' ') {
+        if !word.contains('=') || word.starts_with('-') {
+            break;
+        }
+        rest = after.trim_start();
+    }
+    let (program, args) = rest.split_once(' ').unwrap_or((rest, ""));
+    if program == "sunlit" || program.ends_with("/sunlit") {
+        return Some(format!("sunlit {args}").trim_end().to_string());
+    }
+    let (cargo, args) = rest.strip_prefix("cargo run")?.split_once(" -- ")?;
+    (!cargo.contains("--example")).then(|| format!("sunlit {}", args.trim()))
 }
 
 /// What clap says about one argument list; None when it parses (help and version count).
@@ -329,8 +347,13 @@ fn every_command_in_the_docs_parses_and_every_link_resolves() {
 #[test]
 fn the_check_itself_catches_what_it_should() {
     // Optional parts, quotes and comments; a continuation joins lines.
-    let text = "```sh\nsunlit fraction M.glb --sun 200,35 [--json]   # one sun\nsunlit annual M.glb \\\n  --location 1,2,3 -o o.csv [--refine 0.3] …\nsunlit sweep v.jsonl -o d --slurm [--sbatch \"--partition=cpu --time=2:00:00\"]\n```\n```text\nsunlit nonsense\n```\n";
+    let text = "```sh\nsunlit fraction M.glb --sun 200,35 [--json] 2>/dev/null | head  # one sun\nsunlit annual M.glb \\\n  --location 1,2,3 -o o.csv [--refine 0.3] …\nsunlit sweep v.jsonl -o d --slurm [--sbatch \"--partition=cpu --time=2:00:00\"]\n```\n```text\nsunlit nonsense\n```\n";
     assert_eq!(commands(text).len(), 3);
+    for line in ["RUST_LOG=info sunlit info M.glb", "target/release/sunlit info M.glb", "cargo run --release -- info M.glb"] {
+        assert_eq!(as_sunlit(line).as_deref(), Some("sunlit info M.glb"), "{line}");
+    }
+    assert_eq!(as_sunlit("npm start"), None);
+    assert_eq!(as_sunlit("cargo run --example soak -- 200 64"), None);
     // Inline: a command line is checked (also wrapped), an excerpt (…) or a bare command name not.
     let prose = "Run `sunlit fraction M.glb\n --sun 1,2` or `sunlit annual … -o o.csv` with `sunlit info`.";
     assert_eq!(commands(prose), vec![(1, "sunlit fraction M.glb --sun 1,2".to_string())]);
