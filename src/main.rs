@@ -37,9 +37,12 @@ use sweep_cli::{SweepArgs, sweep};
 #[path = "cli/bench.rs"]
 mod bench_cli;
 use bench_cli::{BenchArgs, run_bench};
+#[cfg(test)]
+#[path = "cli/docs_check.rs"]
+mod docs_check;
 
 #[derive(Parser)]
-#[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces by GPU pixel counting")]
+#[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces, by GPU pixel counting or exact polygon clipping")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -47,14 +50,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Sunlit fraction of every receiver for one sun position.
+    /// Sunlit fraction (sunlit area / area) of every receiver for one sun position.
     Fraction(FractionArgs),
-    /// List receivers (name, area, normal) and occluder counts.
+    /// List the receivers (name, area, normal) and triangle counts a model gives; nothing is counted.
     Info(InfoArgs),
-    /// Annual schedule at every EnergyPlus timestep, written as the CSV EnergyPlus reads.
+    /// Sunlit fractions at every EnergyPlus timestep of a year, written as the CSV EnergyPlus reads
+    /// (and, with --idf-out, a copy of an EnergyPlus model that uses it).
     Annual(AnnualArgs),
     /// Time generated benchmark models (see --list) or model files over the views of an annual
-    /// sampling plan; without models, views per second on synthetic occluder clouds and the office.
+    /// sampling plan, one JSON line a model (fields in docs/benchmarks.md); without models, views
+    /// per second on synthetic occluder clouds and the office.
     Bench(BenchArgs),
     /// Many annual runs from a manifest (one JSON object a line: "id" plus annual's long
     /// options), counted here side by side or submitted as a Slurm job array; resumable.
@@ -65,7 +70,8 @@ enum Command {
 struct AnnualArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Weather file whose LOCATION line gives latitude, longitude and time zone.
+    /// Weather file (EPW) whose LOCATION line gives latitude, longitude and time zone; with
+    /// --summary its direct normal irradiance also gives annual irradiation.
     /// Without --epw or --location, an EnergyPlus model's own Site:Location is used.
     #[arg(long, value_name = "FILE", conflicts_with = "location")]
     epw: Option<PathBuf>,
@@ -74,7 +80,7 @@ struct AnnualArgs {
     location: Option<String>,
     /// Timesteps per hour (one EnergyPlus accepts: 1 2 3 4 5 6 10 12 15 20 30 60); default: the
     /// EnergyPlus model's Timestep, else 4.
-    #[arg(long)]
+    #[arg(long, value_name = "N")]
     timesteps_per_hour: Option<u32>,
     /// The calendar year (a leap year gives 366 days, 8784 rows per timestep per hour); default:
     /// the EnergyPlus model's RunPeriod Begin Year, else the EPW's year if it has a Feb 29, else
@@ -82,10 +88,11 @@ struct AnnualArgs {
     #[arg(long)]
     year: Option<i32>,
     /// Sampled days, evenly over the year.
-    #[arg(long, default_value_t = SamplingPlan::default().days)]
+    #[arg(long, value_name = "N", default_value_t = SamplingPlan::default().days)]
     days_per_year: usize,
-    /// Samples per day, evenly over daylight.
-    #[arg(long, default_value_t = SamplingPlan::default().per_day)]
+    /// Samples per day and lit period of each surface (Chebyshev nodes: closer together towards
+    /// sunrise and sunset, where shadows move fastest).
+    #[arg(long, value_name = "N", default_value_t = SamplingPlan::default().per_day)]
     samples_per_day: usize,
     #[command(flatten)]
     pixels: PixelArgs,
@@ -100,9 +107,9 @@ struct AnnualArgs {
     dense: bool,
     /// Count a timestep directly where the samples around it differ by more than this (a shadow
     /// edge sweeping through); 1 interpolates everywhere.
-    #[arg(long, default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
+    #[arg(long, value_name = "T", default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
-    /// Output CSV (written atomically).
+    /// Output CSV, EnergyPlus's eplusshading.csv layout (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
     /// Also write a per-surface summary (JSON or CSV, by extension; written atomically): area,
@@ -110,11 +117,13 @@ struct AnnualArgs {
     /// with and without shading, from the EPW's direct normal irradiance.
     #[arg(long, value_name = "FILE.json|FILE.csv")]
     summary: Option<PathBuf>,
-    /// Also write a copy of the EnergyPlus model (IDF or epJSON, as given) that uses the CSV.
+    /// Also write a copy of the EnergyPlus model given (IDF or epJSON, as given) that reads the
+    /// CSV (by its absolute path); needs an .idf or .epJSON among the models.
     #[arg(long, value_name = "FILE")]
     idf_out: Option<PathBuf>,
-    /// How the copy hooks the CSV in: scheduled (per-surface Schedule:File, works with 25.2) or
-    /// imported (Schedule:File:Shading, ignored by 25.2); default by the model's Version.
+    /// How the copy reads the CSV: scheduled (a Schedule:File per surface; what EnergyPlus 25.2
+    /// uses) or imported (Schedule:File:Shading, which 25.2 ignores: every surface gets 1.0);
+    /// default scheduled (a model before Version 9.3 cannot be hooked).
     #[arg(long, value_name = "FORM")]
     hook: Option<String>,
     /// Foliage keeps its leaves all year.
@@ -154,16 +163,22 @@ impl AnnualArgs {
 
 #[derive(Args)]
 struct ModelArgs {
-    /// glTF/glb model files; all cast shadows.
+    /// Model files, all casting shadows: glTF (.glb, .gltf) and at most one EnergyPlus model
+    /// (.idf, .epJSON), whose outdoor surfaces and windows are the receivers; glTF files beside
+    /// an EnergyPlus model are context (they only cast shadows).
     #[arg(required = true, value_name = "MODEL")]
     models: Vec<PathBuf>,
-    /// Receivers: glob over node names (case-insensitive); repeatable.
+    /// Receivers: glob over node names (EnergyPlus: surface names), case-insensitive;
+    /// repeatable. Default: the nodes marked {"sunlit": {"receiver": true}} in glTF extras, else
+    /// every named mesh node; an EnergyPlus model's outdoor surfaces and windows.
     #[arg(long = "receivers", value_name = "GLOB")]
     receivers: Vec<String>,
-    /// Degrees clockwise from true north of the model's north (glTF −Z).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Degrees clockwise from true north of a glTF model's north (its −Z), as EnergyPlus's
+    /// Building North Axis; an EnergyPlus model's own North Axis is read from it instead.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
     north: f64,
-    /// Foliage: glob over node names; each leaf casts a shadow only while in leaf. Repeatable.
+    /// Foliage (deciduous unless --evergreen): glob over node names; each leaf (a connected group
+    /// of the node's triangles) casts a shadow only while in leaf (--leaf-out, --leaf-fall). Repeatable.
     #[arg(long = "foliage", value_name = "GLOB")]
     foliage: Vec<String>,
     /// See-through nodes (e.g. perforated screens): GLOB=T lets T (0..1) of the beam through. Repeatable.
@@ -201,12 +216,13 @@ impl ModelArgs {
 /// How views are counted: the tile side, or a target error (fraction, annual, bench).
 #[derive(Args)]
 struct PixelArgs {
-    /// Tile size in pixels.
-    #[arg(long, default_value_t = 512)]
+    /// Side in pixels of the square tile each view is counted on by the GPU (the exact engine
+    /// needs none).
+    #[arg(long, value_name = "PIXELS", default_value_t = 512)]
     resolution: u32,
     /// Target |error| per counted view: count each view at 64² first and again, up to
-    /// --resolution, only where shadow edges make the estimated error larger (see README,
-    /// "Adaptive resolution"). Without it every view is counted at --resolution.
+    /// --resolution, only where shadow edges make the estimated error larger (see
+    /// docs/design.md, "Adaptive resolution"). Without it every view is counted at --resolution.
     #[arg(long, value_name = "A")]
     accuracy: Option<f64>,
 }
@@ -221,7 +237,7 @@ impl PixelArgs {
 #[derive(Args)]
 struct EngineArgs {
     /// auto: each view on the cheaper of exact clipping and GPU pixels, by a cost model measured
-    /// once on this device (see README, "Hybrid engine"); gpu: pixels only; exact: clipping only
+    /// once on this device (see docs/design.md, "Hybrid engine"); gpu: pixels only; exact: clipping only
     /// (see-through nodes count as opaque there).
     #[arg(long, value_name = "auto|gpu|exact", default_value = "auto")]
     engine: String,
@@ -251,16 +267,16 @@ struct FractionArgs {
     sun: String,
     #[command(flatten)]
     pixels: PixelArgs,
-    /// Use the exact CPU polygon-clipping reference instead of the GPU (see-through nodes count
-    /// as opaque there).
+    /// Use the exact CPU polygon-clipping reference (slow, one thread: what both engines are tested
+    /// against) instead of --engine; see-through nodes count as opaque there.
     #[arg(long)]
     exact: bool,
     #[command(flatten)]
     engine: EngineArgs,
     /// Leaf fraction of foliage, 0 (bare) to 1 (full leaf).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, value_name = "L", default_value_t = 1.0)]
     leaves: f64,
-    /// Print JSON.
+    /// Print JSON instead of a table (fields in docs/guide-cli.md).
     #[arg(long)]
     json: bool,
 }
@@ -488,7 +504,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
         if form == Hook::Scheduled {
             // EnergyPlus's own share: the Scheduled method moves annual site energy even when fed
-            // EnergyPlus's own clipped fractions (README, "EnergyPlus").
+            // EnergyPlus's own clipped fractions (docs/guide-energyplus.md).
             eprintln!("note: {}", sunlit::export::hook::SCHEDULED_METHOD_NOTE);
         }
     }

@@ -2,7 +2,7 @@
 //! of a facade (by leaf count), the example office, and models after the paper's case studies ([`models`]) timed over the views `sunlit annual`
 //! counts for its samples.
 //!
-//! Owns what `sunlit bench` measures, so the figures in the README come from one place.
+//! Owns what `sunlit bench` measures, so the figures in docs/benchmarks.md come from one place.
 
 pub mod models;
 
@@ -261,7 +261,7 @@ pub fn check_answers(
         let errors: Vec<f64> = picked.iter().zip(&exact).map(|(&i, e)| (answers[i].fraction - e).abs()).collect();
         ExactCheck {
             views: errors.len(),
-            mean: errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+            mean: mean_abs(errors.iter().copied()),
             max: errors.iter().copied().fold(0.0, f64::max),
             above_estimate: 0,
         }
@@ -271,6 +271,13 @@ pub fn check_answers(
     let exact =
         (0..requests.len()).filter(|&i| answers[i].side.is_none() && answers[i].fraction > 0.0 && answers[i].fraction < 1.0).collect();
     (check(gpu), check(exact))
+}
+
+/// The mean of absolute errors; 0 (never −0: an empty `f64` sum is −0.0, which JSON shows as
+/// `-0.0`) when there are none, as when every view was clipped exactly.
+fn mean_abs(errors: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = errors.fold((0.0, 0usize), |(sum, n), e| (sum + e, n + 1));
+    if n == 0 { 0.0 } else { sum / n as f64 }
 }
 
 /// Checks an even spread of at most `at_most` of the rendered views against the exact CPU
@@ -285,7 +292,7 @@ pub fn check_exact(scene: &Scene, requests: &[ViewRequest], counted: &[Counted],
         picked.iter().zip(&exact).map(|(&i, e)| ((counted[i].fraction - e).abs(), counted[i].error_estimate())).collect();
     ExactCheck {
         views: errors.len(),
-        mean: errors.iter().map(|e| e.0).sum::<f64>() / errors.len().max(1) as f64,
+        mean: mean_abs(errors.iter().map(|e| e.0)),
         max: errors.iter().map(|e| e.0).fold(0.0, f64::max),
         above_estimate: errors.iter().filter(|(error, estimate)| error > estimate).count(),
     }
@@ -305,5 +312,18 @@ impl SplitMix64 {
 
     pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mean_abs;
+
+    #[test]
+    fn the_mean_of_no_errors_is_zero_not_negative_zero() {
+        let none = mean_abs(std::iter::empty());
+        assert!(none == 0.0 && none.is_sign_positive(), "{none:?}");
+        assert_eq!(serde_json::json!(none).to_string(), "0.0");
+        assert_eq!(mean_abs([0.25, 0.75].into_iter()), 0.5);
     }
 }

@@ -19,26 +19,27 @@ pub(super) struct BenchArgs {
     /// Time an even spread of at most this many of a model's views and extrapolate the total.
     #[arg(long, value_name = "N")]
     views: Option<usize>,
-    /// Also check this many of the rendered views against the exact CPU reference (not timed).
+    /// Also check this many of the views counted on the GPU against the exact CPU reference, and
+    /// (unless --engine gpu) as many exactly clipped ones; not timed.
     #[arg(long, value_name = "N", default_value_t = 0)]
     check: usize,
     /// Location of model files (generated models carry their own): latitude, longitude, time zone.
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true, default_value = "39.74,-105.18,-7")]
     location: String,
-    /// Occluder triangle counts for the synthetic cases.
-    #[arg(long, value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
+    /// Occluder triangle counts for the synthetic cases (without models).
+    #[arg(long, value_name = "N,…", value_delimiter = ',', default_values_t = [1_000usize, 100_000, 1_000_000])]
     triangles: Vec<usize>,
     /// Leaf counts for street-tree cases (trees in full leaf in front of a facade), e.g.
-    /// 35905,233866 as in the paper's Blaas case; none by default.
-    #[arg(long, value_delimiter = ',')]
+    /// 35905,233866 as in the paper's Blaas case; none by default (without models).
+    #[arg(long, value_name = "N,…", value_delimiter = ',')]
     trees: Vec<usize>,
-    /// Sun directions per case.
-    #[arg(long, default_value_t = 64)]
+    /// Sun directions per synthetic case (without models).
+    #[arg(long, value_name = "N", default_value_t = 64)]
     suns: usize,
     #[command(flatten)]
     pixels: PixelArgs,
     /// Largest atlas side in pixels (views per submission = (atlas / resolution)²).
-    #[arg(long, default_value_t = CounterOptions::default().max_atlas)]
+    #[arg(long, value_name = "PIXELS", default_value_t = CounterOptions::default().max_atlas)]
     atlas: u32,
     /// Devices counting side by side, each with its own copy of the scene; default: 2 on a CPU
     /// rasterizer (lavapipe bins triangles on one thread a device) with 2 or more cores, else 1.
@@ -46,7 +47,8 @@ pub(super) struct BenchArgs {
     lanes: Option<usize>,
     #[command(flatten)]
     engine: EngineArgs,
-    /// Generated model names (see --list) or glTF/IDF model files.
+    /// Generated model names (see --list) or model files (glTF, IDF, epJSON); none: the synthetic
+    /// occluder clouds and the example office, at random suns.
     models: Vec<String>,
 }
 

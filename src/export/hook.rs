@@ -64,8 +64,8 @@ impl Hook {
     }
 }
 
-/// What the Scheduled method itself changes in EnergyPlus (measured with 25.2; README,
-/// "EnergyPlus"): fed sunlit fractions, EnergyPlus skips its own shadow calculation
+/// What the Scheduled method itself changes in EnergyPlus (measured with 25.2; docs/guide-energyplus.md,
+/// "The Scheduled method's own shift"): fed sunlit fractions, EnergyPlus skips its own shadow calculation
 /// (SolarShading.cc `FigureSolarBeamAtTimestep`), so a window's `SunlitFracWithoutReveal` stays 0
 /// and `CalcInteriorSolarDistribution` adds no beam solar absorbed in its glass layers. Its
 /// transmitted solar is unchanged. Said whenever a Scheduled hook is written.

@@ -4,7 +4,7 @@
 //! A child process per variant makes each output byte for byte what a separate annual run
 //! writes (it is one), isolates a variant's failure (its exit code is recorded, the others go
 //! on), and is what a Slurm task runs as well; on the 2-core machine it measured no slower than
-//! counting variants in one process (README, "Many variants"). The annual run writes its files
+//! counting variants in one process (docs/guide-sweeps.md). The annual run writes its files
 //! atomically; the done record follows, so a killed sweep loses only the variants in flight.
 //! On Linux a child gets SIGTERM when the sweep dies (even by SIGKILL), and its own handler
 //! removes its temporary file: nothing partial stays behind.

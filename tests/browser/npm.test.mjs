@@ -4,7 +4,9 @@
 // through sunlit/three (world matrices, indexed and non-indexed geometry, an InstancedMesh) whose
 // fractions equal the native CLI's on the same scene exported as glb; createEngine({ device })
 // counts the same on the page's own GPUDevice and leaves it alive; the worker entry counts the
-// same; an EPW year gives irradiation; every JS option's bad input is refused naming the option.
+// same; an EPW year gives irradiation; every JS option's bad input is refused naming the option;
+// and the package README's three.js example (www/npm-readme.md, also README.md's quick start) runs
+// as written, so it cannot drift from the API.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync, mkdirSync, existsSync } from 'node:fs';
@@ -88,9 +90,28 @@ export async function exportGlb() {
   return Array.from(new Uint8Array(bytes));
 }
 
-window.sunlitApp = { THREE, createEngine, epwLocation, sunDirection, fromThree, colourByValues, receivingMeshes, buildScene, exportGlb, SunlitWorker };
+import { readmeExample } from './readme-example.js';
+
+window.sunlitApp = { readmeExample, THREE, createEngine, epwLocation, sunDirection, fromThree, colourByValues, receivingMeshes, buildScene, exportGlb, SunlitWorker };
 document.body.dataset.ready = '1';
 `;
+
+/**
+ * The package README's first `js` fence as a module: its imports stay at the top, the rest becomes
+ * the body of `readmeExample(scene, epwText)` (the two names the README says the reader brings),
+ * which returns what the example made.
+ */
+export function readmeExampleModule(readme) {
+  const fence = readme.match(/```js\n([\s\S]*?)```/);
+  assert.ok(fence, 'www/npm-readme.md has a ```js example');
+  const lines = fence[1].split('\n');
+  const imports = lines.filter((l) => l.startsWith('import '));
+  const body = lines.filter((l) => !l.startsWith('import '));
+  for (const name of ['engine', 'model', 'now', 'year']) {
+    assert.ok(body.some((l) => l.includes(`const ${name} =`)), `the README example defines ${name}`);
+  }
+  return `${imports.join('\n')}\n\nexport async function readmeExample(scene, epwText) {\n${body.join('\n')}\n  return { engine, model, now, year };\n}\n`;
+}
 
 function sh(cmd, args, options = {}) {
   return execFileSync(cmd, args, { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'], ...options });
@@ -111,6 +132,7 @@ before(async () => {
   );
   writeFileSync(join(app, 'index.html'), '<!doctype html><html><body><script type="module" src="/main.js"></script></body></html>');
   writeFileSync(join(app, 'main.js'), MAIN_JS);
+  writeFileSync(join(app, 'readme-example.js'), readmeExampleModule(readFileSync(join(ROOT, 'www/npm-readme.md'), 'utf8')));
   sh('npm', ['install', '--no-audit', '--no-fund', '--loglevel=error'], { cwd: app });
   sh('npx', ['vite', 'build', '--logLevel', 'warn'], { cwd: app });
   server = await staticServer(join(app, 'dist'));
@@ -343,4 +365,40 @@ test('every JS option\'s bad input is refused with an error naming the option', 
   };
   for (const [key, pattern] of Object.entries(expect)) assert.match(messages[key], pattern, `${key}: ${messages[key]}`);
   assert.deepEqual(pageErrors, []);
+});
+
+test('the package README\'s three.js example runs as written and gives the native CLI\'s fractions', async () => {
+  const r = await page.evaluate(async (text) => {
+    const { readmeExample, buildScene } = window.sunlitApp;
+    const scene = buildScene();
+    const { model, now, year } = await readmeExample(scene, text);
+    const coloured = [];
+    scene.traverse((o) => o.isMesh && !o.isInstancedMesh && coloured.push(o.material.color.getHexString()));
+    return {
+      names: model.receiverNames,
+      now: Array.from(now),
+      irradiation: Array.from(year.irradiation),
+      unshaded: Array.from(year.unshadedIrradiation),
+      colours: new Set(coloured).size,
+    };
+  }, epw(700));
+  // 'Wall*, Roof*' matches names case-insensitively, as the CLI's --receivers does.
+  assert.deepEqual([...r.names].sort(), ['ROOF', 'WALL_E', 'WALL_S']);
+  const glb = Buffer.from(await page.evaluate(() => window.sunlitApp.exportGlb()));
+  const dir = mkdtempSync(join(tmpdir(), 'sunlit-npm-readme-'));
+  try {
+    writeFileSync(join(dir, 'scene.glb'), glb);
+    const args = ['fraction', join(dir, 'scene.glb'), '--sun', '200,35', '--json', '--receivers', 'Wall*', '--receivers', 'Roof*'];
+    const native = JSON.parse(sh(join(ROOT, 'target/debug/sunlit'), args, { env: { ...process.env, XDG_RUNTIME_DIR: dir } }));
+    const nativeBy = new Map(native.surfaces.map((s) => [s.name, s.fraction]));
+    r.names.forEach((name, i) => {
+      assert.ok(Math.abs(r.now[i] - nativeBy.get(name)) <= 0.005, `${name}: README example ${r.now[i]} native ${nativeBy.get(name)}`);
+    });
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+  r.names.forEach((name, i) => {
+    assert.ok(r.unshaded[i] > 100 && r.irradiation[i] <= r.unshaded[i] + 1e-9, `${name}: ${r.irradiation[i]} of ${r.unshaded[i]} kWh/m²`);
+  });
+  assert.ok(r.colours >= 2, 'colourByValues recoloured the receivers');
 });

@@ -2,10 +2,11 @@
 // example through the Model input and through a dropped file, compute a year, download the
 // EnergyPlus CSV and compare it with the native CLI's; bad files give messages that name the
 // problem and the page keeps working; no request leaves the page's origin; user-supplied names
-// render as text. The 3D view is saved to target/artifacts/page.png for a person to look at.
+// render as text. The 3D view is saved to target/artifacts/page.png for a person to look at, and
+// copied to docs/page.png, the picture README.md shows.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
@@ -110,6 +111,8 @@ test('the example loads through the Model input, computes, and its CSV equals th
 
   // The coloured 3D view and the heat map, for a person to look at.
   await page.locator('.results').screenshot({ path: join(ARTIFACTS, 'page.png') });
+  // README.md shows this picture: each run brings the committed copy up to date.
+  copyFileSync(join(ARTIFACTS, 'page.png'), join(ROOT, 'docs/page.png'));
   const legend = await page.textContent('#legend');
   assert.match(legend, /Annual mean sunlit fraction/);
   assert.equal(await page.locator('#table tbody tr').count(), 10);
