@@ -33,13 +33,10 @@ for part in $PARTS; do
       ;;
     3)
       [ -x "$VENV/bin/python" ] || { python3 -m venv "$VENV" && "$VENV/bin/pip" install -q ladybug-radiance==0.2.12 pyradiance==1.3.1; }
-      bindir=$("$VENV/bin/python" -c 'import pyradiance, os; print(os.path.join(os.path.dirname(pyradiance.__file__), "bin"))')
-      libdir=$("$VENV/bin/python" -c 'import pyradiance, os; print(os.path.join(os.path.dirname(pyradiance.__file__), "lib"))')
       [ -f "$OUT/blaas-louvres.glb" ] || $bin bench blaas-louvres --write "$OUT/blaas-louvres.glb"
       $bin map "$OUT/blaas-louvres.glb" --grid 0.5 --location "$GOLDEN" -o "$OUT/blaas-0.5.csv" --json | tee "$OUT/blaas-0.5.json"
       farm-bench -n "$RUNS" --timeout 300 -- $bin map "$OUT/blaas-louvres.glb" --grid 0.5 --location "$GOLDEN" -o "$OUT/blaas-0.5.csv"
-      PATH="$bindir:$PATH" BINPATH="$bindir" RAYPATH="$libdir" \
-        "$VENV/bin/python" scripts/bench_maps_ladybug.py "$OUT/blaas-louvres.glb" "$OUT/blaas-0.5.csv" 39.74 -105.18 -7 | tee "$OUT/ladybug-0.5.json"
+      "$VENV/bin/python" scripts/bench_maps_ladybug.py "$OUT/blaas-louvres.glb" "$OUT/blaas-0.5.csv" 39.74 -105.18 -7 | tee "$OUT/ladybug-0.5.json"
       ;;
   esac
 done

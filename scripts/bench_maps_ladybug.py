@@ -16,8 +16,16 @@ import struct
 import sys
 import time
 
+import os
+
+import pyradiance
 from ladybug_geometry.geometry3d import Mesh3D, Point3D, Vector3D
-from ladybug_radiance.study.directsun import DirectSunStudy
+from ladybug_radiance.config import folders
+
+# pyradiance's wheel carries Radiance's binaries (bin/) and library (lib/): point Ladybug at
+# them before its intersection module reads the paths.
+folders.radiance_path = os.path.dirname(pyradiance.__file__)
+from ladybug_radiance.study.directsun import DirectSunStudy  # noqa: E402
 
 SINE_DECL = [0.00561800, 0.0657911, -0.392779, 0.00064440, -0.00618495, -0.00010101, -0.00007951, -0.00011691, 0.00002096]
 EQ_TIME = [0.00021971, -0.122649, 0.00762856, -0.156308, -0.0530028, -0.00388702, -0.00123978, -0.00270502, -0.00167992]
