@@ -40,6 +40,9 @@ use bench_cli::{BenchArgs, run_bench};
 #[cfg(test)]
 #[path = "cli/docs_check.rs"]
 mod docs_check;
+#[path = "cli/map.rs"]
+mod map_cli;
+use map_cli::{MapArgs, map};
 
 #[derive(Parser)]
 #[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces, by GPU pixel counting or exact polygon clipping")]
@@ -64,6 +67,9 @@ enum Command {
     /// Many annual runs from a manifest (one JSON object a line: "id" plus annual's long
     /// options), counted here side by side or submitted as a Slurm job array; resumable.
     Sweep(SweepArgs),
+    /// Per point: sun hours and direct irradiation over a period, or lit at an instant, on a grid
+    /// or given points; sun-hours studies (bre-ground, en17037). See docs/maps.md.
+    Map(MapArgs),
 }
 
 #[derive(Args)]
@@ -301,6 +307,7 @@ fn main() -> ExitCode {
         Command::Annual(a) => annual(a),
         Command::Bench(a) => run_bench(a),
         Command::Sweep(a) => sweep(a),
+        Command::Map(a) => map(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -334,6 +341,15 @@ const FLAGS: &[(&str, &str)] = &[
     ("per_task", "--per-task"),
     ("index", "--index"),
     ("summary", "--summary"),
+    ("spacing", "--grid"),
+    ("points", "--points"),
+    ("period", "--period"),
+    ("step", "--step"),
+    ("from", "--from"),
+    ("to", "--to"),
+    ("at", "--at"),
+    ("study", "--study"),
+    ("min_altitude", "--min-altitude"),
 ];
 
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
