@@ -763,16 +763,24 @@ fn models_the_hook_cannot_take() {
     let hook = ["--idf-out", "{dir}/hooked.idf"];
     check(
         "hook timestep",
-        Case::model("ts.idf", idf().into_bytes(), "ts.idf: Timestep (line 8): the model runs 4 timesteps per hour but the CSV has 6: use --timesteps-per-hour 4")
-            .args(&[hook[0], hook[1], "--timesteps-per-hour", "6"])
-            .api(None),
+        Case::model(
+            "ts.idf",
+            idf().into_bytes(),
+            "ts.idf: Timestep (line 8): the model runs 4 timesteps per hour but the CSV has 6: use --timesteps-per-hour 4",
+        )
+        .args(&[hook[0], hook[1], "--timesteps-per-hour", "6"])
+        .api(None),
     );
     let april31 = idf().replacen("RunPeriod, YEAR, 1, 1, , 12, 31,", "RunPeriod, YEAR, 4, 31, , 12, 31,", 1);
     check(
         "hook run period date",
-        Case::model("april.idf", april31.into_bytes(), "april.idf: RunPeriod 'YEAR' (line 12): Begin Month/Day 4/31 is not a date: EnergyPlus would stop on it")
-            .args(&hook)
-            .api(None),
+        Case::model(
+            "april.idf",
+            april31.into_bytes(),
+            "april.idf: RunPeriod 'YEAR' (line 12): Begin Month/Day 4/31 is not a date: EnergyPlus would stop on it",
+        )
+        .args(&hook)
+        .api(None),
     );
     let backwards = idf().replacen("RunPeriod, YEAR, 1, 1, , 12, 31, ,", "RunPeriod, YEAR, 1, 1, 2021, 12, 31, 2020,", 1);
     check(

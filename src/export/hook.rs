@@ -261,7 +261,11 @@ fn check_run_period(o: &IdfObject) -> std::result::Result<(), String> {
         if text.is_empty() {
             return Ok(None);
         }
-        text.parse::<f64>().ok().filter(|v| v.fract() == 0.0).map(|v| Some(v as i64)).ok_or_else(|| format!("{what} '{text}' is not a whole number"))
+        text.parse::<f64>()
+            .ok()
+            .filter(|v| v.fract() == 0.0)
+            .map(|v| Some(v as i64))
+            .ok_or_else(|| format!("{what} '{text}' is not a whole number"))
     };
     let date = |first: usize, which: &str| -> std::result::Result<(i64, i64, Option<i64>), String> {
         let month = number(first, &format!("{which} Month"))?.unwrap_or(if which == "Begin" { 1 } else { 12 });

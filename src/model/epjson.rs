@@ -245,7 +245,14 @@ const CLASSES: &[ClassSpec] = &[
     spec(
         "RunPeriod",
         true,
-        &[("begin_month", Number), ("begin_day_of_month", Number), ("begin_year", Number), ("end_month", Number), ("end_day_of_month", Number), ("end_year", Number)],
+        &[
+            ("begin_month", Number),
+            ("begin_day_of_month", Number),
+            ("begin_year", Number),
+            ("end_month", Number),
+            ("end_day_of_month", Number),
+            ("end_year", Number),
+        ],
         false,
     ),
     spec("Site:Location", true, &[("latitude", Number), ("longitude", Number), ("time_zone", Number), ("elevation", Number)], false),

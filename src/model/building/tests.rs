@@ -118,10 +118,12 @@ fn scene_receivers_face_outwards() {
 
 #[test]
 fn epjson_gives_the_same_surfaces() {
+    // Sun Exposure as the IDF gives it (the ground floor NoSun).
     let wall = |name: &str, kind: &str, boundary: &str, v: &str| {
+        let sun = if boundary == "Ground" { "NoSun" } else { "SunExposed" };
         format!(
             r#""{name}": {{"surface_type": "{kind}", "construction_name": "C1", "zone_name": "Zone One",
-            "outside_boundary_condition": "{boundary}", "number_of_vertices": 4, "vertices": [{v}]}}"#
+            "outside_boundary_condition": "{boundary}", "sun_exposure": "{sun}", "number_of_vertices": 4, "vertices": [{v}]}}"#
         )
     };
     let v =
