@@ -48,13 +48,17 @@ for run in periodic timestep hooked; do
 done
 
 python3 - "$out" "$model" "$t_periodic" "$t_timestep" "$t_sunlit" "$t_hooked" <<'EOF'
-import csv, sys
+import csv, os, re, sys
 out, model, tp, tt, ts, th = sys.argv[1], sys.argv[2], *map(float, sys.argv[3:])
 def site(run):
-    for line in open(f"{out}/{run}/eplustbl.csv", errors="replace"):
-        f = line.split(",")
-        if len(f) > 2 and f[1] == "Total Site Energy":
-            return float(f[2])
+    # The comma-separated table, or the HTML one where the model asks for HTML only.
+    if os.path.exists(f"{out}/{run}/eplustbl.csv"):
+        for line in open(f"{out}/{run}/eplustbl.csv", errors="replace"):
+            f = line.split(",")
+            if len(f) > 2 and f[1] == "Total Site Energy":
+                return float(f[2])
+    html = open(f"{out}/{run}/eplustbl.htm", errors="replace").read()
+    return float(re.search(r"Total Site Energy</td>\s*<td[^>]*>\s*([0-9.]+)", html).group(1))
 def reported(run):
     rows = list(csv.reader(open(f"{out}/{run}/eplusout.csv")))
     suffix = ":SURFACE OUTSIDE FACE SUNLIT FRACTION [](TIMESTEP)"

@@ -254,8 +254,13 @@ pub fn shading_sun_day(day: u32) -> f64 {
 /// A fraction as EnergyPlus stores its own: clamped to [0, 1], and 0 below 1e-5 (SolarShading.cc
 /// zeroes sunlit fractions under 1e-5, so a sliver that small is dark in its heat balance too).
 fn as_energyplus(fraction: f64) -> f32 {
+    energyplus_fraction(fraction) as f32
+}
+
+/// [`as_energyplus`] in f64, for the fitted surfaces' own evaluation.
+pub(super) fn energyplus_fraction(fraction: f64) -> f64 {
     let f = fraction.clamp(0.0, 1.0);
-    if f < MIN_SUNLIT_FRACTION { 0.0 } else { f as f32 }
+    if f < MIN_SUNLIT_FRACTION { 0.0 } else { f }
 }
 
 /// EnergyPlus's smallest non-zero sunlit fraction.
