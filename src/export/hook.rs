@@ -285,10 +285,10 @@ fn check_run_period(o: &IdfObject) -> std::result::Result<(), String> {
         Ok((month, day, year))
     };
     let (begin, end) = (date(1, "Begin")?, date(4, "End")?);
-    if let (Some(by), Some(ey)) = (begin.2, end.2) {
-        if (by, begin.0, begin.1) > (ey, end.0, end.1) {
-            return Err(format!("it begins on {by}-{:02}-{:02}, after it ends ({ey}-{:02}-{:02})", begin.0, begin.1, end.0, end.1));
-        }
+    if let (Some(by), Some(ey)) = (begin.2, end.2)
+        && (by, begin.0, begin.1) > (ey, end.0, end.1)
+    {
+        return Err(format!("it begins on {by}-{:02}-{:02}, after it ends ({ey}-{:02}-{:02})", begin.0, begin.1, end.0, end.1));
     }
     Ok(())
 }
@@ -405,20 +405,20 @@ pub fn hook_for(ep: &EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timeste
     // A Scheduled hook gives each column a SurfaceProperty:LocalEnvironment, which EnergyPlus
     // applies only to the surfaces it lets the sun onto (heat-transfer surfaces facing Outdoors,
     // not NoSun): any other column would be ignored (a window in an underground wall) or refused.
-    if form == Hook::Scheduled {
-        if let Some((r, s)) = scene.receivers.iter().find_map(|r| ep.building.surface(&r.name).filter(|s| !s.receiver).map(|s| (r, s))) {
-            return Err(Error::argument(
-                "hook",
-                format!(
-                    "receiver '{}' ({}) is {}, which EnergyPlus keeps dark or never lights (Outside Boundary Condition '{}'{}): it cannot take a sunlit fraction schedule",
-                    r.name,
-                    r.origin,
-                    s.label(),
-                    s.outside_boundary,
-                    if s.no_sun { ", Sun Exposure NoSun" } else { "" }
-                ),
-            ));
-        }
+    if form == Hook::Scheduled
+        && let Some((r, s)) = scene.receivers.iter().find_map(|r| ep.building.surface(&r.name).filter(|s| !s.receiver).map(|s| (r, s)))
+    {
+        return Err(Error::argument(
+            "hook",
+            format!(
+                "receiver '{}' ({}) is {}, which EnergyPlus keeps dark or never lights (Outside Boundary Condition '{}'{}): it cannot take a sunlit fraction schedule",
+                r.name,
+                r.origin,
+                s.label(),
+                s.outside_boundary,
+                if s.no_sun { ", Sun Exposure NoSun" } else { "" }
+            ),
+        ));
     }
     // The model checks (version, Timestep, existing local environments) before any counting.
     let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
