@@ -518,6 +518,10 @@ fn leap_weather(dir: &Path) -> PathBuf {
     path
 }
 
+/// Per surface: name, steps dark in one and lit in the other against the clipping run and
+/// against the hooked run, mean |Δ| over lit steps against the clipping run.
+type SurfaceStats = (String, usize, usize, f64);
+
 /// One configuration of the sun check: a test file as an annual run with given settings.
 struct SunCase {
     label: &'static str,
@@ -532,7 +536,7 @@ struct SunCase {
 /// hooked model; returns per surface of sunlit's CSV (name, steps dark in one and lit in the other
 /// against the clipping's reported fractions, the same against the hooked run's, mean |Δ| over the
 /// lit steps against the clipping).
-fn sun_case(case: &SunCase) -> Vec<(String, usize, usize, f64)> {
+fn sun_case(case: &SunCase) -> Vec<SurfaceStats> {
     let dir = scratch(&format!("sun-{}", case.label));
     let text = annual(&case.text);
     let idf = dir.join("clipping.idf");
@@ -590,7 +594,7 @@ fn run_energyplus_with(idf: &Path, out: &Path, weather: &Path) {
 fn sun_and_dark_steps_match_energyplus_reported_fractions() {
     let scratch_dir = scratch("sun-weather");
     let four = testfile(CURRENT);
-    let cases = vec![
+    let cases = [
         SunCase { label: "4zone-ts4", text: configured(&four, 4, None), weather: weather(), n: 4, first_day: 1 },
         SunCase {
             label: "4zone-ts1-leap",
@@ -608,7 +612,7 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
         },
         SunCase { label: "5zone-ts4", text: testfile(FIVE_ZONE), weather: weather(), n: 4, first_day: 1 },
     ];
-    let results: Vec<(&'static str, Vec<(String, usize, usize, f64)>)> = std::thread::scope(|s| {
+    let results: Vec<(&'static str, Vec<SurfaceStats>)> = std::thread::scope(|s| {
         let handles: Vec<_> = cases.iter().map(|c| (c.label, s.spawn(move || sun_case(c)))).collect();
         handles.into_iter().map(|(label, h)| (label, h.join().unwrap())).collect()
     });
