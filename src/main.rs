@@ -518,10 +518,12 @@ fn annual(args: AnnualArgs) -> Result<()> {
     if let Some((out, form, text)) = patched {
         sunlit::export::write_atomic(out, text.as_bytes())?;
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
-        if form == Hook::Scheduled {
+        if let (Hook::Scheduled, Some(ep)) = (form, energyplus.as_ref()) {
             // EnergyPlus's own share: the Scheduled method moves annual site energy even when fed
-            // EnergyPlus's own clipped fractions (docs/guide-energyplus.md).
-            eprintln!("note: {}", sunlit::export::hook::SCHEDULED_METHOD_NOTE);
+            // EnergyPlus's own fractions (docs/energyplus-fidelity.md), by cause.
+            for cause in sunlit::export::hook::scheduled_method_gap(ep, &schedule.names) {
+                eprintln!("note: {cause}");
+            }
         }
     }
     eprintln!(

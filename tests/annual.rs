@@ -91,7 +91,7 @@ fn spline_matches_dense(scene: &Scene, label: &str) -> f64 {
     let mut night = 0;
     for row in 0..ts.rows() {
         let i = ts.instant(row);
-        // Night by the sun EnergyPlus's shading uses on that day (the previous day's, see
+        // Night by the sun EnergyPlus's shading uses on that day (the calendar day's, see
         // `shading_sun_day`), which the schedule follows.
         if sun_direction(&golden(), sunlit::year::annual::shading_sun_day(i.day), i.hour).z < 0.0 {
             night += 1;

@@ -752,3 +752,57 @@ fn corrupted_compressed_gltf_never_panics() {
     // Both outcomes occur: the mutations reach the decoders and do not all fail the same way.
     assert!(loaded > 0 && refused > 0, "{loaded} loaded, {refused} refused");
 }
+
+/// Models the hook would break are refused by name before anything is counted or written: a
+/// Timestep other than the CSV's, a RunPeriod EnergyPlus 25.2 stops on (its own messages:
+/// "Invalid input start month/day (4/31)", "start year (2021) is after the end year (2020)"),
+/// and a receiver named after a surface EnergyPlus never lights (the ground floor, NoSun), which
+/// cannot take a sunlit fraction schedule.
+#[test]
+fn models_the_hook_cannot_take() {
+    let hook = ["--idf-out", "{dir}/hooked.idf"];
+    check(
+        "hook timestep",
+        Case::model(
+            "ts.idf",
+            idf().into_bytes(),
+            "ts.idf: Timestep (line 8): the model runs 4 timesteps per hour but the CSV has 6: use --timesteps-per-hour 4",
+        )
+        .args(&[hook[0], hook[1], "--timesteps-per-hour", "6"])
+        .api(None),
+    );
+    let april31 = idf().replacen("RunPeriod, YEAR, 1, 1, , 12, 31,", "RunPeriod, YEAR, 4, 31, , 12, 31,", 1);
+    check(
+        "hook run period date",
+        Case::model(
+            "april.idf",
+            april31.into_bytes(),
+            "april.idf: RunPeriod 'YEAR' (line 12): Begin Month/Day 4/31 is not a date: EnergyPlus would stop on it",
+        )
+        .args(&hook)
+        .api(None),
+    );
+    let backwards = idf().replacen("RunPeriod, YEAR, 1, 1, , 12, 31, ,", "RunPeriod, YEAR, 1, 1, 2021, 12, 31, 2020,", 1);
+    check(
+        "hook run period years",
+        Case::model(
+            "years.idf",
+            backwards.into_bytes(),
+            "years.idf: RunPeriod 'YEAR' (line 12): it begins on 2021-01-01, after it ends (2020-12-31): EnergyPlus would stop on it",
+        )
+        .args(&hook)
+        .api(None),
+    );
+    let floor = glb(&[("FLOOR", &SQUARE, &QUAD)]);
+    check(
+        "hook dark surface",
+        Case::model(
+            "office.idf",
+            idf().into_bytes(),
+            "invalid --hook: receiver 'FLOOR' (floor.glb: node 'FLOOR') is BuildingSurface:Detailed 'FLOOR' (line 111), which EnergyPlus keeps dark or never lights (Outside Boundary Condition 'Ground', Sun Exposure NoSun): it cannot take a sunlit fraction schedule",
+        )
+        .with_file("floor.glb", floor)
+        .args(&[hook[0], hook[1], "--receivers", "FLOOR"])
+        .api(None),
+    );
+}

@@ -64,15 +64,54 @@ impl Hook {
     }
 }
 
-/// What the Scheduled method itself changes in EnergyPlus (measured with 25.2; docs/guide-energyplus.md,
-/// "The Scheduled method's own shift"): fed sunlit fractions, EnergyPlus skips its own shadow calculation
-/// (SolarShading.cc `FigureSolarBeamAtTimestep`), so a window's `SunlitFracWithoutReveal` stays 0
-/// and `CalcInteriorSolarDistribution` adds no beam solar absorbed in its glass layers. Its
-/// transmitted solar is unchanged. Said whenever a Scheduled hook is written.
-pub const SCHEDULED_METHOD_NOTE: &str = "EnergyPlus's Scheduled method drops the beam solar absorbed in exterior windows' glass \
-     (it skips its own shadow calculation, which that term needs); transmitted solar is unchanged. Fed EnergyPlus's own \
-     clipped fractions, annual site energy moves by +0.49% on 4ZoneWithShading_Simple_1 (Chicago) and by +0.004% \
-     with its exterior windows removed; the hook has no input that restores it";
+/// What EnergyPlus's Scheduled method itself changes, for the model it hooks: one line per cause
+/// present, each with what was measured on EnergyPlus's test files (25.2, Chicago TMY3, the hook
+/// fed EnergyPlus's own reported fractions against its own clipping; docs/energyplus-fidelity.md).
+/// Fed sunlit fractions, EnergyPlus skips its own shadow calculation (SolarShading.cc
+/// `FigureSolarBeamAtTimestep`), and with it every term that calculation builds:
+/// - the beam solar absorbed in exterior windows' glass (`SunlitFracWithoutReveal` stays 0, so
+///   `CalcInteriorSolarDistribution` adds none); transmitted solar is unchanged;
+/// - under `FullInteriorAndExterior` (with or without reflections), the back-surface overlaps
+///   that send transmitted beam to the surfaces it lands on: it is spread as diffuse instead;
+/// - for windows set back in their wall, the reveal terms (beam absorbed by the outside and
+///   inside reveals).
+///
+/// EnergyPlus 25.2 has no input that restores the first for ordinary windows:
+/// `ComplexFenestrationProperty:SolarAbsorbedLayers` applies only to
+/// `Construction:ComplexFenestrationState` windows, and the `Surface` EMS actuators of a window
+/// are construction state, convection coefficients, outdoor air and view factor to ground.
+pub fn scheduled_method_gap(ep: &EnergyPlusInput, columns: &[String]) -> Vec<String> {
+    let hooked: Vec<&crate::model::building::EpSurface> = columns.iter().filter_map(|c| ep.building.surface(c)).collect();
+    let glazed = |s: &&&crate::model::building::EpSurface| ["Window", "GlassDoor"].iter().any(|k| s.kind.eq_ignore_ascii_case(k));
+    let windows = hooked.iter().filter(glazed).count();
+    let mut out = Vec::new();
+    if windows > 0 {
+        out.push(format!(
+            "EnergyPlus's Scheduled method drops the beam solar absorbed in exterior windows' glass ({windows} here): it skips its \
+             own shadow calculation, which that term needs; transmitted solar is unchanged. Fed EnergyPlus's own reported \
+             fractions, absorbed solar in glass falls 47% and annual site energy moves +0.49% on 4ZoneWithShading_Simple_1, \
+             32% and +0.20% on 5ZoneAirCooled (Chicago); no EnergyPlus 25.2 input restores it for windows that are not BSDF"
+        ));
+    }
+    let distribution = ep.objects.iter().find(|o| o.is("Building")).map(|o| o.field(5).trim().to_ascii_lowercase()).unwrap_or_default();
+    if windows > 0 && distribution.starts_with("fullinteriorandexterior") {
+        out.push(format!(
+            "Solar Distribution {}: under the Scheduled method EnergyPlus builds no back-surface overlaps, so beam through the \
+             windows reaches the zone as diffuse instead of landing where it falls (measured on 4ZoneWithShading_Simple_1 set \
+             to FullInteriorAndExterior: see docs/energyplus-fidelity.md)",
+            ep.objects.iter().find(|o| o.is("Building")).map_or("", |o| o.field(5).trim())
+        ));
+    }
+    let set_back = hooked.iter().filter(|s| ep.building.reveal_depth(s).is_some()).count();
+    if set_back > 0 {
+        out.push(format!(
+            "{set_back} hooked windows or doors are set back in their walls: EnergyPlus's reveal terms (beam absorbed by the outside \
+             and inside reveals) come from its own shadow calculation and are dropped too (not measured: no committed test file \
+             has a reveal)"
+        ));
+    }
+    out
+}
 
 /// What to hook in: the CSV as the model will find it and its columns.
 #[derive(Debug, Clone)]
@@ -189,6 +228,9 @@ fn shares_lines(o: &IdfObject, objects: &[IdfObject]) -> bool {
 /// too; callers run it first to refuse before any counting.
 pub fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result<()> {
     Hook::for_version(file, crate::model::idf::version(objects).as_deref())?;
+    for o in objects.iter().filter(|o| o.is("RunPeriod")) {
+        check_run_period(o).map_err(|reason| Error::object(file, o.label(), format!("{reason}: EnergyPlus would stop on it")))?;
+    }
     if let Some(ts) = objects.iter().find(|o| o.is("Timestep")) {
         let n: u32 = ts.field(0).trim().parse().unwrap_or(1);
         if n != plan.timesteps.per_hour() {
@@ -205,6 +247,48 @@ pub fn check_model(file: &str, objects: &[IdfObject], plan: &HookPlan) -> Result
                 ));
             }
         }
+    }
+    Ok(())
+}
+
+/// A RunPeriod's dates as EnergyPlus 25.2 checks them (`GetWeatherInput`, measured): months
+/// 1-12, days within their month (Feb 29 only in a leap Begin/End Year or without one), and a
+/// Begin Year not after the End Year, nor the begin date after the end date within one year. A
+/// period without years may wrap over New Year.
+fn check_run_period(o: &IdfObject) -> std::result::Result<(), String> {
+    let number = |i: usize, what: &str| -> std::result::Result<Option<i64>, String> {
+        let text = o.field(i).trim();
+        if text.is_empty() {
+            return Ok(None);
+        }
+        text.parse::<f64>()
+            .ok()
+            .filter(|v| v.fract() == 0.0)
+            .map(|v| Some(v as i64))
+            .ok_or_else(|| format!("{what} '{text}' is not a whole number"))
+    };
+    let date = |first: usize, which: &str| -> std::result::Result<(i64, i64, Option<i64>), String> {
+        let month = number(first, &format!("{which} Month"))?.unwrap_or(if which == "Begin" { 1 } else { 12 });
+        let day = number(first + 1, &format!("{which} Day of Month"))?.unwrap_or(if which == "Begin" { 1 } else { 31 });
+        let year = number(first + 2, &format!("{which} Year"))?;
+        let leap = year.is_none_or(|y| crate::model::run_year::is_leap(y as i32));
+        let days = match month {
+            1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+            4 | 6 | 9 | 11 => 30,
+            2 if leap => 29,
+            2 => 28,
+            _ => return Err(format!("{which} Month {month} is not a month (1-12)")),
+        };
+        if !(1..=days).contains(&day) {
+            return Err(format!("{which} Month/Day {month}/{day} is not a date{}", year.map_or(String::new(), |y| format!(" in {y}"))));
+        }
+        Ok((month, day, year))
+    };
+    let (begin, end) = (date(1, "Begin")?, date(4, "End")?);
+    if let (Some(by), Some(ey)) = (begin.2, end.2)
+        && (by, begin.0, begin.1) > (ey, end.0, end.1)
+    {
+        return Err(format!("it begins on {by}-{:02}-{:02}, after it ends ({ey}-{:02}-{:02})", begin.0, begin.1, end.0, end.1));
     }
     Ok(())
 }
@@ -316,6 +400,24 @@ pub fn hook_for(ep: &EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timeste
         return Err(Error::argument(
             "hook",
             format!("receiver '{}' ({}) is not a surface of {}; hook only EnergyPlus surfaces", r.name, r.origin, ep.file),
+        ));
+    }
+    // A Scheduled hook gives each column a SurfaceProperty:LocalEnvironment, which EnergyPlus
+    // applies only to the surfaces it lets the sun onto (heat-transfer surfaces facing Outdoors,
+    // not NoSun): any other column would be ignored (a window in an underground wall) or refused.
+    if form == Hook::Scheduled
+        && let Some((r, s)) = scene.receivers.iter().find_map(|r| ep.building.surface(&r.name).filter(|s| !s.receiver).map(|s| (r, s)))
+    {
+        return Err(Error::argument(
+            "hook",
+            format!(
+                "receiver '{}' ({}) is {}, which EnergyPlus keeps dark or never lights (Outside Boundary Condition '{}'{}): it cannot take a sunlit fraction schedule",
+                r.name,
+                r.origin,
+                s.label(),
+                s.outside_boundary,
+                if s.no_sun { ", Sun Exposure NoSun" } else { "" }
+            ),
         ));
     }
     // The model checks (version, Timestep, existing local environments) before any counting.

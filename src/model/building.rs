@@ -18,8 +18,11 @@
 //! - Vertex order: converted to counter-clockwise seen from outside (Clockwise input keeps vertex
 //!   1 and reverses the rest) and started at the upper-left corner, as EnergyPlus stores them.
 //!
-//! Receivers: surfaces whose Outside Boundary Condition is Outdoors, plus all fenestration
-//! (windows, glass doors, doors), named exactly as written in the file. EnergyPlus upper-cases
+//! Receivers: the surfaces EnergyPlus lets the sun onto (its `ExtSolar`): Outside Boundary
+//! Condition Outdoors and Sun Exposure not NoSun, with windows, glass doors and doors taking both
+//! from their base surface; named exactly as written in the file. The others EnergyPlus keeps
+//! dark whatever schedule they get (a door in an underground wall, a NoSun wall, an interzone
+//! window), so they get none, and the warnings say why. EnergyPlus upper-cases
 //! names internally (and in its outputs); names are matched case-insensitively here but kept in
 //! the file's spelling. A window or door is a hole in its base surface, whose receiver is the net
 //! area, as EnergyPlus's sunlit fraction of a wall is. Files before 9.6 (no Space Name fields) and
@@ -73,6 +76,8 @@ pub struct EpSurface {
     pub line: usize,
     /// Whether it gets a sunlit fraction.
     pub receiver: bool,
+    /// Its `Sun Exposure` is `NoSun` (a window or door inherits its base surface's).
+    pub no_sun: bool,
 }
 
 impl EpSurface {
@@ -433,8 +438,9 @@ impl<'a> Reader<'a> {
         let (zone_key, zone) = self.zone(object, zone_field)?;
         let raw = vertices(self.file, object, boundary + 5, boundary + 6)?;
         let world = order(&raw, self.place.rules).iter().map(|&p| self.place.vertex(p, Frame::Zone(zone))).collect();
+        let no_sun = object.field(boundary + 2).trim().eq_ignore_ascii_case("NoSun");
         let boundary = object.field(boundary).to_string();
-        self.push(object, &kind, &boundary, None, world, Some(zone_key))
+        self.push_exposed(object, &kind, &boundary, None, world, Some(zone_key), no_sun)
     }
 
     fn rectangular_surface(&mut self, object: &IdfObject, rect: &RectClass) -> Result<()> {
@@ -501,7 +507,8 @@ impl<'a> Reader<'a> {
         let zone = self.surface_zones[base].clone();
         let boundary = self.surfaces[base].outside_boundary.clone();
         let base_name = self.surfaces[base].name.clone();
-        self.push(object, kind, &boundary, Some(base_name), world, zone)
+        let no_sun = self.surfaces[base].no_sun;
+        self.push_exposed(object, kind, &boundary, Some(base_name), world, zone, no_sun)
     }
 
     fn attached_shading(&mut self, object: &IdfObject) -> Result<()> {
@@ -592,6 +599,25 @@ impl<'a> Reader<'a> {
         vertices: Vec<DVec3>,
         zone: Option<String>,
     ) -> Result<()> {
+        self.push_exposed(object, kind, boundary, base, vertices, zone, false)
+    }
+
+    /// As [`Self::push`], with the surface's `Sun Exposure` (`no_sun`: NoSun, or a window's base
+    /// surface's). A surface receives only where EnergyPlus lets the sun onto it (its
+    /// `ExtSolar`): Outside Boundary Condition Outdoors (a window's or door's is its base
+    /// surface's) and not NoSun. EnergyPlus keeps the others dark whatever schedule they are
+    /// given, so an exterior surface, window or door kept dark is said in the warnings.
+    #[allow(clippy::too_many_arguments)] // push's fields plus the exposure; a struct would only rename them.
+    fn push_exposed(
+        &mut self,
+        object: &IdfObject,
+        kind: &str,
+        boundary: &str,
+        base: Option<String>,
+        vertices: Vec<DVec3>,
+        zone: Option<String>,
+        no_sun: bool,
+    ) -> Result<()> {
         let Some(name) = object.name() else { return Err(self.error(object, "has no name")) };
         if let Some(&other) = self.index.get(&key(name)) {
             let first = self.surfaces[other].label();
@@ -604,7 +630,19 @@ impl<'a> Reader<'a> {
             return Err(self.error(object, format!("has no area ({area:.3e} m²): its vertices are collinear or coincide")));
         }
         let fenestration = FENESTRATION_KINDS.iter().any(|k| kind.eq_ignore_ascii_case(k));
-        let receiver = kind != SHADING && (fenestration || boundary.eq_ignore_ascii_case(OUTDOORS));
+        let outdoors = boundary.eq_ignore_ascii_case(OUTDOORS);
+        let receiver = kind != SHADING && outdoors && !no_sun;
+        if kind != SHADING && !receiver && (fenestration || outdoors) {
+            let why = match (&base, outdoors) {
+                (Some(b), false) if fenestration => format!("its base surface '{b}' has Outside Boundary Condition {boundary}"),
+                (Some(b), _) if fenestration => format!("its base surface '{b}' has Sun Exposure NoSun"),
+                _ => "its Sun Exposure is NoSun".to_string(),
+            };
+            self.warnings.push(format!(
+                "{} gets no sunlit fraction: EnergyPlus keeps it dark ({why}) and ignores any schedule given to it",
+                object_label(&object.class, Some(name), object.line)
+            ));
+        }
         let surface = EpSurface {
             name: name.to_string(),
             class: object.class.clone(),
@@ -614,6 +652,7 @@ impl<'a> Reader<'a> {
             vertices,
             line: object.line,
             receiver,
+            no_sun,
         };
         let deviation = plane_deviation(&surface.vertices);
         if deviation > PLANAR_TOLERANCE {

@@ -242,7 +242,19 @@ const fn spec(class: &'static str, named: bool, fields: &'static [(&'static str,
 /// The classes read by [`super::building`], with their epJSON field names in IDD order.
 const CLASSES: &[ClassSpec] = &[
     spec("Version", false, &[("version_identifier", Text)], false),
-    spec("RunPeriod", true, &[("begin_month", Number), ("begin_day_of_month", Number), ("begin_year", Number)], false),
+    spec(
+        "RunPeriod",
+        true,
+        &[
+            ("begin_month", Number),
+            ("begin_day_of_month", Number),
+            ("begin_year", Number),
+            ("end_month", Number),
+            ("end_day_of_month", Number),
+            ("end_year", Number),
+        ],
+        false,
+    ),
     spec("Site:Location", true, &[("latitude", Number), ("longitude", Number), ("time_zone", Number), ("elevation", Number)], false),
     spec(
         "Building",

@@ -2,7 +2,7 @@
 //!
 //! Owns the choice, in order: the year given explicitly; the EnergyPlus model's `RunPeriod`
 //! Begin Year (EnergyPlus 9.0 and later; EnergyPlus runs that calendar year, Feb 29 included
-//! when it is a leap year); the weather file's data, when it holds a Feb 29 record (an
+//! when it is a leap year and the weather file has one, see [`choose`]); the weather file's data, when it holds a Feb 29 record (an
 //! actual-year EPW of a leap year; a TMY file has none). Without any of these the year is a
 //! non-leap year, as EnergyPlus's default run period.
 
@@ -47,11 +47,18 @@ pub enum YearSource {
 }
 
 /// The run's year by the order above, with its source; None for the default non-leap year.
+///
+/// A RunPeriod in a leap year over a weather file without a Feb 29 record (any TMY file) counts
+/// as no year: EnergyPlus 25.2 then runs 365 days, skips Feb 29 and numbers 1 March as day 60 for
+/// its sun (measured: a 2020 RunPeriod on Chicago's TMY3 gives 35,040 rows at Timestep 4, and its
+/// dark steps follow day 60 on 1 March), which is the non-leap year's schedule.
 pub fn choose(given: Option<i32>, objects: Option<&[IdfObject]>, epw: Option<&str>) -> Option<(i32, YearSource)> {
+    let weather_leap = epw.and_then(epw_leap_year);
+    let run_period = objects.and_then(run_period_year).filter(|&y| !(is_leap(y) && epw.is_some() && weather_leap.is_none()));
     given
         .map(|y| (y, YearSource::Given))
-        .or_else(|| objects.and_then(run_period_year).map(|y| (y, YearSource::RunPeriod)))
-        .or_else(|| epw.and_then(epw_leap_year).map(|y| (y, YearSource::Weather)))
+        .or_else(|| run_period.map(|y| (y, YearSource::RunPeriod)))
+        .or_else(|| weather_leap.map(|y| (y, YearSource::Weather)))
 }
 
 #[cfg(test)]
@@ -77,5 +84,11 @@ mod tests {
         assert_eq!(choose(None, Some(&model), Some(&epw)), Some((2020, YearSource::RunPeriod)));
         assert_eq!(choose(None, Some(&no_year), Some(&epw)), Some((2020, YearSource::Weather)));
         assert_eq!(choose(None, None, None), None);
+        // A leap RunPeriod over a TMY file (no Feb 29) runs 365 days in EnergyPlus.
+        let tmy = format!("{header}1986,2,28,24,60,x\n1986,3,1,1,60,x\n");
+        assert_eq!(choose(None, Some(&model), Some(&tmy)), None);
+        let non_leap = parse_idf("m.idf", "Version,25.2;\nRunPeriod,R,1,1,2021,12,31,2021;\n").unwrap();
+        assert_eq!(choose(None, Some(&non_leap), Some(&tmy)), Some((2021, YearSource::RunPeriod)));
+        assert_eq!(choose(None, Some(&model), None), Some((2020, YearSource::RunPeriod)));
     }
 }

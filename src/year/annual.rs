@@ -59,6 +59,14 @@ pub struct AnnualOptions {
     pub refine: f64,
 }
 
+/// With refinement on, a timestep whose sample cell has a corner under this lit fraction (a
+/// shadow about to cover the whole surface, or just uncovering it), or whose fit comes out under
+/// it, is counted directly: the spline cannot place the step at which the last sliver goes dark,
+/// and EnergyPlus tells dark from lit exactly (its heat balance drops a scheduled value wherever
+/// its own sun is behind; docs/energyplus-fidelity.md). Measured on 4ZoneWithShading_Simple_1
+/// (Timestep 4): without it 341 timesteps a year were dark in one and lit in the other.
+pub const NEAR_DARK: f64 = 0.05;
+
 /// The default refinement threshold: 30% of the surface changing state between samples. On the
 /// example office (N = 1) it takes the 27×19 RMS error from 0.017 to 0.006 for 37% more views.
 pub const DEFAULT_REFINE: f64 = 0.3;
@@ -225,15 +233,38 @@ impl<E: Engine> Views<'_, E> {
 /// wall in summer is lit in the morning and again in the evening.
 pub(super) const MAX_PIECES: usize = 2;
 
-/// The day of the sun model whose sun EnergyPlus's shading uses on calendar day `day`: the day
-/// before. Measured against EnergyPlus 25.2's eplusshading.csv (Golden, annual, Timestep 4): with
-/// the calendar day's sun, 44 timesteps a year disagree on whether the sun is up (sunrise,
-/// sunset), and walls facing east or west on whether the sun is in front of them near noon; with
-/// the previous day's declination and equation of time, none do. So the dark timesteps, and the
-/// fractions at grazing sun, are EnergyPlus's.
+/// The day of the sun model whose sun EnergyPlus's shading uses on calendar day `day` (1-based,
+/// Feb 29 = day 60 in a leap year): that day itself, at every instant of it. This is the rule for
+/// the whole project: every sun that must line up with EnergyPlus (schedules, irradiance) takes
+/// its day from here.
+///
+/// EnergyPlus 25.2 with `ShadowCalculation` update method `Timestep` (what the hook writes) calls
+/// `SUN3(DayOfYear)` in `PerformSolarCalculations` at every timestep (SolarShading.cc) and
+/// `SUN4` at the timestep's end (`FigureSolarBeamAtTimestep`; mid-hour with one timestep an
+/// hour), `DayOfYear` being the weather file's calendar day. Measured against the
+/// `Surface Outside Face Sunlit Fraction` it reports and its heat balance uses
+/// (tests/energyplus_testfiles.rs): no timestep a year where one side is dark and the other lit.
+/// `eplusshading.csv` is no reference for this: `InitHeatBalance` writes a day's row at the start
+/// of the day, when all but its first timestep still hold the previous day's values, so it lags
+/// by one day (docs/energyplus-fidelity.md).
 pub fn shading_sun_day(day: u32) -> f64 {
-    f64::from(day) - 1.0
+    f64::from(day)
 }
+
+/// A fraction as EnergyPlus stores its own: clamped to [0, 1], and 0 below 1e-5 (SolarShading.cc
+/// zeroes sunlit fractions under 1e-5, so a sliver that small is dark in its heat balance too).
+fn as_energyplus(fraction: f64) -> f32 {
+    energyplus_fraction(fraction) as f32
+}
+
+/// [`as_energyplus`] in f64, for the fitted surfaces' own evaluation.
+pub(super) fn energyplus_fraction(fraction: f64) -> f64 {
+    let f = fraction.clamp(0.0, 1.0);
+    if f < MIN_SUNLIT_FRACTION { 0.0 } else { f }
+}
+
+/// EnergyPlus's smallest non-zero sunlit fraction.
+const MIN_SUNLIT_FRACTION: f64 = 1e-5;
 
 /// Whether the sun counts as up (EnergyPlus's SunIsUp threshold on cos zenith).
 pub(super) fn sun_is_up(sun: DVec3) -> bool {
@@ -264,7 +295,7 @@ async fn dense_year(
     }
     let values = views.count(&requests, progress).await?;
     for ((row, column), v) in cells.into_iter().zip(values) {
-        schedule.set(row, column, v as f32);
+        schedule.set(row, column, as_energyplus(v));
     }
     Ok(())
 }
@@ -300,12 +331,10 @@ pub(super) enum DayMap {
 
 impl DayMap {
     /// The grid coordinate of calendar day `day` (fractional allowed): the year's fit is over
-    /// the sun's day ([`shading_sun_day`]), a foliage ramp's over the leaves' (calendar) day.
+    /// the sun's day, which is the calendar day ([`shading_sun_day`]), a foliage ramp's over the
+    /// leaves' (calendar) day.
     pub(super) fn grid_day(self, day: f64) -> f64 {
-        match self {
-            DayMap::Year(_) => self.grid_coordinate(day - 1.0),
-            DayMap::Ramp { .. } => self.grid_coordinate(day),
-        }
+        self.grid_coordinate(day)
     }
 
     fn grid_coordinate(self, day: f64) -> f64 {
@@ -427,7 +456,7 @@ async fn spline_year(
         .collect();
     let refined = views.count(&requests, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
     for ((row, column, _, _), v) in rough.into_iter().zip(refined) {
-        schedule.set(row, column, v as f32);
+        schedule.set(row, column, as_energyplus(v));
     }
     let surfaces = regimes
         .iter()
@@ -557,9 +586,9 @@ struct SampleCells {
 }
 
 impl SampleCells {
-    /// Largest difference between the four samples around (day, τ): how much the fraction changes
-    /// across the cell the spline interpolates in.
-    fn spread(&self, samples: &[f64], day: f64, tau: f64) -> f64 {
+    /// Largest difference between the four samples around (day, τ) (how much the fraction changes
+    /// across the cell the spline interpolates in), and the lowest of them.
+    fn spread_and_lowest(&self, samples: &[f64], day: f64, tau: f64) -> (f64, f64) {
         let k0 = ((day - self.first_day) / self.spacing).floor().rem_euclid(self.days as f64) as usize % self.days;
         let k1 = (k0 + 1) % self.days;
         let s = self.taus.len();
@@ -567,13 +596,13 @@ impl SampleCells {
         let j1 = (j0 + 1).min(s - 1);
         let corners = [samples[k0 * s + j0], samples[k0 * s + j1], samples[k1 * s + j0], samples[k1 * s + j1]];
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
-        hi - lo
+        (hi - lo, lo)
     }
 }
 
 /// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
-/// where dark) and returns the (row, column, sun, day) cells whose sample cell spreads more than
-/// `refine`, to count directly.
+/// where dark) and returns the (row, column, sun, day) cells to count directly: those whose sample
+/// cell spreads more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]).
 fn evaluate(
     scene: &Scene,
     location: &Location,
@@ -601,8 +630,10 @@ fn evaluate(
                 }
                 let Some((fit, tau)) = fit_at(&pieces[column], column, instant.hour) else { continue };
                 if let Some(fit) = &regime.fits[fit] {
-                    schedule.set(row, column, fit.spline.eval(grid_day, tau).clamp(0.0, 1.0) as f32);
-                    if regime.cells.spread(&fit.samples, grid_day, tau) > refine {
+                    let value = fit.spline.eval(grid_day, tau);
+                    schedule.set(row, column, as_energyplus(value));
+                    let (spread, lowest) = regime.cells.spread_and_lowest(&fit.samples, grid_day, tau);
+                    if spread > refine || (refine < 1.0 && (lowest < NEAR_DARK || value < NEAR_DARK)) {
                         rough.push((row, column, sun, day as f64));
                     }
                 }

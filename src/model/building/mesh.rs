@@ -34,8 +34,9 @@ pub(super) fn triangulate(surface: &EpSurface, holes: &[&EpSurface]) -> Vec<[DVe
 }
 
 impl Building {
-    /// Adds every surface as shadow-casting geometry; receivers are the surfaces whose Outside
-    /// Boundary Condition is Outdoors plus all fenestration (windows, glass doors, doors). A
+    /// Adds every surface as shadow-casting geometry; receivers are the surfaces EnergyPlus lets
+    /// the sun onto (Outside Boundary Condition Outdoors, not NoSun; see the module doc of
+    /// `building`). A
     /// window or door is a hole in its base surface, so a wall's receiver is its net area, as
     /// EnergyPlus's sunlit fraction of the wall is; polygons with holes are triangulated by ear
     /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
@@ -87,6 +88,15 @@ impl Building {
             return None;
         }
         reveal::place(&base.vertices, &surface.vertices)
+    }
+
+    /// How far a window or door is set back behind its base surface's plane (EnergyPlus's
+    /// reveal), if it is.
+    pub fn reveal_depth(&self, surface: &EpSurface) -> Option<f64> {
+        match self.placed(surface)? {
+            SubPlacement::SetBack { depth, .. } => Some(depth),
+            SubPlacement::InPlane(_) => None,
+        }
     }
 
     /// The sides of a set-back window's reveal: casters only, never receivers (not EnergyPlus

@@ -118,10 +118,12 @@ fn scene_receivers_face_outwards() {
 
 #[test]
 fn epjson_gives_the_same_surfaces() {
+    // Sun Exposure as the IDF gives it (the ground floor NoSun).
     let wall = |name: &str, kind: &str, boundary: &str, v: &str| {
+        let sun = if boundary == "Ground" { "NoSun" } else { "SunExposed" };
         format!(
             r#""{name}": {{"surface_type": "{kind}", "construction_name": "C1", "zone_name": "Zone One",
-            "outside_boundary_condition": "{boundary}", "number_of_vertices": 4, "vertices": [{v}]}}"#
+            "outside_boundary_condition": "{boundary}", "sun_exposure": "{sun}", "number_of_vertices": 4, "vertices": [{v}]}}"#
         )
     };
     let v =
@@ -317,4 +319,43 @@ fn errors_name_object_and_line() {
     assert!(e.contains("BuildingSurface:Detailed 'W' (line 3): has 0 vertices"), "{e}");
     let e = read_err("Version,25.2;\nZone,Z;\nWall:Exterior,W,C,Z,,180,90,0,0,0;\n");
     assert!(e.contains("Wall:Exterior 'W' (line 3): field 10 (Length) is missing"), "{e}");
+}
+
+/// Surfaces EnergyPlus keeps dark get no sunlit fraction (its ExtSolar: Outdoors and not NoSun,
+/// windows and doors taking both from their base surface), and the warnings say why: a NoSun
+/// exterior wall and its window, a door in an underground wall, a window in a ground wall written
+/// as a detailed surface, while the sun-exposed wall and its window still receive.
+#[test]
+fn surfaces_energyplus_keeps_dark_are_not_receivers() {
+    let text = "Version,25.2;
+GlobalGeometryRules,UpperLeftCorner,Counterclockwise,World;
+Zone,Z;
+BuildingSurface:Detailed,Lit,Wall,C,Z,,Outdoors,,SunExposed,WindExposed,autocalculate,4, 0,0,3, 0,0,0, 10,0,0, 10,0,3;
+FenestrationSurface:Detailed,Lit Win,Window,W,Lit,,autocalculate,,1,4, 2,0,2.5, 2,0,1, 8,0,1, 8,0,2.5;
+BuildingSurface:Detailed,Shaded,Wall,C,Z,,Outdoors,,NoSun,WindExposed,autocalculate,4, 10,0,3, 10,0,0, 10,8,0, 10,8,3;
+FenestrationSurface:Detailed,Shaded Win,Window,W,Shaded,,autocalculate,,1,4, 10,2,2.5, 10,2,1, 10,6,1, 10,6,2.5;
+Wall:Underground,UG,C,Z,,270,90,0,8,0,8,3;
+Door,UG Door,D,UG,1,1,0,1,2;
+BuildingSurface:Detailed,Ground Wall,Wall,C,Z,,Ground,,NoSun,NoWind,autocalculate,4, 10,8,3, 10,8,0, 0,8,0, 0,8,3;
+FenestrationSurface:Detailed,Ground Win,Window,W,Ground Wall,,autocalculate,,1,4, 6,8,2.5, 6,8,1, 2,8,1, 2,8,2.5;
+";
+    let b = read(text);
+    assert_eq!(b.receiver_names(), ["Lit", "Lit Win"]);
+    for (name, why) in [
+        ("Shaded", "its Sun Exposure is NoSun"),
+        ("Shaded Win", "its base surface 'Shaded' has Sun Exposure NoSun"),
+        ("UG Door", "its base surface 'UG' has Outside Boundary Condition Ground"),
+        ("Ground Win", "its base surface 'Ground Wall' has Outside Boundary Condition Ground"),
+    ] {
+        let w = b.warnings.iter().find(|w| w.contains(&format!("'{name}'"))).unwrap_or_else(|| panic!("{name}: {:?}", b.warnings));
+        assert!(w.contains("gets no sunlit fraction") && w.contains(why), "{w}");
+    }
+    // The underground wall and the ground wall are simply not exterior: no warning for them.
+    assert!(!b.warnings.iter().any(|w| w.contains("'UG' (") || w.contains("'Ground Wall' (")), "{:?}", b.warnings);
+    // In the scene they still cast shadows, but only the two sun-exposed surfaces receive.
+    let mut builder = SceneBuilder::new();
+    b.add_to(&mut builder).unwrap();
+    let scene = builder.build().unwrap();
+    let names: Vec<&str> = scene.receivers.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["Lit", "Lit Win"]);
 }
