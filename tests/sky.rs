@@ -162,7 +162,9 @@ fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64) -> f64 {
     let f2 = c[3] + c[4] * delta + c[5] * z;
     let (a, b) = (n.dot(sun).max(0.0), sun.z.max(85f64.to_radians().cos()));
     let sin_tilt = (1.0 - n.z * n.z).max(0.0).sqrt();
-    dhi * ((1.0 - f1) * (1.0 + n.z) / 2.0 + f1 * a / b + f2 * sin_tilt).max(0.0)
+    // EnergyPlus keeps a near-horizontal roof's circumsolar ratio at 1 with the sun below 5°.
+    let circumsolar = if sun.z < 85f64.to_radians().cos() && sin_tilt < 0.1 { 1.0 } else { a / b };
+    dhi * ((1.0 - f1) * (1.0 + n.z) / 2.0 + f1 * circumsolar + f2 * sin_tilt).max(0.0)
 }
 
 #[test]

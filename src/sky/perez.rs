@@ -4,6 +4,8 @@
 //! Owns the brightness coefficients F1 (circumsolar) and F2 (horizon brightening) from the sky's
 //! clearness ε and brightness Δ, and how the three parts are shaded:
 //! I_sky = DHI·max(0, (1 − F1)·V_iso + F1·max(0, cos θ)/max(cos 85°, cos Z)·f_beam + F2·sin(tilt)·V_hor),
+//! the circumsolar ratio cos θ/max(cos 85°, cos Z) taken as 1 on near-horizontal surfaces
+//! (sin tilt < 0.1) with the sun below 5°, as EnergyPlus does,
 //! V_iso the receiver's view factor to the visible sky (Σ visibility·cos·Ω/π over the patches),
 //! f_beam the beam's sunlit fraction (the circumsolar disc is shaded like the sun) and V_hor the
 //! horizon band's visibility. Unobstructed, V_iso = (1 + cos tilt)/2 and f_beam = V_hor = 1.
@@ -22,6 +24,9 @@ const F23: [f64; 8] = [-0.0220216, -0.0288748, -0.0260542, -0.0139754, 0.0012448
 const EXTRATERRESTRIAL: f64 = 1353.0;
 /// cos 85°: the circumsolar ratio's denominator never falls below it.
 pub const MIN_COS_ZENITH: f64 = 0.0871557;
+/// Below this sine of tilt a surface is a near-horizontal roof, whose circumsolar ratio
+/// EnergyPlus sets to 1 with the sun below 5° (so its sky diffuse stays close to DHI there).
+const NEAR_HORIZONTAL_SIN_TILT: f64 = 0.1;
 
 /// The sky's brightness coefficients at one timestep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,7 +64,12 @@ impl PerezSky {
     /// sunlit fraction, `sin_tilt` the sine of its tilt and `horizon` its horizon-band visibility.
     pub fn diffuse(&self, dhi: f64, cos_incidence: f64, sky: f64, beam_fraction: f64, sin_tilt: f64, horizon: f64) -> f64 {
         let isotropic = (1.0 - self.f1) * sky;
-        let circumsolar = self.f1 * cos_incidence.max(0.0) / self.cos_zenith.max(MIN_COS_ZENITH) * beam_fraction;
+        let ratio = if self.cos_zenith < MIN_COS_ZENITH && sin_tilt < NEAR_HORIZONTAL_SIN_TILT {
+            1.0
+        } else {
+            cos_incidence.max(0.0) / self.cos_zenith.max(MIN_COS_ZENITH)
+        };
+        let circumsolar = self.f1 * ratio * beam_fraction;
         let horizon_band = self.f2 * sin_tilt * horizon;
         dhi * (isotropic + circumsolar + horizon_band).max(0.0)
     }
