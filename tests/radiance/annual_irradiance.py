@@ -317,7 +317,7 @@ def main():
         start = time.monotonic()
         open_direct = photopic(rcontrib_records(bin_dir, env, at("open-direct.oct"), suns, 1, one_ray, n, direct_opts))
         open_coef = photopic(rcontrib_records(bin_dir, env, at("open-sky.oct"), sky_modifier, 1, one_ray, n,
-                                              sky_opts(65536)))
+                                              sky_opts(16384)))
         timings["unshaded_s"] = time.monotonic() - start
         if coef.shape[1] != PATCHES:
             sys.exit(f"rcontrib: {coef.shape[1]} sky bins, expected {PATCHES}")
