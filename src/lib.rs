@@ -9,12 +9,13 @@
 //! - [`model`]: model files in (glTF/glb, EnergyPlus IDF/epJSON, typed arrays);
 //! - [`scene`]: triangles that cast shadows and planar receivers, laid out for the GPU;
 //! - [`geometry`]: planar geometry the readers, the scene and the hook share;
-//! - [`sun`]: locations, sun positions and directions;
+//! - [`sun`]: locations, sun positions and directions, and the EPW weather;
+//! - [`sky`]: sky patches, each receiver's sky views and the Perez sky;
 //! - [`count`]: one request and one answer ([`count::ViewRequest`], [`count::ViewAnswer`]) and
 //!   the engines that answer it: the GPU pixel counter ([`count::gpu`]) and the exact CPU
 //!   polygon-clipping reference ([`count::exact`]);
 //! - [`year`]: sampling plan, leaf calendar, the settings resolver, the spline and the annual run;
-//! - [`export`]: the EnergyPlus CSV and the model hooked to it;
+//! - [`export`]: the EnergyPlus CSV, the model hooked to it, and the irradiation summary;
 //! - [`error`]: the one typed error, naming parameters, files and objects;
 //! - `sweep` (native only): many annual runs from a manifest, locally or as a Slurm job array.
 //!
@@ -47,6 +48,7 @@ mod js_api;
 pub mod model;
 mod platform;
 pub mod scene;
+pub mod sky;
 pub mod sun;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod sweep;

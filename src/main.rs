@@ -21,7 +21,6 @@ use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
-use sunlit::export::irradiation;
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
@@ -34,6 +33,9 @@ use sunlit::{Error, Result, bench};
 #[path = "cli/sweep.rs"]
 mod sweep_cli;
 use sweep_cli::{SweepArgs, sweep};
+#[path = "cli/solar.rs"]
+mod solar_cli;
+use solar_cli::{solar_outputs, solar_plan};
 #[path = "cli/bench.rs"]
 mod bench_cli;
 use bench_cli::{BenchArgs, run_bench};
@@ -106,10 +108,23 @@ struct AnnualArgs {
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
     /// Also write a per-surface summary (JSON or CSV, by extension; written atomically): area,
-    /// mean fraction over sun-up timesteps and, with --epw, annual direct irradiation (kWh/m²)
-    /// with and without shading, from the EPW's direct normal irradiance.
+    /// mean fraction over sun-up timesteps, sky view factor, EnergyPlus's diffuse shading ratios
+    /// and, with --epw, annual irradiation (kWh/m²): direct, sky diffuse, ground-reflected, total
+    /// and unshaded total (docs/sky.md).
     #[arg(long, value_name = "FILE.json|FILE.csv")]
     summary: Option<PathBuf>,
+    /// Also write total incident solar (W/m², beam + sky + ground, shaded) per surface and
+    /// timestep, in the schedule CSV's layout (needs --epw; written atomically).
+    #[arg(long, value_name = "FILE.csv")]
+    irradiance: Option<PathBuf>,
+    /// Ground reflectance (0..1) for every hour; default: the EPW's albedo (field 33), 0.2 where
+    /// it is missing.
+    #[arg(long, value_name = "R")]
+    albedo: Option<f64>,
+    /// Sky patches for the sky views: tregenza (145, the default) or reinhart:N (N = 1..6,
+    /// 144·N² + 1 patches).
+    #[arg(long, value_name = "SCHEME")]
+    sky_patches: Option<String>,
     /// Also write a copy of the EnergyPlus model (IDF or epJSON, as given) that uses the CSV.
     #[arg(long, value_name = "FILE")]
     idf_out: Option<PathBuf>,
@@ -318,6 +333,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("per_task", "--per-task"),
     ("index", "--index"),
     ("summary", "--summary"),
+    ("irradiance", "--irradiance"),
+    ("albedo", "--albedo"),
+    ("sky_patches", "--sky-patches"),
 ];
 
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
@@ -424,7 +442,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
     check_writable(&args.output)?;
-    let summary = summary_plan(&args)?;
+    let solar = solar_plan(&args)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
     }
@@ -467,20 +485,23 @@ fn annual(args: AnnualArgs) -> Result<()> {
         }
         other => other?,
     };
-    bar.finish_and_clear();
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
         (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form)?)),
         _ => None,
     };
-    let summary_text = match &summary {
-        Some((_, to_text, dni)) => Some(to_text(&irradiation::summarize(&scene, &schedule, &settings.location, dni.as_ref())?)),
-        None => None,
+    let solar_files = match &solar {
+        Some(plan) => {
+            bar.set_message("sky");
+            solar_outputs(plan, &engine, &scene, &settings, &schedule, &args, &mut report)?
+        }
+        None => Vec::new(),
     };
+    bar.finish_and_clear();
     sunlit::export::write_atomic(&args.output, &bytes)?;
-    if let (Some((path, ..)), Some(text)) = (&summary, summary_text) {
-        sunlit::export::write_atomic(path, text.as_bytes())?;
+    for (path, bytes) in &solar_files {
+        sunlit::export::write_atomic(path, bytes)?;
         eprintln!("wrote {}", path.display());
     }
     if let Some((out, form, text)) = patched {
@@ -501,24 +522,6 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.length().unwrap_or(0)
     );
     Ok(())
-}
-
-/// Writes a summary as JSON or CSV.
-type SummaryFormat = fn(&[irradiation::SurfaceSummary]) -> String;
-
-/// `--summary`'s file, its format by extension, and the EPW's direct normal irradiance (read
-/// now, so a bad weather file is refused before the counting).
-fn summary_plan(args: &AnnualArgs) -> Result<Option<(PathBuf, SummaryFormat, Option<irradiation::DirectNormal>)>> {
-    let Some(path) = &args.summary else { return Ok(None) };
-    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    let format: SummaryFormat = match extension.as_deref() {
-        Some("json") => irradiation::summary_json,
-        Some("csv") => irradiation::summary_csv,
-        _ => return Err(Error::argument("summary", format!("{}: give a .json or .csv file", path.display()))),
-    };
-    check_writable(path)?;
-    let dni = args.epw.as_deref().map(irradiation::DirectNormal::from_epw).transpose()?;
-    Ok(Some((path.clone(), format, dni)))
 }
 
 /// Without --epw or --location: the EnergyPlus model's own Site:Location, said so.

@@ -31,8 +31,11 @@ use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::run_year::{choose, is_leap};
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::scene::Scene;
+use crate::sky::patches::SkyPatches;
+use crate::sky::views::sky_views;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::sun::weather::Weather;
 use crate::year::annual::{Progress, annual_fitted_with};
 use crate::year::settings::AnnualSettings;
 
@@ -221,8 +224,15 @@ impl Engine {
                     .await
                     .map_err(js_error)?;
             let means = daylight_means(&schedule, &location);
-            let epw = given.epw.as_deref().map(|text| (given.epw_name.as_deref().unwrap_or("EPW"), text));
-            let extra = embed::Extra::new(&model.scene, &schedule, &location, epw, fitted);
+            let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
+            // The sky views (the same engine, Tregenza's patches) only when there is weather to weigh them.
+            let sky = match &weather {
+                Some(Ok(_)) => Some(
+                    sky_views(&model.chosen(kind, &counter), &model.scene, &SkyPatches::tregenza(), &mut report).await.map_err(js_error)?,
+                ),
+                _ => None,
+            };
+            let extra = embed::Extra::new(&model.scene, &schedule, &location, weather, sky.as_ref().map(|s| (s, &calendar)), fitted);
             Ok(Annual { schedule, means, hook, model, extra }.into())
         })
     }

@@ -88,10 +88,10 @@ function showInViewer() {
  * the legend's title and tick format. Irradiation only when the year had an EPW. */
 function colourScale() {
   const { result } = state;
-  if (state.colourBy === 'irradiation' && result?.irradiation) {
+  if (state.colourBy === 'irradiation' && result?.total) {
     // The palette's top is the most irradiated surface (at least 1 kWh/m², so a dark year draws).
-    const max = Math.max(1, ...result.irradiation);
-    return { values: result.irradiation, max, title: 'Annual direct irradiation, kWh/m² (beam, shaded)', tick: (v) => v.toFixed(0) };
+    const max = Math.max(1, ...result.total);
+    return { values: result.total, max, title: 'Annual total irradiation, kWh/m² (beam + sky + ground, shaded)', tick: (v) => v.toFixed(0) };
   }
   return { values: result?.means ?? [], max: 1, title: 'Annual mean sunlit fraction (sun-up hours)', tick: (v) => String(v) };
 }
@@ -126,7 +126,7 @@ function fillTable(result) {
     mean.textContent = means ? means[i].toFixed(3) : '–';
     mean.className = 'num';
     if (irradiation) {
-      for (const values of [irradiation, result.unshaded]) {
+      for (const values of [irradiation, result.unshaded, result.skyDiffuse, result.groundReflected, result.total]) {
         const cell = row.insertCell();
         cell.textContent = values[i].toFixed(1);
         cell.className = 'num';

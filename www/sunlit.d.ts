@@ -213,6 +213,21 @@ export interface Annual {
   readonly irradiation: Float64Array | undefined;
   /** The same with nothing in the way: Σ DNI·cosθ·Δt over timesteps with the sun in front. */
   readonly unshadedIrradiation: Float64Array | undefined;
+  /** The same as irradiation: the beam part of the total, kWh/m². */
+  readonly direct: Float64Array | undefined;
+  /** Sky diffuse irradiation per receiver (Perez 1990 sky, shaded patch by patch over Tregenza's
+   * 145 sky patches; circumsolar part shaded like the beam), kWh/m²; undefined without an EPW. */
+  readonly skyDiffuse: Float64Array | undefined;
+  /** Ground-reflected irradiation GHI·albedo·(1 − cos tilt)/2 (unobstructed; the EPW's albedo,
+   * 0.2 where missing), kWh/m²; undefined without an EPW. */
+  readonly groundReflected: Float64Array | undefined;
+  /** direct + skyDiffuse + groundReflected, kWh/m²; undefined without an EPW. */
+  readonly total: Float64Array | undefined;
+  /** The total with nothing in the way, kWh/m²; undefined without an EPW. */
+  readonly unshadedTotal: Float64Array | undefined;
+  /** Each receiver's view factor to the visible sky ((1 + cos tilt)/2 unobstructed); undefined
+   * without an EPW. */
+  readonly skyViewFactor: Float64Array | undefined;
   /** Every receiver's fraction at day of year `day` (1..365) and local standard `hour` (0..24),
    * linear between the schedule's rows, 0 with the sun down. */
   fractionsAt(day: number, hour?: number): Float64Array;

@@ -107,13 +107,16 @@ async function computeOnce({ settings, engine: made, csvName }) {
     const columns = annual.names.length;
     const values = new Float32Array(annual.rows * columns);
     for (let c = 0; c < columns; c++) values.set(annual.column(c), c * annual.rows);
-    const { irradiation, unshaded, irradiationError } = energy(annual);
+    const { irradiation, unshaded, skyDiffuse, groundReflected, total, irradiationError } = energy(annual);
     const result = {
       type: 'result',
       names: annual.names,
       means: annual.means,
       irradiation,
       unshaded,
+      skyDiffuse,
+      groundReflected,
+      total,
       irradiationError,
       rows: annual.rows,
       timestepsPerHour: annual.timestepsPerHour,
@@ -139,13 +142,21 @@ function hooked(annual, hasEnergyPlus, csvName) {
   }
 }
 
-/** The year's direct irradiation and its unshaded twin (kWh/m²), both undefined without an EPW;
- * an EPW whose hourly records are unreadable gives the reason instead. */
+/** The year's direct irradiation and its unshaded twin, sky diffuse, ground-reflected and total
+ * (kWh/m²), all undefined without an EPW; an EPW whose hourly records are unreadable gives the
+ * reason instead. */
 function energy(annual) {
   try {
-    return { irradiation: annual.irradiation, unshaded: annual.unshadedIrradiation, irradiationError: undefined };
+    return {
+      irradiation: annual.irradiation,
+      unshaded: annual.unshadedIrradiation,
+      skyDiffuse: annual.skyDiffuse,
+      groundReflected: annual.groundReflected,
+      total: annual.total,
+      irradiationError: undefined,
+    };
   } catch (error) {
-    return { irradiation: undefined, unshaded: undefined, irradiationError: String(error?.message ?? error) };
+    return { irradiation: undefined, unshaded: undefined, skyDiffuse: undefined, groundReflected: undefined, total: undefined, irradiationError: String(error?.message ?? error) };
   }
 }
 

@@ -46,6 +46,10 @@ pub(super) struct BenchArgs {
     lanes: Option<usize>,
     #[command(flatten)]
     engine: EngineArgs,
+    /// Time each model's sky pass instead: every receiver's sky views over the given patch
+    /// scheme (`tregenza` or `reinhart:N`), once, on the chosen engine.
+    #[arg(long, value_name = "SCHEME")]
+    sky: Option<String>,
     /// Generated model names (see --list) or glTF/IDF model files.
     models: Vec<String>,
 }
@@ -68,6 +72,9 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
     }
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
+    }
+    if let Some(scheme) = &args.sky {
+        return bench_sky(&args, scheme);
     }
     if !args.models.is_empty() && args.engine.kind()? != EngineKind::Gpu {
         let start = Instant::now();
@@ -186,6 +193,40 @@ fn bench_model(name: &str, location: &str) -> Result<(Scene, Location, Option<us
         return Ok((scene, m.location, Some(m.shading_polygons)));
     }
     Ok((model::load(&[PathBuf::from(name)], &LoadOptions::default())?, Location::parse(location)?, None))
+}
+
+/// `--sky`: each model's sky pass (the views `sunlit annual --summary` adds) timed on the chosen
+/// engine, engine start-up apart; one JSON line a model.
+fn bench_sky(args: &BenchArgs, scheme: &str) -> Result<()> {
+    let patches = sunlit::sky::patches::SkyPatches::parse(scheme)?;
+    let options = CounterOptions { max_atlas: args.atlas, ..args.pixels.options() };
+    for name in &args.models {
+        let t0 = Instant::now();
+        let (scene, _, shading) = bench_model(name, &args.location)?;
+        let engine = HybridEngine::new(&scene, args.engine.kind()?, options, args.lanes, args.engine.source())?;
+        let load_seconds = t0.elapsed().as_secs_f64();
+        let mut views = 0;
+        let start = Instant::now();
+        let sky = pollster::block_on(sunlit::sky::views::sky_views(&engine, &scene, &patches, &mut |p: Progress| {
+            views = p.total;
+            Ok(())
+        }))?;
+        let sky_seconds = start.elapsed().as_secs_f64();
+        let mean: f64 = (0..sky.receivers()).map(|r| sky.isotropic(r, 1.0)).sum::<f64>() / sky.receivers().max(1) as f64;
+        let line = json!({
+            "model": name,
+            "engine": args.engine.kind()?.name(),
+            "receivers": scene.receivers.len(),
+            "shading_polygons": shading,
+            "patches": patches.len(),
+            "sky_views": views,
+            "load_seconds": load_seconds,
+            "sky_seconds": sky_seconds,
+            "mean_sky_view_factor": mean,
+        });
+        println!("{line}");
+    }
+    Ok(())
 }
 
 /// The sampling plan `--samples` names.

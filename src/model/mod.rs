@@ -117,6 +117,11 @@ pub fn load_bytes_all(files: &[(String, Vec<u8>)], options: &LoadOptions) -> Res
     read_inputs(files, &vec![None; files.len()], options)
 }
 
+/// Whether a file name is an EnergyPlus model (IDF or epJSON, by extension).
+pub fn is_energyplus_file(name: &str) -> bool {
+    energyplus_kind(name).is_some()
+}
+
 /// Whether a file name is an EnergyPlus model (by extension).
 fn energyplus_kind(name: &str) -> Option<bool> {
     let lower = name.to_ascii_lowercase();

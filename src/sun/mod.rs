@@ -2,11 +2,13 @@
 //!
 //! Owns the convention every other stage uses: the vector points *towards* the sun.
 //! Where the sun is at a given place and time lives in the submodules:
-//! - [`location`]: the site (latitude, longitude, time zone), from the command line or an EPW weather file;
+//! - [`location`]: the site (latitude, longitude, time zone) and its ranges;
 //! - [`position`]: solar declination, equation of time, sun directions and daylight hours as EnergyPlus computes them.
+//! - [`weather`]: the EPW weather file: the site, hourly direct normal, diffuse and global horizontal irradiance and albedo.
 
 pub mod location;
 pub mod position;
+pub mod weather;
 
 use glam::DVec3;
 

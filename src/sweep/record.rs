@@ -75,6 +75,31 @@ pub struct SurfaceMean {
     /// The same unshaded, kWh/m².
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unshaded_irradiation: Option<f64>,
+    /// The rest of the annual summary's split ([`SOLAR_KEYS`]), where the run wrote it.
+    #[serde(default, skip_serializing_if = "Solar::is_empty")]
+    pub solar: Solar,
+}
+
+/// The annual summary's keys beside the direct irradiation, in summary.csv's column order.
+pub const SOLAR_KEYS: [&str; 7] = [
+    "sky_diffuse",
+    "ground_reflected",
+    "total",
+    "unshaded_total",
+    "sky_view_factor",
+    "energyplus_iso_sky_ratio",
+    "energyplus_horizon_ratio",
+];
+
+/// A surface's values for [`SOLAR_KEYS`] (kWh/m² for the first four, ratios for the rest).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Solar(pub Vec<Option<f64>>);
+
+impl Solar {
+    /// Nothing was read.
+    pub fn is_empty(&self) -> bool {
+        self.0.iter().all(Option::is_none)
+    }
 }
 
 /// The record of a finished variant.

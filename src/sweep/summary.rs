@@ -3,20 +3,22 @@
 //!
 //! The means are taken once, when a variant finishes, from its CSV (read back with
 //! [`Schedule::from_csv`]) and the sun at each timestep, and kept in its done record; the summary
-//! is assembled from the records. A variant with an EPW also has annual direct irradiation and
-//! its unshaded twin (kWh/m²): its annual run writes them per surface
+//! is assembled from the records. A variant with an EPW also has annual irradiation (direct and
+//! its unshaded twin, sky diffuse, ground-reflected, total, unshaded total, kWh/m²) and the sky
+//! view factor and EnergyPlus's diffuse shading ratios: its annual run writes them per surface
 //! ([`Variant::surface_summary`], the scene's normals and the weather are the run's), read back
 //! here beside the means; summary.csv has their columns when any finished variant has them.
 
 use std::path::Path;
 
 use super::manifest::Variant;
-use super::record::{Done, SurfaceMean};
+use super::record::{Done, SOLAR_KEYS, Solar, SurfaceMean};
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
 
 /// The summary's file name in the output folder.
 pub const SUMMARY: &str = "summary.csv";
@@ -24,7 +26,7 @@ pub const SUMMARY: &str = "summary.csv";
 /// Where the variant's sun is: its `epw` file's LOCATION, else its `location` setting.
 pub fn location(variant: &Variant) -> Result<Location> {
     match (variant.arg("epw"), variant.arg("location")) {
-        (Some(epw), _) => Location::from_epw(Path::new(epw)),
+        (Some(epw), _) => crate::sun::weather::location_from_epw(Path::new(epw)),
         (None, Some(text)) => Location::parse(text),
         (None, None) => Err(Error::argument(format!("variant '{}'", variant.id), "has neither epw nor location")),
     }
@@ -37,7 +39,8 @@ pub fn means(schedule: &Schedule, location: &Location) -> Vec<SurfaceMean> {
     let mut sums = vec![0.0f64; columns];
     let mut up = 0usize;
     for (row, instant) in schedule.timesteps.instants().enumerate() {
-        if sun_direction(location, instant.day as f64, instant.hour).z < MIN_COS_INCIDENCE {
+        // The sun the fractions were counted for (EnergyPlus's day rule, `shading_sun_day`).
+        if sun_direction(location, shading_sun_day(instant.day), instant.hour).z < MIN_COS_INCIDENCE {
             continue;
         }
         up += 1;
@@ -55,6 +58,7 @@ pub fn means(schedule: &Schedule, location: &Location) -> Vec<SurfaceMean> {
             sunup_timesteps: up,
             irradiation: None,
             unshaded_irradiation: None,
+            solar: Solar::default(),
         })
         .collect()
 }
@@ -84,9 +88,21 @@ fn add_irradiation(surfaces: &mut [SurfaceMean], path: &Path) -> Result<()> {
         };
         s.irradiation = entry["irradiation"].as_f64();
         s.unshaded_irradiation = entry["unshaded_irradiation"].as_f64();
+        s.solar = Solar(SOLAR_KEYS.iter().map(|k| entry[*k].as_f64()).collect());
     }
     Ok(())
 }
+
+/// summary.csv's columns for [`SOLAR_KEYS`], after the direct irradiation's.
+const SOLAR_COLUMNS: [&str; 7] = [
+    "sky_diffuse_kwh_m2",
+    "ground_reflected_kwh_m2",
+    "total_kwh_m2",
+    "unshaded_total_kwh_m2",
+    "sky_view_factor",
+    "energyplus_iso_sky_ratio",
+    "energyplus_horizon_ratio",
+];
 
 /// The summary's text: a header, then a row per finished variant and surface, in manifest order.
 /// Settings columns are every key any variant sets, sorted; a variant without it leaves it empty.
@@ -99,6 +115,7 @@ pub fn summary_csv(finished: &[(&Variant, &Done)]) -> String {
     let mut header = vec!["id", "surface", "mean_sunlit_fraction", "sunup_timesteps"];
     if energy {
         header.extend(["irradiation_kwh_m2", "unshaded_irradiation_kwh_m2"]);
+        header.extend(SOLAR_COLUMNS);
     }
     header.extend(&keys);
     let mut out = header.iter().map(|h| field(h)).collect::<Vec<_>>().join(",");
@@ -110,6 +127,7 @@ pub fn summary_csv(finished: &[(&Variant, &Done)]) -> String {
             if energy {
                 let optional = |v: Option<f64>| v.map(|v| format!("{v:.4}")).unwrap_or_default();
                 row.extend([optional(s.irradiation), optional(s.unshaded_irradiation)]);
+                row.extend((0..SOLAR_KEYS.len()).map(|k| optional(s.solar.0.get(k).copied().flatten())));
             }
             row.extend(settings.iter().cloned());
             out.push_str(&row.join(","));

@@ -1,5 +1,6 @@
 //! The bindings for embedding sunlit in a web viewer: scenes from meshes and placements (a
-//! three.js scene graph, instancing kept), a year's direct irradiation on [`Annual`], its
+//! three.js scene graph, instancing kept), a year's irradiation on [`Annual`] (direct, sky
+//! diffuse, ground-reflected, total, unshaded total, sky view factor), its
 //! fractions at any instant (for a time slider: the fitted surfaces, or the schedule's rows
 //! interpolated), and an EPW's location for a form.
 
@@ -9,13 +10,16 @@ use wasm_bindgen::prelude::*;
 use super::{Annual, Engine, Model, js_error};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::export::irradiation::{DirectNormal, SurfaceSummary, summarize};
+use crate::export::irradiation::{SurfaceSummary, summarize};
 use crate::model::placed::{Placed, scene_from_placed};
 use crate::scene::Scene;
+use crate::sky::views::SkyViews;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::sun::weather::{Weather, location_from_text};
 use crate::year::fitted::FittedYear;
 use crate::year::samples::DAYS;
+use crate::year::season::LeafCalendar;
 
 #[wasm_bindgen]
 impl Engine {
@@ -50,17 +54,19 @@ pub(super) struct Extra {
 }
 
 impl Extra {
-    /// The summary of `schedule`, with irradiation when `epw` (its text, labelled `epw_name`) is given.
+    /// The summary of `schedule`, with irradiation when `weather` (read from the EPW) is given
+    /// and readable; `sky` the receivers' sky views (counted when the weather is readable).
     pub(super) fn new(
         scene: &Scene,
         schedule: &Schedule,
         location: &Location,
-        epw: Option<(&str, &str)>,
+        weather: Option<Result<Weather>>,
+        sky: Option<(&SkyViews, &LeafCalendar)>,
         fitted: Option<FittedYear>,
     ) -> Self {
         let summary = (|| -> Result<Vec<SurfaceSummary>> {
-            let dni = epw.map(|(name, text)| DirectNormal::from_epw_text(name, text)).transpose()?;
-            summarize(scene, schedule, location, dni.as_ref())
+            let weather = weather.transpose()?;
+            summarize(scene, schedule, location, sky, weather.as_ref(), &[])
         })()
         .map_err(|e| e.to_string());
         Self { location: location.clone(), summary, fitted }
@@ -75,6 +81,42 @@ impl Annual {
     #[wasm_bindgen(getter)]
     pub fn irradiation(&self) -> Result<Option<Float64Array>, JsValue> {
         self.summary_column(|s| s.irradiation)
+    }
+
+    /// The same as `irradiation`: the beam part of the total, kWh/m².
+    #[wasm_bindgen(getter)]
+    pub fn direct(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.irradiation)
+    }
+
+    /// Sky diffuse irradiation (Perez sky, shaded by the visible sky patches), kWh/m².
+    #[wasm_bindgen(getter, js_name = skyDiffuse)]
+    pub fn sky_diffuse(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.sky_diffuse)
+    }
+
+    /// Ground-reflected irradiation (GHI·albedo·(1 − cos tilt)/2, unobstructed), kWh/m².
+    #[wasm_bindgen(getter, js_name = groundReflected)]
+    pub fn ground_reflected(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.ground_reflected)
+    }
+
+    /// Direct + sky diffuse + ground-reflected, shaded, kWh/m².
+    #[wasm_bindgen(getter)]
+    pub fn total(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.total)
+    }
+
+    /// The total with nothing in the way, kWh/m².
+    #[wasm_bindgen(getter, js_name = unshadedTotal)]
+    pub fn unshaded_total(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.unshaded_total)
+    }
+
+    /// Each receiver's view factor to the visible sky ((1 + cos tilt)/2 unobstructed); with an EPW only.
+    #[wasm_bindgen(getter, js_name = skyViewFactor)]
+    pub fn sky_view_factor(&self) -> Result<Option<Float64Array>, JsValue> {
+        self.summary_column(|s| s.sky_view_factor)
     }
 
     /// The same without shading: Σ DNI·cos θ·Δt (cos θ > 0), kWh/m².
@@ -152,7 +194,7 @@ fn interpolated_row(schedule: &Schedule, time: f64) -> Vec<f64> {
 /// can show the site the weather file sets. Throws naming `name` and the reason.
 #[wasm_bindgen(js_name = epwLocation)]
 pub fn epw_location(name: &str, text: &str) -> Result<Object, JsValue> {
-    let location = Location::from_epw_text(name, text).map_err(js_error)?;
+    let location = location_from_text(name, text).map_err(js_error)?;
     let object = Object::new();
     for (key, value) in [
         ("latitude", JsValue::from(location.latitude)),

@@ -100,8 +100,8 @@ impl AnnualSettings {
 
     fn location(&self) -> Result<Location> {
         match (&self.epw_file, &self.epw, self.latitude, self.longitude, self.time_zone) {
-            (Some(path), ..) => Location::from_epw(path),
-            (None, Some(epw), ..) => Location::from_epw_text(self.epw_name.as_deref().unwrap_or("EPW"), epw),
+            (Some(path), ..) => crate::sun::weather::location_from_epw(path),
+            (None, Some(epw), ..) => crate::sun::weather::location_from_text(self.epw_name.as_deref().unwrap_or("EPW"), epw),
             (None, None, Some(lat), Some(lon), Some(tz)) => Location::new(lat, lon, tz),
             _ => Err(Error::argument("location", "give an EPW or latitude, longitude and time zone")),
         }

@@ -470,7 +470,7 @@ test('with an EPW: its location in the form, irradiation columns and colours, eq
     head: [...document.querySelectorAll('#table thead th')].filter((th) => !th.hidden).map((th) => th.textContent),
     rows: [...document.querySelectorAll('#table tbody tr')].map((tr) => [...tr.cells].map((td) => td.textContent)),
   }));
-  assert.deepEqual(table.head, ['Surface', 'Area m²', 'Mean fraction', 'Irradiation kWh/m²', 'Unshaded kWh/m²']);
+  assert.deepEqual(table.head, ['Surface', 'Area m²', 'Mean fraction', 'Irradiation kWh/m²', 'Unshaded kWh/m²', 'Sky diffuse kWh/m²', 'Ground kWh/m²', 'Total kWh/m²']);
   // The same year through the JS API (its own engine, on the page's thread).
   const api = await page.evaluate(async (text) => {
     const sunlit = await import('/sunlit.js');
@@ -478,30 +478,42 @@ test('with an EPW: its location in the form, irradiation columns and colours, eq
     const bytes = new Uint8Array(await (await fetch('/pkg/office.glb')).arrayBuffer());
     const model = engine.loadFiles([{ name: 'office.glb', bytes }]);
     const year = await engine.annual(model, { epw: text, epwName: 'sydney.epw', daysPerYear: 6, samplesPerDay: 5, timestepsPerHour: 1 });
-    const out = { names: year.names, means: Array.from(year.means), irradiation: Array.from(year.irradiation), unshaded: Array.from(year.unshadedIrradiation) };
+    const out = {
+      names: year.names,
+      means: Array.from(year.means),
+      irradiation: Array.from(year.irradiation),
+      unshaded: Array.from(year.unshadedIrradiation),
+      sky: Array.from(year.skyDiffuse),
+      ground: Array.from(year.groundReflected),
+      total: Array.from(year.total),
+    };
     year.free();
     model.free();
     return out;
   }, epwText);
   assert.equal(table.rows.length, api.names.length);
-  table.rows.forEach(([name, , mean, irradiation, unshaded], i) => {
+  table.rows.forEach(([name, , mean, irradiation, unshaded, sky, ground, total], i) => {
     assert.equal(name, api.names[i]);
     assert.ok(Math.abs(Number(mean) - api.means[i]) <= 0.0015, `${name}: mean ${mean} vs API ${api.means[i]}`);
     assert.ok(Math.abs(Number(irradiation) - api.irradiation[i]) <= 0.05 + 0.002 * api.irradiation[i], `${name}: ${irradiation} vs API ${api.irradiation[i]}`);
     assert.ok(Math.abs(Number(unshaded) - api.unshaded[i]) <= 0.051, `${name}: unshaded ${unshaded} vs API ${api.unshaded[i]}`);
+    assert.ok(Math.abs(Number(sky) - api.sky[i]) <= 0.05 + 0.002 * api.sky[i], `${name}: sky ${sky} vs API ${api.sky[i]}`);
+    assert.ok(Math.abs(Number(ground) - api.ground[i]) <= 0.051, `${name}: ground ${ground} vs API ${api.ground[i]}`);
+    assert.ok(Math.abs(Number(total) - api.total[i]) <= 0.05 + 0.002 * api.total[i], `${name}: total ${total} vs API ${api.total[i]}`);
+    assert.ok(Math.abs(api.total[i] - api.irradiation[i] - api.sky[i] - api.ground[i]) <= 1e-6 * api.total[i], `${name}: total is the sum`);
   });
   assert.ok(api.irradiation.some((v) => v > 100), 'the year has sun on it');
 
-  // Colour by irradiation: the legend's title and top tick (the most irradiated surface), and
-  // the view changes.
+  // Colour by (total) irradiation: the legend's title and top tick (the most irradiated surface),
+  // and the view changes.
   const byMean = await page.locator('#view').screenshot();
   assert.match(await page.textContent('#legendtitle'), /mean sunlit fraction/);
   assert.deepEqual(await page.$$eval('#legendticks span', (s) => s.map((x) => x.textContent)), ['0', '0.25', '0.5', '0.75', '1']);
   await page.selectOption('#colourby', 'irradiation');
   assert.match(await page.textContent('#legendtitle'), /irradiation, kWh\/m²/);
   const ticks = await page.$$eval('#legendticks span', (s) => s.map((x) => Number(x.textContent)));
-  const top = Math.max(...api.irradiation);
-  assert.ok(Math.abs(ticks[4] - top) <= 1 + 0.002 * top, `legend top ${ticks[4]} vs the largest irradiation ${top}`);
+  const top = Math.max(...api.total);
+  assert.ok(Math.abs(ticks[4] - top) <= 1 + 0.002 * top, `legend top ${ticks[4]} vs the largest total irradiation ${top}`);
   assert.ok(Math.abs(ticks[2] - top / 2) <= 1 + 0.002 * top);
   const byIrradiation = await page.locator('#view').screenshot();
   assert.notDeepEqual(byIrradiation, byMean, 'the 3D view is recoloured');
