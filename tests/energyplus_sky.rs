@@ -146,7 +146,7 @@ fn office_ratios_and_unshaded_diffuse_match_energyplus() {
     let ours = sunlit_summary(&idf, &dir, GOLDEN);
     compare_ratios("office", &ours, &theirs);
     let hours = 8760.0;
-    let mut unshaded = 0;
+    let (mut unshaded, mut failures) = (0, Vec::new());
     let mut names: Vec<&String> = ours.keys().collect();
     names.sort();
     for name in names {
@@ -165,8 +165,13 @@ fn office_ratios_and_unshaded_diffuse_match_energyplus() {
         eprintln!(
             "office {name:>8} (unshaded): sky diffuse {sky:.1} vs EnergyPlus {ep_sky:.1} kWh/m² ({dsky:+.2}%); ground {ground:.1} vs {ep_ground:.1} ({dground:+.2}%)"
         );
-        assert!(dsky.abs() <= 1.0, "{name}: sky diffuse {sky} vs EnergyPlus {ep_sky} ({dsky:+.2}%)");
-        assert!(dground.abs() <= 1.5 || (ground - ep_ground).abs() < 0.5, "{name}: ground {ground} vs EnergyPlus {ep_ground}");
+        if dsky.abs() > 1.0 {
+            failures.push(format!("{name}: sky diffuse {sky:.1} vs EnergyPlus {ep_sky:.1} kWh/m² ({dsky:+.2}%)"));
+        }
+        if dground.abs() > 1.5 && (ground - ep_ground).abs() >= 0.5 {
+            failures.push(format!("{name}: ground {ground:.1} vs EnergyPlus {ep_ground:.1} kWh/m² ({dground:+.2}%)"));
+        }
     }
+    assert!(failures.is_empty(), "office, unshaded surfaces:\n{}", failures.join("\n"));
     assert!(unshaded >= 3, "only {unshaded} unshaded surfaces (the office's roof, east, north and west walls expected)");
 }

@@ -159,8 +159,8 @@ fn compare(model: &str, ours: &HashMap<String, Value>, truth: &HashMap<String, V
         let s = ours.get(name).unwrap_or_else(|| panic!("{model}: {name} missing from sunlit's summary"));
         let rad = |k: &str| number(r, k, name);
         let sun = |k: &str| number(s, k, name);
-        let unobstructed = rad("sky_view_factor") >= rad("unshaded_sky_view_factor") - 0.002
-            && rad("direct") >= 0.998 * rad("unshaded_direct");
+        let unobstructed =
+            rad("sky_view_factor") >= rad("unshaded_sky_view_factor") - 0.002 && rad("direct") >= 0.998 * rad("unshaded_direct");
         let (class, tolerance) = if unobstructed { ("unobstructed", 3.0) } else { ("shaded", 5.0) };
         let truth_total = rad("direct") + rad("sky") + rad("ground");
         let truth_diffuse = rad("sky") + rad("ground");
