@@ -24,8 +24,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;
 
+use std::fmt::Write as _;
+
 use serde_json::{Value, json};
 use sunlit::model::LoadOptions;
+use sunlit::sun::location::Location;
+use sunlit::sun::position::sun_direction;
+use sunlit::year::annual::shading_sun_day;
 
 /// The ground reflectance given to both (sunlit's `--albedo`, gendaymtx's `-g`): the EPW's own
 /// albedo varies by the hour, gendaymtx takes one.
@@ -82,15 +87,35 @@ fn scene_json(model: &Path, out: &Path) {
     std::fs::write(out, json!({ "triangles": triangles, "receivers": receivers }).to_string()).unwrap();
 }
 
+/// The sun sunlit counts each EPW hour with at one timestep per hour (mid-hour, EnergyPlus's
+/// previous-day declination: [`shading_sun_day`]), one `index x y z` line per hour it is up: the
+/// harness makes these its suns, so that beam differences are shading, not sun models (Radiance's
+/// own suns sit 0.43° from these on average, −0.86% on a roof's annual beam: docs/sky-truth.md).
+fn sunlit_suns(epw: &Path, out: &Path) {
+    let text = std::fs::read_to_string(epw).unwrap();
+    let fields: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let location = Location::parse(&format!("{},{},{}", fields[6], fields[7], fields[8])).unwrap();
+    let mut lines = String::new();
+    for h in 0..8760u32 {
+        let sun = sun_direction(&location, shading_sun_day(h / 24 + 1), f64::from(h % 24) + 0.5);
+        if sun.z > 0.0 {
+            let _ = writeln!(lines, "{h} {:.9} {:.9} {:.9}", sun.x, sun.y, sun.z);
+        }
+    }
+    std::fs::write(out, lines).unwrap();
+}
+
 /// Runs the Radiance harness: per receiver name, its fields (kWh/m², view factors).
 fn radiance(scene: &Path, epw: &Path, points: usize, out: &Path) -> HashMap<String, Value> {
+    let suns = out.with_file_name("suns.txt");
+    sunlit_suns(epw, &suns);
     let harness = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/radiance/annual_irradiance.py");
     let start = Instant::now();
     let run = Command::new(radiance_python())
         .arg(&harness)
         .arg(scene)
         .args(["--epw", epw.to_str().unwrap(), "--albedo", &ALBEDO.to_string(), "--points", &points.to_string()])
-        .args(["-o", out.to_str().unwrap()])
+        .args(["--suns", suns.to_str().unwrap(), "-o", out.to_str().unwrap()])
         .output()
         .expect("run the Radiance harness");
     assert!(run.status.success(), "Radiance harness: {}", String::from_utf8_lossy(&run.stderr));

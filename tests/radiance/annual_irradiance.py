@@ -249,6 +249,32 @@ def perez_1990_unshaded(epw, normals):
     return out
 
 
+SUN_ANGLE = 0.533  # degrees, the sun's full angle (gendaymtx's)
+
+
+def write_suns(path_rad, path_mod, suns_file, epw):
+    """Radiance suns at the given directions (one line per hour: EPW hour index 0..8759, x y z),
+    each with the radiance that gives that hour's EPW direct normal irradiance (as gendaymtx -D
+    does: DNI over the disc's solid angle); hours without DNI are left out."""
+    dni = read_epw(epw)[4]
+    solid = 2 * np.pi * (1 - np.cos(np.radians(SUN_ANGLE / 2)))
+    names = []
+    with open(suns_file) as f, open(path_rad, "w") as rad:
+        for line in f:
+            if not line.strip():
+                continue
+            hour, x, y, z = line.split()
+            hour = int(hour)
+            if dni[hour] <= 0:
+                continue
+            radiance = dni[hour] / solid
+            rad.write(f"void light solar{hour}\n0\n0\n3 {radiance:.6e} {radiance:.6e} {radiance:.6e}\n\n")
+            rad.write(f"solar{hour} source sun{hour}\n0\n0\n4 {x} {y} {z} {SUN_ANGLE}\n\n")
+            names.append(f"solar{hour}")
+    with open(path_mod, "w") as mod:
+        mod.write("\n".join(names) + "\n")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("scene", help="scene JSON: triangles, receivers (name, triangles, normal)")
@@ -257,6 +283,7 @@ def main():
     parser.add_argument("--points", type=int, default=64, help="points per receiver")
     parser.add_argument("--ambient-divisions", type=int, default=1024, help="rcontrib -ad for the sky")
     parser.add_argument("--processes", type=int, default=2, help="rcontrib -n")
+    parser.add_argument("--suns", help="sun directions per hour (index x y z); default: gendaymtx's own suns")
     parser.add_argument("-o", "--output", required=True)
     args = parser.parse_args()
 
@@ -279,7 +306,10 @@ def main():
         # the sun too: that matrix is discarded).
         with open(at("sky.mtx"), "wb") as out:
             run([*gendaymtx, "-s", at("weather.wea")], env, stdout=out)
-        run([*gendaymtx, "-D", at("suns.rad"), "-M", at("suns.mod"), at("weather.wea")], env)
+        if args.suns:
+            write_suns(at("suns.rad"), at("suns.mod"), args.suns, args.epw)
+        else:
+            run([*gendaymtx, "-D", at("suns.rad"), "-M", at("suns.mod"), at("weather.wea")], env)
         sky = photopic(read_matrix(at("sky.mtx")))  # (146, hours) W/m²/sr
         if sky.shape[0] != PATCHES:
             sys.exit(f"gendaymtx: {sky.shape[0]} rows, expected {PATCHES}")
