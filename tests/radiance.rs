@@ -1,14 +1,23 @@
 //! Radiance as the independent truth for `sunlit annual`'s irradiance: beam, sky diffuse and
 //! ground-reflected per surface against Radiance's own `gendaymtx` + `rcontrib` from the same EPW
 //! (tests/radiance/annual_irradiance.py says how), on the example office and a Blaas-like louvred
-//! model. Black surfaces: only the sun, the sky and the ground count.
+//! model. Black surfaces: only the sun, the sky and the ground count. Radiance's suns are put at
+//! the directions sunlit counts each hour with, so that beam differences are shading differences.
 //!
 //! Each surface is classed by Radiance alone: unobstructed when its visible sky and its beam are
 //! within 0.2% of its unobstructed ones, shaded otherwise. Asserted per surface:
-//! - `total` within 3% (unobstructed) or 5% (shaded) of Radiance's beam + sky + ground;
-//! - `direct` alone against Radiance's exact suns, and `sky_diffuse` + `ground_reflected` alone
-//!   against Radiance's sky and ground, so that one error cannot hide another;
+//! - `total` within 3% (unobstructed) or 5% (shaded) of Radiance's beam + sky + ground, plus the
+//!   gap between the two sky models on that orientation (below);
+//! - `direct` alone against Radiance's suns within 3% / 5%, and `sky_diffuse` + `ground_reflected`
+//!   alone against Radiance's sky and ground (3% / 5% plus the gap), so that one error cannot hide
+//!   another;
 //! - `sky_view_factor` within 0.01 of Radiance's view factor to the visible sky.
+//!
+//! The gap: sunlit's Perez 1990 irradiance model and gendaymtx's Perez all-weather sky differ by
+//! construction, by up to 7.9% of an unobstructed north wall's sky diffuse (4.3% of its total).
+//! The harness computes the closed-form Perez 1990 on each unobstructed orientation (within 0.07%
+//! of EnergyPlus's own); its difference to Radiance's open sky, scaled by the surface's shading of
+//! the sky, is allowed on top, and nothing else (docs/sky-truth.md).
 //!
 //! Radiance comes from the pyradiance wheel in .venv-rad (`SUNLIT_RADIANCE=1 . scripts/setup.sh`,
 //! which `npm test` runs). Without it these tests fail, saying how to get it; they never skip.
@@ -189,11 +198,8 @@ fn compare(model: &str, ours: &HashMap<String, Value>, truth: &HashMap<String, V
         let (class, tolerance) = if unobstructed { ("unobstructed", 3.0) } else { ("shaded", 5.0) };
         let truth_total = rad("direct") + rad("sky") + rad("ground");
         let truth_diffuse = rad("sky") + rad("ground");
-        // The sky models differ by construction: sunlit's Perez 1990 irradiance model against
-        // gendaymtx's Perez all-weather radiance distribution. Their gap on this orientation,
-        // unobstructed (the closed-form Perez 1990 against Radiance's open sky), is allowed on
-        // top of the tolerance, and only that: up to 7.9% of a north wall's sky diffuse, 0.5% of
-        // a roof's (docs/sky-truth.md).
+        // The sky models differ by construction (see the module doc): their gap on this
+        // orientation, unobstructed, scaled by this surface's shading of the sky.
         let sky_gap = (rad("perez_1990_unshaded_sky") - rad("unshaded_sky")).abs() * rad("sky") / rad("unshaded_sky").max(1e-9);
         let checks = [
             ("total", percent(sun("total"), truth_total, 0.0), tolerance + 100.0 * sky_gap / truth_total),
@@ -252,7 +258,7 @@ fn check_model(label: &str, model: &Path, points: usize) {
 #[test]
 fn example_office_irradiance_matches_radiance() {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
-    check_model("office", &model, 256);
+    check_model("office", &model, 512);
 }
 
 #[test]
@@ -261,5 +267,5 @@ fn blaas_louvres_irradiance_matches_radiance() {
     let model = dir.join("blaas-louvres.glb");
     let out = sunlit(&["bench", "blaas-louvres", "--write", model.to_str().unwrap()]);
     assert!(out.status.success(), "sunlit bench --write: {}", String::from_utf8_lossy(&out.stderr));
-    check_model("blaas-louvres", &model, 256);
+    check_model("blaas-louvres", &model, 512);
 }

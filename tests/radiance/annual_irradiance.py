@@ -7,10 +7,12 @@ Input: a scene JSON written by the Rust test from sunlit's own scene (world tria
 with their triangles and outward normals), an EPW and a ground reflectance. Output: a JSON with, per
 receiver, annual kWh/m² of
 
-- ``direct``: the beam. Every daytime hour's sun is an exact Radiance `source` (gendaymtx -D: its
-  position at the hour's middle, HH-0.5, as EnergyPlus and sunlit at one timestep per hour, and its
-  radiance from the EPW's direct normal irradiance). `rcontrib -ab 0` sums every sun's
-  contribution (cos, and a shadow ray to the sun) over points on the receiver.
+- ``direct``: the beam. Every daytime hour's sun is an exact Radiance `source` of 0.533° whose
+  radiance gives the EPW's direct normal irradiance, at the hour's middle (HH-0.5, as EnergyPlus and
+  sunlit at one timestep per hour): at the directions given with --suns (the Rust test gives
+  sunlit's), else gendaymtx's own (-D; Radiance's solar position, 0.43° from EnergyPlus's on
+  average). `rcontrib -ab 0` sums every sun's contribution (cos, and a shadow ray to the sun) over
+  points on the receiver.
 - ``sky``: the sky without the sun: gendaymtx's Perez all-weather sky (-s: diffuse only) on
   Tregenza's 145 patches (-m 1), each patch's coefficient (the visible cos-weighted solid angle,
   `rcontrib -ab 1` over the same points) times the patch's annual radiance.
@@ -202,7 +204,7 @@ def read_epw(path):
 def sun_vectors(latitude, longitude, zone, hours):
     """Unit vectors (x east, y north, z up) to the sun at each hour's middle (local standard
     time), from the Spencer (1971) declination and equation of time: only for the closed-form
-    Perez diagnostic, never for the truths (those are Radiance's own suns)."""
+    Perez diagnostic, never for the truths."""
     day = np.floor(hours / 24) + 1
     clock = hours % 24 + 0.5
     g = 2 * np.pi * (day - 1) / 365
@@ -281,7 +283,7 @@ def main():
     parser.add_argument("--epw", required=True)
     parser.add_argument("--albedo", type=float, required=True)
     parser.add_argument("--points", type=int, default=64, help="points per receiver")
-    parser.add_argument("--ambient-divisions", type=int, default=1024, help="rcontrib -ad for the sky")
+    parser.add_argument("--ambient-divisions", type=int, default=512, help="rcontrib -ad for the sky")
     parser.add_argument("--processes", type=int, default=2, help="rcontrib -n")
     parser.add_argument("--suns", help="sun directions per hour (index x y z); default: gendaymtx's own suns")
     parser.add_argument("-o", "--output", required=True)
