@@ -129,7 +129,13 @@ fn summary_irradiation_matches_the_closed_form() {
     run(&table);
     let text = std::fs::read_to_string(&table).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("name,area_m2,mean_fraction,irradiation_kwh_m2,unshaded_irradiation_kwh_m2"));
+    assert_eq!(
+        lines.next(),
+        Some(
+            "name,area_m2,mean_fraction,irradiation_kwh_m2,unshaded_irradiation_kwh_m2,direct_kwh_m2,sky_diffuse_kwh_m2,\
+             ground_reflected_kwh_m2,total_kwh_m2,unshaded_total_kwh_m2,sky_view_factor,energyplus_iso_sky_ratio,energyplus_horizon_ratio"
+        )
+    );
     let row: Vec<&str> = lines.find(|l| l.starts_with("ROOF_B,")).unwrap().split(',').collect();
     assert!((row[3].parse::<f64>().unwrap() - field("ROOF_B", "irradiation")).abs() < 1e-3, "{row:?}");
 }

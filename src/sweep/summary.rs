@@ -156,7 +156,7 @@ mod tests {
         let mut s = Schedule::zeros(vec!["A".into(), "B".into()], t);
         let mut up = 0;
         for (row, i) in t.instants().enumerate() {
-            let day = sun_direction(&location, i.day as f64, i.hour).z >= MIN_COS_INCIDENCE;
+            let day = sun_direction(&location, shading_sun_day(i.day), i.hour).z >= MIN_COS_INCIDENCE;
             up += day as usize;
             s.set(row, 0, if day { 1.0 } else { 0.5 });
             s.set(row, 1, if day && row % 2 == 0 { 1.0 } else { 0.0 });
