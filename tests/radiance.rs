@@ -14,7 +14,7 @@
 //! - `sky_view_factor` within 0.01 of Radiance's view factor to the visible sky.
 //!
 //! The gap: sunlit's Perez 1990 irradiance model and gendaymtx's Perez all-weather sky differ by
-//! construction, by up to 7.9% of an unobstructed north wall's sky diffuse (4.3% of its total).
+//! construction, by up to ~8% of an unobstructed north wall's sky diffuse (~4% of its total).
 //! The harness computes the closed-form Perez 1990 on each unobstructed orientation (within 0.07%
 //! of EnergyPlus's own); its difference to Radiance's open sky, scaled by the surface's shading of
 //! the sky, is allowed on top, and nothing else (docs/sky-truth.md).
