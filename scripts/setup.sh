@@ -85,3 +85,21 @@ if [ "${SUNLIT_ENERGYPLUS:-0}" = 1 ]; then
   chmod +x "$payload/energyplus" "$payload/PostProcess/ReadVarsESO" 2>/dev/null || true
   export ENERGYPLUS="$payload/energyplus"
 fi
+
+# Radiance (its own binaries: gendaymtx, rcontrib, oconv, epw2wea…, in the pyradiance wheel) in a
+# cached venv: the independent truth of tests/radiance.rs for sky-diffuse and ground-reflected
+# irradiance. Only when asked: `SUNLIT_RADIANCE=1 . scripts/setup.sh`.
+if [ "${SUNLIT_RADIANCE:-0}" = 1 ]; then
+  rad_venv="${SUNLIT_RAD_VENV:-$PWD/.venv-rad}"
+  if [ ! -x "$rad_venv/bin/python" ]; then
+    if ! python3 -m venv "$rad_venv" 2>/dev/null; then
+      apt_install python3-venv
+      python3 -m venv "$rad_venv"
+    fi
+  fi
+  if [ "$("$rad_venv/bin/python" -c "import importlib.metadata as m; print(m.version('pyradiance'))" 2>/dev/null)" != 1.3.1 ]; then
+    say "installing Radiance (pip pyradiance 1.3.1, ~40 MB)"
+    "$rad_venv/bin/pip" install --quiet "pyradiance==1.3.1" "numpy>=1.26,<3"
+  fi
+  export SUNLIT_RADIANCE_PYTHON="$rad_venv/bin/python"
+fi
