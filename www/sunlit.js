@@ -5,6 +5,9 @@
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
+import { mapCsv } from './map.js';
+
+export { mapCsv };
 
 let wasmReady;
 
@@ -136,6 +139,38 @@ class SunlitEngine {
     } catch (error) {
       if (signal?.aborted && error?.code === 'cancelled') throw abortError();
       throw error;
+    }
+  }
+
+  /** Per-point values on the receivers (sunlit.d.ts, MapOptions): a plain object of typed arrays
+   * (points, normals, receivers, values) and its legend. Rejects with an AbortError when
+   * `signal` aborts. */
+  async map(model, options, { onProgress, signal } = {}) {
+    if (signal?.aborted) throw abortError();
+    let map;
+    try {
+      map = await this.#engine.map(model, options, onProgress, signal);
+    } catch (error) {
+      if (signal?.aborted && error?.code === 'cancelled') throw abortError();
+      throw error;
+    }
+    try {
+      return {
+        value: map.value,
+        title: map.title,
+        unit: map.unit,
+        spacing: map.spacing,
+        instants: map.instants,
+        points: map.points,
+        normals: map.normals,
+        receivers: map.receivers,
+        values: map.values,
+        min: map.min,
+        max: map.max,
+        receiverNames: model.receiverNames,
+      };
+    } finally {
+      map.free();
     }
   }
 }

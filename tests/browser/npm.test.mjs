@@ -135,6 +135,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
     'colour.js',
     'device.js',
     'engine-worker.js',
+    'map.js',
     'package.json',
     'pkg/sunlit_wasm.js',
     'pkg/sunlit_wasm_bg.wasm',
@@ -148,7 +149,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
   assert.equal(manifest.dependencies, undefined, 'three is a peer dependency only');
   assert.ok(manifest.peerDependencies.three);
   // three is not in the tarball and not imported by the package's modules.
-  for (const f of ['sunlit.js', 'three.js', 'device.js', 'engine-worker.js']) {
+  for (const f of ['sunlit.js', 'three.js', 'map.js', 'device.js', 'engine-worker.js']) {
     assert.doesNotMatch(readFileSync(join(ROOT, 'target/npm/pkg', f), 'utf8'), /from ['"]three/, f);
   }
   console.log(`tarball ${report.filename}: ${report.size} bytes packed, ${report.unpackedSize} unpacked`);
