@@ -13,6 +13,8 @@
 //! - [`count`]: one request and one answer ([`count::ViewRequest`], [`count::ViewAnswer`]) and
 //!   the engines that answer it: the GPU pixel counter ([`count::gpu`]) and the exact CPU
 //!   polygon-clipping reference ([`count::exact`]);
+//! - [`map`]: points on receivers (a grid or a CSV) and, per point, the sun seen at an instant,
+//!   sun hours and direct irradiation over a period, and sun-hours studies;
 //! - [`year`]: sampling plan, leaf calendar, the settings resolver, the spline and the annual run;
 //! - [`export`]: the EnergyPlus CSV and the model hooked to it;
 //! - [`error`]: the one typed error, naming parameters, files and objects;
@@ -44,6 +46,7 @@ pub mod export;
 pub mod geometry;
 #[cfg(test)]
 mod js_api;
+pub mod map;
 pub mod model;
 mod platform;
 pub mod scene;

@@ -37,6 +37,9 @@ use sweep_cli::{SweepArgs, sweep};
 #[path = "cli/bench.rs"]
 mod bench_cli;
 use bench_cli::{BenchArgs, run_bench};
+#[path = "cli/map.rs"]
+mod map_cli;
+use map_cli::{MapArgs, map};
 
 #[derive(Parser)]
 #[command(name = "sunlit", version, about = "Sunlit fractions of building surfaces by GPU pixel counting")]
@@ -59,6 +62,9 @@ enum Command {
     /// Many annual runs from a manifest (one JSON object a line: "id" plus annual's long
     /// options), counted here side by side or submitted as a Slurm job array; resumable.
     Sweep(SweepArgs),
+    /// Per point: sun hours and direct irradiation over a period, or lit at an instant, on a grid
+    /// or given points; sun-hours studies (bre-ground, en17037). See docs/maps.md.
+    Map(MapArgs),
 }
 
 #[derive(Args)]
@@ -285,6 +291,7 @@ fn main() -> ExitCode {
         Command::Annual(a) => annual(a),
         Command::Bench(a) => run_bench(a),
         Command::Sweep(a) => sweep(a),
+        Command::Map(a) => map(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -318,6 +325,15 @@ const FLAGS: &[(&str, &str)] = &[
     ("per_task", "--per-task"),
     ("index", "--index"),
     ("summary", "--summary"),
+    ("spacing", "--grid"),
+    ("points", "--points"),
+    ("period", "--period"),
+    ("step", "--step"),
+    ("from", "--from"),
+    ("to", "--to"),
+    ("at", "--at"),
+    ("study", "--study"),
+    ("min_altitude", "--min-altitude"),
 ];
 
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.

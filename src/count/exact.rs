@@ -21,6 +21,8 @@
 //! f32 test the GPU makes, so both see the same leaves. See-through casters count as opaque here
 //! (the reference has no transmittance).
 //!
+//! Point queries ([`rays`]) test points against the same shadows the fast engine casts.
+//!
 //! Degenerate cases: an unknown receiver id, a non-finite sun vector or a receiver without area
 //! give 0 (nothing can be lit); a receiver that nothing shades gives exactly 1.
 
@@ -40,6 +42,7 @@ mod boundary;
 pub mod engine;
 mod objects;
 mod placed;
+pub mod rays;
 
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).
 type Contour = Vec<[f64; 2]>;

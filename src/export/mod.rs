@@ -14,6 +14,8 @@ use crate::year::samples::Timesteps;
 
 pub mod hook;
 pub mod irradiation;
+pub mod map_glb;
+pub mod map_table;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]

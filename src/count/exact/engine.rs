@@ -94,6 +94,13 @@ pub struct Scratch {
     shadows: usize,
     /// The receiver's triangles and the view's shadows on the grid.
     boundary: Boundary,
+    /// Set for a point query ([`super::rays`]): shadows are kept as polygons, not integrated.
+    keep: bool,
+    /// Transmittance of the caster whose shadow is being cast (0: opaque).
+    casting: f32,
+    /// Kept shadows' corners (receiver frame), and per shadow its range of them and transmittance.
+    pub(super) kept_points: Vec<DVec2>,
+    pub(super) kept: Vec<(Range<usize>, f32)>,
 }
 
 /// What a view costs the exact engine, known before clipping: from the BVH walk alone.
@@ -171,6 +178,10 @@ impl ExactEngine {
             cap_ranges: Vec::new(),
             shadows: 0,
             boundary: Boundary::default(),
+            keep: false,
+            casting: 0.0,
+            kept_points: Vec::new(),
+            kept: Vec::new(),
         }
     }
 
@@ -289,8 +300,10 @@ impl ExactEngine {
         }
         scratch.shadows = 0;
         scratch.boundary.clear();
-        for t in &outline.lit {
-            scratch.boundary.push_points(t, true);
+        if !scratch.keep {
+            for t in &outline.lit {
+                scratch.boundary.push_points(t, true);
+            }
         }
         // Taken out for the walk over it, which needs the rest of the scratch mutably.
         let reached = std::mem::take(&mut scratch.reached);
@@ -298,6 +311,7 @@ impl ExactEngine {
             if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
                 continue;
             }
+            scratch.casting = self.veils[p].transmittance;
             match self.objects.of(p) {
                 None => self.triangle_shadow(frame, outline, p, scratch),
                 Some(o) => {
@@ -309,7 +323,46 @@ impl ExactEngine {
             }
         }
         scratch.reached = reached;
+        if scratch.keep {
+            return 1.0;
+        }
         self.sunlit_ratio(outline, scratch)
+    }
+
+    /// Keeps one view's shadows on its receiver's plane as convex polygons in the receiver's
+    /// frame (`s.kept`, `s.kept_points`), cast exactly as [`Self::fraction`] casts them, for point
+    /// queries; `false` (nothing kept) when the view is dark: the sun is down or behind the
+    /// receiver, or the receiver is unknown.
+    pub(super) fn keep_shadows(&self, request: ViewRequest, s: &mut Scratch) -> bool {
+        let sun = request.sun;
+        let (Some(Some(outline)), Some(Some(frame))) =
+            (self.outlines.get(request.receiver as usize), self.frames.get(request.receiver as usize))
+        else {
+            return false;
+        };
+        s.kept.clear();
+        s.kept_points.clear();
+        if !sun.is_finite() || is_dark(outline.normal, sun) {
+            return false;
+        }
+        s.reached.clear();
+        self.walk(outline, sun, |r| s.reached.push(r));
+        s.keep = true;
+        self.clip_reached(outline, &frame.towards(sun), request.leaves, s);
+        s.keep = false;
+        true
+    }
+
+    /// A point's orthogonal projection into `receiver`'s plane frame (the frame of its kept
+    /// shadows); `None` for an unknown receiver.
+    pub(super) fn to_plane(&self, receiver: u32, p: DVec3) -> Option<DVec2> {
+        self.frames.get(receiver as usize)?.as_ref().map(|f| f.to_2d(p))
+    }
+
+    /// The box around `receiver`'s outline in its plane frame, the window beyond which kept
+    /// shadows are clipped; `None` for an unknown receiver.
+    pub(super) fn plane_window(&self, receiver: u32) -> Option<(DVec2, DVec2)> {
+        self.outlines.get(receiver as usize)?.as_ref().map(|o| (o.window.min, o.window.max))
     }
 
     /// The shadow of one triangle, as the reference casts it.
@@ -403,6 +456,13 @@ impl ExactEngine {
         }
         let area = objects::polygon_area(polygon);
         if area.abs() <= self.area_eps {
+            return;
+        }
+        if s.keep {
+            let start = s.kept_points.len();
+            s.kept_points.extend_from_slice(polygon);
+            s.kept.push((start..s.kept_points.len(), s.casting));
+            s.shadows += 1;
             return;
         }
         s.boundary.push(&outline.snap, polygon, false);

@@ -1,0 +1,239 @@
+//! `sunlit map`, the CLI's edge of [`sunlit::map`]: its flags, the period they describe, the
+//! points CSV, the map glb and the study reports. The library owns the points, the rays, the
+//! sums and the rules.
+
+use serde_json::Value;
+use sunlit::export::map_glb::map_glb;
+use sunlit::export::map_table::{Column, points_csv, study_csv, study_json};
+use sunlit::export::write_atomic;
+use sunlit::map::period::{parse_clock, parse_date};
+use sunlit::map::study::{self, SunRule};
+use sunlit::map::{Mapper, Period, Points, Site};
+use sunlit::year::season::LeafCalendar;
+
+use super::*;
+
+#[derive(Args)]
+#[command(group = clap::ArgGroup::new("site").required(true).args(["epw", "location"]))]
+pub(super) struct MapArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// A grid on every receiver at this spacing in metres (the default, at 0.5 m).
+    #[arg(long, value_name = "SPACING", conflicts_with = "points")]
+    grid: Option<f64>,
+    /// Points from a CSV with the header x,y,z,nx,ny,nz (world axes, metres), each on a receiver.
+    #[arg(long, value_name = "FILE.csv")]
+    points: Option<PathBuf>,
+    /// Weather file: the site and the direct normal irradiance (adds direct_kwh_m2).
+    #[arg(long, value_name = "FILE.epw")]
+    epw: Option<PathBuf>,
+    /// Site without weather: latitude, longitude, time zone (sun hours only).
+    #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true)]
+    location: Option<String>,
+    /// annual, one day MM-DD, or days MM-DD..MM-DD (default annual; a study's day with --study).
+    #[arg(long, value_name = "annual|MM-DD|MM-DD..MM-DD")]
+    period: Option<String>,
+    /// Minutes between instants: an EnergyPlus timestep over days (default 60), 1–60 dividing the
+    /// window on one day (default 10; 1 for studies).
+    #[arg(long, value_name = "MINUTES")]
+    step: Option<u32>,
+    /// Start of a one-day window, local standard time (default 00:00).
+    #[arg(long, value_name = "HH:MM")]
+    from: Option<String>,
+    /// End of a one-day window (default 24:00).
+    #[arg(long, value_name = "HH:MM")]
+    to: Option<String>,
+    /// One instant: date and local standard time; writes a lit column (1 lit, 0 shaded).
+    #[arg(long, num_args = 2, value_names = ["MM-DD", "HH:MM"], conflicts_with_all = ["period", "from", "to", "step", "study"])]
+    at: Option<Vec<String>>,
+    /// The points CSV to write.
+    #[arg(short = 'o', long = "output", value_name = "POINTS.csv")]
+    output: PathBuf,
+    /// Also write the receivers coloured by the value as a glb (legend in the scene's extras).
+    #[arg(long, value_name = "MAP.glb")]
+    glb_out: Option<PathBuf>,
+    /// Sun-hours study: bre-ground or en17037; repeatable. Reports go beside the output as
+    /// POINTS.study-NAME.json and .csv.
+    #[arg(long, value_name = "NAME")]
+    study: Vec<String>,
+    /// Minimum sun altitude (degrees) for en17037 (default 10).
+    #[arg(long, value_name = "DEGREES")]
+    min_altitude: Option<f64>,
+    /// Print a JSON summary.
+    #[arg(long)]
+    json: bool,
+}
+
+/// What the flags ask for, checked before the model is read.
+struct Plan {
+    period: Period,
+    rules: Vec<SunRule>,
+    instant: bool,
+}
+
+impl MapArgs {
+    fn plan(&self) -> Result<Plan> {
+        if let Some(at) = &self.at {
+            let day = parse_date("at", &at[0])?;
+            let minute = parse_clock("at", &at[1])?;
+            return Ok(Plan { period: Period::at(day, minute)?, rules: Vec::new(), instant: true });
+        }
+        let mut rules: Vec<SunRule> = self.study.iter().map(|s| study::preset(s)).collect::<Result<_>>()?;
+        if let Some(a) = self.min_altitude {
+            if !(0.0..90.0).contains(&a) {
+                return Err(Error::argument("min_altitude", format!("{a}° is not in 0..90")));
+            }
+            for r in rules.iter_mut().filter(|r| r.name == "en17037") {
+                r.min_altitude_deg = a;
+            }
+        }
+        let text = self.period.as_deref().unwrap_or(if rules.is_empty() { "annual" } else { "" });
+        let (from, to) = (
+            self.from.as_deref().map(|t| parse_clock("from", t)).transpose()?,
+            self.to.as_deref().map(|t| parse_clock("to", t)).transpose()?,
+        );
+        let one_day =
+            |day: u32, default_step: u32| Period::day(day, from.unwrap_or(0), to.unwrap_or(24 * 60), self.step.unwrap_or(default_step));
+        let period = if text.is_empty() {
+            // Studies without a period: their (shared) default day.
+            let day = rules[0].default_day;
+            one_day(day, 1)?
+        } else if text == "annual" || text.contains("..") {
+            if from.is_some() || to.is_some() {
+                return Err(Error::argument("from", "--from and --to need a one-day --period MM-DD"));
+            }
+            let step = self.step.unwrap_or(60);
+            if step == 0 || 60 % step != 0 {
+                return Err(Error::argument(
+                    "step",
+                    format!("{step} min: over days the step must divide the hour as an EnergyPlus timestep does"),
+                ));
+            }
+            match text.split_once("..") {
+                None => Period::annual(60 / step)?,
+                Some((a, b)) => Period::days(parse_date("period", a)?, parse_date("period", b)?, 60 / step)?,
+            }
+        } else {
+            one_day(parse_date("period", text)?, if rules.is_empty() { 10 } else { 1 })?
+        };
+        for rule in &rules {
+            let Some(day) = period.single_day() else {
+                return Err(Error::argument("study", format!("{} evaluates one day; give --period MM-DD, not '{text}'", rule.name)));
+            };
+            rule.check_day(day)?;
+        }
+        Ok(Plan { period, rules, instant: false })
+    }
+
+    fn points(&self, scene: &Scene) -> Result<Points> {
+        let all: Vec<u32> = (0..scene.receivers.len() as u32).collect();
+        match &self.points {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+                sunlit::map::from_csv(scene, &path.display().to_string(), &text, &all)
+            }
+            None => sunlit::map::grid(scene, self.grid.unwrap_or(0.5), &all),
+        }
+    }
+
+    fn study_path(&self, name: &str, extension: &str) -> PathBuf {
+        let stem = self.output.file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
+        self.output.with_file_name(format!("{stem}.study-{name}.{extension}"))
+    }
+}
+
+pub(super) fn map(args: MapArgs) -> Result<()> {
+    let plan = args.plan()?;
+    if let Some(g) = args.grid
+        && !(g.is_finite() && g > 0.0)
+    {
+        return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
+    }
+    let (location, dni) = match (&args.epw, &args.location) {
+        (Some(epw), _) => (Location::from_epw(epw)?, Some(irradiation::DirectNormal::from_epw(epw)?)),
+        (None, Some(text)) => (Location::parse(text)?, None),
+        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+    };
+    check_writable(&args.output)?;
+    if let Some(glb) = &args.glb_out {
+        check_writable(glb)?;
+    }
+    let scene = args.model.load()?;
+    let points = args.points(&scene)?;
+    let start = Instant::now();
+    let mapper = Mapper::new(&scene, &points)?;
+    let calendar = LeafCalendar::for_latitude(location.latitude);
+    let site = Site { location: &location, calendar: &calendar, dni: dni.as_ref() };
+    let samples = plan.period.samples();
+    let bar = indicatif::ProgressBar::new(samples.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} instants, {eta} left")
+            .map_err(|e| Error::argument("progress", e.to_string()))?,
+    );
+    bar.set_message(format!("{} points", points.len()));
+    let mut report = |done: usize, total: usize| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    };
+
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut summary = json!({});
+    let (csv, glb_values, glb_name, glb_unit) = if plan.instant {
+        let s = samples[0];
+        let sun = sunlit::sun::position::sun_direction(&location, sunlit::year::annual::shading_sun_day(s.day), s.hour);
+        let lit: Vec<f64> = mapper.visibility(sun, calendar.fraction(f64::from(s.day)) as f32).into_iter().map(f64::from).collect();
+        let csv = points_csv(&scene, &points, &[Column { name: "lit", values: &lit, decimals: 0 }]);
+        summary["lit_points"] = json!(lit.iter().filter(|&&v| v >= 0.5).count());
+        summary["sun_up"] = json!(sun.z >= sunlit::count::MIN_COS_INCIDENCE);
+        (csv, lit, "lit", "")
+    } else {
+        let values = mapper.accumulate(&samples, site, &mut report);
+        let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
+        if let Some(d) = &values.direct_kwh_m2 {
+            columns.push(Column { name: "direct_kwh_m2", values: d, decimals: 4 });
+        }
+        let csv = points_csv(&scene, &points, &columns);
+        summary["sun_up_instants"] = json!(values.sun_up);
+        let mut studies = Vec::new();
+        for rule in &plan.rules {
+            let series = mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut report);
+            let day = plan.period.single_day().unwrap_or(rule.default_day);
+            let result = study::evaluate(rule, day, &samples, &series, &points.receivers);
+            let inputs = json!({
+                "models": args.model.models,
+                "points": args.points.as_ref().map_or(json!({"grid_spacing_m": args.grid.unwrap_or(0.5)}), |p| json!({"file": p})),
+                "site": {"latitude": location.latitude, "longitude": location.longitude, "time_zone": location.time_zone},
+                "step_minutes": samples.first().map(|s| s.hours * 60.0),
+            });
+            let report_json = study_json(&scene, &points, &result, inputs);
+            studies.push(json!({"study": rule.name, "areas": report_json["areas"].clone()}));
+            files.push((args.study_path(&rule.name, "json"), format!("{report_json:#}\n").into_bytes()));
+            files.push((args.study_path(&rule.name, "csv"), study_csv(&scene, &points, &result).into_bytes()));
+        }
+        summary["studies"] = Value::Array(studies);
+        let (name, unit, v) = match values.direct_kwh_m2 {
+            Some(d) => ("direct_kwh_m2", "kWh/m²", d),
+            None => ("sun_hours", "h", values.sun_hours),
+        };
+        (csv, v, name, unit)
+    };
+    bar.finish_and_clear();
+    files.insert(0, (args.output.clone(), csv.into_bytes()));
+    if let Some(glb) = &args.glb_out {
+        files.push((glb.clone(), map_glb(&scene, &points, &glb_values, glb_name, glb_unit)));
+    }
+    for (path, bytes) in &files {
+        write_atomic(path, bytes)?;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    summary["points"] = json!(points.len());
+    summary["instants"] = json!(samples.len());
+    summary["seconds"] = json!(round(seconds, 3));
+    summary["engine"] = json!({"exact_rays": points.len() * samples.len(), "gpu_masks": 0});
+    summary["written"] = json!(files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>());
+    if args.json {
+        println!("{summary:#}");
+    } else {
+        eprintln!("{} points × {} instants in {seconds:.2} s → {}", points.len(), samples.len(), args.output.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,331 @@
+//! Maps: where on each surface the sun falls, point by point.
+//!
+//! Owns the points a map is evaluated at and what is summed over them:
+//! - [`Points`]: positions, normals and receiver ids as flat arrays (`3n` f32, `3n` f32, `n`
+//!   u32), made by [`grid`] (a grid at a spacing on every chosen receiver, holes left out) or
+//!   [`from_csv`] (`x,y,z,nx,ny,nz` rows, each assigned to the receiver it lies on);
+//! - [`Mapper`]: the points indexed per receiver for the exact engine's shadow rays
+//!   ([`crate::count::exact::rays`]). [`Mapper::visibility`] answers one instant
+//!   ([`lit`] for a one-off), [`Mapper::accumulate`] sums sun hours and direct irradiation over a
+//!   [`Period`], [`Mapper::lit_series`] keeps each point's lit instants for the sun-hours
+//!   [`study`] rules;
+//! - [`period`]: years at EnergyPlus timesteps, date ranges, one day at minute steps, an instant,
+//!   with the sun `sunlit annual` uses.
+//!
+//! Every point is counted directly at every instant (a shadow ray is cheap once a receiver's
+//! casters are culled), never interpolated: a point's visibility jumps when a shadow edge
+//! crosses it, which a spline over sparse samples (what [`crate::year`] fits to surface fractions,
+//! smooth in time) would blur. Per instant and receiver the casters are culled once (the
+//! receiver's sun prism through the exact engine's BVH) and every point of that receiver is
+//! tested against them; instants are spread over every core.
+//!
+//! A point's own receiver never shades it. A point's visibility is 1 (sun seen), 0 (shaded, sun
+//! down, or behind the receiver), or the product of see-through casters' transmittances.
+//!
+//! Sky-diffuse and total irradiation per point need the sky's patch visibility (not here yet):
+//! [`MapValues`] has room for them beside `direct_kwh_m2`.
+
+pub mod period;
+pub mod points;
+pub mod study;
+
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+
+use glam::DVec3;
+
+pub use period::{Period, Sample};
+pub use points::{from_csv, grid};
+
+use crate::count::MIN_COS_INCIDENCE;
+use crate::count::exact::engine::ExactEngine;
+use crate::count::exact::rays::PlanePoints;
+use crate::error::{Error, Result};
+use crate::export::irradiation::DirectNormal;
+use crate::scene::Scene;
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
+use crate::year::season::LeafCalendar;
+
+/// Points on receivers, as flat arrays (what the web hands to JS as typed arrays).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Points {
+    /// `x, y, z` per point, world axes (x east, y north, z up), metres.
+    pub positions: Vec<f32>,
+    /// Unit normal per point (`nx, ny, nz`): the receiver's for a grid, as given for a CSV.
+    pub normals: Vec<f32>,
+    /// The receiver (index into `Scene::receivers`) each point lies on.
+    pub receivers: Vec<u32>,
+    /// The grid spacing (m) when the points are a grid (each stands for `spacing²` of surface).
+    pub spacing: Option<f64>,
+}
+
+impl Points {
+    /// How many points.
+    pub fn len(&self) -> usize {
+        self.receivers.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.receivers.is_empty()
+    }
+
+    /// Position of point `i`.
+    pub fn position(&self, i: usize) -> DVec3 {
+        DVec3::new(self.positions[3 * i].into(), self.positions[3 * i + 1].into(), self.positions[3 * i + 2].into())
+    }
+
+    /// Normal of point `i`.
+    pub fn normal(&self, i: usize) -> DVec3 {
+        DVec3::new(self.normals[3 * i].into(), self.normals[3 * i + 1].into(), self.normals[3 * i + 2].into())
+    }
+
+    pub(crate) fn push(&mut self, p: DVec3, n: DVec3, receiver: u32) {
+        self.positions.extend(p.to_array().map(|v| v as f32));
+        self.normals.extend(n.to_array().map(|v| v as f32));
+        self.receivers.push(receiver);
+    }
+}
+
+/// The weather and site a period is evaluated under.
+#[derive(Debug, Clone, Copy)]
+pub struct Site<'a> {
+    /// Where (the sun's path).
+    pub location: &'a Location,
+    /// The foliage's leaf fraction through the year.
+    pub calendar: &'a LeafCalendar,
+    /// Direct normal irradiance, for direct irradiation; `None`: sun hours only.
+    pub dni: Option<&'a DirectNormal>,
+}
+
+/// Per point sums over a period.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MapValues {
+    /// Hours of sun seen (visibility × hours, sun up and in front of the surface).
+    pub sun_hours: Vec<f64>,
+    /// Direct irradiation on the point's plane (kWh/m²): visibility · DNI · cos incidence ·
+    /// hours; `None` without DNI.
+    pub direct_kwh_m2: Option<Vec<f64>>,
+    /// Instants in the period, and those with the sun up (each counted at every point).
+    pub instants: usize,
+    /// Instants with the sun up.
+    pub sun_up: usize,
+}
+
+/// One receiver's points, indexed for the rays, and where they sit in [`Points`].
+struct Group {
+    plane: PlanePoints,
+    members: Vec<u32>,
+    normal: DVec3,
+}
+
+/// Points indexed for the exact engine's shadow rays. Build once, ask many instants.
+pub struct Mapper {
+    engine: ExactEngine,
+    groups: Vec<Group>,
+    points: usize,
+    normals: Vec<DVec3>,
+}
+
+impl Mapper {
+    /// Indexes `points` on `scene`; refuses a point whose receiver is not in the scene.
+    pub fn new(scene: &Scene, points: &Points) -> Result<Self> {
+        let engine = ExactEngine::new(scene);
+        let mut by_receiver: Vec<Vec<u32>> = vec![Vec::new(); scene.receivers.len()];
+        for (i, &r) in points.receivers.iter().enumerate() {
+            by_receiver
+                .get_mut(r as usize)
+                .ok_or_else(|| Error::argument("points", format!("point {i} names receiver {r}; the scene has {}", scene.receivers.len())))?
+                .push(i as u32);
+        }
+        let mut groups = Vec::new();
+        for (r, members) in by_receiver.into_iter().enumerate() {
+            if members.is_empty() {
+                continue;
+            }
+            let world: Vec<DVec3> = members.iter().map(|&i| points.position(i as usize)).collect();
+            let Some(plane) = engine.plane_points(r as u32, &world) else {
+                return Err(Error::argument("points", format!("receiver '{}' has no area to put points on", scene.receivers[r].name)));
+            };
+            groups.push(Group { plane, members, normal: scene.receivers[r].normal });
+        }
+        let normals = (0..points.len()).map(|i| points.normal(i)).collect();
+        Ok(Self { engine, groups, points: points.len(), normals })
+    }
+
+    /// Each point's visibility of the sun along `sun` (unit, towards the sun) at leaf fraction
+    /// `leaves`: 1 lit, 0 shaded or dark.
+    pub fn visibility(&self, sun: DVec3, leaves: f32) -> Vec<f32> {
+        let mut out = vec![0.0f32; self.points];
+        let mut scratch = self.engine.point_scratch();
+        let mut buffer = Vec::new();
+        for g in &self.groups {
+            buffer.resize(g.members.len(), 0.0);
+            self.engine.visibility(&g.plane, sun, leaves, &mut scratch, &mut buffer);
+            for (&i, &v) in g.members.iter().zip(&buffer) {
+                out[i as usize] = v;
+            }
+        }
+        out
+    }
+
+    /// Sun hours and (with DNI) direct irradiation per point over `samples`; `progress(done,
+    /// total)` is called now and then from the calling thread. Instants are shared over every
+    /// core; the sums do not depend on how.
+    pub fn accumulate(&self, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> MapValues {
+        let n = self.points;
+        let with_dni = site.dni.is_some();
+        let hourly = crate::year::samples::Timesteps::new(1).ok();
+        let parts = self.sweep(
+            samples,
+            site,
+            progress,
+            || (vec![0.0f64; n], if with_dni { vec![0.0f64; n] } else { Vec::new() }),
+            |acc, _, s, sun, g, vis| {
+                let dni = match (site.dni, hourly) {
+                    (Some(d), Some(t)) => d.at(t, s.epw_hour),
+                    _ => 0.0,
+                };
+                for (&i, &v) in g.members.iter().zip(vis) {
+                    if v > 0.0 {
+                        let i = i as usize;
+                        acc.0[i] += f64::from(v) * s.hours;
+                        if with_dni {
+                            let cos = self.normals[i].dot(sun).max(0.0);
+                            acc.1[i] += f64::from(v) * dni * cos * s.hours / 1000.0;
+                        }
+                    }
+                }
+            },
+        );
+        let mut values =
+            MapValues { sun_hours: vec![0.0; n], direct_kwh_m2: with_dni.then(|| vec![0.0; n]), instants: samples.len(), sun_up: 0 };
+        values.sun_up = samples.iter().filter(|s| self.sun(site, s).z >= MIN_COS_INCIDENCE).count();
+        for (hours, direct) in parts {
+            for (a, b) in values.sun_hours.iter_mut().zip(hours) {
+                *a += b;
+            }
+            if let Some(d) = values.direct_kwh_m2.as_mut() {
+                for (a, b) in d.iter_mut().zip(direct) {
+                    *a += b;
+                }
+            }
+        }
+        values
+    }
+
+    /// Which instants of `samples` each point sees the sun at (visibility ≥ 0.5) with the sun
+    /// at least `min_altitude_deg` above the horizon: for the study rules, which need the order
+    /// of lit instants (continuous periods), not just their sum.
+    pub fn lit_series(
+        &self,
+        samples: &[Sample],
+        site: Site<'_>,
+        min_altitude_deg: f64,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> LitSeries {
+        let words = samples.len().div_ceil(64);
+        let bits: Vec<AtomicU64> = (0..self.points * words).map(|_| AtomicU64::new(0)).collect();
+        let min_z = min_altitude_deg.to_radians().sin();
+        self.sweep(
+            samples,
+            site,
+            progress,
+            || (),
+            |_, k, _, sun, g, vis| {
+                if sun.z < min_z {
+                    return;
+                }
+                for (&i, &v) in g.members.iter().zip(vis) {
+                    if v >= 0.5 {
+                        bits[i as usize * words + k / 64].fetch_or(1 << (k % 64), Ordering::Relaxed);
+                    }
+                }
+            },
+        );
+        LitSeries { words, instants: samples.len(), bits: bits.into_iter().map(AtomicU64::into_inner).collect() }
+    }
+
+    fn sun(&self, site: Site<'_>, s: &Sample) -> DVec3 {
+        sun_direction(site.location, shading_sun_day(s.day), s.hour)
+    }
+
+    /// Every sun-up instant's visibility per receiver, handed to `record` with a thread's own
+    /// state (made by `state`); the states come back, one per thread.
+    fn sweep<S: Send>(
+        &self,
+        samples: &[Sample],
+        site: Site<'_>,
+        progress: &mut dyn FnMut(usize, usize),
+        state: impl Fn() -> S + Sync,
+        record: impl Fn(&mut S, usize, &Sample, DVec3, &Group, &[f32]) + Sync,
+    ) -> Vec<S> {
+        let next = AtomicUsize::new(0);
+        let done = AtomicUsize::new(0);
+        let total = samples.len();
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(total.max(1));
+        let work = || {
+            let mut s = state();
+            let mut scratch = self.engine.point_scratch();
+            let mut vis: Vec<f32> = Vec::new();
+            loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                let Some(sample) = samples.get(k) else { break s };
+                let sun = self.sun(site, sample);
+                if sun.z >= MIN_COS_INCIDENCE {
+                    let leaves = site.calendar.fraction(f64::from(sample.day)) as f32;
+                    for g in &self.groups {
+                        if crate::count::is_dark(g.normal, sun) {
+                            continue;
+                        }
+                        vis.resize(g.members.len(), 0.0);
+                        self.engine.visibility(&g.plane, sun, leaves, &mut scratch, &mut vis);
+                        record(&mut s, k, sample, sun, g, &vis);
+                    }
+                }
+                done.fetch_add(1, Ordering::Relaxed);
+            }
+        };
+        std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads).map(|_| scope.spawn(work)).collect();
+            while workers.iter().any(|w| !w.is_finished()) {
+                progress(done.load(Ordering::Relaxed), total);
+                std::thread::sleep(std::time::Duration::from_millis(100));
+            }
+            progress(total, total);
+            workers.into_iter().filter_map(|w| w.join().ok()).collect()
+        })
+    }
+}
+
+/// Per point, which instants of a period it saw the sun at (see [`Mapper::lit_series`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LitSeries {
+    words: usize,
+    instants: usize,
+    bits: Vec<u64>,
+}
+
+impl LitSeries {
+    /// Whether point `i` saw the sun at instant `k`.
+    pub fn lit(&self, i: usize, k: usize) -> bool {
+        k < self.instants && self.bits[i * self.words + k / 64] >> (k % 64) & 1 == 1
+    }
+
+    /// Instants in the period.
+    pub fn instants(&self) -> usize {
+        self.instants
+    }
+}
+
+/// Each point's visibility of the sun along `sun` at leaf fraction `leaves` (a one-off
+/// [`Mapper::visibility`]).
+pub fn lit(scene: &Scene, points: &Points, sun: DVec3, leaves: f32) -> Result<Vec<f32>> {
+    Ok(Mapper::new(scene, points)?.visibility(sun, leaves))
+}
+
+/// Sun hours and direct irradiation per point over `period` (a one-off [`Mapper::accumulate`]).
+pub fn accumulate(scene: &Scene, points: &Points, period: &Period, site: Site<'_>) -> Result<MapValues> {
+    Ok(Mapper::new(scene, points)?.accumulate(&period.samples(), site, &mut |_, _| {}))
+}
