@@ -6,7 +6,7 @@
 //   { id, op: 'loadFiles', files, options }        → { id, result: { names, areas } }
 //   { id, op: 'fractions', sun }                   → { id, result: Float64Array }
 //   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
-//   { id, op: 'map', options }                     → { id, result: SunlitMap }  (engine.map's typed arrays, transferred)
+//   { id, op: 'map', options, csv, glb }           → { id, result: SunlitMap }  (engine.map's typed arrays, transferred)
 //   { id, op: 'cancel' }                           → aborts a running annual or map
 // Errors come back as { id, error: message }; progress of an annual as { id, progress: [done, total] }.
 import { createEngine } from './sunlit.js';
@@ -42,11 +42,12 @@ const ops = {
 };
 
 /** engine.map's answer, its arrays moved (not copied) to the caller. */
-async function map({ id, options }) {
+async function map({ id, options, csv, glb }) {
   running = new AbortController();
   const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
-  const result = await need(engine, 'create').map(need(model, 'fromMeshes or loadFiles'), options, { onProgress, signal: running.signal });
-  return transfer(result, [result.points, result.normals, result.receivers, result.values].map((a) => a.buffer));
+  const result = await need(engine, 'create').map(need(model, 'fromMeshes or loadFiles'), options, { onProgress, signal: running.signal, csv, glb });
+  const arrays = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct, result.glb];
+  return transfer(result, arrays.filter(Boolean).map((a) => a.buffer));
 }
 
 const transfers = new WeakMap();

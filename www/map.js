@@ -1,14 +1,14 @@
 // Per-point maps (what engine.map returns: points, normals, receiver ids, values) as things to
-// draw and to save, without three.js or the DOM: a small square cell on its surface per point
-// (the generated grid mesh that the page's view and sunlit/three colour per vertex), the colours
-// of the values, and the points CSV in the CLI's columns (`sunlit map -o POINTS.csv`).
+// draw, without three.js or the DOM: a small square cell on its surface per point (the
+// generated grid mesh that the page's view and sunlit/three colour per vertex), and the colours
+// of the values. (The points CSV and the map glb come from the library: engine.map's csv/glb.)
 import { colourOf } from './colour.js';
 
-/** The values a map can hold: the CSV's column, the legend's title and unit. */
+/** The values a map can hold: the legend's title and unit. */
 export const MAP_VALUES = {
-  sunHours: { column: 'sun_hours', title: 'Sun hours', unit: 'h' },
-  direct: { column: 'direct_kwh_m2', title: 'Direct irradiation', unit: 'kWh/m²' },
-  lit: { column: 'lit', title: 'Sunlit at the instant', unit: '' },
+  sunHours: { title: 'Sun hours', unit: 'h' },
+  direct: { title: 'Direct irradiation', unit: 'kWh/m²' },
+  lit: { title: 'Sunlit at the instant', unit: '' },
 };
 
 /** A point in the sun at the instant, and one in shadow: the palette's two ends. */
@@ -88,20 +88,3 @@ export function mapColours(values, range) {
   return out;
 }
 
-/** The points CSV, as `sunlit map -o POINTS.csv` writes it: receiver,x,y,z,nx,ny,nz,VALUE with
- * the receiver's name, for the map's one value (`sun_hours`, `direct_kwh_m2` or `lit`). */
-export function mapCsv(map) {
-  const { points, normals, receivers, values, receiverNames } = map;
-  const column = MAP_VALUES[map.value]?.column;
-  if (!column) throw new TypeError(`mapCsv: unknown value '${map.value}'`);
-  const quote = (s) => (/[",\n\r]/.test(s) ? `"${s.replace(/"/g, '""')}"` : s);
-  const lines = [`receiver,x,y,z,nx,ny,nz,${column}`];
-  const f = (x) => String(Math.round(x * 1e4) / 1e4);
-  for (let i = 0; i < receivers.length; i++) {
-    const p = [points[3 * i], points[3 * i + 1], points[3 * i + 2]].map(f);
-    const n = [normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]].map(f);
-    const v = map.value === 'lit' ? String(values[i] >= 0.5 ? 1 : 0) : String(Math.round(values[i] * 1e4) / 1e4);
-    lines.push([quote(receiverNames[receivers[i]]), ...p, ...n, v].join(','));
-  }
-  return `${lines.join('\n')}\n`;
-}

@@ -1,7 +1,8 @@
 // The page's Map mode: per-point values on the receivers (engine.map, run by the worker): a grid
 // at a spacing, a period or an instant, a value; the cells drawn over the 3D view with a legend;
-// a day/time slider that maps the instant as it moves; the points CSV to download.
-import { MAP_VALUES, mapCells, mapColours, mapCsv, mapRange } from './map.js';
+// a day/time slider that maps the instant as it moves; the points CSV and the map glb to
+// download (the library's own writers, as `sunlit map` writes them).
+import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 const MONTH_DAYS = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
 
@@ -57,8 +58,11 @@ export function mapMode(page) {
     return o;
   }
 
-  /** One map request at a time: a slider moved during one sends only its latest instant after. */
-  async function request(tag) {
+  /** One map request at a time: a slider moved during one sends only its latest instant after.
+   * The tag (what was asked, and for an instant the sliders' day and time) comes back with the
+   * answer. */
+  async function request(kind) {
+    const tag = { kind, day: $('mapday').value, time: $('maptime').value };
     const message = { type: 'map', options: await options(), engine: page.engineOptions(), tag };
     if (state.inFlight) {
       state.pending = message;
@@ -91,25 +95,27 @@ export function mapMode(page) {
     state.colours = mapColours(map.values, { ...range, value: map.value });
     const info = MAP_VALUES[map.value];
     showFields();
-    page.showLegend(legendOf(map, range));
+    page.showLegend(legendOf(map, range, tag));
     const lit = map.value === 'lit' ? map.values.reduce((n, v) => n + (v >= 0.5), 0) : null;
     const view = $('view');
     view.dataset.cells = String(map.values.length);
     view.dataset.lit = lit === null ? '' : String(lit);
-    view.dataset.at = map.value === 'lit' ? `${$('mapday').value},${$('maptime').value}` : '';
-    $('downloadmap').disabled = false;
+    view.dataset.at = map.value === 'lit' ? `${tag.day},${tag.time}` : '';
+    $('downloadmap').disabled = !map.csv;
+    $('downloadglb').disabled = !map.glb;
     const receivers = new Set(map.receivers).size;
     const summary =
       lit === null
         ? `${info.title} from ${map.min.toFixed(2)} to ${map.max.toFixed(2)}${info.unit ? ` ${info.unit}` : ''} over ${map.instants.toLocaleString()} instants`
         : `${lit.toLocaleString()} in the sun`;
-    page.status(`Map in ${seconds.toFixed(1)} s (${tag}): ${map.values.length.toLocaleString()} points on ${receivers} receivers; ${summary}.`);
+    page.status(`Map in ${seconds.toFixed(1)} s (${tag.kind}): ${map.values.length.toLocaleString()} points on ${receivers} receivers; ${summary}.`);
   }
 
-  function legendOf(map, range) {
+  function legendOf(map, range, tag) {
     const info = MAP_VALUES[map.value];
     if (map.value === 'lit') {
-      return { max: 1, title: `Sunlit at ${$('mapday').nextElementSibling.textContent} (yellow: sun, blue: shadow)`, tick: (v) => (v === 0 ? 'shadow' : v === 1 ? 'sun' : '') };
+      const at = `${monthDay(Number(tag.day))} ${clock(Number(tag.time))}`;
+      return { max: 1, title: `Sunlit at ${at} (yellow: sun, blue: shadow)`, tick: (v) => (v === 0 ? 'shadow' : v === 1 ? 'sun' : '') };
     }
     return { max: range.max, title: `${info.title}${info.unit ? `, ${info.unit}` : ''} per point`, tick: (v) => (range.max >= 10 ? v.toFixed(0) : v.toFixed(2)) };
   }
@@ -128,11 +134,9 @@ export function mapMode(page) {
         if (mode() === 'map' && instant() && state.map && !page.busy()) request('instant');
       });
     }
-    $('downloadmap').addEventListener('click', () => {
-      if (!state.map) return;
-      const base = page.modelName().replace(/\.[^.]*$/, '') || 'model';
-      page.download(`${base}-points.csv`, mapCsv(state.map), 'text/csv');
-    });
+    const base = () => page.modelName().replace(/\.[^.]*$/, '') || 'model';
+    $('downloadmap').addEventListener('click', () => state.map?.csv && page.download(`${base()}-points.csv`, state.map.csv, 'text/csv'));
+    $('downloadglb').addEventListener('click', () => state.map?.glb && page.download(`${base()}-map.glb`, state.map.glb, 'model/gltf-binary'));
     showFields();
   }
 
@@ -146,6 +150,7 @@ export function mapMode(page) {
     reset() {
       state.map = null;
       $('downloadmap').disabled = true;
+      $('downloadglb').disabled = true;
       showFields();
     },
   };

@@ -173,7 +173,7 @@ export interface SunlitEngine {
   annual(model: Model, settings: AnnualSettings, options?: AnnualRunOptions): Promise<Annual>;
   /** Per-point values on the receivers (a grid, or given points): sun hours or direct irradiation
    * over a period, or lit (1) or not (0) at an instant, each point by its own shadow ray. */
-  map(model: Model, options: MapOptions, run?: AnnualRunOptions): Promise<SunlitMap>;
+  map(model: Model, options: MapOptions, run?: MapRunOptions): Promise<SunlitMap>;
 }
 
 /** engine.map's options: where (a grid or given points), when (a period or an instant) and what
@@ -205,6 +205,19 @@ export interface MapOptions {
   at?: string;
   /** 'sunHours' (default), 'direct' (kWh/m², needs an EPW) or 'lit' (needs `at`). */
   value?: 'sunHours' | 'direct' | 'lit';
+  /** Foliage keeps its leaves all year (as AnnualSettings). */
+  evergreen?: boolean;
+  /** Leaf-out period "MM-DD,MM-DD" (as AnnualSettings). */
+  leafOut?: string;
+  /** Leaf-fall period "MM-DD,MM-DD" (as AnnualSettings). */
+  leafFall?: string;
+}
+
+export interface MapRunOptions extends AnnualRunOptions {
+  /** Also return the points CSV (`csv`), as `sunlit map -o POINTS.csv` writes it. */
+  csv?: boolean;
+  /** Also return the map glb (`glb`), as `sunlit map --glb-out MAP.glb` writes it. */
+  glb?: boolean;
 }
 
 /** engine.map's answer: plain typed arrays (transferable to and from a worker), one entry per
@@ -227,16 +240,22 @@ export interface SunlitMap {
   receivers: Uint32Array;
   /** The value per point. */
   values: Float32Array;
+  /** A period's sun hours per point (undefined for an instant). */
+  sunHours: Float32Array | undefined;
+  /** A period's direct irradiation per point, kWh/m² (undefined without an EPW, or for an instant). */
+  direct: Float32Array | undefined;
+  /** The points CSV (with `csv: true`): receiver,x,y,z,nx,ny,nz then lit, or sun_hours and, with
+   * an EPW, direct_kwh_m2. */
+  csv: string | undefined;
+  /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
+   * legend in the scene's extras. */
+  glb: Uint8Array | undefined;
   /** The legend's range: 0 and the largest value (lit: 0 and 1). */
   min: number;
   max: number;
   /** The model's receiver names. */
   receiverNames: string[];
 }
-
-/** The points CSV as `sunlit map -o POINTS.csv` writes it: receiver,x,y,z,nx,ny,nz and the value's
- * column (sun_hours, direct_kwh_m2 or lit). */
-export function mapCsv(map: SunlitMap): string;
 
 /** A scene on the engine's GPU device; use it only with the engine that made it. */
 export interface Model {

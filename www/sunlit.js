@@ -5,9 +5,6 @@
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
-import { mapCsv } from './map.js';
-
-export { mapCsv };
 
 let wasmReady;
 
@@ -143,9 +140,10 @@ class SunlitEngine {
   }
 
   /** Per-point values on the receivers (sunlit.d.ts, MapOptions): a plain object of typed arrays
-   * (points, normals, receivers, values) and its legend. Rejects with an AbortError when
-   * `signal` aborts. */
-  async map(model, options, { onProgress, signal } = {}) {
+   * (points, normals, receivers, values; transferable to and from a worker) and its legend; with
+   * `csv` / `glb` true, also the points CSV (text) and the map glb (bytes) as `sunlit map` writes
+   * them. Rejects with an AbortError when `signal` aborts. */
+  async map(model, options, { onProgress, signal, csv = false, glb = false } = {}) {
     if (signal?.aborted) throw abortError();
     let map;
     try {
@@ -165,9 +163,13 @@ class SunlitEngine {
         normals: map.normals,
         receivers: map.receivers,
         values: map.values,
+        sunHours: map.sunHours,
+        direct: map.direct,
         min: map.min,
         max: map.max,
         receiverNames: model.receiverNames,
+        csv: csv ? map.csv() : undefined,
+        glb: glb ? map.glb() : undefined,
       };
     } finally {
       map.free();

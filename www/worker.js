@@ -137,8 +137,9 @@ async function map({ options, engine: made, tag }) {
   running = new AbortController();
   const started = performance.now();
   const onProgress = (done, total) => postMessage({ type: 'progress', done, total });
-  const result = await e.map(m, options, { onProgress, signal: running.signal });
-  const buffers = [result.points, result.normals, result.receivers, result.values].map((a) => a.buffer);
+  // The files come along (the page offers them for download): cheap beside the rays.
+  const result = await e.map(m, options, { onProgress, signal: running.signal, csv: true, glb: true });
+  const buffers = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct, result.glb].filter(Boolean).map((a) => a.buffer);
   postMessage({ type: 'mapResult', tag, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
 }
 

@@ -287,6 +287,12 @@ impl Mapper {
                 done.fetch_add(1, Ordering::Relaxed);
             }
         };
+        if cfg!(target_arch = "wasm32") {
+            // No threads to spawn on the web (wasm32-unknown-unknown): one pass on this one.
+            let s = work();
+            progress(total, total);
+            return vec![s];
+        }
         std::thread::scope(|scope| {
             let workers: Vec<_> = (0..threads).map(|_| scope.spawn(work)).collect();
             while workers.iter().any(|w| !w.is_finished()) {

@@ -1,10 +1,10 @@
 // www/map.js without a browser: the cells a map is painted with lie in their surface's plane,
 // centred on their points, and tile a grid laid out as the library lays it (adjacent cells share
-// edges, no gaps or overlaps); y-up turns sunlit's axes into three.js's; the CSV has the CLI's
-// columns and quotes names that need it.
+// edges, no gaps or overlaps); y-up turns sunlit's axes into three.js's; lit maps take the
+// palette's two ends.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { LIT, SHADED, mapCells, mapColours, mapCsv, mapRange } from '../../www/map.js';
+import { LIT, SHADED, mapCells, mapColours, mapRange } from '../../www/map.js';
 
 const close = (a, b, what) => assert.ok(Math.abs(a - b) < 1e-5, `${what}: ${a} vs ${b}`);
 
@@ -65,21 +65,4 @@ test('colours: the palette over the range, lit and shaded for a lit map', () => 
   assert.deepEqual(Array.from(lit.subarray(0, 3)), LIT.map(Math.fround));
   assert.deepEqual(Array.from(lit.subarray(18, 21)), SHADED.map(Math.fround));
   assert.notDeepEqual(LIT, SHADED);
-});
-
-test('the points CSV has the CLI columns, one row per point, names quoted when needed', () => {
-  const map = {
-    value: 'sunHours',
-    points: new Float32Array([1, 2, 3, 4, 5, 6]),
-    normals: new Float32Array([0, -1, 0, 0, 0, 1]),
-    receivers: new Uint32Array([1, 0]),
-    values: new Float32Array([2.5, 0]),
-    receiverNames: ['Roof', 'Wall, "south"'],
-  };
-  const rows = mapCsv(map).trim().split('\n');
-  assert.equal(rows[0], 'receiver,x,y,z,nx,ny,nz,sun_hours');
-  assert.equal(rows[1], '"Wall, ""south""",1,2,3,0,-1,0,2.5');
-  assert.equal(rows[2], 'Roof,4,5,6,0,0,1,0');
-  assert.match(mapCsv({ ...map, value: 'lit', values: new Float32Array([1, 0]) }), /^receiver,x,y,z,nx,ny,nz,lit\n.*,1\n.*,0\n$/);
-  assert.match(mapCsv({ ...map, value: 'direct' }).split('\n')[0], /,direct_kwh_m2$/);
 });
