@@ -201,7 +201,8 @@ impl Engine {
                 PointMap { model, points, value, values, sums: None, instants: samples.len() }
             } else {
                 let sums = summed(&mapper, site, &samples, progress.as_ref(), signal.as_ref()).await.map_err(map_error)?;
-                let values = if value == MapValue::Direct { sums.direct_kwh_m2.clone().unwrap_or_default() } else { sums.sun_hours.clone() };
+                let values =
+                    if value == MapValue::Direct { sums.direct_kwh_m2.clone().unwrap_or_default() } else { sums.sun_hours.clone() };
                 PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums) }
             };
             Ok(map.into())

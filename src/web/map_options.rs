@@ -112,7 +112,10 @@ impl MapRequest {
             return Err(Error::argument("options", "give an object with at least a location (latitude, longitude, timeZone) or an EPW"));
         };
         if let Some(key) = all.keys().find(|k| !MAP_KEYS.contains(&k.as_str()) && !SITE_KEYS.contains(&k.as_str())) {
-            return Err(Error::argument("options", format!("'{key}' is not a map option ({}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", "))));
+            return Err(Error::argument(
+                "options",
+                format!("'{key}' is not a map option ({}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", ")),
+            ));
         }
         let mut take = |key: &str| all.remove(key);
         let (grid, points, period, step, from, to, at, value) =
@@ -126,11 +129,22 @@ impl MapRequest {
                 Where::Given(serde_json::from_value(points).map_err(|_| Error::argument("points", "must be an array of numbers"))?)
             }
         };
-        let (period, step, from, to, at, value) = (text_of("period", period)?, number("step", step)?, text_of("from", from)?, text_of("to", to)?, text_of("at", at)?, text_of("value", value)?);
+        let (period, step, from, to, at, value) = (
+            text_of("period", period)?,
+            number("step", step)?,
+            text_of("from", from)?,
+            text_of("to", to)?,
+            text_of("at", at)?,
+            text_of("value", value)?,
+        );
         let value = value.as_deref().map(MapValue::parse).transpose()?;
         let period = match at {
             Some(at) => {
-                if let Some((name, _)) = [("period", period.is_some()), ("step", step.is_some()), ("from", from.is_some()), ("to", to.is_some())].iter().find(|(_, given)| *given) {
+                if let Some((name, _)) =
+                    [("period", period.is_some()), ("step", step.is_some()), ("from", from.is_some()), ("to", to.is_some())]
+                        .iter()
+                        .find(|(_, given)| *given)
+                {
                     return Err(Error::argument(*name, "an instant ('at') has no period, step or window"));
                 }
                 instant(&at)?
@@ -142,7 +156,9 @@ impl MapRequest {
             (None, true) | (Some(MapValue::Lit), true) => MapValue::Lit,
             (None, false) => MapValue::SunHours,
             (Some(MapValue::Lit), false) => return Err(Error::argument("value", "'lit' needs an instant: give 'at' (MM-DD HH:MM)")),
-            (Some(_), true) => return Err(Error::argument("value", "at an instant the value is 'lit'; sun hours and irradiation need a period")),
+            (Some(_), true) => {
+                return Err(Error::argument("value", "at an instant the value is 'lit'; sun hours and irradiation need a period"));
+            }
             (Some(v), false) => v,
         };
         let dni = match (value, &settings.epw) {
@@ -184,7 +200,10 @@ fn span(period: &str, step: Option<f64>, from: Option<&str>, to: Option<&str>) -
         }
         let step = step.unwrap_or(DEFAULT_STEP);
         if 60 % step != 0 {
-            return Err(Error::argument("step", format!("{step} min: over days the step must divide the hour as an EnergyPlus timestep does")));
+            return Err(Error::argument(
+                "step",
+                format!("{step} min: over days the step must divide the hour as an EnergyPlus timestep does"),
+            ));
         }
         return match period.split_once("..") {
             None => Period::annual(60 / step),
@@ -195,4 +214,3 @@ fn span(period: &str, step: Option<f64>, from: Option<&str>, to: Option<&str>) -
     let to = to.map(|t| parse_clock("to", t)).transpose()?.unwrap_or(24 * 60);
     Period::day(parse_date("period", period)?, from, to, step.unwrap_or(DEFAULT_DAY_STEP))
 }
-
