@@ -191,7 +191,7 @@ fn bre_ground_study_on_a_yard_behind_a_wall() {
     let series = mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut |_, _| {});
     let result = study::evaluate(&rule, rule.default_day, &samples, &series, &points.receivers);
     // The equinox noon sun stands 38.5° up: 8 m of wall shades about 10 m behind it at noon,
-    // so the first row (y = 0.5) gets no sun, the last (y = 9.5) hours of it.
+    // so the first row (y = 0.5) gets next to no sun, the last (y = 9.5) hours of it.
     let by_instant: Vec<Vec<f32>> =
         samples.iter().map(|sample| mapper.visibility(sun_direction(&location, shading_sun_day(sample.day), sample.hour), 1.0)).collect();
     for i in 0..points.len() {
@@ -204,7 +204,8 @@ fn bre_ground_study_on_a_yard_behind_a_wall() {
         }
         assert!((result.hours[i] - by_hand).abs() < 1e-9);
         if p.y < 1.0 {
-            assert_eq!(result.hours[i], 0.0, "{p}");
+            // Only the sun grazing past the wall's ends at sunrise or sunset reaches them.
+            assert!(result.hours[i] <= 0.1, "{p}: {} h", result.hours[i]);
         }
     }
     let area = &result.areas[0];
@@ -262,4 +263,68 @@ fn bad_input_is_refused_with_its_name() {
     refused(study::preset("sunny"), "study", "not a study");
     refused(study::preset("en17037").unwrap().check_day(100), "study", "outside");
     assert!(matches!(grid(&s, 0.0, &ids), Err(Error::Argument { .. })));
+}
+
+/// The CLI on the example office: a points CSV with the contract's columns and a map glb that
+/// Khronos's glTF-Validator passes; `--at` writes `lit`; a study writes its reports; refused input
+/// names the flag and its value and writes nothing.
+#[test]
+fn cli_writes_points_glb_and_studies_and_refuses_bad_input() {
+    use std::path::PathBuf;
+    use std::process::Command;
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("sunlit-maps-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let office = root.join("examples/office.glb");
+    let run =
+        |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_sunlit")).arg("map").arg(&office).args(args).current_dir(&dir).output().unwrap();
+
+    let out =
+        run(&["--grid", "0.5", "--location", "39.74,-105.18,-7", "--period", "06-21", "-o", "day.csv", "--glb-out", "day.glb", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let csv = std::fs::read_to_string(dir.join("day.csv")).unwrap();
+    assert!(csv.starts_with("receiver,x,y,z,nx,ny,nz,sun_hours\n"), "{}", &csv[..60]);
+    assert_eq!(csv.lines().count() - 1, summary["points"].as_u64().unwrap() as usize);
+    assert_eq!(summary["instants"], 144);
+
+    let validator = root.join("node_modules/gltf-validator");
+    assert!(validator.exists(), "node_modules/gltf-validator is missing: run `npm ci` (scripts/setup.sh does)");
+    let v = Command::new("node").arg(root.join("tests/gltf/validate.mjs")).arg(dir.join("day.glb")).output().unwrap();
+    assert!(v.status.success(), "validate.mjs: {}", String::from_utf8_lossy(&v.stderr));
+    let report: serde_json::Value = serde_json::from_slice(v.stdout.split(|&b| b == b'\n').next().unwrap()).unwrap();
+    assert_eq!(report["errors"], 0, "gltf-validator: {report}");
+
+    let out = run(&["--grid", "1", "--location", "39.74,-105.18,-7", "--at", "03-21", "12:00", "-o", "at.csv"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let at = std::fs::read_to_string(dir.join("at.csv")).unwrap();
+    assert!(at.starts_with("receiver,x,y,z,nx,ny,nz,lit\n"));
+    assert!(at.lines().skip(1).all(|l| l.ends_with(",0") || l.ends_with(",1")));
+
+    let out = run(&["--grid", "1", "--location", "51.5,-0.1,0", "--study", "bre-ground", "-o", "study.csv"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("study.study-bre-ground.json")).unwrap()).unwrap();
+    assert_eq!(report["rule"]["day"], "03-21");
+    assert!(report["areas"].as_array().unwrap().iter().all(|a| a["passes"].is_boolean()));
+
+    for (args, says) in [
+        (vec!["--grid", "0", "--location", "0,0,0"], "--grid"),
+        (vec!["--grid", "0.00001", "--location", "0,0,0"], "points"),
+        (vec!["--location", "0,0,0", "--period", "02-30"], "--period"),
+        (vec!["--location", "0,0,0", "--period", "03-01", "--from", "14:00", "--to", "10:00"], "--from"),
+        (vec!["--location", "0,0,0", "--period", "03-01", "--step", "7"], "--step"),
+        (vec!["--location", "0,0,0", "--study", "sunny"], "--study"),
+        (vec!["--location", "0,0,0", "--study", "en17037", "--period", "annual"], "--study"),
+        (vec!["--location", "0,0,0", "--study", "en17037", "--period", "06-21"], "--study"),
+    ] {
+        let mut all = args.clone();
+        all.extend(["-o", "bad.csv"]);
+        let out = run(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!dir.join("bad.csv").exists(), "{args:?} wrote its output");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -145,7 +145,7 @@ impl Mapper {
                 continue;
             }
             let world: Vec<DVec3> = members.iter().map(|&i| points.position(i as usize)).collect();
-            let Some(plane) = engine.plane_points(r as u32, &world) else {
+            let Some(plane) = engine.plane_points(r as u32, &world, scene.receivers[r].normal) else {
                 return Err(Error::argument("points", format!("receiver '{}' has no area to put points on", scene.receivers[r].name)));
             };
             groups.push(Group { plane, members, normal: scene.receivers[r].normal });

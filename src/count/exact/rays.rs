@@ -29,6 +29,10 @@ const POINTS_PER_BIN: f64 = 4.0;
 #[derive(Debug, Clone)]
 pub struct PlanePoints {
     receiver: u32,
+    /// The bins' axes in the receiver's frame: `axis` and its perpendicular. Horizontal on walls,
+    /// so the shadows of horizontal slats and overhangs (horizontal strips) meet few bins.
+    axis: DVec2,
+    /// The points in the bins' axes.
     flat: Vec<DVec2>,
     lo: DVec2,
     /// Bin size (m) along the frame's axes.
@@ -76,21 +80,28 @@ pub struct PointScratch {
     view: Scratch,
     /// The current shadow's edges as inward half-planes `n·p > c`.
     edges: Vec<(DVec2, f64)>,
+    /// The current shadow in the bins' axes.
+    turned: Vec<DVec2>,
 }
 
 impl ExactEngine {
     /// Fresh per-thread memory for [`Self::visibility`].
     pub fn point_scratch(&self) -> PointScratch {
-        PointScratch { view: self.scratch(), edges: Vec::new() }
+        PointScratch { view: self.scratch(), edges: Vec::new(), turned: Vec::new() }
     }
 
     /// Indexes points lying on `receiver` (world positions; each is projected orthogonally into
-    /// the receiver's plane) for [`Self::visibility`]. `None` for an unknown receiver or one
+    /// the receiver's plane; `normal` is the receiver's) for [`Self::visibility`]. `None` for an unknown receiver or one
     /// without area.
-    pub fn plane_points(&self, receiver: u32, points: &[DVec3]) -> Option<PlanePoints> {
-        let (wlo, whi) = self.plane_window(receiver)?;
-        let flat: Vec<DVec2> = points.iter().map(|&p| self.to_plane(receiver, p)).collect::<Option<_>>()?;
-        let (lo, hi) = flat.iter().fold((wlo, whi), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    pub fn plane_points(&self, receiver: u32, points: &[DVec3], normal: DVec3) -> Option<PlanePoints> {
+        self.plane_window(receiver)?;
+        let horizontal = if normal.z.abs() < 0.9 { DVec3::Z.cross(normal) } else { DVec3::X };
+        let axis = (self.to_plane(receiver, horizontal)? - self.to_plane(receiver, DVec3::ZERO)?).normalize_or(DVec2::X);
+        let flat: Vec<DVec2> = points.iter().map(|&p| self.to_plane(receiver, p).map(|q| turn(axis, q))).collect::<Option<_>>()?;
+        let (lo, hi) = flat.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        if !(lo.is_finite() && hi.is_finite()) {
+            return None;
+        }
         let size = (hi - lo).max(DVec2::splat(1e-9));
         // Bins about square, POINTS_PER_BIN points each on average.
         let bins = (flat.len() as f64 / POINTS_PER_BIN).max(1.0);
@@ -98,7 +109,8 @@ impl ExactEngine {
         let columns = ((size.x / side).ceil() as usize).clamp(1, 1 << 14);
         let rows = ((size.y / side).ceil() as usize).clamp(1, 1 << 14);
         let cell = size / DVec2::new(columns as f64, rows as f64);
-        let mut index = PlanePoints { receiver, flat, lo, cell, columns, rows, start: vec![0; columns * rows + 1], order: Vec::new() };
+        let mut index =
+            PlanePoints { receiver, axis, flat, lo, cell, columns, rows, start: vec![0; columns * rows + 1], order: Vec::new() };
         let bin_ids: Vec<usize> = index
             .flat
             .iter()
@@ -132,9 +144,11 @@ impl ExactEngine {
             return;
         }
         out.fill(1.0);
-        let PointScratch { view, edges } = scratch;
+        let PointScratch { view, edges, turned } = scratch;
         for (range, transmittance) in &view.kept {
-            let polygon = &view.kept_points[range.clone()];
+            turned.clear();
+            turned.extend(view.kept_points[range.clone()].iter().map(|&q| turn(points.axis, q)));
+            let polygon = &turned[..];
             if !inward_edges(polygon, edges) {
                 continue;
             }
@@ -159,6 +173,11 @@ impl ExactEngine {
             }
         }
     }
+}
+
+/// `q` in axes turned so that `axis` is the first.
+fn turn(axis: DVec2, q: DVec2) -> DVec2 {
+    DVec2::new(q.dot(axis), axis.perp_dot(q))
 }
 
 /// The convex polygon's edges as inward half-planes (either orientation); `false` for a polygon
