@@ -92,7 +92,7 @@ pub struct MapRequest {
 /// Given points (6 numbers each) as the `x,y,z,nx,ny,nz` text the library reads, so a JS array
 /// and a CSV file are checked alike (on a receiver, a normal of non-zero length).
 pub fn points_csv(numbers: &[f64]) -> Result<String> {
-    if numbers.is_empty() || numbers.len() % 6 != 0 {
+    if numbers.is_empty() || !numbers.len().is_multiple_of(6) {
         return Err(Error::argument("points", format!("{} numbers: give 6 per point (x, y, z, nx, ny, nz)", numbers.len())));
     }
     let mut text = String::from("x,y,z,nx,ny,nz\n");
@@ -199,7 +199,7 @@ fn span(period: &str, step: Option<f64>, from: Option<&str>, to: Option<&str>) -
             return Err(Error::argument(*name, "a window within the day needs a one-day period (MM-DD)"));
         }
         let step = step.unwrap_or(DEFAULT_STEP);
-        if 60 % step != 0 {
+        if !60u32.is_multiple_of(step) {
             return Err(Error::argument(
                 "step",
                 format!("{step} min: over days the step must divide the hour as an EnergyPlus timestep does"),
