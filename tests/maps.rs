@@ -176,6 +176,7 @@ fn open_roof_sun_hours_are_the_day_length() {
 /// A tall wall south of a yard on 21 March (London): the BRE rule's per point hours agree with
 /// each point's own lit minutes, and points right behind the wall get none.
 #[test]
+#[allow(clippy::needless_range_loop)] // Points index several parallel arrays.
 fn bre_ground_study_on_a_yard_behind_a_wall() {
     let yard = quad([[0., 0., 0.], [10., 0., 0.], [10., 10., 0.], [0., 10., 0.]]);
     let wall = box_mesh(DVec3::new(-30.0, -0.3, 0.0), DVec3::new(40.0, 0.0, 8.0));

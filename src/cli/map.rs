@@ -103,7 +103,7 @@ impl MapArgs {
                 return Err(Error::argument("from", "--from and --to need a one-day --period MM-DD"));
             }
             let step = self.step.unwrap_or(60);
-            if step == 0 || 60 % step != 0 {
+            if step == 0 || !60u32.is_multiple_of(step) {
                 return Err(Error::argument(
                     "step",
                     format!("{step} min: over days the step must divide the hour as an EnergyPlus timestep does"),

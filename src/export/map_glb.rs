@@ -146,11 +146,11 @@ pub fn map_glb(scene: &Scene, points: &Points, values: &[f64], value: &str, unit
 /// The GLB container: header, JSON chunk padded with spaces, BIN chunk padded with zeros.
 fn glb_bytes(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut text = json.as_bytes().to_vec();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut data = bin.to_vec();
-    while data.len() % 4 != 0 {
+    while !data.len().is_multiple_of(4) {
         data.push(0);
     }
     let total = 12 + 8 + text.len() + if data.is_empty() { 0 } else { 8 + data.len() };

@@ -252,7 +252,8 @@ impl Mapper {
     }
 
     /// Every sun-up instant's visibility per receiver, handed to `record` with a thread's own
-    /// state (made by `state`); the states come back, one per thread.
+    /// state (made by `state`); the states come back, one per thread (natively every core, on
+    /// the web the calling thread alone).
     fn sweep<S: Send>(
         &self,
         samples: &[Sample],
@@ -264,7 +265,7 @@ impl Mapper {
         let next = AtomicUsize::new(0);
         let done = AtomicUsize::new(0);
         let total = samples.len();
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(total.max(1));
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, total.max(1));
         let work = || {
             let mut s = state();
             let mut scratch = self.engine.point_scratch();
@@ -287,8 +288,8 @@ impl Mapper {
                 done.fetch_add(1, Ordering::Relaxed);
             }
         };
+        // No threads to spawn on the web: one pass on the calling thread.
         if cfg!(target_arch = "wasm32") {
-            // No threads to spawn on the web (wasm32-unknown-unknown): one pass on this one.
             let s = work();
             progress(total, total);
             return vec![s];

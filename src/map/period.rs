@@ -92,7 +92,7 @@ impl Period {
         if !(1..=60).contains(&step) {
             return Err(Error::argument("step", format!("{step} min: a day's step must be 1 to 60 minutes")));
         }
-        if (to - from) % step != 0 {
+        if !(to - from).is_multiple_of(step) {
             return Err(Error::argument("step", format!("{step} min does not divide {}–{} ({} min)", clock(from), clock(to), to - from)));
         }
         Ok(Self::Day { day, from, to, step })
