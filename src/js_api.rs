@@ -1,7 +1,8 @@
 //! Holds `www/sunlit.d.ts`, the hand-written types of the JS API, to the Rust types behind it
-//! (tests only): the annual settings' keys are [`AnnualSettings`]'s serialised names, and the
-//! error codes are [`Error::code`]'s and [`GpuError::code`]'s. A field or code added on one side
-//! only fails here.
+//! (tests only): the annual settings' keys are [`AnnualSettings`]'s serialised names, the map
+//! options' keys and values are `web::map_options`' (read here natively, with `sunlit map`'s
+//! defaults checked), and the error codes are [`Error::code`]'s and [`GpuError::code`]'s. A field
+//! or code added on one side only fails here.
 
 use std::collections::BTreeSet;
 
@@ -132,4 +133,76 @@ fn the_engine_names_are_the_same_on_both_sides() {
     assert_eq!(literals_after("  readonly engine: "), rust, "SunlitEngine.engine");
     let error = EngineKind::parse("fast").unwrap_err();
     assert_eq!((error.code(), error.parameter()), ("bad-option", Some("engine")));
+}
+
+/// The web's map options reader, compiled natively so that it is tested without a browser.
+#[path = "web/map_options.rs"]
+mod map_options;
+
+use map_options::{MAP_KEYS, MapRequest, MapValue, SITE_KEYS, Where};
+use serde_json::json;
+
+use crate::map::Period;
+
+#[test]
+fn the_map_options_are_the_same_on_both_sides() {
+    let rust: BTreeSet<String> = MAP_KEYS.iter().chain(&SITE_KEYS).map(|k| k.to_string()).collect();
+    assert_eq!(fields(interface("MapOptions")), rust);
+    let annual: BTreeSet<String> = match serde_json::to_value(AnnualSettings::default()).unwrap() {
+        serde_json::Value::Object(map) => map.keys().cloned().collect(),
+        other => panic!("{other}"),
+    };
+    assert!(SITE_KEYS.iter().all(|k| annual.contains(*k)), "the site keys are annual settings' keys");
+    let all = [MapValue::SunHours, MapValue::Direct, MapValue::Lit];
+    assert_eq!(all.map(MapValue::name), MapValue::NAMES);
+    assert_eq!(all.map(|v| v.title().1), ["h", "kWh/m²", ""], "the units the legend shows");
+    let values: BTreeSet<String> = MapValue::NAMES.iter().map(|v| v.to_string()).collect();
+    assert_eq!(literals_after("  value?: "), values, "MapOptions.value");
+    assert_eq!(union(interface("SunlitMap"), "value"), values, "SunlitMap.value");
+}
+
+fn request(extra: serde_json::Value) -> crate::error::Result<MapRequest> {
+    let mut options = json!({"latitude": 39.74, "longitude": -105.18, "timeZone": -7});
+    options.as_object_mut().unwrap().extend(extra.as_object().unwrap().clone());
+    MapRequest::from_value(options)
+}
+
+#[test]
+fn map_options_read_as_sunlit_map_reads_its_flags() {
+    let plain = request(json!({})).unwrap();
+    assert_eq!(plain.site.location.latitude, 39.74);
+    assert!(plain.dni.is_none(), "no EPW, no direct normal irradiance");
+    assert_eq!((plain.place, plain.period, plain.value), (Where::Grid(0.5), Period::annual(1).unwrap(), MapValue::SunHours));
+    let day = request(json!({"grid": 1, "period": "03-21"})).unwrap();
+    assert_eq!((day.place, day.period), (Where::Grid(1.0), Period::day(80, 0, 1440, 10).unwrap()));
+    let window = request(json!({"period": "03-21", "step": 15, "from": "06:00", "to": "18:00"})).unwrap();
+    assert_eq!(window.period, Period::day(80, 360, 1080, 15).unwrap());
+    let range = request(json!({"period": "06-01..06-07", "step": 30})).unwrap();
+    assert_eq!(range.period, Period::days(152, 158, 2).unwrap());
+    let at = request(json!({"at": "03-21 09:30"})).unwrap();
+    assert_eq!((at.period, at.value), (Period::at(80, 570).unwrap(), MapValue::Lit));
+    let given = request(json!({"points": [1, 2, 3, 0, 0, 1]})).unwrap();
+    assert_eq!(given.place, Where::Given(vec![1.0, 2.0, 3.0, 0.0, 0.0, 1.0]));
+    assert_eq!(map_options::points_csv(&[1.0, 2.5, 3.0, 0.0, 0.0, 1.0]).unwrap(), "x,y,z,nx,ny,nz\n1.0,2.5,3.0,0.0,0.0,1.0\n");
+}
+
+#[test]
+fn bad_map_options_are_refused_naming_the_option() {
+    let named = |extra: serde_json::Value| request(extra).err().map(|e| (e.code(), e.parameter().map(String::from)));
+    let bad = |option: &str| Some(("bad-option", Some(option.to_string())));
+    assert_eq!(named(json!({"period": "02-30"})), bad("period"));
+    assert_eq!(named(json!({"period": "03-21", "from": "15:00", "to": "09:00"})), bad("from"));
+    assert_eq!(named(json!({"period": "03-21", "step": 7})), bad("step"));
+    assert_eq!(named(json!({"period": "annual", "step": 7})), bad("step"));
+    assert_eq!(named(json!({"period": "annual", "from": "08:00"})), bad("from"));
+    assert_eq!(named(json!({"at": "03-21 25:00"})), bad("at"));
+    assert_eq!(named(json!({"at": "03-21"})), bad("at"));
+    assert_eq!(named(json!({"at": "03-21 09:30", "period": "03-21"})), bad("period"));
+    assert_eq!(named(json!({"value": "lit"})), bad("value"));
+    assert_eq!(named(json!({"value": "direct"})), bad("value"));
+    assert_eq!(named(json!({"value": "shade"})), bad("value"));
+    assert_eq!(named(json!({"grid": 1, "points": [0, 0, 0, 0, 0, 1]})), bad("points"));
+    assert_eq!(named(json!({"grid": "fine"})), bad("grid"));
+    assert_eq!(named(json!({"timestepsPerHour": 4})), bad("options"));
+    assert_eq!(MapRequest::from_value(json!({"grid": 1})).err().map(|e| e.code()), Some("bad-option"), "no location");
 }

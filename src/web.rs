@@ -14,6 +14,8 @@ use std::rc::Rc;
 
 mod choice;
 mod embed;
+mod map;
+mod map_options;
 
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
 use wasm_bindgen::prelude::*;
@@ -174,7 +176,7 @@ impl Engine {
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
         let gpu = self.counter.upload(&scene).map_err(js_error)?;
-        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default() }) })
+        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default() }) })
     }
 
     /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
@@ -257,6 +259,8 @@ struct ModelInner {
     notes: Vec<String>,
     /// The exact engine over `scene`, made when a view is first routed to it.
     exact: std::cell::OnceCell<ExactEngine>,
+    /// The last points `engine.map` was asked for, indexed for shadow rays ([`map`]).
+    maps: std::cell::RefCell<Option<map::MapCache>>,
 }
 
 impl ModelInner {

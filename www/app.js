@@ -2,6 +2,7 @@
 // and shows the results (3D view, table, heat map, downloads). All work stays on this machine.
 import { colourOf, UNCOMPUTED } from './colour.js';
 import { drawHeatmap } from './heatmap.js';
+import { mapMode } from './mapmode.js';
 import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
@@ -12,6 +13,23 @@ function status(text, { error = false } = {}) {
   $('status').textContent = text;
   $('status').classList.toggle('error', error);
 }
+
+const maps = mapMode({
+  $,
+  worker,
+  status: (text) => status(text),
+  location: async () => {
+    const { latitude, longitude, timeZone, epw, epwName } = await settings();
+    return epw ? { epw, epwName } : { latitude, longitude, timeZone };
+  },
+  engineOptions: () => engineOptions(),
+  viewer: () => state.viewer,
+  showLegend: (scale) => showLegend(scale ?? colourScale()),
+  setBusy: (busy) => setBusy(busy),
+  busy: () => state.busy,
+  download: (...args) => download(...args),
+  modelName: () => state.modelName,
+});
 
 function setBusy(busy) {
   state.busy = busy;
@@ -60,6 +78,7 @@ function showModel(msg) {
   $('downloadidf').disabled = true;
   $('heatfigure').hidden = true;
   fillTable(null);
+  maps.reset();
   showInViewer();
   const n = msg.names.length;
   // An EnergyPlus model's own Site:Location is its location (an EPW, if chosen, still wins).
@@ -167,11 +186,12 @@ function showResult(msg) {
 }
 
 function showError(msg) {
+  maps.failed();
   setBusy(false);
   $('progress').value = 0;
   if (msg.cancelled) return status('Cancelled.');
   $('retry').hidden = !msg.gpu;
-  const what = msg.request === 'load' ? 'Could not read the model' : 'Could not compute';
+  const what = { load: 'Could not read the model', map: 'Could not map' }[msg.request] ?? 'Could not compute';
   const hint = msg.gpu ? ' The GPU device was lost or failed; press Retry to start a new one.' : '';
   status(`${what}: ${msg.message}.${hint}`, { error: true });
 }
@@ -192,6 +212,8 @@ worker.onmessage = ({ data: msg }) => {
     status(msg.text);
   } else if (msg.type === 'result') {
     showResult(msg);
+  } else if (msg.type === 'mapResult') {
+    maps.shown(msg);
   } else if (msg.type === 'epwLocation') {
     showEpwLocation(msg);
   } else if (msg.type === 'error') {
@@ -293,6 +315,10 @@ function wire() {
     $('retry').hidden = true;
     setBusy(true);
     $('progress').value = 0;
+    if (maps.active()) {
+      status('Mapping the points…');
+      return maps.compute();
+    }
     status('Sampling the sun…');
     worker.postMessage({ type: 'compute', settings: await settings(), engine: engineOptions(), csvName: state.csvName });
   });
@@ -303,6 +329,7 @@ function wire() {
     showInViewer();
   });
   $('retry').addEventListener('click', () => $('settings').requestSubmit());
+  maps.wire();
   $('download').addEventListener('click', () => state.result && download(state.csvName, state.result.csv, 'text/csv'));
   $('downloadidf').addEventListener('click', () => {
     if (!state.result?.hooked) return;
@@ -324,6 +351,7 @@ async function start() {
   try {
     state.viewer = await Viewer.create($('view'));
     showInViewer();
+    maps.reset();
   } catch (error) {
     status(`The 3D view is unavailable (${error.message}); results still work.`, { error: true });
   }

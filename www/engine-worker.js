@@ -6,7 +6,8 @@
 //   { id, op: 'loadFiles', files, options }        → { id, result: { names, areas } }
 //   { id, op: 'fractions', sun }                   → { id, result: Float64Array }
 //   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
-//   { id, op: 'cancel' }                           → aborts a running annual
+//   { id, op: 'map', options, csv, glb }           → { id, result: SunlitMap }  (engine.map's typed arrays, transferred)
+//   { id, op: 'cancel' }                           → aborts a running annual or map
 // Errors come back as { id, error: message }; progress of an annual as { id, progress: [done, total] }.
 import { createEngine } from './sunlit.js';
 
@@ -40,6 +41,24 @@ const ops = {
   },
 };
 
+/** engine.map's answer, its arrays moved (not copied) to the caller. */
+async function map({ id, options, csv, glb }) {
+  running = new AbortController();
+  const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
+  const result = await need(engine, 'create').map(need(model, 'fromMeshes or loadFiles'), options, { onProgress, signal: running.signal, csv, glb });
+  const arrays = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct, result.glb];
+  return transfer(result, arrays.filter(Boolean).map((a) => a.buffer));
+}
+
+const transfers = new WeakMap();
+
+function transfer(result, buffers) {
+  transfers.set(result, buffers);
+  return result;
+}
+
+ops.map = map;
+
 function need(value, step) {
   if (!value) throw new Error(`sunlit worker: call '${step}' first`);
   return value;
@@ -49,8 +68,9 @@ onmessage = async ({ data }) => {
   if (data?.op === 'cancel') return running?.abort();
   const op = ops[data?.op];
   try {
-    if (!op) throw new Error(`sunlit worker: unknown op '${data?.op}' (create, fromMeshes, loadFiles, fractions, annual, cancel)`);
-    postMessage({ id: data.id, result: await op(data) });
+    if (!op) throw new Error(`sunlit worker: unknown op '${data?.op}' (create, fromMeshes, loadFiles, fractions, annual, map, cancel)`);
+    const result = await op(data);
+    postMessage({ id: data.id, result }, transfers.get(result) ?? []);
   } catch (error) {
     postMessage({ id: data?.id, error: String(error?.message ?? error) });
   }

@@ -171,6 +171,90 @@ export interface SunlitEngine {
   fractions(model: Model, sun: [number, number, number] | { azimuth: number; altitude: number }): Promise<Float64Array>;
   /** The year's sunlit fractions at every EnergyPlus timestep. */
   annual(model: Model, settings: AnnualSettings, options?: AnnualRunOptions): Promise<Annual>;
+  /** Per-point values on the receivers (a grid, or given points): sun hours or direct irradiation
+   * over a period, or lit (1) or not (0) at an instant, each point by its own shadow ray. */
+  map(model: Model, options: MapOptions, run?: MapRunOptions): Promise<SunlitMap>;
+}
+
+/** engine.map's options: where (a grid or given points), when (a period or an instant) and what
+ * (the value), as `sunlit map` takes them; the location as AnnualSettings gives it. */
+export interface MapOptions {
+  /** Degrees north; with longitude and timeZone, unless `epw` is given. */
+  latitude?: number;
+  /** Degrees east. */
+  longitude?: number;
+  /** Hours from UTC of the standard time the period is in. */
+  timeZone?: number;
+  /** An EPW weather file's text: its location, and the direct normal irradiance for `direct`. */
+  epw?: string;
+  /** The EPW's file name, for messages. */
+  epwName?: string;
+  /** A grid on every receiver at this spacing in metres (default 0.5), inside its polygon. */
+  grid?: number;
+  /** Or given points: 6 numbers per point, x y z nx ny nz (sunlit's axes: x east, y north, z up). */
+  points?: ArrayLike<number>;
+  /** 'annual' (default), one day 'MM-DD', or a date range 'MM-DD..MM-DD'. */
+  period?: string;
+  /** Minutes between the instants counted within a day (1..60; default: the year's timestep). */
+  step?: number;
+  /** Local standard time 'HH:MM' each day's window starts (default 00:00). */
+  from?: string;
+  /** Local standard time 'HH:MM' each day's window ends (default 24:00). */
+  to?: string;
+  /** One instant, 'MM-DD HH:MM' local standard time: then the value is 'lit'. */
+  at?: string;
+  /** 'sunHours' (default), 'direct' (kWh/m², needs an EPW) or 'lit' (needs `at`). */
+  value?: 'sunHours' | 'direct' | 'lit';
+  /** Foliage keeps its leaves all year (as AnnualSettings). */
+  evergreen?: boolean;
+  /** Leaf-out period "MM-DD,MM-DD" (as AnnualSettings). */
+  leafOut?: string;
+  /** Leaf-fall period "MM-DD,MM-DD" (as AnnualSettings). */
+  leafFall?: string;
+}
+
+export interface MapRunOptions extends AnnualRunOptions {
+  /** Also return the points CSV (`csv`), as `sunlit map -o POINTS.csv` writes it. */
+  csv?: boolean;
+  /** Also return the map glb (`glb`), as `sunlit map --glb-out MAP.glb` writes it. */
+  glb?: boolean;
+}
+
+/** engine.map's answer: plain typed arrays (transferable to and from a worker), one entry per
+ * point, in sunlit's world axes (x east, y north, z up, metres). */
+export interface SunlitMap {
+  /** The value held: 'sunHours' (h), 'direct' (kWh/m²) or 'lit' (1 sunlit, 0 shaded). */
+  value: 'sunHours' | 'direct' | 'lit';
+  /** The legend's title and unit. */
+  title: string;
+  unit: string;
+  /** The grid's spacing in metres (the cells' size for painting); given points: 0. */
+  spacing: number;
+  /** Instants counted per point over the period (1 for `at`). */
+  instants: number;
+  /** x y z per point. */
+  points: Float32Array;
+  /** The surface's outward unit normal per point. */
+  normals: Float32Array;
+  /** The receiver each point lies on: an index into receiverNames. */
+  receivers: Uint32Array;
+  /** The value per point. */
+  values: Float32Array;
+  /** A period's sun hours per point (undefined for an instant). */
+  sunHours: Float32Array | undefined;
+  /** A period's direct irradiation per point, kWh/m² (undefined without an EPW, or for an instant). */
+  direct: Float32Array | undefined;
+  /** The points CSV (with `csv: true`): receiver,x,y,z,nx,ny,nz then lit, or sun_hours and, with
+   * an EPW, direct_kwh_m2. */
+  csv: string | undefined;
+  /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
+   * legend in the scene's extras. */
+  glb: Uint8Array | undefined;
+  /** The legend's range: 0 and the largest value (lit: 0 and 1). */
+  min: number;
+  max: number;
+  /** The model's receiver names. */
+  receiverNames: string[];
 }
 
 /** A scene on the engine's GPU device; use it only with the engine that made it. */

@@ -138,4 +138,41 @@ class SunlitEngine {
       throw error;
     }
   }
+
+  /** Per-point values on the receivers (sunlit.d.ts, MapOptions): a plain object of typed arrays
+   * (points, normals, receivers, values; transferable to and from a worker) and its legend; with
+   * `csv` / `glb` true, also the points CSV (text) and the map glb (bytes) as `sunlit map` writes
+   * them. Rejects with an AbortError when `signal` aborts. */
+  async map(model, options, { onProgress, signal, csv = false, glb = false } = {}) {
+    if (signal?.aborted) throw abortError();
+    let map;
+    try {
+      map = await this.#engine.map(model, options, onProgress, signal);
+    } catch (error) {
+      if (signal?.aborted && error?.code === 'cancelled') throw abortError();
+      throw error;
+    }
+    try {
+      return {
+        value: map.value,
+        title: map.title,
+        unit: map.unit,
+        spacing: map.spacing,
+        instants: map.instants,
+        points: map.points,
+        normals: map.normals,
+        receivers: map.receivers,
+        values: map.values,
+        sunHours: map.sunHours,
+        direct: map.direct,
+        min: map.min,
+        max: map.max,
+        receiverNames: model.receiverNames,
+        csv: csv ? map.csv() : undefined,
+        glb: glb ? map.glb() : undefined,
+      };
+    } finally {
+      map.free();
+    }
+  }
 }

@@ -1,7 +1,9 @@
 // sunlit/three: a sunlit Model from a three.js scene graph, and the way back (receiving meshes
-// coloured by fraction or irradiation, with a legend). three is a peer dependency: nothing here
-// imports it; the scene's own objects (Matrix4, Color) are used, so the app's three is the one.
+// coloured by fraction or irradiation, with a legend; per-point maps painted on the receivers).
+// three is a peer dependency: nothing here imports it; the scene's own objects (Matrix4, Color)
+// are used, or the three module the app passes in, so the app's three is the one.
 import { colourOf } from './colour.js';
+import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 /** Comma-separated globs (`*`, `?`, case-insensitive) as one predicate over names. */
 function globPredicate(text) {
@@ -188,5 +190,69 @@ export function legend(min, max, label = '') {
     ends.append(span);
   }
   box.append(bar, ends);
+  return box;
+}
+
+/** sRGB (the palette's, the legend's CSS) to linear: three.js reads vertex colours as linear, and
+ * an unlit material's output is encoded back to sRGB, so a cell shows the legend's colour. */
+function linear(c) {
+  return c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4;
+}
+
+/**
+ * A three.js Mesh that paints `map` (what engine.map returns) on the receivers: per point a
+ * square cell of side `size` (default the map's grid spacing) in its surface's plane, lifted
+ * `lift` metres along its normal, coloured per vertex by its value (unlit, so the colour is the
+ * legend's). A lit-at-an-instant map draws sunlit's own shadow pattern: lit cells in the
+ * palette's top colour, shaded ones in its bottom. `THREE` is the app's three module. `yUp`
+ * (default true: fromThree's axes) turns sunlit's z-up points into three's y-up scene.
+ * Returns { mesh, min, max, legend, update(values) }: `update` recolours the same cells (e.g. the
+ * same grid at another instant) without new geometry.
+ */
+export function paintMap(THREE, map, { size, lift = 0.01, yUp = true, min, max, label } = {}) {
+  if (typeof THREE?.BufferGeometry !== 'function') throw new TypeError('paintMap: pass the app\'s three module (import * as THREE from \'three\')');
+  if (!map?.points || !map.normals || !map.values) throw new TypeError('paintMap: map must come from engine.map (points, normals, values)');
+  if (map.values.length * 3 !== map.points.length) {
+    throw new RangeError(`paintMap: ${map.points.length / 3} points but ${map.values.length} values`);
+  }
+  const kind = MAP_VALUES[map.value] ? map.value : 'sunHours';
+  const cells = mapCells(map.points, map.normals, { size: size ?? map.spacing ?? 0.5, lift, yUp });
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(cells.positions, 3));
+  geometry.setAttribute('normal', new THREE.BufferAttribute(cells.normals, 3));
+  const colour = new THREE.BufferAttribute(new Float32Array(cells.positions.length), 3);
+  geometry.setAttribute('color', colour);
+  const material = new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide });
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.name = 'sunlit map';
+  const painted = { mesh, min: 0, max: 1, legend: null };
+  painted.update = (values) => {
+    if (values.length !== map.values.length) throw new RangeError(`paintMap: update needs ${map.values.length} values, got ${values.length}`);
+    const auto = mapRange(values, kind);
+    const range = { min: min ?? auto.min, max: max ?? auto.max, value: kind };
+    if (!(range.max > range.min)) throw new RangeError(`paintMap: min ${range.min} must be below max ${range.max}`);
+    const rgb = mapColours(values, range);
+    for (let i = 0; i < rgb.length; i++) colour.array[i] = linear(rgb[i]);
+    colour.needsUpdate = true;
+    const title = label ?? [MAP_VALUES[kind].title, MAP_VALUES[kind].unit].filter(Boolean).join(', ');
+    Object.assign(painted, { min: range.min, max: range.max, values });
+    painted.legend = typeof document === 'undefined' ? null : kind === 'lit' ? litLegend() : legend(range.min, range.max, title);
+    return painted;
+  };
+  return painted.update(map.values);
+}
+
+/** The lit-at-an-instant legend: the two colours, named. */
+function litLegend() {
+  const box = document.createElement('div');
+  box.className = 'sunlit-legend';
+  box.style.cssText = 'display:flex;gap:0.8rem;font:12px sans-serif;align-items:center';
+  for (const [value, text] of [[1, 'sun'], [0, 'shadow']]) {
+    const swatch = document.createElement('span');
+    swatch.style.cssText = `display:inline-block;width:14px;height:14px;background:rgb(${colourOf(value).map((c) => Math.round(c * 255)).join(',')})`;
+    const span = document.createElement('span');
+    span.append(swatch, ` ${text}`);
+    box.append(span);
+  }
   return box;
 }

@@ -1,5 +1,6 @@
 // The 3D view: the model's triangles on a WebGPU canvas, coloured per receiver, with an orbit
-// camera (drag to turn, wheel to zoom). Its shader is shaders/viewer.wgsl (copied to pkg/).
+// camera (drag to turn, wheel to zoom); over them, optionally, a per-point map's cells coloured
+// per vertex (setOverlay). Its shader is shaders/viewer.wgsl (copied to pkg/).
 import { GREY } from './colour.js';
 
 const FLOATS_PER_VERTEX = 9; // position, normal, colour
@@ -76,10 +77,38 @@ export class Viewer {
         data.set([p[3 * v], p[3 * v + 1], p[3 * v + 2], n[0], n[1], n[2], c[0], c[1], c[2]], (3 * t + v) * FLOATS_PER_VERTEX);
       }
     }
+    this.base = data;
+    this.upload();
+  }
+
+  /** Cells drawn over the model (a map: mapCells' positions and normals, mapColours' colours,
+   * 3 floats per vertex each), or none with `null`. */
+  setOverlay(cells, colours) {
+    if (!cells) {
+      this.overlay = null;
+    } else {
+      const n = cells.positions.length / 3;
+      const data = new Float32Array(n * FLOATS_PER_VERTEX);
+      for (let v = 0; v < n; v++) {
+        data.set(cells.positions.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX);
+        data.set(cells.normals.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX + 3);
+        data.set(colours.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX + 6);
+      }
+      this.overlay = data;
+    }
+    this.upload();
+  }
+
+  upload() {
+    const base = this.base ?? new Float32Array(0);
+    const over = this.overlay ?? new Float32Array(0);
+    const data = new Float32Array(base.length + over.length);
+    data.set(base);
+    data.set(over, base.length);
     this.vertices?.destroy();
     this.vertices = this.device.createBuffer({ size: Math.max(data.byteLength, 36), usage: GPUBufferUsage.VERTEX | GPUBufferUsage.COPY_DST });
     this.device.queue.writeBuffer(this.vertices, 0, data);
-    this.count = triangles * 3;
+    this.count = data.length / FLOATS_PER_VERTEX;
     this.draw();
   }
 

@@ -1,6 +1,6 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: load, compute, cancel, epw. Messages out: loaded, progress,
-// notice, result, epwLocation, error (with the error's `code`, and `gpu: true` when the device
+// page stays responsive. Messages in: load, compute, map, cancel, epw. Messages out: loaded,
+// progress, notice, result, mapResult, epwLocation, error (with the error's `code`, and `gpu: true` when the device
 // failed twice and a retry may help). Errors are told apart by their `code` (sunlit.d.ts,
 // SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
@@ -131,6 +131,21 @@ async function computeOnce({ settings, engine: made, csvName }) {
   }
 }
 
+/** A per-point map (engine.map) of the loaded model; its typed arrays are transferred. `tag`
+ * comes back unchanged (the page tells an instant's answer from a period's). */
+async function map({ options, engine: made, tag }) {
+  if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
+  const e = await engineFor(made);
+  const m = modelOn(e);
+  running = new AbortController();
+  const started = performance.now();
+  const onProgress = (done, total) => postMessage({ type: 'progress', done, total });
+  // The files come along (the page offers them for download): cheap beside the rays.
+  const result = await e.map(m, options, { onProgress, signal: running.signal, csv: true, glb: true });
+  const buffers = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct, result.glb].filter(Boolean).map((a) => a.buffer);
+  postMessage({ type: 'mapResult', tag, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
+}
+
 /** The EnergyPlus model with the CSV hooked in, or why it cannot be hooked (e.g. its Version is
  * too old): the year is counted either way, only the model's download needs the hook. */
 function hooked(annual, hasEnergyPlus, csvName) {
@@ -177,11 +192,12 @@ onmessage = async ({ data }) => {
   try {
     if (data.type === 'load') await load(data);
     else if (data.type === 'compute') await compute(data);
+    else if (data.type === 'map') await map(data);
     else if (data.type === 'epw') await epw(data);
   } catch (error) {
     fail(error, data.type);
   } finally {
-    if (data.type === 'compute') running = null;
+    if (data.type === 'compute' || data.type === 'map') running = null;
   }
 };
 postMessage({ type: 'ready', webgpu: !!self.navigator?.gpu });

@@ -1,12 +1,14 @@
 // A three.js glTF viewer with sunlit: GLTFLoader reads the model, sunlit/three hands the scene
 // to sunlit (fromThree), the year is computed on WebGPU, and the time-of-year sliders recolour
 // the receiving surfaces by their sunlit fraction at that instant (Annual.splineFractionsAt: the
-// year's fitted spline surfaces, evaluated in wasm at every slider move).
+// year's fitted spline surfaces, evaluated in wasm at every slider move), and paint the shadow
+// pattern at that instant on a grid over the receivers: each point lit or not by sunlit's own
+// shadow ray (engine.map with `at`, painted by sunlit/three's paintMap), no three.js shadow maps.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { createEngine } from 'sunlit';
-import { fromThree, colourByValues, receivingMeshes } from 'sunlit/three';
+import { fromThree, colourByValues, receivingMeshes, paintMap } from 'sunlit/three';
 import officeUrl from '../office.glb?url';
 
 const $ = (id) => document.getElementById(id);
@@ -25,6 +27,8 @@ const controls = new OrbitControls(camera, renderer.domElement);
 controls.addEventListener('change', render);
 
 const state = { engine: null, content: null, model: null, year: null, busy: false };
+// The shadow pattern: the painted cells, the instant they show, and a newer instant to map next.
+const shadows = { painted: null, at: null, running: false, again: false };
 
 function status(text, error = false) {
   $('status').textContent = text;
@@ -74,27 +78,89 @@ async function load(buffer, name) {
     state.engine ??= await createEngine({ resolution: Number($('resolution').value) || 256 });
     const model = fromThree(state.engine, gltf.scene, { receivers: receivers() });
     if (state.content) scene.remove(state.content);
+    clearShadows();
     state.year?.free();
     state.model?.free();
     Object.assign(state, { content: gltf.scene, model, year: null });
     scene.add(gltf.scene);
     frame(gltf.scene);
-    $('time').disabled = true;
+    $('time').disabled = false;
     $('compute').disabled = false;
     $('values').tBodies[0].replaceChildren();
     $('legend').replaceChildren();
     status(`Loaded ${name}: ${model.receiverNames.length} receiving surfaces, ${model.triangles} triangles. Compute the year.`);
     render();
+    drawShadows();
   } catch (error) {
     status(`Could not load ${name}: ${error.message}`, true);
   }
 }
 
-async function settings() {
-  const s = { daysPerYear: Number($('days').value), samplesPerDay: Number($('perday').value), timestepsPerHour: 1 };
+/** The form's location: an EPW, else latitude, longitude and time zone. */
+async function location() {
   const epw = $('epw').files[0];
-  if (epw) return { ...s, epw: await epw.text(), epwName: epw.name };
-  return { ...s, latitude: Number($('latitude').value), longitude: Number($('longitude').value), timeZone: Number($('timezone').value) };
+  if (epw) return { epw: await epw.text(), epwName: epw.name };
+  return { latitude: Number($('latitude').value), longitude: Number($('longitude').value), timeZone: Number($('timezone').value) };
+}
+
+async function settings() {
+  return { daysPerYear: Number($('days').value), samplesPerDay: Number($('perday').value), timestepsPerHour: 1, ...(await location()) };
+}
+
+/** The slider's instant as engine.map's `at`: 'MM-DD HH:MM', local standard time. */
+function instantOf(day, hour) {
+  let d = day;
+  let m = 0;
+  while (m < 11 && d > MONTH_DAYS[m]) d -= MONTH_DAYS[m++];
+  const minutes = Math.min(Math.round(hour * 60), 24 * 60 - 1);
+  const two = (n) => String(n).padStart(2, '0');
+  return `${two(m + 1)}-${two(d)} ${two(Math.floor(minutes / 60))}:${two(minutes % 60)}`;
+}
+
+function clearShadows() {
+  if (shadows.painted) {
+    scene.remove(shadows.painted.mesh);
+    shadows.painted.mesh.geometry.dispose();
+    shadows.painted.mesh.material.dispose();
+  }
+  Object.assign(shadows, { painted: null, at: null });
+  $('shadowlegend').replaceChildren();
+}
+
+/** sunlit's shadow pattern at the slider's instant, painted on the receivers. One map at a time:
+ * slider moves during one are mapped once it is done, at the latest instant. */
+async function drawShadows() {
+  if (!state.model || !$('shadows').checked) return clearShadows(), render();
+  if (shadows.running) {
+    shadows.again = true;
+    return;
+  }
+  shadows.running = true;
+  try {
+    do {
+      shadows.again = false;
+      const [day, hour] = [Number($('day').value), Number($('hour').value)];
+      const grid = Number($('grid').value);
+      const map = await state.engine.map(state.model, { ...(await location()), grid, at: instantOf(day, hour) });
+      const same = shadows.painted && shadows.painted.values.length === map.values.length && shadows.grid === grid;
+      if (same) shadows.painted.update(map.values);
+      else {
+        clearShadows();
+        shadows.painted = paintMap(THREE, map);
+        shadows.grid = grid;
+        scene.add(shadows.painted.mesh);
+      }
+      shadows.map = map;
+      shadows.at = [day, hour];
+      $('shadowlegend').replaceChildren(shadows.painted.legend);
+      document.body.dataset.shadowAt = `${day},${hour}`;
+      render();
+    } while (shadows.again);
+  } catch (error) {
+    status(`Could not map the shadows: ${error.message}`, true);
+  } finally {
+    shadows.running = false;
+  }
 }
 
 async function compute() {
@@ -163,16 +229,33 @@ $('file').addEventListener('change', async (e) => {
 });
 $('example').addEventListener('click', async () => load(await (await fetch(officeUrl)).arrayBuffer(), 'office.glb'));
 $('compute').addEventListener('click', compute);
-for (const id of ['day', 'hour']) $(id).addEventListener('input', recolour);
+for (const id of ['day', 'hour']) $(id).addEventListener('input', () => (recolour(), drawShadows()));
+for (const id of ['shadows', 'grid']) $(id).addEventListener('change', drawShadows);
 
 // For the console (and the tests): the live objects, and each receiving mesh's colour (sRGB, as
 // the legend).
 window.sunlitViewer = {
+  get engine() {
+    return state.engine;
+  },
   get year() {
     return state.year;
   },
   get model() {
     return state.model;
+  },
+  /** The painted shadow pattern: its instant, engine.map's lit values, and each cell's colour
+   * (sRGB, read back from the painted mesh's vertex colours). */
+  shadows: () => {
+    if (!shadows.painted) return null;
+    const colour = shadows.painted.mesh.geometry.getAttribute('color');
+    const srgb = (c) => new THREE.Color().setRGB(c[0], c[1], c[2], THREE.LinearSRGBColorSpace).getRGB(new THREE.Color(), THREE.SRGBColorSpace);
+    const cells = [];
+    for (let i = 0; i < colour.count; i += 6) {
+      const { r, g, b } = srgb([colour.getX(i), colour.getY(i), colour.getZ(i)]);
+      cells.push([r, g, b]);
+    }
+    return { at: shadows.at, values: Array.from(shadows.map.values), cells, points: shadows.map.values.length };
   },
   colours: () =>
     receivingMeshes(state.model).map(({ mesh, name }) => {

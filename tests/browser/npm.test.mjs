@@ -157,6 +157,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
     'colour.js',
     'device.js',
     'engine-worker.js',
+    'map.js',
     'package.json',
     'pkg/sunlit_wasm.js',
     'pkg/sunlit_wasm_bg.wasm',
@@ -170,7 +171,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
   assert.equal(manifest.dependencies, undefined, 'three is a peer dependency only');
   assert.ok(manifest.peerDependencies.three);
   // three is not in the tarball and not imported by the package's modules.
-  for (const f of ['sunlit.js', 'three.js', 'device.js', 'engine-worker.js']) {
+  for (const f of ['sunlit.js', 'three.js', 'map.js', 'device.js', 'engine-worker.js']) {
     assert.doesNotMatch(readFileSync(join(ROOT, 'target/npm/pkg', f), 'utf8'), /from ['"]three/, f);
   }
   console.log(`tarball ${report.filename}: ${report.size} bytes packed, ${report.unpackedSize} unpacked`);
@@ -250,6 +251,16 @@ test('createEngine({ device }) counts on the caller\'s GPUDevice and leaves it a
     const bytes = new Uint8Array(await exportGlb());
     const loaded = await call({ op: 'loadFiles', files: [{ name: 'scene.glb', bytes }], options: { receivers: 'WALL*,ROOF' } });
     const inWorker = Array.from(await call({ op: 'fractions', sun }));
+    // A map through the worker entry (typed arrays transferred) is the page's, CSV for CSV.
+    const mapOptions = { latitude: 39.74, longitude: -105.18, timeZone: -7, grid: 0.5, at: '06-21 10:00' };
+    const workerMap = await call({ op: 'map', options: mapOptions, csv: true });
+    const pageMap = await own.map(own.loadFiles([{ name: 'scene.glb', bytes }], { receivers: 'WALL*,ROOF' }), mapOptions, { csv: true });
+    const map = {
+      kinds: ['points', 'normals', 'receivers', 'values'].map((k) => workerMap[k].constructor.name),
+      points: workerMap.values.length,
+      lit: workerMap.values.filter((v) => v === 1).length,
+      same: workerMap.csv === pageMap.csv,
+    };
     worker.terminate();
     // Its owner destroys the device: sunlit, counting on it, reports the loss.
     const again = fromThree(shared, buildScene(), { receivers: 'ROOF' });
@@ -258,8 +269,11 @@ test('createEngine({ device }) counts on the caller\'s GPUDevice and leaves it a
     device.destroy();
     await device.lost;
     const afterLoss = await shared.fractions(again, sun).then(() => 'no error', (e) => String(e?.message ?? e));
-    return { base, onDevice, back, lost: lostBefore, workerNames: loaded.names, inWorker, names, afterLoss };
+    return { base, onDevice, back, lost: lostBefore, workerNames: loaded.names, inWorker, names, afterLoss, map };
   }, SUN);
+  assert.deepEqual(r.map.kinds, ['Float32Array', 'Float32Array', 'Uint32Array', 'Float32Array']);
+  assert.ok(r.map.points > 20 && r.map.lit > 0 && r.map.lit < r.map.points, `worker map: ${JSON.stringify(r.map)}`);
+  assert.ok(r.map.same, 'the worker\'s map CSV is the page\'s');
   assert.deepEqual(r.back, [1, 2, 3, 4]);
   assert.equal(r.lost, false, 'the caller\'s device is not destroyed');
   assert.match(r.afterLoss, /device lost/i);

@@ -3,7 +3,10 @@
 // on SwiftShader): load the example office through three's GLTFLoader, compute the year, move the
 // time-of-year sliders; the surfaces' shown values are Annual.splineFractionsAt's at that instant,
 // their colours are the palette's colour of those values, and both change with the slider. The
-// page at 21 December 09:30 is saved to target/artifacts/viewer.png.
+// page at 21 December 09:30 is saved to target/artifacts/viewer.png. The shadow pattern painted
+// on the receivers is sunlit's own (engine.map lit per point at the slider's instant, equal to a
+// call of the API), its cells coloured sun or shadow, and it moves on screen with the slider
+// (target/artifacts/viewer-shadows-*.png).
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import { cpSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
@@ -12,6 +15,7 @@ import { join } from 'node:path';
 import { after, before, test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 import { colourOf } from '../../www/colour.js';
+import { LIT, SHADED } from '../../www/map.js';
 import { launch, staticServer } from './chromium.mjs';
 
 const ROOT = fileURLToPath(new URL('../../', import.meta.url));
@@ -156,5 +160,67 @@ test('the example viewer: glTF in, the year computed, the slider recolours by th
   assert.ok(night.api.every((v) => v === 0), 'night: every surface dark');
   const partly = noon.api.filter((v) => v > 0.02 && v < 0.98).length;
   console.log(`viewer: ${partly} of ${noon.api.length} surfaces partly shaded on 21 June 12:30`);
+  assert.deepEqual(pageErrors, []);
+});
+
+/** The painted shadow pattern at the slider's instant, and engine.map's own answer for it. */
+async function shadowsAt(day, hour) {
+  await slide(day, hour);
+  await page.waitForFunction((at) => document.body.dataset.shadowAt === at, `${day},${hour}`, { timeout: 60_000 });
+  return page.evaluate(async ([d, h]) => {
+    const v = window.sunlitViewer;
+    const painted = v.shadows();
+    const two = (n) => String(n).padStart(2, '0');
+    const date = new Date(Date.UTC(2001, 0, d));
+    const at = `${two(date.getUTCMonth() + 1)}-${two(date.getUTCDate())} ${two(Math.floor(h))}:${two(Math.round((h % 1) * 60))}`;
+    const map = await v.engine.map(v.model, { latitude: 39.74, longitude: -105.18, timeZone: -7, grid: 0.25, at });
+    return { painted, api: Array.from(map.values), at };
+  }, [day, hour]);
+}
+
+/** Screen pixels within a few levels of `rgb` (0..1): the painted cells are unlit, so exact. */
+function pixelsNear(png, rgb) {
+  return page.evaluate(async ([b64, want]) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = new OffscreenCanvas(img.width, img.height);
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const data = g.getImageData(0, 0, img.width, img.height).data;
+    const target = want.map((x) => Math.round(x * 255));
+    let n = 0;
+    for (let i = 0; i < data.length; i += 4) if (Math.abs(data[i] - target[0]) <= 3 && Math.abs(data[i + 1] - target[1]) <= 3 && Math.abs(data[i + 2] - target[2]) <= 3) n++;
+    return n;
+  }, [png.toString('base64'), rgb]);
+}
+
+test('the viewer paints sunlit\'s own shadow pattern at the slider\'s instant, and the slider moves it', { timeout: 300_000 }, async () => {
+  // Shadows need no year: a loaded model is enough (loaded here when this test runs alone).
+  if (!(await page.evaluate(() => !!window.sunlitViewer.model))) {
+    await page.click('#example');
+    assert.match(await waitForStatus(/^Loaded|^Could not/), /^Loaded office\.glb/);
+  }
+  const shots = [];
+  const seen = [];
+  for (const [day, hour] of [[80, 9.5], [80, 15.5]]) {
+    const s = await shadowsAt(day, hour);
+    assert.deepEqual(s.painted.at, [day, hour]);
+    assert.deepEqual(s.painted.values, s.api, `${s.at}: the painted values are engine.map's`);
+    s.painted.cells.forEach((rgb, i) => {
+      const want = s.api[i] >= 0.5 ? LIT : SHADED;
+      rgb.forEach((c, k) => assert.ok(Math.abs(c - want[k]) < 2e-3, `${s.at} cell ${i}: ${rgb} vs ${want}`));
+    });
+    const lit = s.api.filter((v) => v >= 0.5).length;
+    assert.ok(lit > 0 && lit < s.api.length, `${s.at}: part of the receivers in shadow (${lit} of ${s.api.length} lit)`);
+    const png = await page.locator('#view').screenshot({ path: join(ROOT, `target/artifacts/viewer-shadows-${hour}.png`) });
+    shots.push({ at: s.at, lit, sun: await pixelsNear(png, LIT), shade: await pixelsNear(png, SHADED) });
+    seen.push(s.api);
+  }
+  const moved = seen[1].filter((v, i) => v !== seen[0][i]).length;
+  console.log(`viewer shadows: ${JSON.stringify(shots)}; ${moved} of ${seen[0].length} cells changed`);
+  assert.ok(moved >= seen[0].length / 20, `the shadow moves: ${moved} cells changed`);
+  assert.ok(shots.every((s) => s.sun > 100 && s.shade > 100), 'sun and shadow cells are on screen');
+  assert.notEqual(shots[0].sun, shots[1].sun, 'the sunlit pixels on screen change with the slider');
   assert.deepEqual(pageErrors, []);
 });

@@ -1,0 +1,294 @@
+//! `engine.map`: per-point maps in the browser ([`crate::map`]), translated to and from JS.
+//!
+//! Owns the call (its options are read by [`super::map_options`]) and the answer as typed
+//! arrays and as `sunlit map`'s files. The points and their shadow-ray index
+//! ([`Mapper`]) are kept on the model for the last grid asked, so a time slider that maps the
+//! same grid at instant after instant pays for them once. A period's instants are summed in
+//! chunks, between which the worker's event loop runs: progress is reported and an abort is
+//! seen.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use js_sys::{Float32Array, Function, Promise, Uint8Array, Uint32Array};
+use wasm_bindgen::prelude::*;
+use wasm_bindgen_futures::{JsFuture, future_to_promise};
+
+use super::map_options::{MapRequest, MapValue, Where, points_csv as given_points};
+use super::{Engine, Model, ModelInner, js_error};
+use crate::error::{Error, Result};
+use crate::export::map_glb::map_glb;
+use crate::export::map_table::{Column, points_csv};
+use crate::map::{MapValues, Mapper, Points, Sample, Site, from_csv, grid};
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
+
+/// Chunks a period's instants are summed in (each followed by a turn of the event loop).
+const CHUNKS: usize = 50;
+
+/// The last points asked of a model, indexed for shadow rays.
+pub(super) struct MapCache {
+    place: Where,
+    points: Rc<Points>,
+    mapper: Rc<Mapper>,
+}
+
+/// The model's points and mapper for `place`, made once per place.
+fn points_for(model: &ModelInner, place: &Where) -> Result<(Rc<Points>, Rc<Mapper>)> {
+    let cache: &RefCell<Option<MapCache>> = &model.maps;
+    if let Some(c) = cache.borrow().as_ref().filter(|c| c.place == *place) {
+        return Ok((c.points.clone(), c.mapper.clone()));
+    }
+    let all: Vec<u32> = (0..model.scene.receivers.len() as u32).collect();
+    let points = match place {
+        Where::Grid(spacing) => grid(&model.scene, *spacing, &all)?,
+        Where::Given(numbers) => from_csv(&model.scene, "points", &given_points(numbers)?, &all)?,
+    };
+    let mapper = Rc::new(Mapper::new(&model.scene, &points)?);
+    let points = Rc::new(points);
+    *cache.borrow_mut() = Some(MapCache { place: place.clone(), points: points.clone(), mapper: mapper.clone() });
+    Ok((points, mapper))
+}
+
+/// A map's answer, handed to JS as typed arrays (sunlit.js copies them into a plain object),
+/// and as the CLI's files: the points CSV and the map glb, by the library's own writers.
+#[wasm_bindgen]
+pub struct PointMap {
+    model: Rc<ModelInner>,
+    points: Rc<Points>,
+    value: MapValue,
+    /// The value asked, per point.
+    values: Vec<f64>,
+    /// A period's sums (None for an instant), as `sunlit map` writes them.
+    sums: Option<MapValues>,
+    instants: usize,
+}
+
+impl PointMap {
+    /// The CSV's value columns, as `sunlit map` writes them: `lit` for an instant, else
+    /// `sun_hours` and, with an EPW, `direct_kwh_m2`.
+    fn columns(&self) -> Vec<Column<'_>> {
+        match &self.sums {
+            None => vec![Column { name: "lit", values: &self.values, decimals: 0 }],
+            Some(sums) => {
+                let mut columns = vec![Column { name: "sun_hours", values: &sums.sun_hours, decimals: 4 }];
+                if let Some(d) = &sums.direct_kwh_m2 {
+                    columns.push(Column { name: "direct_kwh_m2", values: d, decimals: 4 });
+                }
+                columns
+            }
+        }
+    }
+}
+
+#[wasm_bindgen]
+impl PointMap {
+    /// `sunHours`, `direct` or `lit`.
+    #[wasm_bindgen(getter)]
+    pub fn value(&self) -> String {
+        self.value.name().into()
+    }
+
+    /// The legend's title.
+    #[wasm_bindgen(getter)]
+    pub fn title(&self) -> String {
+        self.value.title().0.into()
+    }
+
+    /// The value's unit (empty for lit).
+    #[wasm_bindgen(getter)]
+    pub fn unit(&self) -> String {
+        self.value.title().1.into()
+    }
+
+    /// The grid spacing (m); 0 for given points.
+    #[wasm_bindgen(getter)]
+    pub fn spacing(&self) -> f64 {
+        self.points.spacing.unwrap_or(0.0)
+    }
+
+    /// Instants counted per point.
+    #[wasm_bindgen(getter)]
+    pub fn instants(&self) -> usize {
+        self.instants
+    }
+
+    /// x y z per point (world axes: x east, y north, z up).
+    #[wasm_bindgen(getter)]
+    pub fn points(&self) -> Float32Array {
+        Float32Array::from(self.points.positions.as_slice())
+    }
+
+    /// The outward unit normal per point.
+    #[wasm_bindgen(getter)]
+    pub fn normals(&self) -> Float32Array {
+        Float32Array::from(self.points.normals.as_slice())
+    }
+
+    /// The receiver (index into `receiverNames`) per point.
+    #[wasm_bindgen(getter)]
+    pub fn receivers(&self) -> Uint32Array {
+        Uint32Array::from(self.points.receivers.as_slice())
+    }
+
+    /// The value per point.
+    #[wasm_bindgen(getter)]
+    pub fn values(&self) -> Float32Array {
+        to_f32(&self.values)
+    }
+
+    /// A period's sun hours per point (undefined for an instant).
+    #[wasm_bindgen(getter, js_name = sunHours)]
+    pub fn sun_hours(&self) -> Option<Float32Array> {
+        self.sums.as_ref().map(|s| to_f32(&s.sun_hours))
+    }
+
+    /// A period's direct irradiation per point, kWh/m² (undefined without an EPW or for an instant).
+    #[wasm_bindgen(getter)]
+    pub fn direct(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.direct_kwh_m2.as_deref()).map(to_f32)
+    }
+
+    /// The legend's low end: 0.
+    #[wasm_bindgen(getter)]
+    pub fn min(&self) -> f64 {
+        0.0
+    }
+
+    /// The legend's high end: the largest value (1 when all are 0); 1 for lit.
+    #[wasm_bindgen(getter)]
+    pub fn max(&self) -> f64 {
+        let top = self.values.iter().copied().fold(0.0, f64::max);
+        if self.value == MapValue::Lit || top <= 0.0 { 1.0 } else { top }
+    }
+
+    /// The points CSV as `sunlit map -o POINTS.csv` writes it for the same options.
+    pub fn csv(&self) -> String {
+        points_csv(&self.model.scene, &self.points, &self.columns())
+    }
+
+    /// The map glb as `sunlit map --glb-out` writes it, coloured by the value asked.
+    pub fn glb(&self) -> Uint8Array {
+        let (name, unit) = match self.value {
+            MapValue::SunHours => ("sun_hours", "h"),
+            MapValue::Direct => ("direct_kwh_m2", "kWh/m²"),
+            MapValue::Lit => ("lit", ""),
+        };
+        Uint8Array::from(map_glb(&self.model.scene, &self.points, &self.values, name, unit).as_slice())
+    }
+}
+
+fn to_f32(values: &[f64]) -> Float32Array {
+    let v: Vec<f32> = values.iter().map(|&x| x as f32).collect();
+    Float32Array::from(v.as_slice())
+}
+
+#[wasm_bindgen]
+impl Engine {
+    /// Promise of a per-point map ([`PointMap`]) of `model`; `options` is a plain object
+    /// (`MapOptions` in sunlit.d.ts). `progress(done, total)` is called between chunks of a
+    /// period's instants; an aborted `signal` rejects with `code: 'cancelled'`.
+    pub fn map(&self, model: &Model, options: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
+        let model = model.inner.clone();
+        future_to_promise(async move {
+            let request = request_from_js(&options).map_err(map_error)?;
+            let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
+            let site = Site { location: &request.site.location, calendar: &request.site.calendar, dni: request.dni.as_ref() };
+            let samples = request.period.samples();
+            let value = request.value;
+            let map = if value == MapValue::Lit {
+                let values = lit_at(&mapper, site, &samples, points.len()).into_iter().map(f64::from).collect();
+                PointMap { model, points, value, values, sums: None, instants: samples.len() }
+            } else {
+                let sums = summed(&mapper, site, &samples, progress.as_ref(), signal.as_ref()).await.map_err(map_error)?;
+                let values =
+                    if value == MapValue::Direct { sums.direct_kwh_m2.clone().unwrap_or_default() } else { sums.sun_hours.clone() };
+                PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums) }
+            };
+            Ok(map.into())
+        })
+    }
+}
+
+/// The JS options object as a [`MapRequest`].
+fn request_from_js(options: &JsValue) -> Result<MapRequest> {
+    if options.is_undefined() || options.is_null() {
+        return Err(Error::argument("options", "give at least a location (latitude, longitude, timeZone) or an EPW"));
+    }
+    let text = js_sys::JSON::stringify(options).map_err(|_| Error::argument("options", "not a plain object"))?;
+    MapRequest::from_value(serde_json::from_str(&String::from(text)).map_err(|e| Error::argument("options", e.to_string()))?)
+}
+
+/// A library error as a JS one, its `spacing` named as this API spells it: `grid`.
+fn map_error(error: Error) -> JsValue {
+    js_error(match error {
+        Error::Argument { what, reason } if what == "spacing" => Error::Argument { what: "grid".into(), reason },
+        other => other,
+    })
+}
+
+/// Each point's visibility at the period's one instant, as `sunlit map --at` finds it (0 with
+/// the sun down or behind the point's surface).
+fn lit_at(mapper: &Mapper, site: Site<'_>, samples: &[Sample], points: usize) -> Vec<f32> {
+    let Some(s) = samples.first() else { return vec![0.0; points] };
+    let sun = sun_direction(site.location, shading_sun_day(s.day), s.hour);
+    mapper.visibility(sun, site.calendar.fraction(f64::from(s.day)) as f32)
+}
+
+/// The period's sums, chunk by chunk with a turn of the event loop between (progress, abort).
+async fn summed(
+    mapper: &Mapper,
+    site: Site<'_>,
+    samples: &[Sample],
+    progress: Option<&Function>,
+    signal: Option<&web_sys::AbortSignal>,
+) -> Result<MapValues> {
+    let mut total: Option<MapValues> = None;
+    let size = samples.len().div_ceil(CHUNKS).max(1);
+    let mut done = 0usize;
+    for chunk in samples.chunks(size) {
+        let part = mapper.accumulate(chunk, site, &mut |_, _| {});
+        done += chunk.len();
+        total = Some(match total {
+            None => part,
+            Some(mut t) => {
+                add(&mut t.sun_hours, &part.sun_hours);
+                if let (Some(a), Some(b)) = (t.direct_kwh_m2.as_mut(), part.direct_kwh_m2.as_ref()) {
+                    add(a, b);
+                }
+                t.instants += part.instants;
+                t.sun_up += part.sun_up;
+                t
+            }
+        });
+        if let Some(f) = progress {
+            // A throwing progress callback is the caller's bug, not a reason to stop.
+            let _ = f.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(samples.len() as f64));
+        }
+        next_turn().await;
+        if signal.is_some_and(|s| s.aborted()) {
+            return Err(Error::Cancelled);
+        }
+    }
+    Ok(total.unwrap_or_else(|| mapper.accumulate(&[], site, &mut |_, _| {})))
+}
+
+fn add(into: &mut [f64], from: &[f64]) {
+    for (a, b) in into.iter_mut().zip(from) {
+        *a += b;
+    }
+}
+
+/// Resolves after the event loop's next turn (a zero `setTimeout`), so that messages (a cancel)
+/// reach the worker between chunks.
+async fn next_turn() {
+    let promise = Promise::new(&mut |resolve, _| {
+        let global = js_sys::global();
+        if let Ok(set_timeout) = js_sys::Reflect::get(&global, &"setTimeout".into()).and_then(|f| f.dyn_into::<Function>()) {
+            let _ = set_timeout.call2(&global, &resolve, &JsValue::from(0));
+        } else {
+            let _ = resolve.call0(&JsValue::NULL);
+        }
+    });
+    let _ = JsFuture::from(promise).await;
+}
