@@ -151,13 +151,15 @@ const PEREZ: [[f64; 6]; 8] = [
 ];
 
 /// The closed-form Perez sky diffuse (W/m²) on an unobstructed surface with normal `n`.
-fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64) -> f64 {
+/// `elevation` in metres thins the air mass as EnergyPlus does (× (1 − 0.1·elevation/1000)).
+fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64, elevation: f64) -> f64 {
     let z = sun.z.acos();
-    let air_mass = if z.to_degrees() <= 75.0 { 1.0 / sun.z } else { 1.0 / (sun.z + 0.15 * (93.9 - z.to_degrees()).powf(-1.253)) };
+    let m = 1.0 - 0.1 * elevation / 1000.0;
+    let air_mass = if z.to_degrees() <= 75.0 { m / sun.z } else { m / (sun.z + 0.15 * (93.9 - z.to_degrees()).powf(-1.253)) };
     let k = 1.041 * z.powi(3);
     let epsilon = ((dni + dhi) / dhi + k) / (1.0 + k);
     let delta = dhi * air_mass / 1353.0;
-    let c = PEREZ[LIMITS.iter().take_while(|&&l| epsilon > l).count()];
+    let c = PEREZ[LIMITS.iter().take_while(|&&l| epsilon >= l).count()];
     let f1 = (c[0] + c[1] * delta + c[2] * z).max(0.0);
     let f2 = c[3] + c[4] * delta + c[5] * z;
     let (a, b) = (n.dot(sun).max(0.0), sun.z.max(85f64.to_radians().cos()));
@@ -169,7 +171,9 @@ fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64) -> f64 {
 
 #[test]
 fn an_unobstructed_surface_gets_the_closed_form_perez_sky() {
-    let location = Location::new(39.74, -105.18, -7.0).unwrap();
+    // Golden, CO at its EPW's elevation: the air mass's elevation term must be applied.
+    let mut location = Location::new(39.74, -105.18, -7.0).unwrap();
+    location.elevation = 1829.0;
     let calendar = LeafCalendar::default();
     let timesteps = Timesteps::new(1).unwrap();
     for (dni, dhi) in [(0.0, 150.0), (300.0, 200.0), (850.0, 90.0), (600.0, 300.0)] {
@@ -192,7 +196,7 @@ fn an_unobstructed_surface_gets_the_closed_form_perez_sky() {
                 }
                 schedule.set(row, 0, if scene.receivers[0].normal.dot(sun) > 1e-5 { 1.0 } else { 0.0 });
                 if dhi > 0.0 {
-                    expected += closed_form_perez(scene.receivers[0].normal, sun, dni, dhi) / 1000.0;
+                    expected += closed_form_perez(scene.receivers[0].normal, sun, dni, dhi, location.elevation) / 1000.0;
                 }
             }
             let s = summarize(&scene, &schedule, &location, Some((&views, &calendar)), Some(&weather), &[]).unwrap();

@@ -87,7 +87,7 @@ fn for_each_incident(
             continue;
         }
         let hour = solar.weather.at(schedule.timesteps, row);
-        let perez = PerezSky::new(hour.dni, hour.dhi, sun.z);
+        let perez = PerezSky::new(hour.dni, hour.dhi, sun.z, location.elevation);
         let leaves = solar.calendar.fraction(f64::from(instant.day));
         for (c, receiver) in scene.receivers.iter().enumerate() {
             let fraction = f64::from(schedule.get(row, c));
