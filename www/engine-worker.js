@@ -7,7 +7,9 @@
 //   { id, op: 'fractions', sun }                   → { id, result: Float64Array }
 //   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
 //   { id, op: 'cancel' }                           → aborts a running annual
-// Errors come back as { id, error: message }; progress of an annual as { id, progress: [done, total] }.
+// Errors come back as { id, error: message, code }; progress of an annual as { id, progress: [done, total] }.
+// The engine clips on its own pool of workers and routes `auto` by a measured profile, as
+// createEngine does anywhere (create's options take `workers` and `profile` too).
 import { createEngine } from './sunlit.js';
 
 let engine = null;
@@ -22,6 +24,7 @@ function replaceModel(next) {
 
 const ops = {
   async create({ options }) {
+    engine?.close();
     engine = await createEngine(options ?? {});
     return { adapter: engine.adapter, resolution: engine.resolution };
   },
@@ -33,7 +36,7 @@ const ops = {
     const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
     const year = await need(engine, 'create').annual(need(model, 'fromMeshes or loadFiles'), settings, { onProgress, signal: running.signal });
     try {
-      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv() };
+      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv(), profile: year.profile, profileSource: year.profileSource };
     } finally {
       year.free();
     }
@@ -52,6 +55,6 @@ onmessage = async ({ data }) => {
     if (!op) throw new Error(`sunlit worker: unknown op '${data?.op}' (create, fromMeshes, loadFiles, fractions, annual, cancel)`);
     postMessage({ id: data.id, result: await op(data) });
   } catch (error) {
-    postMessage({ id: data?.id, error: String(error?.message ?? error) });
+    postMessage({ id: data?.id, error: String(error?.message ?? error), code: error?.code });
   }
 };
