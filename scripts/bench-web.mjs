@@ -62,7 +62,7 @@ function treeRss(root) {
 }
 
 async function browserRun(side) {
-  copyFileSync(model, join(ROOT, 'www/pkg/bench-model.glb'));
+  copyFileSync(model, join(ROOT, `www/pkg/bench-model-${process.pid}.glb`));
   const server = await serve(0);
   const browser = await launch();
   let peak = 0;
@@ -74,10 +74,10 @@ async function browserRun(side) {
     page.on('console', (m) => m.type() === 'error' && console.error(m.text()));
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
     const result = await page.evaluate(
-      async ({ name, days, perDay, resolution, place, options }) => {
+      async ({ name, file, days, perDay, resolution, place, options }) => {
         const { createEngine, wasmMemoryBytes } = await import('/sunlit.js');
         const engine = await createEngine({ resolution, ...options });
-        const bytes = new Uint8Array(await (await fetch('/pkg/bench-model.glb')).arrayBuffer());
+        const bytes = new Uint8Array(await (await fetch(`/pkg/bench-model-${file}.glb`)).arrayBuffer());
         const t0 = performance.now();
         const model = engine.loadFiles([{ name, bytes }]);
         const t1 = performance.now();
@@ -106,14 +106,14 @@ async function browserRun(side) {
         engine.close();
         return out;
       },
-      { name: basename(model), days, perDay, resolution: Number(resolution), place, options: ENGINES[side] },
+      { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side] },
     );
     return { side: `page-${side}`, ...result, peak_rss_mb: Math.round(Math.max(peak, treeRss(process.pid)) / 1e6) };
   } finally {
     clearInterval(sampler);
     await browser.close();
     server.close();
-    rmSync(join(ROOT, 'www/pkg/bench-model.glb'), { force: true });
+    rmSync(join(ROOT, `www/pkg/bench-model-${process.pid}.glb`), { force: true });
   }
 }
 

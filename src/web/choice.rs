@@ -120,6 +120,14 @@ impl<'a> Chosen<'a> {
         })
     }
 
+    /// Whether `auto` clips every view whatever its load, so the loads need not be walked here
+    /// (the pool walks them as it clips): a profile without a GPU cost, or no GPU, and nothing
+    /// see-through in the scene. [`Profile::route`] would send every view to the exact engine.
+    fn clips_everything(&self) -> bool {
+        let exact_only = self.profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.lane.is_none());
+        exact_only && self.scene.see_through_triangles == 0
+    }
+
     /// The profile `auto` routed by, as JSON, and where it came from (`pinned`, `cache`, `probe`).
     pub(super) fn profile(&self) -> Option<(String, &'static str)> {
         self.profile.get().and_then(|(p, source)| serde_json::to_string(p).ok().map(|t| (t, *source)))
@@ -223,6 +231,7 @@ impl Engine for Chosen<'_> {
         let (routes, loads) = match self.kind {
             EngineKind::Gpu => return self.lane()?.answer(requests).await,
             EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
+            EngineKind::Auto if self.clips_everything() => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto => {
                 let loads = self.exact().loads(requests);
                 let profile = self.routing_profile(requests, &loads).await?;
