@@ -86,9 +86,10 @@ export async function epwLocation(text, name = 'EPW') {
 }
 
 /** Model files above this many bytes cannot be read within wasm32's 4 GiB: reading one holds
- * its bytes, the parsed scene, the GPU upload's staging and the exact engine's index at once,
- * measured at about MEMORY_PER_BYTE times the file's size (docs/page-speed.md, nyt-blocks). */
-const MEMORY_PER_BYTE = 12;
+ * its bytes, the parsed scene, the GPU upload's staging and the exact engine's index at once.
+ * Estimated from nyt-blocks (docs/page-speed.md): for its 95 MB glb the renderer held 4.37 GB for
+ * the engine's worker and two clipping workers, about 15× the file per instance. */
+const MEMORY_PER_BYTE = 16;
 const WASM32_BYTES = 4 * 2 ** 30;
 const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
 
