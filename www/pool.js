@@ -40,7 +40,7 @@ export class ClipPool {
   #broken = null;
 
   /** `size` workers running `url` (default: clip-worker.js beside this module). */
-  constructor(size, url = new URL('./clip-worker.js', import.meta.url)) {
+  constructor(size, url = null) {
     this.#size = size;
     this.#url = url;
   }
@@ -68,7 +68,10 @@ export class ClipPool {
     return new Promise((resolve, reject) => {
       let worker;
       try {
-        worker = new Worker(this.#url, { type: 'module' });
+        // Written out for the default so that bundlers (Vite, webpack) see and bundle the worker.
+        worker = this.#url
+          ? new Worker(this.#url, { type: 'module' })
+          : new Worker(new URL('./clip-worker.js', import.meta.url), { type: 'module' });
       } catch (error) {
         reject(coded(`clipping worker ${index} could not start: ${error?.message ?? error}`, 'worker', { worker: index, workerCode: 'start' }));
         return;
