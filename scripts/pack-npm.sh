@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 out="${SUNLIT_PACK_DIR:-target/npm}"
 version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -n1)
 rm -rf "$out" && mkdir -p "$out/pkg/pkg"
-cp www/sunlit.js www/device.js www/colour.js www/map.js www/three.js www/engine-worker.js www/sunlit.d.ts www/three.d.ts "$out/pkg/"
+cp www/sunlit.js www/device.js www/colour.js www/map.js www/three.js www/engine-worker.js www/pool.js www/clip-worker.js www/profiles.js www/sunlit.d.ts www/three.d.ts "$out/pkg/"
 cp www/pkg/sunlit_wasm.js www/pkg/sunlit_wasm_bg.wasm "$out/pkg/pkg/"
 cp www/npm-readme.md "$out/pkg/README.md"
 cat > "$out/pkg/package.json" <<JSON

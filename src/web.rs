@@ -13,6 +13,7 @@
 use std::rc::Rc;
 
 mod choice;
+mod clipper;
 mod embed;
 mod map;
 mod map_options;
@@ -85,10 +86,12 @@ pub fn js_option(param: &str) -> String {
     out
 }
 
-/// The GPU counter on this page's WebGPU device.
+/// The GPU counter on this page's WebGPU device (none where the browser has no WebGPU: then
+/// views are clipped only).
 #[wasm_bindgen]
 pub struct Engine {
-    counter: Rc<Counter>,
+    counter: Option<Rc<Counter>>,
+    options: CounterOptions,
     /// Which engine answers views (`auto`, `gpu`, `exact`; see [`choice`]).
     kind: EngineKind,
 }
@@ -98,13 +101,40 @@ impl Engine {
     /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512);
     /// `accuracy`: a target |error| per view, counting each at 64² first and finer, up to
     /// `resolution`, only where its shadow edges need it (default: every view at `resolution`);
-    /// `engine`: `auto` (default), `gpu` or `exact` ([`choice`]).
-    pub async fn create(resolution: Option<u32>, accuracy: Option<f64>, engine: Option<String>) -> Result<Engine, JsValue> {
+    /// `engine`: `auto` (default), `gpu` or `exact` ([`choice`]); `gpu: false` (no WebGPU in
+    /// this browser) makes no device: views are clipped, and `engine: 'gpu'` is refused.
+    pub async fn create(
+        resolution: Option<u32>,
+        accuracy: Option<f64>,
+        engine: Option<String>,
+        gpu: Option<bool>,
+    ) -> Result<Engine, JsValue> {
         let kind = engine.as_deref().map_or(Ok(EngineKind::Auto), EngineKind::parse).map_err(js_error)?;
         let options =
             CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), accuracy, ..Default::default() };
+        if gpu == Some(false) {
+            if kind == EngineKind::Gpu {
+                return Err(js_error(Error::argument(
+                    "engine",
+                    "'gpu' needs WebGPU, which this browser does not offer; 'exact' and 'auto' clip without it",
+                )));
+            }
+            if let Some(a) = accuracy
+                && !(a > 0.0 && a < 1.0)
+            {
+                return Err(js_error(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)"))));
+            }
+            return Ok(Engine { counter: None, options, kind });
+        }
         let counter = Counter::new(options).await.map_err(js_error)?;
-        Ok(Engine { counter: Rc::new(counter), kind })
+        Ok(Engine { counter: Some(Rc::new(counter)), options, kind })
+    }
+
+    /// The key under which this model's `auto` profile is kept (IndexedDB in the page), as the
+    /// native cache keys it: adapter, driver, `workers` clipping threads, side, scene size.
+    #[wasm_bindgen(js_name = profileKey)]
+    pub fn profile_key(&self, model: &Model, workers: usize) -> String {
+        choice::store_key(&model.inner.scene, self.counter.as_ref().map(|c| c.adapter_info()), &self.options, workers.max(1))
     }
 
     /// Which engine answers views: `auto`, `gpu` or `exact`.
@@ -116,15 +146,22 @@ impl Engine {
     /// The adapter's name and backend, for the page's status line.
     #[wasm_bindgen(getter)]
     pub fn adapter(&self) -> String {
+        let Some(counter) = &self.counter else { return "none (no WebGPU: views are clipped only)".into() };
         // Browsers hide the adapter's name unless asked; say what is known.
-        let info = self.counter.adapter_info();
+        let info = counter.adapter_info();
         if info.name.is_empty() { "the browser's WebGPU".into() } else { format!("{} ({:?})", info.name, info.backend) }
     }
 
     /// Pixels along a view's side.
     #[wasm_bindgen(getter)]
     pub fn resolution(&self) -> u32 {
-        self.counter.resolution()
+        self.options.resolution
+    }
+
+    /// Whether a GPU device was made (false where the browser has no WebGPU).
+    #[wasm_bindgen(getter, js_name = hasGpu)]
+    pub fn has_gpu(&self) -> bool {
+        self.counter.is_some()
     }
 
     /// Reads model files (glb/gltf with embedded buffers, IDF, epJSON) and uploads the scene.
@@ -142,21 +179,7 @@ impl Engine {
         foliage: Option<String>,
         transmittance: Option<String>,
     ) -> Result<Model, JsValue> {
-        if names.len() != contents.length() as usize {
-            return Err(js_error(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length()))));
-        }
-        let files: Vec<(String, Vec<u8>)> =
-            names.into_iter().zip(contents.iter()).map(|(name, bytes)| (name, Uint8Array::new(&bytes).to_vec())).collect();
-        let transmittance =
-            list(transmittance.as_deref()).iter().map(|t| parse_transmittance(t)).collect::<Result<Vec<_>>>().map_err(js_error)?;
-        let options = LoadOptions {
-            receivers: list(receivers.as_deref()),
-            north: north.unwrap_or(0.0),
-            foliage: list(foliage.as_deref()),
-            transmittance,
-            ..Default::default()
-        };
-        let loaded = load_bytes_all(&files, &options).map_err(js_error)?;
+        let loaded = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
         self.model(loaded.scene, loaded.energyplus, loaded.notes)
     }
 
@@ -175,15 +198,17 @@ impl Engine {
     }
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
-        let gpu = self.counter.upload(&scene).map_err(js_error)?;
+        let gpu = self.counter.as_ref().map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
         Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default() }) })
     }
 
     /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
-    /// direction: a unit vector towards the sun, x east, y north, z up.
-    pub fn fractions(&self, model: &Model, sun_x: f64, sun_y: f64, sun_z: f64) -> Promise {
-        let (counter, model, kind) = (self.counter.clone(), model.inner.clone(), self.kind);
+    /// direction: a unit vector towards the sun, x east, y north, z up. `routing`: the pool and
+    /// profile ([`choice::Routing`]).
+    pub fn fractions(&self, model: &Model, sun_x: f64, sun_y: f64, sun_z: f64, routing: JsValue) -> Promise {
+        let (counter, model, kind, options) = (self.counter.clone(), model.inner.clone(), self.kind, self.options);
         future_to_promise(async move {
+            let routing = choice::Routing::from_js(&routing).map_err(js_error)?;
             let sun = glam::DVec3::new(sun_x, sun_y, sun_z);
             if !sun.is_finite() || sun.length() < 1e-9 {
                 return Err(js_error(Error::argument("sun", format!("({sun_x}, {sun_y}, {sun_z}) is not a direction"))));
@@ -191,7 +216,8 @@ impl Engine {
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
                 (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
-            let answers = model.chosen(kind, &counter).answer(&requests).await.map_err(js_error)?;
+            let chosen = model.chosen(kind, counter.as_deref(), &options, &routing);
+            let answers = chosen.answer(&requests).await.map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?;
             let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
         })
@@ -199,10 +225,20 @@ impl Engine {
 
     /// Promise of the year's schedule ([`Annual`]). `settings` is a plain object (see
     /// [`AnnualSettings`]); `progress(done, total)` is called as views are counted; an aborted
-    /// `signal` rejects the promise with an `Error` whose `code` is `cancelled`.
-    pub fn annual(&self, model: &Model, settings: JsValue, progress: Option<Function>, signal: Option<web_sys::AbortSignal>) -> Promise {
-        let (counter, model, kind) = (self.counter.clone(), model.inner.clone(), self.kind);
+    /// `signal` rejects the promise with an `Error` whose `code` is `cancelled`. `routing`: the
+    /// pool of clipping workers and a profile to try ([`choice::Routing`]); a failing pool's
+    /// error comes back as the pool threw it.
+    pub fn annual(
+        &self,
+        model: &Model,
+        settings: JsValue,
+        progress: Option<Function>,
+        signal: Option<web_sys::AbortSignal>,
+        routing: JsValue,
+    ) -> Promise {
+        let (counter, model, kind, counter_options) = (self.counter.clone(), model.inner.clone(), self.kind, self.options);
         future_to_promise(async move {
+            let routing = choice::Routing::from_js(&routing).map_err(js_error)?;
             let given = settings_from_js(&settings).map_err(js_error)?;
             let settings = given.resolve().map_err(js_error)?;
             let mut options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
@@ -221,23 +257,51 @@ impl Engine {
                 }
                 Ok(())
             };
-            let (schedule, fitted) =
-                annual_fitted_with(&model.chosen(kind, &counter), &model.scene, &location, &options, &calendar, &mut report)
-                    .await
-                    .map_err(js_error)?;
+            let chosen = model.chosen(kind, counter.as_deref(), &counter_options, &routing);
+            let (schedule, fitted) = annual_fitted_with(&chosen, &model.scene, &location, &options, &calendar, &mut report)
+                .await
+                .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?;
+            let routed = Routed { profile: chosen.profile(), refused: chosen.refused() };
             let means = daylight_means(&schedule, &location);
             let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
             // The sky views (the same engine, Tregenza's patches) only when there is weather to weigh them.
             let sky = match &weather {
                 Some(Ok(_)) => Some(
-                    sky_views(&model.chosen(kind, &counter), &model.scene, &SkyPatches::tregenza(), &mut report).await.map_err(js_error)?,
+                    sky_views(&chosen, &model.scene, &SkyPatches::tregenza(), &mut report)
+                        .await
+                        .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?,
                 ),
                 _ => None,
             };
             let extra = embed::Extra::new(&model.scene, &schedule, &location, weather, sky.as_ref().map(|s| (s, &calendar)), fitted);
-            Ok(Annual { schedule, means, hook, model, extra }.into())
+            Ok(Annual { schedule, means, hook, model, extra, routed }.into())
         })
     }
+}
+
+/// Reads model files (see [`Engine::load_files`]) into a scene, on any thread of the page.
+fn load_files(
+    names: Vec<String>,
+    contents: Array,
+    receivers: Option<String>,
+    north: Option<f64>,
+    foliage: Option<String>,
+    transmittance: Option<String>,
+) -> Result<crate::model::Loaded> {
+    if names.len() != contents.length() as usize {
+        return Err(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length())));
+    }
+    let files: Vec<(String, Vec<u8>)> =
+        names.into_iter().zip(contents.iter()).map(|(name, bytes)| (name, Uint8Array::new(&bytes).to_vec())).collect();
+    let transmittance = list(transmittance.as_deref()).iter().map(|t| parse_transmittance(t)).collect::<Result<Vec<_>>>()?;
+    let options = LoadOptions {
+        receivers: list(receivers.as_deref()),
+        north: north.unwrap_or(0.0),
+        foliage: list(foliage.as_deref()),
+        transmittance,
+        ..Default::default()
+    };
+    load_bytes_all(&files, &options)
 }
 
 /// A comma-separated setting (globs, `GLOB=T` items); empty when not given.
@@ -253,7 +317,8 @@ pub struct Model {
 
 struct ModelInner {
     scene: Scene,
-    gpu: GpuScene,
+    /// The scene on the GPU (none without WebGPU).
+    gpu: Option<GpuScene>,
     energyplus: Option<EnergyPlusInput>,
     /// What loading chose that the user should hear (e.g. many default receivers).
     notes: Vec<String>,
@@ -264,9 +329,16 @@ struct ModelInner {
 }
 
 impl ModelInner {
-    /// The engine `kind` over this model, on `counter`'s device.
-    fn chosen<'a>(&'a self, kind: EngineKind, counter: &'a Counter) -> choice::Chosen<'a> {
-        choice::Chosen { kind, scene: &self.scene, exact: &self.exact, lane: Lane { counter, gpu: &self.gpu } }
+    /// The engine `kind` over this model, on `counter`'s device (if any), routed by `routing`.
+    fn chosen<'a>(
+        &'a self,
+        kind: EngineKind,
+        counter: Option<&'a Counter>,
+        options: &CounterOptions,
+        routing: &'a choice::Routing,
+    ) -> choice::Chosen<'a> {
+        let lane = counter.zip(self.gpu.as_ref()).map(|(counter, gpu)| Lane { counter, gpu });
+        choice::Chosen::new(kind, &self.scene, &self.exact, lane, options, routing)
     }
 }
 
@@ -392,6 +464,13 @@ pub struct Annual {
     hook: Option<Result<Hook, JsValue>>,
     model: Rc<ModelInner>,
     extra: embed::Extra,
+    routed: Routed,
+}
+
+/// How `auto` routed a year: the profile (JSON) and its source, and a profile refused.
+struct Routed {
+    profile: Option<(String, &'static str)>,
+    refused: Option<String>,
 }
 
 #[wasm_bindgen]
@@ -428,6 +507,25 @@ impl Annual {
     #[wasm_bindgen(getter)]
     pub fn means(&self) -> Float64Array {
         Float64Array::from(self.means.as_slice())
+    }
+
+    /// The profile `auto` routed by (JSON, as `createEngine({ profile })` takes it); `undefined`
+    /// for `gpu` and `exact`.
+    #[wasm_bindgen(getter)]
+    pub fn profile(&self) -> Option<String> {
+        self.routed.profile.as_ref().map(|(p, _)| p.clone())
+    }
+
+    /// Where that profile came from: `pinned`, `cache` or `probe` (measured in this run).
+    #[wasm_bindgen(getter, js_name = profileSource)]
+    pub fn profile_source(&self) -> Option<String> {
+        self.routed.profile.as_ref().map(|(_, s)| (*s).to_string())
+    }
+
+    /// Why a profile handed in was refused (it was measured anew), naming it and the reason.
+    #[wasm_bindgen(getter, js_name = profileRefused)]
+    pub fn profile_refused(&self) -> Option<String> {
+        self.routed.refused.clone()
     }
 
     /// The EnergyPlus CSV (the layout EnergyPlus writes as eplusshading.csv).

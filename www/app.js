@@ -178,6 +178,7 @@ function showResult(msg) {
   $('downloadidf').disabled = !msg.hooked;
   $('downloadidf').title = msg.hookError ?? '';
   selectReceiver(state.selected >= 0 ? state.selected : 0);
+  showRouting(msg);
   // An EPW whose hourly records cannot be read still gives fractions; say why there is no energy.
   const weather = msg.irradiationError ? ` No irradiation: ${msg.irradiationError}.` : '';
   // A model that cannot be hooked (e.g. too old a Version) still gets its CSV; say why no IDF.
@@ -199,8 +200,8 @@ function showError(msg) {
 worker.onmessage = ({ data: msg }) => {
   if (msg.type === 'ready') {
     if (!msg.webgpu) noWebGPU();
-    else if ($('nowebgpu').hidden) status('Ready. Choose a model, drop one here, or load the example.');
-    $('compute').disabled = !state.model || !$('nowebgpu').hidden;
+    else status('Ready. Choose a model, drop one here, or load the example.');
+    $('compute').disabled = !state.model || state.busy;
   } else if (msg.type === 'loaded') {
     showModel(msg);
     setBusy(state.busy);
@@ -208,6 +209,8 @@ worker.onmessage = ({ data: msg }) => {
     $('progress').max = msg.total || 1;
     $('progress').value = msg.done;
     status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}`);
+  } else if (msg.type === 'loading') {
+    showLoading(msg);
   } else if (msg.type === 'notice') {
     status(msg.text);
   } else if (msg.type === 'result') {
@@ -250,9 +253,27 @@ function epwChosen() {
 function noWebGPU() {
   const box = $('nowebgpu');
   box.hidden = false;
-  box.textContent = 'This browser offers no WebGPU, which sunlit needs to count pixels. Use a current Chrome or Edge (or enable WebGPU in your browser\'s settings).';
-  status('WebGPU is not available.', { error: true });
-  $('compute').disabled = true;
+  box.textContent =
+    'This browser offers no WebGPU, so only the GPU engine is missing: every view is clipped exactly on the CPU (slower on heavy models). For the GPU engine use a current Chrome or Edge (or enable WebGPU in your browser\'s settings).';
+  status('Ready without WebGPU (views are clipped). Choose a model, drop one here, or load the example.');
+}
+
+/** A large model's loading, stage by stage: parsing in the engine's worker, then the clipping
+ * workers building their copies. */
+function showLoading({ stage, bytes, workers, poolError }) {
+  if (stage === 'parse') status(`Reading ${state.modelName} (${(bytes / 1e6).toFixed(1)} MB)…`);
+  else if (stage === 'workers') $('poolinfo').textContent = `Preparing ${workers} clipping worker${workers === 1 ? '' : 's'}…`;
+  else if (stage === 'ready') $('poolinfo').textContent = poolError ? `Clipping in one thread: ${poolError}` : `${workers} clipping worker${workers === 1 ? '' : 's'} ready.`;
+}
+
+/** How the year was routed: the engine profile `auto` used (shown, as the API gives it). */
+function showRouting(msg) {
+  const r = msg.routing;
+  $('routing').hidden = !r;
+  if (!r) return;
+  const refused = r.refused ? ` (${r.refused}; measured anew)` : '';
+  $('routingsource').textContent = `auto routed by the ${r.source === 'probe' ? 'freshly measured' : r.source} profile${refused}; ${msg.workers} clipping worker(s)${msg.hasGpu ? '' : ', no GPU'}.`;
+  $('routingprofile').textContent = JSON.stringify(JSON.parse(r.profile), null, 2);
 }
 
 async function settings() {

@@ -8,7 +8,9 @@
 //   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
 //   { id, op: 'map', options, csv, glb }           → { id, result: SunlitMap }  (engine.map's typed arrays, transferred)
 //   { id, op: 'cancel' }                           → aborts a running annual or map
-// Errors come back as { id, error: message }; progress of an annual as { id, progress: [done, total] }.
+// Errors come back as { id, error: message, code }; progress of an annual as { id, progress: [done, total] }.
+// The engine clips on its own pool of workers and routes `auto` by a measured profile, as
+// createEngine does anywhere (create's options take `workers` and `profile` too).
 import { createEngine } from './sunlit.js';
 
 let engine = null;
@@ -23,6 +25,7 @@ function replaceModel(next) {
 
 const ops = {
   async create({ options }) {
+    engine?.close();
     engine = await createEngine(options ?? {});
     return { adapter: engine.adapter, resolution: engine.resolution };
   },
@@ -34,7 +37,7 @@ const ops = {
     const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
     const year = await need(engine, 'create').annual(need(model, 'fromMeshes or loadFiles'), settings, { onProgress, signal: running.signal });
     try {
-      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv() };
+      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv(), profile: year.profile, profileSource: year.profileSource };
     } finally {
       year.free();
     }
@@ -72,6 +75,6 @@ onmessage = async ({ data }) => {
     const result = await op(data);
     postMessage({ id: data.id, result }, transfers.get(result) ?? []);
   } catch (error) {
-    postMessage({ id: data?.id, error: String(error?.message ?? error) });
+    postMessage({ id: data?.id, error: String(error?.message ?? error), code: error?.code });
   }
 };

@@ -17,7 +17,9 @@ export interface SunlitError extends Error {
     | 'gpu'
     | 'device-lost'
     | 'cancelled'
-    | 'no-webgpu';
+    | 'no-webgpu'
+    | 'worker'
+    | 'too-large';
   /** The file the error is about (a model or EPW file name), where it is about one. */
   file?: string;
   /** The object in that file, e.g. "node 'Wall_S'" or "Timestep". */
@@ -27,6 +29,11 @@ export interface SunlitError extends Error {
   /** With code 'gpu': what failed. A 'gpu' or 'device-lost' error leaves the engine unusable;
    * a new engine (createEngine) may work. */
   gpu?: 'no-adapter' | 'device' | 'out-of-memory' | 'over-limit' | 'validation' | 'readback';
+  /** With code 'worker': the index of the clipping worker that failed, and the code it gave
+   * ('start' when it could not start: a CSP, a missing module; 'wasm-trap' when its wasm
+   * trapped, e.g. out of memory). The engine's pool is then closed: make a new engine. */
+  worker?: number;
+  workerCode?: string;
 }
 
 /** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
@@ -38,7 +45,8 @@ export function hasWebGPU(): boolean;
 /** Unit vector towards the sun from azimuth (degrees clockwise from north) and altitude (degrees). */
 export function sunDirection(azimuth: number, altitude: number): [number, number, number];
 
-/** Opens the GPU device (rejects with a SunlitError, code 'no-webgpu' where WebGPU is missing). `resolution`: pixels along a view's side (default 512). `accuracy`: a
+/** Opens the GPU device and starts the pool of clipping workers. Without WebGPU the engine
+ * still clips (`hasGpu` false), and only `engine: 'gpu'` rejects, with code 'no-webgpu'. `resolution`: pixels along a view's side (default 512). `accuracy`: a
  * target |error| per view (e.g. 0.002): each view is counted at 64² first and again, finer up to
  * `resolution`, only where its shadow edges make the estimated error larger; without it every
  * view is counted at `resolution`. */
@@ -49,11 +57,20 @@ export function createEngine(options?: {
    * destroys it; its loss is reported as a "GPU device lost" error. */
   device?: GPUDevice;
   /** Which engine answers views (default 'auto'). 'gpu': pixels on WebGPU. 'exact': polygon
-   * clipping in the wasm, on one thread, no resolution error (see-through geometry counts as
-   * opaque). 'auto': per view, clipping when the view's prism holds nothing see-through and at
-   * most 2,000 triangles, else pixels; a fixed rule (no timing), so answers are reproducible.
+   * clipping in the wasm, on the pool's workers, no resolution error (see-through geometry counts
+   * as opaque). 'auto': per view the engine with the lower cost in a profile measured once on
+   * this device and model (a probe of both engines on the model's own views, kept in IndexedDB
+   * keyed like the native CLI's cache); routing is a pure function of the views' loads, the
+   * profile and the run's size, so the same profile gives the same CSV byte for byte.
    * Another value rejects with code 'bad-option', option 'engine'. */
   engine?: 'auto' | 'gpu' | 'exact';
+  /** Clipping workers (default navigator.hardwareConcurrency; 0: clip in this thread). Each has
+   * its own wasm instance and copy of the model's exact engine; answers do not depend on it. */
+  workers?: number;
+  /** An 'auto' profile to route by (JSON text or object, as Annual.profile gives it), pinning
+   * the routing. One that does not parse, or was measured for another model or device, is
+   * refused (Annual.profileRefused says why) and measured anew. */
+  profile?: string | object;
 }): Promise<SunlitEngine>;
 
 /** An EPW weather file's LOCATION record (throws naming `name` and the reason). */
@@ -161,6 +178,19 @@ export interface SunlitEngine {
   readonly resolution: number;
   /** Which engine answers views (createEngine's `engine`). */
   readonly engine: 'auto' | 'gpu' | 'exact';
+  /** Whether a GPU device is in use (false without WebGPU: views are clipped). */
+  readonly hasGpu: boolean;
+  /** Clipping workers in the pool (0: clipping runs in the engine's thread). */
+  readonly workers: number;
+  /** How the last 'auto' year was routed: its profile key, the profile (JSON), where the profile
+   * came from, and why a profile handed in was refused; null before one. */
+  readonly routing: { key: string; profile: string; source: 'pinned' | 'cache' | 'probe'; refused?: string } | null;
+  /** Why the pool could not start (clipping then runs in the engine's thread), or null. */
+  readonly poolError: string | null;
+  /** Has the pool's workers build their copies of the model now (else the first year does). */
+  prepare(model: Model): Promise<void>;
+  /** Stops the pool's workers. */
+  close(): void;
   /** Reads model files; throws a SunlitError naming the file, object and reason when one is bad. */
   loadFiles(files: ModelFile[], options?: LoadOptions): Model;
   /** Builds a model from typed arrays; throws a SunlitError naming the array and element when bad. */
@@ -291,6 +321,12 @@ export interface Annual {
   readonly means: Float64Array;
   /** One receiver's fraction at every timestep. */
   column(index: number): Float32Array;
+  /** The profile 'auto' routed by (JSON; pass it to createEngine({ profile }) to pin it). */
+  readonly profile: string | undefined;
+  /** Where it came from: 'pinned', 'cache' (IndexedDB) or 'probe' (measured in this run). */
+  readonly profileSource: 'pinned' | 'cache' | 'probe' | undefined;
+  /** Why a profile handed in was refused, naming it and the reason (it was measured anew). */
+  readonly profileRefused: string | undefined;
   /** Annual direct (beam) irradiation Σ DNI·cosθ·fraction·Δt per receiver, kWh/m², from the EPW's
    * direct normal irradiance (each hour's value held over its timesteps); undefined without an
    * EPW. Throws naming the file and line when the EPW's hourly records are unreadable. */

@@ -5,6 +5,8 @@
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
+import { ClipPool, defaultWorkers } from './pool.js';
+import { cachedProfile, storeProfile } from './profiles.js';
 
 let wasmReady;
 
@@ -38,22 +40,67 @@ function coded(message, code, names = {}) {
   return Object.assign(new Error(message), { code }, names);
 }
 
-/** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps).
- * `engine`: 'auto' (default), 'gpu' or 'exact' (sunlit.d.ts). Rejects with code 'no-webgpu'
- * where WebGPU is missing, 'bad-option' (option 'engine') for another engine name. */
-export async function createEngine({ resolution, accuracy, device, engine } = {}) {
-  if (!hasWebGPU()) {
-    throw coded('This browser offers no WebGPU (try a current Chrome or Edge, or enable WebGPU).', 'no-webgpu');
+/** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps) and starts
+ * the pool of clipping workers. `engine`: 'auto' (default), 'gpu' or 'exact'; `workers`: the
+ * pool's size (default navigator.hardwareConcurrency; 0 clips in this thread); `profile`: an
+ * `auto` profile (JSON text or object, as `year.profile` gives it) to route by instead of the
+ * cached or measured one (sunlit.d.ts). Without WebGPU the engine still clips (`hasGpu` false);
+ * only `engine: 'gpu'` is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
+ * for another engine name or pool size. */
+export async function createEngine({ resolution, accuracy, device, engine, workers, profile } = {}) {
+  const size = workers === undefined ? defaultWorkers() : Number(workers);
+  if (!Number.isInteger(size) || size < 0) {
+    throw coded(`workers: ${workers} is not a whole number of at least 0`, 'bad-option', { option: 'workers' });
   }
+  const wantsGpu = engine !== undefined && String(engine).trim().toLowerCase() === 'gpu';
+  const noGpu = () =>
+    coded(
+      "This browser offers no WebGPU, so the GPU engine is missing (try a current Chrome or Edge, or enable WebGPU); engine 'auto' or 'exact' clips without it.",
+      'no-webgpu',
+      { option: 'engine' },
+    );
+  if (device === undefined && !hasWebGPU() && wantsGpu) throw noGpu();
   await ready();
-  const open = () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine));
-  return new SunlitEngine(device === undefined ? await open() : await onDevice(device, open));
+  const open = (gpu) => () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine), gpu);
+  let made;
+  if (device !== undefined) made = await onDevice(device, open(true));
+  else if (!hasWebGPU()) made = await open(false)();
+  else {
+    try {
+      made = await open(true)();
+    } catch (error) {
+      // WebGPU present but no adapter (a blocklisted GPU, flags off): clip without it.
+      if (error?.gpu !== 'no-adapter') throw error;
+      if (wantsGpu) throw noGpu();
+      made = await open(false)();
+    }
+  }
+  const pinned = profile === undefined || profile === null ? undefined : typeof profile === 'string' ? profile : JSON.stringify(profile);
+  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, pinned);
 }
 
 /** An EPW's LOCATION record: { latitude, longitude, timeZone, elevation, name }. */
 export async function epwLocation(text, name = 'EPW') {
   await ready();
   return wasmEpwLocation(String(name), String(text));
+}
+
+/** Model files above this many bytes cannot be read within wasm32's 4 GiB: reading one holds
+ * its bytes, the parsed scene, the GPU upload's staging and the exact engine's index at once.
+ * Estimated from nyt-blocks (docs/page-speed.md): for its 95 MB glb the renderer held 4.37 GB for
+ * the engine's worker and two clipping workers, about 15× the file per instance. */
+const MEMORY_PER_BYTE = 16;
+const WASM32_BYTES = 4 * 2 ** 30;
+const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
+
+function tooLarge(names, bytes, cause) {
+  const mb = (bytes / 1e6).toFixed(1);
+  const why = cause ? ` (reading it ran out of memory: ${cause.message})` : ` (the limit is about ${(MAX_MODEL_BYTES / 1e6).toFixed(0)} MB)`;
+  return coded(
+    `${names.join(', ')}: ${mb} MB of model files do not fit in this page's memory: wasm32 addresses 4 GiB, and reading a model needs about ${MEMORY_PER_BYTE}× its size${why}. Use the native CLI for this model.`,
+    'too-large',
+    { file: names[0], bytes },
+  );
 }
 
 function toBytes(bytes, name) {
@@ -67,11 +114,94 @@ function abortError() {
   return new DOMException('cancelled', 'AbortError');
 }
 
+/** What built each model, so the pool's workers can build their own copy of it. */
+const sources = new WeakMap();
+
+function remember(model, kind, args) {
+  sources.set(model, { kind, args });
+  return model;
+}
+
 class SunlitEngine {
   #engine;
+  #pool;
+  #pinned;
+  #routed = null;
+  #poolError = null;
 
-  constructor(engine) {
+  constructor(engine, pool, pinned) {
     this.#engine = engine;
+    this.#pool = pool;
+    this.#pinned = pinned;
+  }
+
+  /** Whether a GPU device is in use (false where the browser has no WebGPU: views are clipped). */
+  get hasGpu() {
+    return this.#engine.hasGpu;
+  }
+
+  /** Clipping workers in the pool (0: clipping runs in this thread). */
+  get workers() {
+    return this.#pool?.size ?? 0;
+  }
+
+  /** How the last `auto` run routed: { key, profile (JSON), source ('pinned', 'cache', 'probe'),
+   * refused (why a profile handed in was not used) }, or null before one. */
+  get routing() {
+    return this.#routed;
+  }
+
+  /** Why the pool could not start (clipping then runs in this thread), or null. */
+  get poolError() {
+    return this.#poolError;
+  }
+
+  /** Has the pool's workers build their copies of `model` now (else the first year does). */
+  async prepare(model) {
+    await this.#routing(model);
+  }
+
+  /** Stops the pool's workers; the engine then clips in this thread. */
+  close() {
+    this.#pool?.terminate();
+    this.#pool = null;
+  }
+
+  /** The pool and profile for a call on `model` (see src/web/choice.rs, Routing). */
+  async #routing(model, signal) {
+    const source = sources.get(model);
+    // A pool closed by a failed worker (its error went to the call that hit it) starts afresh.
+    if (this.#pool?.broken) this.#pool = new ClipPool(this.#pool.size);
+    if (this.#pool && source) {
+      try {
+        await this.#pool.use(source);
+      } catch (error) {
+        if (error?.workerCode !== 'start') throw error;
+        // A worker that cannot start (a CSP, a missing module): clip here instead, and say why.
+        this.#poolError = error.message;
+        this.#pool.terminate();
+        this.#pool = null;
+      }
+    }
+    const pool = source ? this.#pool : null;
+    const workers = pool?.size ?? 1;
+    const key = this.engine === 'auto' ? this.#engine.profileKey(model, workers) : undefined;
+    let profile = this.#pinned;
+    let profileSource = 'pinned';
+    if (profile === undefined && key !== undefined) {
+      profile = await cachedProfile(key);
+      profileSource = 'cache';
+    }
+    const routing = { workers, profile, profileSource };
+    if (pool) routing.clip = (packed) => pool.clip(packed, signal);
+    return { routing, key };
+  }
+
+  /** Keeps what `auto` routed by, and caches a freshly measured profile. */
+  async #keepRouting(year, key) {
+    if (key === undefined || year.profile === undefined) return;
+    this.#routed = { key, profile: year.profile, source: year.profileSource, refused: year.profileRefused };
+    if (year.profileSource === 'probe') await storeProfile(key, year.profile);
   }
 
   /** The GPU adapter in use. */
@@ -93,23 +223,28 @@ class SunlitEngine {
   loadFiles(files, { receivers = '', north = 0, foliage = '', transmittance = '' } = {}) {
     const names = files.map((f) => String(f.name));
     const contents = files.map((f) => toBytes(f.bytes, f.name));
-    return this.#engine.loadFiles(names, contents, receivers, north, foliage, transmittance);
+    const bytes = contents.reduce((sum, c) => sum + c.byteLength, 0);
+    if (bytes > MAX_MODEL_BYTES) throw tooLarge(names, bytes);
+    let model;
+    try {
+      model = this.#engine.loadFiles(names, contents, receivers, north, foliage, transmittance);
+    } catch (error) {
+      // wasm32 addresses 4 GiB; an allocation past it traps (a RuntimeError) rather than throws.
+      if (error instanceof WebAssembly.RuntimeError) throw tooLarge(names, bytes, error);
+      throw error;
+    }
+    return remember(model, 'files', [names, contents, receivers, north, foliage, transmittance]);
   }
 
   /** A model from typed arrays (see sunlit.d.ts). */
   fromArrays({ positions, indices, triangleReceivers, names, yUp = false }) {
-    return this.#engine.fromArrays(
-      Float32Array.from(positions),
-      Uint32Array.from(indices),
-      Int32Array.from(triangleReceivers),
-      names.map(String),
-      !!yUp,
-    );
+    const args = [Float32Array.from(positions), Uint32Array.from(indices), Int32Array.from(triangleReceivers), names.map(String), !!yUp];
+    return remember(this.#engine.fromArrays(...args), 'arrays', args);
   }
 
   /** A model from meshes and their placements (instancing kept; see sunlit.d.ts, and three.js). */
   fromMeshes({ positions, vertexStarts, indices, indexStarts, placementMeshes, matrices, names, receivers, yUp = false }) {
-    return this.#engine.fromMeshes(
+    const args = [
       Float32Array.from(positions),
       Uint32Array.from(vertexStarts),
       Uint32Array.from(indices),
@@ -119,20 +254,26 @@ class SunlitEngine {
       names.map(String),
       Uint8Array.from(receivers, (r) => (r ? 1 : 0)),
       !!yUp,
-    );
+    ];
+    return remember(this.#engine.fromMeshes(...args), 'meshes', args);
   }
 
   /** Every receiver's sunlit fraction for one sun: [x, y, z] or { azimuth, altitude }. */
   async fractions(model, sun) {
     const [x, y, z] = Array.isArray(sun) ? sun : sunDirection(sun.azimuth, sun.altitude);
-    return this.#engine.fractions(model, x, y, z);
+    const { routing } = await this.#routing(model);
+    return this.#engine.fractions(model, x, y, z, routing);
   }
 
   /** The year's schedule. Rejects with an AbortError when `signal` aborts. */
   async annual(model, settings, { onProgress, signal } = {}) {
     if (signal?.aborted) throw abortError();
     try {
-      return await this.#engine.annual(model, settings, onProgress, signal);
+      const { routing, key } = await this.#routing(model, signal);
+      if (signal?.aborted) throw coded('cancelled', 'cancelled');
+      const year = await this.#engine.annual(model, settings, onProgress, signal, routing);
+      await this.#keepRouting(year, key);
+      return year;
     } catch (error) {
       if (signal?.aborted && error?.code === 'cancelled') throw abortError();
       throw error;

@@ -14,6 +14,7 @@ let running = null;
 /** The engine for these options ({ resolution, engine }), made again when either changes. */
 async function engineFor(options) {
   if (!engine || engine.resolution !== options.resolution || engine.engine !== options.engine) {
+    engine?.close();
     engine = null;
     model?.free();
     model = null;
@@ -39,6 +40,7 @@ function fail(error, request) {
   const gpu = isGpuFailure(error);
   if (gpu) {
     // A lost or failed device cannot be reused; the next request makes a new one.
+    engine?.close();
     engine = null;
     model = null;
   }
@@ -47,6 +49,8 @@ function fail(error, request) {
 
 async function load({ files: given, options, engine: made }) {
   const e = await engineFor(made);
+  const bytes = given.reduce((sum, f) => sum + (f.bytes?.byteLength ?? 0), 0);
+  postMessage({ type: 'loading', stage: 'parse', bytes });
   // Read first: a bad file leaves the last good model in place.
   const m = e.loadFiles(given, options);
   model?.free();
@@ -73,6 +77,14 @@ async function load({ files: given, options, engine: made }) {
     },
     [positions.buffer, receiversOf.buffer],
   );
+  // The pool's workers build their own copies now, while the user sets up the year.
+  if (e.workers) {
+    postMessage({ type: 'loading', stage: 'workers', workers: e.workers });
+    e.prepare(m).then(
+      () => postMessage({ type: 'loading', stage: 'ready', workers: e.workers, poolError: e.poolError }),
+      () => {}, // Said again, with its code, by the year that needs the pool.
+    );
+  }
 }
 
 /** A year; on a lost or failed device, once more on a new one (as the CLI does). */
@@ -81,6 +93,7 @@ async function compute(request) {
     return await computeOnce(request);
   } catch (error) {
     if (!isGpuFailure(error)) throw error;
+    engine?.close();
     engine = null;
     model = null;
     postMessage({ type: 'notice', text: `The GPU device failed (${error.message}); counting again on a new one…` });
@@ -124,6 +137,10 @@ async function computeOnce({ settings, engine: made, csvName }) {
       csv: annual.csv(),
       ...hooked(annual, m.hasEnergyPlus, csvName),
       seconds: (performance.now() - started) / 1000,
+      routing: e.routing,
+      workers: e.workers,
+      hasGpu: e.hasGpu,
+      poolError: e.poolError,
     };
     postMessage(result, [values.buffer]);
   } finally {
@@ -200,4 +217,12 @@ onmessage = async ({ data }) => {
     if (data.type === 'compute' || data.type === 'map') running = null;
   }
 };
-postMessage({ type: 'ready', webgpu: !!self.navigator?.gpu });
+/** Whether this browser offers a WebGPU adapter (navigator.gpu alone may offer none). */
+async function webgpu() {
+  try {
+    return !!(await self.navigator?.gpu?.requestAdapter());
+  } catch {
+    return false;
+  }
+}
+postMessage({ type: 'ready', webgpu: await webgpu() });

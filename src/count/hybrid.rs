@@ -17,8 +17,10 @@
 //!   and of the GPU only where the exact engine's estimate exceeds a GPU's start-up), kept in a cache file keyed by adapter, driver, resolution, cores and the scene's size, and can be pinned
 //!   with a profile file of its own;
 //! - both engines run at once: natively the exact views on every core's threads while the GPU
-//!   lanes count theirs; on the web one after the other (one thread), routed by
-//!   [`simple_route`] since no probe runs there.
+//!   lanes count theirs; on the web the page's pool of workers clips while its GPU counts
+//!   (`web::choice`), routed by the same profile, probed by the same functions
+//!   ([`probe_exact`], [`probe_gpu`]) and keyed alike ([`adapter_threads_key`]); only where it
+//!   is kept differs (IndexedDB there, a file here).
 
 use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
@@ -34,7 +36,7 @@ use crate::platform;
 use crate::scene::Scene;
 
 /// Views each engine is timed on when calibrating (spread over the loads).
-const PROBE_EXACT_VIEWS: usize = 48;
+pub const PROBE_EXACT_VIEWS: usize = 48;
 /// Most time the exact probe may take (s); it stops early past it.
 const PROBE_EXACT_SECONDS: f64 = 0.15;
 /// Times each probed view is clipped (the fastest counts) ...
@@ -154,18 +156,6 @@ impl Profile {
             _ => Route::Exact,
         }
     }
-}
-
-/// Prism triangles up to which [`simple_route`] clips a view rather than counting its pixels.
-pub const SIMPLE_EXACT_TRIANGLES: usize = 2_000;
-
-/// `auto` without a measured profile (the web, where no probe runs): a view is clipped exactly
-/// when nothing see-through is in its prism and the prism holds at most
-/// [`SIMPLE_EXACT_TRIANGLES`] triangles (natively the exact engine answers such a view in well
-/// under a millisecond on one thread, about what one view costs a browser's GPU with its
-/// read-back); heavier views go to the GPU. A pure function of the load, so reproducible.
-pub fn simple_route(load: ViewLoad) -> Route {
-    if load.triangles == 0 || (load.see_through == 0 && load.triangles <= SIMPLE_EXACT_TRIANGLES) { Route::Exact } else { Route::Gpu }
 }
 
 /// The requests `routes` sends to `route`, with their indices in `requests` (to put the answers
@@ -507,7 +497,7 @@ impl<'a> HybridEngine<'a> {
     /// The scene's size, as the profile's key names it: a profile is measured on the model's own
     /// views, and its loads cost differently per model (leaves overlap far more than slats).
     fn scene_key(&self) -> String {
-        format!("scene {} triangles, {} receivers", self.scene.triangle_count(), self.scene.receivers.len())
+        scene_key(self.scene)
     }
 
     /// The profile to route by when one is known without measuring: already in use, pinned in a
@@ -521,7 +511,7 @@ impl<'a> HybridEngine<'a> {
             ProfileSource::File(path) if path.exists() => Some((read_profile(path)?, "file")),
             ProfileSource::Cache => {
                 // An exact-only profile is kept under the CPU's key: finding it asks no adapter.
-                let cpu = cpu_key(&self.options).map(|k| format!("{k}; {scene}"));
+                let cpu = cpu_key(&self.options, cpu_threads()).map(|k| format!("{k}; {scene}"));
                 match cpu.as_deref().and_then(cached) {
                     Some(p) => Some((p, "cache")),
                     None => cached(&format!("{}; {scene}", device_key(&self.options).await?)).map(|p| {
@@ -560,20 +550,15 @@ impl<'a> HybridEngine<'a> {
     async fn calibrate(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], scene: &str) -> Result<Profile> {
         let start = now();
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
-        let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe);
+        let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe, cpu_threads());
         let mut profile = Profile { device: String::new(), exact: exact_cost, gpu: None, gpu_startup_seconds: None };
-        // The probe's views are spread evenly over the sorted loads, so their mean time is the
-        // loaded views' mean (a line through them extrapolates worse: most of a view's time is
-        // its objects' shadows, not its triangles). Below a GPU's start-up for all of them, no
-        // GPU can pay for itself here: it is neither made nor probed.
-        let loaded = loads.iter().filter(|l| l.triangles > 0).count() as f64;
-        if mean_us * loaded > 1e6 * ASSUMED_GPU_STARTUP {
+        if gpu_worth_probing(mean_us, loads) {
             let before = self.stats().gpu_startup_seconds;
-            let lanes = self.gpu_lanes().await?;
+            let lanes: Vec<Lane<'_>> = self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
             profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
-            profile.gpu = Some(probe_gpu(lanes, requests, loads).await?);
+            profile.gpu = Some(probe_gpu(&lanes, requests, loads).await?);
         }
-        let device = match (&profile.gpu, cpu_key(&self.options)) {
+        let device = match (&profile.gpu, cpu_key(&self.options, cpu_threads())) {
             (None, Some(cpu)) => cpu,
             _ => device_key(&self.options).await?,
         };
@@ -611,7 +596,7 @@ fn sample_may_go_to_gpu(exact: &ExactEngine, profile: &Profile, requests: &[View
 }
 
 /// Indices of up to `n` views with something in their prism, spread evenly over their loads.
-fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
+pub fn probe_views(loads: &[ViewLoad], n: usize) -> Vec<usize> {
     let mut loaded: Vec<usize> = (0..loads.len()).filter(|&i| loads[i].triangles > 0 && loads[i].see_through == 0).collect();
     loaded.sort_by_key(|&i| (loads[i].triangles, i));
     let stride = loaded.len().div_ceil(n.max(1)).max(1);
@@ -632,8 +617,9 @@ fn coarse_to_fine<T: Copy>(items: &[T]) -> Vec<T> {
 }
 
 /// Times the exact engine view by view on one thread and fits its cost line; also the mean µs
-/// of a probed view (both per thread: a view costs the machine its time over the threads).
-fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize]) -> (Cost, f64) {
+/// of a probed view (both per thread: a view costs the machine its time over the `threads` that
+/// clip: natively the cores, on the web the pool's workers).
+pub fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad], probe: &[usize], threads: usize) -> (Cost, f64) {
     let mut scratch = exact.scratch();
     let leaves_of = |i: usize| requests[i].leaves;
     // Warm caches and the scratch memory first, on the lightest views.
@@ -662,16 +648,15 @@ fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]
             break;
         }
     }
-    // Work spreads over every core: a view costs the machine its time over the threads.
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+    // Work spreads over every thread: a view costs the machine its time over the threads.
+    let threads = threads.max(1) as f64;
     let line = fit_line(&samples);
     let mean_us = samples.iter().map(|(_, us)| us).sum::<f64>() / samples.len().max(1) as f64;
     (Cost { per_view_us: line.per_view_us / threads, per_triangle_us: line.per_triangle_us / threads }, mean_us / threads)
 }
 
 /// Times a light and a heavy batch of views on the GPU lanes and fits its cost line.
-async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Cost> {
-    let lanes: Vec<Lane<'_>> = lanes.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
+pub async fn probe_gpu(lanes: &[Lane<'_>], requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Cost> {
     let views = probe_views(loads, 6 * PROBE_GPU_VIEWS);
     let third = views.len() / 3;
     let batch = |part: &[usize]| -> (Vec<ViewRequest>, f64) {
@@ -683,7 +668,7 @@ async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], load
     let heavy = &views[views.len() - third.min(PROBE_GPU_VIEWS)..];
     // Warm-up (pipelines, first submission), not timed.
     let (warm, _) = batch(&views[..views.len().min(4)]);
-    Lanes(&lanes).answer(&warm).await?;
+    Lanes(lanes).answer(&warm).await?;
     let mut samples = Vec::new();
     for part in [light, heavy] {
         if part.is_empty() {
@@ -691,7 +676,7 @@ async fn probe_gpu(lanes: &[(Counter, GpuScene)], requests: &[ViewRequest], load
         }
         let (reqs, mean) = batch(part);
         let t0 = now();
-        Lanes(&lanes).answer(&reqs).await?;
+        Lanes(lanes).answer(&reqs).await?;
         samples.push((mean, 1e6 * (now() - t0) / part.len() as f64));
     }
     Ok(fit_line(&samples))
@@ -719,27 +704,59 @@ fn fit_line(samples: &[(f64, f64)]) -> Cost {
     Cost { per_view_us: intercept, per_triangle_us: slope.max(0.0) }
 }
 
-/// The CPU threads and tile side (with the accuracy, if any) of a profile's key.
-fn threads_and_side(options: &CounterOptions) -> String {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+/// Whether the exact engine's probe says a GPU could pay for itself on these views: the probe's
+/// views are spread evenly over the sorted loads, so their mean time (`mean_us`, per thread) is
+/// the loaded views' mean (a line through them extrapolates worse: most of a view's time is its
+/// objects' shadows, not its triangles). Below a GPU's start-up for all of them, no GPU is
+/// worth making or probing.
+pub fn gpu_worth_probing(mean_us: f64, loads: &[ViewLoad]) -> bool {
+    let loaded = loads.iter().filter(|l| l.triangles > 0).count() as f64;
+    mean_us * loaded > 1e6 * ASSUMED_GPU_STARTUP
+}
+
+/// This machine's threads for clipping (1 where it cannot tell).
+fn cpu_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The scene's size, as a profile's key names it: a profile is measured on the model's own
+/// views, and its loads cost differently per model (leaves overlap far more than slats).
+pub fn scene_key(scene: &Scene) -> String {
+    format!("scene {} triangles, {} receivers", scene.triangle_count(), scene.receivers.len())
+}
+
+/// The clipping threads and tile side (with the accuracy, if any) of a profile's key.
+fn threads_and_side(options: &CounterOptions, threads: usize) -> String {
     let accuracy = options.accuracy.map_or(String::new(), |a| format!(" ±{a}"));
     format!("{threads} CPU threads; {}²{accuracy}", options.resolution)
 }
 
-/// The key of a profile that never needs the GPU (no view was worth its start-up): the CPU's
+/// The key of a profile that never needs the GPU (no view was worth its start-up): the clipping
 /// threads and the tile side, without the adapter, since asking for one costs a small model a
 /// third of its run (on lavapipe: loading the driver). `None` for a side outside what every
 /// adapter renders (wgpu's downlevel minimum), which only the adapter can check.
-fn cpu_key(options: &CounterOptions) -> Option<String> {
+pub fn cpu_key(options: &CounterOptions, threads: usize) -> Option<String> {
     let every_adapter = 16..=wgpu::Limits::downlevel_defaults().max_texture_dimension_2d;
-    every_adapter.contains(&options.resolution).then(|| format!("exact only; {}", threads_and_side(options)))
+    every_adapter.contains(&options.resolution).then(|| format!("exact only; {}", threads_and_side(options, threads)))
+}
+
+/// An adapter as a profile's key names it: name, backend and driver.
+pub fn adapter_key(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {} {})", info.name, info.backend, info.driver, info.driver_info)
+}
+
+/// The key of a profile measured with `adapter` (None: no GPU adapter) and `threads` clipping
+/// threads at `options`' side: adapter, driver, threads and side.
+pub fn adapter_threads_key(adapter: Option<&wgpu::AdapterInfo>, options: &CounterOptions, threads: usize) -> String {
+    let adapter = adapter.map_or_else(|| "no GPU adapter".to_string(), adapter_key);
+    format!("{adapter}; {}", threads_and_side(options, threads))
 }
 
 /// What identifies the device a profile belongs to: adapter, driver, CPU threads and tile side.
 /// Refuses a side the adapter cannot render, as the GPU would (without making a device).
 pub async fn device_key(options: &CounterOptions) -> Result<String> {
     let resolution = options.resolution;
-    let adapter = match platform::instance().request_adapter(&wgpu::RequestAdapterOptions::default()).await {
+    let info = match platform::instance().request_adapter(&wgpu::RequestAdapterOptions::default()).await {
         Ok(a) => {
             let limit = a.limits().max_texture_dimension_2d;
             if !(16..=limit).contains(&resolution) {
@@ -748,12 +765,26 @@ pub async fn device_key(options: &CounterOptions) -> Result<String> {
                     format!("{resolution} is outside 16..={limit} (this device's texture size limit)"),
                 ));
             }
-            let info = a.get_info();
-            format!("{} ({:?}, {} {})", info.name, info.backend, info.driver, info.driver_info)
+            Some(a.get_info())
         }
-        Err(_) => "no GPU adapter".to_string(),
+        Err(_) => None,
     };
-    Ok(format!("{adapter}; {}", threads_and_side(options)))
+    Ok(adapter_threads_key(info.as_ref(), options, cpu_threads()))
+}
+
+/// A profile's text (JSON, as [`write_profile`] writes it) for the device and scene `keys` name
+/// (the adapter's key and the exact-only key, each with the scene's size): refused, naming
+/// `source` and the reason, when it does not parse or was measured for another model or device.
+pub fn profile_for(text: &str, source: &str, keys: &[&str]) -> Result<Profile> {
+    let profile: Profile =
+        serde_json::from_str(text).map_err(|e| Error::argument("engine profile", format!("{source} is not a profile: {e}")))?;
+    if !keys.contains(&profile.device.as_str()) {
+        return Err(Error::argument(
+            "engine profile",
+            format!("{source} was measured for '{}', not this model and device ('{}')", profile.device, keys.first().unwrap_or(&"")),
+        ));
+    }
+    Ok(profile)
 }
 
 /// Reads a profile file.

@@ -1,54 +1,272 @@
-//! The JS API's `engine` option (`createEngine({ engine })`): which engine answers a page's views.
+//! The JS API's `engine` option (`createEngine({ engine })`): which engine answers a page's views,
+//! and the page's `auto`, routed by a measured profile as natively.
 //!
-//! Owns the split of a batch of views between the exact engine (single-threaded here: the wasm
-//! runs in one worker) and the engine's GPU lane, and the web's rule for `auto`: no probe runs
-//! in a page, so `auto` routes by [`simple_route`] (light views clipped, heavy or see-through
-//! ones counted on the GPU), never by timing, so a page's answers do not depend on its load.
+//! Owns the split of a batch of views between the exact engine and the GPU lane on the web:
+//! - the exact share goes to the JS pool of clipping workers (`www/pool.js`, each with its own
+//!   wasm instance and scene) through one callback, started before the GPU's share is counted so
+//!   both run at once; without a pool it is clipped here;
+//! - `auto` routes by a [`Profile`] measured by the native calibration's own probes
+//!   ([`probe_exact`], [`probe_gpu`]) on the model's own views, keyed like the native cache
+//!   ([`adapter_threads_key`], [`cpu_key`]) with the pool's size as the clipping threads. A
+//!   profile handed in (pinned by the caller, or the page's IndexedDB cache) is used when it
+//!   parses and belongs to this model and device ([`profile_for`]); otherwise it is refused by
+//!   name (see [`Chosen::refused`]) and measured anew. Routing is [`Profile::route`]: a pure
+//!   function of the loads, the profile and the run's size, so the same inputs with the same
+//!   profile give the same answers byte for byte, whatever the pool's size.
 
-use crate::count::exact::engine::ExactEngine;
-use crate::count::hybrid::{EngineKind, Route, Split, simple_route};
+use std::cell::{Cell, OnceCell, RefCell};
+
+use js_sys::{Float64Array, Function, Promise, Reflect};
+use wasm_bindgen::prelude::*;
+use wasm_bindgen_futures::JsFuture;
+
+use crate::count::exact::engine::{ExactEngine, ViewLoad};
+use crate::count::gpu::CounterOptions;
+use crate::count::hybrid::{
+    EngineKind, PROBE_EXACT_VIEWS, Profile, Route, Split, adapter_threads_key, cpu_key, gpu_worth_probing, probe_exact, probe_gpu,
+    probe_views, profile_for, scene_key,
+};
 use crate::count::lanes::Lane;
-use crate::count::{Engine, ViewAnswer, ViewRequest};
-use crate::error::Result;
+use crate::count::{Engine, ViewAnswer, ViewRequest, check_receivers};
+use crate::error::{Error, Result};
 use crate::scene::Scene;
 
-/// The chosen engine over one model: its exact engine (made on first use) and its GPU lane.
-pub(super) struct Chosen<'a> {
-    pub kind: EngineKind,
-    pub scene: &'a Scene,
-    pub exact: &'a std::cell::OnceCell<ExactEngine>,
-    pub lane: Lane<'a>,
+/// Numbers per packed request handed to the pool: receiver, sun x, y, z, leaf fraction.
+pub(super) const PACKED: usize = 5;
+
+/// How the caller routes: its pool of clipping workers and a profile to try first.
+#[derive(Default)]
+pub(super) struct Routing {
+    /// `clip(Float64Array of packed requests) → Promise<Float64Array of fractions>`.
+    pool: Option<Function>,
+    /// Threads that clip: the pool's workers (1 without a pool).
+    threads: usize,
+    /// A profile's JSON text and where it came from (`pinned`, `cache`).
+    given: Option<(String, String)>,
 }
 
-impl Chosen<'_> {
+impl Routing {
+    /// Reads `{ clip, workers, profile, profileSource }` (each optional) from the JS object.
+    pub(super) fn from_js(value: &JsValue) -> Result<Self> {
+        if value.is_undefined() || value.is_null() {
+            return Ok(Self { threads: 1, ..Default::default() });
+        }
+        let get = |key: &str| Reflect::get(value, &JsValue::from(key)).ok().filter(|v| !v.is_undefined() && !v.is_null());
+        let pool = match get("clip") {
+            Some(f) => Some(f.dyn_into::<Function>().map_err(|_| Error::argument("clip", "not a function"))?),
+            None => None,
+        };
+        let threads = match get("workers").and_then(|w| w.as_f64()) {
+            Some(w) if w >= 1.0 && w.fract() == 0.0 => w as usize,
+            Some(w) => return Err(Error::argument("workers", format!("{w} is not a whole number of at least 1"))),
+            None => 1,
+        };
+        let source = get("profileSource").and_then(|s| s.as_string()).unwrap_or_else(|| "pinned".into());
+        let text = |p: JsValue| p.as_string().unwrap_or_else(|| js_sys::JSON::stringify(&p).ok().map(String::from).unwrap_or_default());
+        let given = get("profile").map(|p| (text(p), source));
+        Ok(Self { pool, threads, given })
+    }
+}
+
+/// The chosen engine over one model for one call: its exact engine (made on first use), its GPU
+/// lane (none without WebGPU), the caller's routing, and what routing learnt.
+pub(super) struct Chosen<'a> {
+    kind: EngineKind,
+    scene: &'a Scene,
+    exact: &'a OnceCell<ExactEngine>,
+    lane: Option<Lane<'a>>,
+    routing: &'a Routing,
+    /// The profile's keys: with the adapter, and exact-only (when the side allows one).
+    keys: (String, Option<String>),
+    profile: OnceCell<(Profile, &'static str)>,
+    refused: RefCell<Option<String>>,
+    /// Why the pool failed, as the pool said it (its `code`, the worker's index), for the caller.
+    pool_error: RefCell<Option<JsValue>>,
+    run_views: Cell<usize>,
+}
+
+impl<'a> Chosen<'a> {
+    /// The engine `kind` over `scene`; `adapter` names the GPU (None without WebGPU).
+    pub(super) fn new(
+        kind: EngineKind,
+        scene: &'a Scene,
+        exact: &'a OnceCell<ExactEngine>,
+        lane: Option<Lane<'a>>,
+        options: &CounterOptions,
+        routing: &'a Routing,
+    ) -> Self {
+        let keys = profile_keys(scene, lane.as_ref().map(|l| l.counter.adapter_info()), options, routing.threads);
+        Self {
+            kind,
+            scene,
+            exact,
+            lane,
+            routing,
+            keys,
+            profile: OnceCell::new(),
+            refused: RefCell::new(None),
+            pool_error: RefCell::new(None),
+            run_views: Cell::new(0),
+        }
+    }
+
     fn exact(&self) -> &ExactEngine {
         self.exact.get_or_init(|| ExactEngine::new(self.scene))
     }
+
+    fn lane(&self) -> Result<&Lane<'a>> {
+        self.lane.as_ref().ok_or_else(|| {
+            Error::argument("engine", "the GPU engine is missing: this browser offers no WebGPU ('exact' and 'auto' clip without it)")
+        })
+    }
+
+    /// Whether `auto` clips every view whatever its load, so the loads need not be walked here
+    /// (the pool walks them as it clips): a profile without a GPU cost, or no GPU, and nothing
+    /// see-through in the scene. [`Profile::route`] would send every view to the exact engine.
+    fn clips_everything(&self) -> bool {
+        let exact_only = self.profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.lane.is_none());
+        exact_only && self.scene.see_through_triangles == 0
+    }
+
+    /// The profile `auto` routed by, as JSON, and where it came from (`pinned`, `cache`, `probe`).
+    pub(super) fn profile(&self) -> Option<(String, &'static str)> {
+        self.profile.get().and_then(|(p, source)| serde_json::to_string(p).ok().map(|t| (t, *source)))
+    }
+
+    /// Why a profile handed in was refused (it was then measured anew).
+    pub(super) fn refused(&self) -> Option<String> {
+        self.refused.borrow().clone()
+    }
+
+    /// The pool's own error, when the pool failed: the caller gets it as the pool threw it.
+    pub(super) fn take_pool_error(&self) -> Option<JsValue> {
+        self.pool_error.borrow_mut().take()
+    }
+
+    /// The profile for these views: the one handed in if it fits, else measured on them.
+    async fn routing_profile(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
+        if let Some((p, _)) = self.profile.get() {
+            return Ok(p);
+        }
+        let keys: Vec<&str> = [Some(self.keys.0.as_str()), self.keys.1.as_deref()].into_iter().flatten().collect();
+        let found = self.routing.given.as_ref().map(|(text, source)| (profile_for(text, &format!("the {source} profile"), &keys), source));
+        let chosen = match found {
+            Some((Ok(p), source)) => (p, if source == "cache" { "cache" } else { "pinned" }),
+            Some((Err(e), _)) => {
+                *self.refused.borrow_mut() = Some(e.to_string());
+                (self.measure(requests, loads).await?, "probe")
+            }
+            None => (self.measure(requests, loads).await?, "probe"),
+        };
+        let _ = self.profile.set(chosen);
+        self.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
+    }
+
+    /// The native calibration on this page: the exact engine timed on one thread (a pool
+    /// worker's speed) and spread over the pool's workers; the GPU only where it could pay.
+    /// The device exists already, so its start-up is spent (0 s).
+    async fn measure(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Profile> {
+        let probe = probe_views(loads, PROBE_EXACT_VIEWS);
+        let (exact, mean_us) = probe_exact(self.exact(), requests, loads, &probe, self.routing.threads);
+        let gpu = match &self.lane {
+            Some(lane) if gpu_worth_probing(mean_us, loads) => Some(probe_gpu(std::slice::from_ref(lane), requests, loads).await?),
+            _ => None,
+        };
+        let device = match (&gpu, &self.keys.1) {
+            (None, Some(cpu)) => cpu.clone(),
+            _ => self.keys.0.clone(),
+        };
+        Ok(Profile { device, exact, gpu, gpu_startup_seconds: gpu.map(|_| 0.0) })
+    }
+
+    /// Starts the pool on `requests` (its promise runs while the GPU counts).
+    fn start_pool(&self, pool: &Function, requests: &[ViewRequest]) -> Result<JsFuture> {
+        let packed: Vec<f64> =
+            requests.iter().flat_map(|r| [f64::from(r.receiver), r.sun.x, r.sun.y, r.sun.z, f64::from(r.leaves)]).collect();
+        let promise = pool.call1(&JsValue::NULL, &Float64Array::from(packed.as_slice())).map_err(|e| self.pool_failed(e))?;
+        let promise = promise.dyn_into::<Promise>().map_err(|_| Error::argument("clip", "did not return a promise"))?;
+        Ok(JsFuture::from(promise))
+    }
+
+    async fn finish_pool(&self, pending: JsFuture, views: usize) -> Result<Vec<f64>> {
+        let value = pending.await.map_err(|e| self.pool_failed(e))?;
+        let fractions = Float64Array::new(&value).to_vec();
+        if fractions.len() != views {
+            return Err(Error::argument("clip", format!("answered {} views of {views}", fractions.len())));
+        }
+        Ok(fractions)
+    }
+
+    /// Keeps the pool's error for the caller; the library sees a cancellation (stop counting).
+    fn pool_failed(&self, error: JsValue) -> Error {
+        *self.pool_error.borrow_mut() = Some(error);
+        Error::Cancelled
+    }
+}
+
+/// The keys a profile of this model may carry: measured with the adapter, and exact-only.
+fn profile_keys(scene: &Scene, adapter: Option<&wgpu::AdapterInfo>, options: &CounterOptions, threads: usize) -> (String, Option<String>) {
+    let scene = scene_key(scene);
+    let with_adapter = format!("{}; {scene}", adapter_threads_key(adapter, options, threads));
+    (with_adapter, cpu_key(options, threads).map(|k| format!("{k}; {scene}")))
+}
+
+/// The key under which the page keeps this model's profile: the adapter's (None: no WebGPU).
+pub(super) fn store_key(scene: &Scene, adapter: Option<&wgpu::AdapterInfo>, options: &CounterOptions, threads: usize) -> String {
+    profile_keys(scene, adapter, options, threads).0
 }
 
 impl Engine for Chosen<'_> {
     fn batch(&self) -> usize {
-        self.lane.batch()
+        // A GPU's atlas, or without one a batch every worker of a pool gets views of.
+        self.lane.as_ref().map_or(256, |l| l.batch())
+    }
+
+    fn expect(&self, views: usize) {
+        self.run_views.set(views);
     }
 
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
-        let (routes, clipped): (Vec<Route>, Option<Vec<f64>>) = match self.kind {
-            EngineKind::Gpu => return self.lane.answer(requests).await,
+        check_receivers(self.scene.receivers.len(), requests)?;
+        let (routes, loads) = match self.kind {
+            EngineKind::Gpu => return self.lane()?.answer(requests).await,
             EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
+            EngineKind::Auto if self.clips_everything() => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto => {
-                // One walk a view: its load routes it, and a view routed exact is clipped from it.
-                let walked = self.exact().fractions_unless(requests, |load| simple_route(load) == Route::Gpu);
-                let routes = walked.iter().map(|(_, f)| if f.is_some() { Route::Exact } else { Route::Gpu }).collect();
-                (routes, Some(walked.into_iter().filter_map(|(_, f)| f).collect()))
+                let loads = self.exact().loads(requests);
+                let profile = self.routing_profile(requests, &loads).await?;
+                let mut routes = profile.route(&loads, self.run_views.get());
+                if self.lane.is_none() {
+                    // No WebGPU: see-through views are clipped as opaque, as `exact` does.
+                    routes.iter_mut().for_each(|r| *r = Route::Exact);
+                }
+                (routes, Some(loads))
             }
         };
-        let split = Split::new(requests, &routes, None);
-        let exact = match clipped {
-            Some(clipped) => clipped,
+        let split = Split::new(requests, &routes, loads.as_deref());
+        let pooled = match &self.routing.pool {
+            Some(pool) if !split.exact_reqs.is_empty() => Some(self.start_pool(pool, &split.exact_reqs)?),
+            _ => None,
+        };
+        let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane()?.answer(&split.gpu_reqs).await? };
+        let exact = match pooled {
+            Some(pending) => self.finish_pool(pending, split.exact_reqs.len()).await?,
             None if split.exact_reqs.is_empty() => Vec::new(),
             None => split.exact_fractions(self.exact()),
         };
-        let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane.answer(&split.gpu_reqs).await? };
         Ok(split.merge(self.scene, requests, exact, gpu))
     }
+}
+
+/// Unpacks the pool's requests ([`PACKED`] numbers each), refusing a receiver the scene lacks.
+pub(super) fn unpack(packed: &[f64], receivers: usize) -> Result<Vec<ViewRequest>> {
+    if !packed.len().is_multiple_of(PACKED) {
+        return Err(Error::argument("requests", format!("{} numbers is not a multiple of {PACKED}", packed.len())));
+    }
+    let requests: Vec<ViewRequest> = packed
+        .chunks_exact(PACKED)
+        .map(|p| ViewRequest::new(p[0] as u32, glam::DVec3::new(p[1], p[2], p[3])).with_leaves(p[4] as f32))
+        .collect();
+    check_receivers(receivers, &requests)?;
+    Ok(requests)
 }

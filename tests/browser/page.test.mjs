@@ -422,14 +422,25 @@ test('a dense year has no fitted surfaces: splineFractionsAt is refused naming d
   assert.deepEqual(r.linear, [1], 'fractionsAt still answers');
 });
 
-test('a browser without WebGPU is told so', async () => {
+test('a browser without WebGPU is told only the GPU engine is missing, and still computes', { timeout: 600_000 }, async () => {
   const plain = await launch({ webgpu: false });
   try {
     const p = await plain.newPage();
+    const errors = [];
+    p.on('pageerror', (e) => errors.push(e.message));
     await p.goto(`${origin}/`);
     await p.waitForSelector('#nowebgpu:not([hidden])', { timeout: 60_000 });
-    assert.match(await p.textContent('#nowebgpu'), /no WebGPU, which sunlit needs/);
-    assert.equal(await p.isDisabled('#compute'), true);
+    assert.match(await p.textContent('#nowebgpu'), /no WebGPU, so only the GPU engine is missing/);
+    await p.setInputFiles('#model', EXAMPLE);
+    await p.waitForFunction(() => /^Loaded/.test(document.getElementById('status').textContent), null, { timeout: 120_000 });
+    assert.match(await p.textContent('#status'), /on none \(no WebGPU/);
+    await p.fill('#days', '6');
+    await p.fill('#perday', '7');
+    await p.click('#compute');
+    await p.waitForFunction(() => /^Done|^Could not/.test(document.getElementById('status').textContent), null, { timeout: 300_000 });
+    assert.match(await p.textContent('#status'), /^Done in [\d.]+ s: 10 surfaces/);
+    assert.match(await p.textContent('#routingsource'), /no GPU/);
+    assert.deepEqual(errors, []);
   } finally {
     await plain.close();
   }

@@ -1,0 +1,253 @@
+// The page's measured `auto` and its pool of clipping workers, in headless Chromium through the
+// JS API (sunlit.js): a pool of 2 answers a year byte for byte as one worker and as no worker do;
+// `auto` measures a profile once, keeps it in IndexedDB (the next engine finds it: 'cache'), and a
+// pinned profile gives the same CSV whatever the pool's size; a profile that does not parse or
+// was measured for another model is refused by name and measured anew; one worker's failure is
+// reported with its index and code; Cancel in the middle of a pooled year rejects with an
+// AbortError and the engine then computes the same year again; a browser without WebGPU still
+// computes (clipping), and only the GPU engine is refused there.
+import assert from 'node:assert/strict';
+import { after, before, test } from 'node:test';
+import { serve } from '../../scripts/serve.mjs';
+import { launch } from './chromium.mjs';
+
+let server;
+let origin;
+let browser;
+
+before(async () => {
+  server = await serve(0);
+  origin = `http://127.0.0.1:${server.address().port}`;
+  browser = await launch();
+});
+
+after(async () => {
+  await browser?.close();
+  server?.close();
+});
+
+/** A page of the site to import the API in (its CSP is the site's). */
+async function apiPage(b = browser) {
+  const p = await b.newPage();
+  const errors = [];
+  p.on('pageerror', (e) => errors.push(e.message));
+  await p.goto(`${origin}/api-example.html`);
+  return { p, errors };
+}
+
+/** In the page: a box-shaped building (4 walls and a roof, the receivers) behind rows of louvre
+ * slats and a neighbouring block, as typed arrays: shadows with many edges, built the same way in
+ * every run (no randomness). */
+const SCENE = `
+function louvredBlock() {
+  const positions = [];
+  const indices = [];
+  const triangleReceivers = [];
+  const quad = (a, b, c, d, receiver) => {
+    const i = positions.length / 3;
+    positions.push(...a, ...b, ...c, ...d);
+    indices.push(i, i + 1, i + 2, i, i + 2, i + 3);
+    triangleReceivers.push(receiver, receiver);
+  };
+  const box = (x0, y0, z0, x1, y1, z1) => {
+    quad([x0, y0, z0], [x1, y0, z0], [x1, y0, z1], [x0, y0, z1], -1);
+    quad([x1, y1, z0], [x0, y1, z0], [x0, y1, z1], [x1, y1, z1], -1);
+    quad([x0, y1, z0], [x0, y0, z0], [x0, y0, z1], [x0, y1, z1], -1);
+    quad([x1, y0, z0], [x1, y1, z0], [x1, y1, z1], [x1, y0, z1], -1);
+    quad([x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1], -1);
+    quad([x0, y1, z0], [x1, y1, z0], [x1, y0, z0], [x0, y0, z0], -1);
+  };
+  // Receivers: south, east, north, west walls and the roof of a 10 x 8 x 6 m block.
+  quad([0, 0, 0], [10, 0, 0], [10, 0, 6], [0, 0, 6], 0);
+  quad([10, 0, 0], [10, 8, 0], [10, 8, 6], [10, 0, 6], 1);
+  quad([10, 8, 0], [0, 8, 0], [0, 8, 6], [10, 8, 6], 2);
+  quad([0, 8, 0], [0, 0, 0], [0, 0, 6], [0, 8, 6], 3);
+  quad([0, 0, 6], [10, 0, 6], [10, 8, 6], [0, 8, 6], 4);
+  // Louvres: 24 slats 0.6 m in front of the south wall, 15 fins in front of the east wall.
+  for (let k = 0; k < 24; k++) box(0.2, -0.8, 0.2 + k * 0.24, 9.8, -0.6, 0.25 + k * 0.24);
+  for (let k = 0; k < 15; k++) box(10.6, 0.3 + k * 0.5, 0.2, 10.7, 0.5 + k * 0.5, 5.8);
+  // A neighbour to the south-west, and a rooftop plant box.
+  box(-14, -12, 0, -4, -6, 14);
+  box(3, 3, 6, 5, 4.5, 7.5);
+  return { positions, indices, triangleReceivers, names: ['South', 'East', 'North', 'West', 'Roof'] };
+}
+`;
+
+const YEAR = { latitude: 39.74, longitude: -105.18, timeZone: -7, timestepsPerHour: 1, daysPerYear: 12, samplesPerDay: 9 };
+
+test('a pool of 2 answers as one worker and as none: the same CSV, byte for byte', async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(
+    async ({ scene, year }) => {
+      eval(scene);
+      const { createEngine } = await import('/sunlit.js');
+      const csvs = {};
+      for (const workers of [0, 1, 2]) {
+        const engine = await createEngine({ resolution: 128, engine: 'exact', workers });
+        const model = engine.fromArrays(louvredBlock());
+        const y = await engine.annual(model, year);
+        csvs[workers] = { csv: y.csv(), means: Array.from(y.means), pool: engine.workers };
+        engine.close();
+      }
+      return csvs;
+    },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR },
+  );
+  await p.close();
+  assert.deepEqual(errors, []);
+  assert.deepEqual([r[0].pool, r[1].pool, r[2].pool], [0, 1, 2]);
+  // Shadows were cast (else equal CSVs would prove nothing): the louvred wall is partly lit.
+  assert.ok(r[0].means[0] > 0.05 && r[0].means[0] < 0.95, `south wall's mean ${r[0].means[0]}`);
+  assert.equal(r[1].csv, r[0].csv, 'one worker = no worker');
+  assert.equal(r[2].csv, r[0].csv, 'two workers = no worker');
+});
+
+test('auto measures a profile once, caches it, and a pinned profile gives the same CSV', async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(
+    async ({ scene, year }) => {
+      eval(scene);
+      const { createEngine } = await import('/sunlit.js');
+      const run = async (options) => {
+        const engine = await createEngine({ resolution: 128, ...options });
+        const model = engine.fromArrays(louvredBlock());
+        const y = await engine.annual(model, year);
+        const out = { csv: y.csv(), profile: y.profile, source: y.profileSource, refused: y.profileRefused, routing: engine.routing };
+        engine.close();
+        return out;
+      };
+      const measured = await run({ workers: 2 });
+      const cached = await run({ workers: 2 });
+      const pinned2 = await run({ workers: 2, profile: measured.profile });
+      const pinned1 = await run({ workers: 1, profile: measured.profile });
+      const garbled = await run({ workers: 2, profile: '{"device": 3' });
+      const other = JSON.parse(measured.profile);
+      other.device = other.device.replace(/scene \d+ triangles/, 'scene 7 triangles');
+      const foreign = await run({ workers: 2, profile: other });
+      const exact = await run({ workers: 2, engine: 'exact' });
+      return { measured, cached, pinned2, pinned1, garbled, foreign, exact };
+    },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR },
+  );
+  await p.close();
+  assert.deepEqual(errors, []);
+  assert.equal(r.measured.source, 'probe');
+  assert.match(r.measured.routing.key, /2 CPU threads; 128²; scene \d+ triangles, 5 receivers$/);
+  assert.equal(r.cached.source, 'cache', 'the second engine finds the profile in IndexedDB');
+  assert.equal(r.cached.profile, r.measured.profile);
+  assert.equal(r.cached.csv, r.measured.csv, 'same profile, same CSV');
+  assert.equal(r.pinned2.source, 'pinned');
+  assert.equal(r.pinned2.refused, undefined);
+  assert.equal(r.pinned2.csv, r.measured.csv, 'a pinned profile routes as the measured one did');
+  // A profile measured with 2 workers names 2 threads: pinned on 1 worker it belongs to another
+  // device, and is refused by name and measured anew.
+  assert.equal(r.pinned1.source, 'probe');
+  assert.match(r.pinned1.refused, /pinned profile was measured for '.*2 CPU threads.*', not this model and device/);
+  assert.match(r.garbled.refused, /engine profile.*the pinned profile is not a profile/);
+  assert.equal(r.garbled.source, 'probe');
+  assert.match(r.foreign.refused, /scene 7 triangles/);
+  // Whatever the profile, every answer is exact or counted: here the views go to the exact engine
+  // (the profile's GPU cost is absent or dearer on SwiftShader), so auto's CSV is exact's.
+  const profile = JSON.parse(r.measured.profile);
+  if (profile.gpu === null) assert.equal(r.measured.csv, r.exact.csv);
+});
+
+test('one worker failing is reported with its index and code; a missing module says it could not start', async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(async () => {
+    const { ClipPool } = await import('/pool.js');
+    const caught = async (work) => {
+      try {
+        await work();
+        return null;
+      } catch (e) {
+        return { code: e.code, worker: e.worker, workerCode: e.workerCode, message: e.message };
+      }
+    };
+    const pool = new ClipPool(2);
+    const unloaded = await caught(() => pool.clip(new Float64Array([0, 0, 0, 1, 1, 0, 0, 0, 1, 1])));
+    const badSource = await caught(() => new ClipPool(2).use({ kind: 'nonsense', args: [] }));
+    const missing = await caught(() => new ClipPool(1, new URL('/no-such-worker.js', location.href)).start());
+    return { unloaded, badSource, missing };
+  });
+  await p.close();
+  assert.deepEqual(errors, []);
+  assert.equal(r.unloaded.code, 'worker');
+  assert.equal(r.unloaded.workerCode, 'no-model');
+  assert.ok([0, 1].includes(r.unloaded.worker));
+  assert.match(r.unloaded.message, /clipping worker [01] failed: no model loaded/);
+  assert.equal(r.badSource.code, 'bad-option');
+  assert.match(r.badSource.message, /unknown model source 'nonsense'/);
+  assert.equal(r.missing.code, 'worker');
+  assert.equal(r.missing.workerCode, 'start');
+});
+
+test('Cancel in the middle of a pooled year rejects, and the same engine computes the year after', async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(
+    async ({ scene, year }) => {
+      eval(scene);
+      const { createEngine } = await import('/sunlit.js');
+      const engine = await createEngine({ resolution: 128, engine: 'exact', workers: 2 });
+      const model = engine.fromArrays(louvredBlock());
+      const controller = new AbortController();
+      let seen = 0;
+      let cancelled = null;
+      try {
+        await engine.annual(model, { ...year, daysPerYear: 60, samplesPerDay: 30 }, {
+          signal: controller.signal,
+          onProgress: (done, total) => {
+            seen = done;
+            if (done > 0 && done < total) controller.abort();
+          },
+        });
+      } catch (e) {
+        cancelled = e.name;
+      }
+      const again = (await engine.annual(model, year)).csv();
+      const fresh = await createEngine({ resolution: 128, engine: 'exact', workers: 0 });
+      const reference = (await fresh.annual(fresh.fromArrays(louvredBlock()), year)).csv();
+      return { cancelled, seen, same: again === reference };
+    },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR },
+  );
+  await p.close();
+  assert.deepEqual(errors, []);
+  assert.equal(r.cancelled, 'AbortError');
+  assert.ok(r.seen > 0);
+  assert.ok(r.same, 'after a cancel the pool answers the next year as a fresh engine does');
+});
+
+test('without WebGPU the engine clips (auto and exact agree), and only the GPU engine is refused', async () => {
+  const plain = await launch({ webgpu: false });
+  try {
+    const { p, errors } = await apiPage(plain);
+    const r = await p.evaluate(
+      async ({ scene, year }) => {
+        eval(scene);
+        const { createEngine } = await import('/sunlit.js');
+        let refused = null;
+        try {
+          await createEngine({ engine: 'gpu' });
+        } catch (e) {
+          refused = { code: e.code, message: e.message };
+        }
+        const auto = await createEngine({ resolution: 128, workers: 2 });
+        const exact = await createEngine({ resolution: 128, engine: 'exact', workers: 0 });
+        const a = await auto.annual(auto.fromArrays(louvredBlock()), year);
+        const e = await exact.annual(exact.fromArrays(louvredBlock()), year);
+        return { refused, hasGpu: auto.hasGpu, adapter: auto.adapter, same: a.csv() === e.csv(), key: auto.routing.key };
+      },
+      { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR },
+    );
+    assert.deepEqual(errors, []);
+    assert.equal(r.refused.code, 'no-webgpu');
+    assert.match(r.refused.message, /GPU engine is missing/);
+    assert.equal(r.hasGpu, false);
+    assert.match(r.adapter, /no WebGPU/);
+    assert.ok(r.same, 'auto without a GPU clips every view, as exact does');
+    assert.match(r.key, /^no GPU adapter; 2 CPU threads/);
+  } finally {
+    await plain.close();
+  }
+});

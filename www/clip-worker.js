@@ -1,0 +1,45 @@
+// One worker of the clipping pool (pool.js): its own wasm instance, holding one model's exact
+// engine (a Clipper), answering chunks of packed views. Messages in: load { source }, clip
+// { job, data }. Out: ready, loaded, loadError { message, code }, clipped { job, fractions },
+// clipError { job, message, code }.
+import init, { Clipper } from './pkg/sunlit_wasm.js';
+
+let clipper = null;
+
+/** A Clipper from what built the engine's model (sunlit.js keeps it: files, arrays or meshes). */
+function build({ kind, args }) {
+  if (kind === 'files') return Clipper.fromFiles(...args);
+  if (kind === 'arrays') return Clipper.fromArrays(...args);
+  if (kind === 'meshes') return Clipper.fromMeshes(...args);
+  throw Object.assign(new Error(`unknown model source '${kind}'`), { code: 'bad-option' });
+}
+
+function failure(error) {
+  // A trap (out of memory, a bug) has no code; name it so the page can say what happened.
+  const code = error?.code ?? (error instanceof WebAssembly.RuntimeError ? 'wasm-trap' : 'worker');
+  return { message: String(error?.message ?? error), code };
+}
+
+onmessage = ({ data }) => {
+  if (data.type === 'load') {
+    try {
+      clipper?.free();
+      clipper = null;
+      clipper = build(data.source);
+      postMessage({ type: 'loaded' });
+    } catch (error) {
+      postMessage({ type: 'loadError', ...failure(error) });
+    }
+  } else if (data.type === 'clip') {
+    try {
+      if (!clipper) throw Object.assign(new Error('no model loaded'), { code: 'no-model' });
+      const fractions = clipper.fractions(data.data);
+      postMessage({ type: 'clipped', job: data.job, fractions }, [fractions.buffer]);
+    } catch (error) {
+      postMessage({ type: 'clipError', job: data.job, ...failure(error) });
+    }
+  }
+};
+
+await init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) });
+postMessage({ type: 'ready' });
