@@ -9,6 +9,7 @@ use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
 use sunlit::map::study::{self, SunRule};
 use sunlit::map::{Mapper, Period, Points, Site};
+use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
 
 use super::*;
@@ -150,7 +151,10 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
     let (location, dni) = match (&args.epw, &args.location) {
-        (Some(epw), _) => (Location::from_epw(epw)?, Some(irradiation::DirectNormal::from_epw(epw)?)),
+        (Some(epw), _) => {
+            let weather = Weather::from_epw(epw)?;
+            (weather.location.clone(), Some(weather))
+        }
         (None, Some(text)) => (Location::parse(text)?, None),
         (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
     };

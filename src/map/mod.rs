@@ -40,7 +40,7 @@ use crate::count::MIN_COS_INCIDENCE;
 use crate::count::exact::engine::ExactEngine;
 use crate::count::exact::rays::PlanePoints;
 use crate::error::{Error, Result};
-use crate::export::irradiation::DirectNormal;
+use crate::sun::weather::Weather;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
@@ -95,8 +95,8 @@ pub struct Site<'a> {
     pub location: &'a Location,
     /// The foliage's leaf fraction through the year.
     pub calendar: &'a LeafCalendar,
-    /// Direct normal irradiance, for direct irradiation; `None`: sun hours only.
-    pub dni: Option<&'a DirectNormal>,
+    /// The weather whose direct normal irradiance gives direct irradiation; `None`: sun hours only.
+    pub dni: Option<&'a Weather>,
 }
 
 /// Per point sums over a period.
@@ -184,7 +184,7 @@ impl Mapper {
             || (vec![0.0f64; n], if with_dni { vec![0.0f64; n] } else { Vec::new() }),
             |acc, _, s, sun, g, vis| {
                 let dni = match (site.dni, hourly) {
-                    (Some(d), Some(t)) => d.at(t, s.epw_hour),
+                    (Some(d), Some(t)) => d.at(t, s.epw_hour).dni,
                     _ => 0.0,
                 };
                 for (&i, &v) in g.members.iter().zip(vis) {

@@ -6,7 +6,7 @@
 use serde_json::Value;
 
 use crate::error::{Error, Result};
-use crate::export::irradiation::DirectNormal;
+use crate::sun::weather::Weather;
 use crate::map::Period;
 use crate::map::period::{parse_clock, parse_date};
 use crate::year::settings::{AnnualSettings, Resolved};
@@ -80,7 +80,7 @@ pub struct MapRequest {
     /// The site and the leaf calendar.
     pub site: Resolved,
     /// The EPW's direct normal irradiance, for `direct`.
-    pub dni: Option<DirectNormal>,
+    pub dni: Option<Weather>,
     /// Where the points are.
     pub place: Where,
     /// When.
@@ -162,7 +162,7 @@ impl MapRequest {
             (Some(v), false) => v,
         };
         let dni = match (value, &settings.epw) {
-            (MapValue::Direct, Some(epw)) => Some(DirectNormal::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw)?),
+            (MapValue::Direct, Some(epw)) => Some(Weather::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw)?),
             (MapValue::Direct, None) => return Err(Error::argument("value", "'direct' needs an EPW (its direct normal irradiance)")),
             _ => None,
         };
