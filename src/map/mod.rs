@@ -40,10 +40,10 @@ use crate::count::MIN_COS_INCIDENCE;
 use crate::count::exact::engine::ExactEngine;
 use crate::count::exact::rays::PlanePoints;
 use crate::error::{Error, Result};
-use crate::sun::weather::Weather;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
+use crate::sun::weather::Weather;
 use crate::year::annual::shading_sun_day;
 use crate::year::season::LeafCalendar;
 

@@ -6,9 +6,9 @@
 use serde_json::Value;
 
 use crate::error::{Error, Result};
-use crate::sun::weather::Weather;
 use crate::map::Period;
 use crate::map::period::{parse_clock, parse_date};
+use crate::sun::weather::Weather;
 use crate::year::settings::{AnnualSettings, Resolved};
 
 /// The grid spacing (m) when neither `grid` nor `points` is given.
