@@ -108,12 +108,17 @@ fn every_gpu_error() -> Vec<GpuError> {
 fn the_error_codes_are_the_same_on_both_sides() {
     let body = interface("SunlitError");
     let mut rust: BTreeSet<String> = every_error().iter().map(|e| e.code().to_string()).collect();
-    // Thrown by sunlit.js itself, before the wasm is reached.
-    rust.insert("no-webgpu".into());
+    // Thrown by sunlit.js itself, before the wasm is reached: no WebGPU, a model too large for
+    // wasm32's memory (refused by its size up front, or trapped while reading), and a failure
+    // of one of the pool's clipping workers (pool.js).
+    for js_only in ["no-webgpu", "too-large", "worker"] {
+        rust.insert(js_only.into());
+    }
     assert_eq!(union(body, "code"), rust);
     let gpu: BTreeSet<String> = every_gpu_error().iter().map(|e| e.code().to_string()).collect();
     assert_eq!(union(body, "gpu"), gpu);
-    assert_eq!(fields(body), ["code", "file", "gpu", "object", "option"].map(String::from).into());
+    // `worker` and `workerCode` come with the pool's `worker` code, set in pool.js.
+    assert_eq!(fields(body), ["code", "file", "gpu", "object", "option", "worker", "workerCode"].map(String::from).into());
 }
 
 /// The string literals after the first `marker` in the file, up to its `;`.
