@@ -12,6 +12,7 @@ use sunlit::count::{ViewRequest, exact};
 use sunlit::model::arrays::{Arrays, scene_from_arrays};
 use sunlit::scene::Scene;
 use sunlit::web::Engine;
+use wasm_bindgen::JsValue;
 use wasm_bindgen_futures::JsFuture;
 use wasm_bindgen_test::*;
 
@@ -114,13 +115,13 @@ async fn adaptive_webgpu_counts_meet_their_accuracy() {
 
 #[wasm_bindgen_test]
 async fn the_page_bindings_give_the_analytic_overhang_shadow() {
-    let engine = Engine::create(Some(512), None, Some("gpu".into())).await.map_err(|e| format!("{e:?}")).unwrap();
+    let engine = Engine::create(Some(512), None, Some("gpu".into()), None).await.map_err(|e| format!("{e:?}")).unwrap();
     let (positions, indices, receivers, names) = arrays();
     let model = engine.from_arrays(&positions, &indices, &receivers, names, false).map_err(|e| format!("{e:?}")).unwrap();
     for altitude in [20.0f64, 35.0, 50.0] {
         // Due south: the overhang's edge throws a horizontal line d·tan h below the window's top.
         let s = sun(180.0, altitude);
-        let promise = engine.fractions(&model, s.x, s.y, s.z);
+        let promise = engine.fractions(&model, s.x, s.y, s.z, JsValue::UNDEFINED);
         let fractions = js_sys::Float64Array::new(&JsFuture::from(promise).await.unwrap()).to_vec();
         let analytic = (1.0 - DEPTH * altitude.to_radians().tan() / HEIGHT).clamp(0.0, 1.0);
         assert!((fractions[0] - analytic).abs() < 0.005, "altitude {altitude}: {:.4} vs analytic {analytic:.4}", fractions[0]);
@@ -137,12 +138,12 @@ async fn the_engine_option_picks_exact_gpu_or_auto_and_they_agree() {
     let suns = [sun(180.0, 35.0), sun(120.0, 20.0), sun(240.0, 50.0)];
     let mut answers = Vec::new();
     for kind in ["exact", "gpu", "auto"] {
-        let engine = Engine::create(Some(512), None, Some(kind.into())).await.map_err(|e| format!("{e:?}")).unwrap();
+        let engine = Engine::create(Some(512), None, Some(kind.into()), None).await.map_err(|e| format!("{e:?}")).unwrap();
         assert_eq!(engine.engine(), kind);
         let model = engine.from_arrays(&positions, &indices, &receivers, names.clone(), false).map_err(|e| format!("{e:?}")).unwrap();
         let mut fractions = Vec::new();
         for s in suns {
-            let promise = engine.fractions(&model, s.x, s.y, s.z);
+            let promise = engine.fractions(&model, s.x, s.y, s.z, JsValue::UNDEFINED);
             fractions.extend(js_sys::Float64Array::new(&JsFuture::from(promise).await.unwrap()).to_vec());
         }
         answers.push(fractions);
@@ -155,7 +156,7 @@ async fn the_engine_option_picks_exact_gpu_or_auto_and_they_agree() {
         // The light views of this small scene are all clipped under `auto`'s rule.
         assert!((answers[2][i] - r).abs() < 1e-6, "auto {i}: {} vs reference {r}", answers[2][i]);
     }
-    let error = match Engine::create(Some(512), None, Some("fastest".into())).await {
+    let error = match Engine::create(Some(512), None, Some("fastest".into()), None).await {
         Ok(_) => panic!("an unknown engine was accepted"),
         Err(e) => e,
     };

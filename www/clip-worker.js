@@ -41,5 +41,10 @@ onmessage = ({ data }) => {
   }
 };
 
-await init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) });
-postMessage({ type: 'ready' });
+// No top-level await: bundlers build workers as classic scripts by default (Vite's 'iife'), where
+// it is a syntax error. A wasm that cannot start is thrown from a task of its own, so the pool
+// sees it as the worker's error event, as it would a module that cannot load.
+init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) }).then(
+  () => postMessage({ type: 'ready' }),
+  (error) => setTimeout(() => { throw error; }),
+);

@@ -154,6 +154,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
   const files = report.files.map((f) => f.path).sort();
   assert.deepEqual(files, [
     'README.md',
+    'clip-worker.js',
     'colour.js',
     'device.js',
     'engine-worker.js',
@@ -161,6 +162,8 @@ test('the tarball holds only what ships and runs no install scripts', () => {
     'package.json',
     'pkg/sunlit_wasm.js',
     'pkg/sunlit_wasm_bg.wasm',
+    'pool.js',
+    'profiles.js',
     'sunlit.d.ts',
     'sunlit.js',
     'three.d.ts',
@@ -171,7 +174,7 @@ test('the tarball holds only what ships and runs no install scripts', () => {
   assert.equal(manifest.dependencies, undefined, 'three is a peer dependency only');
   assert.ok(manifest.peerDependencies.three);
   // three is not in the tarball and not imported by the package's modules.
-  for (const f of ['sunlit.js', 'three.js', 'map.js', 'device.js', 'engine-worker.js']) {
+  for (const f of ['sunlit.js', 'three.js', 'map.js', 'device.js', 'engine-worker.js', 'pool.js', 'clip-worker.js', 'profiles.js']) {
     assert.doesNotMatch(readFileSync(join(ROOT, 'target/npm/pkg', f), 'utf8'), /from ['"]three/, f);
   }
   console.log(`tarball ${report.filename}: ${report.size} bytes packed, ${report.unpackedSize} unpacked`);
