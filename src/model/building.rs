@@ -44,8 +44,10 @@ use super::reveal::{self, Placement as SubPlacement};
 use crate::error::{Error, Result};
 use crate::geometry::{self, Plane, inside_or_on, newell, plane_deviation};
 use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
+use frame::{SurfaceFrame, WindowFrame, rectangle};
 use mesh::hole_problem;
 
+mod frame;
 mod mesh;
 #[cfg(test)]
 mod tests;
@@ -827,91 +829,4 @@ fn order(raw: &[DVec3], rules: Rules) -> Vec<DVec3> {
         v.rotate_left((n + 1 - rules.corner.min(n + 1)) % n);
     }
     v
-}
-
-/// EnergyPlus's rectangle from a lower-left corner: upper-left, lower-left, lower-right,
-/// upper-right, with "right" = (−cos a, sin a, 0) and "up" = (−cos t sin a, −cos t cos a, sin t).
-fn rectangle(corner: DVec3, azimuth: f64, tilt: f64, length: f64, height: f64) -> Vec<DVec3> {
-    let axes = SurfaceAxes::new(azimuth, tilt);
-    let (right, up) = (axes.right * length, axes.up * height);
-    vec![corner + up, corner, corner + right, corner + right + up]
-}
-
-/// In-plane axes of a surface of given azimuth and tilt (degrees), as EnergyPlus builds them.
-#[derive(Debug, Clone, Copy)]
-struct SurfaceAxes {
-    right: DVec3,
-    up: DVec3,
-}
-
-impl SurfaceAxes {
-    fn new(azimuth: f64, tilt: f64) -> Self {
-        let (sa, ca) = azimuth.to_radians().sin_cos();
-        let (st, ct) = tilt.to_radians().sin_cos();
-        SurfaceAxes { right: DVec3::new(-ca, sa, 0.0), up: DVec3::new(-ct * sa, -ct * ca, st) }
-    }
-}
-
-/// A base surface's frame for simple subsurfaces: origin at its vertex 2, axes from its azimuth
-/// and tilt.
-#[derive(Debug, Clone, Copy)]
-struct SurfaceFrame {
-    origin: DVec3,
-    azimuth: f64,
-    tilt: f64,
-    axes: SurfaceAxes,
-}
-
-impl SurfaceFrame {
-    fn of(vertices: &[DVec3]) -> Self {
-        let (azimuth, tilt) = azimuth_tilt(vertices);
-        let origin = vertices.get(1).or(vertices.first()).copied().unwrap_or(DVec3::ZERO);
-        SurfaceFrame { origin, azimuth, tilt, axes: SurfaceAxes::new(azimuth, tilt) }
-    }
-
-    /// The point at (x, z) in the surface's plane.
-    fn at(&self, x: f64, z: f64) -> DVec3 {
-        self.origin + self.axes.right * x + self.axes.up * z
-    }
-
-    /// (x, z) of a point in the plane.
-    fn coords(&self, p: DVec3) -> (f64, f64) {
-        let d = p - self.origin;
-        (d.dot(self.axes.right), d.dot(self.axes.up))
-    }
-}
-
-/// A window or door in its base surface's frame, for overhangs and fins.
-struct WindowFrame {
-    base: SurfaceFrame,
-    own: SurfaceFrame,
-    x: f64,
-    z: f64,
-    width: f64,
-    height: f64,
-}
-
-impl WindowFrame {
-    fn of(window: &[DVec3], base: &[DVec3]) -> Self {
-        let base = SurfaceFrame::of(base);
-        let own = SurfaceFrame::of(window);
-        let (x, z) = base.coords(own.origin);
-        let at = |i: usize| window.get(i).copied().unwrap_or(own.origin);
-        WindowFrame { base, own, x, z, width: at(2).distance(at(1)), height: at(1).distance(at(0)) }
-    }
-}
-
-/// Azimuth (degrees clockwise from north, 0..360) and tilt (degrees from up) of a surface, as
-/// EnergyPlus's `DetermineAzimuthAndTilt`: from the normal, except for horizontal surfaces, whose
-/// azimuth puts "right" along their vertex 2 → 3 edge (so a skylight placed on a flat roof lines
-/// up with the roof's edges; checked against EnergyPlus 25.2).
-fn azimuth_tilt(vertices: &[DVec3]) -> (f64, f64) {
-    let n = newell(vertices).normalize_or_zero();
-    let tilt = n.z.clamp(-1.0, 1.0).acos().to_degrees();
-    let edge = match (vertices.get(1), vertices.get(2)) {
-        (Some(a), Some(b)) => *b - *a,
-        _ => DVec3::X,
-    };
-    let azimuth = if n.x.hypot(n.y) > 1e-8 { n.x.atan2(n.y) } else { edge.y.atan2(-edge.x) };
-    (azimuth.to_degrees().rem_euclid(360.0), tilt)
 }

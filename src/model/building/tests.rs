@@ -2,6 +2,7 @@
 
 use super::super::epjson::parse_epjson;
 use super::super::idf::parse_idf;
+use super::frame::azimuth_tilt;
 use super::mesh::triangulate;
 use super::*;
 
