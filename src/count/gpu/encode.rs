@@ -4,6 +4,7 @@
 
 use std::ops::Range;
 
+use super::masks::{GpuPoints, MaskBatch};
 use super::pipelines::{
     COUNTS_PER_MEMBER, DEPTH_FORMAT, GpuTileView, GpuView, ID_FORMAT, Pipelines, ROWS_PER_GROUP, attachment, buffer, entry,
 };
@@ -82,7 +83,9 @@ impl BatchBuffers {
 
 impl Counter {
     /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
-    /// `first_entry` on. Returns the number of member entries.
+    /// `first_entry` on. With `masks`, the mask pass then reads the same atlas for the batch's
+    /// map points (its words land in the points' readback from word `masks.2` on). Returns the
+    /// number of member entries.
     pub(super) fn submit_batch(
         &self,
         scene: &GpuScene,
@@ -90,6 +93,7 @@ impl Counter {
         batch: &[Tile],
         side: u32,
         first_entry: usize,
+        masks: Option<(&GpuPoints, &MaskBatch, u64)>,
     ) -> Result<usize> {
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
@@ -124,6 +128,9 @@ impl Counter {
         let entry_bytes = COUNTS_PER_MEMBER * 4;
         let bytes = members.len() as u64 * entry_bytes;
         encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, first_entry as u64 * entry_bytes, bytes);
+        if let Some((points, mask_batch, first_word)) = masks {
+            self.encode_masks(&mut encoder, points, mask_batch, first_word);
+        }
         self.queue.submit([encoder.finish()]);
         Ok(members.len())
     }
