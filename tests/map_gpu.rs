@@ -74,7 +74,7 @@ fn gpu_answer(counter: &Counter, scene: &Scene, points: &Points, sun: DVec3) -> 
     let gpu = counter.upload(scene).unwrap();
     let uploaded = counter.upload_points(&gpu, &points.positions, &points.receivers).unwrap();
     let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32).map(|r| ViewRequest::new(r, sun)).collect();
-    let masks = pollster::block_on(counter.masks(&gpu, &uploaded, &requests)).unwrap();
+    let masks = pollster::block_on(counter.masks(&gpu, &uploaded, &requests, true)).unwrap();
     let mut out = GpuAnswer { lit: vec![false; points.len()], tile: vec![None; points.len()] };
     for (i, req) in requests.iter().enumerate() {
         for (j, &p) in uploaded.points_of(req.receiver).iter().enumerate() {
@@ -102,7 +102,7 @@ fn masks_match_their_cpu_truth_on_the_same_atlas() {
     let suns = [sun(180.0, 35.0), sun(215.0, 50.0), sun(150.0, 20.0)];
     let requests: Vec<ViewRequest> = suns.iter().flat_map(|&s| (0..2).map(move |r| ViewRequest::new(r, s))).collect();
     assert!(requests.len() <= counter.tiles_per_batch());
-    let masks = pollster::block_on(counter.masks(&gpu, &uploaded, &requests)).unwrap();
+    let masks = pollster::block_on(counter.masks(&gpu, &uploaded, &requests, true)).unwrap();
     let (atlas_side, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
     let (mut checked, mut lit, mut borderline) = (0, 0, 0);
     for (i, req) in requests.iter().enumerate() {

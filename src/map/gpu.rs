@@ -103,7 +103,7 @@ impl<'a> MapGpu<'a> {
             return Ok(());
         }
         let requests: Vec<ViewRequest> = views.iter().map(|v| v.request).collect();
-        let masks = self.counter.masks(&self.scene, &self.points, &requests).await?;
+        let masks = self.counter.masks(&self.scene, &self.points, &requests, false).await?;
         let mut vis: Vec<f32> = Vec::new();
         let mut rendered = 0u64;
         for (i, view) in views.iter().enumerate() {

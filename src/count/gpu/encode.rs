@@ -82,10 +82,10 @@ impl BatchBuffers {
 }
 
 impl Counter {
-    /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
-    /// `first_entry` on. With `masks`, the mask pass then reads the same atlas for the batch's
-    /// map points (its words land in the points' readback from word `masks.2` on). Returns the
-    /// number of member entries.
+    /// Renders and (with `count`) counts one batch of tiles; their member counts land in
+    /// `readback` from entry `first_entry` on. With `masks`, the mask pass then reads the same
+    /// atlas for the batch's map points (its words land in the points' readback from word
+    /// `masks.2` on). Returns the number of member entries.
     pub(super) fn submit_batch(
         &self,
         scene: &GpuScene,
@@ -93,6 +93,7 @@ impl Counter {
         batch: &[Tile],
         side: u32,
         first_entry: usize,
+        count: bool,
         masks: Option<(&GpuPoints, &MaskBatch, u64)>,
     ) -> Result<usize> {
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
@@ -117,17 +118,18 @@ impl Counter {
         self.queue.write_buffer(&self.batch.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.batch.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-        encoder.clear_buffer(&self.batch.counts, 0, None);
         self.render_tiles(&mut encoder, scene, requests, batch, side);
-        {
+        if count {
+            encoder.clear_buffer(&self.batch.counts, 0, None);
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("count"), timestamp_writes: None });
             pass.set_pipeline(&self.pipelines.count);
             pass.set_bind_group(0, &scene.count_bind, &[]);
             pass.dispatch_workgroups(side.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
+            drop(pass);
+            let entry_bytes = COUNTS_PER_MEMBER * 4;
+            let bytes = members.len() as u64 * entry_bytes;
+            encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, first_entry as u64 * entry_bytes, bytes);
         }
-        let entry_bytes = COUNTS_PER_MEMBER * 4;
-        let bytes = members.len() as u64 * entry_bytes;
-        encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, first_entry as u64 * entry_bytes, bytes);
         if let Some((points, mask_batch, first_word)) = masks {
             self.encode_masks(&mut encoder, points, mask_batch, first_word);
         }

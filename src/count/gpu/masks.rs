@@ -24,6 +24,7 @@ use std::ops::Range;
 
 use super::pipelines::{GpuMaskView, WORDS_PER_MASK_GROUP, buffer, entry};
 use super::plan::Tile;
+use super::readback::MaskOut;
 use super::{Counter, GpuScene};
 use crate::count::view::SunView;
 use crate::count::{ViewRequest, is_dark};
@@ -92,7 +93,7 @@ pub enum PointMask {
 /// What [`Counter::masks`] answers: the views' counts and their points' masks, in request order.
 #[derive(Debug, Clone, Default)]
 pub struct Masks {
-    /// Each view counted, as [`Counter::fractions`] counts it.
+    /// Each view counted, as [`Counter::fractions`] counts it (with `count`).
     pub counted: Vec<super::Counted>,
     /// Each view's points.
     pub masks: Vec<PointMask>,
@@ -197,15 +198,19 @@ impl Counter {
         Ok(GpuPoints { ranges, order, batch_views, batch_words, views, masks, readback, bind })
     }
 
-    /// Counts `requests` as [`Self::fractions`] does (at `resolution`, never adaptively) and
-    /// answers, for each, whether each of its receiver's points in `points` sees the sun.
-    pub async fn masks(&self, scene: &GpuScene, points: &GpuPoints, requests: &[ViewRequest]) -> Result<Masks> {
+    /// Renders `requests` as [`Self::fractions`] does (at `resolution`, never adaptively) and
+    /// answers, for each, whether each of its receiver's points in `points` sees the sun; with
+    /// `count`, the same tiles' pixels are counted too (the fractions in [`Masks::counted`];
+    /// without, a map that needs only its points skips the count pass, a third of a view's cost
+    /// on lavapipe, and `counted` holds the cosines alone).
+    pub async fn masks(&self, scene: &GpuScene, points: &GpuPoints, requests: &[ViewRequest], count: bool) -> Result<Masks> {
         let side = self.options.resolution;
         let mut counted = vec![super::Counted::default(); requests.len()];
         let tiles = super::plan::plan_tiles(&scene.layout, requests, side, &mut counted)?;
         let mut masks: Vec<Option<PointMask>> = vec![None; requests.len()];
         let mut words = Vec::new();
-        self.count_tiles(scene, requests, &tiles, side, &mut counted, Some((points, &mut masks, &mut words))).await?;
+        let out = MaskOut { points, answers: &mut masks, words: &mut words, count };
+        self.count_tiles(scene, requests, &tiles, side, &mut counted, Some(out)).await?;
         let masks = masks
             .into_iter()
             .zip(requests)

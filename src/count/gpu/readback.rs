@@ -16,8 +16,13 @@ use crate::platform;
 pub(super) const BATCHES_PER_READBACK: usize = 32;
 
 /// Where [`Counter::count_tiles`] puts map points' masks: the points, each request's mask, and
-/// the words the rendered masks point into.
-pub(super) type MaskOut<'a> = (&'a GpuPoints, &'a mut Vec<Option<PointMask>>, &'a mut Vec<u32>);
+/// the words the rendered masks point into; `count`: whether the count pass runs too.
+pub(super) struct MaskOut<'a> {
+    pub(super) points: &'a GpuPoints,
+    pub(super) answers: &'a mut [Option<PointMask>],
+    pub(super) words: &'a mut Vec<u32>,
+    pub(super) count: bool,
+}
 
 /// Maps `words` words of `points`'s readback (the masks of `batches`, in order) and hands each
 /// view's words to its request.
@@ -52,7 +57,8 @@ async fn read_masks(
 impl Counter {
     /// Renders and counts `tiles` at side `side` and writes their members' counts into `out`.
     /// With `masks`, also each rendered member's map points' mask (into the request's slot,
-    /// its words appended to the words).
+    /// its words appended to the words); without its `count`, no pixels are counted and `out`
+    /// keeps what planning wrote.
     pub(super) async fn count_tiles(
         &self,
         scene: &GpuScene,
@@ -68,21 +74,29 @@ impl Counter {
             // do its masks.
             let (mut entries, mut words) = (0, 0u64);
             let mut mask_batches = Vec::new();
+            let count = masks.as_ref().is_none_or(|m| m.count);
             for batch in chunk.chunks(per_batch) {
-                let mask = masks.as_ref().map(|(points, ..)| (*points, self.mask_batch(scene, points, requests, batch, side)));
-                entries += self.submit_batch(scene, requests, batch, side, entries, mask.as_ref().map(|(p, m)| (*p, m, words)))?;
+                let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
+                let with_masks = mask.as_ref().map(|(p, m)| (*p, m, words));
+                entries += self.submit_batch(scene, requests, batch, side, entries, count, with_masks)?;
                 if let Some((_, m)) = mask {
                     words += m.words;
                     mask_batches.push(m);
                 }
             }
+            if let Some(m) = masks.as_mut() {
+                read_masks(self, m.points, &mask_batches, words, m.answers, m.words).await?;
+            }
+            let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
+            self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
+            self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
+            if !count {
+                continue;
+            }
             let counts = platform::read_buffer(&self.device, &self.batch.readback, entries as u64 * COUNTS_PER_MEMBER * 4).await;
             // A failed read on a lost device is the loss, not a read error.
             self.check_errors("counting pixels")?;
             let counts = counts?;
-            if let Some((points, answers, all_words)) = masks.as_mut() {
-                read_masks(self, points, &mask_batches, words, answers, all_words).await?;
-            }
             let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
             let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
             for ((i, pixel_area), c) in members.zip(counts.chunks_exact(COUNTS_PER_MEMBER as usize)) {
@@ -95,9 +109,6 @@ impl Counter {
                 o.pixel_area = pixel_area;
                 o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
             }
-            let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
-            self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
-            self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
         }
         Ok(())
     }
