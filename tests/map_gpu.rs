@@ -122,6 +122,12 @@ fn masks_match_their_cpu_truth_on_the_same_atlas() {
     }
     assert!(borderline * 100 < checked, "{borderline} borderline of {checked}");
     assert!(lit > checked / 10 && lit < checked * 9 / 10, "partly shaded: {lit} of {checked} lit");
+    // The same tiles counted: the fractions are those of a plain count.
+    let fractions = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
+    for (a, b) in masks.counted.iter().zip(&fractions) {
+        assert_eq!((a.visible, a.covered), (b.visible, b.covered));
+        assert!(a.covered > 1000 && a.fraction > 0.0 && a.fraction < 1.0, "{a:?}");
+    }
 }
 
 /// GPU masks against the exact engine's shadow rays on the louvred wall: every point whose exact
@@ -320,4 +326,53 @@ fn a_days_sun_hours_on_the_gpu_match_the_rays() {
     eprintln!("{} points: {differ} differ; totals {total_rays:.2} h (rays) and {total_masks:.2} h (masks)", points.len());
     assert!(total_rays > 0.0 && (total_rays - total_masks).abs() <= 0.01 * total_rays);
     assert!(differ * 10 < points.len(), "{differ} of {} points differ", points.len());
+}
+
+/// `sunlit map --engine gpu` on the example office: the summary's engine split says the GPU
+/// answered, its per point sun hours are the rays' but within a few steps, and a bad `--engine`
+/// or `--resolution` is refused by name with nothing written.
+#[test]
+fn cli_maps_on_the_gpu_and_refuses_bad_engine_options() {
+    use std::path::PathBuf;
+    use std::process::Command;
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("sunlit-map-gpu-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let office = root.join("examples/office.glb");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_sunlit"))
+            .arg("map")
+            .arg(&office)
+            .args(["--grid", "0.5", "--location", "39.74,-105.18,-7", "--period", "06-21", "--step", "15"])
+            .args(args)
+            .env("XDG_RUNTIME_DIR", runtime_dir())
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let mut hours = Vec::new();
+    for engine in ["exact", "gpu"] {
+        let out = run(&["--engine", engine, "-o", &format!("{engine}.csv"), "--json"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let point_instants = summary["points"].as_u64().unwrap() * summary["instants"].as_u64().unwrap();
+        let (rays, masks) = (summary["engine"]["exact_rays"].as_u64().unwrap(), summary["engine"]["gpu_masks"].as_u64().unwrap());
+        assert_eq!(if engine == "gpu" { (0, point_instants) } else { (point_instants, 0) }, (rays, masks), "{summary}");
+        let csv = std::fs::read_to_string(dir.join(format!("{engine}.csv"))).unwrap();
+        hours.push(csv.lines().skip(1).map(|l| l.rsplit(',').next().unwrap().parse::<f64>().unwrap()).collect::<Vec<_>>());
+    }
+    assert_eq!(hours[0].len(), hours[1].len());
+    let differ = hours[0].iter().zip(&hours[1]).filter(|(a, b)| (*a - *b).abs() > 1e-9).count();
+    let worst = hours[0].iter().zip(&hours[1]).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(differ * 20 <= hours[0].len() && worst <= 1.0, "{differ} of {} points differ, by up to {worst} h", hours[0].len());
+    for (args, says) in [(vec!["--engine", "fast"], "--engine"), (vec!["--engine", "gpu", "--resolution", "4"], "resolution")] {
+        let mut all = args.clone();
+        all.extend(["-o", "bad.csv"]);
+        let out = run(&all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!dir.join("bad.csv").exists(), "{args:?} wrote its output");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
