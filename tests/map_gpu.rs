@@ -126,7 +126,7 @@ fn masks_match_their_cpu_truth_on_the_same_atlas() {
     let fractions = pollster::block_on(counter.fractions(&gpu, &requests)).unwrap();
     for (a, b) in masks.counted.iter().zip(&fractions) {
         assert_eq!((a.visible, a.covered), (b.visible, b.covered));
-        assert!(a.covered > 1000 && a.fraction > 0.0 && a.fraction < 1.0, "{a:?}");
+        assert!(a.covered > 1000 && a.side == SIDE, "{a:?}");
     }
 }
 
