@@ -81,11 +81,19 @@ impl BatchBuffers {
     }
 }
 
+/// The compute passes a batch runs after its render.
+pub(super) struct Passes<'a> {
+    /// The count pass.
+    pub(super) count: bool,
+    /// The mask pass for these map points and views; its words land in the points' readback
+    /// from this word on.
+    pub(super) masks: Option<(&'a GpuPoints, &'a MaskBatch, u64)>,
+}
+
 impl Counter {
-    /// Renders and (with `count`) counts one batch of tiles; their member counts land in
-    /// `readback` from entry `first_entry` on. With `masks`, the mask pass then reads the same
-    /// atlas for the batch's map points (its words land in the points' readback from word
-    /// `masks.2` on). Returns the number of member entries.
+    /// Renders one batch of tiles and runs `passes` over it: the count (member counts land in
+    /// `readback` from entry `first_entry` on) and the masks. Returns the number of member
+    /// entries.
     pub(super) fn submit_batch(
         &self,
         scene: &GpuScene,
@@ -93,9 +101,9 @@ impl Counter {
         batch: &[Tile],
         side: u32,
         first_entry: usize,
-        count: bool,
-        masks: Option<(&GpuPoints, &MaskBatch, u64)>,
+        passes: Passes<'_>,
     ) -> Result<usize> {
+        let Passes { count, masks } = passes;
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());

@@ -4,6 +4,7 @@
 
 use std::sync::atomic::Ordering;
 
+use super::encode::Passes;
 use super::masks::{GpuPoints, MaskBatch, PointMask};
 use super::pipelines::COUNTS_PER_MEMBER;
 use super::plan::{Tile, tiles_at};
@@ -77,8 +78,8 @@ impl Counter {
             let count = masks.as_ref().is_none_or(|m| m.count);
             for batch in chunk.chunks(per_batch) {
                 let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
-                let with_masks = mask.as_ref().map(|(p, m)| (*p, m, words));
-                entries += self.submit_batch(scene, requests, batch, side, entries, count, with_masks)?;
+                let passes = Passes { count, masks: mask.as_ref().map(|(p, m)| (*p, m, words)) };
+                entries += self.submit_batch(scene, requests, batch, side, entries, passes)?;
                 if let Some((_, m)) = mask {
                     words += m.words;
                     mask_batches.push(m);
