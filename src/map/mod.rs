@@ -10,7 +10,9 @@
 //!   [`Period`], [`Mapper::lit_series`] keeps each point's lit instants for the sun-hours
 //!   [`study`] rules;
 //! - [`period`]: years at EnergyPlus timesteps, date ranges, one day at minute steps, an instant,
-//!   with the sun `sunlit annual` uses.
+//!   with the sun `sunlit annual` uses;
+//! - [`MapGpu`]: the same sweeps with each point answered by its texel in the GPU counter's tile
+//!   of its receiver (`gpu`, [`crate::count::gpu::masks`]): `*_gpu` methods of [`Mapper`].
 //!
 //! Every point is counted directly at every instant (a shadow ray is cheap once a receiver's
 //! casters are culled), never interpolated: a point's visibility jumps when a shadow edge
