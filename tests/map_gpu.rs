@@ -326,6 +326,23 @@ fn a_days_sun_hours_on_the_gpu_match_the_rays() {
     eprintln!("{} points: {differ} differ; totals {total_rays:.2} h (rays) and {total_masks:.2} h (masks)", points.len());
     assert!(total_rays > 0.0 && (total_rays - total_masks).abs() <= 0.01 * total_rays);
     assert!(differ * 10 < points.len(), "{differ} of {} points differ", points.len());
+    // The studies' lit instants and one instant's visibility, on the GPU, against the rays.
+    let series_rays = mapper.lit_series(&samples, site, 10.0, &mut |_, _| {});
+    let series_gpu = pollster::block_on(mapper.lit_series_gpu(&gpu, &samples, site, 10.0, &mut |_, _| {})).unwrap();
+    let (mut same, mut lit) = (0, 0);
+    for i in 0..points.len() {
+        for k in 0..samples.len() {
+            same += usize::from(series_rays.lit(i, k) == series_gpu.lit(i, k));
+            lit += usize::from(series_rays.lit(i, k));
+        }
+    }
+    let all = points.len() * samples.len();
+    assert!(lit > all / 50 && same * 100 >= all * 99, "{same} of {all} lit instants agree ({lit} lit by rays)");
+    let sun = sunlit::sun::position::sun_direction(&location, sunlit::year::annual::shading_sun_day(80), 11.5);
+    let at_rays = mapper.visibility(sun, 1.0);
+    let at_gpu = pollster::block_on(mapper.visibility_gpu(&gpu, sun, 1.0)).unwrap();
+    let differ = at_rays.iter().zip(&at_gpu).filter(|(a, b)| a != b).count();
+    assert!(at_rays.contains(&0.0) && at_rays.contains(&1.0) && differ * 50 <= points.len(), "{differ} points differ at 11:30");
 }
 
 /// `sunlit map --engine gpu` on the example office: the summary's engine split says the GPU
