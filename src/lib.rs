@@ -14,8 +14,9 @@
 //! - [`count`]: one request and one answer ([`count::ViewRequest`], [`count::ViewAnswer`]) and
 //!   the engines that answer it: the GPU pixel counter ([`count::gpu`]) and the exact CPU
 //!   polygon-clipping reference ([`count::exact`]);
-//! - [`map`]: points on receivers (a grid or a CSV) and, per point, the sun seen at an instant,
-//!   sun hours and direct irradiation over a period, and sun-hours studies;
+//! - [`map`]: points on receivers (a grid or a CSV) and, per point, the sun seen at an instant
+//!   (by a shadow ray, or by its texel in the GPU counter's tile), sun hours and direct
+//!   irradiation over a period, and sun-hours studies;
 //! - [`year`]: sampling plan, leaf calendar, the settings resolver, the spline and the annual run;
 //! - [`export`]: the EnergyPlus CSV, the model hooked to it, and the irradiation summary;
 //! - [`error`]: the one typed error, naming parameters, files and objects;

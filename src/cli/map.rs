@@ -8,7 +8,7 @@ use sunlit::export::map_table::{Column, points_csv, study_csv, study_json};
 use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
 use sunlit::map::study::{self, SunRule};
-use sunlit::map::{Mapper, Period, Points, Site};
+use sunlit::map::{MapGpu, Mapper, Period, Points, Site};
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
 
@@ -60,6 +60,13 @@ pub(super) struct MapArgs {
     /// Minimum sun altitude (degrees) for en17037 (default 10).
     #[arg(long, value_name = "DEGREES")]
     min_altitude: Option<f64>,
+    /// Who answers each point: exact (a shadow ray through the exact engine's BVH), gpu (its
+    /// texel in the GPU's sun-view tile of its receiver), or auto (exact: see docs/maps.md).
+    #[arg(long, value_name = "auto|gpu|exact", default_value = "auto")]
+    engine: String,
+    /// With --engine gpu: side in pixels of the square tile each receiver is rendered on.
+    #[arg(long, value_name = "PIXELS", default_value_t = 512)]
+    resolution: u32,
     /// Print a JSON summary.
     #[arg(long)]
     json: bool,
@@ -137,6 +144,13 @@ impl MapArgs {
         }
     }
 
+    /// Whether the GPU answers the points: `auto` picks the exact rays (docs/maps.md says why).
+    fn on_gpu(&self) -> Result<bool> {
+        let kind = EngineKind::parse(&self.engine)
+            .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))?;
+        Ok(kind == EngineKind::Gpu)
+    }
+
     fn study_path(&self, name: &str, extension: &str) -> PathBuf {
         let stem = self.output.file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
         self.output.with_file_name(format!("{stem}.study-{name}.{extension}"))
@@ -145,6 +159,7 @@ impl MapArgs {
 
 pub(super) fn map(args: MapArgs) -> Result<()> {
     let plan = args.plan()?;
+    let on_gpu = args.on_gpu()?;
     if let Some(g) = args.grid
         && !(g.is_finite() && g > 0.0)
     {
@@ -166,6 +181,12 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     let points = args.points(&scene)?;
     let start = Instant::now();
     let mapper = Mapper::new(&scene, &points)?;
+    let counter = if on_gpu {
+        Some(pollster::block_on(Counter::new(CounterOptions { resolution: args.resolution, ..Default::default() }))?)
+    } else {
+        None
+    };
+    let gpu = counter.as_ref().map(|c| MapGpu::new(c, &scene, &points)).transpose()?;
     let calendar = LeafCalendar::for_latitude(location.latitude);
     let site = Site { location: &location, calendar: &calendar, dni: dni.as_ref() };
     let samples = plan.period.samples();
@@ -184,13 +205,21 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     let (csv, glb_values, glb_name, glb_unit) = if plan.instant {
         let s = samples[0];
         let sun = sunlit::sun::position::sun_direction(&location, sunlit::year::annual::shading_sun_day(s.day), s.hour);
-        let lit: Vec<f64> = mapper.visibility(sun, calendar.fraction(f64::from(s.day)) as f32).into_iter().map(f64::from).collect();
+        let leaves = calendar.fraction(f64::from(s.day)) as f32;
+        let lit = match &gpu {
+            Some(g) => pollster::block_on(mapper.visibility_gpu(g, sun, leaves))?,
+            None => mapper.visibility(sun, leaves),
+        };
+        let lit: Vec<f64> = lit.into_iter().map(f64::from).collect();
         let csv = points_csv(&scene, &points, &[Column { name: "lit", values: &lit, decimals: 0 }]);
         summary["lit_points"] = json!(lit.iter().filter(|&&v| v >= 0.5).count());
         summary["sun_up"] = json!(sun.z >= sunlit::count::MIN_COS_INCIDENCE);
         (csv, lit, "lit", "")
     } else {
-        let values = mapper.accumulate(&samples, site, &mut report);
+        let values = match &gpu {
+            Some(g) => pollster::block_on(mapper.accumulate_gpu(g, &samples, site, &mut report))?,
+            None => mapper.accumulate(&samples, site, &mut report),
+        };
         let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
         if let Some(d) = &values.direct_kwh_m2 {
             columns.push(Column { name: "direct_kwh_m2", values: d, decimals: 4 });
@@ -199,7 +228,10 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         summary["sun_up_instants"] = json!(values.sun_up);
         let mut studies = Vec::new();
         for rule in &plan.rules {
-            let series = mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut report);
+            let series = match &gpu {
+                Some(g) => pollster::block_on(mapper.lit_series_gpu(g, &samples, site, rule.min_altitude_deg, &mut report))?,
+                None => mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut report),
+            };
             let day = plan.period.single_day().unwrap_or(rule.default_day);
             let result = study::evaluate(rule, day, &samples, &series, &points.receivers);
             let inputs = json!({
@@ -232,7 +264,17 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     summary["points"] = json!(points.len());
     summary["instants"] = json!(samples.len());
     summary["seconds"] = json!(round(seconds, 3));
-    summary["engine"] = json!({"exact_rays": points.len() * samples.len(), "gpu_masks": 0});
+    let point_instants = points.len() * samples.len();
+    summary["engine"] = match &gpu {
+        Some(g) => json!({
+            "exact_rays": 0,
+            "gpu_masks": point_instants,
+            "gpu_masks_rendered": g.rendered(),
+            "resolution": args.resolution,
+            "adapter": counter.as_ref().map(|c| c.adapter_info().name.clone()),
+        }),
+        None => json!({"exact_rays": point_instants, "gpu_masks": 0}),
+    };
     summary["written"] = json!(files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>());
     if args.json {
         println!("{summary:#}");

@@ -10,7 +10,9 @@
 //!   [`Period`], [`Mapper::lit_series`] keeps each point's lit instants for the sun-hours
 //!   [`study`] rules;
 //! - [`period`]: years at EnergyPlus timesteps, date ranges, one day at minute steps, an instant,
-//!   with the sun `sunlit annual` uses.
+//!   with the sun `sunlit annual` uses;
+//! - [`MapGpu`]: the same sweeps with each point answered by its texel in the GPU counter's tile
+//!   of its receiver (`gpu`, [`crate::count::gpu::masks`]): `*_gpu` methods of [`Mapper`].
 //!
 //! Every point is counted directly at every instant (a shadow ray is cheap once a receiver's
 //! casters are culled), never interpolated: a point's visibility jumps when a shadow edge
@@ -25,6 +27,7 @@
 //! Sky-diffuse and total irradiation per point need the sky's patch visibility (not here yet):
 //! [`MapValues`] has room for them beside `direct_kwh_m2`.
 
+mod gpu;
 pub mod period;
 pub mod points;
 pub mod study;
@@ -33,6 +36,7 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use glam::DVec3;
 
+pub use gpu::MapGpu;
 pub use period::{Period, Sample};
 pub use points::{from_csv, grid};
 
@@ -174,45 +178,23 @@ impl Mapper {
     /// total)` is called now and then from the calling thread. Instants are shared over every
     /// core; the sums do not depend on how.
     pub fn accumulate(&self, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> MapValues {
-        let n = self.points;
-        let with_dni = site.dni.is_some();
-        let hourly = crate::year::samples::Timesteps::new(1).ok();
-        let parts = self.sweep(
-            samples,
-            site,
-            progress,
-            || (vec![0.0f64; n], if with_dni { vec![0.0f64; n] } else { Vec::new() }),
-            |acc, _, s, sun, g, vis| {
-                let dni = match (site.dni, hourly) {
-                    (Some(d), Some(t)) => d.at(t, s.epw_hour).dni,
-                    _ => 0.0,
-                };
-                for (&i, &v) in g.members.iter().zip(vis) {
-                    if v > 0.0 {
-                        let i = i as usize;
-                        acc.0[i] += f64::from(v) * s.hours;
-                        if with_dni {
-                            let cos = self.normals[i].dot(sun).max(0.0);
-                            acc.1[i] += f64::from(v) * dni * cos * s.hours / 1000.0;
-                        }
-                    }
-                }
-            },
-        );
-        let mut values =
-            MapValues { sun_hours: vec![0.0; n], direct_kwh_m2: with_dni.then(|| vec![0.0; n]), instants: samples.len(), sun_up: 0 };
-        values.sun_up = samples.iter().filter(|s| self.sun(site, s).z >= MIN_COS_INCIDENCE).count();
-        for (hours, direct) in parts {
-            for (a, b) in values.sun_hours.iter_mut().zip(hours) {
-                *a += b;
-            }
-            if let Some(d) = values.direct_kwh_m2.as_mut() {
-                for (a, b) in d.iter_mut().zip(direct) {
-                    *a += b;
-                }
-            }
-        }
-        values
+        let sums = Sums::new(self, site);
+        let parts = self.sweep(samples, site, progress, || sums.state(), |acc, _, s, sun, g, vis| sums.record(acc, s, sun, g, vis));
+        sums.finish(parts, samples)
+    }
+
+    /// [`Self::accumulate`] with the points answered by GPU masks ([`MapGpu`]) instead of rays.
+    pub async fn accumulate_gpu(
+        &self,
+        gpu: &MapGpu<'_>,
+        samples: &[Sample],
+        site: Site<'_>,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<MapValues> {
+        let sums = Sums::new(self, site);
+        let parts =
+            gpu.sweep(self, samples, site, progress, || sums.state(), |acc, _, s, sun, g, vis| sums.record(acc, s, sun, g, vis)).await?;
+        Ok(sums.finish(parts, samples))
     }
 
     /// Which instants of `samples` each point sees the sun at (visibility ≥ 0.5) with the sun
@@ -225,29 +207,38 @@ impl Mapper {
         min_altitude_deg: f64,
         progress: &mut dyn FnMut(usize, usize),
     ) -> LitSeries {
-        let words = samples.len().div_ceil(64);
-        let bits: Vec<AtomicU64> = (0..self.points * words).map(|_| AtomicU64::new(0)).collect();
-        let min_z = min_altitude_deg.to_radians().sin();
-        self.sweep(
-            samples,
-            site,
-            progress,
-            || (),
-            |_, k, _, sun, g, vis| {
-                if sun.z < min_z {
-                    return;
-                }
-                for (&i, &v) in g.members.iter().zip(vis) {
-                    if v >= 0.5 {
-                        bits[i as usize * words + k / 64].fetch_or(1 << (k % 64), Ordering::Relaxed);
-                    }
-                }
-            },
-        );
-        LitSeries { words, instants: samples.len(), bits: bits.into_iter().map(AtomicU64::into_inner).collect() }
+        let bits = LitBits::new(self.points, samples.len(), min_altitude_deg);
+        self.sweep(samples, site, progress, || (), |_, k, _, sun, g, vis| bits.record(k, sun, g, vis));
+        bits.finish()
     }
 
-    fn sun(&self, site: Site<'_>, s: &Sample) -> DVec3 {
+    /// [`Self::lit_series`] with the points answered by GPU masks ([`MapGpu`]).
+    pub async fn lit_series_gpu(
+        &self,
+        gpu: &MapGpu<'_>,
+        samples: &[Sample],
+        site: Site<'_>,
+        min_altitude_deg: f64,
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<LitSeries> {
+        let bits = LitBits::new(self.points, samples.len(), min_altitude_deg);
+        gpu.sweep(self, samples, site, progress, || (), |_, k, _, sun, g, vis| bits.record(k, sun, g, vis)).await?;
+        Ok(bits.finish())
+    }
+
+    /// [`Self::visibility`] answered by GPU masks ([`MapGpu`]): 1 lit, 0 shaded or dark.
+    pub async fn visibility_gpu(&self, gpu: &MapGpu<'_>, sun: DVec3, leaves: f32) -> Result<Vec<f32>> {
+        let mut out = vec![0.0f32; self.points];
+        gpu.instant(self, sun, leaves, |g, vis| {
+            for (&i, &v) in g.members.iter().zip(vis) {
+                out[i as usize] = v;
+            }
+        })
+        .await?;
+        Ok(out)
+    }
+
+    pub(crate) fn sun(&self, site: Site<'_>, s: &Sample) -> DVec3 {
         sun_direction(site.location, shading_sun_day(s.day), s.hour)
     }
 
@@ -303,6 +294,91 @@ impl Mapper {
             progress(total, total);
             workers.into_iter().filter_map(|w| w.join().ok()).collect()
         })
+    }
+}
+
+/// What [`Mapper::accumulate`] sums per point: sun hours and direct irradiation, per thread.
+struct Sums<'a> {
+    mapper: &'a Mapper,
+    site: Site<'a>,
+    with_dni: bool,
+    hourly: Option<crate::year::samples::Timesteps>,
+}
+
+impl<'a> Sums<'a> {
+    fn new(mapper: &'a Mapper, site: Site<'a>) -> Self {
+        Self { mapper, site, with_dni: site.dni.is_some(), hourly: crate::year::samples::Timesteps::new(1).ok() }
+    }
+
+    fn state(&self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.mapper.points;
+        (vec![0.0f64; n], if self.with_dni { vec![0.0f64; n] } else { Vec::new() })
+    }
+
+    fn record(&self, acc: &mut (Vec<f64>, Vec<f64>), s: &Sample, sun: DVec3, g: &Group, vis: &[f32]) {
+        let dni = match (self.site.dni, self.hourly) {
+            (Some(d), Some(t)) => d.at(t, s.epw_hour).dni,
+            _ => 0.0,
+        };
+        for (&i, &v) in g.members.iter().zip(vis) {
+            if v > 0.0 {
+                let i = i as usize;
+                acc.0[i] += f64::from(v) * s.hours;
+                if self.with_dni {
+                    let cos = self.mapper.normals[i].dot(sun).max(0.0);
+                    acc.1[i] += f64::from(v) * dni * cos * s.hours / 1000.0;
+                }
+            }
+        }
+    }
+
+    fn finish(&self, parts: Vec<(Vec<f64>, Vec<f64>)>, samples: &[Sample]) -> MapValues {
+        let n = self.mapper.points;
+        let mut values =
+            MapValues { sun_hours: vec![0.0; n], direct_kwh_m2: self.with_dni.then(|| vec![0.0; n]), instants: samples.len(), sun_up: 0 };
+        values.sun_up = samples.iter().filter(|s| self.mapper.sun(self.site, s).z >= MIN_COS_INCIDENCE).count();
+        for (hours, direct) in parts {
+            for (a, b) in values.sun_hours.iter_mut().zip(hours) {
+                *a += b;
+            }
+            if let Some(d) = values.direct_kwh_m2.as_mut() {
+                for (a, b) in d.iter_mut().zip(direct) {
+                    *a += b;
+                }
+            }
+        }
+        values
+    }
+}
+
+/// What [`Mapper::lit_series`] records: a bit per point and lit instant, shared by threads.
+struct LitBits {
+    words: usize,
+    instants: usize,
+    min_z: f64,
+    bits: Vec<AtomicU64>,
+}
+
+impl LitBits {
+    fn new(points: usize, instants: usize, min_altitude_deg: f64) -> Self {
+        let words = instants.div_ceil(64);
+        let bits = (0..points * words).map(|_| AtomicU64::new(0)).collect();
+        Self { words, instants, min_z: min_altitude_deg.to_radians().sin(), bits }
+    }
+
+    fn record(&self, k: usize, sun: DVec3, g: &Group, vis: &[f32]) {
+        if sun.z < self.min_z {
+            return;
+        }
+        for (&i, &v) in g.members.iter().zip(vis) {
+            if v >= 0.5 {
+                self.bits[i as usize * self.words + k / 64].fetch_or(1 << (k % 64), Ordering::Relaxed);
+            }
+        }
+    }
+
+    fn finish(self) -> LitSeries {
+        LitSeries { words: self.words, instants: self.instants, bits: self.bits.into_iter().map(AtomicU64::into_inner).collect() }
     }
 }
 

@@ -4,6 +4,7 @@
 
 use std::ops::Range;
 
+use super::masks::{GpuPoints, MaskBatch};
 use super::pipelines::{
     COUNTS_PER_MEMBER, DEPTH_FORMAT, GpuTileView, GpuView, ID_FORMAT, Pipelines, ROWS_PER_GROUP, attachment, buffer, entry,
 };
@@ -80,9 +81,19 @@ impl BatchBuffers {
     }
 }
 
+/// The compute passes a batch runs after its render.
+pub(super) struct Passes<'a> {
+    /// The count pass.
+    pub(super) count: bool,
+    /// The mask pass for these map points and views; its words land in the points' readback
+    /// from this word on.
+    pub(super) masks: Option<(&'a GpuPoints, &'a MaskBatch, u64)>,
+}
+
 impl Counter {
-    /// Renders and counts one batch of tiles; their member counts land in `readback` from entry
-    /// `first_entry` on. Returns the number of member entries.
+    /// Renders one batch of tiles and runs `passes` over it: the count (member counts land in
+    /// `readback` from entry `first_entry` on) and the masks. Returns the number of member
+    /// entries.
     pub(super) fn submit_batch(
         &self,
         scene: &GpuScene,
@@ -90,7 +101,9 @@ impl Counter {
         batch: &[Tile],
         side: u32,
         first_entry: usize,
+        passes: Passes<'_>,
     ) -> Result<usize> {
+        let Passes { count, masks } = passes;
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());
@@ -113,17 +126,21 @@ impl Counter {
         self.queue.write_buffer(&self.batch.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.batch.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-        encoder.clear_buffer(&self.batch.counts, 0, None);
         self.render_tiles(&mut encoder, scene, requests, batch, side);
-        {
+        if count {
+            encoder.clear_buffer(&self.batch.counts, 0, None);
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("count"), timestamp_writes: None });
             pass.set_pipeline(&self.pipelines.count);
             pass.set_bind_group(0, &scene.count_bind, &[]);
             pass.dispatch_workgroups(side.div_ceil(ROWS_PER_GROUP), batch.len() as u32, 1);
+            drop(pass);
+            let entry_bytes = COUNTS_PER_MEMBER * 4;
+            let bytes = members.len() as u64 * entry_bytes;
+            encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, first_entry as u64 * entry_bytes, bytes);
         }
-        let entry_bytes = COUNTS_PER_MEMBER * 4;
-        let bytes = members.len() as u64 * entry_bytes;
-        encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, first_entry as u64 * entry_bytes, bytes);
+        if let Some((points, mask_batch, first_word)) = masks {
+            self.encode_masks(&mut encoder, points, mask_batch, first_word);
+        }
         self.queue.submit([encoder.finish()]);
         Ok(members.len())
     }

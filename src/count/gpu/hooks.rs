@@ -2,6 +2,9 @@
 //! (the id atlas, where tiles sit, the culling and the view groups, a forced device loss, a small
 //! static-mesh chunk). Not part of the API the CLI and the web use.
 
+use glam::{DVec3, Vec4};
+
+use super::masks::MaskTile;
 use super::plan::tile_origin;
 use super::{Counter, GpuScene, pipelines::buffer};
 use crate::count::cull::Culling;
@@ -62,10 +65,48 @@ impl Counter {
     }
 }
 
+/// Tests only: the CPU truth of `shaders/point_masks.wgsl` for one point: whether `position`
+/// (world) on the receiver whose pixels carry `id` is lit in `tile` of an id atlas of side
+/// `atlas_side` read by [`Counter::read_atlas`] (scene origin `origin`). The same steps as the
+/// shader, in f32: the nearest texel's red id is the receiver's, or, where the receiver does not
+/// cover that texel, the first neighbour's (row by row) that it covers. Also returns the point's
+/// pixel coordinates in the tile, so a test can tell points too close to a texel border for f32
+/// rounding to agree.
+pub fn mask_truth(atlas: &[[u32; 2]], atlas_side: u32, tile: &MaskTile, id: u32, origin: DVec3, position: DVec3) -> (bool, [f32; 2]) {
+    let q = (position - origin).as_vec3();
+    let clip = tile.view.view_proj.as_mat4() * Vec4::new(q.x, q.y, q.z, 1.0);
+    let side = tile.side as f32;
+    let pixel = [(clip.x / clip.w * 0.5 + 0.5) * side, (0.5 - clip.y / clip.w * 0.5) * side];
+    let at = pixel.map(|p| p.floor().clamp(0.0, side - 1.0) as i64);
+    let texel = |x: i64, y: i64| atlas[((tile.atlas[1] as i64 + y) * atlas_side as i64 + tile.atlas[0] as i64 + x) as usize];
+    let here = texel(at[0], at[1]);
+    if here[1] == id {
+        return (here[0] == id, pixel);
+    }
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let (x, y) = (at[0] + dx, at[1] + dy);
+            if (dx == 0 && dy == 0) || x < 0 || y < 0 || x >= tile.side as i64 || y >= tile.side as i64 {
+                continue;
+            }
+            let n = texel(x, y);
+            if n[1] == id {
+                return (n[0] == id, pixel);
+            }
+        }
+    }
+    (false, pixel)
+}
+
 impl GpuScene {
     /// The receivers that share a view (a wall and the windows in it).
     pub fn view_groups(&self) -> &ViewGroups {
         &self.layout.groups
+    }
+
+    /// The id receiver `receiver`'s pixels carry (its own, or the mirrored surface's).
+    pub fn gpu_id(&self, receiver: u32) -> u32 {
+        self.layout.receivers[receiver as usize].gpu_id
     }
 
     /// The spatial index that picks what each view draws (benchmarks report what it saves).

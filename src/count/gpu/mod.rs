@@ -31,7 +31,9 @@
 //! - `upload`: a scene's buffers (static mesh in chunks within the device's buffer limit);
 //! - [`plan`]: CPU only — which views need a render, tiles, their cameras, adaptive sides;
 //! - `encode`: the per-batch buffers, render and count passes, one submission per batch;
-//! - `readback`: mapping the counts and turning them into fractions.
+//! - [`masks`]: map points uploaded per receiver and the mask pass that reads, after the count
+//!   pass and from the same atlas, whether each point sees the sun;
+//! - `readback`: mapping the counts (and masks) and turning them into fractions.
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
@@ -40,6 +42,7 @@ mod device;
 mod encode;
 #[cfg(feature = "test-hooks")]
 mod hooks;
+pub mod masks;
 mod pipelines;
 pub mod plan;
 mod readback;
@@ -52,6 +55,8 @@ use glam::DVec3;
 
 use self::device::Faults;
 use self::encode::BatchBuffers;
+#[cfg(feature = "test-hooks")]
+pub use self::hooks::mask_truth;
 use self::pipelines::Pipelines;
 pub use self::pipelines::SHADERS;
 use self::plan::{SceneLayout, Tile, finer_side, fit_tile, plan_tiles, sides, tiles_at};
@@ -238,7 +243,7 @@ impl Counter {
         // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
         let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
         while let Some((side, tiles)) = waiting.pop_first() {
-            self.count_tiles(scene, requests, &tiles, side, &mut out).await?;
+            self.count_tiles(scene, requests, &tiles, side, &mut out, None).await?;
             let Some(target) = self.options.accuracy else { continue };
             for tile in tiles {
                 let worst = tile.requests.iter().map(|&i| out[i].error_estimate()).fold(0.0, f64::max);

@@ -7,6 +7,9 @@
 
 pub(super) const SUN_VIEW_WGSL: &str = include_str!("../../../shaders/sun_view.wgsl");
 pub(super) const COUNT_PIXELS_WGSL: &str = include_str!("../../../shaders/count_pixels.wgsl");
+pub(super) const POINT_MASKS_WGSL: &str = include_str!("../../../shaders/point_masks.wgsl");
+/// Mask words per compute workgroup (the shader's `WORDS_PER_GROUP`).
+pub(super) const WORDS_PER_MASK_GROUP: u32 = 64;
 /// Rows of a tile per compute workgroup (the shader's `ROWS_PER_GROUP`).
 pub(super) const ROWS_PER_GROUP: u32 = 64;
 /// One target, two channels: red = the visible surface's id (scene pass), green = the target
@@ -45,6 +48,20 @@ pub(super) struct GpuTileView {
     pub(super) _pad: [u32; 3],
 }
 
+/// One view's map points as the mask pass reads them (`MaskView` in point_masks.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct GpuMaskView {
+    pub(super) view_proj: [[f32; 4]; 4],
+    pub(super) tile: [u32; 2],
+    pub(super) side: u32,
+    pub(super) id: u32,
+    pub(super) first_point: u32,
+    pub(super) point_count: u32,
+    pub(super) first_word: u32,
+    pub(super) _pad: u32,
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub(super) struct GpuParams {
@@ -71,8 +88,11 @@ pub(super) struct Pipelines {
     pub(super) tile_layout: wgpu::BindGroupLayout,
     /// The id atlas, tile views, parameters, counts and members, for the count pass.
     pub(super) count_layout: wgpu::BindGroupLayout,
+    /// The id atlas, mask views, map points and masks, for the mask pass.
+    pub(super) mask_layout: wgpu::BindGroupLayout,
     pub(super) view: ViewPipelines,
     pub(super) count: wgpu::ComputePipeline,
+    pub(super) mask: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -80,9 +100,11 @@ impl Pipelines {
         let render_layout = render_bind_layout(device);
         let tile_layout = tile_bind_layout(device);
         let count_layout = count_bind_layout(device);
+        let mask_layout = mask_bind_layout(device);
         let view = render_pipelines(device, &render_layout, &tile_layout);
-        let count = count_pipeline(device, &count_layout);
-        Self { render_layout, tile_layout, count_layout, view, count }
+        let count = compute_pipeline(device, &count_layout, "count_pixels.wgsl", COUNT_PIXELS_WGSL, "count_main");
+        let mask = compute_pipeline(device, &mask_layout, "point_masks.wgsl", POINT_MASKS_WGSL, "mask_main");
+        Self { render_layout, tile_layout, count_layout, mask_layout, view, count, mask }
     }
 }
 
@@ -151,21 +173,25 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_
     }
 }
 
-fn count_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("count_pixels.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(COUNT_PIXELS_WGSL.into()),
-    });
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    source: &str,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    let module =
+        device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(label), source: wgpu::ShaderSource::Wgsl(source.into()) });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("count"),
+        label: Some(label),
         bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("count"),
+        label: Some(label),
         layout: Some(&pipeline_layout),
         module: &module,
-        entry_point: Some("count_main"),
+        entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     })
@@ -207,6 +233,14 @@ fn count_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             storage_entry(3, cs, false),
             storage_entry(4, cs, true),
         ],
+    })
+}
+
+fn mask_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let cs = wgpu::ShaderStages::COMPUTE;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("masks"),
+        entries: &[uint_texture_entry(0), storage_entry(1, cs, true), storage_entry(2, cs, true), storage_entry(3, cs, false)],
     })
 }
 
@@ -273,4 +307,5 @@ pub(super) fn attachment(device: &wgpu::Device, label: &str, side: u32, format: 
 }
 
 /// WGSL sources, for validation in tests.
-pub const SHADERS: [(&str, &str); 2] = [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL)];
+pub const SHADERS: [(&str, &str); 3] =
+    [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL), ("point_masks.wgsl", POINT_MASKS_WGSL)];

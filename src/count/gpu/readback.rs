@@ -4,6 +4,8 @@
 
 use std::sync::atomic::Ordering;
 
+use super::encode::Passes;
+use super::masks::{GpuPoints, MaskBatch, PointMask};
 use super::pipelines::COUNTS_PER_MEMBER;
 use super::plan::{Tile, tiles_at};
 use super::{Counted, Counter, GpuScene};
@@ -14,8 +16,50 @@ use crate::platform;
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 pub(super) const BATCHES_PER_READBACK: usize = 32;
 
+/// Where [`Counter::count_tiles`] puts map points' masks: the points, each request's mask, and
+/// the words the rendered masks point into; `count`: whether the count pass runs too.
+pub(super) struct MaskOut<'a> {
+    pub(super) points: &'a GpuPoints,
+    pub(super) answers: &'a mut [Option<PointMask>],
+    pub(super) words: &'a mut Vec<u32>,
+    pub(super) count: bool,
+}
+
+/// Maps `words` words of `points`'s readback (the masks of `batches`, in order) and hands each
+/// view's words to its request.
+async fn read_masks(
+    counter: &Counter,
+    points: &GpuPoints,
+    batches: &[MaskBatch],
+    words: u64,
+    answers: &mut [Option<PointMask>],
+    all_words: &mut Vec<u32>,
+) -> Result<()> {
+    if words == 0 {
+        return Ok(());
+    }
+    let bytes = platform::read_buffer(&counter.device, &points.readback, words * 4).await;
+    counter.check_errors("reading point masks")?;
+    let bytes = bytes?;
+    let read: &[u32] = bytemuck::try_cast_slice(&bytes).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
+    let mut at = 0usize;
+    for batch in batches {
+        for ((view, &i), tile) in batch.views.iter().zip(&batch.requests).zip(&batch.tiles) {
+            let n = view.point_count.div_ceil(32) as usize;
+            let start = all_words.len();
+            all_words.extend_from_slice(&read[at + view.first_word as usize..][..n]);
+            answers[i] = Some(PointMask::Rendered { words: start..start + n, tile: *tile });
+        }
+        at += batch.words as usize;
+    }
+    Ok(())
+}
+
 impl Counter {
     /// Renders and counts `tiles` at side `side` and writes their members' counts into `out`.
+    /// With `masks`, also each rendered member's map points' mask (into the request's slot,
+    /// its words appended to the words); without its `count`, no pixels are counted and `out`
+    /// keeps what planning wrote.
     pub(super) async fn count_tiles(
         &self,
         scene: &GpuScene,
@@ -23,13 +67,32 @@ impl Counter {
         tiles: &[Tile],
         side: u32,
         out: &mut [Counted],
+        mut masks: Option<MaskOut<'_>>,
     ) -> Result<()> {
         let per_batch = tiles_at(self.atlas_side, side);
         for chunk in tiles.chunks(per_batch * BATCHES_PER_READBACK) {
-            // Each batch's counts land in the readback right after the previous batch's.
-            let mut entries = 0;
+            // Each batch's counts land in the readback right after the previous batch's, and so
+            // do its masks.
+            let (mut entries, mut words) = (0, 0u64);
+            let mut mask_batches = Vec::new();
+            let count = masks.as_ref().is_none_or(|m| m.count);
             for batch in chunk.chunks(per_batch) {
-                entries += self.submit_batch(scene, requests, batch, side, entries)?;
+                let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
+                let passes = Passes { count, masks: mask.as_ref().map(|(p, m)| (*p, m, words)) };
+                entries += self.submit_batch(scene, requests, batch, side, entries, passes)?;
+                if let Some((_, m)) = mask {
+                    words += m.words;
+                    mask_batches.push(m);
+                }
+            }
+            if let Some(m) = masks.as_mut() {
+                read_masks(self, m.points, &mask_batches, words, m.answers, m.words).await?;
+            }
+            let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
+            self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
+            self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
+            if !count {
+                continue;
             }
             let counts = platform::read_buffer(&self.device, &self.batch.readback, entries as u64 * COUNTS_PER_MEMBER * 4).await;
             // A failed read on a lost device is the loss, not a read error.
@@ -47,9 +110,6 @@ impl Counter {
                 o.pixel_area = pixel_area;
                 o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
             }
-            let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
-            self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
-            self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
         }
         Ok(())
     }
