@@ -45,7 +45,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{self, Plane, inside_or_on, newell, plane_deviation};
 use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
 use frame::{SurfaceFrame, WindowFrame, rectangle};
-use mesh::hole_problem;
+use mesh::{hole_problem, reveal_problem};
 
 mod frame;
 mod mesh;
@@ -684,6 +684,9 @@ impl<'a> Reader<'a> {
                 let base = building.surfaces.iter().find(|b| b.name.eq_ignore_ascii_case(base));
                 if let Some(why) = base.and_then(|b| hole_problem(b, surface)) {
                     building.warnings.push(format!("{} {why}; it is not cut out of its base surface", building.surfaces[i].label()));
+                }
+                if let Some(why) = base.and_then(|b| reveal_problem(b, surface)) {
+                    building.warnings.push(format!("{} {why}", building.surfaces[i].label()));
                 }
             }
         }

@@ -67,6 +67,17 @@ pub struct AnnualOptions {
 /// (Timestep 4): without it 341 timesteps a year were dark in one and lit in the other.
 pub const NEAR_DARK: f64 = 0.05;
 
+/// With refinement on, a timestep where the fitted spline and the bilinear interpolation of the
+/// four samples around it differ by more than this is counted directly. Where the fraction is
+/// smooth at the samples' spacing the two agree to second order; where a shadow edge enters or
+/// leaves the surface inside the cell (a kink: the fraction stays at 1, or at a plateau, then
+/// falls) the cubic spline rings over the neighbouring cells while the corners still differ by
+/// less than the refinement threshold. Measured against EnergyPlus 25.2's clipping on
+/// 4ZoneWithShading_Simple_1 (Timestep 6, 15 March – 20 October, default settings): the door
+/// under its overhang and fins went from a mean |Δ| of 0.0059 to 0.0040 over lit steps for 7 %
+/// more views (docs/energyplus-fidelity.md).
+pub const KINK: f64 = 0.03;
+
 /// The default refinement threshold: 30% of the surface changing state between samples. On the
 /// example office (N = 1) it takes the 27×19 RMS error from 0.017 to 0.006 for 37% more views.
 pub const DEFAULT_REFINE: f64 = 0.3;
@@ -585,24 +596,39 @@ struct SampleCells {
     taus: Vec<f64>,
 }
 
+/// The four samples around a (day, τ) as [`SampleCells::cell`] sums them up.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell {
+    /// Largest difference between them: how much the fraction changes across the cell.
+    spread: f64,
+    /// The lowest of them.
+    lowest: f64,
+    /// Their bilinear interpolation at (day, τ) (τ outside the outermost nodes is held at the node).
+    bilinear: f64,
+}
+
 impl SampleCells {
-    /// Largest difference between the four samples around (day, τ) (how much the fraction changes
-    /// across the cell the spline interpolates in), and the lowest of them.
-    fn spread_and_lowest(&self, samples: &[f64], day: f64, tau: f64) -> (f64, f64) {
-        let k0 = ((day - self.first_day) / self.spacing).floor().rem_euclid(self.days as f64) as usize % self.days;
+    /// The cell of samples around (day, τ) that the spline interpolates in.
+    fn cell(&self, samples: &[f64], day: f64, tau: f64) -> Cell {
+        let x = (day - self.first_day) / self.spacing;
+        let u = x - x.floor();
+        let k0 = x.floor().rem_euclid(self.days as f64) as usize % self.days;
         let k1 = (k0 + 1) % self.days;
         let s = self.taus.len();
         let j0 = self.taus.partition_point(|t| *t <= tau).saturating_sub(1).min(s.saturating_sub(2));
         let j1 = (j0 + 1).min(s - 1);
         let corners = [samples[k0 * s + j0], samples[k0 * s + j1], samples[k1 * s + j0], samples[k1 * s + j1]];
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
-        (hi - lo, lo)
+        let v = if j1 > j0 { ((tau - self.taus[j0]) / (self.taus[j1] - self.taus[j0])).clamp(0.0, 1.0) } else { 0.0 };
+        let bilinear = (1.0 - u) * ((1.0 - v) * corners[0] + v * corners[1]) + u * ((1.0 - v) * corners[2] + v * corners[3]);
+        Cell { spread: hi - lo, lowest: lo, bilinear }
     }
 }
 
 /// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
 /// where dark) and returns the (row, column, sun, day) cells to count directly: those whose sample
-/// cell spreads more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]).
+/// cell spreads more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]) or where
+/// the spline leaves its cell's bilinear interpolation ([`KINK`]).
 fn evaluate(
     scene: &Scene,
     location: &Location,
@@ -632,8 +658,8 @@ fn evaluate(
                 if let Some(fit) = &regime.fits[fit] {
                     let value = fit.spline.eval(grid_day, tau);
                     schedule.set(row, column, as_energyplus(value));
-                    let (spread, lowest) = regime.cells.spread_and_lowest(&fit.samples, grid_day, tau);
-                    if spread > refine || (refine < 1.0 && (lowest < NEAR_DARK || value < NEAR_DARK)) {
+                    let cell = regime.cells.cell(&fit.samples, grid_day, tau);
+                    if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
                         rough.push((row, column, sun, day as f64));
                     }
                 }
@@ -641,6 +667,13 @@ fn evaluate(
         }
     }
     rough
+}
+
+/// With refinement on, whether a fitted `value` in `cell` is counted directly beyond the spread
+/// rule: near dark ([`NEAR_DARK`]) or where the spline leaves the cell's bilinear interpolation
+/// ([`KINK`]).
+fn needs_count(cell: &Cell, value: f64) -> bool {
+    cell.lowest < NEAR_DARK || value < NEAR_DARK || (value - cell.bilinear).abs() > KINK
 }
 
 /// Which of a regime's fits (by receiver and piece) serves receiver `column` at time `t`, given

@@ -78,6 +78,18 @@ impl WindowFrame {
     }
 }
 
+/// Whether four vertices are an upright rectangle in the base surface's frame listed upper-left,
+/// lower-left, lower-right, upper-right (to 1 mm): the shape EnergyPlus's reveal shading takes a
+/// four-sided set-back window to be (see `mesh::reveal_problem`).
+pub(super) fn upright_from_upper_left(sub: &[DVec3], base: &[DVec3]) -> bool {
+    const TOLERANCE: f64 = 1e-3;
+    let [a, b, c, d] = sub else { return false };
+    let frame = SurfaceFrame::of(base);
+    let [(u1, v1), (u2, v2), (u3, v3), (u4, v4)] = [a, b, c, d].map(|p| frame.coords(*p));
+    let same = |x: f64, y: f64| (x - y).abs() <= TOLERANCE;
+    same(u1, u2) && same(u3, u4) && u1 < u3 && same(v1, v4) && same(v2, v3) && v1 > v2
+}
+
 /// Azimuth (degrees clockwise from north, 0..360) and tilt (degrees from up) of a surface, as
 /// EnergyPlus's `DetermineAzimuthAndTilt`: from the normal, except for horizontal surfaces, whose
 /// azimuth puts "right" along their vertex 2 → 3 edge (so a skylight placed on a flat roof lines

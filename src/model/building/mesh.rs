@@ -15,6 +15,24 @@ pub(super) fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String>
     None
 }
 
+/// Why EnergyPlus's own clipping does not shade a set-back window as the window is shaded, if it
+/// does not: `SHDRVL` (SolarShading.cc) builds a four-sided window's reveal opening by moving its
+/// vertices 1 and 2 as the left edge, 3 and 4 as the right, 1 and 4 as the top and 2 and 3 as the
+/// bottom, so it is right only for an upright rectangle listed from its upper-left corner. Listed
+/// from another corner, a window 0.152 m back under an overhang and fins got 0.61 from EnergyPlus
+/// against 0.17 (its real mean over lit steps, which EnergyPlus gives when the same window is
+/// listed from the upper-left; docs/energyplus-fidelity.md).
+pub(super) fn reveal_problem(base: &EpSurface, sub: &EpSurface) -> Option<String> {
+    let SubPlacement::SetBack { depth, .. } = reveal::place(&base.vertices, &sub.vertices)? else { return None };
+    if sub.vertices.len() != 4 || frame::upright_from_upper_left(&sub.vertices, &base.vertices) {
+        return None;
+    }
+    Some(format!(
+        "is set back {depth:.3} m behind '{}' but its vertices are not an upright rectangle listed from its upper-left corner, which EnergyPlus's reveal shading (SHDRVL) assumes: EnergyPlus's own shading calculation gives it a sunlit fraction that is not the window's; sunlit gives the window's own (and a hooked model uses it)",
+        base.name
+    ))
+}
+
 /// A surface's triangles in world coordinates, holes cut out, wound counter-clockwise seen from
 /// outside. Receivers are flattened onto their best-fit plane (a scene receiver must be planar).
 pub(super) fn triangulate(surface: &EpSurface, holes: &[&EpSurface]) -> Vec<[DVec3; 3]> {

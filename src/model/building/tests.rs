@@ -360,3 +360,20 @@ FenestrationSurface:Detailed,Ground Win,Window,W,Ground Wall,,autocalculate,,1,4
     let names: Vec<&str> = scene.receivers.iter().map(|r| r.name.as_str()).collect();
     assert_eq!(names, ["Lit", "Lit Win"]);
 }
+
+/// A window set back behind its wall is shaded by EnergyPlus's reveal rule as the window is only
+/// when listed from its upper-left corner as an upright rectangle: listed from another corner, the
+/// warning says EnergyPlus's own fraction for it is not the window's. Flush windows and windows
+/// listed from the upper-left get no warning.
+#[test]
+fn set_back_windows_listed_from_another_corner_warn() {
+    let window = "  2,0,2.5, 2,0,1, 8,0,1, 8,0,2.5;";
+    assert!(MODEL.contains(window));
+    let warned = |text: String| read(&text).warnings.into_iter().find(|w| w.contains("Win S"));
+    assert_eq!(warned(MODEL.to_string()), None, "flush");
+    assert_eq!(warned(MODEL.replace(window, "  2,0.15,2.5, 2,0.15,1, 8,0.15,1, 8,0.15,2.5;")), None, "set back, from the upper-left");
+    assert_eq!(warned(MODEL.replace(window, "  2,0,1, 8,0,1, 8,0,2.5, 2,0,2.5;")), None, "flush, from the lower-left");
+    let warning = warned(MODEL.replace(window, "  2,0.15,1, 8,0.15,1, 8,0.15,2.5, 2,0.15,2.5;")).expect("set back, from the lower-left");
+    assert!(warning.starts_with("FenestrationSurface:Detailed 'Win S' (line 18) is set back 0.150 m behind 'Wall S'"), "{warning}");
+    assert!(warning.contains("SHDRVL"), "{warning}");
+}
