@@ -162,10 +162,10 @@ fn open_roof_sun_hours_are_the_day_length() {
     let points = grid(&s, 0.5, &all(&s)).unwrap();
     let location = Location::new(51.5, -0.1, 0.0).unwrap();
     let calendar = LeafCalendar::evergreen();
-    let site = Site { location: &location, calendar: &calendar, dni: None };
+    let site = Site { location: &location, calendar: &calendar, weather: None, sky: None };
     for day in [80, 172, 355] {
         let period = Period::day(day, 0, 24 * 60, 1).unwrap();
-        let values = Mapper::new(&s, &points).unwrap().accumulate(&period.samples(), site, &mut |_, _| {});
+        let values = Mapper::new(&s, &points).unwrap().accumulate(&period.samples(), site, &mut |_, _| {}).unwrap();
         let (rise, set) = daylight(&location, shading_sun_day(day)).unwrap();
         for h in &values.sun_hours {
             assert!((h - (set - rise)).abs() <= 2.0 / 60.0, "day {day}: {h} h of sun, daylight {} h", set - rise);
@@ -184,7 +184,7 @@ fn bre_ground_study_on_a_yard_behind_a_wall() {
     let points = grid(&s, 1.0, &all(&s)).unwrap();
     let location = Location::new(51.5, -0.1, 0.0).unwrap();
     let calendar = LeafCalendar::evergreen();
-    let site = Site { location: &location, calendar: &calendar, dni: None };
+    let site = Site { location: &location, calendar: &calendar, weather: None, sky: None };
     let rule = study::preset("bre-ground").unwrap();
     let period = Period::day(rule.default_day, 0, 24 * 60, 2).unwrap();
     let samples = period.samples();
