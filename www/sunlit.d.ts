@@ -286,9 +286,12 @@ export interface SunlitMap {
   groundReflected: Float32Array | undefined;
   /** direct + skyDiffuse + groundReflected per point, kWh/m²; with value 'skyDiffuse' or 'total'. */
   total: Float32Array | undefined;
+  /** Each point's view factor to the visible sky ((1 + cos tilt)/2 with nothing in the way); with
+   * value 'skyDiffuse' or 'total'. */
+  skyViewFactor: Float32Array | undefined;
   /** The points CSV (with `csv: true`): receiver,x,y,z,nx,ny,nz then lit, or sun_hours and, with
    * an EPW, direct_kwh_m2 (and with the sky sky_diffuse_kwh_m2, ground_reflected_kwh_m2,
-   * total_kwh_m2). */
+   * total_kwh_m2, sky_view_factor). */
   csv: string | undefined;
   /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
    * legend in the scene's extras. */

@@ -309,6 +309,7 @@ class SunlitEngine {
         skyDiffuse: map.skyDiffuse,
         groundReflected: map.groundReflected,
         total: map.total,
+        skyViewFactor: map.skyViewFactor,
         min: map.min,
         max: map.max,
         receiverNames: model.receiverNames,

@@ -32,7 +32,7 @@ pub(super) struct MapArgs {
     epw: Option<PathBuf>,
     /// Ground reflectance (0..1) for every hour, with --epw; default: the EPW's albedo (field 33),
     /// 0.2 where it is missing.
-    #[arg(long, value_name = "R")]
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
     albedo: Option<f64>,
     /// Sky patches for each point's sky views, with --epw: tregenza (145, the default) or
     /// reinhart:N (N = 1..6, 144·N² + 1 patches).

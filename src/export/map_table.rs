@@ -3,8 +3,8 @@
 //!
 //! A period's value columns ([`value_columns`]) are `sun_hours`, then with weather
 //! `direct_kwh_m2`, then with the points' sky views `sky_diffuse_kwh_m2`,
-//! `ground_reflected_kwh_m2` and `total_kwh_m2` (the per-surface summary's names,
-//! [`crate::export::irradiation::SUMMARY_CSV_HEADER`]).
+//! `ground_reflected_kwh_m2`, `total_kwh_m2` and `sky_view_factor` (the per-surface summary's
+//! names, [`crate::export::irradiation::SUMMARY_CSV_HEADER`]).
 
 use std::fmt::Write;
 
@@ -38,6 +38,9 @@ pub fn value_columns(values: &MapValues) -> Vec<Column<'_>> {
         if let Some(v) = v {
             columns.push(Column { name, values: v, decimals: 4 });
         }
+    }
+    if let Some(v) = &values.sky_view_factor {
+        columns.push(Column { name: "sky_view_factor", values: v, decimals: 6 });
     }
     columns
 }

@@ -126,6 +126,9 @@ pub struct MapValues {
     pub ground_reflected_kwh_m2: Option<Vec<f64>>,
     /// Direct + sky diffuse + ground-reflected (kWh/m²); `None` as for the sky.
     pub total_kwh_m2: Option<Vec<f64>>,
+    /// The view factor to the visible sky (the period's mean over the leaf calendar; (1 + cos
+    /// tilt)/2 with nothing in the way); `None` as for the sky.
+    pub sky_view_factor: Option<Vec<f64>>,
     /// Instants in the period, and those with the sun up (each counted at every point).
     pub instants: usize,
     /// Instants with the sun up.
@@ -136,6 +139,13 @@ impl MapValues {
     /// Adds the sums of `other` (another stretch of the same points' period).
     pub fn merge(&mut self, other: &MapValues) {
         add_into(&mut self.sun_hours, &other.sun_hours);
+        // A mean over instants: weighted by each stretch's instants.
+        if let (Some(a), Some(b)) = (self.sky_view_factor.as_mut(), other.sky_view_factor.as_ref()) {
+            let (na, nb) = (self.instants as f64, other.instants as f64);
+            if na + nb > 0.0 {
+                a.iter_mut().zip(b).for_each(|(a, b)| *a = (*a * na + b * nb) / (na + nb));
+            }
+        }
         for (into, from) in [
             (&mut self.direct_kwh_m2, &other.direct_kwh_m2),
             (&mut self.sky_diffuse_kwh_m2, &other.sky_diffuse_kwh_m2),
@@ -283,6 +293,11 @@ impl Mapper {
             values.total_kwh_m2 = Some((0..n).map(|i| direct.get(i).copied().unwrap_or(0.0) + sky_diffuse[i] + ground[i]).collect());
             values.sky_diffuse_kwh_m2 = Some(sky_diffuse);
             values.ground_reflected_kwh_m2 = Some(ground);
+            if let Some(sky) = sky {
+                // The views are linear in the leaf fraction: the mean view is the view at the mean.
+                let leaves = samples.iter().map(|s| site.calendar.fraction(f64::from(s.day))).sum::<f64>() / samples.len().max(1) as f64;
+                values.sky_view_factor = Some((0..n).map(|i| sky.isotropic(i, leaves)).collect());
+            }
         }
         Ok(values)
     }

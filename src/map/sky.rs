@@ -3,14 +3,19 @@
 //!
 //! Owns how a point's patch visibility is found, the same way a receiver's is:
 //! - the patch layout is [`SkyPatches`] (Tregenza's 145 or Reinhart's MF:n);
-//! - a patch's visibility is asked along the one direction that stands for its part in front of
-//!   the receiver ([`SkyPatches::weights`]' cos-weighted mean direction, the direction the surface
-//!   views ask the engines with), here by the exact engine's shadow rays ([`Mapper`]'s
-//!   [`crate::count::exact::rays`]) from every point of the receiver at once: 0 or 1, or the
-//!   transmittance of see-through casters;
-//! - the patch's weight is the point's own (∫ cos dΩ for the point's normal, the receiver's for a
-//!   grid), and the visibilities are combined as the surfaces' are ([`Seen`]): view factor to the
-//!   visible sky, horizon-band visibility, and the unobstructed view factor;
+//! - each patch is cut into [`SUBDIVISION`]² sub-patches ([`Patch::split`]), and each sub-patch's
+//!   visibility is asked as the surface views ask a patch's: along the one direction that stands
+//!   for its part in front of the receiver ([`Patch::weight`]'s cos-weighted mean direction), here
+//!   by the exact engine's shadow rays ([`Mapper`]'s [`crate::count::exact::rays`]) from every
+//!   point of the receiver at once: 0 or 1, or the transmittance of see-through casters. A
+//!   surface's fraction is an area mean, smooth in the direction, so one direction a patch does
+//!   for it; a point's visibility is a step in the direction (a louvre gap is a few degrees
+//!   wide), and one ray per 12° Tregenza patch put points behind louvres 15–17 % off Radiance's
+//!   sky (docs/maps.md);
+//! - the sub-patch's weight is the point's own (∫ cos dΩ for the point's normal, the receiver's
+//!   for a grid), and the visibilities are combined as the surfaces' are ([`Seen`], each
+//!   sub-patch in its patch's band): view factor to the visible sky, horizon-band visibility, and
+//!   the unobstructed view factor;
 //! - with foliage, once at bare and once at full leaf ([`SkyViews`] interpolates between them as
 //!   the leaf calendar ramps, as for surfaces).
 //!
@@ -29,9 +34,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::DVec3;
 
 use super::Mapper;
-use crate::sky::patches::{PatchWeight, SkyPatches};
+use crate::sky::patches::{Patch, PatchWeight, SkyPatches};
 use crate::sky::perez::PerezSky;
 use crate::sky::views::{Seen, SkyViews};
+
+/// Rows and columns each sky patch is cut into for a point's view of it.
+pub const SUBDIVISION: usize = 6;
 
 /// One receiver's points split by normal (a grid has one; CSV points may each have their own),
 /// each normal with its patch weights.
@@ -46,8 +54,10 @@ struct NormalClasses {
 /// (natively; on the web the calling thread alone); `progress(done, total)` counts patch views.
 pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut(usize, usize)) -> SkyViews {
     let leaf_states: Vec<f32> = if mapper.foliage { vec![0.0, 1.0] } else { vec![1.0] };
-    let receiver_weights: Vec<Vec<PatchWeight>> = mapper.groups.iter().map(|g| patches.weights(g.normal)).collect();
-    let classes: Vec<NormalClasses> = mapper.groups.iter().map(|g| classes(mapper, &g.members, patches)).collect();
+    let fine: Vec<Patch> = patches.patches.iter().flat_map(|p| p.split(SUBDIVISION)).collect();
+    let weights_of = |normal: DVec3| -> Vec<PatchWeight> { fine.iter().map(|p| p.weight(normal)).collect() };
+    let receiver_weights: Vec<Vec<PatchWeight>> = mapper.groups.iter().map(|g| weights_of(g.normal)).collect();
+    let classes: Vec<NormalClasses> = mapper.groups.iter().map(|g| classes(mapper, &g.members, &weights_of)).collect();
     // One job per (leaf state, group, patch in front of the receiver).
     let jobs: Vec<(usize, usize, usize)> = (0..leaf_states.len())
         .flat_map(|s| {
@@ -71,7 +81,7 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
             vis.resize(group.members.len(), 0.0);
             let direction = receiver_weights[g][p].direction;
             mapper.engine.visibility(&group.plane, direction, leaf_states[s], &mut scratch, &mut vis);
-            let horizon = patches.patches[p].band == 0;
+            let horizon = fine[p].band == 0;
             let c = &classes[g];
             for ((&i, &v), &class) in group.members.iter().zip(&vis).zip(&c.class) {
                 let weight = c.weights[class as usize][p].weight;
@@ -101,7 +111,7 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
 }
 
 /// The distinct normals of a group's members and their weights.
-fn classes(mapper: &Mapper, members: &[u32], patches: &SkyPatches) -> NormalClasses {
+fn classes(mapper: &Mapper, members: &[u32], weights_of: &dyn Fn(DVec3) -> Vec<PatchWeight>) -> NormalClasses {
     let mut index: HashMap<[u64; 3], u32> = HashMap::new();
     let mut weights = Vec::new();
     let class = members
@@ -109,7 +119,7 @@ fn classes(mapper: &Mapper, members: &[u32], patches: &SkyPatches) -> NormalClas
         .map(|&i| {
             let normal = mapper.normals[i as usize];
             *index.entry(normal.to_array().map(f64::to_bits)).or_insert_with(|| {
-                weights.push(patches.weights(normal));
+                weights.push(weights_of(normal));
                 (weights.len() - 1) as u32
             })
         })

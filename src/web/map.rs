@@ -178,6 +178,12 @@ impl PointMap {
         self.sums.as_ref().and_then(|s| s.total_kwh_m2.as_deref()).map(to_f32)
     }
 
+    /// Each point's view factor to the visible sky (with `skyDiffuse` or `total`).
+    #[wasm_bindgen(getter, js_name = skyViewFactor)]
+    pub fn sky_view_factor(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.sky_view_factor.as_deref()).map(to_f32)
+    }
+
     /// The legend's low end: 0.
     #[wasm_bindgen(getter)]
     pub fn min(&self) -> f64 {
