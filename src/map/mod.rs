@@ -247,7 +247,9 @@ impl Mapper {
             |acc, _, s, sun, g, vis| {
                 let hour = weather.map(|(w, t)| w.at(t, s.epw_hour));
                 let dni = hour.map_or(0.0, |h| h.dni);
-                for (&i, &v) in g.members.iter().zip(vis) {
+                // Facing away from the sun every visibility is 0: only the sky's shared terms count.
+                let dark = crate::count::is_dark(g.normal, sun);
+                for (&i, &v) in g.members.iter().zip(vis).filter(|_| !dark) {
                     if v > 0.0 {
                         let i = i as usize;
                         acc.hours[i] += f64::from(v) * s.hours;
@@ -261,7 +263,7 @@ impl Mapper {
                     && let Some(perez) = PerezSky::new(hour.dni, hour.dhi, sun.z, site.location.elevation)
                 {
                     let leaves = site.calendar.fraction(f64::from(s.day));
-                    plan.add(sums, self, g.index, &perez, hour.dhi, sun, leaves, s.hours, vis);
+                    plan.add(sums, self, g.index, &perez, hour.dhi, sun, leaves, s.hours, if dark { &[] } else { vis });
                 }
             },
         );

@@ -187,7 +187,8 @@ impl<'a> SkyPlan<'a> {
     }
 
     /// Adds one timestep (`hours` long, sky `perez` with diffuse horizontal `dhi` W/m², sun `sun`,
-    /// leaf fraction `leaves`) on group `g` whose points see the sun with `visibility`.
+    /// leaf fraction `leaves`) on group `g` whose points see the sun with `visibility` (empty:
+    /// none sees it).
     #[allow(clippy::too_many_arguments)] // One timestep's state, handed down from the sweep.
     pub(super) fn add(
         &self,
@@ -226,7 +227,9 @@ impl<'a> SkyPlan<'a> {
                 return;
             }
         }
-        for (&i, &v) in group.members.iter().zip(visibility) {
+        let dark = [0.0f32];
+        let shades = group.members.iter().enumerate().map(|(k, _)| visibility.get(k).unwrap_or(&dark[0]));
+        for (&i, &v) in group.members.iter().zip(shades) {
             let i = i as usize;
             let normal = mapper.normals[i];
             let terms = perez.terms(dhi, normal.dot(sun).max(0.0), normal.truncate().length());
