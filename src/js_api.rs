@@ -162,7 +162,6 @@ fn the_map_options_are_the_same_on_both_sides() {
     assert_eq!(all.map(MapValue::name), MapValue::NAMES);
     assert_eq!(all.map(|v| v.title().1), ["h", "kWh/m²", "kWh/m²", "kWh/m²", ""], "the units the legend shows");
     assert_eq!(all.map(MapValue::needs_weather), [false, true, true, true, false], "the irradiation values need an EPW");
-    assert_eq!(all.map(MapValue::needs_sky), [false, false, true, true, false], "sky diffuse and total need the points' sky views");
     let values: BTreeSet<String> = MapValue::NAMES.iter().map(|v| v.to_string()).collect();
     assert_eq!(literals_after("  value?: "), values, "MapOptions.value");
     assert_eq!(union(interface("SunlitMap"), "value"), values, "SunlitMap.value");

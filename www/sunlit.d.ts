@@ -235,8 +235,9 @@ export interface MapOptions {
   to?: string;
   /** One instant, 'MM-DD HH:MM' local standard time: then the value is 'lit'. */
   at?: string;
-  /** 'sunHours' (default), 'direct', 'skyDiffuse' or 'total' (kWh/m², need an EPW; the last two
-   * count each point's view of Tregenza's 145 sky patches once per grid) or 'lit' (needs `at`). */
+  /** 'sunHours' (default), 'direct', 'skyDiffuse' or 'total' (kWh/m², need an EPW; each sums
+   * every part, as `sunlit map --epw`, counting each point's view of Tregenza's 145 sky patches
+   * once per grid) or 'lit' (needs `at`). */
   value?: 'sunHours' | 'direct' | 'skyDiffuse' | 'total' | 'lit';
   /** Foliage keeps its leaves all year (as AnnualSettings). */
   evergreen?: boolean;
@@ -279,15 +280,15 @@ export interface SunlitMap {
   /** A period's direct irradiation per point, kWh/m² (undefined without an EPW, or for an instant). */
   direct: Float32Array | undefined;
   /** A period's sky-diffuse irradiation per point (Perez 1990 sky over the point's own visible
-   * patches, circumsolar part shaded like its beam), kWh/m²; with value 'skyDiffuse' or 'total'. */
+   * patches, circumsolar part shaded like its beam), kWh/m²; with an irradiation value. */
   skyDiffuse: Float32Array | undefined;
   /** A period's ground-reflected irradiation per point, GHI·albedo·(1 − cos tilt)/2 (unobstructed),
-   * kWh/m²; with value 'skyDiffuse' or 'total'. */
+   * kWh/m²; with an irradiation value. */
   groundReflected: Float32Array | undefined;
-  /** direct + skyDiffuse + groundReflected per point, kWh/m²; with value 'skyDiffuse' or 'total'. */
+  /** direct + skyDiffuse + groundReflected per point, kWh/m²; with an irradiation value. */
   total: Float32Array | undefined;
   /** Each point's view factor to the visible sky ((1 + cos tilt)/2 with nothing in the way); with
-   * value 'skyDiffuse' or 'total'. */
+   * an irradiation value. */
   skyViewFactor: Float32Array | undefined;
   /** The points CSV (with `csv: true`): receiver,x,y,z,nx,ny,nz then lit, or sun_hours and, with
    * an EPW, direct_kwh_m2 (and with the sky sky_diffuse_kwh_m2, ground_reflected_kwh_m2,

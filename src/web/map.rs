@@ -160,25 +160,25 @@ impl PointMap {
         self.sums.as_ref().and_then(|s| s.direct_kwh_m2.as_deref()).map(to_f32)
     }
 
-    /// A period's sky-diffuse irradiation per point, kWh/m² (with `skyDiffuse` or `total`).
+    /// A period's sky-diffuse irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
     #[wasm_bindgen(getter, js_name = skyDiffuse)]
     pub fn sky_diffuse(&self) -> Option<Float32Array> {
         self.sums.as_ref().and_then(|s| s.sky_diffuse_kwh_m2.as_deref()).map(to_f32)
     }
 
-    /// A period's ground-reflected irradiation per point, kWh/m² (with `skyDiffuse` or `total`).
+    /// A period's ground-reflected irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
     #[wasm_bindgen(getter, js_name = groundReflected)]
     pub fn ground_reflected(&self) -> Option<Float32Array> {
         self.sums.as_ref().and_then(|s| s.ground_reflected_kwh_m2.as_deref()).map(to_f32)
     }
 
-    /// A period's total irradiation per point, kWh/m² (with `skyDiffuse` or `total`).
+    /// A period's total irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
     #[wasm_bindgen(getter)]
     pub fn total(&self) -> Option<Float32Array> {
         self.sums.as_ref().and_then(|s| s.total_kwh_m2.as_deref()).map(to_f32)
     }
 
-    /// Each point's view factor to the visible sky (with `skyDiffuse` or `total`).
+    /// Each point's view factor to the visible sky (with an irradiation value: `direct`, `skyDiffuse` or `total`).
     #[wasm_bindgen(getter, js_name = skyViewFactor)]
     pub fn sky_view_factor(&self) -> Option<Float32Array> {
         self.sums.as_ref().and_then(|s| s.sky_view_factor.as_deref()).map(to_f32)
@@ -230,7 +230,7 @@ impl Engine {
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
             let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
-            let sky = request.value.needs_sky().then(|| sky_for(&model, &request.place, &mapper));
+            let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper));
             let site = Site {
                 location: &request.site.location,
                 calendar: &request.site.calendar,

@@ -62,14 +62,11 @@ impl MapValue {
         Self::NAMES[self as usize]
     }
 
-    /// Whether the value needs the EPW's irradiance.
+    /// Whether the value is an irradiation: it needs the EPW, and the map then sums every part
+    /// (direct, sky diffuse with each point's sky views, ground-reflected, total), as
+    /// `sunlit map --epw` does, so that its CSV is the CLI's.
     pub fn needs_weather(self) -> bool {
         matches!(self, Self::Direct | Self::SkyDiffuse | Self::Total)
-    }
-
-    /// Whether the value needs each point's sky views.
-    pub fn needs_sky(self) -> bool {
-        matches!(self, Self::SkyDiffuse | Self::Total)
     }
 
     /// The legend's title and the unit.

@@ -229,8 +229,11 @@ test('engine.map: typed arrays; direct irradiation under an EPW equals `sunlit m
   assert.equal(api.glb, 'glTF', 'the map glb has the glb magic');
   assert.ok(api.same, 'values are the direct irradiation asked for');
   const native = nativeMap('direct', ['--epw', epwPath, '--period', '12-01..12-07']);
-  // The CLI's columns: sun_hours and, with an EPW, direct_kwh_m2; the API's CSV is the same.
-  assert.deepEqual(parseCsv(native).header.slice(7), ['sun_hours', 'direct_kwh_m2']);
+  // The CLI's columns: sun_hours and, with an EPW, the irradiation's parts and the sky view
+  // factor; the API's CSV is the same (every column compared below).
+  assert.deepEqual(parseCsv(native).header.slice(7), [
+    'sun_hours', 'direct_kwh_m2', 'sky_diffuse_kwh_m2', 'ground_reflected_kwh_m2', 'total_kwh_m2', 'sky_view_factor',
+  ]);
   const { worst } = compare(api.csv, native, 1e-3);
   console.log(`engine.map: ${api.count} points, direct up to ${api.max.toFixed(2)} kWh/m² over a week of Sydney's summer; vs CLI worst |Δ| ${JSON.stringify(worst)}`);
   assert.ok(api.max > 1, 'a week of summer sun');
