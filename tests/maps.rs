@@ -537,6 +537,46 @@ fn a_louvred_walls_fine_grid_mean_converges_to_the_surface_summary() {
     }
 }
 
+/// Foliage: a roof under a wide canopy of one leaf, 1 m above it. Its sky views are counted bare
+/// and in full leaf; in January (bare, the latitude's leaf calendar) every point gets the
+/// closed-form Perez sky of an open roof, in July (full leaf) the canopy takes most of it.
+#[test]
+fn the_sky_per_point_follows_the_leaf_calendar() {
+    let roof = quad([[0., 0., 0.], [2., 0., 0.], [2., 2., 0.], [0., 2., 0.]]);
+    let canopy = quad([[-10., -10., 1.], [12., -10., 1.], [12., 12., 1.], [-10., 12., 1.]]);
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "ROOF", roof, true);
+    b.add_object("test", "CANOPY", canopy, false);
+    b.set_node_veil(1, sunlit::scene::NodeVeil { foliage: true, transmittance: 0.0 });
+    let s = b.build().unwrap();
+    assert!(s.has_foliage());
+    let (location, weather) = golden(Hour { dni: 700.0, dhi: 160.0, ghi: 450.0, albedo: 0.2 });
+    let calendar = LeafCalendar::for_latitude(location.latitude);
+    let points = grid(&s, 0.5, &all(&s)).unwrap();
+    let mapper = Mapper::new(&s, &points).unwrap();
+    let sky = point_sky(&mapper, &SkyPatches::tregenza(), &mut |_, _| {});
+    assert_eq!(sky.leaf_states, vec![0.0, 1.0]);
+    let site = Site { location: &location, calendar: &calendar, weather: Some(&weather), sky: Some(&sky) };
+    let january = mapper.accumulate(&Period::days(1, 31, 1).unwrap().samples(), site, &mut |_, _| {}).unwrap();
+    let july = mapper.accumulate(&Period::days(182, 212, 1).unwrap().samples(), site, &mut |_, _| {}).unwrap();
+    let mut open = 0.0;
+    for s in Period::days(1, 31, 1).unwrap().samples() {
+        let sun = sun_direction(&location, shading_sun_day(s.day), s.hour);
+        if sun.z >= sunlit::count::MIN_COS_INCIDENCE {
+            open += closed_form_perez(DVec3::Z, sun, 700.0, 160.0, location.elevation) / 1000.0;
+        }
+    }
+    for i in 0..points.len() {
+        let bare = january.sky_diffuse_kwh_m2.as_ref().unwrap()[i];
+        assert!((bare - open).abs() <= 0.005 * open, "point {i}: January {bare} vs open {open}");
+        assert!((january.sky_view_factor.as_ref().unwrap()[i] - 1.0).abs() < 1e-3, "bare: the whole sky");
+        let leafy = july.sky_diffuse_kwh_m2.as_ref().unwrap()[i];
+        let view = july.sky_view_factor.as_ref().unwrap()[i];
+        assert!(view < 0.1, "point {i}: in full leaf the canopy hides the sky ({view})");
+        assert!(leafy < 0.25 * open, "point {i}: July {leafy} vs January's open {open}");
+    }
+}
+
 /// An EPW of one hour repeated (DNI 600, DHI 100, GHI 500, albedo 0.2) at Golden, CO.
 fn synthetic_epw() -> String {
     use std::fmt::Write as _;
