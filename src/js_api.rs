@@ -158,9 +158,10 @@ fn the_map_options_are_the_same_on_both_sides() {
         other => panic!("{other}"),
     };
     assert!(SITE_KEYS.iter().all(|k| annual.contains(*k)), "the site keys are annual settings' keys");
-    let all = [MapValue::SunHours, MapValue::Direct, MapValue::Lit];
+    let all = [MapValue::SunHours, MapValue::Direct, MapValue::SkyDiffuse, MapValue::Total, MapValue::Lit];
     assert_eq!(all.map(MapValue::name), MapValue::NAMES);
-    assert_eq!(all.map(|v| v.title().1), ["h", "kWh/m²", ""], "the units the legend shows");
+    assert_eq!(all.map(|v| v.title().1), ["h", "kWh/m²", "kWh/m²", "kWh/m²", ""], "the units the legend shows");
+    assert_eq!(all.map(MapValue::needs_weather), [false, true, true, true, false], "the irradiation values need an EPW");
     let values: BTreeSet<String> = MapValue::NAMES.iter().map(|v| v.to_string()).collect();
     assert_eq!(literals_after("  value?: "), values, "MapOptions.value");
     assert_eq!(union(interface("SunlitMap"), "value"), values, "SunlitMap.value");
@@ -176,7 +177,7 @@ fn request(extra: serde_json::Value) -> crate::error::Result<MapRequest> {
 fn map_options_read_as_sunlit_map_reads_its_flags() {
     let plain = request(json!({})).unwrap();
     assert_eq!(plain.site.location.latitude, 39.74);
-    assert!(plain.dni.is_none(), "no EPW, no direct normal irradiance");
+    assert!(plain.weather.is_none(), "no EPW, no irradiance");
     assert_eq!((plain.place, plain.period, plain.value), (Where::Grid(0.5), Period::annual(1).unwrap(), MapValue::SunHours));
     let day = request(json!({"grid": 1, "period": "03-21"})).unwrap();
     assert_eq!((day.place, day.period), (Where::Grid(1.0), Period::day(80, 0, 1440, 10).unwrap()));
@@ -205,6 +206,8 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"at": "03-21 09:30", "period": "03-21"})), bad("period"));
     assert_eq!(named(json!({"value": "lit"})), bad("value"));
     assert_eq!(named(json!({"value": "direct"})), bad("value"));
+    assert_eq!(named(json!({"value": "skyDiffuse"})), bad("value"), "the sky needs an EPW");
+    assert_eq!(named(json!({"value": "total"})), bad("value"), "the total needs an EPW");
     assert_eq!(named(json!({"value": "shade"})), bad("value"));
     assert_eq!(named(json!({"grid": 1, "points": [0, 0, 0, 0, 0, 1]})), bad("points"));
     assert_eq!(named(json!({"grid": "fine"})), bad("grid"));

@@ -305,13 +305,13 @@ fn a_days_sun_hours_on_the_gpu_match_the_rays() {
     let points = grid(&scene, 0.1, &all(&scene)).unwrap();
     let location = Location::new(46.5, 11.35, 1.0).unwrap();
     let calendar = LeafCalendar::evergreen();
-    let site = Site { location: &location, calendar: &calendar, dni: None };
+    let site = Site { location: &location, calendar: &calendar, weather: None, sky: None };
     let period = Period::day(80, 6 * 60, 18 * 60, 20).unwrap();
     let samples = period.samples();
     let mapper = Mapper::new(&scene, &points).unwrap();
     let counter = counter(SIDE);
     let gpu = MapGpu::new(&counter, &scene, &points).unwrap();
-    let rays = mapper.accumulate(&samples, site, &mut |_, _| {});
+    let rays = mapper.accumulate(&samples, site, &mut |_, _| {}).unwrap();
     let masks = pollster::block_on(mapper.accumulate_gpu(&gpu, &samples, site, &mut |_, _| {})).unwrap();
     assert_eq!((rays.instants, rays.sun_up), (masks.instants, masks.sun_up));
     assert!(gpu.rendered() > 0, "the louvres shade the wall: views were rendered");

@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
-use common::{TestScene, counter, flat_rect, runtime_dir};
+use common::{TestScene, closed_form_perez, counter, flat_rect, runtime_dir};
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
@@ -135,38 +135,6 @@ fn exact_and_gpu_sky_views_agree() {
         assert!((exact.horizon(r, 1.0) - counted.horizon(r, 1.0)).abs() < 0.01);
         assert!(e < exact.unobstructed(r) - 0.02, "the block hides some sky");
     }
-}
-
-/// Perez 1990 coefficients, typed in again from the paper for an independent check.
-const LIMITS: [f64; 7] = [1.065, 1.230, 1.500, 1.950, 2.800, 4.500, 6.200];
-const PEREZ: [[f64; 6]; 8] = [
-    [-0.008, 0.588, -0.062, -0.060, 0.072, -0.022],
-    [0.130, 0.683, -0.151, -0.019, 0.066, -0.029],
-    [0.330, 0.487, -0.221, 0.055, -0.064, -0.026],
-    [0.568, 0.187, -0.295, 0.109, -0.152, -0.014],
-    [0.873, -0.392, -0.362, 0.226, -0.462, 0.001],
-    [1.132, -1.237, -0.412, 0.288, -0.823, 0.056],
-    [1.060, -1.600, -0.359, 0.264, -1.127, 0.131],
-    [0.678, -0.327, -0.250, 0.156, -1.377, 0.251],
-];
-
-/// The closed-form Perez sky diffuse (W/m²) on an unobstructed surface with normal `n`.
-/// `elevation` in metres thins the air mass as EnergyPlus does (× (1 − 0.1·elevation/1000)).
-fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64, elevation: f64) -> f64 {
-    let z = sun.z.acos();
-    let m = 1.0 - 0.1 * elevation / 1000.0;
-    let air_mass = if z.to_degrees() <= 75.0 { m / sun.z } else { m / (sun.z + 0.15 * (93.9 - z.to_degrees()).powf(-1.253)) };
-    let k = 1.041 * z.powi(3);
-    let epsilon = ((dni + dhi) / dhi + k) / (1.0 + k);
-    let delta = dhi * air_mass / 1353.0;
-    let c = PEREZ[LIMITS.iter().take_while(|&&l| epsilon >= l).count()];
-    let f1 = (c[0] + c[1] * delta + c[2] * z).max(0.0);
-    let f2 = c[3] + c[4] * delta + c[5] * z;
-    let (a, b) = (n.dot(sun).max(0.0), sun.z.max(85f64.to_radians().cos()));
-    let sin_tilt = (1.0 - n.z * n.z).max(0.0).sqrt();
-    // EnergyPlus keeps a near-horizontal roof's circumsolar ratio at 1 with the sun below 5°.
-    let circumsolar = if sun.z < 85f64.to_radians().cos() && sin_tilt < 0.1 { 1.0 } else { a / b };
-    dhi * ((1.0 - f1) * (1.0 + n.z) / 2.0 + f1 * circumsolar + f2 * sin_tilt).max(0.0)
 }
 
 #[test]

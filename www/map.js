@@ -8,6 +8,8 @@ import { colourOf } from './colour.js';
 export const MAP_VALUES = {
   sunHours: { title: 'Sun hours', unit: 'h' },
   direct: { title: 'Direct irradiation', unit: 'kWh/m²' },
+  skyDiffuse: { title: 'Sky-diffuse irradiation', unit: 'kWh/m²' },
+  total: { title: 'Total irradiation', unit: 'kWh/m²' },
   lit: { title: 'Sunlit at the instant', unit: '' },
 };
 

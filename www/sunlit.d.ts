@@ -201,8 +201,9 @@ export interface SunlitEngine {
   fractions(model: Model, sun: [number, number, number] | { azimuth: number; altitude: number }): Promise<Float64Array>;
   /** The year's sunlit fractions at every EnergyPlus timestep. */
   annual(model: Model, settings: AnnualSettings, options?: AnnualRunOptions): Promise<Annual>;
-  /** Per-point values on the receivers (a grid, or given points): sun hours or direct irradiation
-   * over a period, or lit (1) or not (0) at an instant, each point by its own shadow ray. */
+  /** Per-point values on the receivers (a grid, or given points): sun hours, or direct, sky-diffuse
+   * or total irradiation over a period, or lit (1) or not (0) at an instant, each point by its own
+   * shadow rays (to the sun, and to each sky patch for the sky). */
   map(model: Model, options: MapOptions, run?: MapRunOptions): Promise<SunlitMap>;
 }
 
@@ -215,7 +216,8 @@ export interface MapOptions {
   longitude?: number;
   /** Hours from UTC of the standard time the period is in. */
   timeZone?: number;
-  /** An EPW weather file's text: its location, and the direct normal irradiance for `direct`. */
+  /** An EPW weather file's text: its location, and the solar irradiance for `direct`,
+   * `skyDiffuse` and `total` (the EPW's albedo, 0.2 where missing). */
   epw?: string;
   /** The EPW's file name, for messages. */
   epwName?: string;
@@ -233,8 +235,10 @@ export interface MapOptions {
   to?: string;
   /** One instant, 'MM-DD HH:MM' local standard time: then the value is 'lit'. */
   at?: string;
-  /** 'sunHours' (default), 'direct' (kWh/m², needs an EPW) or 'lit' (needs `at`). */
-  value?: 'sunHours' | 'direct' | 'lit';
+  /** 'sunHours' (default), 'direct', 'skyDiffuse' or 'total' (kWh/m², need an EPW; each sums
+   * every part, as `sunlit map --epw`, counting each point's view of Tregenza's 145 sky patches
+   * once per grid) or 'lit' (needs `at`). */
+  value?: 'sunHours' | 'direct' | 'skyDiffuse' | 'total' | 'lit';
   /** Foliage keeps its leaves all year (as AnnualSettings). */
   evergreen?: boolean;
   /** Leaf-out period "MM-DD,MM-DD" (as AnnualSettings). */
@@ -253,8 +257,9 @@ export interface MapRunOptions extends AnnualRunOptions {
 /** engine.map's answer: plain typed arrays (transferable to and from a worker), one entry per
  * point, in sunlit's world axes (x east, y north, z up, metres). */
 export interface SunlitMap {
-  /** The value held: 'sunHours' (h), 'direct' (kWh/m²) or 'lit' (1 sunlit, 0 shaded). */
-  value: 'sunHours' | 'direct' | 'lit';
+  /** The value held: 'sunHours' (h), 'direct', 'skyDiffuse', 'total' (kWh/m²) or 'lit' (1 sunlit,
+   * 0 shaded). */
+  value: 'sunHours' | 'direct' | 'skyDiffuse' | 'total' | 'lit';
   /** The legend's title and unit. */
   title: string;
   unit: string;
@@ -274,8 +279,20 @@ export interface SunlitMap {
   sunHours: Float32Array | undefined;
   /** A period's direct irradiation per point, kWh/m² (undefined without an EPW, or for an instant). */
   direct: Float32Array | undefined;
+  /** A period's sky-diffuse irradiation per point (Perez 1990 sky over the point's own visible
+   * patches, circumsolar part shaded like its beam), kWh/m²; with an irradiation value. */
+  skyDiffuse: Float32Array | undefined;
+  /** A period's ground-reflected irradiation per point, GHI·albedo·(1 − cos tilt)/2 (unobstructed),
+   * kWh/m²; with an irradiation value. */
+  groundReflected: Float32Array | undefined;
+  /** direct + skyDiffuse + groundReflected per point, kWh/m²; with an irradiation value. */
+  total: Float32Array | undefined;
+  /** Each point's view factor to the visible sky ((1 + cos tilt)/2 with nothing in the way); with
+   * an irradiation value. */
+  skyViewFactor: Float32Array | undefined;
   /** The points CSV (with `csv: true`): receiver,x,y,z,nx,ny,nz then lit, or sun_hours and, with
-   * an EPW, direct_kwh_m2. */
+   * an EPW, direct_kwh_m2 (and with the sky sky_diffuse_kwh_m2, ground_reflected_kwh_m2,
+   * total_kwh_m2, sky_view_factor). */
   csv: string | undefined;
   /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
    * legend in the scene's extras. */

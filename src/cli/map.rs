@@ -4,12 +4,13 @@
 
 use serde_json::Value;
 use sunlit::export::map_glb::map_glb;
-use sunlit::export::map_table::{Column, points_csv, study_csv, study_json};
+use sunlit::export::map_table::{Column, points_csv, study_csv, study_json, value_columns};
 use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
 use sunlit::map::study::{self, SunRule};
-use sunlit::map::{MapGpu, Mapper, Period, Points, Site};
-use sunlit::sun::weather::Weather;
+use sunlit::map::{MapGpu, MapValues, Mapper, Period, Points, Site, point_sky};
+use sunlit::sky::patches::SkyPatches;
+use sunlit::sun::weather::{Weather, check_albedo};
 use sunlit::year::season::LeafCalendar;
 
 use super::*;
@@ -25,9 +26,18 @@ pub(super) struct MapArgs {
     /// Points from a CSV with the header x,y,z,nx,ny,nz (world axes, metres), each on a receiver.
     #[arg(long, value_name = "FILE.csv")]
     points: Option<PathBuf>,
-    /// Weather file: the site and the direct normal irradiance (adds direct_kwh_m2).
+    /// Weather file: the site and its solar data (adds direct_kwh_m2, sky_diffuse_kwh_m2,
+    /// ground_reflected_kwh_m2 and total_kwh_m2).
     #[arg(long, value_name = "FILE.epw")]
     epw: Option<PathBuf>,
+    /// Ground reflectance (0..1) for every hour, with --epw; default: the EPW's albedo (field 33),
+    /// 0.2 where it is missing.
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
+    albedo: Option<f64>,
+    /// Sky patches for each point's sky views, with --epw: tregenza (145, the default) or
+    /// reinhart:N (N = 1..6, 144·N² + 1 patches).
+    #[arg(long, value_name = "SCHEME")]
+    sky_patches: Option<String>,
     /// Site without weather: latitude, longitude, time zone (sun hours only).
     #[arg(long, value_name = "LAT,LON,TZ", allow_hyphen_values = true)]
     location: Option<String>,
@@ -165,9 +175,23 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
-    let (location, dni) = match (&args.epw, &args.location) {
+    let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;
+    if let Some(albedo) = args.albedo {
+        check_albedo(albedo)?;
+        if args.epw.is_none() {
+            return Err(Error::argument("albedo", "needs a weather file (--epw): the ground reflects its global horizontal irradiance"));
+        }
+    }
+    if args.sky_patches.is_some() && args.epw.is_none() {
+        return Err(Error::argument("sky_patches", "needs a weather file (--epw): the sky's light comes from it"));
+    }
+    let (location, weather) = match (&args.epw, &args.location) {
         (Some(epw), _) => {
             let weather = Weather::from_epw(epw)?;
+            let weather = match args.albedo {
+                Some(albedo) => weather.with_albedo(albedo)?,
+                None => weather,
+            };
             (weather.location.clone(), Some(weather))
         }
         (None, Some(text)) => (Location::parse(text)?, None),
@@ -188,7 +212,6 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     };
     let gpu = counter.as_ref().map(|c| MapGpu::new(c, &scene, &points)).transpose()?;
     let calendar = LeafCalendar::for_latitude(location.latitude);
-    let site = Site { location: &location, calendar: &calendar, dni: dni.as_ref() };
     let samples = plan.period.samples();
     let bar = indicatif::ProgressBar::new(samples.len() as u64).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} instants, {eta} left")
@@ -199,6 +222,13 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         bar.set_length(total as u64);
         bar.set_position(done as u64);
     };
+    // Each point's own sky views, once (geometry only), when irradiation is summed.
+    let sky_start = Instant::now();
+    bar.set_message(format!("{} points: sky views ({} patches)", points.len(), patches.len()));
+    let sky = (weather.is_some() && !plan.instant).then(|| point_sky(&mapper, &patches, &mut report));
+    bar.set_message(format!("{} points", points.len()));
+    let sky_seconds = sky_start.elapsed().as_secs_f64();
+    let site = Site { location: &location, calendar: &calendar, weather: weather.as_ref(), sky: sky.as_ref() };
 
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     let mut summary = json!({});
@@ -218,13 +248,9 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     } else {
         let values = match &gpu {
             Some(g) => pollster::block_on(mapper.accumulate_gpu(g, &samples, site, &mut report))?,
-            None => mapper.accumulate(&samples, site, &mut report),
+            None => mapper.accumulate(&samples, site, &mut report)?,
         };
-        let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
-        if let Some(d) = &values.direct_kwh_m2 {
-            columns.push(Column { name: "direct_kwh_m2", values: d, decimals: 4 });
-        }
-        let csv = points_csv(&scene, &points, &columns);
+        let csv = points_csv(&scene, &points, &value_columns(&values));
         summary["sun_up_instants"] = json!(values.sun_up);
         let mut studies = Vec::new();
         for rule in &plan.rules {
@@ -246,10 +272,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
             files.push((args.study_path(&rule.name, "csv"), study_csv(&scene, &points, &result).into_bytes()));
         }
         summary["studies"] = Value::Array(studies);
-        let (name, unit, v) = match values.direct_kwh_m2 {
-            Some(d) => ("direct_kwh_m2", "kWh/m²", d),
-            None => ("sun_hours", "h", values.sun_hours),
-        };
+        let (name, unit, v) = glb_value(values);
         (csv, v, name, unit)
     };
     bar.finish_and_clear();
@@ -275,6 +298,9 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         }),
         None => json!({"exact_rays": point_instants, "gpu_masks": 0}),
     };
+    if let Some(sky) = &sky {
+        summary["sky"] = json!({"patches": sky.patches.name(), "count": sky.patches.len(), "leaf_states": sky.leaf_states.len(), "seconds": round(sky_seconds, 3)});
+    }
     summary["written"] = json!(files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>());
     if args.json {
         println!("{summary:#}");
@@ -282,4 +308,13 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         eprintln!("{} points × {} instants in {seconds:.2} s → {}", points.len(), samples.len(), args.output.display());
     }
     Ok(())
+}
+
+/// The glb's value: total irradiation with the sky, else direct with an EPW, else sun hours.
+fn glb_value(values: MapValues) -> (&'static str, &'static str, Vec<f64>) {
+    match (values.total_kwh_m2, values.direct_kwh_m2) {
+        (Some(t), _) => ("total_kwh_m2", "kWh/m²", t),
+        (None, Some(d)) => ("direct_kwh_m2", "kWh/m²", d),
+        (None, None) => ("sun_hours", "h", values.sun_hours),
+    }
 }

@@ -1,12 +1,17 @@
 //! A map's tables: the points CSV (`receiver,x,y,z,nx,ny,nz` then the values) and a study's
 //! report as JSON and CSV (the rule, its inputs, per point and per area results).
+//!
+//! A period's value columns ([`value_columns`]) are `sun_hours`, then with weather
+//! `direct_kwh_m2`, then with the points' sky views `sky_diffuse_kwh_m2`,
+//! `ground_reflected_kwh_m2`, `total_kwh_m2` and `sky_view_factor` (the per-surface summary's
+//! names, [`crate::export::irradiation::SUMMARY_CSV_HEADER`]).
 
 use std::fmt::Write;
 
 use serde_json::{Value, json};
 
-use crate::map::Points;
 use crate::map::study::StudyResult;
+use crate::map::{MapValues, Points};
 use crate::scene::Scene;
 use crate::year::samples::month_day;
 
@@ -18,6 +23,26 @@ pub struct Column<'a> {
     pub values: &'a [f64],
     /// Decimals written.
     pub decimals: usize,
+}
+
+/// A period's sums as the points CSV's value columns, in the order the module doc gives.
+pub fn value_columns(values: &MapValues) -> Vec<Column<'_>> {
+    let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
+    let energy = [
+        ("direct_kwh_m2", &values.direct_kwh_m2),
+        ("sky_diffuse_kwh_m2", &values.sky_diffuse_kwh_m2),
+        ("ground_reflected_kwh_m2", &values.ground_reflected_kwh_m2),
+        ("total_kwh_m2", &values.total_kwh_m2),
+    ];
+    for (name, v) in energy {
+        if let Some(v) = v {
+            columns.push(Column { name, values: v, decimals: 4 });
+        }
+    }
+    if let Some(v) = &values.sky_view_factor {
+        columns.push(Column { name: "sky_view_factor", values: v, decimals: 6 });
+    }
+    columns
 }
 
 /// The points CSV: `receiver,x,y,z,nx,ny,nz` then `columns`, one row per point in order.

@@ -59,6 +59,7 @@ impl<'a> MapGpu<'a> {
     ) -> Result<Vec<S>> {
         let mut s = state();
         let mut views: Vec<View> = Vec::new();
+        let mut zeros: Vec<f32> = Vec::new();
         let mut k = 0;
         while k < samples.len() {
             views.clear();
@@ -68,6 +69,13 @@ impl<'a> MapGpu<'a> {
                 if sun.z >= MIN_COS_INCIDENCE {
                     let leaves = site.calendar.fraction(f64::from(sample.day)) as f32;
                     self.views_at(mapper, k, sun, leaves, &mut views);
+                    // Receivers facing away are not rendered, but they are recorded (all shaded):
+                    // the sky's shared terms still count for them, as in the rays' sweep.
+                    for g in mapper.groups.iter().filter(|g| is_dark(g.normal, sun)) {
+                        zeros.clear();
+                        zeros.resize(g.members.len(), 0.0);
+                        record(&mut s, k, sample, sun, g, &zeros);
+                    }
                 }
                 k += 1;
             }

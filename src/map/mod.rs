@@ -6,9 +6,11 @@
 //!   [`from_csv`] (`x,y,z,nx,ny,nz` rows, each assigned to the receiver it lies on);
 //! - [`Mapper`]: the points indexed per receiver for the exact engine's shadow rays
 //!   ([`crate::count::exact::rays`]). [`Mapper::visibility`] answers one instant
-//!   ([`lit`] for a one-off), [`Mapper::accumulate`] sums sun hours and direct irradiation over a
-//!   [`Period`], [`Mapper::lit_series`] keeps each point's lit instants for the sun-hours
-//!   [`study`] rules;
+//!   ([`lit`] for a one-off), [`Mapper::accumulate`] sums sun hours and irradiation (direct;
+//!   with the points' sky views, sky diffuse, ground-reflected and total) over a [`Period`],
+//!   [`Mapper::lit_series`] keeps each point's lit instants for the sun-hours [`study`] rules;
+//! - [`sky`]: each point's own sky patch visibility ([`point_sky`]), combined per timestep with
+//!   the Perez sky exactly as a receiver's is ([`crate::export::irradiation`]);
 //! - [`period`]: years at EnergyPlus timesteps, date ranges, one day at minute steps, an instant,
 //!   with the sun `sunlit annual` uses;
 //! - [`MapGpu`]: the same sweeps with each point answered by its texel in the GPU counter's tile
@@ -24,12 +26,16 @@
 //! A point's own receiver never shades it. A point's visibility is 1 (sun seen), 0 (shaded, sun
 //! down, or behind the receiver), or the product of see-through casters' transmittances.
 //!
-//! Sky-diffuse and total irradiation per point need the sky's patch visibility (not here yet):
-//! [`MapValues`] has room for them beside `direct_kwh_m2`.
+//! Irradiation per point is a receiver's ([`crate::export::irradiation`]) with the point in the
+//! receiver's place: at each sun-up instant (cos zenith ≥ [`MIN_COS_INCIDENCE`]) beam DNI·cos θ·v
+//! (v the point's visibility of the sun), Perez 1990 sky diffuse from the point's own sky views
+//! with its circumsolar part shaded by v, ground-reflected GHI·albedo·(1 − cos tilt)/2
+//! unobstructed; the weather's hour holds over its instants.
 
 mod gpu;
 pub mod period;
 pub mod points;
+pub mod sky;
 pub mod study;
 
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -39,12 +45,15 @@ use glam::DVec3;
 pub use gpu::MapGpu;
 pub use period::{Period, Sample};
 pub use points::{from_csv, grid};
+pub use sky::point_sky;
 
 use crate::count::MIN_COS_INCIDENCE;
 use crate::count::exact::engine::ExactEngine;
 use crate::count::exact::rays::PlanePoints;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::sky::perez::PerezSky;
+use crate::sky::views::SkyViews;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 use crate::sun::weather::Weather;
@@ -99,8 +108,11 @@ pub struct Site<'a> {
     pub location: &'a Location,
     /// The foliage's leaf fraction through the year.
     pub calendar: &'a LeafCalendar,
-    /// The weather whose direct normal irradiance gives direct irradiation; `None`: sun hours only.
-    pub dni: Option<&'a Weather>,
+    /// The weather (DNI, DHI, GHI, albedo) that gives irradiation; `None`: sun hours only.
+    pub weather: Option<&'a Weather>,
+    /// The points' sky views ([`point_sky`], one per point in order): with `weather`, adds sky
+    /// diffuse, ground-reflected and total irradiation.
+    pub sky: Option<&'a SkyViews>,
 }
 
 /// Per point sums over a period.
@@ -111,14 +123,52 @@ pub struct MapValues {
     /// Direct irradiation on the point's plane (kWh/m²): visibility · DNI · cos incidence ·
     /// hours; `None` without DNI.
     pub direct_kwh_m2: Option<Vec<f64>>,
+    /// Sky-diffuse irradiation (kWh/m², Perez 1990, shaded by the point's sky views); `None`
+    /// without weather or sky views.
+    pub sky_diffuse_kwh_m2: Option<Vec<f64>>,
+    /// Ground-reflected irradiation (kWh/m², unobstructed); `None` as for the sky.
+    pub ground_reflected_kwh_m2: Option<Vec<f64>>,
+    /// Direct + sky diffuse + ground-reflected (kWh/m²); `None` as for the sky.
+    pub total_kwh_m2: Option<Vec<f64>>,
+    /// The view factor to the visible sky (the period's mean over the leaf calendar; (1 + cos
+    /// tilt)/2 with nothing in the way); `None` as for the sky.
+    pub sky_view_factor: Option<Vec<f64>>,
     /// Instants in the period, and those with the sun up (each counted at every point).
     pub instants: usize,
     /// Instants with the sun up.
     pub sun_up: usize,
 }
 
+impl MapValues {
+    /// Adds the sums of `other` (another stretch of the same points' period).
+    pub fn merge(&mut self, other: &MapValues) {
+        add_into(&mut self.sun_hours, &other.sun_hours);
+        // A mean over instants: weighted by each stretch's instants.
+        if let (Some(a), Some(b)) = (self.sky_view_factor.as_mut(), other.sky_view_factor.as_ref()) {
+            let (na, nb) = (self.instants as f64, other.instants as f64);
+            if na + nb > 0.0 {
+                a.iter_mut().zip(b).for_each(|(a, b)| *a = (*a * na + b * nb) / (na + nb));
+            }
+        }
+        for (into, from) in [
+            (&mut self.direct_kwh_m2, &other.direct_kwh_m2),
+            (&mut self.sky_diffuse_kwh_m2, &other.sky_diffuse_kwh_m2),
+            (&mut self.ground_reflected_kwh_m2, &other.ground_reflected_kwh_m2),
+            (&mut self.total_kwh_m2, &other.total_kwh_m2),
+        ] {
+            if let (Some(a), Some(b)) = (into.as_mut(), from.as_ref()) {
+                add_into(a, b);
+            }
+        }
+        self.instants += other.instants;
+        self.sun_up += other.sun_up;
+    }
+}
+
 /// One receiver's points, indexed for the rays, and where they sit in [`Points`].
 struct Group {
+    /// Its place in [`Mapper`]'s groups.
+    index: usize,
     plane: PlanePoints,
     members: Vec<u32>,
     normal: DVec3,
@@ -130,6 +180,8 @@ pub struct Mapper {
     groups: Vec<Group>,
     points: usize,
     normals: Vec<DVec3>,
+    /// Whether the scene has foliage (sky views then need two leaf states).
+    foliage: bool,
 }
 
 impl Mapper {
@@ -152,10 +204,10 @@ impl Mapper {
             let Some(plane) = engine.plane_points(r as u32, &world, scene.receivers[r].normal) else {
                 return Err(Error::argument("points", format!("receiver '{}' has no area to put points on", scene.receivers[r].name)));
             };
-            groups.push(Group { plane, members, normal: scene.receivers[r].normal });
+            groups.push(Group { index: groups.len(), plane, members, normal: scene.receivers[r].normal });
         }
         let normals = (0..points.len()).map(|i| points.normal(i)).collect();
-        Ok(Self { engine, groups, points: points.len(), normals })
+        Ok(Self { engine, groups, points: points.len(), normals, foliage: scene.has_foliage() })
     }
 
     /// Each point's visibility of the sun along `sun` (unit, towards the sun) at leaf fraction
@@ -174,13 +226,21 @@ impl Mapper {
         out
     }
 
-    /// Sun hours and (with DNI) direct irradiation per point over `samples`; `progress(done,
-    /// total)` is called now and then from the calling thread. Instants are shared over every
-    /// core; the sums do not depend on how.
-    pub fn accumulate(&self, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> MapValues {
-        let sums = Sums::new(self, site);
-        let parts = self.sweep(samples, site, progress, || sums.state(), |acc, _, s, sun, g, vis| sums.record(acc, s, sun, g, vis));
-        sums.finish(parts, samples)
+    /// Sun hours and irradiation per point over `samples` (see [`MapValues`] for which parts
+    /// `site` gives); `progress(done, total)` is called now and then from the calling thread.
+    /// Instants are shared over every core; the sums do not depend on how. Refuses sky views
+    /// made for other points.
+    pub fn accumulate(&self, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<MapValues> {
+        let sums = Sums::new(self, site)?;
+        let parts = self.sweep(
+            samples,
+            site,
+            sums.dark_too(),
+            progress,
+            || sums.state(),
+            |acc, _, s, sun, g, vis| sums.record(acc, s, sun, g, vis),
+        );
+        Ok(sums.finish(parts, samples))
     }
 
     /// [`Self::accumulate`] with the points answered by GPU masks ([`MapGpu`]) instead of rays.
@@ -191,7 +251,7 @@ impl Mapper {
         site: Site<'_>,
         progress: &mut dyn FnMut(usize, usize),
     ) -> Result<MapValues> {
-        let sums = Sums::new(self, site);
+        let sums = Sums::new(self, site)?;
         let parts =
             gpu.sweep(self, samples, site, progress, || sums.state(), |acc, _, s, sun, g, vis| sums.record(acc, s, sun, g, vis)).await?;
         Ok(sums.finish(parts, samples))
@@ -208,7 +268,7 @@ impl Mapper {
         progress: &mut dyn FnMut(usize, usize),
     ) -> LitSeries {
         let bits = LitBits::new(self.points, samples.len(), min_altitude_deg);
-        self.sweep(samples, site, progress, || (), |_, k, _, sun, g, vis| bits.record(k, sun, g, vis));
+        self.sweep(samples, site, false, progress, || (), |_, k, _, sun, g, vis| bits.record(k, sun, g, vis));
         bits.finish()
     }
 
@@ -244,19 +304,19 @@ impl Mapper {
 
     /// Every sun-up instant's visibility per receiver, handed to `record` with a thread's own
     /// state (made by `state`); the states come back, one per thread (natively every core, on
-    /// the web the calling thread alone).
+    /// the web the calling thread alone). Receivers facing away from the sun are skipped unless
+    /// `dark_too` (then handed zeros: the sky still lights them).
     fn sweep<S: Send>(
         &self,
         samples: &[Sample],
         site: Site<'_>,
+        dark_too: bool,
         progress: &mut dyn FnMut(usize, usize),
         state: impl Fn() -> S + Sync,
         record: impl Fn(&mut S, usize, &Sample, DVec3, &Group, &[f32]) + Sync,
     ) -> Vec<S> {
         let next = AtomicUsize::new(0);
         let done = AtomicUsize::new(0);
-        let total = samples.len();
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, total.max(1));
         let work = || {
             let mut s = state();
             let mut scratch = self.engine.point_scratch();
@@ -268,86 +328,135 @@ impl Mapper {
                 if sun.z >= MIN_COS_INCIDENCE {
                     let leaves = site.calendar.fraction(f64::from(sample.day)) as f32;
                     for g in &self.groups {
-                        if crate::count::is_dark(g.normal, sun) {
-                            continue;
-                        }
                         vis.resize(g.members.len(), 0.0);
-                        self.engine.visibility(&g.plane, sun, leaves, &mut scratch, &mut vis);
+                        if crate::count::is_dark(g.normal, sun) {
+                            if !dark_too {
+                                continue;
+                            }
+                            vis.fill(0.0);
+                        } else {
+                            self.engine.visibility(&g.plane, sun, leaves, &mut scratch, &mut vis);
+                        }
                         record(&mut s, k, sample, sun, g, &vis);
                     }
                 }
                 done.fetch_add(1, Ordering::Relaxed);
             }
         };
-        // No threads to spawn on the web: one pass on the calling thread.
-        if cfg!(target_arch = "wasm32") {
-            let s = work();
-            progress(total, total);
-            return vec![s];
-        }
-        std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads).map(|_| scope.spawn(work)).collect();
-            while workers.iter().any(|w| !w.is_finished()) {
-                progress(done.load(Ordering::Relaxed), total);
-                std::thread::sleep(std::time::Duration::from_millis(100));
-            }
-            progress(total, total);
-            workers.into_iter().filter_map(|w| w.join().ok()).collect()
-        })
+        run_on_every_core(samples.len(), &done, progress, work)
     }
 }
 
-/// What [`Mapper::accumulate`] sums per point: sun hours and direct irradiation, per thread.
+/// What [`Mapper::accumulate`] sums per point, shared by the rays' and the GPU masks' sweeps: sun
+/// hours, and with weather the direct and (with sky views) the sky's parts.
 struct Sums<'a> {
     mapper: &'a Mapper,
     site: Site<'a>,
-    with_dni: bool,
-    hourly: Option<crate::year::samples::Timesteps>,
+    weather: Option<(&'a Weather, crate::year::samples::Timesteps)>,
+    sky: Option<&'a SkyViews>,
+    plan: Option<sky::SkyPlan<'a>>,
+}
+
+/// A thread's running sums (see [`Sums`]).
+struct Acc {
+    hours: Vec<f64>,
+    direct: Option<Vec<f64>>,
+    sky: Option<sky::SkySums>,
 }
 
 impl<'a> Sums<'a> {
-    fn new(mapper: &'a Mapper, site: Site<'a>) -> Self {
-        Self { mapper, site, with_dni: site.dni.is_some(), hourly: crate::year::samples::Timesteps::new(1).ok() }
-    }
-
-    fn state(&self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.mapper.points;
-        (vec![0.0f64; n], if self.with_dni { vec![0.0f64; n] } else { Vec::new() })
-    }
-
-    fn record(&self, acc: &mut (Vec<f64>, Vec<f64>), s: &Sample, sun: DVec3, g: &Group, vis: &[f32]) {
-        let dni = match (self.site.dni, self.hourly) {
-            (Some(d), Some(t)) => d.at(t, s.epw_hour).dni,
-            _ => 0.0,
+    /// Refuses sky views made for other points.
+    fn new(mapper: &'a Mapper, site: Site<'a>) -> Result<Self> {
+        let n = mapper.points;
+        let hourly = crate::year::samples::Timesteps::new(1).ok();
+        let weather = site.weather.zip(hourly);
+        let sky = match (weather, site.sky) {
+            (Some(_), Some(sky)) if sky.receivers() != n => {
+                return Err(Error::argument("sky", format!("sky views of {} points for {n}", sky.receivers())));
+            }
+            (Some(_), sky) => sky,
+            (None, _) => None,
         };
-        for (&i, &v) in g.members.iter().zip(vis) {
+        let plan = sky.map(|sky| sky::SkyPlan::new(mapper, sky));
+        Ok(Self { mapper, site, weather, sky, plan })
+    }
+
+    /// Whether receivers facing away from the sun must be visited too (the sky's shared terms).
+    fn dark_too(&self) -> bool {
+        self.plan.is_some()
+    }
+
+    fn state(&self) -> Acc {
+        let n = self.mapper.points;
+        Acc { hours: vec![0.0; n], direct: self.weather.is_some().then(|| vec![0.0; n]), sky: self.plan.as_ref().map(|p| p.sums(n)) }
+    }
+
+    fn record(&self, acc: &mut Acc, s: &Sample, sun: DVec3, g: &Group, vis: &[f32]) {
+        let hour = self.weather.map(|(w, t)| w.at(t, s.epw_hour));
+        let dni = hour.map_or(0.0, |h| h.dni);
+        // Facing away from the sun every visibility is 0: only the sky's shared terms count.
+        let dark = crate::count::is_dark(g.normal, sun);
+        for (&i, &v) in g.members.iter().zip(vis).filter(|_| !dark) {
             if v > 0.0 {
                 let i = i as usize;
-                acc.0[i] += f64::from(v) * s.hours;
-                if self.with_dni {
+                acc.hours[i] += f64::from(v) * s.hours;
+                if let Some(direct) = acc.direct.as_mut() {
                     let cos = self.mapper.normals[i].dot(sun).max(0.0);
-                    acc.1[i] += f64::from(v) * dni * cos * s.hours / 1000.0;
+                    direct[i] += f64::from(v) * dni * cos * s.hours / 1000.0;
                 }
             }
         }
+        if let (Some(plan), Some(sums), Some(hour)) = (&self.plan, acc.sky.as_mut(), hour)
+            && let Some(perez) = PerezSky::new(hour.dni, hour.dhi, sun.z, self.site.location.elevation)
+        {
+            let leaves = self.site.calendar.fraction(f64::from(s.day));
+            plan.add(sums, self.mapper, g.index, &perez, hour.dhi, sun, leaves, s.hours, if dark { &[] } else { vis });
+        }
     }
 
-    fn finish(&self, parts: Vec<(Vec<f64>, Vec<f64>)>, samples: &[Sample]) -> MapValues {
-        let n = self.mapper.points;
-        let mut values =
-            MapValues { sun_hours: vec![0.0; n], direct_kwh_m2: self.with_dni.then(|| vec![0.0; n]), instants: samples.len(), sun_up: 0 };
-        values.sun_up = samples.iter().filter(|s| self.mapper.sun(self.site, s).z >= MIN_COS_INCIDENCE).count();
-        for (hours, direct) in parts {
-            for (a, b) in values.sun_hours.iter_mut().zip(hours) {
-                *a += b;
+    fn finish(self, parts: Vec<Acc>, samples: &[Sample]) -> MapValues {
+        let (mapper, site, n) = (self.mapper, self.site, self.mapper.points);
+        let mut total = Acc { hours: vec![0.0; n], direct: self.weather.is_some().then(|| vec![0.0; n]), sky: None };
+        let mut sky_parts = Vec::new();
+        for part in parts {
+            add_into(&mut total.hours, &part.hours);
+            if let (Some(a), Some(b)) = (total.direct.as_mut(), part.direct.as_ref()) {
+                add_into(a, b);
             }
-            if let Some(d) = values.direct_kwh_m2.as_mut() {
-                for (a, b) in d.iter_mut().zip(direct) {
-                    *a += b;
-                }
+            sky_parts.extend(part.sky);
+        }
+        let sky_diffuse = self.plan.map(|p| p.finish(mapper, sky_parts));
+        let sun_up: Vec<&Sample> = samples.iter().filter(|s| mapper.sun(site, s).z >= MIN_COS_INCIDENCE).collect();
+        let mut values = MapValues { sun_hours: total.hours, instants: samples.len(), sun_up: sun_up.len(), ..MapValues::default() };
+        values.direct_kwh_m2 = total.direct;
+        if let (Some((w, t)), Some(sky_diffuse)) = (self.weather, sky_diffuse) {
+            // Ground-reflected light is unobstructed: GHI·albedo summed once, times each point's
+            // view factor to the ground (1 − cos tilt)/2.
+            let ground_horizontal: f64 = sun_up
+                .iter()
+                .map(|s| {
+                    let hour = w.at(t, s.epw_hour);
+                    hour.ghi * hour.albedo * s.hours / 1000.0
+                })
+                .sum();
+            let ground: Vec<f64> = mapper.normals.iter().map(|n| ground_horizontal * (1.0 - n.z) / 2.0).collect();
+            let direct = values.direct_kwh_m2.as_deref().unwrap_or_default();
+            values.total_kwh_m2 = Some((0..n).map(|i| direct.get(i).copied().unwrap_or(0.0) + sky_diffuse[i] + ground[i]).collect());
+            values.sky_diffuse_kwh_m2 = Some(sky_diffuse);
+            values.ground_reflected_kwh_m2 = Some(ground);
+            if let Some(sky) = self.sky {
+                // The views are linear in the leaf fraction: the mean view is the view at the mean.
+                let leaves = samples.iter().map(|s| site.calendar.fraction(f64::from(s.day))).sum::<f64>() / samples.len().max(1) as f64;
+                values.sky_view_factor = Some((0..n).map(|i| sky.isotropic(i, leaves)).collect());
             }
         }
         values
+    }
+}
+
+fn add_into(into: &mut [f64], from: &[f64]) {
+    for (a, b) in into.iter_mut().zip(from) {
+        *a += b;
     }
 }
 
@@ -382,6 +491,32 @@ impl LitBits {
     }
 }
 
+/// Runs `work` on every core (natively; on the web once, on the calling thread: it has no
+/// threads to spawn) and returns what each run returned. `done` counts finished units of
+/// `total`, reported through `progress` from the calling thread every 100 ms.
+fn run_on_every_core<S: Send>(
+    total: usize,
+    done: &AtomicUsize,
+    progress: &mut dyn FnMut(usize, usize),
+    work: impl Fn() -> S + Sync,
+) -> Vec<S> {
+    if cfg!(target_arch = "wasm32") {
+        let s = work();
+        progress(total, total);
+        return vec![s];
+    }
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, total.max(1));
+    std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads).map(|_| scope.spawn(&work)).collect();
+        while workers.iter().any(|w| !w.is_finished()) {
+            progress(done.load(Ordering::Relaxed), total);
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        progress(total, total);
+        workers.into_iter().filter_map(|w| w.join().ok()).collect()
+    })
+}
+
 /// Per point, which instants of a period it saw the sun at (see [`Mapper::lit_series`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LitSeries {
@@ -408,7 +543,7 @@ pub fn lit(scene: &Scene, points: &Points, sun: DVec3, leaves: f32) -> Result<Ve
     Ok(Mapper::new(scene, points)?.visibility(sun, leaves))
 }
 
-/// Sun hours and direct irradiation per point over `period` (a one-off [`Mapper::accumulate`]).
+/// Sun hours and irradiation per point over `period` (a one-off [`Mapper::accumulate`]).
 pub fn accumulate(scene: &Scene, points: &Points, period: &Period, site: Site<'_>) -> Result<MapValues> {
-    Ok(Mapper::new(scene, points)?.accumulate(&period.samples(), site, &mut |_, _| {}))
+    Mapper::new(scene, points)?.accumulate(&period.samples(), site, &mut |_, _| {})
 }

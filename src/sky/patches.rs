@@ -157,6 +157,38 @@ impl SkyPatches {
     }
 }
 
+impl Patch {
+    /// The patch cut into `k` rows of altitude by `k` columns of azimuth (the cap into `k` rings
+    /// of `k` sectors), each a patch of its own in the same band, their solid angles summing to
+    /// the patch's.
+    pub fn split(&self, k: usize) -> Vec<Patch> {
+        let k = k.max(1);
+        let (bottom, top) = self.altitude;
+        let (start, end) = self.azimuth;
+        let mut out = Vec::with_capacity(k * k);
+        for row in 0..k {
+            let (lo, hi) = (bottom + (top - bottom) * row as f64 / k as f64, bottom + (top - bottom) * (row + 1) as f64 / k as f64);
+            for column in 0..k {
+                let (a, b) = (start + (end - start) * column as f64 / k as f64, start + (end - start) * (column + 1) as f64 / k as f64);
+                out.push(Patch {
+                    altitude: (lo, hi),
+                    azimuth: (a, b),
+                    direction: direction(0.5 * (lo + hi), 0.5 * (a + b)),
+                    solid_angle: (b - a) * (hi.sin() - lo.sin()),
+                    band: self.band,
+                });
+            }
+        }
+        out
+    }
+
+    /// The patch's weight and lit direction for a receiver facing `normal` (unit), as
+    /// [`SkyPatches::weights`] gives them.
+    pub fn weight(&self, normal: DVec3) -> PatchWeight {
+        patch_weight(self, normal)
+    }
+}
+
 /// Unit vector at `altitude` and `azimuth` (radians, clockwise from north).
 pub fn direction(altitude: f64, azimuth: f64) -> DVec3 {
     let (sa, ca) = altitude.sin_cos();

@@ -71,15 +71,39 @@ impl PerezSky {
     /// `cos_incidence` of the beam, `sky` its view factor to the visible sky, `beam_fraction` its
     /// sunlit fraction, `sin_tilt` the sine of its tilt and `horizon` its horizon-band visibility.
     pub fn diffuse(&self, dhi: f64, cos_incidence: f64, sky: f64, beam_fraction: f64, sin_tilt: f64, horizon: f64) -> f64 {
-        let isotropic = (1.0 - self.f1) * sky;
+        self.terms(dhi, cos_incidence, sin_tilt).diffuse(sky, beam_fraction, horizon)
+    }
+
+    /// The sky's three parts on a plane (`dhi`, `cos_incidence`, `sin_tilt` as for
+    /// [`Self::diffuse`]) before they meet the plane's shading: many points on one plane share
+    /// them (a map's grid on a receiver).
+    pub fn terms(&self, dhi: f64, cos_incidence: f64, sin_tilt: f64) -> PerezTerms {
         let ratio = if self.cos_zenith < MIN_COS_ZENITH && sin_tilt < NEAR_HORIZONTAL_SIN_TILT {
             1.0
         } else {
             cos_incidence.max(0.0) / self.cos_zenith.max(MIN_COS_ZENITH)
         };
-        let circumsolar = self.f1 * ratio * beam_fraction;
-        let horizon_band = self.f2 * sin_tilt * horizon;
-        dhi * (isotropic + circumsolar + horizon_band).max(0.0)
+        PerezTerms { isotropic: dhi * (1.0 - self.f1), circumsolar: dhi * self.f1 * ratio, horizon: dhi * self.f2 * sin_tilt }
+    }
+}
+
+/// The Perez sky on one plane at one timestep, W/m² per unit of each shading factor: sky diffuse
+/// is max(0, isotropic·V_iso + circumsolar·f_beam + horizon·V_hor) ([`PerezSky::diffuse`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PerezTerms {
+    /// DHI·(1 − F1): times the view factor to the visible sky.
+    pub isotropic: f64,
+    /// DHI·F1·(circumsolar ratio), ≥ 0: times the beam's sunlit fraction.
+    pub circumsolar: f64,
+    /// DHI·F2·sin tilt: times the horizon band's visibility.
+    pub horizon: f64,
+}
+
+impl PerezTerms {
+    /// Sky diffuse irradiance (W/m²) with view factor `sky`, sunlit fraction `beam_fraction` and
+    /// horizon-band visibility `horizon`.
+    pub fn diffuse(&self, sky: f64, beam_fraction: f64, horizon: f64) -> f64 {
+        (self.isotropic * sky + self.circumsolar * beam_fraction + self.horizon * horizon).max(0.0)
     }
 }
 

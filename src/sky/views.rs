@@ -10,6 +10,10 @@
 //!   sky: (1 + cos tilt)/2 with nothing in the way), its unobstructed twin Σ weight / π, and its
 //!   horizon-band visibility (the weight-averaged visibility of the band nearest the horizon,
 //!   1 where the receiver sees none of that band), the three things the Perez sky needs.
+//!
+//! [`Seen`] is that combination patch by patch, and [`SkyViews`] holds its results for any list
+//! of items: the receivers here, a map's points in [`crate::map::sky`] (each point's own patch
+//! visibility, from shadow rays instead of fractions).
 
 use crate::count::{Engine, ViewRequest};
 use crate::error::Result;
@@ -36,7 +40,19 @@ pub struct SkyViews {
 }
 
 impl SkyViews {
-    /// Receivers covered.
+    /// The views of items (receivers or points) from their patch visibilities as [`Seen`]
+    /// gathered them: per leaf state, per item. `unobstructed` is each item's Σ weight / π.
+    pub(crate) fn from_seen(patches: &SkyPatches, leaf_states: Vec<f32>, seen: &[Vec<Seen>], unobstructed: Vec<f64>) -> Self {
+        Self {
+            patches: patches.clone(),
+            leaf_states,
+            isotropic: seen.iter().map(|state| state.iter().map(Seen::isotropic).collect()).collect(),
+            horizon: seen.iter().map(|state| state.iter().map(Seen::horizon).collect()).collect(),
+            unobstructed,
+        }
+    }
+
+    /// Receivers covered (points, for a map's views).
     pub fn receivers(&self) -> usize {
         self.unobstructed.len()
     }
@@ -77,7 +93,6 @@ pub async fn sky_views(
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<SkyViews> {
     let leaf_states: Vec<f32> = if scene.has_foliage() { vec![0.0, 1.0] } else { vec![1.0] };
-    let horizon_patches: Vec<usize> = patches.horizon_band().map(|(i, _)| i).collect();
     let weights: Vec<_> = scene.receivers.iter().map(|r| patches.weights(r.normal)).collect();
     // One request per lit (receiver, patch) and leaf state; `lit` remembers which they were.
     let lit: Vec<(usize, usize)> = weights
@@ -92,33 +107,52 @@ pub async fn sky_views(
     let fractions = count(engine, &requests, progress).await?;
     let receivers = scene.receivers.len();
     let unobstructed: Vec<f64> = weights.iter().map(|w| w.iter().map(|pw| pw.weight).sum::<f64>() / std::f64::consts::PI).collect();
-    let (mut isotropic, mut horizon) = (Vec::new(), Vec::new());
-    for state in fractions.chunks(lit.len().max(1)).take(leaf_states.len()) {
-        let mut visible = vec![vec![0.0f64; patches.len()]; receivers];
-        for (&(r, p), &f) in lit.iter().zip(state) {
-            visible[r][p] = f;
+    let mut seen = vec![vec![Seen::default(); receivers]; leaf_states.len()];
+    for (state, fractions) in seen.iter_mut().zip(fractions.chunks(lit.len().max(1))) {
+        for (&(r, p), &f) in lit.iter().zip(fractions) {
+            state[r].add(weights[r][p].weight, f, patches.patches[p].band == 0);
         }
-        isotropic.push(
-            (0..receivers)
-                .map(|r| weights[r].iter().zip(&visible[r]).map(|(pw, v)| pw.weight * v).sum::<f64>() / std::f64::consts::PI)
-                .collect(),
-        );
-        horizon.push((0..receivers).map(|r| band_visibility(&horizon_patches, &weights[r], &visible[r])).collect());
     }
-    if lit.is_empty() {
-        isotropic = vec![vec![0.0; receivers]; leaf_states.len()];
-        horizon = vec![vec![1.0; receivers]; leaf_states.len()];
-    }
-    Ok(SkyViews { patches: patches.clone(), leaf_states, isotropic, horizon, unobstructed })
+    Ok(SkyViews::from_seen(patches, leaf_states, &seen, unobstructed))
 }
 
-/// The weight-averaged visibility of `band`'s patches; 1 where none has weight.
-fn band_visibility(band: &[usize], weights: &[crate::sky::patches::PatchWeight], visible: &[f64]) -> f64 {
-    let total: f64 = band.iter().map(|&p| weights[p].weight).sum();
-    if total <= 0.0 {
-        return 1.0;
+/// What one item (a receiver, a map's point) sees of the sky, gathered patch by patch: Σ
+/// weight·visibility over every patch, and over the horizon band Σ weight·visibility and Σ weight.
+/// Patches of weight 0 (behind the item) need not be added.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Seen {
+    visible: f64,
+    band_visible: f64,
+    band: f64,
+}
+
+impl Seen {
+    /// Adds a patch of `weight` (∫ cos dΩ in front of the item) seen with `visibility` (0..1);
+    /// `horizon`: the patch is in the band nearest the horizon.
+    pub fn add(&mut self, weight: f64, visibility: f64, horizon: bool) {
+        self.visible += weight * visibility;
+        if horizon {
+            self.band_visible += weight * visibility;
+            self.band += weight;
+        }
     }
-    band.iter().map(|&p| weights[p].weight * visible[p]).sum::<f64>() / total
+
+    /// Sums two partial gatherings of the same item (over different patches).
+    pub fn merge(&mut self, other: &Seen) {
+        self.visible += other.visible;
+        self.band_visible += other.band_visible;
+        self.band += other.band;
+    }
+
+    /// The view factor to the visible sky, Σ visibility·weight / π.
+    pub fn isotropic(&self) -> f64 {
+        self.visible / std::f64::consts::PI
+    }
+
+    /// The horizon band's weight-averaged visibility; 1 where no band patch has weight.
+    pub fn horizon(&self) -> f64 {
+        if self.band <= 0.0 { 1.0 } else { self.band_visible / self.band }
+    }
 }
 
 /// The engine's fractions for `requests`, reporting progress between chunks.

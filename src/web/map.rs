@@ -18,8 +18,10 @@ use super::map_options::{MapRequest, MapValue, Where, points_csv as given_points
 use super::{Engine, Model, ModelInner, js_error};
 use crate::error::{Error, Result};
 use crate::export::map_glb::map_glb;
-use crate::export::map_table::{Column, points_csv};
-use crate::map::{MapValues, Mapper, Points, Sample, Site, from_csv, grid};
+use crate::export::map_table::{Column, points_csv, value_columns};
+use crate::map::{MapValues, Mapper, Points, Sample, Site, from_csv, grid, point_sky};
+use crate::sky::patches::SkyPatches;
+use crate::sky::views::SkyViews;
 use crate::sun::position::sun_direction;
 use crate::year::annual::shading_sun_day;
 
@@ -31,6 +33,8 @@ pub(super) struct MapCache {
     place: Where,
     points: Rc<Points>,
     mapper: Rc<Mapper>,
+    /// The points' sky views (Tregenza's patches, as the annual run's), once asked.
+    sky: Option<Rc<SkyViews>>,
 }
 
 /// The model's points and mapper for `place`, made once per place.
@@ -46,8 +50,21 @@ fn points_for(model: &ModelInner, place: &Where) -> Result<(Rc<Points>, Rc<Mappe
     };
     let mapper = Rc::new(Mapper::new(&model.scene, &points)?);
     let points = Rc::new(points);
-    *cache.borrow_mut() = Some(MapCache { place: place.clone(), points: points.clone(), mapper: mapper.clone() });
+    *cache.borrow_mut() = Some(MapCache { place: place.clone(), points: points.clone(), mapper: mapper.clone(), sky: None });
     Ok((points, mapper))
+}
+
+/// The points' sky views for `place` (whose mapper is `mapper`), counted once per place.
+fn sky_for(model: &ModelInner, place: &Where, mapper: &Mapper) -> Rc<SkyViews> {
+    let mut cache = model.maps.borrow_mut();
+    if let Some(sky) = cache.as_ref().filter(|c| c.place == *place).and_then(|c| c.sky.clone()) {
+        return sky;
+    }
+    let sky = Rc::new(point_sky(mapper, &SkyPatches::tregenza(), &mut |_, _| {}));
+    if let Some(c) = cache.as_mut().filter(|c| c.place == *place) {
+        c.sky = Some(sky.clone());
+    }
+    sky
 }
 
 /// A map's answer, handed to JS as typed arrays (sunlit.js copies them into a plain object),
@@ -66,24 +83,18 @@ pub struct PointMap {
 
 impl PointMap {
     /// The CSV's value columns, as `sunlit map` writes them: `lit` for an instant, else
-    /// `sun_hours` and, with an EPW, `direct_kwh_m2`.
+    /// `sun_hours` and, with an EPW, the irradiation computed ([`value_columns`]).
     fn columns(&self) -> Vec<Column<'_>> {
         match &self.sums {
             None => vec![Column { name: "lit", values: &self.values, decimals: 0 }],
-            Some(sums) => {
-                let mut columns = vec![Column { name: "sun_hours", values: &sums.sun_hours, decimals: 4 }];
-                if let Some(d) = &sums.direct_kwh_m2 {
-                    columns.push(Column { name: "direct_kwh_m2", values: d, decimals: 4 });
-                }
-                columns
-            }
+            Some(sums) => value_columns(sums),
         }
     }
 }
 
 #[wasm_bindgen]
 impl PointMap {
-    /// `sunHours`, `direct` or `lit`.
+    /// `sunHours`, `direct`, `skyDiffuse`, `total` or `lit`.
     #[wasm_bindgen(getter)]
     pub fn value(&self) -> String {
         self.value.name().into()
@@ -149,6 +160,30 @@ impl PointMap {
         self.sums.as_ref().and_then(|s| s.direct_kwh_m2.as_deref()).map(to_f32)
     }
 
+    /// A period's sky-diffuse irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
+    #[wasm_bindgen(getter, js_name = skyDiffuse)]
+    pub fn sky_diffuse(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.sky_diffuse_kwh_m2.as_deref()).map(to_f32)
+    }
+
+    /// A period's ground-reflected irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
+    #[wasm_bindgen(getter, js_name = groundReflected)]
+    pub fn ground_reflected(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.ground_reflected_kwh_m2.as_deref()).map(to_f32)
+    }
+
+    /// A period's total irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
+    #[wasm_bindgen(getter)]
+    pub fn total(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.total_kwh_m2.as_deref()).map(to_f32)
+    }
+
+    /// Each point's view factor to the visible sky (with an irradiation value: `direct`, `skyDiffuse` or `total`).
+    #[wasm_bindgen(getter, js_name = skyViewFactor)]
+    pub fn sky_view_factor(&self) -> Option<Float32Array> {
+        self.sums.as_ref().and_then(|s| s.sky_view_factor.as_deref()).map(to_f32)
+    }
+
     /// The legend's low end: 0.
     #[wasm_bindgen(getter)]
     pub fn min(&self) -> f64 {
@@ -172,6 +207,8 @@ impl PointMap {
         let (name, unit) = match self.value {
             MapValue::SunHours => ("sun_hours", "h"),
             MapValue::Direct => ("direct_kwh_m2", "kWh/m²"),
+            MapValue::SkyDiffuse => ("sky_diffuse_kwh_m2", "kWh/m²"),
+            MapValue::Total => ("total_kwh_m2", "kWh/m²"),
             MapValue::Lit => ("lit", ""),
         };
         Uint8Array::from(map_glb(&self.model.scene, &self.points, &self.values, name, unit).as_slice())
@@ -193,7 +230,13 @@ impl Engine {
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
             let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
-            let site = Site { location: &request.site.location, calendar: &request.site.calendar, dni: request.dni.as_ref() };
+            let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper));
+            let site = Site {
+                location: &request.site.location,
+                calendar: &request.site.calendar,
+                weather: request.weather.as_ref(),
+                sky: sky.as_deref(),
+            };
             let samples = request.period.samples();
             let value = request.value;
             let map = if value == MapValue::Lit {
@@ -201,8 +244,13 @@ impl Engine {
                 PointMap { model, points, value, values, sums: None, instants: samples.len() }
             } else {
                 let sums = summed(&mapper, site, &samples, progress.as_ref(), signal.as_ref()).await.map_err(map_error)?;
-                let values =
-                    if value == MapValue::Direct { sums.direct_kwh_m2.clone().unwrap_or_default() } else { sums.sun_hours.clone() };
+                let values = match value {
+                    MapValue::Direct => sums.direct_kwh_m2.clone(),
+                    MapValue::SkyDiffuse => sums.sky_diffuse_kwh_m2.clone(),
+                    MapValue::Total => sums.total_kwh_m2.clone(),
+                    MapValue::SunHours | MapValue::Lit => Some(sums.sun_hours.clone()),
+                }
+                .unwrap_or_default();
                 PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums) }
             };
             Ok(map.into())
@@ -247,17 +295,12 @@ async fn summed(
     let size = samples.len().div_ceil(CHUNKS).max(1);
     let mut done = 0usize;
     for chunk in samples.chunks(size) {
-        let part = mapper.accumulate(chunk, site, &mut |_, _| {});
+        let part = mapper.accumulate(chunk, site, &mut |_, _| {})?;
         done += chunk.len();
         total = Some(match total {
             None => part,
             Some(mut t) => {
-                add(&mut t.sun_hours, &part.sun_hours);
-                if let (Some(a), Some(b)) = (t.direct_kwh_m2.as_mut(), part.direct_kwh_m2.as_ref()) {
-                    add(a, b);
-                }
-                t.instants += part.instants;
-                t.sun_up += part.sun_up;
+                t.merge(&part);
                 t
             }
         });
@@ -270,12 +313,9 @@ async fn summed(
             return Err(Error::Cancelled);
         }
     }
-    Ok(total.unwrap_or_else(|| mapper.accumulate(&[], site, &mut |_, _| {})))
-}
-
-fn add(into: &mut [f64], from: &[f64]) {
-    for (a, b) in into.iter_mut().zip(from) {
-        *a += b;
+    match total {
+        Some(t) => Ok(t),
+        None => mapper.accumulate(&[], site, &mut |_, _| {}),
     }
 }
 

@@ -34,18 +34,24 @@ pub enum MapValue {
     SunHours,
     /// Direct irradiation over the period, kWh/m² (needs an EPW).
     Direct,
+    /// Sky-diffuse irradiation over the period, kWh/m² (needs an EPW; each point's sky views).
+    SkyDiffuse,
+    /// Direct + sky diffuse + ground-reflected irradiation over the period, kWh/m² (needs an EPW).
+    Total,
     /// Sun seen (1) or not (0) at one instant.
     Lit,
 }
 
 impl MapValue {
     /// The JS API's names, as `value` takes them.
-    pub const NAMES: [&str; 3] = ["sunHours", "direct", "lit"];
+    pub const NAMES: [&str; 5] = ["sunHours", "direct", "skyDiffuse", "total", "lit"];
 
     fn parse(text: &str) -> Result<Self> {
         match text {
             "sunHours" => Ok(Self::SunHours),
             "direct" => Ok(Self::Direct),
+            "skyDiffuse" => Ok(Self::SkyDiffuse),
+            "total" => Ok(Self::Total),
             "lit" => Ok(Self::Lit),
             other => Err(Error::argument("value", format!("'{other}' is not one of {}", Self::NAMES.join(", ")))),
         }
@@ -56,11 +62,20 @@ impl MapValue {
         Self::NAMES[self as usize]
     }
 
+    /// Whether the value is an irradiation: it needs the EPW, and the map then sums every part
+    /// (direct, sky diffuse with each point's sky views, ground-reflected, total), as
+    /// `sunlit map --epw` does, so that its CSV is the CLI's.
+    pub fn needs_weather(self) -> bool {
+        matches!(self, Self::Direct | Self::SkyDiffuse | Self::Total)
+    }
+
     /// The legend's title and the unit.
     pub fn title(self) -> (&'static str, &'static str) {
         match self {
             Self::SunHours => ("Sun hours", "h"),
             Self::Direct => ("Direct irradiation", "kWh/m²"),
+            Self::SkyDiffuse => ("Sky-diffuse irradiation", "kWh/m²"),
+            Self::Total => ("Total irradiation", "kWh/m²"),
             Self::Lit => ("Sunlit at the instant", ""),
         }
     }
@@ -79,8 +94,8 @@ pub enum Where {
 pub struct MapRequest {
     /// The site and the leaf calendar.
     pub site: Resolved,
-    /// The EPW's direct normal irradiance, for `direct`.
-    pub dni: Option<Weather>,
+    /// The EPW's solar data, for the irradiation values.
+    pub weather: Option<Weather>,
     /// Where the points are.
     pub place: Where,
     /// When.
@@ -161,12 +176,12 @@ impl MapRequest {
             }
             (Some(v), false) => v,
         };
-        let dni = match (value, &settings.epw) {
-            (MapValue::Direct, Some(epw)) => Some(Weather::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw)?),
-            (MapValue::Direct, None) => return Err(Error::argument("value", "'direct' needs an EPW (its direct normal irradiance)")),
-            _ => None,
+        let weather = match (value.needs_weather(), &settings.epw) {
+            (true, Some(epw)) => Some(Weather::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw)?),
+            (true, None) => return Err(Error::argument("value", format!("'{}' needs an EPW (its solar irradiance)", value.name()))),
+            (false, _) => None,
         };
-        Ok(Self { site, dni, place, period, value })
+        Ok(Self { site, weather, place, period, value })
     }
 }
 

@@ -222,15 +222,24 @@ test('engine.map: typed arrays; direct irradiation under an EPW equals `sunlit m
     };
     const same = map.values.every((v, i) => v === map.direct[i]);
     const glb = String.fromCharCode(...map.glb.subarray(0, 4));
-    return { kinds, csv: map.csv, glb, same, count: map.values.length, max: map.max, value: map.value, unit: map.unit, instants: map.instants, errors };
+    // Total: the values are the total, each the sum of its parts (f32 arrays).
+    const total = await engine.map(model, { epw: text, grid: Number(grid), period: '12-01..12-07', value: 'total' });
+    const sums = total.values.every((v, i) => v === total.total[i]
+      && Math.abs(v - (total.direct[i] + total.skyDiffuse[i] + total.groundReflected[i])) <= 1e-3 * Math.max(1, v));
+    const totalOf = { value: total.value, title: total.title, sums, sky: total.skyDiffuse.every((v) => v > 0), views: total.skyViewFactor.every((v) => v > 0 && v <= 1) };
+    return { kinds, csv: map.csv, glb, same, count: map.values.length, max: map.max, value: map.value, unit: map.unit, instants: map.instants, errors, totalOf };
   }, { text: epw, grid: GRID });
   assert.deepEqual(api.kinds, ['Float32Array', 'Float32Array', 'Uint32Array', 'Float32Array']);
   assert.deepEqual([api.value, api.unit, api.instants], ['direct', 'kWh/m²', 7 * 24]);
   assert.equal(api.glb, 'glTF', 'the map glb has the glb magic');
   assert.ok(api.same, 'values are the direct irradiation asked for');
+  assert.deepEqual(api.totalOf, { value: 'total', title: 'Total irradiation', sums: true, sky: true, views: true }, 'value total: the sum of its parts');
   const native = nativeMap('direct', ['--epw', epwPath, '--period', '12-01..12-07']);
-  // The CLI's columns: sun_hours and, with an EPW, direct_kwh_m2; the API's CSV is the same.
-  assert.deepEqual(parseCsv(native).header.slice(7), ['sun_hours', 'direct_kwh_m2']);
+  // The CLI's columns: sun_hours and, with an EPW, the irradiation's parts and the sky view
+  // factor; the API's CSV is the same (every column compared below).
+  assert.deepEqual(parseCsv(native).header.slice(7), [
+    'sun_hours', 'direct_kwh_m2', 'sky_diffuse_kwh_m2', 'ground_reflected_kwh_m2', 'total_kwh_m2', 'sky_view_factor',
+  ]);
   const { worst } = compare(api.csv, native, 1e-3);
   console.log(`engine.map: ${api.count} points, direct up to ${api.max.toFixed(2)} kWh/m² over a week of Sydney's summer; vs CLI worst |Δ| ${JSON.stringify(worst)}`);
   assert.ok(api.max > 1, 'a week of summer sun');

@@ -22,6 +22,10 @@ receiver, annual kWh/m² of
 - ``sky_view_factor``: the view factor to the visible sky (the sky patches' coefficients / π).
 - ``unshaded_*``: the same with no geometry at all (one point per receiver).
 
+With --sensors FILE.csv (header x,y,z,nx,ny,nz: a map's points, e.g. `sunlit map`'s own), each
+point is its own record instead of a receiver's average (named p0, p1, … in the file's order),
+offset 1 mm along its own normal; ``unshaded_*`` are then the point's with no geometry.
+
 Every surface in the scene is black (reflectance 0), as in Ladybug's RadiationStudy: only the sun,
 the sky and the ground count. Points are quasi-random (Halton) over each receiver's triangles,
 offset 1 mm along its normal, the same number per receiver (rcontrib -c averages them).
@@ -131,6 +135,21 @@ def receiver_points(receiver, count):
         if inside.any():
             points.append(origin + p[0] * u + p[1] * v + OFFSET * normal)
     return np.array(points), normal
+
+
+def read_sensors(path):
+    """Points and unit normals from a CSV with the header x,y,z,nx,ny,nz."""
+    with open(path) as f:
+        header = f.readline().strip()
+        if header != "x,y,z,nx,ny,nz":
+            sys.exit(f"{path}: header {header!r}, expected x,y,z,nx,ny,nz")
+        rows = [[float(v) for v in line.split(",")] for line in f if line.strip()]
+    out = []
+    for row in rows:
+        point, normal = np.array(row[:3]), np.array(row[3:6])
+        normal /= np.linalg.norm(normal)
+        out.append((point, normal))
+    return out
 
 
 def write_scene(path, triangles):
@@ -286,6 +305,7 @@ def main():
     parser.add_argument("--ambient-divisions", type=int, default=512, help="rcontrib -ad for the sky")
     parser.add_argument("--processes", type=int, default=2, help="rcontrib -n")
     parser.add_argument("--suns", help="sun directions per hour (index x y z); default: gendaymtx's own suns")
+    parser.add_argument("--sensors", help="points CSV (x,y,z,nx,ny,nz): one record per point instead of per receiver")
     parser.add_argument("-o", "--output", required=True)
     args = parser.parse_args()
 
@@ -327,10 +347,17 @@ def main():
             with open(at(name), "wb") as out:
                 run([oconv, "-f", *[at(p) for p in parts]], env, stdout=out)
 
-        placed = [receiver_points(r, args.points) for r in receivers]
+        if args.sensors:
+            placed = [(np.array([p + OFFSET * nrm]), nrm) for p, nrm in read_sensors(args.sensors)]
+            names = [f"p{i}" for i in range(len(placed))]
+            per_record = 1
+        else:
+            placed = [receiver_points(r, args.points) for r in receivers]
+            names = [r["name"] for r in receivers]
+            per_record = args.points
         ray_text = rays(placed)
         one_ray = rays([(points[:1], normal) for points, normal in placed])
-        n = len(receivers)
+        n = len(placed)
         suns = ["-M", at("suns.mod")]
         # Every sun as a point source, every one tested (no thresholds, no jitter), no bounce.
         # -V+: contributions (times each sun's radiance), not coefficients.
@@ -340,10 +367,10 @@ def main():
         sky_opts = lambda ad: ["-n", str(args.processes), "-ab", "1", "-ad", str(ad), "-lw", f"{0.1 / ad:g}", "-dc", "1"]
 
         start = time.monotonic()
-        direct = photopic(rcontrib_records(bin_dir, env, at("direct.oct"), suns, args.points, ray_text, n, direct_opts))
+        direct = photopic(rcontrib_records(bin_dir, env, at("direct.oct"), suns, per_record, ray_text, n, direct_opts))
         timings["direct_s"] = time.monotonic() - start
         start = time.monotonic()
-        coef = photopic(rcontrib_records(bin_dir, env, at("sky.oct"), sky_modifier, args.points, ray_text, n,
+        coef = photopic(rcontrib_records(bin_dir, env, at("sky.oct"), sky_modifier, per_record, ray_text, n,
                                          sky_opts(args.ambient_divisions)))
         timings["sky_s"] = time.monotonic() - start
         start = time.monotonic()
@@ -354,14 +381,14 @@ def main():
         if coef.shape[1] != PATCHES:
             sys.exit(f"rcontrib: {coef.shape[1]} sky bins, expected {PATCHES}")
 
-    perez = perez_1990_unshaded(args.epw, [r["normal"] for r in receivers])
+    perez = perez_1990_unshaded(args.epw, [normal for _, normal in placed])
     # Every sun stands for one hour: W/m² summed over hours is Wh/m².
     kwh = lambda wh: wh / 1000.0
     results = []
-    for i, receiver in enumerate(receivers):
+    for i, name in enumerate(names):
         results.append({
-            "name": receiver["name"],
-            "points": args.points,
+            "name": name,
+            "points": per_record,
             "direct": kwh(direct[i].sum()),
             "sky": kwh(coef[i, 1:] @ patch_hours[1:]),
             "ground": kwh(open_coef[i, 0] * patch_hours[0]),
