@@ -187,6 +187,8 @@ function showResult(msg) {
 }
 
 function showError(msg) {
+  // A download of the map's files failing leaves the map (and any map in flight) as it is.
+  if (msg.request === 'mapFile') return status(`Could not download the map: ${msg.message}.`, { error: true });
   maps.failed();
   setBusy(false);
   $('progress').value = 0;
@@ -217,6 +219,8 @@ worker.onmessage = ({ data: msg }) => {
     showResult(msg);
   } else if (msg.type === 'mapResult') {
     maps.shown(msg);
+  } else if (msg.type === 'mapFile') {
+    maps.fileArrived(msg);
   } else if (msg.type === 'epwLocation') {
     showEpwLocation(msg);
   } else if (msg.type === 'error') {

@@ -19,7 +19,8 @@ export interface SunlitError extends Error {
     | 'cancelled'
     | 'no-webgpu'
     | 'worker'
-    | 'too-large';
+    | 'too-large'
+    | 'freed';
   /** The file the error is about (a model or EPW file name), where it is about one. */
   file?: string;
   /** The object in that file, e.g. "node 'Wall_S'" or "Timestep". */
@@ -248,6 +249,18 @@ export interface MapRunOptions extends AnnualRunOptions {
   csv?: boolean;
   /** Also return the map glb (`glb`), as `sunlit map --glb-out MAP.glb` writes it. */
   glb?: boolean;
+  /** Keep the map for its files, written only when asked (`files.csv()`, `files.glb()`): for a
+   * caller that draws every map but downloads few (a time slider). */
+  files?: boolean;
+}
+
+/** A map's points CSV and map glb on demand (`files: true`), as `csv`/`glb` would have given
+ * them. It holds the map in the engine's memory until `free()`; after it, both throw a
+ * SunlitError with code 'freed'. Not transferable: ask for the files where the map was made. */
+export interface MapFiles {
+  csv(): string;
+  glb(): Uint8Array;
+  free(): void;
 }
 
 /** engine.map's answer: plain typed arrays (transferable to and from a worker), one entry per
@@ -280,6 +293,8 @@ export interface SunlitMap {
   /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
    * legend in the scene's extras. */
   glb: Uint8Array | undefined;
+  /** The files on demand (with `files: true`). */
+  files: MapFiles | undefined;
   /** The legend's range: 0 and the largest value (lit: 0 and 1). */
   min: number;
   max: number;

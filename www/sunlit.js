@@ -283,8 +283,10 @@ class SunlitEngine {
   /** Per-point values on the receivers (sunlit.d.ts, MapOptions): a plain object of typed arrays
    * (points, normals, receivers, values; transferable to and from a worker) and its legend; with
    * `csv` / `glb` true, also the points CSV (text) and the map glb (bytes) as `sunlit map` writes
-   * them. Rejects with an AbortError when `signal` aborts. */
-  async map(model, options, { onProgress, signal, csv = false, glb = false } = {}) {
+   * them; with `files` true, `files`: the same two on demand (`csv()`, `glb()`) until `free()`, so
+   * a caller that only draws the map (a time slider) pays for the files only when they are asked
+   * for. Rejects with an AbortError when `signal` aborts. */
+  async map(model, options, { onProgress, signal, csv = false, glb = false, files = false } = {}) {
     if (signal?.aborted) throw abortError();
     let map;
     try {
@@ -293,8 +295,9 @@ class SunlitEngine {
       if (signal?.aborted && error?.code === 'cancelled') throw abortError();
       throw error;
     }
+    let answer;
     try {
-      return {
+      answer = {
         value: map.value,
         title: map.title,
         unit: map.unit,
@@ -311,9 +314,31 @@ class SunlitEngine {
         receiverNames: model.receiverNames,
         csv: csv ? map.csv() : undefined,
         glb: glb ? map.glb() : undefined,
+        files: files ? mapFiles(map) : undefined,
       };
-    } finally {
+    } catch (error) {
       map.free();
+      throw error;
     }
+    if (!files) map.free();
+    return answer;
   }
+}
+
+/** A map's files on demand: the wasm map is kept (its values in full precision, as the CLI writes
+ * them) until `free()`; after it, asking throws with code 'freed'. */
+function mapFiles(map) {
+  let kept = map;
+  const held = () => {
+    if (!kept) throw coded("this map's files were freed; map again to get them", 'freed');
+    return kept;
+  };
+  return {
+    csv: () => held().csv(),
+    glb: () => held().glb(),
+    free() {
+      kept?.free();
+      kept = null;
+    },
+  };
 }
