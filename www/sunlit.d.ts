@@ -40,6 +40,16 @@ export interface SunlitError extends Error {
 /** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
 export function wasmMemoryBytes(): Promise<number>;
 
+/** The largest model files (bytes in all) that loadFiles reads: about 4 GiB (wasm32's memory)
+ * over 16 (the memory a read takes per byte of file, an estimate); larger ones are refused with
+ * code 'too-large'. */
+export const maxModelBytes: number;
+
+/** Throws loadFiles' 'too-large' SunlitError (naming the files and their size in MB) for model
+ * files of `bytes` in all above maxModelBytes, so a page can refuse a file by its size before
+ * reading it. */
+export function checkModelSize(names: string[], bytes: number): void;
+
 /** Whether this browser (or worker) offers WebGPU. */
 export function hasWebGPU(): boolean;
 
@@ -183,6 +193,9 @@ export interface SunlitEngine {
   readonly hasGpu: boolean;
   /** Clipping workers in the pool (0: clipping runs in the engine's thread). */
   readonly workers: number;
+  /** Each clipping worker's wasm memory in bytes once it built the model (its load's peak; wasm
+   * memory never shrinks); empty without a pool. */
+  readonly workerMemoryBytes: (number | undefined)[];
   /** How the last 'auto' year was routed: its profile key, the profile (JSON), where the profile
    * came from, and why a profile handed in was refused; null before one. */
   readonly routing: { key: string; profile: string; source: 'pinned' | 'cache' | 'probe'; refused?: string } | null;

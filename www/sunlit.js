@@ -93,6 +93,16 @@ const MEMORY_PER_BYTE = 16;
 const WASM32_BYTES = 4 * 2 ** 30;
 const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
 
+/** The largest model files (bytes in all) a page reads: wasm32's 4 GiB over the memory a read
+ * takes per byte of file (an estimate; see MEMORY_PER_BYTE). */
+export const maxModelBytes = MAX_MODEL_BYTES;
+
+/** Refuses model files of `bytes` in all (code 'too-large', naming the files and their size)
+ * before any is read: a page can check a chosen file's size before reading it into memory. */
+export function checkModelSize(names, bytes) {
+  if (bytes > MAX_MODEL_BYTES) throw tooLarge(names.map(String), bytes);
+}
+
 function tooLarge(names, bytes, cause) {
   const mb = (bytes / 1e6).toFixed(1);
   const why = cause ? ` (reading it ran out of memory: ${cause.message})` : ` (the limit is about ${(MAX_MODEL_BYTES / 1e6).toFixed(0)} MB)`;
@@ -149,6 +159,12 @@ class SunlitEngine {
    * refused (why a profile handed in was not used) }, or null before one. */
   get routing() {
     return this.#routed;
+  }
+
+  /** The wasm memory (bytes) each clipping worker holds once it built the model: its copy's
+   * cost (docs/page-speed.md). Empty without a pool. */
+  get workerMemoryBytes() {
+    return this.#pool?.memoryBytes ?? [];
   }
 
   /** Why the pool could not start (clipping then runs in this thread), or null. */
@@ -224,7 +240,7 @@ class SunlitEngine {
     const names = files.map((f) => String(f.name));
     const contents = files.map((f) => toBytes(f.bytes, f.name));
     const bytes = contents.reduce((sum, c) => sum + c.byteLength, 0);
-    if (bytes > MAX_MODEL_BYTES) throw tooLarge(names, bytes);
+    checkModelSize(names, bytes);
     let model;
     try {
       model = this.#engine.loadFiles(names, contents, receivers, north, foliage, transmittance);
