@@ -40,9 +40,9 @@ export interface SunlitError extends Error {
 /** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
 export function wasmMemoryBytes(): Promise<number>;
 
-/** The largest model files (bytes in all) that loadFiles reads: about 4 GiB (wasm32's memory)
- * over 16 (the memory a read takes per byte of file, an estimate); larger ones are refused with
- * code 'too-large'. */
+/** The largest model files (bytes in all) that loadFiles reads: 4 GiB (wasm32's memory) over 17
+ * (the most memory an instance was measured to take per byte of file, rounded up), about 253 MB;
+ * larger ones are refused with code 'too-large'. */
 export const maxModelBytes: number;
 
 /** Throws loadFiles' 'too-large' SunlitError (naming the files and their size in MB) for model

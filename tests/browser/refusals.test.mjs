@@ -65,13 +65,13 @@ test('model files over the memory limit are refused by their size, naming it, an
     return { maxModelBytes, huge, split, fits, same: before === after };
   }, YEAR);
   await p.close();
-  assert.equal(r.maxModelBytes, Math.floor(4 * 2 ** 30 / 16));
+  assert.equal(r.maxModelBytes, Math.floor(4 * 2 ** 30 / 17));
   const mb = ((r.maxModelBytes + 1) / 1e6).toFixed(1);
   assert.equal(r.huge.code, 'too-large');
   assert.equal(r.huge.file, 'huge.glb');
   assert.equal(r.huge.bytes, r.maxModelBytes + 1);
   assert.ok(r.huge.message.startsWith(`huge.glb: ${mb} MB of model files do not fit in this page's memory`), r.huge.message);
-  assert.match(r.huge.message, /the limit is about 268 MB/);
+  assert.match(r.huge.message, /the limit is about 253 MB/);
   assert.equal(r.split.code, 'too-large');
   assert.match(r.split.message, new RegExp(`^a\\.gltf, a\\.bin: ${mb} MB`));
   assert.equal(r.fits, null, 'at the limit a model is read');
