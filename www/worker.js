@@ -1,8 +1,8 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
 // page stays responsive. Messages in: load, compute, map, mapFile, cancel, epw. Messages out:
 // loaded, progress, notice, result, mapResult, mapFile, epwLocation, error (with the error's
-// `code`, and `gpu: true` when the device failed twice and a retry may help). Errors are told apart by their `code` (sunlit.d.ts,
-// SunlitError), never by their message.
+// `code`, and `gpu: true` when the device failed twice and a retry may help). Errors are told
+// apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
 
 let engine = null;
