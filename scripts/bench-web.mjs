@@ -1,12 +1,13 @@
 // Times one model's year in headless Chromium (WebGPU on SwiftShader) through the JS API, with
 // the default engine and with each engine forced, and the same year with the native CLI:
-//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides LIST]
+//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides LIST] [--load-only]
 // Sides (default all): default (auto, the default pool), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto). Each side
 // runs N times (default 1) in a fresh browser and prints one JSON line per run, then one summary
 // line per side with the median seconds; the browser's lines also carry the peak resident memory
-// of all of Chromium's processes (sampled from /proc every 200 ms) and the wasm memory of the
-// engine's worker. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
+// of Chromium's processes (sampled from /proc every 200 ms; in all and by process type), the wasm
+// memory of the engine's instance (the page's thread here) after the load and at the end, and
+// of each clipping worker once it built the model. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
 import { copyFileSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
@@ -24,17 +25,21 @@ const flag = (name, fallback) => {
   return value;
 };
 const runs = Number(flag('--runs', '1'));
+// --load-only: the model's load and the pool's copies, no year (where the memory goes, quickly).
+const loadOnly = args.includes('--load-only') && Boolean(args.splice(args.indexOf('--load-only'), 1));
 const sides = flag('--sides', 'default,exact,gpu,exact-1,native').split(',');
 const [model, samples = '27x19', resolution = '512'] = args;
 if (!model) {
-  console.error('usage: node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides default,exact,gpu,exact-1,native]');
+  console.error('usage: node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides default,exact,gpu,exact-1,native] [--load-only]');
   process.exit(2);
 }
 const [days, perDay] = samples.split('x').map(Number);
 const place = { latitude: 39.74, longitude: -105.18, timeZone: -7 };
 const ENGINES = { default: {}, exact: { engine: 'exact' }, gpu: { engine: 'gpu' }, 'exact-1': { engine: 'exact', workers: 1 } };
 
-/** Resident bytes of `root` and every process below it (from /proc). */
+/** Resident bytes of every process below `root` (from /proc), in all and by Chromium's process
+ * type (`renderer`: the page and its workers, whose wasm instances are the model's copies;
+ * `gpu-process`: WebGPU's buffers, on SwiftShader here; `other`: the browser and its utilities). */
 function treeRss(root) {
   const parent = new Map();
   for (const name of readdirSync('/proc')) {
@@ -46,47 +51,89 @@ function treeRss(root) {
       // Gone between the listing and the read.
     }
   }
-  let total = 0;
+  const out = { total: 0, renderer: 0, 'gpu-process': 0, other: 0 };
   for (const [pid] of parent) {
     let p = pid;
     while (p > 1 && p !== root) p = parent.get(p) ?? 0;
     if (p !== root || pid === root) continue;
     try {
       const rss = /VmRSS:\s+(\d+) kB/.exec(readFileSync(`/proc/${pid}/status`, 'utf8'));
-      total += rss ? Number(rss[1]) * 1024 : 0;
+      const bytes = rss ? Number(rss[1]) * 1024 : 0;
+      const type = /--type=([\w-]+)/.exec(readFileSync(`/proc/${pid}/cmdline`, 'utf8'))?.[1];
+      out.total += bytes;
+      out[type in out ? type : 'other'] += bytes;
     } catch {
       // Gone.
     }
   }
-  return total;
+  return out;
 }
+
+/** The larger of each field. */
+function peakOf(a, b) {
+  return Object.fromEntries(Object.keys(b).map((k) => [k, Math.max(a[k] ?? 0, b[k])]));
+}
+
+const mb = (bytes) => Math.round(bytes / 1e6);
 
 async function browserRun(side) {
   copyFileSync(model, join(ROOT, `www/pkg/bench-model-${process.pid}.glb`));
   const server = await serve(0);
   const browser = await launch();
-  let peak = 0;
+  let peak = {};
   const sampler = setInterval(() => {
-    peak = Math.max(peak, treeRss(process.pid));
+    peak = peakOf(peak, treeRss(process.pid));
   }, 200);
   try {
     const page = await browser.newPage();
-    page.on('console', (m) => m.type() === 'error' && console.error(m.text()));
+    // Progress, as the year goes (a run stopped early says how far it got): elapsed seconds,
+    // views done of all, and the peak memory so far.
+    const started = Date.now();
+    page.on('console', (m) => {
+      if (m.type() === 'error') console.error(m.text());
+      const at = /^progress (\d+) (\d+)$/.exec(m.text());
+      if (at) {
+        const so = Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)]));
+        console.error(JSON.stringify({ side, elapsed_s: Math.round((Date.now() - started) / 1000), done: Number(at[1]), total: Number(at[2]), peak_rss_mb_by_process: so }));
+      }
+    });
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
     const result = await page.evaluate(
-      async ({ name, file, days, perDay, resolution, place, options }) => {
+      async ({ name, file, days, perDay, resolution, place, options, loadOnly }) => {
         const { createEngine, wasmMemoryBytes } = await import('/sunlit.js');
         const engine = await createEngine({ resolution, ...options });
         const bytes = new Uint8Array(await (await fetch(`/pkg/bench-model-${file}.glb`)).arrayBuffer());
         const t0 = performance.now();
         const model = engine.loadFiles([{ name, bytes }]);
         const t1 = performance.now();
+        const loadedWasm = await wasmMemoryBytes();
         await engine.prepare(model);
         const t2 = performance.now();
+        console.log(`progress 0 0`);
         let views = 0;
+        if (loadOnly) {
+          const out = {
+            load_s: (t1 - t0) / 1000,
+            workers_load_s: (t2 - t1) / 1000,
+            total_s: (t2 - t0) / 1000,
+            triangles: model.triangles,
+            workers: engine.workers,
+            engine_wasm_mb_loaded: Math.round(loadedWasm / 1e6),
+            engine_wasm_mb: Math.round((await wasmMemoryBytes()) / 1e6),
+            worker_wasm_mb: engine.workerMemoryBytes.map((b) => Math.round(b / 1e6)),
+          };
+          engine.close();
+          return out;
+        }
         const year = await engine.annual(model, { ...place, timestepsPerHour: 4, daysPerYear: days, samplesPerDay: perDay }, {
-          onProgress: (done) => {
+          onProgress: (done, total) => {
             views = Math.max(views, done);
+            // Every 30 s to the bench's stderr (the console), and at the end.
+            const now = performance.now();
+            if (now - (globalThis.lastProgress ?? 0) > 30_000 || done === total) {
+              globalThis.lastProgress = now;
+              console.log(`progress ${done} ${total}`);
+            }
           },
         });
         const t3 = performance.now();
@@ -101,14 +148,17 @@ async function browserRun(side) {
           workers: engine.workers,
           profile_source: year.profileSource,
           profile: year.profile,
-          wasm_bytes: await wasmMemoryBytes(),
+          engine_wasm_mb_loaded: Math.round(loadedWasm / 1e6),
+          engine_wasm_mb: Math.round((await wasmMemoryBytes()) / 1e6),
+          worker_wasm_mb: engine.workerMemoryBytes.map((b) => Math.round(b / 1e6)),
         };
         engine.close();
         return out;
       },
-      { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side] },
+      { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side], loadOnly },
     );
-    return { side: `page-${side}`, ...result, peak_rss_mb: Math.round(Math.max(peak, treeRss(process.pid)) / 1e6) };
+    peak = peakOf(peak, treeRss(process.pid));
+    return { side: `page-${side}`, ...result, peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
   } finally {
     clearInterval(sampler);
     await browser.close();

@@ -110,8 +110,8 @@ fn the_error_codes_are_the_same_on_both_sides() {
     let mut rust: BTreeSet<String> = every_error().iter().map(|e| e.code().to_string()).collect();
     // Thrown by sunlit.js itself, before the wasm is reached: no WebGPU, a model too large for
     // wasm32's memory (refused by its size up front, or trapped while reading), and a failure
-    // of one of the pool's clipping workers (pool.js).
-    for js_only in ["no-webgpu", "too-large", "worker"] {
+    // of one of the pool's clipping workers (pool.js); a map's files asked for after `free()`.
+    for js_only in ["no-webgpu", "too-large", "worker", "freed"] {
         rust.insert(js_only.into());
     }
     assert_eq!(union(body, "code"), rust);

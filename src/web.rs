@@ -198,7 +198,10 @@ impl Engine {
     }
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
-        let gpu = self.counter.as_ref().map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
+        // `exact` never draws: no upload, which for a large model is as much wasm memory again as
+        // its scene (nyt-blocks: 1,103 MB with the upload, 620 MB without; docs/page-speed.md).
+        let counter = self.counter.as_ref().filter(|_| self.kind != EngineKind::Exact);
+        let gpu = counter.map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
         Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default() }) })
     }
 

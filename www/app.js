@@ -1,12 +1,13 @@
 // The page: collects files and settings, talks to the worker (worker.js) that runs the engine,
 // and shows the results (3D view, table, heat map, downloads). All work stays on this machine.
 import { colourOf, UNCOMPUTED } from './colour.js';
+import { checkModelSize } from './sunlit.js';
 import { drawHeatmap } from './heatmap.js';
 import { mapMode } from './mapmode.js';
 import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
-const state = { files: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '', colourBy: 'mean' };
+const state = { files: null, reading: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '', colourBy: 'mean' };
 const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
 
 function status(text, { error = false } = {}) {
@@ -48,21 +49,38 @@ async function readFiles(list) {
   return Promise.all([...list].map(async (f) => ({ name: f.name, bytes: new Uint8Array(await f.arrayBuffer()) })));
 }
 
+/** Chosen or dropped files, refused by their size before they are read (a model too large for
+ * the page's memory), else read. Returns null after saying why. */
+async function readChosen(list) {
+  const chosen = [...list];
+  try {
+    checkModelSize(chosen.map((f) => f.name), chosen.reduce((sum, f) => sum + f.size, 0));
+  } catch (error) {
+    // The last good model and its result stay as they are.
+    status(`Could not read the model: ${error.message.replace(/\.$/, '')}.`, { error: true });
+    return null;
+  }
+  return readFiles(chosen);
+}
+
+/** Sends files to the worker; they become the page's model (its name, its CSV's name) only once
+ * the worker has read them, so a file that cannot be read leaves the last good model in place. */
 async function loadFiles(files) {
-  if (!files.length) return;
+  if (!files?.length) return;
   if (state.busy) return status('Could not read the model while computing: cancel first.', { error: true });
-  state.files = files;
-  state.modelName = files.map((f) => f.name).join(', ');
+  const modelName = files.map((f) => f.name).join(', ');
   const main = files.find((f) => !/\.(bin|png|jpe?g|webp|ktx2)$/i.test(f.name)) ?? files[0];
   const base = main.name.replace(/\.[^.]*$/, '');
-  state.csvName = `${base}-shading.csv`;
-  status(`Reading ${state.modelName}…`);
+  state.reading = { files, modelName, csvName: `${base}-shading.csv` };
+  status(`Reading ${modelName}…`);
   $('compute').disabled = true;
   const options = { receivers: $('receivers').value, north: 0, foliage: $('foliage').value, transmittance: $('transmittance').value };
   worker.postMessage({ type: 'load', files, options, engine: engineOptions() });
 }
 
 function showModel(msg) {
+  Object.assign(state, state.reading ?? {});
+  state.reading = null;
   state.model = msg;
   state.result = null;
   state.selected = -1;
@@ -187,14 +205,20 @@ function showResult(msg) {
 }
 
 function showError(msg) {
+  // A download of the map's files failing leaves the map (and any map in flight) as it is.
+  if (msg.request === 'mapFile') return status(`Could not download the map: ${msg.message}.`, { error: true });
   maps.failed();
+  if (msg.request === 'load') {
+    // The files were not read: the last good model (if any) stays, and Compute with it.
+    state.reading = null;
+  }
   setBusy(false);
   $('progress').value = 0;
   if (msg.cancelled) return status('Cancelled.');
   $('retry').hidden = !msg.gpu;
   const what = { load: 'Could not read the model', map: 'Could not map' }[msg.request] ?? 'Could not compute';
   const hint = msg.gpu ? ' The GPU device was lost or failed; press Retry to start a new one.' : '';
-  status(`${what}: ${msg.message}.${hint}`, { error: true });
+  status(`${what}: ${String(msg.message).replace(/\.$/, '')}.${hint}`, { error: true });
 }
 
 worker.onmessage = ({ data: msg }) => {
@@ -217,6 +241,8 @@ worker.onmessage = ({ data: msg }) => {
     showResult(msg);
   } else if (msg.type === 'mapResult') {
     maps.shown(msg);
+  } else if (msg.type === 'mapFile') {
+    maps.fileArrived(msg);
   } else if (msg.type === 'epwLocation') {
     showEpwLocation(msg);
   } else if (msg.type === 'error') {
@@ -261,7 +287,7 @@ function noWebGPU() {
 /** A large model's loading, stage by stage: parsing in the engine's worker, then the clipping
  * workers building their copies. */
 function showLoading({ stage, bytes, workers, poolError }) {
-  if (stage === 'parse') status(`Reading ${state.modelName} (${(bytes / 1e6).toFixed(1)} MB)…`);
+  if (stage === 'parse') status(`Reading ${state.reading?.modelName ?? state.modelName} (${(bytes / 1e6).toFixed(1)} MB)…`);
   else if (stage === 'workers') $('poolinfo').textContent = `Preparing ${workers} clipping worker${workers === 1 ? '' : 's'}…`;
   else if (stage === 'ready') $('poolinfo').textContent = poolError ? `Clipping in one thread: ${poolError}` : `${workers} clipping worker${workers === 1 ? '' : 's'} ready.`;
 }
@@ -312,7 +338,7 @@ function download(name, text, type) {
 
 function wire() {
   $('model').addEventListener('change', async (e) => {
-    const files = await readFiles(e.target.files);
+    const files = await readChosen(e.target.files);
     // Cleared so that choosing the same file again (after fixing a setting) reads it again.
     e.target.value = '';
     await loadFiles(files);
@@ -328,7 +354,7 @@ function wire() {
   for (const ev of ['dragleave', 'drop']) drop.addEventListener(ev, () => drop.classList.remove('over'));
   drop.addEventListener('drop', async (e) => {
     e.preventDefault();
-    await loadFiles(await readFiles(e.dataTransfer.files));
+    await loadFiles(await readChosen(e.dataTransfer.files));
   });
   $('settings').addEventListener('submit', async (e) => {
     e.preventDefault();

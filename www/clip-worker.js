@@ -1,10 +1,12 @@
 // One worker of the clipping pool (pool.js): its own wasm instance, holding one model's exact
 // engine (a Clipper), answering chunks of packed views. Messages in: load { source }, clip
-// { job, data }. Out: ready, loaded, loadError { message, code }, clipped { job, fractions },
-// clipError { job, message, code }.
+// { job, data }. Out: ready, loaded { wasmBytes }, loadError { message, code }, clipped { job,
+// fractions }, clipError { job, message, code }. `wasmBytes`: this instance's wasm memory once the
+// model is built (it never shrinks, so it is the load's peak).
 import init, { Clipper } from './pkg/sunlit_wasm.js';
 
 let clipper = null;
+let memory = null;
 
 /** A Clipper from what built the engine's model (sunlit.js keeps it: files, arrays or meshes). */
 function build({ kind, args }) {
@@ -26,7 +28,7 @@ onmessage = ({ data }) => {
       clipper?.free();
       clipper = null;
       clipper = build(data.source);
-      postMessage({ type: 'loaded' });
+      postMessage({ type: 'loaded', wasmBytes: memory?.buffer.byteLength });
     } catch (error) {
       postMessage({ type: 'loadError', ...failure(error) });
     }
@@ -45,6 +47,9 @@ onmessage = ({ data }) => {
 // it is a syntax error. A wasm that cannot start is thrown from a task of its own, so the pool
 // sees it as the worker's error event, as it would a module that cannot load.
 init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) }).then(
-  () => postMessage({ type: 'ready' }),
+  (exports) => {
+    memory = exports.memory;
+    postMessage({ type: 'ready' });
+  },
   (error) => setTimeout(() => { throw error; }),
 );

@@ -1,7 +1,8 @@
 // The page's Map mode: per-point values on the receivers (engine.map, run by the worker): a grid
 // at a spacing, a period or an instant, a value; the cells drawn over the 3D view with a legend;
 // a day/time slider that maps the instant as it moves; the points CSV and the map glb to
-// download (the library's own writers, as `sunlit map` writes them).
+// download (the library's own writers, as `sunlit map` writes them), written by the worker only
+// when a download is clicked: a slider's move asks for nothing the view does not draw.
 import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 const MONTH_DAYS = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
@@ -29,7 +30,7 @@ export function clock(hours) {
  */
 export function mapMode(page) {
   const { $ } = page;
-  const state = { map: null, pending: null, inFlight: false, csvName: 'points.csv' };
+  const state = { map: null, id: null, pending: null, inFlight: false };
 
   const mode = () => $('mode').value;
   const instant = () => $('mapperiod').value === 'instant' || $('mapvalue').value === 'lit';
@@ -78,8 +79,9 @@ export function mapMode(page) {
     return cellsCache.get(map);
   }
 
-  /** The worker's answer: drawn, summarised, ready to download. */
-  function shown({ map, seconds, tag }) {
+  /** The worker's answer: drawn, summarised, ready to download (the worker keeps map `id`'s
+   * files until the next map). */
+  function shown({ map, seconds, tag, id }) {
     state.inFlight = false;
     if (state.pending) {
       const next = state.pending;
@@ -101,8 +103,9 @@ export function mapMode(page) {
     view.dataset.cells = String(map.values.length);
     view.dataset.lit = lit === null ? '' : String(lit);
     view.dataset.at = map.value === 'lit' ? `${tag.day},${tag.time}` : '';
-    $('downloadmap').disabled = !map.csv;
-    $('downloadglb').disabled = !map.glb;
+    state.id = id;
+    $('downloadmap').disabled = false;
+    $('downloadglb').disabled = false;
     const receivers = new Set(map.receivers).size;
     const summary =
       lit === null
@@ -120,6 +123,14 @@ export function mapMode(page) {
     return { max: range.max, title: `${info.title}${info.unit ? `, ${info.unit}` : ''} per point`, tick: (v) => (range.max >= 10 ? v.toFixed(0) : v.toFixed(2)) };
   }
 
+  /** A file of the map shown, written by the worker on a download's click: saved. */
+  function fileArrived({ id, kind, data }) {
+    if (id !== state.id) return;
+    const base = page.modelName().replace(/\.[^.]*$/, '') || 'model';
+    if (kind === 'glb') page.download(`${base}-map.glb`, data, 'model/gltf-binary');
+    else page.download(`${base}-points.csv`, data, 'text/csv');
+  }
+
   function failed() {
     state.inFlight = false;
     state.pending = null;
@@ -134,9 +145,10 @@ export function mapMode(page) {
         if (mode() === 'map' && instant() && state.map && !page.busy()) request('instant');
       });
     }
-    const base = () => page.modelName().replace(/\.[^.]*$/, '') || 'model';
-    $('downloadmap').addEventListener('click', () => state.map?.csv && page.download(`${base()}-points.csv`, state.map.csv, 'text/csv'));
-    $('downloadglb').addEventListener('click', () => state.map?.glb && page.download(`${base()}-map.glb`, state.map.glb, 'model/gltf-binary'));
+    // The files are written by the worker when asked for, of the map shown (fileArrived saves them).
+    const ask = (kind) => state.map && page.worker.postMessage({ type: 'mapFile', id: state.id, kind });
+    $('downloadmap').addEventListener('click', () => ask('csv'));
+    $('downloadglb').addEventListener('click', () => ask('glb'));
     showFields();
   }
 
@@ -145,10 +157,12 @@ export function mapMode(page) {
     active: () => mode() === 'map',
     compute: () => request(instant() ? 'instant' : 'period'),
     shown,
+    fileArrived,
     failed,
     /** A new model: its old map is gone. */
     reset() {
       state.map = null;
+      state.id = null;
       $('downloadmap').disabled = true;
       $('downloadglb').disabled = true;
       showFields();

@@ -49,6 +49,12 @@ export class ClipPool {
     return this.#size;
   }
 
+  /** Each worker's wasm memory in bytes once it built the pool's model (its load's peak: wasm
+   * memory never shrinks); undefined before. */
+  get memoryBytes() {
+    return this.#workers.map((slot) => slot?.wasmBytes);
+  }
+
   /** The error that closed the pool (one worker failed), or null. */
   get broken() {
     return this.#broken;
@@ -157,7 +163,10 @@ export class ClipPool {
     if (data.type === 'loaded' || data.type === 'loadError') {
       const pending = slot.pending;
       slot.pending = null;
-      if (data.type === 'loaded') pending?.resolve();
+      if (data.type === 'loaded') {
+        slot.wasmBytes = data.wasmBytes;
+        pending?.resolve();
+      }
       else pending?.reject(Object.assign(new Error(data.message), { code: data.code, worker: slot.index }));
       return;
     }

@@ -19,7 +19,8 @@ export interface SunlitError extends Error {
     | 'cancelled'
     | 'no-webgpu'
     | 'worker'
-    | 'too-large';
+    | 'too-large'
+    | 'freed';
   /** The file the error is about (a model or EPW file name), where it is about one. */
   file?: string;
   /** The object in that file, e.g. "node 'Wall_S'" or "Timestep". */
@@ -38,6 +39,16 @@ export interface SunlitError extends Error {
 
 /** Bytes of the wasm linear memory (it grows and never shrinks, so a leak shows as growth). */
 export function wasmMemoryBytes(): Promise<number>;
+
+/** The largest model files (bytes in all) that loadFiles reads: 4 GiB (wasm32's memory) over 17
+ * (the most memory an instance was measured to take per byte of file, rounded up), about 253 MB;
+ * larger ones are refused with code 'too-large'. */
+export const maxModelBytes: number;
+
+/** Throws loadFiles' 'too-large' SunlitError (naming the files and their size in MB) for model
+ * files of `bytes` in all above maxModelBytes, so a page can refuse a file by its size before
+ * reading it. */
+export function checkModelSize(names: string[], bytes: number): void;
 
 /** Whether this browser (or worker) offers WebGPU. */
 export function hasWebGPU(): boolean;
@@ -182,6 +193,9 @@ export interface SunlitEngine {
   readonly hasGpu: boolean;
   /** Clipping workers in the pool (0: clipping runs in the engine's thread). */
   readonly workers: number;
+  /** Each clipping worker's wasm memory in bytes once it built the model (its load's peak; wasm
+   * memory never shrinks); empty without a pool. */
+  readonly workerMemoryBytes: (number | undefined)[];
   /** How the last 'auto' year was routed: its profile key, the profile (JSON), where the profile
    * came from, and why a profile handed in was refused; null before one. */
   readonly routing: { key: string; profile: string; source: 'pinned' | 'cache' | 'probe'; refused?: string } | null;
@@ -252,6 +266,18 @@ export interface MapRunOptions extends AnnualRunOptions {
   csv?: boolean;
   /** Also return the map glb (`glb`), as `sunlit map --glb-out MAP.glb` writes it. */
   glb?: boolean;
+  /** Keep the map for its files, written only when asked (`files.csv()`, `files.glb()`): for a
+   * caller that draws every map but downloads few (a time slider). */
+  files?: boolean;
+}
+
+/** A map's points CSV and map glb on demand (`files: true`), as `csv`/`glb` would have given
+ * them. It holds the map in the engine's memory until `free()`; after it, both throw a
+ * SunlitError with code 'freed'. Not transferable: ask for the files where the map was made. */
+export interface MapFiles {
+  csv(): string;
+  glb(): Uint8Array;
+  free(): void;
 }
 
 /** engine.map's answer: plain typed arrays (transferable to and from a worker), one entry per
@@ -297,6 +323,8 @@ export interface SunlitMap {
   /** The map glb (with `glb: true`): the receivers, a square per point coloured by the value, the
    * legend in the scene's extras. */
   glb: Uint8Array | undefined;
+  /** The files on demand (with `files: true`). */
+  files: MapFiles | undefined;
   /** The legend's range: 0 and the largest value (lit: 0 and 1). */
   min: number;
   max: number;

@@ -85,13 +85,23 @@ export async function epwLocation(text, name = 'EPW') {
   return wasmEpwLocation(String(name), String(text));
 }
 
-/** Model files above this many bytes cannot be read within wasm32's 4 GiB: reading one holds
- * its bytes, the parsed scene, the GPU upload's staging and the exact engine's index at once.
- * Estimated from nyt-blocks (docs/page-speed.md): for its 95 MB glb the renderer held 4.37 GB for
- * the engine's worker and two clipping workers, about 15× the file per instance. */
-const MEMORY_PER_BYTE = 16;
+/** Model files above this many bytes cannot be read within wasm32's 4 GiB: an instance keeps
+ * its peak (wasm memory never shrinks): the file's bytes, the parsed scene, the GPU upload's
+ * staging and the exact engine's index. Measured on nyt-blocks' 95 MB glb (docs/page-speed.md):
+ * 1,568 MB in the engine's instance under `auto` (16.5×), 1,312 MB in each clipping worker. */
+const MEMORY_PER_BYTE = 17;
 const WASM32_BYTES = 4 * 2 ** 30;
 const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
+
+/** The largest model files (bytes in all) a page reads: wasm32's 4 GiB over the memory a read
+ * takes per byte of file (an estimate; see MEMORY_PER_BYTE). */
+export const maxModelBytes = MAX_MODEL_BYTES;
+
+/** Refuses model files of `bytes` in all (code 'too-large', naming the files and their size)
+ * before any is read: a page can check a chosen file's size before reading it into memory. */
+export function checkModelSize(names, bytes) {
+  if (bytes > MAX_MODEL_BYTES) throw tooLarge(names.map(String), bytes);
+}
 
 function tooLarge(names, bytes, cause) {
   const mb = (bytes / 1e6).toFixed(1);
@@ -149,6 +159,12 @@ class SunlitEngine {
    * refused (why a profile handed in was not used) }, or null before one. */
   get routing() {
     return this.#routed;
+  }
+
+  /** The wasm memory (bytes) each clipping worker holds once it built the model: its copy's
+   * cost (docs/page-speed.md). Empty without a pool. */
+  get workerMemoryBytes() {
+    return this.#pool?.memoryBytes ?? [];
   }
 
   /** Why the pool could not start (clipping then runs in this thread), or null. */
@@ -224,7 +240,7 @@ class SunlitEngine {
     const names = files.map((f) => String(f.name));
     const contents = files.map((f) => toBytes(f.bytes, f.name));
     const bytes = contents.reduce((sum, c) => sum + c.byteLength, 0);
-    if (bytes > MAX_MODEL_BYTES) throw tooLarge(names, bytes);
+    checkModelSize(names, bytes);
     let model;
     try {
       model = this.#engine.loadFiles(names, contents, receivers, north, foliage, transmittance);
@@ -283,8 +299,10 @@ class SunlitEngine {
   /** Per-point values on the receivers (sunlit.d.ts, MapOptions): a plain object of typed arrays
    * (points, normals, receivers, values; transferable to and from a worker) and its legend; with
    * `csv` / `glb` true, also the points CSV (text) and the map glb (bytes) as `sunlit map` writes
-   * them. Rejects with an AbortError when `signal` aborts. */
-  async map(model, options, { onProgress, signal, csv = false, glb = false } = {}) {
+   * them; with `files` true, `files`: the same two on demand (`csv()`, `glb()`) until `free()`, so
+   * a caller that only draws the map (a time slider) pays for the files only when they are asked
+   * for. Rejects with an AbortError when `signal` aborts. */
+  async map(model, options, { onProgress, signal, csv = false, glb = false, files = false } = {}) {
     if (signal?.aborted) throw abortError();
     let map;
     try {
@@ -293,8 +311,9 @@ class SunlitEngine {
       if (signal?.aborted && error?.code === 'cancelled') throw abortError();
       throw error;
     }
+    let answer;
     try {
-      return {
+      answer = {
         value: map.value,
         title: map.title,
         unit: map.unit,
@@ -315,9 +334,31 @@ class SunlitEngine {
         receiverNames: model.receiverNames,
         csv: csv ? map.csv() : undefined,
         glb: glb ? map.glb() : undefined,
+        files: files ? mapFiles(map) : undefined,
       };
-    } finally {
+    } catch (error) {
       map.free();
+      throw error;
     }
+    if (!files) map.free();
+    return answer;
   }
+}
+
+/** A map's files on demand: the wasm map is kept (its values in full precision, as the CLI writes
+ * them) until `free()`; after it, asking throws with code 'freed'. */
+function mapFiles(map) {
+  let kept = map;
+  const held = () => {
+    if (!kept) throw coded("this map's files were freed; map again to get them", 'freed');
+    return kept;
+  };
+  return {
+    csv: () => held().csv(),
+    glb: () => held().glb(),
+    free() {
+      kept?.free();
+      kept = null;
+    },
+  };
 }

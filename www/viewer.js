@@ -84,19 +84,29 @@ export class Viewer {
   /** Cells drawn over the model (a map: mapCells' positions and normals, mapColours' colours,
    * 3 floats per vertex each), or none with `null`. */
   setOverlay(cells, colours) {
-    if (!cells) {
-      this.overlay = null;
-    } else {
-      const n = cells.positions.length / 3;
-      const data = new Float32Array(n * FLOATS_PER_VERTEX);
-      for (let v = 0; v < n; v++) {
-        data.set(cells.positions.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX);
-        data.set(cells.normals.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX + 3);
-        data.set(colours.subarray(3 * v, 3 * v + 3), v * FLOATS_PER_VERTEX + 6);
+    if (cells === this.overlayCells && colours === this.overlayColours) return;
+    const n = cells ? cells.positions.length / 3 : 0;
+    // A time slider's move: the same cells, new colours. Only the colours are written, in place,
+    // and only the overlay's part of the vertex buffer is sent again.
+    const recolour = cells && cells === this.overlayCells && this.overlay && this.vertices;
+    if (!cells) this.overlay = null;
+    else if (!recolour) this.overlay = new Float32Array(n * FLOATS_PER_VERTEX);
+    const data = this.overlay;
+    for (let v = 0; v < n; v++) {
+      const at = v * FLOATS_PER_VERTEX;
+      for (let k = 0; k < 3; k++) {
+        if (!recolour) {
+          data[at + k] = cells.positions[3 * v + k];
+          data[at + 3 + k] = cells.normals[3 * v + k];
+        }
+        data[at + 6 + k] = colours[3 * v + k];
       }
-      this.overlay = data;
     }
-    this.upload();
+    this.overlayCells = cells;
+    this.overlayColours = colours;
+    if (!recolour) return this.upload();
+    this.device.queue.writeBuffer(this.vertices, (this.base?.length ?? 0) * 4, data);
+    this.draw();
   }
 
   upload() {

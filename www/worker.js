@@ -1,8 +1,8 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: load, compute, map, cancel, epw. Messages out: loaded,
-// progress, notice, result, mapResult, epwLocation, error (with the error's `code`, and `gpu: true` when the device
-// failed twice and a retry may help). Errors are told apart by their `code` (sunlit.d.ts,
-// SunlitError), never by their message.
+// page stays responsive. Messages in: load, compute, map, mapFile, cancel, epw. Messages out:
+// loaded, progress, notice, result, mapResult, mapFile, epwLocation, error (with the error's
+// `code`, and `gpu: true` when the device failed twice and a retry may help). Errors are told
+// apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
 
 let engine = null;
@@ -53,6 +53,7 @@ async function load({ files: given, options, engine: made }) {
   postMessage({ type: 'loading', stage: 'parse', bytes });
   // Read first: a bad file leaves the last good model in place.
   const m = e.loadFiles(given, options);
+  dropMapFiles();
   model?.free();
   model = m;
   files = given;
@@ -148,8 +149,20 @@ async function computeOnce({ settings, engine: made, csvName }) {
   }
 }
 
+/** The last map's files (engine.map's `files`), written only when the page downloads them, and
+ * the map they belong to. */
+let mapFiles = null;
+let mapSerial = 0;
+
+function dropMapFiles() {
+  mapFiles?.files.free();
+  mapFiles = null;
+}
+
 /** A per-point map (engine.map) of the loaded model; its typed arrays are transferred. `tag`
- * comes back unchanged (the page tells an instant's answer from a period's). */
+ * comes back unchanged (the page tells an instant's answer from a period's). Only what the view
+ * draws is sent: the points CSV and the map glb are written when the page asks for them
+ * (mapFile), so a time slider pays for neither on every move. */
 async function map({ options, engine: made, tag }) {
   if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
   const e = await engineFor(made);
@@ -157,10 +170,20 @@ async function map({ options, engine: made, tag }) {
   running = new AbortController();
   const started = performance.now();
   const onProgress = (done, total) => postMessage({ type: 'progress', done, total });
-  // The files come along (the page offers them for download): cheap beside the rays.
-  const result = await e.map(m, options, { onProgress, signal: running.signal, csv: true, glb: true });
-  const buffers = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct, result.glb].filter(Boolean).map((a) => a.buffer);
-  postMessage({ type: 'mapResult', tag, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
+  const { files: kept, ...result } = await e.map(m, options, { onProgress, signal: running.signal, files: true });
+  dropMapFiles();
+  mapFiles = { files: kept, id: ++mapSerial };
+  const buffers = [result.points, result.normals, result.receivers, result.values, result.sunHours, result.direct].filter(Boolean).map((a) => a.buffer);
+  postMessage({ type: 'mapResult', tag, id: mapFiles.id, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
+}
+
+/** The points CSV ('csv') or the map glb ('glb') of map `id`, as `sunlit map` writes them. */
+function mapFile({ id, kind }) {
+  if (!mapFiles || mapFiles.id !== id) {
+    throw Object.assign(new Error('the map shown is no longer the last one mapped; map again to download it'), { code: 'freed' });
+  }
+  const data = kind === 'glb' ? mapFiles.files.glb() : mapFiles.files.csv();
+  postMessage({ type: 'mapFile', id, kind, data }, kind === 'glb' ? [data.buffer] : []);
 }
 
 /** The EnergyPlus model with the CSV hooked in, or why it cannot be hooked (e.g. its Version is
@@ -210,6 +233,7 @@ onmessage = async ({ data }) => {
     if (data.type === 'load') await load(data);
     else if (data.type === 'compute') await compute(data);
     else if (data.type === 'map') await map(data);
+    else if (data.type === 'mapFile') mapFile(data);
     else if (data.type === 'epw') await epw(data);
   } catch (error) {
     fail(error, data.type);

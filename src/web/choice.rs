@@ -149,7 +149,7 @@ impl<'a> Chosen<'a> {
             return Ok(p);
         }
         let keys: Vec<&str> = [Some(self.keys.0.as_str()), self.keys.1.as_deref()].into_iter().flatten().collect();
-        let found = self.routing.given.as_ref().map(|(text, source)| (profile_for(text, &format!("the {source} profile"), &keys), source));
+        let found = self.routing.given.as_ref().map(|(text, source)| (profile_for(text, &given_name(source), &keys), source));
         let chosen = match found {
             Some((Ok(p), source)) => (p, if source == "cache" { "cache" } else { "pinned" }),
             Some((Err(e), _)) => {
@@ -201,6 +201,14 @@ impl<'a> Chosen<'a> {
     fn pool_failed(&self, error: JsValue) -> Error {
         *self.pool_error.borrow_mut() = Some(error);
         Error::Cancelled
+    }
+}
+
+/// How a refusal names a profile handed in: the pinned one, or the page's stored one (where).
+fn given_name(source: &str) -> String {
+    match source {
+        "cache" => "the profile stored in IndexedDB (database 'sunlit', store 'engine-profiles')".into(),
+        other => format!("the {other} profile"),
     }
 }
 

@@ -36,6 +36,20 @@ before(async () => {
   browser = await launch();
   page = await (await browser.newContext({ acceptDownloads: true })).newPage();
   page.on('pageerror', (e) => pageErrors.push(e.message));
+  // Records what the page's worker sends back for maps: a map's answer, and a map's file.
+  await page.addInitScript(() => {
+    const PageWorker = globalThis.Worker;
+    globalThis.mapReplies = [];
+    globalThis.Worker = class extends PageWorker {
+      constructor(...args) {
+        super(...args);
+        this.addEventListener('message', ({ data }) => {
+          if (data?.type === 'mapResult') mapReplies.push({ type: data.type, kind: data.tag.kind, keys: Object.keys(data.map).filter((k) => data.map[k] !== undefined) });
+          if (data?.type === 'mapFile') mapReplies.push({ type: data.type, kind: data.kind });
+        });
+      }
+    };
+  });
   await page.goto(`${origin}/`);
   await waitForStatus(/^Ready/);
 });
@@ -107,6 +121,11 @@ async function downloadMap(name) {
   return readFileSync(file, 'utf8');
 }
 
+/** The worker's map replies since the last call. */
+async function mapReplies() {
+  return page.evaluate(() => globalThis.mapReplies.splice(0));
+}
+
 async function setSlider(day, hour) {
   await page.evaluate(([d, h]) => {
     for (const [id, v] of [['mapday', d], ['maptime', h]]) {
@@ -149,6 +168,7 @@ test('the Map mode: a day of sun hours on a 1 m grid is drawn, and its points CS
 
 test('the Map mode\'s day/time slider maps each instant: lit points equal `sunlit map --at`, and the shadow moves', { timeout: 300_000 }, async () => {
   await page.selectOption('#mapperiod', 'instant');
+  await mapReplies();
   await setSlider(80, 9.5);
   const done = await statusAfter(() => page.click('#compute'), /^Map in|^Could not/, 120_000);
   assert.match(done, /^Map in [\d.]+ s \(instant\): [\d,]+ points on \d+ receivers; [\d,]+ in the sun/);
@@ -172,6 +192,19 @@ test('the Map mode\'s day/time slider maps each instant: lit points equal `sunli
   await setSlider(80, 2);
   await page.waitForFunction(() => document.getElementById('view').dataset.at === '80,2', null, { timeout: 60_000 });
   assert.equal(await page.getAttribute('#view', 'data-lit'), '0', 'at night nothing is lit');
+  // The slider's moves ask only for what the view draws: no map answer carries the points CSV or
+  // the map glb; the worker writes a file only when a download asks (one CSV per download above).
+  const replies = await mapReplies();
+  const maps = replies.filter((r) => r.type === 'mapResult');
+  assert.ok(maps.length >= 3, `the Compute and the slider's moves were mapped (${maps.length})`);
+  for (const r of maps) assert.deepEqual(r.keys.filter((k) => ['csv', 'glb', 'files'].includes(k)), [], `a ${r.kind} map's answer carries no files`);
+  assert.deepEqual(replies.filter((r) => r.type === 'mapFile').map((r) => r.kind), ['csv', 'csv'], 'a file only for each download');
+  // The glb, on demand: the map shown's, with the glb magic.
+  const download = page.waitForEvent('download');
+  await page.click('#downloadglb');
+  const glb = join(WORK, 'night.glb');
+  await (await download).saveAs(glb);
+  assert.equal(readFileSync(glb).subarray(0, 4).toString('latin1'), 'glTF');
 });
 
 function sydneyEpw() {
@@ -220,6 +253,20 @@ test('engine.map: typed arrays; direct irradiation under an EPW equals `sunlit m
       points: await refused({ ...where, points: [0, 0, 100, 0, 0, 1] }),
       normal: await refused({ ...where, points: [0, 0, 0, 0, 0, 0] }),
     };
+    // The files on demand (files: true) are those asked for up front; freed, they are refused.
+    const kept = await engine.map(model, { epw: text, epwName: 'sydney.epw', grid: Number(grid), period: '12-01..12-07', value: 'direct' }, { files: true });
+    const glbLater = kept.files.glb();
+    const onDemand = {
+      csv: kept.files.csv() === map.csv,
+      glb: glbLater.length === map.glb.length && glbLater.every((b, i) => b === map.glb[i]),
+      upFront: [kept.csv === undefined, kept.glb === undefined],
+    };
+    kept.files.free();
+    try {
+      kept.files.csv();
+    } catch (e) {
+      onDemand.freed = e.code;
+    }
     const same = map.values.every((v, i) => v === map.direct[i]);
     const glb = String.fromCharCode(...map.glb.subarray(0, 4));
     // Total: the values are the total, each the sum of its parts (f32 arrays).
@@ -227,11 +274,12 @@ test('engine.map: typed arrays; direct irradiation under an EPW equals `sunlit m
     const sums = total.values.every((v, i) => v === total.total[i]
       && Math.abs(v - (total.direct[i] + total.skyDiffuse[i] + total.groundReflected[i])) <= 1e-3 * Math.max(1, v));
     const totalOf = { value: total.value, title: total.title, sums, sky: total.skyDiffuse.every((v) => v > 0), views: total.skyViewFactor.every((v) => v > 0 && v <= 1) };
-    return { kinds, csv: map.csv, glb, same, count: map.values.length, max: map.max, value: map.value, unit: map.unit, instants: map.instants, errors, totalOf };
+    return { kinds, csv: map.csv, glb, same, onDemand, count: map.values.length, max: map.max, value: map.value, unit: map.unit, instants: map.instants, errors, totalOf };
   }, { text: epw, grid: GRID });
   assert.deepEqual(api.kinds, ['Float32Array', 'Float32Array', 'Uint32Array', 'Float32Array']);
   assert.deepEqual([api.value, api.unit, api.instants], ['direct', 'kWh/m²', 7 * 24]);
   assert.equal(api.glb, 'glTF', 'the map glb has the glb magic');
+  assert.deepEqual(api.onDemand, { csv: true, glb: true, upFront: [true, true], freed: 'freed' }, 'files on demand are the files asked for up front');
   assert.ok(api.same, 'values are the direct irradiation asked for');
   assert.deepEqual(api.totalOf, { value: 'total', title: 'Total irradiation', sums: true, sky: true, views: true }, 'value total: the sum of its parts');
   const native = nativeMap('direct', ['--epw', epwPath, '--period', '12-01..12-07']);
