@@ -11,7 +11,7 @@
 //!   horizon-band visibility (the weight-averaged visibility of the band nearest the horizon,
 //!   1 where the receiver sees none of that band), the three things the Perez sky needs.
 
-use crate::count::{Engine, ViewRequest};
+use crate::count::{Engine, ViewKind, ViewRequest};
 use crate::error::Result;
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
@@ -121,12 +121,20 @@ fn band_visibility(band: &[usize], weights: &[crate::sky::patches::PatchWeight],
     band.iter().map(|&p| weights[p].weight * visible[p]).sum::<f64>() / total
 }
 
-/// The engine's fractions for `requests`, reporting progress between chunks.
+/// The engine's fractions for `requests` (sky directions: the engine is told so, and told sun
+/// views follow again afterwards), reporting progress between chunks.
 pub(crate) async fn count(
     engine: &impl Engine,
     requests: &[ViewRequest],
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
+    engine.views_of(ViewKind::Sky);
+    let counted = count_sky(engine, requests, progress).await;
+    engine.views_of(ViewKind::Sun);
+    counted
+}
+
+async fn count_sky(engine: &impl Engine, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
     let mut out = Vec::with_capacity(requests.len());
     progress(Progress { done: 0, total: requests.len() })?;
     engine.expect(requests.len());
