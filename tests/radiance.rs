@@ -270,9 +270,13 @@ fn blaas_louvres_irradiance_matches_radiance() {
     check_model("blaas-louvres", &model, 512);
 }
 
-/// Radiance's `gendaymtx -d` on crafted weather (tests/radiance/patch_order.py): per sun that is
-/// up, Radiance's own direction for it and the matrix rows it put the sun in, with their radiance.
-fn gendaymtx_suns(subdivision: usize) -> (usize, Vec<(glam::DVec3, Vec<(usize, f64)>)>) {
+/// One sun of a `gendaymtx -d` matrix: Radiance's direction for it and the rows it was put in,
+/// with their radiance.
+type MatrixSun = (glam::DVec3, Vec<(usize, f64)>);
+
+/// Radiance's `gendaymtx -d` on crafted weather (tests/radiance/patch_order.py): the matrix's rows
+/// and each sun that is up.
+fn gendaymtx_suns(subdivision: usize) -> (usize, Vec<MatrixSun>) {
     let dir = scratch(&format!("patch-order-{subdivision}"));
     let out = dir.join("suns.json");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/radiance/patch_order.py");

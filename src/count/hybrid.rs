@@ -574,10 +574,14 @@ impl<'a> HybridEngine<'a> {
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe, cpu_threads());
         let mut profile = Profile { device: String::new(), exact: exact_cost, gpu: None, gpu_startup_seconds: None };
+        let mut made_now = 0.0;
         if gpu_worth_probing(mean_us, loads) {
             let before = self.stats().gpu_startup_seconds;
             let lanes: Vec<Lane<'_>> = self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
-            profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
+            made_now = self.stats().gpu_startup_seconds - before;
+            // Lanes this run made earlier (for the other kind of views) cost their start-up all
+            // the same to a later run that finds this profile: it is the run's, not 0.
+            profile.gpu_startup_seconds = Some(if made_now > 0.0 { made_now } else { before });
             profile.gpu = Some(probe_gpu(&lanes, requests, loads).await?);
         }
         let device = match (&profile.gpu, cpu_key(&self.options, cpu_threads())) {
@@ -586,7 +590,7 @@ impl<'a> HybridEngine<'a> {
         };
         profile.device = format!("{device}; {scene}");
         // The GPU's start-up is reported on its own (`gpu_startup_seconds`), not twice.
-        let seconds = now() - start - profile.gpu_startup_seconds.unwrap_or(0.0);
+        let seconds = now() - start - made_now;
         self.add_stats(|s| s.calibration_seconds += seconds);
         Ok(profile)
     }
