@@ -263,7 +263,8 @@ struct EngineArgs {
     #[arg(long, value_name = "auto|gpu|exact", default_value = "auto")]
     engine: String,
     /// The cost model `auto` routes by: read from FILE when it exists, else measured and written
-    /// there (pins the routing); default: a per-device cache.
+    /// there (pins the routing); sky views have their own beside it (FILE with `.sky` before its
+    /// extension); default: a per-device cache.
     #[arg(long, value_name = "FILE")]
     engine_profile: Option<PathBuf>,
 }

@@ -111,6 +111,32 @@ fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
     assert!(partly >= 10, "only {partly} views partly shaded");
 }
 
+/// Sky views are priced on views of their own kind: a pinned profile that sends every loaded sun
+/// view to the GPU does not route the sky pass, which measures its own profile (on this small
+/// scene the exact engine alone, no GPU worth its start-up) and pins it beside the sun's; the sun
+/// views after it are routed by the sun's profile again.
+#[test]
+fn sky_views_are_routed_by_a_profile_of_their_own() {
+    let scene = louvred_walls();
+    let ProfileSource::File(sun_file) = pinned(true) else { unreachable!() };
+    let sky_file = sunlit::count::hybrid::profile_file(&sun_file, sunlit::count::ViewKind::Sky);
+    assert_eq!(sky_file, sun_file.with_file_name("gpu.sky.json"));
+    let _ = std::fs::remove_file(&sky_file);
+    let sun_before = std::fs::read(&sun_file).unwrap();
+    let engine = HybridEngine::new(&scene, EngineKind::Auto, options(), Some(1), ProfileSource::File(sun_file.clone())).unwrap();
+    let patches = sunlit::sky::patches::SkyPatches::tregenza();
+    let sky = pollster::block_on(sunlit::sky::views::sky_views(&engine, &scene, &patches, &mut |_| Ok(()))).unwrap();
+    assert_eq!(engine.stats().gpu_views, 0, "the sky pass followed the sun's GPU-favouring profile");
+    let exact_engine = HybridEngine::new(&scene, EngineKind::Exact, options(), Some(1), ProfileSource::Probe).unwrap();
+    let exact_sky = pollster::block_on(sunlit::sky::views::sky_views(&exact_engine, &scene, &patches, &mut |_| Ok(()))).unwrap();
+    assert_eq!(sky, exact_sky, "routed to the exact engine, the sky views are the exact engine's");
+    let pinned_sky: Profile = serde_json::from_str(&std::fs::read_to_string(&sky_file).expect("the sky profile is pinned")).unwrap();
+    assert!(pinned_sky.device.ends_with("; sky views") && pinned_sky.gpu.is_none(), "{pinned_sky:?}");
+    assert_eq!(std::fs::read(&sun_file).unwrap(), sun_before, "the sun's pinned profile is left as it was");
+    pollster::block_on(engine.count(&requests(&scene))).unwrap();
+    assert!(engine.stats().gpu_views > 0, "sun views after the sky pass are routed by the sun's profile");
+}
+
 fn sunlit(args: &[&str], cache: &std::path::Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_CACHE_HOME", cache).output().expect("run sunlit")
 }

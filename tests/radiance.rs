@@ -389,4 +389,86 @@ fn blaas_louvres_point_irradiance_matches_radiance() {
     let ours = sunlit_points(&model, &epw, &points, &dir);
     let failures = compare_parts("blaas-louvres points", &ours, &truth, false);
     assert!(failures.is_empty(), "{} of {count} points miss:\n{}", failures.len(), failures.join("\n"));
+
+/// One sun of a `gendaymtx -d` matrix: Radiance's direction for it and the rows it was put in,
+/// with their radiance.
+type MatrixSun = (glam::DVec3, Vec<(usize, f64)>);
+
+/// Radiance's `gendaymtx -d` on crafted weather (tests/radiance/patch_order.py): the matrix's rows
+/// and each sun that is up.
+fn gendaymtx_suns(subdivision: usize) -> (usize, Vec<MatrixSun>) {
+    let dir = scratch(&format!("patch-order-{subdivision}"));
+    let out = dir.join("suns.json");
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/radiance/patch_order.py");
+    let run = Command::new(radiance_python())
+        .arg(&script)
+        .args(["--mf", &subdivision.to_string(), "-o", out.to_str().unwrap()])
+        .output()
+        .expect("run the patch order harness");
+    assert!(run.status.success(), "patch order harness: {}", String::from_utf8_lossy(&run.stderr));
+    let report: Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let suns = report["suns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            let v: Vec<f64> = s["sun"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            let rows = s["rows"].as_array().unwrap().iter().map(|r| (r[0].as_u64().unwrap() as usize, r[1].as_f64().unwrap())).collect();
+            (glam::DVec3::new(v[0], v[1], v[2]).normalize(), rows)
+        })
+        .collect();
+    (report["rows"].as_u64().unwrap() as usize, suns)
+}
+
+/// sunlit's patch numbering is Radiance's, patch by patch, for Tregenza's sky and Reinhart's MF:2.
+///
+/// gendaymtx gives each sun's energy to the few patches whose centres lie nearest it, the nearest
+/// the largest share, and writes radiance: share over the patch's solid angle. So for every sun
+/// (Radiance's own direction), the matrix row with the largest radiance × solid angle (sunlit's
+/// solid angle of the patch that row would be) must be row 1 + the sunlit patch whose centre is
+/// nearest that sun (row 0 is the ground). Suns about equally near two centres are left out. The
+/// suns of 14 sites from pole to pole put the largest share into every patch at least once, so
+/// a patch out of place anywhere fails; the solid angles enter only to rank a sun's few rows.
+#[test]
+fn sky_patches_are_numbered_as_gendaymtx_numbers_them() {
+    for subdivision in [1, 2] {
+        let sky = sunlit::sky::patches::SkyPatches::reinhart(subdivision);
+        let (rows, suns) = gendaymtx_suns(subdivision);
+        assert_eq!(rows, sky.len() + 1, "MF:{subdivision}: gendaymtx's rows are the ground and sunlit's {} patches", sky.len());
+        let mut largest_share = vec![0usize; sky.len()];
+        let mut misplaced = Vec::new();
+        let mut ties = 0;
+        for (sun, lit) in &suns {
+            let mut nearest: Vec<(f64, usize)> = sky.patches.iter().enumerate().map(|(i, p)| (p.direction.dot(*sun), i)).collect();
+            nearest.sort_by(|a, b| b.0.total_cmp(&a.0));
+            if nearest[0].0 - nearest[1].0 < 1e-5 {
+                ties += 1;
+                continue;
+            }
+            let share = |&(row, radiance): &(usize, f64)| if row == 0 { 0.0 } else { radiance * sky.patches[row - 1].solid_angle };
+            let Some(&(row, _)) = lit.iter().max_by(|a, b| share(a).total_cmp(&share(b))) else {
+                misplaced.push(format!("sun {sun:?}: in no row"));
+                continue;
+            };
+            if row != nearest[0].1 + 1 {
+                misplaced.push(format!(
+                    "sun {sun:?}: gendaymtx row {row}, sunlit's nearest patch {} (row {})",
+                    nearest[0].1,
+                    nearest[0].1 + 1
+                ));
+            } else {
+                largest_share[nearest[0].1] += 1;
+            }
+        }
+        eprintln!("MF:{subdivision}: {} suns, {ties} about equally near two patch centres", suns.len());
+        assert!(
+            misplaced.is_empty(),
+            "MF:{subdivision}: {} of {} suns misplaced, e.g.\n{}",
+            misplaced.len(),
+            suns.len(),
+            misplaced[..misplaced.len().min(10)].join("\n")
+        );
+        let never: Vec<usize> = (0..sky.len()).filter(|&p| largest_share[p] == 0).collect();
+        assert!(never.is_empty(), "MF:{subdivision}: patches no sun checked: {never:?}");
+    }
 }

@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 use super::exact::engine::{ExactEngine, ViewLoad};
 use super::gpu::{Counter, CounterOptions, GpuScene};
 use super::lanes::{Lane, Lanes, default_lanes};
-use super::{Engine, ViewAnswer, ViewRequest, check_receivers, cos_incidence};
+use super::{Engine, ViewAnswer, ViewKind, ViewRequest, check_receivers, cos_incidence};
 use crate::error::{Error, GpuError, Result};
 use crate::platform;
 use crate::scene::Scene;
@@ -265,7 +265,10 @@ pub struct HybridEngine<'a> {
     source: ProfileSource,
     exact: Option<ExactEngine>,
     gpu: OnceCell<Vec<(Counter, GpuScene)>>,
-    profile: OnceCell<(Profile, &'static str)>,
+    /// Per kind of views ([`ViewKind`], sun first), the profile `auto` routes them by.
+    profiles: [OnceCell<(Profile, &'static str)>; 2],
+    /// The kind of views being asked for now.
+    views: std::cell::Cell<ViewKind>,
     stats: std::cell::Cell<EngineStats>,
     /// Views the caller expects to ask for in all ([`Engine::expect`]; 0: each batch alone).
     run_views: std::cell::Cell<usize>,
@@ -292,7 +295,8 @@ impl<'a> HybridEngine<'a> {
             source,
             exact,
             gpu: OnceCell::new(),
-            profile: OnceCell::new(),
+            profiles: [OnceCell::new(), OnceCell::new()],
+            views: Default::default(),
             stats: Default::default(),
             run_views: Default::default(),
         })
@@ -309,9 +313,18 @@ impl<'a> HybridEngine<'a> {
         self.kind
     }
 
-    /// The profile `auto` routes by and where it came from (`cache`, `file`, `probe`), once known.
+    /// The profile `auto` routes the current kind of views by and where it came from (`cache`,
+    /// `file`, `probe`), once known.
     pub fn profile(&self) -> Option<(&Profile, &'static str)> {
-        self.profile.get().map(|(p, s)| (p, *s))
+        self.profile_slot().get().map(|(p, s)| (p, *s))
+    }
+
+    /// The profile of the kind of views being asked for now.
+    fn profile_slot(&self) -> &OnceCell<(Profile, &'static str)> {
+        &self.profiles[match self.views.get() {
+            ViewKind::Sun => 0,
+            ViewKind::Sky => 1,
+        }]
     }
 
     /// Views and seconds per engine so far.
@@ -494,20 +507,29 @@ impl<'a> HybridEngine<'a> {
         Ok(split.merge(self.scene, requests, exact_fractions, gpu_answers))
     }
 
-    /// The scene's size, as the profile's key names it: a profile is measured on the model's own
-    /// views, and its loads cost differently per model (leaves overlap far more than slats).
+    /// The scene's size and the kind of views, as the profile's key names them: a profile is
+    /// measured on the model's own views of that kind, and their loads cost differently per model
+    /// (leaves overlap far more than slats) and per kind (see [`ViewKind`]).
     fn scene_key(&self) -> String {
-        scene_key(self.scene)
+        views_key(self.scene, self.views.get())
+    }
+
+    /// Where the current kind of views' profile is kept and how (see [`profile_file`]).
+    fn source(&self) -> ProfileSource {
+        match &self.source {
+            ProfileSource::File(path) => ProfileSource::File(profile_file(path, self.views.get())),
+            other => other.clone(),
+        }
     }
 
     /// The profile to route by when one is known without measuring: already in use, pinned in a
     /// file that exists, or cached for this device (see [`ProfileSource`]).
     async fn stored_profile(&self) -> Result<Option<&Profile>> {
-        if let Some((p, _)) = self.profile.get() {
+        if let Some((p, _)) = self.profile_slot().get() {
             return Ok(Some(p));
         }
         let scene = self.scene_key();
-        let found = match &self.source {
+        let found = match &self.source() {
             ProfileSource::File(path) if path.exists() => Some((read_profile(path)?, "file")),
             ProfileSource::Cache => {
                 // An exact-only profile is kept under the CPU's key: finding it asks no adapter.
@@ -526,8 +548,8 @@ impl<'a> HybridEngine<'a> {
             _ => None,
         };
         Ok(found.and_then(|found| {
-            let _ = self.profile.set(found);
-            self.profile.get().map(|(p, _)| p)
+            let _ = self.profile_slot().set(found);
+            self.profile_slot().get().map(|(p, _)| p)
         }))
     }
 
@@ -535,13 +557,13 @@ impl<'a> HybridEngine<'a> {
     /// written where the source keeps it.
     async fn measure_profile(&self, exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
         let profile = self.calibrate(exact, requests, loads, &self.scene_key()).await?;
-        match &self.source {
+        match &self.source() {
             ProfileSource::File(path) => write_profile(path, &profile)?,
             ProfileSource::Cache => store_cached(&profile.device, &profile),
             ProfileSource::Probe => {}
         }
-        let _ = self.profile.set((profile, "probe"));
-        self.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
+        let _ = self.profile_slot().set((profile, "probe"));
+        self.profile_slot().get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
     }
 
     /// Measures both engines on a spread of these views (the GPU only if the exact engine alone
@@ -552,10 +574,14 @@ impl<'a> HybridEngine<'a> {
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe, cpu_threads());
         let mut profile = Profile { device: String::new(), exact: exact_cost, gpu: None, gpu_startup_seconds: None };
+        let mut made_now = 0.0;
         if gpu_worth_probing(mean_us, loads) {
             let before = self.stats().gpu_startup_seconds;
             let lanes: Vec<Lane<'_>> = self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
-            profile.gpu_startup_seconds = Some(self.stats().gpu_startup_seconds - before);
+            made_now = self.stats().gpu_startup_seconds - before;
+            // Lanes this run made earlier (for the other kind of views) cost their start-up all
+            // the same to a later run that finds this profile: it is the run's, not 0.
+            profile.gpu_startup_seconds = Some(if made_now > 0.0 { made_now } else { before });
             profile.gpu = Some(probe_gpu(&lanes, requests, loads).await?);
         }
         let device = match (&profile.gpu, cpu_key(&self.options, cpu_threads())) {
@@ -564,7 +590,7 @@ impl<'a> HybridEngine<'a> {
         };
         profile.device = format!("{device}; {scene}");
         // The GPU's start-up is reported on its own (`gpu_startup_seconds`), not twice.
-        let seconds = now() - start - profile.gpu_startup_seconds.unwrap_or(0.0);
+        let seconds = now() - start - made_now;
         self.add_stats(|s| s.calibration_seconds += seconds);
         Ok(profile)
     }
@@ -582,6 +608,10 @@ impl Engine for HybridEngine<'_> {
 
     fn expect(&self, views: usize) {
         self.run_views.set(views);
+    }
+
+    fn views_of(&self, kind: ViewKind) {
+        self.views.set(kind);
     }
 }
 
@@ -723,6 +753,32 @@ fn cpu_threads() -> usize {
 /// views, and its loads cost differently per model (leaves overlap far more than slats).
 pub fn scene_key(scene: &Scene) -> String {
     format!("scene {} triangles, {} receivers", scene.triangle_count(), scene.receivers.len())
+}
+
+/// The scene's key ([`scene_key`]) for a kind of views: sun views' is the scene's alone (as
+/// profiles kept before sky views were priced apart), sky views' says so.
+pub fn views_key(scene: &Scene, views: ViewKind) -> String {
+    match views {
+        ViewKind::Sun => scene_key(scene),
+        ViewKind::Sky => format!("{}; sky views", scene_key(scene)),
+    }
+}
+
+/// The file that pins a kind of views' profile, given the file named for the run: that file for
+/// sun views, for sky views the same name with `.sky` before its extension (`p.json` →
+/// `p.sky.json`), so a pinned run pins both kinds and neither is routed by the other's prices.
+pub fn profile_file(path: &Path, views: ViewKind) -> PathBuf {
+    match views {
+        ViewKind::Sun => path.to_path_buf(),
+        ViewKind::Sky => {
+            let stem = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+            let name = match path.extension() {
+                Some(ext) => format!("{stem}.sky.{}", ext.to_string_lossy()),
+                None => format!("{stem}.sky"),
+            };
+            path.with_file_name(name)
+        }
+    }
 }
 
 /// The clipping threads and tile side (with the accuracy, if any) of a profile's key.

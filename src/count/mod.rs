@@ -68,6 +68,18 @@ pub struct ViewAnswer {
     pub error_estimate: Option<f64>,
 }
 
+/// What kind of views a caller asks for next. Their loads cost the engines differently (a sun
+/// view's prism is short and steep; a low sky patch's runs through the whole scene, past many
+/// triangles that cost the exact engine little), so `auto` prices each kind on views of its own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ViewKind {
+    /// Sun positions: the year's views.
+    #[default]
+    Sun,
+    /// Sky directions: sky patches and EnergyPlus's 144 diffuse directions.
+    Sky,
+}
+
 /// Something that answers views: the GPU counter, the exact reference, or a mix of them.
 ///
 /// Asynchronous because the GPU's read-back is awaited (the web cannot block); the exact
@@ -83,6 +95,10 @@ pub trait Engine {
     /// Told that about `views` views will be asked for in all, batch by batch: an engine with a
     /// once-a-run cost (a GPU's start-up) weighs it against the run, not one batch.
     fn expect(&self, _views: usize) {}
+
+    /// Told which kind of views follow, until told otherwise ([`ViewKind::Sun`] at first): an
+    /// engine that prices views by a measured profile keeps one per kind.
+    fn views_of(&self, _kind: ViewKind) {}
 }
 
 /// A leaf fraction as a [`ViewRequest`] takes it, refused outside 0 (bare) ..= 1 (full leaf).

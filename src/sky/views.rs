@@ -15,7 +15,7 @@
 //! of items: the receivers here, a map's points in [`crate::map::sky`] (each point's own patch
 //! visibility, from shadow rays instead of fractions).
 
-use crate::count::{Engine, ViewRequest};
+use crate::count::{Engine, ViewKind, ViewRequest};
 use crate::error::Result;
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
@@ -155,12 +155,20 @@ impl Seen {
     }
 }
 
-/// The engine's fractions for `requests`, reporting progress between chunks.
+/// The engine's fractions for `requests` (sky directions: the engine is told so, and told sun
+/// views follow again afterwards), reporting progress between chunks.
 pub(crate) async fn count(
     engine: &impl Engine,
     requests: &[ViewRequest],
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
+    engine.views_of(ViewKind::Sky);
+    let counted = count_sky(engine, requests, progress).await;
+    engine.views_of(ViewKind::Sun);
+    counted
+}
+
+async fn count_sky(engine: &impl Engine, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
     let mut out = Vec::with_capacity(requests.len());
     progress(Progress { done: 0, total: requests.len() })?;
     engine.expect(requests.len());

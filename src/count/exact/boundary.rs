@@ -85,6 +85,14 @@ struct Poly {
     receiver: bool,
 }
 
+/// A candidate polygon for the current polygon's edges: its box and its index.
+#[derive(Debug, Clone, Copy)]
+struct Near {
+    lo: Point,
+    hi: Point,
+    poly: u32,
+}
+
 /// How a convex polygon covers an edge over a parameter interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Side {
@@ -118,8 +126,11 @@ pub(super) struct Boundary {
     /// Per polygon: the edge that last tested it (so a polygon in several cells is tested once).
     stamp: Vec<u32>,
     epoch: u32,
-    /// Candidates of the current edge.
-    candidates: Vec<u32>,
+    /// Candidates of the current polygon (the others whose boxes overlap its box), their boxes
+    /// copied beside their index so each edge's scan reads one contiguous array.
+    candidates: Vec<Near>,
+    /// Scratch for [`Self::build_buckets`]: each cell's next free slot.
+    next_slot: Vec<u32>,
     buckets: Buckets,
     /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
     big: Vec<u32>,
@@ -211,7 +222,7 @@ impl Boundary {
                 continue;
             }
             // The polygons near this one, once for all its edges.
-            self.collect_candidates(poly.lo, poly.hi);
+            self.collect_candidates(p, poly.lo, poly.hi);
             for k in poly.start..poly.end {
                 let a = self.points[k as usize];
                 let b = self.points[if k + 1 == poly.end { poly.start } else { k + 1 } as usize];
@@ -229,11 +240,12 @@ impl Boundary {
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         self.events.clear();
         for c in 0..self.candidates.len() {
-            let q = self.candidates[c] as usize;
-            let other = self.polys[q];
-            if q == p || !boxes_overlap(lo, hi, other.lo, other.hi) {
+            let near = self.candidates[c];
+            if !boxes_overlap(lo, hi, near.lo, near.hi) {
                 continue;
             }
+            let q = near.poly as usize;
+            let other = self.polys[q];
             let Some((t0, t1, side)) = cover(&self.points[other.start as usize..other.end as usize], a, b) else { continue };
             let (left, right) = if other.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
             let mut counters = match side {
@@ -276,10 +288,9 @@ impl Boundary {
         let mut at = 0.0;
         for &(t, counters, step) in &self.events {
             total += piece(&count, at, t);
+            // Without branches: which counters move is unpredictable.
             for (bit, c) in count.iter_mut().enumerate() {
-                if counters & (1 << bit) != 0 {
-                    *c += i32::from(step);
-                }
+                *c += i32::from(step) * i32::from((counters >> bit) & 1);
             }
             at = at.max(t);
         }
@@ -336,16 +347,19 @@ impl Boundary {
         let [cx, cy] = b.cell(self.polys[p].lo);
         let cell = cy * b.n + cx;
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
-        self.big.iter().chain(bucketed).map(|&q| q as usize).find(|&q| self.covers(q, p))
+        // The boxes first, here: most candidates fail them, and that test is cheaper inline.
+        let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
+        let boxed = |q: usize| box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
+        self.big.iter().chain(bucketed).map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p))
     }
 
-    /// Polygons whose boxes overlap `[lo, hi]` into `self.candidates`.
-    fn collect_candidates(&mut self, lo: Point, hi: Point) {
+    /// Polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
+    fn collect_candidates(&mut self, own: usize, lo: Point, hi: Point) {
         self.candidates.clear();
         let b = self.buckets;
         if b.n == 0 {
-            let hits = self.polys.iter().enumerate().filter(|(_, q)| boxes_overlap(lo, hi, q.lo, q.hi));
-            self.candidates.extend(hits.map(|(i, _)| i as u32));
+            let hits = self.polys.iter().enumerate().filter(|&(i, q)| i != own && boxes_overlap(lo, hi, q.lo, q.hi));
+            self.candidates.extend(hits.map(|(i, q)| Near { lo: q.lo, hi: q.hi, poly: i as u32 }));
             return;
         }
         self.epoch = self.epoch.wrapping_add(1);
@@ -356,8 +370,8 @@ impl Boundary {
         for k in 0..self.big.len() {
             let q = self.big[k];
             let poly = &self.polys[q as usize];
-            if boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                self.candidates.push(q);
+            if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
             }
         }
         let (c0, c1) = (b.cell(lo), b.cell(hi));
@@ -369,8 +383,8 @@ impl Boundary {
                     if self.stamp[q as usize] != self.epoch {
                         self.stamp[q as usize] = self.epoch;
                         let poly = &self.polys[q as usize];
-                        if boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                            self.candidates.push(q);
+                        if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                            self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
                         }
                     }
                 }
@@ -413,7 +427,7 @@ impl Boundary {
         self.cell_items.clear();
         self.cell_items.resize(self.cell_start[side * side] as usize, 0);
         // Fill each cell from its start, in push order.
-        let mut next: Vec<u32> = std::mem::take(&mut self.candidates);
+        let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
         next.clear();
         next.extend_from_slice(&self.cell_start[..side * side]);
         for (i, p) in self.polys.iter().enumerate() {
@@ -429,7 +443,7 @@ impl Boundary {
                 }
             }
         }
-        self.candidates = next;
+        self.next_slot = next;
     }
 }
 
@@ -450,7 +464,7 @@ fn box_within(lo: Point, hi: Point, lo2: Point, hi2: Point) -> bool {
 /// `outer` (so the hull of `inner` does); exact.
 fn convex_contains(outer: &[Point], inner: &[Point]) -> bool {
     (0..outer.len()).all(|k| {
-        let (q0, q1) = (outer[k], outer[(k + 1) % outer.len()]);
+        let (q0, q1) = (outer[k], if k + 1 == outer.len() { outer[0] } else { outer[k + 1] });
         inner.iter().all(|&v| orient(q0, q1, v) >= 0)
     })
 }
@@ -470,7 +484,9 @@ fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     let mut side = Side::Both;
     for k in 0..q.len() {
-        let (q0, q1) = (q[k], q[(k + 1) % q.len()]);
+        // The edge from vertex k to the next (the last closes on the first); no `%` in this loop,
+        // the hottest of the engine.
+        let (q0, q1) = (q[k], if k + 1 == q.len() { q[0] } else { q[k + 1] });
         let (oa, ob) = (orient(q0, q1, a), orient(q0, q1, b));
         if oa > 0 && ob > 0 {
             continue;
