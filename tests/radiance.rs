@@ -389,6 +389,7 @@ fn blaas_louvres_point_irradiance_matches_radiance() {
     let ours = sunlit_points(&model, &epw, &points, &dir);
     let failures = compare_parts("blaas-louvres points", &ours, &truth, false);
     assert!(failures.is_empty(), "{} of {count} points miss:\n{}", failures.len(), failures.join("\n"));
+}
 
 /// One sun of a `gendaymtx -d` matrix: Radiance's direction for it and the rows it was put in,
 /// with their radiance.
