@@ -35,8 +35,16 @@ for part in $PARTS; do
       [ -x "$VENV/bin/python" ] || { python3 -m venv "$VENV" && "$VENV/bin/pip" install -q ladybug-radiance==0.2.12 pyradiance==1.3.1; }
       [ -f "$OUT/blaas-louvres.glb" ] || $bin bench blaas-louvres --write "$OUT/blaas-louvres.glb"
       $bin map "$OUT/blaas-louvres.glb" --grid 0.5 --location "$GOLDEN" -o "$OUT/blaas-0.5.csv" --json | tee "$OUT/blaas-0.5.json"
-      farm-bench -n "$RUNS" --timeout 300 -- $bin map "$OUT/blaas-louvres.glb" --grid 0.5 --location "$GOLDEN" -o "$OUT/blaas-0.5.csv"
-      "$VENV/bin/python" scripts/bench_maps_ladybug.py "$OUT/blaas-louvres.glb" "$OUT/blaas-0.5.csv" 39.74 -105.18 -7 | tee "$OUT/ladybug-0.5.json"
+      # Paired: Ladybug then sunlit, RUNS times, so both see the same load; the median of the
+      # per-pair wall-time ratios is the speed-up (sunlit writes its points to another file so
+      # Ladybug always reads the first run's).
+      for run in $(seq "$RUNS"); do
+        /usr/bin/time -f "ladybug $run %e s wall %U+%S s cpu" "$VENV/bin/python" scripts/bench_maps_ladybug.py \
+          "$OUT/blaas-louvres.glb" "$OUT/blaas-0.5.csv" 39.74 -105.18 -7 2>>"$OUT/pairs.txt" | tee "$OUT/ladybug-0.5-$run.json"
+        /usr/bin/time -f "sunlit $run %e s wall %U+%S s cpu" $bin map "$OUT/blaas-louvres.glb" --grid 0.5 \
+          --location "$GOLDEN" -o "$OUT/blaas-0.5-again.csv" 2>>"$OUT/pairs.txt"
+      done
+      grep -E '^(ladybug|sunlit) ' "$OUT/pairs.txt" | tail -n $((2 * RUNS))
       ;;
   esac
 done
