@@ -288,11 +288,20 @@ impl ExactEngine {
         if defer(load) {
             return (load, None);
         }
-        (load, Some(self.clip_reached(outline, &frame.towards(sun), leaves, scratch)))
+        (load, Some(self.clip_reached(outline, &frame.towards(sun), leaves, scratch, |_| false)))
     }
 
-    /// The sunlit fraction of `outline` under the shadows of the triangles in `s.reached`.
-    fn clip_reached(&self, outline: &Outline, frame: &PlaneFrame, leaves: f32, scratch: &mut Scratch) -> f64 {
+    /// The sunlit fraction of `outline` under the shadows of the triangles in `s.reached`. When
+    /// shadows are kept, `enough` sees the scratch after each caster that added some and may stop
+    /// the walk over the rest (the fraction is then meaningless; point queries never read it).
+    fn clip_reached(
+        &self,
+        outline: &Outline,
+        frame: &PlaneFrame,
+        leaves: f32,
+        scratch: &mut Scratch,
+        mut enough: impl FnMut(&Scratch) -> bool,
+    ) -> f64 {
         scratch.epoch = scratch.epoch.wrapping_add(1);
         if scratch.epoch == 0 {
             scratch.stamp.fill(0);
@@ -312,6 +321,7 @@ impl ExactEngine {
                 continue;
             }
             scratch.casting = self.veils[p].transmittance;
+            let kept = scratch.kept.len();
             match self.objects.of(p) {
                 None => self.triangle_shadow(frame, outline, p, scratch),
                 Some(o) => {
@@ -320,6 +330,9 @@ impl ExactEngine {
                         self.object_shadow(frame, outline, o, scratch);
                     }
                 }
+            }
+            if scratch.kept.len() > kept && enough(scratch) {
+                break;
             }
         }
         scratch.reached = reached;
@@ -332,8 +345,9 @@ impl ExactEngine {
     /// Keeps one view's shadows on its receiver's plane as convex polygons in the receiver's
     /// frame (`s.kept`, `s.kept_points`), cast exactly as [`Self::fraction`] casts them, for point
     /// queries; `false` (nothing kept) when the view is dark: the sun is down or behind the
-    /// receiver, or the receiver is unknown.
-    pub(super) fn keep_shadows(&self, request: ViewRequest, s: &mut Scratch) -> bool {
+    /// receiver, or the receiver is unknown. `enough` sees the shadows kept so far each time some
+    /// are added and returns `true` to stop casting the rest (every point already dark).
+    pub(super) fn keep_shadows(&self, request: ViewRequest, s: &mut Scratch, enough: impl FnMut(&Scratch) -> bool) -> bool {
         let sun = request.sun;
         let (Some(Some(outline)), Some(Some(frame))) =
             (self.outlines.get(request.receiver as usize), self.frames.get(request.receiver as usize))
@@ -348,7 +362,7 @@ impl ExactEngine {
         s.reached.clear();
         self.walk(outline, sun, |r| s.reached.push(r));
         s.keep = true;
-        self.clip_reached(outline, &frame.towards(sun), request.leaves, s);
+        self.clip_reached(outline, &frame.towards(sun), request.leaves, s, enough);
         s.keep = false;
         true
     }

@@ -139,40 +139,63 @@ impl ExactEngine {
     /// casters only. `sun` is a unit vector towards the sun, `leaves` the leaf fraction.
     pub fn visibility(&self, points: &PlanePoints, sun: DVec3, leaves: f32, scratch: &mut PointScratch, out: &mut [f32]) {
         let request = ViewRequest::new(points.receiver, sun).with_leaves(leaves);
-        if !self.keep_shadows(request, &mut scratch.view) {
-            out.fill(0.0);
-            return;
-        }
         out.fill(1.0);
         let PointScratch { view, edges, turned } = scratch;
-        for (range, transmittance) in &view.kept {
-            turned.clear();
-            turned.extend(view.kept_points[range.clone()].iter().map(|&q| turn(points.axis, q)));
-            let polygon = &turned[..];
-            if !inward_edges(polygon, edges) {
+        // Each shadow is applied as soon as it is cast; once every point is dark (0 times any
+        // transmittance stays 0) the remaining casters cannot change an answer and are skipped.
+        let mut applied = 0;
+        let mut lit = out.len();
+        let seen = self.keep_shadows(request, view, |view| {
+            for (range, transmittance) in &view.kept[applied..] {
+                lit -= apply_shadow(points, &view.kept_points[range.clone()], *transmittance, edges, turned, out);
+            }
+            applied = view.kept.len();
+            lit == 0
+        });
+        if !seen {
+            out.fill(0.0);
+        }
+    }
+}
+
+/// Multiplies the visibility of the points inside one kept shadow (`shadow`, in the receiver's
+/// frame) by its `transmittance`; returns how many points it turned dark.
+fn apply_shadow(
+    points: &PlanePoints,
+    shadow: &[DVec2],
+    transmittance: f32,
+    edges: &mut Vec<(DVec2, f64)>,
+    turned: &mut Vec<DVec2>,
+    out: &mut [f32],
+) -> usize {
+    turned.clear();
+    turned.extend(shadow.iter().map(|&q| turn(points.axis, q)));
+    let polygon = &turned[..];
+    if !inward_edges(polygon, edges) {
+        return 0;
+    }
+    let (lo, hi) = polygon.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let Some(((c0, r0), (c1, r1))) = points.bins_over(lo, hi) else { return 0 };
+    let mut darkened = 0;
+    for row in r0..=r1 {
+        for column in c0..=c1 {
+            let b = row * points.columns + column;
+            let members = &points.order[points.start[b] as usize..points.start[b + 1] as usize];
+            if members.is_empty() {
                 continue;
             }
-            let (lo, hi) = polygon.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-            let Some(((c0, r0), (c1, r1))) = points.bins_over(lo, hi) else { continue };
-            for row in r0..=r1 {
-                for column in c0..=c1 {
-                    let b = row * points.columns + column;
-                    let members = &points.order[points.start[b] as usize..points.start[b + 1] as usize];
-                    if members.is_empty() {
-                        continue;
-                    }
-                    let corner = points.lo + points.cell * DVec2::new(column as f64, row as f64);
-                    let whole = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y].iter().all(|k| inside(edges, corner + points.cell * *k));
-                    for &i in members {
-                        let i = i as usize;
-                        if out[i] > 0.0 && (whole || inside(edges, points.flat[i])) {
-                            out[i] *= transmittance;
-                        }
-                    }
+            let corner = points.lo + points.cell * DVec2::new(column as f64, row as f64);
+            let whole = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y].iter().all(|k| inside(edges, corner + points.cell * *k));
+            for &i in members {
+                let i = i as usize;
+                if out[i] > 0.0 && (whole || inside(edges, points.flat[i])) {
+                    out[i] *= transmittance;
+                    darkened += usize::from(out[i] == 0.0);
                 }
             }
         }
     }
+    darkened
 }
 
 /// `q` in axes turned so that `axis` is the first.
