@@ -28,6 +28,7 @@ use common::energyplus::{columns, energyplus};
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
 const FIVE_ZONE: &str = "5ZoneAirCooled.idf";
+const MEDIUM_OFFICE: &str = "RefBldgMediumOfficeNew2004_Chicago.idf";
 
 /// The weather the test files are written for (their Site:Location is Chicago O'Hare).
 fn weather() -> PathBuf {
@@ -632,6 +633,44 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
         }
     }
     println!("largest per-surface mean |Δ| against EnergyPlus's clipping: {worst:.4}");
+}
+
+/// RefBldgMediumOfficeNew2004_Chicago in the layout [`annual`] takes: its SimulationControl (design
+/// days only, its last field the weather-file flag) written as the other files', and its own
+/// ShadowCalculation (Periodic, every 7 days) removed, as scripts/bench-eplus-large.sh does.
+fn medium_office() -> String {
+    let text = testfile(MEDIUM_OFFICE);
+    let design_days = "    YES,                     !- Run Simulation for Sizing Periods\n    NO;                      !- Run Simulation for Weather File Run Periods";
+    assert!(text.contains(design_days), "{MEDIUM_OFFICE}: SimulationControl in another layout");
+    let text = text.replacen(
+        design_days,
+        "    No,                      !- Run Simulation for Sizing Periods\n    Yes,                     !- Run Simulation for Weather File Run Periods\n    No;                      !- Do HVAC Sizing Simulation for Sizing Periods",
+        1,
+    );
+    let start = text.find("\n  ShadowCalculation,").expect("its own ShadowCalculation");
+    let end = start + text[start..].find(';').expect("ShadowCalculation ends") + 1;
+    format!("{}{}", &text[..start], &text[end..])
+}
+
+/// The large committed file, RefBldgMediumOfficeNew2004_Chicago (Timestep 6, 37 exterior
+/// surfaces and windows, one of them NoSun and so not hooked), as the four cases above: sunlit at
+/// its defaults against EnergyPlus's reported fractions, in its own Timestep clipping and in the
+/// hooked run. Its own test, so that it runs beside the four cases (its two EnergyPlus runs take
+/// about 2 min each on 2 cores).
+#[test]
+fn medium_office_sun_and_dark_steps_match_energyplus_reported_fractions() {
+    let case = SunCase { label: "mediumoffice-ts6", text: medium_office(), weather: weather(), n: 6, first_day: 1 };
+    let stats = sun_case(&case);
+    assert!(stats.len() >= 30, "{}: {} surfaces", case.label, stats.len());
+    let worst = stats.iter().map(|s| s.3).fold(0.0f64, f64::max);
+    for (name, clip, hook, mean) in &stats {
+        println!("{} {name}: dark/lit disagreements {clip} (clipping), {hook} (hooked); mean |Δ| {mean:.4}", case.label);
+    }
+    for (name, clip, hook, mean) in &stats {
+        assert_eq!((*clip, *hook), (0, 0), "{} {name}: steps dark in one and lit in the other", case.label);
+        assert!(*mean <= 0.005, "{} {name}: mean |Δ| {mean}", case.label);
+    }
+    println!("{}: largest per-surface mean |Δ| against EnergyPlus's clipping: {worst:.4}", case.label);
 }
 
 /// The test file with its window under an overhang and two fins (`Zn001:Wall001:Win001`, 3 m × 5 m
