@@ -34,12 +34,11 @@ const HALF: f64 = (1u64 << 29) as f64;
 /// Up to this many polygons every edge is tested against all of them (a bounding-box check is
 /// cheaper than building buckets); above, a grid of buckets.
 const SCAN_ALL: usize = 48;
-/// Buckets along one side of the grid per square root of the polygons: under one polygon a
-/// bucket, since a leaf's shadow in a crowded canopy spans several and is met again in each
-/// (measured faster than one a bucket on `blaas-trees-summer`).
-const SIDE_PER_ROOT: f64 = 0.6;
-/// Most buckets along one side of the grid.
-const MAX_BUCKETS: usize = 64;
+/// A bucket's side per typical polygon's box side (the median of their longer sides).
+const BUCKET_PER_TYPICAL: f64 = 1.0;
+/// Most buckets per polygon, and in all.
+const BUCKETS_PER_POLYGON: f64 = 1.0;
+const MAX_BUCKETS: usize = 1 << 16;
 /// A polygon over more buckets than this (a receiver triangle, a wall's shadow) is kept out of
 /// them and tested by its box alone: in every bucket it would be met again by every query.
 const BIG_SPAN: usize = 16;
@@ -136,14 +135,16 @@ pub(super) struct Boundary {
     big: Vec<u32>,
     /// Per polygon: whether it is kept (scratch for [`Self::drop_covered`]).
     keep: Vec<bool>,
+    /// Scratch: the polygons' longer box sides.
+    sides: Vec<i64>,
 }
 
-/// The bucket grid: `n × n` cells of `size` grid units (per axis) from `origin`.
+/// The bucket grid: `n[0] × n[1]` square cells of `size` grid units from `origin`.
 #[derive(Debug, Default, Clone, Copy)]
 struct Buckets {
-    n: usize,
+    n: [usize; 2],
     origin: Point,
-    size: Point,
+    size: i64,
 }
 
 impl Boundary {
@@ -339,13 +340,13 @@ impl Boundary {
     /// A shadow that covers polygon `p` (see [`Self::covers`]), if any.
     fn container(&self, p: usize) -> Option<usize> {
         let b = self.buckets;
-        if b.n == 0 {
+        if b.n[0] == 0 {
             return (0..self.polys.len()).find(|&q| self.covers(q, p));
         }
         // A container's bounds hold `lo`, so it is in that point's cell or among the big ones
         // (a container of a big polygon spans at least as many cells, so is big too).
         let [cx, cy] = b.cell(self.polys[p].lo);
-        let cell = cy * b.n + cx;
+        let cell = cy * b.n[0] + cx;
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
         let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
@@ -357,7 +358,7 @@ impl Boundary {
     fn collect_candidates(&mut self, own: usize, lo: Point, hi: Point) {
         self.candidates.clear();
         let b = self.buckets;
-        if b.n == 0 {
+        if b.n[0] == 0 {
             let hits = self.polys.iter().enumerate().filter(|&(i, q)| i != own && boxes_overlap(lo, hi, q.lo, q.hi));
             self.candidates.extend(hits.map(|(i, q)| Near { lo: q.lo, hi: q.hi, poly: i as u32 }));
             return;
@@ -377,7 +378,7 @@ impl Boundary {
         let (c0, c1) = (b.cell(lo), b.cell(hi));
         for cy in c0[1]..=c1[1] {
             for cx in c0[0]..=c1[0] {
-                let cell = cy * b.n + cx;
+                let cell = cy * b.n[0] + cx;
                 for k in self.cell_start[cell]..self.cell_start[cell + 1] {
                     let q = self.cell_items[k as usize];
                     if self.stamp[q as usize] != self.epoch {
@@ -393,7 +394,7 @@ impl Boundary {
         // Not in push order, but the sums do not depend on the order the counters move in.
     }
 
-    /// Buckets the polygons by their boxes when there are many (else `buckets.n = 0`).
+    /// Buckets the polygons by their boxes when there are many (else `buckets.n = [0, 0]`).
     fn build_buckets(&mut self) {
         let n = self.polys.len();
         if n <= SCAN_ALL {
@@ -402,12 +403,12 @@ impl Boundary {
         }
         let lo = self.polys.iter().fold([i64::MAX; 2], |m, p| [m[0].min(p.lo[0]), m[1].min(p.lo[1])]);
         let hi = self.polys.iter().fold([i64::MIN; 2], |m, p| [m[0].max(p.hi[0]), m[1].max(p.hi[1])]);
-        let side = ((SIDE_PER_ROOT * (n as f64).sqrt()).ceil() as usize).clamp(1, MAX_BUCKETS);
-        let size = |k: usize| (hi[k] - lo[k]).max(1) / side as i64 + 1;
-        let buckets = Buckets { n: side, origin: lo, size: [size(0), size(1)] };
+        let extent = [(hi[0] - lo[0]).max(1), (hi[1] - lo[1]).max(1)];
+        let buckets = Buckets::over(lo, extent, self.typical_side(), n);
         self.buckets = buckets;
+        let cells = buckets.n[0] * buckets.n[1];
         self.cell_start.clear();
-        self.cell_start.resize(side * side + 1, 0);
+        self.cell_start.resize(cells + 1, 0);
         self.big.clear();
         for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
@@ -417,19 +418,19 @@ impl Boundary {
             }
             for cy in c0[1]..=c1[1] {
                 for cx in c0[0]..=c1[0] {
-                    self.cell_start[cy * side + cx + 1] += 1;
+                    self.cell_start[cy * buckets.n[0] + cx + 1] += 1;
                 }
             }
         }
-        for c in 0..side * side {
+        for c in 0..cells {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         self.cell_items.clear();
-        self.cell_items.resize(self.cell_start[side * side] as usize, 0);
+        self.cell_items.resize(self.cell_start[cells] as usize, 0);
         // Fill each cell from its start, in push order.
         let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
         next.clear();
-        next.extend_from_slice(&self.cell_start[..side * side]);
+        next.extend_from_slice(&self.cell_start[..cells]);
         for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
             if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
@@ -437,7 +438,7 @@ impl Boundary {
             }
             for cy in c0[1]..=c1[1] {
                 for cx in c0[0]..=c1[0] {
-                    let cell = cy * side + cx;
+                    let cell = cy * buckets.n[0] + cx;
                     self.cell_items[next[cell] as usize] = i as u32;
                     next[cell] += 1;
                 }
@@ -445,12 +446,34 @@ impl Boundary {
         }
         self.next_slot = next;
     }
+
+    /// The median of the polygons' longer box sides (the typical leaf's shadow among many).
+    fn typical_side(&mut self) -> i64 {
+        let mut sides = std::mem::take(&mut self.sides);
+        sides.clear();
+        sides.extend(self.polys.iter().map(|p| (p.hi[0] - p.lo[0]).max(p.hi[1] - p.lo[1])));
+        let middle = sides.len() / 2;
+        let typical = (*sides.select_nth_unstable(middle).1).max(1);
+        self.sides = sides;
+        typical
+    }
 }
 
 impl Buckets {
+    /// Square buckets over `extent` from `lo`: [`BUCKET_PER_TYPICAL`] of a typical polygon's side,
+    /// fewer where that would make more than [`BUCKETS_PER_POLYGON`] a polygon or [`MAX_BUCKETS`].
+    fn over(lo: Point, extent: Point, typical: i64, polygons: usize) -> Self {
+        let area = extent[0] as f64 * extent[1] as f64;
+        let most = (BUCKETS_PER_POLYGON * polygons as f64).min(MAX_BUCKETS as f64);
+        let fewest = (area / most).sqrt().ceil();
+        let size = ((typical as f64 * BUCKET_PER_TYPICAL).max(fewest) as i64).max(1);
+        let along = |k: usize| (extent[k] / size + 1) as usize;
+        Self { n: [along(0), along(1)], origin: lo, size }
+    }
+
     /// The cell holding grid point `p` (clamped to the grid of cells).
     fn cell(&self, p: Point) -> [usize; 2] {
-        let c = |k: usize| (((p[k] - self.origin[k]) / self.size[k]).max(0) as usize).min(self.n - 1);
+        let c = |k: usize| (((p[k] - self.origin[k]) / self.size).max(0) as usize).min(self.n[k] - 1);
         [c(0), c(1)]
     }
 }
