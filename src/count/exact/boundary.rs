@@ -109,6 +109,20 @@ const RECEIVER_RIGHT: u8 = 2;
 const SHADOW_LEFT: u8 = 4;
 const SHADOW_RIGHT: u8 = 8;
 const EARLIER_EDGE: u8 = 16;
+/// Per set of counters (the bits above), which of eight lanes each moves (the last three never).
+const COUNTER_BITS: [[i32; 8]; 32] = {
+    let mut table = [[0; 8]; 32];
+    let mut set = 0;
+    while set < 32 {
+        let mut bit = 0;
+        while bit < 5 {
+            table[set][bit] = (set as i32 >> bit) & 1;
+            bit += 1;
+        }
+        set += 1;
+    }
+    table
+};
 
 /// The polygons of one view and the memory to integrate them, reused from view to view.
 #[derive(Debug, Default)]
@@ -268,12 +282,13 @@ impl Boundary {
             self.events.push((t0, counters, 1));
             self.events.push((t1, counters, -1));
         }
-        self.events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        // Parameters are ≥ 0 (never −0: see `cover`), so their bits sort as they do.
+        self.events.sort_unstable_by_key(|e| e.0.to_bits());
         // The polygon itself covers its edge's left side.
-        let mut count = [0i32; 5];
+        let mut count = [0i32; 8];
         count[if own.receiver { 0 } else { 2 }] = 1;
         let (ax, dx, dy) = (a[0] as f64, (b[0] - a[0]) as f64, (b[1] - a[1]) as f64);
-        let piece = |count: &[i32; 5], t0: f64, t1: f64| -> f64 {
+        let piece = |count: &[i32; 8], t0: f64, t1: f64| -> f64 {
             if t1 <= t0 || count[4] > 0 {
                 return 0.0;
             }
@@ -289,11 +304,14 @@ impl Boundary {
         let mut at = 0.0;
         for &(t, counters, step) in &self.events {
             total += piece(&count, at, t);
-            // Without branches: which counters move is unpredictable.
-            for (bit, c) in count.iter_mut().enumerate() {
-                *c += i32::from(step) * i32::from((counters >> bit) & 1);
+            // Without branches (which counters move is unpredictable), eight lanes at once.
+            let moved = &COUNTER_BITS[usize::from(counters & 31)];
+            for (c, &m) in count.iter_mut().zip(moved) {
+                *c += i32::from(step) * m;
             }
-            at = at.max(t);
+            if t > at {
+                at = t;
+            }
         }
         total + piece(&count, at, 1.0)
     }
@@ -351,7 +369,8 @@ impl Boundary {
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
         let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
         let boxed = |q: usize| box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
-        self.big.iter().chain(bucketed).map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p))
+        let found = |list: &[u32]| list.iter().map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p));
+        found(&self.big).or_else(|| found(bucketed))
     }
 
     /// Polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
@@ -526,10 +545,13 @@ fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
         }
         // Signs differ: the segment crosses this edge's line once.
         let t = oa as f64 / (oa - ob) as f64;
+        // Compared, not `min`/`max`: `t` may be −0 (where `oa` is 0), which must not replace 0.
         if oa > 0 {
-            t1 = t1.min(t);
-        } else {
-            t0 = t0.max(t);
+            if t < t1 {
+                t1 = t;
+            }
+        } else if t > t0 {
+            t0 = t;
         }
         if t0 >= t1 {
             return None;
