@@ -84,12 +84,22 @@ struct Poly {
     receiver: bool,
 }
 
-/// A candidate polygon for the current polygon's edges: its box and its index.
+/// A candidate polygon for the current polygon's edges: its box, vertices and index, copied so
+/// each edge's scan reads one contiguous array.
 #[derive(Debug, Clone, Copy)]
 struct Near {
     lo: Point,
     hi: Point,
+    start: u32,
+    end: u32,
     poly: u32,
+    receiver: bool,
+}
+
+impl Near {
+    fn of(i: usize, p: &Poly) -> Self {
+        Self { lo: p.lo, hi: p.hi, start: p.start, end: p.end, poly: i as u32, receiver: p.receiver }
+    }
 }
 
 /// How a convex polygon covers an edge over a parameter interval.
@@ -254,21 +264,19 @@ impl Boundary {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         self.events.clear();
-        for c in 0..self.candidates.len() {
-            let near = self.candidates[c];
+        let (events, points) = (&mut self.events, &self.points);
+        for near in &self.candidates {
             if !boxes_overlap(lo, hi, near.lo, near.hi) {
                 continue;
             }
-            let q = near.poly as usize;
-            let other = self.polys[q];
-            let Some((t0, t1, side)) = cover(&self.points[other.start as usize..other.end as usize], a, b) else { continue };
-            let (left, right) = if other.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
+            let Some((t0, t1, side)) = cover(&points[near.start as usize..near.end as usize], a, b) else { continue };
+            let (left, right) = if near.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
             let mut counters = match side {
                 Side::Both => left | right,
                 Side::Left => left,
                 Side::Right => right,
             };
-            if side != Side::Both && q < p {
+            if side != Side::Both && (near.poly as usize) < p {
                 counters |= EARLIER_EDGE;
                 if t0 <= 0.0 && t1 >= 1.0 {
                     return 0.0;
@@ -276,11 +284,11 @@ impl Boundary {
             }
             // A shadow over the whole edge on the side the region could lie (both sides for a
             // receiver's edge, the outer side for a shadow's): nothing of it bounds the region.
-            if !other.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
+            if !near.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
                 return 0.0;
             }
-            self.events.push((t0, counters, 1));
-            self.events.push((t1, counters, -1));
+            events.push((t0, counters, 1));
+            events.push((t1, counters, -1));
         }
         // Parameters are ≥ 0 (never −0: see `cover`), so their bits sort as they do.
         self.events.sort_unstable_by_key(|e| e.0.to_bits());
@@ -379,7 +387,7 @@ impl Boundary {
         let b = self.buckets;
         if b.n[0] == 0 {
             let hits = self.polys.iter().enumerate().filter(|&(i, q)| i != own && boxes_overlap(lo, hi, q.lo, q.hi));
-            self.candidates.extend(hits.map(|(i, q)| Near { lo: q.lo, hi: q.hi, poly: i as u32 }));
+            self.candidates.extend(hits.map(|(i, q)| Near::of(i, q)));
             return;
         }
         self.epoch = self.epoch.wrapping_add(1);
@@ -391,7 +399,7 @@ impl Boundary {
             let q = self.big[k];
             let poly = &self.polys[q as usize];
             if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
+                self.candidates.push(Near::of(q as usize, poly));
             }
         }
         let (c0, c1) = (b.cell(lo), b.cell(hi));
@@ -404,7 +412,7 @@ impl Boundary {
                         self.stamp[q as usize] = self.epoch;
                         let poly = &self.polys[q as usize];
                         if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                            self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
+                            self.candidates.push(Near::of(q as usize, poly));
                         }
                     }
                 }
