@@ -264,6 +264,9 @@ impl Boundary {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         self.events.clear();
+        // The polygon itself covers its edge's left side; so do those that cover it from its start.
+        let mut count = [0i32; 8];
+        count[if own.receiver { 0 } else { 2 }] = 1;
         let (events, points) = (&mut self.events, &self.points);
         for near in &self.candidates {
             if !boxes_overlap(lo, hi, near.lo, near.hi) {
@@ -287,14 +290,21 @@ impl Boundary {
             if !near.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
                 return 0.0;
             }
-            events.push((t0, counters, 1));
-            events.push((t1, counters, -1));
+            // Ends at the edge's ends move the counters before or after every piece, so they
+            // need no events (most leaves' edges lie across a receiver triangle, end to end).
+            if t0 <= 0.0 {
+                for (c, &m) in count.iter_mut().zip(&COUNTER_BITS[usize::from(counters & 31)]) {
+                    *c += m;
+                }
+            } else {
+                events.push((t0, counters, 1));
+            }
+            if t1 < 1.0 {
+                events.push((t1, counters, -1));
+            }
         }
         // Parameters are ≥ 0 (never −0: see `cover`), so their bits sort as they do.
         self.events.sort_unstable_by_key(|e| e.0.to_bits());
-        // The polygon itself covers its edge's left side.
-        let mut count = [0i32; 8];
-        count[if own.receiver { 0 } else { 2 }] = 1;
         let (ax, dx, dy) = (a[0] as f64, (b[0] - a[0]) as f64, (b[1] - a[1]) as f64);
         let piece = |count: &[i32; 8], t0: f64, t1: f64| -> f64 {
             if t1 <= t0 || count[4] > 0 {
