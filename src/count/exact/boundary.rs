@@ -36,6 +36,7 @@
 
 use glam::DVec2;
 
+
 /// Half the grid's side: snapped coordinates lie in `[−HALF, HALF]`, so differences stay below
 /// 2^30, products below 2^60 and orientation determinants below 2^61, inside `i64`.
 const HALF: f64 = (1u64 << 29) as f64;
@@ -394,7 +395,8 @@ impl Boundary {
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
         let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
-        let boxed = |q: usize| box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
+        // Receivers (big, around most boxes) never contain: skipped before the call.
+        let boxed = |q: usize| !self.polys[q].receiver && box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
         let found = |list: &[u32]| list.iter().map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p));
         found(&self.big).or_else(|| found(bucketed))
     }
@@ -591,6 +593,16 @@ fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
 /// appended to `out`, counter-clockwise, without collinear or repeated points.
 fn hull(points: &mut [Point], out: &mut Vec<Point>) {
     let base = out.len();
+    // A triangle (most shadows): sorted by three swaps, turned counter-clockwise, as the chain
+    // below would give it; collinear ones take the chain.
+    if let [a, b, c] = points {
+        super::objects::sort3(a, b, c, |x, y| x < y);
+        match orient(*a, *b, *c).signum() {
+            1 => return out.extend_from_slice(&[*a, *b, *c]),
+            -1 => return out.extend_from_slice(&[*a, *c, *b]),
+            _ => {}
+        }
+    }
     if points.is_empty() {
         return;
     }
