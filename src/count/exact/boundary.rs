@@ -166,6 +166,8 @@ pub(super) struct Boundary {
     buckets: Buckets,
     /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
     big: Vec<u32>,
+    /// Per polygon: the buckets its box spans, `[x0, y0, x1, y1]` (found once a build).
+    spans: Vec<[usize; 4]>,
     /// Per polygon: whether it is kept (scratch for [`Self::drop_covered`]).
     keep: Vec<bool>,
     /// Scratch: the polygons' longer box sides.
@@ -390,7 +392,7 @@ impl Boundary {
         }
         // A container's bounds hold `lo`, so it is in that point's cell or among the big ones
         // (a container of a big polygon spans at least as many cells, so is big too).
-        let [cx, cy] = b.cell(self.polys[p].lo);
+        let [cx, cy, _, _] = self.spans[p];
         let cell = cy * b.n[0] + cx;
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
@@ -422,9 +424,9 @@ impl Boundary {
                 self.candidates.push(Near::of(q as usize, poly));
             }
         }
-        let (c0, c1) = (b.cell(lo), b.cell(hi));
-        for cy in c0[1]..=c1[1] {
-            for cx in c0[0]..=c1[0] {
+        let [x0, y0, x1, y1] = self.spans[own];
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
                 let cell = cy * b.n[0] + cx;
                 for k in self.cell_start[cell]..self.cell_start[cell + 1] {
                     let q = self.cell_items[k as usize];
@@ -457,8 +459,10 @@ impl Boundary {
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
         self.big.clear();
+        self.spans.clear();
         for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            self.spans.push([c0[0], c0[1], c1[0], c1[1]]);
             if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
                 self.big.push(i as u32);
                 continue;
@@ -478,13 +482,12 @@ impl Boundary {
         let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
         next.clear();
         next.extend_from_slice(&self.cell_start[..cells]);
-        for (i, p) in self.polys.iter().enumerate() {
-            let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
-            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+        for (i, &[x0, y0, x1, y1]) in self.spans.iter().enumerate() {
+            if (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN {
                 continue;
             }
-            for cy in c0[1]..=c1[1] {
-                for cx in c0[0]..=c1[0] {
+            for cy in y0..=y1 {
+                for cx in x0..=x1 {
                     let cell = cy * buckets.n[0] + cx;
                     self.cell_items[next[cell] as usize] = i as u32;
                     next[cell] += 1;
@@ -533,8 +536,11 @@ fn box_within(lo: Point, hi: Point, lo2: Point, hi2: Point) -> bool {
 /// Whether every point of `inner` lies inside or on the convex counter-clockwise polygon
 /// `outer` (so the hull of `inner` does); exact.
 fn convex_contains(outer: &[Point], inner: &[Point]) -> bool {
-    (0..outer.len()).all(|k| {
-        let (q0, q1) = (outer[k], if k + 1 == outer.len() { outer[0] } else { outer[k + 1] });
+    // Each edge from the vertex before, as in `cover`.
+    let Some(&last) = outer.last() else { return true };
+    let mut before = last;
+    outer.iter().all(|&q1| {
+        let q0 = std::mem::replace(&mut before, q1);
         inner.iter().all(|&v| orient(q0, q1, v) >= 0)
     })
 }
