@@ -22,9 +22,17 @@
 //! along its segment by an ulp, never change which polygons cover which side of it.
 //!
 //! Cost: each edge is tested only against polygons whose bounding boxes overlap its own (all of
-//! them when there are few, a uniform grid of buckets when there are many, as leaves give), so a
-//! view with `n` shadows of bounded overlap costs about `n` times their edges. A polygon inside
-//! one shadow (most leaves of a crowded canopy) is dropped first: it cannot change the area.
+//! them when there are few, a grid of square buckets about a typical polygon wide when there are
+//! many, as leaves give; square whatever the window's shape, since a façade's window may be 10:1),
+//! so a view with `n` shadows of bounded overlap costs about `n` times their edges. A cover that
+//! runs from an edge's start or to its end moves the counters without an event (a leaf's edges
+//! lie across a receiver triangle end to end), so most edges sort only their leaf neighbours'
+//! crossings. A polygon inside one shadow (most leaves of a crowded canopy) is dropped first: it
+//! cannot change the area. Polygons inside the union of several others are not looked for: on
+//! `blaas-trees-summer`'s heaviest sky views (34,000 leaf shadows, none inside one other) a grid
+//! of cells each inside one shadow (exact corner tests) found no polygon whose cells were all
+//! covered, at cells of 1/3 to 1/16 of a leaf, and cost 16% more instructions: the canopy's
+//! gaps put nearly every leaf on the union's boundary (docs/sky.md, "Benchmarks").
 
 use glam::DVec2;
 
@@ -34,12 +42,11 @@ const HALF: f64 = (1u64 << 29) as f64;
 /// Up to this many polygons every edge is tested against all of them (a bounding-box check is
 /// cheaper than building buckets); above, a grid of buckets.
 const SCAN_ALL: usize = 48;
-/// Buckets along one side of the grid per square root of the polygons: under one polygon a
-/// bucket, since a leaf's shadow in a crowded canopy spans several and is met again in each
-/// (measured faster than one a bucket on `blaas-trees-summer`).
-const SIDE_PER_ROOT: f64 = 0.6;
-/// Most buckets along one side of the grid.
-const MAX_BUCKETS: usize = 64;
+/// A bucket's side per typical polygon's box side (the median of their longer sides).
+const BUCKET_PER_TYPICAL: f64 = 1.0;
+/// Most buckets per polygon, and in all.
+const BUCKETS_PER_POLYGON: f64 = 1.0;
+const MAX_BUCKETS: usize = 1 << 16;
 /// A polygon over more buckets than this (a receiver triangle, a wall's shadow) is kept out of
 /// them and tested by its box alone: in every bucket it would be met again by every query.
 const BIG_SPAN: usize = 16;
@@ -85,12 +92,22 @@ struct Poly {
     receiver: bool,
 }
 
-/// A candidate polygon for the current polygon's edges: its box and its index.
+/// A candidate polygon for the current polygon's edges: its box, vertices and index, copied so
+/// each edge's scan reads one contiguous array.
 #[derive(Debug, Clone, Copy)]
 struct Near {
     lo: Point,
     hi: Point,
+    start: u32,
+    end: u32,
     poly: u32,
+    receiver: bool,
+}
+
+impl Near {
+    fn of(i: usize, p: &Poly) -> Self {
+        Self { lo: p.lo, hi: p.hi, start: p.start, end: p.end, poly: i as u32, receiver: p.receiver }
+    }
 }
 
 /// How a convex polygon covers an edge over a parameter interval.
@@ -110,6 +127,20 @@ const RECEIVER_RIGHT: u8 = 2;
 const SHADOW_LEFT: u8 = 4;
 const SHADOW_RIGHT: u8 = 8;
 const EARLIER_EDGE: u8 = 16;
+/// Per set of counters (the bits above), which of eight lanes each moves (the last three never).
+const COUNTER_BITS: [[i32; 8]; 32] = {
+    let mut table = [[0; 8]; 32];
+    let mut set = 0;
+    while set < 32 {
+        let mut bit = 0;
+        while bit < 5 {
+            table[set][bit] = (set as i32 >> bit) & 1;
+            bit += 1;
+        }
+        set += 1;
+    }
+    table
+};
 
 /// The polygons of one view and the memory to integrate them, reused from view to view.
 #[derive(Debug, Default)]
@@ -134,16 +165,20 @@ pub(super) struct Boundary {
     buckets: Buckets,
     /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
     big: Vec<u32>,
+    /// Per polygon: the buckets its box spans, `[x0, y0, x1, y1]` (found once a build).
+    spans: Vec<[usize; 4]>,
     /// Per polygon: whether it is kept (scratch for [`Self::drop_covered`]).
     keep: Vec<bool>,
+    /// Scratch: the polygons' longer box sides.
+    sides: Vec<i64>,
 }
 
-/// The bucket grid: `n × n` cells of `size` grid units (per axis) from `origin`.
+/// The bucket grid: `n[0] × n[1]` square cells of `size` grid units from `origin`.
 #[derive(Debug, Default, Clone, Copy)]
 struct Buckets {
-    n: usize,
+    n: [usize; 2],
     origin: Point,
-    size: Point,
+    size: i64,
 }
 
 impl Boundary {
@@ -239,21 +274,22 @@ impl Boundary {
         let lo = [a[0].min(b[0]), a[1].min(b[1])];
         let hi = [a[0].max(b[0]), a[1].max(b[1])];
         self.events.clear();
-        for c in 0..self.candidates.len() {
-            let near = self.candidates[c];
+        // The polygon itself covers its edge's left side; so do those that cover it from its start.
+        let mut count = [0i32; 8];
+        count[if own.receiver { 0 } else { 2 }] = 1;
+        let (events, points) = (&mut self.events, &self.points);
+        for near in &self.candidates {
             if !boxes_overlap(lo, hi, near.lo, near.hi) {
                 continue;
             }
-            let q = near.poly as usize;
-            let other = self.polys[q];
-            let Some((t0, t1, side)) = cover(&self.points[other.start as usize..other.end as usize], a, b) else { continue };
-            let (left, right) = if other.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
+            let Some((t0, t1, side)) = cover(&points[near.start as usize..near.end as usize], a, b) else { continue };
+            let (left, right) = if near.receiver { (RECEIVER_LEFT, RECEIVER_RIGHT) } else { (SHADOW_LEFT, SHADOW_RIGHT) };
             let mut counters = match side {
                 Side::Both => left | right,
                 Side::Left => left,
                 Side::Right => right,
             };
-            if side != Side::Both && q < p {
+            if side != Side::Both && (near.poly as usize) < p {
                 counters |= EARLIER_EDGE;
                 if t0 <= 0.0 && t1 >= 1.0 {
                     return 0.0;
@@ -261,18 +297,26 @@ impl Boundary {
             }
             // A shadow over the whole edge on the side the region could lie (both sides for a
             // receiver's edge, the outer side for a shadow's): nothing of it bounds the region.
-            if !other.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
+            if !near.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
                 return 0.0;
             }
-            self.events.push((t0, counters, 1));
-            self.events.push((t1, counters, -1));
+            // Ends at the edge's ends move the counters before or after every piece, so they
+            // need no events (most leaves' edges lie across a receiver triangle, end to end).
+            if t0 <= 0.0 {
+                for (c, &m) in count.iter_mut().zip(&COUNTER_BITS[usize::from(counters & 31)]) {
+                    *c += m;
+                }
+            } else {
+                events.push((t0, counters, 1));
+            }
+            if t1 < 1.0 {
+                events.push((t1, counters, -1));
+            }
         }
-        self.events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-        // The polygon itself covers its edge's left side.
-        let mut count = [0i32; 5];
-        count[if own.receiver { 0 } else { 2 }] = 1;
+        // Parameters are ≥ 0 (never −0: see `cover`), so their bits sort as they do.
+        self.events.sort_unstable_by_key(|e| e.0.to_bits());
         let (ax, dx, dy) = (a[0] as f64, (b[0] - a[0]) as f64, (b[1] - a[1]) as f64);
-        let piece = |count: &[i32; 5], t0: f64, t1: f64| -> f64 {
+        let piece = |count: &[i32; 8], t0: f64, t1: f64| -> f64 {
             if t1 <= t0 || count[4] > 0 {
                 return 0.0;
             }
@@ -288,11 +332,14 @@ impl Boundary {
         let mut at = 0.0;
         for &(t, counters, step) in &self.events {
             total += piece(&count, at, t);
-            // Without branches: which counters move is unpredictable.
-            for (bit, c) in count.iter_mut().enumerate() {
-                *c += i32::from(step) * i32::from((counters >> bit) & 1);
+            // Without branches (which counters move is unpredictable), eight lanes at once.
+            let moved = &COUNTER_BITS[usize::from(counters & 31)];
+            for (c, &m) in count.iter_mut().zip(moved) {
+                *c += i32::from(step) * m;
             }
-            at = at.max(t);
+            if t > at {
+                at = t;
+            }
         }
         total + piece(&count, at, 1.0)
     }
@@ -339,27 +386,29 @@ impl Boundary {
     /// A shadow that covers polygon `p` (see [`Self::covers`]), if any.
     fn container(&self, p: usize) -> Option<usize> {
         let b = self.buckets;
-        if b.n == 0 {
+        if b.n[0] == 0 {
             return (0..self.polys.len()).find(|&q| self.covers(q, p));
         }
         // A container's bounds hold `lo`, so it is in that point's cell or among the big ones
         // (a container of a big polygon spans at least as many cells, so is big too).
-        let [cx, cy] = b.cell(self.polys[p].lo);
-        let cell = cy * b.n + cx;
+        let [cx, cy, _, _] = self.spans[p];
+        let cell = cy * b.n[0] + cx;
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
         let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
-        let boxed = |q: usize| box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
-        self.big.iter().chain(bucketed).map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p))
+        // Receivers (big, around most boxes) never contain: skipped before the call.
+        let boxed = |q: usize| !self.polys[q].receiver && box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
+        let found = |list: &[u32]| list.iter().map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p));
+        found(&self.big).or_else(|| found(bucketed))
     }
 
     /// Polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
     fn collect_candidates(&mut self, own: usize, lo: Point, hi: Point) {
         self.candidates.clear();
         let b = self.buckets;
-        if b.n == 0 {
+        if b.n[0] == 0 {
             let hits = self.polys.iter().enumerate().filter(|&(i, q)| i != own && boxes_overlap(lo, hi, q.lo, q.hi));
-            self.candidates.extend(hits.map(|(i, q)| Near { lo: q.lo, hi: q.hi, poly: i as u32 }));
+            self.candidates.extend(hits.map(|(i, q)| Near::of(i, q)));
             return;
         }
         self.epoch = self.epoch.wrapping_add(1);
@@ -371,20 +420,20 @@ impl Boundary {
             let q = self.big[k];
             let poly = &self.polys[q as usize];
             if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
+                self.candidates.push(Near::of(q as usize, poly));
             }
         }
-        let (c0, c1) = (b.cell(lo), b.cell(hi));
-        for cy in c0[1]..=c1[1] {
-            for cx in c0[0]..=c1[0] {
-                let cell = cy * b.n + cx;
+        let [x0, y0, x1, y1] = self.spans[own];
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let cell = cy * b.n[0] + cx;
                 for k in self.cell_start[cell]..self.cell_start[cell + 1] {
                     let q = self.cell_items[k as usize];
                     if self.stamp[q as usize] != self.epoch {
                         self.stamp[q as usize] = self.epoch;
                         let poly = &self.polys[q as usize];
                         if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                            self.candidates.push(Near { lo: poly.lo, hi: poly.hi, poly: q });
+                            self.candidates.push(Near::of(q as usize, poly));
                         }
                     }
                 }
@@ -393,7 +442,7 @@ impl Boundary {
         // Not in push order, but the sums do not depend on the order the counters move in.
     }
 
-    /// Buckets the polygons by their boxes when there are many (else `buckets.n = 0`).
+    /// Buckets the polygons by their boxes when there are many (else `buckets.n = [0, 0]`).
     fn build_buckets(&mut self) {
         let n = self.polys.len();
         if n <= SCAN_ALL {
@@ -402,42 +451,43 @@ impl Boundary {
         }
         let lo = self.polys.iter().fold([i64::MAX; 2], |m, p| [m[0].min(p.lo[0]), m[1].min(p.lo[1])]);
         let hi = self.polys.iter().fold([i64::MIN; 2], |m, p| [m[0].max(p.hi[0]), m[1].max(p.hi[1])]);
-        let side = ((SIDE_PER_ROOT * (n as f64).sqrt()).ceil() as usize).clamp(1, MAX_BUCKETS);
-        let size = |k: usize| (hi[k] - lo[k]).max(1) / side as i64 + 1;
-        let buckets = Buckets { n: side, origin: lo, size: [size(0), size(1)] };
+        let extent = [(hi[0] - lo[0]).max(1), (hi[1] - lo[1]).max(1)];
+        let buckets = Buckets::over(lo, extent, self.typical_side(), n);
         self.buckets = buckets;
+        let cells = buckets.n[0] * buckets.n[1];
         self.cell_start.clear();
-        self.cell_start.resize(side * side + 1, 0);
+        self.cell_start.resize(cells + 1, 0);
         self.big.clear();
+        self.spans.clear();
         for (i, p) in self.polys.iter().enumerate() {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
+            self.spans.push([c0[0], c0[1], c1[0], c1[1]]);
             if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
                 self.big.push(i as u32);
                 continue;
             }
             for cy in c0[1]..=c1[1] {
                 for cx in c0[0]..=c1[0] {
-                    self.cell_start[cy * side + cx + 1] += 1;
+                    self.cell_start[cy * buckets.n[0] + cx + 1] += 1;
                 }
             }
         }
-        for c in 0..side * side {
+        for c in 0..cells {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         self.cell_items.clear();
-        self.cell_items.resize(self.cell_start[side * side] as usize, 0);
+        self.cell_items.resize(self.cell_start[cells] as usize, 0);
         // Fill each cell from its start, in push order.
         let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
         next.clear();
-        next.extend_from_slice(&self.cell_start[..side * side]);
-        for (i, p) in self.polys.iter().enumerate() {
-            let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
-            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
+        next.extend_from_slice(&self.cell_start[..cells]);
+        for (i, &[x0, y0, x1, y1]) in self.spans.iter().enumerate() {
+            if (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN {
                 continue;
             }
-            for cy in c0[1]..=c1[1] {
-                for cx in c0[0]..=c1[0] {
-                    let cell = cy * side + cx;
+            for cy in y0..=y1 {
+                for cx in x0..=x1 {
+                    let cell = cy * buckets.n[0] + cx;
                     self.cell_items[next[cell] as usize] = i as u32;
                     next[cell] += 1;
                 }
@@ -445,12 +495,34 @@ impl Boundary {
         }
         self.next_slot = next;
     }
+
+    /// The median of the polygons' longer box sides (the typical leaf's shadow among many).
+    fn typical_side(&mut self) -> i64 {
+        let mut sides = std::mem::take(&mut self.sides);
+        sides.clear();
+        sides.extend(self.polys.iter().map(|p| (p.hi[0] - p.lo[0]).max(p.hi[1] - p.lo[1])));
+        let middle = sides.len() / 2;
+        let typical = (*sides.select_nth_unstable(middle).1).max(1);
+        self.sides = sides;
+        typical
+    }
 }
 
 impl Buckets {
+    /// Square buckets over `extent` from `lo`: [`BUCKET_PER_TYPICAL`] of a typical polygon's side,
+    /// fewer where that would make more than [`BUCKETS_PER_POLYGON`] a polygon or [`MAX_BUCKETS`].
+    fn over(lo: Point, extent: Point, typical: i64, polygons: usize) -> Self {
+        let area = extent[0] as f64 * extent[1] as f64;
+        let most = (BUCKETS_PER_POLYGON * polygons as f64).min(MAX_BUCKETS as f64);
+        let fewest = (area / most).sqrt().ceil();
+        let size = ((typical as f64 * BUCKET_PER_TYPICAL).max(fewest) as i64).max(1);
+        let along = |k: usize| (extent[k] / size + 1) as usize;
+        Self { n: [along(0), along(1)], origin: lo, size }
+    }
+
     /// The cell holding grid point `p` (clamped to the grid of cells).
     fn cell(&self, p: Point) -> [usize; 2] {
-        let c = |k: usize| (((p[k] - self.origin[k]) / self.size[k]).max(0) as usize).min(self.n - 1);
+        let c = |k: usize| (((p[k] - self.origin[k]) / self.size).max(0) as usize).min(self.n[k] - 1);
         [c(0), c(1)]
     }
 }
@@ -463,8 +535,11 @@ fn box_within(lo: Point, hi: Point, lo2: Point, hi2: Point) -> bool {
 /// Whether every point of `inner` lies inside or on the convex counter-clockwise polygon
 /// `outer` (so the hull of `inner` does); exact.
 fn convex_contains(outer: &[Point], inner: &[Point]) -> bool {
-    (0..outer.len()).all(|k| {
-        let (q0, q1) = (outer[k], if k + 1 == outer.len() { outer[0] } else { outer[k + 1] });
+    // Each edge from the vertex before, as in `cover`.
+    let Some(&last) = outer.last() else { return true };
+    let mut before = last;
+    outer.iter().all(|&q1| {
+        let q0 = std::mem::replace(&mut before, q1);
         inner.iter().all(|&v| orient(q0, q1, v) >= 0)
     })
 }
@@ -483,10 +558,11 @@ fn orient(o: Point, a: Point, b: Point) -> i64 {
 fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
     let (mut t0, mut t1) = (0.0f64, 1.0f64);
     let mut side = Side::Both;
-    for k in 0..q.len() {
-        // The edge from vertex k to the next (the last closes on the first); no `%` in this loop,
-        // the hottest of the engine.
-        let (q0, q1) = (q[k], if k + 1 == q.len() { q[0] } else { q[k + 1] });
+    // Each edge from the vertex before (the last closes on the first): no index arithmetic in
+    // this loop, the hottest of the engine. The result does not depend on the edges' order.
+    let mut before = *q.last()?;
+    for &q1 in q {
+        let q0 = std::mem::replace(&mut before, q1);
         let (oa, ob) = (orient(q0, q1, a), orient(q0, q1, b));
         if oa > 0 && ob > 0 {
             continue;
@@ -503,10 +579,13 @@ fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
         }
         // Signs differ: the segment crosses this edge's line once.
         let t = oa as f64 / (oa - ob) as f64;
+        // Compared, not `min`/`max`: `t` may be −0 (where `oa` is 0), which must not replace 0.
         if oa > 0 {
-            t1 = t1.min(t);
-        } else {
-            t0 = t0.max(t);
+            if t < t1 {
+                t1 = t;
+            }
+        } else if t > t0 {
+            t0 = t;
         }
         if t0 >= t1 {
             return None;
@@ -519,6 +598,16 @@ fn cover(q: &[Point], a: Point, b: Point) -> Option<(f64, f64, Side)> {
 /// appended to `out`, counter-clockwise, without collinear or repeated points.
 fn hull(points: &mut [Point], out: &mut Vec<Point>) {
     let base = out.len();
+    // A triangle (most shadows): sorted by three swaps, turned counter-clockwise, as the chain
+    // below would give it; collinear ones take the chain.
+    if let [a, b, c] = points {
+        super::objects::sort3(a, b, c, |x, y| x < y);
+        match orient(*a, *b, *c).signum() {
+            1 => return out.extend_from_slice(&[*a, *b, *c]),
+            -1 => return out.extend_from_slice(&[*a, *c, *b]),
+            _ => {}
+        }
+    }
     if points.is_empty() {
         return;
     }
@@ -541,258 +630,4 @@ fn hull(points: &mut [Point], out: &mut Vec<Point>) {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::count::exact::{Contour, sunlit_ratio};
-
-    /// A grid where multiples of 1/4 in [−8, 8] land exactly on grid points (scale 2^26), so
-    /// shared and collinear edges stay exactly so after snapping.
-    fn snap() -> Snap {
-        Snap::new(DVec2::splat(-8.0), DVec2::splat(8.0)).unwrap()
-    }
-
-    fn ratio(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>]) -> f64 {
-        let s = snap();
-        let mut b = Boundary::default();
-        for r in receiver {
-            b.push(&s, r, true);
-        }
-        let whole = b.uncovered_area();
-        for sh in shadows {
-            b.push(&s, sh, false);
-        }
-        let lit = b.uncovered_area();
-        if whole <= 0.0 { 0.0 } else { (lit / whole).clamp(0.0, 1.0) }
-    }
-
-    fn contour(p: &[DVec2]) -> Contour {
-        let area: f64 = (0..p.len()).map(|i| p[i].perp_dot(p[(i + 1) % p.len()])).sum();
-        let mut c: Contour = p.iter().map(|q| q.to_array()).collect();
-        if area < 0.0 {
-            c.reverse();
-        }
-        c
-    }
-
-    fn reference(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>]) -> f64 {
-        let r: Vec<Contour> = receiver.iter().map(|p| contour(p)).collect();
-        let s: Vec<Contour> = shadows.iter().map(|p| contour(p)).collect();
-        sunlit_ratio(&r, &s, 0.0)
-    }
-
-    fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<DVec2> {
-        vec![DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x1, y1), DVec2::new(x0, y1)]
-    }
-
-    fn tri(p: [[f64; 2]; 3]) -> Vec<DVec2> {
-        p.iter().map(|&[x, y]| DVec2::new(x, y)).collect()
-    }
-
-    /// A 4 × 3 wall as two triangles.
-    fn wall() -> Vec<Vec<DVec2>> {
-        vec![tri([[0., 0.], [4., 0.], [4., 3.]]), tri([[0., 0.], [4., 3.], [0., 3.]])]
-    }
-
-    /// The wall with a 2 × 1 hole at [1, 3] × [1, 2], as eight triangles.
-    fn holed_wall() -> Vec<Vec<DVec2>> {
-        let t = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| tri([a, b, c]);
-        vec![
-            t([0., 0.], [4., 0.], [3., 1.]),
-            t([0., 0.], [3., 1.], [1., 1.]),
-            t([4., 0.], [4., 3.], [3., 2.]),
-            t([4., 0.], [3., 2.], [3., 1.]),
-            t([4., 3.], [0., 3.], [1., 2.]),
-            t([4., 3.], [1., 2.], [3., 2.]),
-            t([0., 3.], [0., 0.], [1., 1.]),
-            t([0., 3.], [1., 1.], [1., 2.]),
-        ]
-    }
-
-    fn assert_agrees(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>], what: &str) -> f64 {
-        let (got, want) = (ratio(receiver, shadows), reference(receiver, shadows));
-        assert!((got - want).abs() < 1e-6, "{what}: boundary {got}, reference {want}");
-        got
-    }
-
-    #[test]
-    fn degenerate_arrangements_match_closed_forms_and_the_reference() {
-        let w = wall();
-        let a = square(1., 1., 2., 2.);
-        // Identical shadows, each alone and both: one square metre of twelve.
-        assert!((assert_agrees(&w, &[a.clone(), a.clone(), a.clone()], "identical") - 11. / 12.).abs() < 1e-12);
-        // Sharing an edge (opposite directions), and overlapping along a collinear edge (same direction).
-        assert!((assert_agrees(&w, &[a.clone(), square(2., 1., 3., 2.)], "shared edge") - 10. / 12.).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[a.clone(), square(1.5, 1., 3., 1.5)], "collinear overlap") - (12. - 1.5) / 12.).abs() < 1e-12);
-        // Touching at a vertex; nested; along the wall's own edge and its diagonal; beyond it.
-        assert!((assert_agrees(&w, &[a.clone(), square(2., 2., 3., 3.)], "vertex") - 10. / 12.).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[square(0.5, 0.5, 3., 2.5), a.clone()], "nested") - 7. / 12.).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[square(0., 0., 4., 1.)], "on the wall's edge") - 8. / 12.).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[tri([[0., 0.], [4., 3.], [0., 3.]])], "the upper triangle itself") - 0.5).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[square(-1., -1., 5., 4.)], "all of it")).abs() < 1e-12);
-        assert!((assert_agrees(&w, &[square(-2., 1., 6., 2.)], "beyond both sides") - 8. / 12.).abs() < 1e-12);
-        assert_eq!(assert_agrees(&w, &[square(5., 0., 6., 3.)], "beside it"), 1.0);
-        // The holed wall (10 m²): a shadow over the hole shades only its frame.
-        let h = holed_wall();
-        assert!((assert_agrees(&h, &[square(0.5, 0.5, 3.5, 2.5)], "over the hole") - 6. / 10.).abs() < 1e-12);
-        assert!((assert_agrees(&h, &[square(1., 1., 3., 2.)], "the hole itself") - 1.0).abs() < 1e-12);
-        assert!((assert_agrees(&h, &[square(1., 1., 3., 2.5)], "the hole's top edge and above") - 9. / 10.).abs() < 1e-12);
-    }
-
-    /// Deterministic pseudo-random numbers (xorshift).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        fn below(&mut self, n: u64) -> u64 {
-            self.next() % n
-        }
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
-
-    /// The hull of a few random points: on a coarse lattice (so edges coincide, overlap, touch)
-    /// or anywhere.
-    fn random_convex(rng: &mut Rng, lattice: bool) -> Vec<DVec2> {
-        let mut pts: Vec<DVec2> = (0..3 + rng.below(6))
-            .map(|_| {
-                if lattice {
-                    DVec2::new(rng.below(25) as f64 * 0.25 - 1.0, rng.below(19) as f64 * 0.25 - 1.0)
-                } else {
-                    DVec2::new(rng.unit() * 6.0 - 1.0, rng.unit() * 5.0 - 1.0)
-                }
-            })
-            .collect();
-        let mut h = Vec::new();
-        super::super::objects::convex_hull(&mut pts, &mut h);
-        h
-    }
-
-    #[test]
-    fn random_convex_shadows_agree_with_the_reference() {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-        let mut partly = 0;
-        for case in 0..400 {
-            let receiver = if case % 2 == 0 { wall() } else { holed_wall() };
-            let lattice = case % 3 != 0;
-            let count = 1 + rng.below(if case % 5 == 0 { 80 } else { 12 }) as usize;
-            let mut shadows: Vec<Vec<DVec2>> = Vec::new();
-            for _ in 0..count {
-                let s = random_convex(&mut rng, lattice);
-                if s.len() < 3 {
-                    continue;
-                }
-                match rng.below(6) {
-                    // A copy of an earlier shadow, or one reversed (same polygon, other start).
-                    0 if !shadows.is_empty() => {
-                        let k = rng.below(shadows.len() as u64) as usize;
-                        let mut copy = shadows[k].clone();
-                        copy.rotate_left(1);
-                        shadows.push(copy);
-                    }
-                    // One nested in an earlier one: shrunk about its centre.
-                    1 if !shadows.is_empty() => {
-                        let k = rng.below(shadows.len() as u64) as usize;
-                        let c = shadows[k].iter().copied().sum::<DVec2>() / shadows[k].len() as f64;
-                        shadows.push(shadows[k].iter().map(|&p| c + (p - c) * 0.5).collect());
-                    }
-                    _ => shadows.push(s),
-                }
-            }
-            let got = assert_agrees(&receiver, &shadows, &format!("case {case}"));
-            partly += usize::from(got > 0.01 && got < 0.99);
-        }
-        assert!(partly > 200, "only {partly} cases partly shaded");
-    }
-
-    /// Pushes `receiver` and `shadows`, returns the area (m²) and the polygons kept after it.
-    fn area_and_kept(receiver: &[Vec<DVec2>], shadows: &[Vec<DVec2>]) -> (f64, usize) {
-        let s = snap();
-        let mut b = Boundary::default();
-        for r in receiver {
-            b.push(&s, r, true);
-        }
-        for sh in shadows {
-            b.push(&s, sh, false);
-        }
-        let area = b.uncovered_area() / s.area_scale();
-        (area, b.len())
-    }
-
-    #[test]
-    fn polygons_inside_one_shadow_are_dropped_and_the_area_is_unchanged() {
-        let w = wall();
-        let big = square(0.5, 0.5, 3., 2.5);
-        // Alone: 12 − 5 m² lit, two receiver triangles and the shadow kept.
-        assert_eq!(area_and_kept(&w, std::slice::from_ref(&big)), (7.0, 3));
-        // Nested, touching its edges from inside, an identical copy before and after: all go,
-        // whichever is pushed first, and the area is the same.
-        let inside = [square(1., 1., 2., 2.), square(0.5, 0.5, 3., 1.), tri([[0.5, 0.5], [3., 0.5], [3., 2.5]])];
-        for first in [false, true] {
-            let mut shadows: Vec<Vec<DVec2>> = inside.to_vec();
-            shadows.insert(if first { 0 } else { shadows.len() }, big.clone());
-            shadows.push(big.clone());
-            assert_eq!(area_and_kept(&w, &shadows), (7.0, 3), "big first: {first}");
-        }
-        // Sticking out by a quarter on one side: kept, and its sliver is shaded too.
-        let (area, kept) = area_and_kept(&w, &[big.clone(), square(1., 1., 3.25, 2.)]);
-        assert_eq!((area, kept), (12. - 5. - 0.25, 4));
-        // Within the bounds of a triangular shadow but beside it: kept.
-        let half = tri([[0.5, 0.5], [3., 0.5], [3., 2.5]]);
-        assert_eq!(area_and_kept(&w, &[half, square(0.5, 2., 1., 2.5)]), (12. - 2.5 - 0.25, 4));
-        // A receiver triangle in full shade (its diagonal on the shadow's edge) goes; the other
-        // stays, all lit.
-        let upper = tri([[-1., -0.75], [5., 3.75], [-1., 3.75]]);
-        assert_eq!(area_and_kept(&w, &[upper]), (6.0, 2));
-        // Everything in shade: no receiver left, nothing lit.
-        assert_eq!(area_and_kept(&w, &[square(-1., -1., 5., 4.), big]), (0.0, 1));
-    }
-
-    #[test]
-    fn leaves_inside_a_wide_shadow_are_dropped_with_buckets_and_agree() {
-        // A wall's shadow over the left half, 300 leaves: inside it, across its edge, beyond it.
-        let mut rng = Rng(11);
-        let mut shadows = vec![square(-0.5, -0.5, 2., 3.5)];
-        for _ in 0..300 {
-            let c = DVec2::new(rng.below(33) as f64 * 0.125, rng.below(25) as f64 * 0.125);
-            let r = 0.125 * (1 + rng.below(2)) as f64;
-            shadows.push(vec![c + DVec2::new(-r, 0.), c + DVec2::new(0., -r), c + DVec2::new(r, 0.), c + DVec2::new(0., r)]);
-        }
-        let receiver = holed_wall();
-        let got = assert_agrees(&receiver, &shadows, "leaves and a wall's shadow");
-        assert!(got > 0.0 && got < 0.5, "{got}");
-        let inside = shadows[1..].iter().filter(|l| l.iter().all(|p| p.x <= 2. && p.y >= -0.5 && p.y <= 3.5)).count();
-        let (_, kept) = area_and_kept(&receiver, &shadows);
-        assert!(shadows.len() > SCAN_ALL && inside > 100, "{inside} inside");
-        // Kept: the receiver's triangles that reach out of the shade, the wide shadow, and at
-        // most the leaves not inside it.
-        assert!(kept <= receiver.len() + 1 + shadows.len() - 1 - inside, "{kept} kept of {} ({inside} inside)", shadows.len());
-    }
-
-    #[test]
-    fn many_shadows_use_buckets_and_agree() {
-        // Leaves: 600 small shadows, some overlapping, some identical, and two wide ones.
-        let mut rng = Rng(7);
-        let mut shadows = Vec::new();
-        for _ in 0..600 {
-            let c = DVec2::new(rng.below(33) as f64 * 0.125, rng.below(25) as f64 * 0.125);
-            let r = 0.125 * (1 + rng.below(3)) as f64;
-            shadows.push(vec![c + DVec2::new(-r, 0.), c + DVec2::new(0., -r), c + DVec2::new(r, 0.), c + DVec2::new(0., r)]);
-        }
-        // A few wide shadows among them (a branch, a wall's): kept out of the buckets.
-        shadows.insert(100, square(-0.5, 0.25, 4.5, 0.5));
-        shadows.push(tri([[-1., 1.0], [5., 1.2], [-1., 1.4]]));
-        let receiver = holed_wall();
-        let got = assert_agrees(&receiver, &shadows, "leaves");
-        assert!(got > 0.0 && got < 1.0, "{got}");
-        let mut b = Boundary::default();
-        for sh in &shadows {
-            b.push(&snap(), sh, false);
-        }
-        assert!(b.len() > SCAN_ALL);
-    }
-}
+mod tests;

@@ -305,6 +305,19 @@ fn extent(points: &[DVec3]) -> Option<f64> {
     size.is_finite().then_some(size)
 }
 
+/// Sorts three values in place by `less` (a strict total order; equal values are the same value).
+pub(super) fn sort3<T>(a: &mut T, b: &mut T, c: &mut T, less: impl Fn(&T, &T) -> bool) {
+    if less(b, a) {
+        std::mem::swap(a, b);
+    }
+    if less(c, b) {
+        std::mem::swap(b, c);
+    }
+    if less(b, a) {
+        std::mem::swap(a, b);
+    }
+}
+
 /// Signed area of a polygon (positive counter-clockwise).
 pub(super) fn polygon_area(p: &[DVec2]) -> f64 {
     let n = p.len();
@@ -315,12 +328,27 @@ pub(super) fn polygon_area(p: &[DVec2]) -> f64 {
 /// without collinear points or a repeated first point.
 pub(super) fn convex_hull(points: &mut [DVec2], hull: &mut Vec<DVec2>) {
     hull.clear();
-    points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let order = |a: &DVec2, b: &DVec2| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y));
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    // A leaf's triangle, most of what a canopy casts: sorted by three swaps, and its hull read
+    // off the two turns the chain below would test (the same points in the same order).
+    if let [a, b, c] = points {
+        sort3(a, b, c, |x, y| order(x, y).is_lt());
+        let (turn, back) = (cross(*a, *b, *c), cross(*c, *b, *a));
+        if turn > 0.0 && back <= 0.0 {
+            hull.extend_from_slice(&[*a, *b, *c]);
+            return;
+        }
+        if turn < 0.0 && back > 0.0 {
+            hull.extend_from_slice(&[*a, *c, *b]);
+            return;
+        }
+    }
+    points.sort_unstable_by(order);
     if points.len() < 3 {
         hull.extend_from_slice(points);
         return;
     }
-    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
     for &q in points.iter() {
         while hull.len() >= 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
             hull.pop();
