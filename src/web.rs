@@ -354,6 +354,13 @@ impl Model {
         self.inner.notes.clone()
     }
 
+    /// The scene, encoded ([`Scene::to_bytes`]) for the pool's clipping workers
+    /// (`Clipper.fromScene`): they build their copies from it without reading the model files.
+    #[wasm_bindgen(js_name = sceneBytes)]
+    pub fn scene_bytes(&self) -> Vec<u8> {
+        self.inner.scene.to_bytes()
+    }
+
     /// Receiver names: the CSV's columns, in order.
     #[wasm_bindgen(getter, js_name = receiverNames)]
     pub fn receiver_names(&self) -> Vec<String> {

@@ -124,11 +124,13 @@ function abortError() {
   return new DOMException('cancelled', 'AbortError');
 }
 
-/** What built each model, so the pool's workers can build their own copy of it. */
+/** Each model's source for the pool's workers: its scene, encoded when the pool first needs it
+ * (Model.sceneBytes), so a worker decodes the scene instead of reading the model files again
+ * (docs/page-speed.md). Nothing of the model's input (a glb's bytes) is kept for it. */
 const sources = new WeakMap();
 
-function remember(model, kind, args) {
-  sources.set(model, { kind, args });
+function remember(model) {
+  sources.set(model, { kind: 'scene', encode: () => [model.sceneBytes()] });
   return model;
 }
 
@@ -249,13 +251,13 @@ class SunlitEngine {
       if (error instanceof WebAssembly.RuntimeError) throw tooLarge(names, bytes, error);
       throw error;
     }
-    return remember(model, 'files', [names, contents, receivers, north, foliage, transmittance]);
+    return remember(model);
   }
 
   /** A model from typed arrays (see sunlit.d.ts). */
   fromArrays({ positions, indices, triangleReceivers, names, yUp = false }) {
     const args = [Float32Array.from(positions), Uint32Array.from(indices), Int32Array.from(triangleReceivers), names.map(String), !!yUp];
-    return remember(this.#engine.fromArrays(...args), 'arrays', args);
+    return remember(this.#engine.fromArrays(...args));
   }
 
   /** A model from meshes and their placements (instancing kept; see sunlit.d.ts, and three.js). */
@@ -271,7 +273,7 @@ class SunlitEngine {
       Uint8Array.from(receivers, (r) => (r ? 1 : 0)),
       !!yUp,
     ];
-    return remember(this.#engine.fromMeshes(...args), 'meshes', args);
+    return remember(this.#engine.fromMeshes(...args));
   }
 
   /** Every receiver's sunlit fraction for one sun: [x, y, z] or { azimuth, altitude }. */
