@@ -43,11 +43,12 @@ function coded(message, code, names = {}) {
 /** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps) and starts
  * the pool of clipping workers. `engine`: 'auto' (default), 'gpu' or 'exact'; `workers`: the
  * pool's size (default navigator.hardwareConcurrency; 0 clips in this thread); `profile`: an
- * `auto` profile (JSON text or object, as `year.profile` gives it) to route by instead of the
- * cached or measured one (sunlit.d.ts). Without WebGPU the engine still clips (`hasGpu` false);
+ * `auto` profile (JSON text or object, as `year.profile` gives it) to route the sun views by
+ * instead of the cached or measured one (sunlit.d.ts); `skyProfile`: the same for the sky views
+ * (as `year.skyProfile` gives it), which are routed by their own profile as natively. Without WebGPU the engine still clips (`hasGpu` false);
  * only `engine: 'gpu'` is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
  * for another engine name or pool size. */
-export async function createEngine({ resolution, accuracy, device, engine, workers, profile } = {}) {
+export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile } = {}) {
   const size = workers === undefined ? defaultWorkers() : Number(workers);
   if (!Number.isInteger(size) || size < 0) {
     throw coded(`workers: ${workers} is not a whole number of at least 0`, 'bad-option', { option: 'workers' });
@@ -75,8 +76,8 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
       made = await open(false)();
     }
   }
-  const pinned = profile === undefined || profile === null ? undefined : typeof profile === 'string' ? profile : JSON.stringify(profile);
-  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, pinned);
+  const text = (p) => (p === undefined || p === null ? undefined : typeof p === 'string' ? p : JSON.stringify(p));
+  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, { sun: text(profile), sky: text(skyProfile) });
 }
 
 /** An EPW's LOCATION record: { latitude, longitude, timeZone, elevation, name }. */
@@ -157,8 +158,9 @@ class SunlitEngine {
     return this.#pool?.size ?? 0;
   }
 
-  /** How the last `auto` run routed: { key, profile (JSON), source ('pinned', 'cache', 'probe'),
-   * refused (why a profile handed in was not used) }, or null before one. */
+  /** How the last `auto` run routed its sun views: { key, profile (JSON), source ('pinned',
+   * 'cache', 'probe'), refused (why a profile handed in was not used), sky (the same for its sky
+   * views, under their own key; null for a year without weather) }, or null before one. */
   get routing() {
     return this.#routed;
   }
@@ -203,23 +205,28 @@ class SunlitEngine {
     }
     const pool = source ? this.#pool : null;
     const workers = pool?.size ?? 1;
-    const key = this.engine === 'auto' ? this.#engine.profileKey(model, workers) : undefined;
-    let profile = this.#pinned;
-    let profileSource = 'pinned';
-    if (profile === undefined && key !== undefined) {
-      profile = await cachedProfile(key);
-      profileSource = 'cache';
-    }
-    const routing = { workers, profile, profileSource };
+    const auto = this.engine === 'auto';
+    // Sun and sky views each have their own profile, kept under their own key (the sky's says
+    // `sky views`), so a sun profile is never taken for a sky one (src/web/choice.rs).
+    const key = auto ? { sun: this.#engine.profileKey(model, workers), sky: this.#engine.skyProfileKey(model, workers) } : undefined;
+    const given = async (views) => {
+      if (this.#pinned[views] !== undefined) return [this.#pinned[views], 'pinned'];
+      return [key === undefined ? undefined : await cachedProfile(key[views]), 'cache'];
+    };
+    const [profile, profileSource] = await given('sun');
+    const [skyProfile, skyProfileSource] = await given('sky');
+    const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
     if (pool) routing.clip = (packed) => pool.clip(packed, signal);
     return { routing, key };
   }
 
-  /** Keeps what `auto` routed by, and caches a freshly measured profile. */
+  /** Keeps what `auto` routed by, and caches each freshly measured profile under its key. */
   async #keepRouting(year, key) {
     if (key === undefined || year.profile === undefined) return;
-    this.#routed = { key, profile: year.profile, source: year.profileSource, refused: year.profileRefused };
-    if (year.profileSource === 'probe') await storeProfile(key, year.profile);
+    const sky = year.skyProfile === undefined ? null : { key: key.sky, profile: year.skyProfile, source: year.skyProfileSource, refused: year.skyProfileRefused };
+    this.#routed = { key: key.sun, profile: year.profile, source: year.profileSource, refused: year.profileRefused, sky };
+    if (year.profileSource === 'probe') await storeProfile(key.sun, year.profile);
+    if (sky?.source === 'probe') await storeProfile(key.sky, sky.profile);
   }
 
   /** The GPU adapter in use. */

@@ -266,10 +266,9 @@ fn check(scene: &Scene) -> Decoded<()> {
         if inst.transform.to_cols_array().iter().any(|x| !x.is_finite()) || !inst.leaf_shift.is_finite() {
             return Err(invalid(what(), "a transform that is not finite"));
         }
-        if let (Some(top), false) = (top, inst.receiver_base == NO_RECEIVER) {
-            if u64::from(inst.receiver_base) + u64::from(top) >= receivers {
-                return Err(invalid(what(), format!("receiver {} of {receivers}", u64::from(inst.receiver_base) + u64::from(top))));
-            }
+        let highest = top.filter(|_| inst.receiver_base != NO_RECEIVER).map(|top| u64::from(inst.receiver_base) + u64::from(top));
+        if let Some(id) = highest.filter(|&id| id >= receivers) {
+            return Err(invalid(what(), format!("receiver {id} of {receivers}")));
         }
     }
     for (i, r) in scene.receivers.iter().enumerate() {
