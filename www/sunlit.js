@@ -89,7 +89,7 @@ export async function epwLocation(text, name = 'EPW') {
 /** Model files above this many bytes cannot be read within wasm32's 4 GiB: an instance keeps
  * its peak (wasm memory never shrinks): the file's bytes, the parsed scene, the GPU upload's
  * staging and the exact engine's index. Measured on nyt-blocks' 95 MB glb (docs/page-speed.md):
- * 1,568 MB in the engine's instance under `auto` (16.5×), 1,312 MB in each clipping worker. */
+ * 1,568 MB in the engine's instance under `auto` (16.5×), 1,253 MB in each clipping worker. */
 const MEMORY_PER_BYTE = 17;
 const WASM32_BYTES = 4 * 2 ** 30;
 const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
