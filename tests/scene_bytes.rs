@@ -69,6 +69,56 @@ fn a_decoded_scene_gives_the_same_fractions_bit_for_bit() {
     assert!(by_leaves.iter().any(|&d| d > 0.01), "full leaves shade more than none somewhere");
 }
 
+/// Encoded, decoded and encoded again: the same bytes, and the same exact fractions.
+fn round_trips(scene: &Scene, what: &str) {
+    let bytes = scene.to_bytes();
+    let decoded = Scene::from_bytes(&bytes).unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert_eq!(decoded.to_bytes(), bytes, "{what}");
+    let requests: Vec<ViewRequest> = (0..scene.receivers.len() as u32)
+        .flat_map(|r| sunlit::bench::suns(12, 3).into_iter().map(move |sun| ViewRequest::new(r, sun)))
+        .collect();
+    let bits = |f: Vec<f64>| f.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+    assert_eq!(bits(ExactEngine::new(&decoded).fractions(&requests)), bits(ExactEngine::new(scene).fractions(&requests)), "{what}");
+}
+
+#[test]
+fn every_way_into_a_scene_round_trips() {
+    use sunlit::model::arrays::{Arrays, scene_from_arrays};
+    use sunlit::model::office_idf::{Shading, office_idf};
+    use sunlit::model::placed::{Placed, scene_from_placed};
+    let glb = sunlit::model::office::office(3).to_glb();
+    round_trips(&load_bytes(&[("office.glb".into(), glb)], &LoadOptions::default()).unwrap(), "office.glb");
+    let idf = office_idf(2, true, Shading::None).into_bytes();
+    round_trips(&load_bytes(&[("office.idf".into(), idf)], &LoadOptions::default()).unwrap(), "office.idf");
+    // A wall (receiver) and a slat before it, as the JS API's typed arrays.
+    let positions =
+        [0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 4.0, 0.0, 3.0, 0.0, 0.0, 3.0, 0.0, -1.0, 2.0, 4.0, -1.0, 2.0, 4.0, -0.5, 2.2, 0.0, -0.5, 2.2];
+    let indices = [0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7];
+    let names = ["Wall".to_string()];
+    let arrays = Arrays { positions: &positions, indices: &indices, triangle_receivers: &[0, 0, -1, -1], names: &names, y_up: false };
+    round_trips(&scene_from_arrays(&arrays).unwrap(), "arrays");
+    // The same slat placed twice (one mesh, two placements) before the wall, as three.js meshes.
+    let mut matrices = Vec::new();
+    for z in [0.0, 0.6, 0.0] {
+        matrices.extend([1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, z, 1.0]);
+    }
+    let names = ["Slat1".to_string(), "Slat2".to_string(), "Wall".to_string()];
+    let placed = Placed {
+        positions: &positions,
+        vertex_starts: &[0, 4, 8],
+        indices: &[0, 1, 2, 0, 2, 3, 0, 1, 2, 0, 2, 3],
+        index_starts: &[0, 6, 12],
+        placement_meshes: &[1, 1, 0],
+        matrices: &matrices,
+        names: &names,
+        receivers: &[0, 0, 1],
+        y_up: false,
+    };
+    let scene = scene_from_placed(&placed).unwrap();
+    assert!(scene.instances.iter().filter(|i| i.mesh == scene.instances[1].mesh).count() >= 2, "the slat is instanced");
+    round_trips(&scene, "placed meshes");
+}
+
 #[test]
 fn truncated_foreign_and_corrupt_bytes_are_refused_by_their_reason() {
     let bytes = street().to_bytes();

@@ -10,7 +10,9 @@
 //!   ([`adapter_threads_key`], [`cpu_key`]) with the pool's size as the clipping threads. A
 //!   profile handed in (pinned by the caller, or the page's IndexedDB cache) is used when it
 //!   parses and belongs to this model and device ([`profile_for`]); otherwise it is refused by
-//!   name (see [`Chosen::refused`]) and measured anew. Routing is [`Profile::route`]: a pure
+//!   name (see [`Chosen::refused`]) and measured anew. Sun and sky views ([`ViewKind`]) each
+//!   have their own profile, handed in, kept and measured apart, the sky's keys ending in
+//!   `; sky views` ([`views_key`]), as natively. Routing is [`Profile::route`]: a pure
 //!   function of the loads, the profile and the run's size, so the same inputs with the same
 //!   profile give the same answers byte for byte, whatever the pool's size.
 
