@@ -80,6 +80,62 @@ pub enum Error {
     DeviceLost(String),
     /// The caller asked the run to stop (a progress callback said so, or an `AbortSignal` fired).
     Cancelled,
+    /// Bytes given as an encoded scene ([`crate::scene::Scene::from_bytes`]) are not one.
+    SceneBytes(SceneBytesError),
+}
+
+/// Why bytes do not decode as a scene ([`crate::scene::codec`]).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SceneBytesError {
+    /// They do not start with the encoding's magic.
+    NotAScene,
+    /// They were written by another version of the encoding.
+    Version {
+        /// The version they carry.
+        found: u32,
+        /// The one this build reads.
+        supported: u32,
+    },
+    /// They end before what is being read (or a list's length exceeds the bytes left).
+    Truncated {
+        /// What was being read, e.g. `mesh indices`.
+        reading: &'static str,
+        /// Where, in bytes from the start.
+        offset: usize,
+        /// Bytes it needs.
+        need: usize,
+        /// Bytes left.
+        left: usize,
+    },
+    /// A part refers past its lists or holds a non-finite number.
+    Invalid {
+        /// The part, e.g. `instance 3` or `mesh 0 ('static')`.
+        what: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Bytes follow the encoded scene.
+    TrailingBytes {
+        /// How many.
+        extra: usize,
+    },
+}
+
+impl fmt::Display for SceneBytesError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SceneBytesError::NotAScene => f.write_str("they are not an encoded scene (no SUNLITSC magic)"),
+            SceneBytesError::Version { found, supported } => {
+                write!(f, "they are version {found} of the encoding; this build reads version {supported}")
+            }
+            SceneBytesError::Truncated { reading, offset, need, left } => {
+                write!(f, "truncated: reading {reading} at byte {offset} needs {need} bytes, {left} are left")
+            }
+            SceneBytesError::Invalid { what, reason } => write!(f, "{what}: {reason}"),
+            SceneBytesError::TrailingBytes { extra } => write!(f, "{extra} bytes follow the scene"),
+        }
+    }
 }
 
 /// Why no receiving surface was chosen.
@@ -165,7 +221,7 @@ impl Error {
 
     /// A stable, kebab-case name of the kind of failure, for programs to switch on (the JS API's
     /// `code`): `io`, `model`, `object`, `timestep-mismatch`, `duplicate-receiver`,
-    /// `no-receivers`, `bad-option`, `gpu`, `device-lost`, `cancelled`.
+    /// `no-receivers`, `bad-option`, `gpu`, `device-lost`, `cancelled`, `scene-bytes`.
     pub fn code(&self) -> &'static str {
         match self {
             Error::Io { .. } => "io",
@@ -178,6 +234,7 @@ impl Error {
             Error::Gpu(_) => "gpu",
             Error::DeviceLost(_) => "device-lost",
             Error::Cancelled => "cancelled",
+            Error::SceneBytes(_) => "scene-bytes",
         }
     }
 
@@ -217,6 +274,7 @@ impl Error {
             Error::Gpu(e) => format!("GPU: {}", e.render(&name)),
             Error::DeviceLost(why) => format!("GPU device lost ({why})"),
             Error::Cancelled => "cancelled".into(),
+            Error::SceneBytes(why) => format!("encoded scene: {why}"),
         }
     }
 }

@@ -63,6 +63,7 @@ fn every_error() -> Vec<Error> {
         Error::Gpu(GpuError::Device("d".into())),
         Error::DeviceLost("l".into()),
         Error::Cancelled,
+        Error::SceneBytes(crate::error::SceneBytesError::NotAScene),
     ];
     for e in &errors {
         match e {
@@ -76,7 +77,8 @@ fn every_error() -> Vec<Error> {
             | Error::Unmatched { .. }
             | Error::Gpu(_)
             | Error::DeviceLost(_)
-            | Error::Cancelled => {}
+            | Error::Cancelled
+            | Error::SceneBytes(_) => {}
         }
     }
     errors

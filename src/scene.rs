@@ -25,6 +25,8 @@ use glam::{DMat4, DVec3};
 use crate::error::{Error, NoReceivers, Result};
 use crate::geometry::{triangle_area, triangle_normal};
 
+pub mod codec;
+
 /// Surface id of geometry that only casts shadows.
 pub const NO_RECEIVER: u32 = u32::MAX;
 

@@ -26,7 +26,7 @@ use crate::count::exact::engine::ExactEngine;
 use crate::count::gpu::{Counter, CounterOptions, GpuScene};
 use crate::count::hybrid::EngineKind;
 use crate::count::lanes::Lane;
-use crate::count::{Engine as _, ViewRequest};
+use crate::count::{Engine as _, ViewKind, ViewRequest};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
@@ -130,11 +130,22 @@ impl Engine {
         Ok(Engine { counter: Some(Rc::new(counter)), options, kind })
     }
 
-    /// The key under which this model's `auto` profile is kept (IndexedDB in the page), as the
-    /// native cache keys it: adapter, driver, `workers` clipping threads, side, scene size.
+    /// The key under which this model's `auto` profile for sun views is kept (IndexedDB in the
+    /// page), as the native cache keys it: adapter, driver, `workers` clipping threads, side,
+    /// scene size.
     #[wasm_bindgen(js_name = profileKey)]
     pub fn profile_key(&self, model: &Model, workers: usize) -> String {
-        choice::store_key(&model.inner.scene, self.counter.as_ref().map(|c| c.adapter_info()), &self.options, workers.max(1))
+        self.key_of(model, ViewKind::Sun, workers)
+    }
+
+    /// The same for sky views (the key says `sky views`): they are routed by their own profile.
+    #[wasm_bindgen(js_name = skyProfileKey)]
+    pub fn sky_profile_key(&self, model: &Model, workers: usize) -> String {
+        self.key_of(model, ViewKind::Sky, workers)
+    }
+
+    fn key_of(&self, model: &Model, views: ViewKind, workers: usize) -> String {
+        choice::store_key(&model.inner.scene, views, self.counter.as_ref().map(|c| c.adapter_info()), &self.options, workers.max(1))
     }
 
     /// Which engine answers views: `auto`, `gpu` or `exact`.
@@ -264,7 +275,7 @@ impl Engine {
             let (schedule, fitted) = annual_fitted_with(&chosen, &model.scene, &location, &options, &calendar, &mut report)
                 .await
                 .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?;
-            let routed = Routed { profile: chosen.profile(), refused: chosen.refused() };
+            let routed = |views| Routed { profile: chosen.profile(views), refused: chosen.refused(views) };
             let means = daylight_means(&schedule, &location);
             let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
             // The sky views (the same engine, Tregenza's patches) only when there is weather to weigh them.
@@ -277,6 +288,7 @@ impl Engine {
                 _ => None,
             };
             let extra = embed::Extra::new(&model.scene, &schedule, &location, weather, sky.as_ref().map(|s| (s, &calendar)), fitted);
+            let routed = [routed(ViewKind::Sun), routed(ViewKind::Sky)];
             Ok(Annual { schedule, means, hook, model, extra, routed }.into())
         })
     }
@@ -352,6 +364,13 @@ impl Model {
     #[wasm_bindgen(getter)]
     pub fn notes(&self) -> Vec<String> {
         self.inner.notes.clone()
+    }
+
+    /// The scene, encoded ([`Scene::to_bytes`]) for the pool's clipping workers
+    /// (`Clipper.fromScene`): they build their copies from it without reading the model files.
+    #[wasm_bindgen(js_name = sceneBytes)]
+    pub fn scene_bytes(&self) -> Vec<u8> {
+        self.inner.scene.to_bytes()
     }
 
     /// Receiver names: the CSV's columns, in order.
@@ -467,7 +486,8 @@ pub struct Annual {
     hook: Option<Result<Hook, JsValue>>,
     model: Rc<ModelInner>,
     extra: embed::Extra,
-    routed: Routed,
+    /// Sun views', then sky views' (none without weather).
+    routed: [Routed; 2],
 }
 
 /// How `auto` routed a year: the profile (JSON) and its source, and a profile refused.
@@ -512,23 +532,43 @@ impl Annual {
         Float64Array::from(self.means.as_slice())
     }
 
-    /// The profile `auto` routed by (JSON, as `createEngine({ profile })` takes it); `undefined`
-    /// for `gpu` and `exact`.
+    /// The profile `auto` routed the sun views by (JSON, as `createEngine({ profile })` takes
+    /// it); `undefined` for `gpu` and `exact`.
     #[wasm_bindgen(getter)]
     pub fn profile(&self) -> Option<String> {
-        self.routed.profile.as_ref().map(|(p, _)| p.clone())
+        self.routed[0].profile.as_ref().map(|(p, _)| p.clone())
     }
 
     /// Where that profile came from: `pinned`, `cache` or `probe` (measured in this run).
     #[wasm_bindgen(getter, js_name = profileSource)]
     pub fn profile_source(&self) -> Option<String> {
-        self.routed.profile.as_ref().map(|(_, s)| (*s).to_string())
+        self.routed[0].profile.as_ref().map(|(_, s)| (*s).to_string())
     }
 
     /// Why a profile handed in was refused (it was measured anew), naming it and the reason.
     #[wasm_bindgen(getter, js_name = profileRefused)]
     pub fn profile_refused(&self) -> Option<String> {
-        self.routed.refused.clone()
+        self.routed[0].refused.clone()
+    }
+
+    /// The profile `auto` routed the sky views by (as `createEngine({ skyProfile })` takes it):
+    /// measured on sky views, as natively; `undefined` without weather (no sky views) and for
+    /// `gpu` and `exact`.
+    #[wasm_bindgen(getter, js_name = skyProfile)]
+    pub fn sky_profile(&self) -> Option<String> {
+        self.routed[1].profile.as_ref().map(|(p, _)| p.clone())
+    }
+
+    /// Where the sky views' profile came from: `pinned`, `cache` or `probe`.
+    #[wasm_bindgen(getter, js_name = skyProfileSource)]
+    pub fn sky_profile_source(&self) -> Option<String> {
+        self.routed[1].profile.as_ref().map(|(_, s)| (*s).to_string())
+    }
+
+    /// Why a sky profile handed in was refused (it was measured anew).
+    #[wasm_bindgen(getter, js_name = skyProfileRefused)]
+    pub fn sky_profile_refused(&self) -> Option<String> {
+        self.routed[1].refused.clone()
     }
 
     /// The EnergyPlus CSV (the layout EnergyPlus writes as eplusshading.csv).

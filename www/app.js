@@ -299,7 +299,10 @@ function showRouting(msg) {
   if (!r) return;
   const refused = r.refused ? ` (${r.refused}; measured anew)` : '';
   $('routingsource').textContent = `auto routed by the ${r.source === 'probe' ? 'freshly measured' : r.source} profile${refused}; ${msg.workers} clipping worker(s)${msg.hasGpu ? '' : ', no GPU'}.`;
-  $('routingprofile').textContent = JSON.stringify(JSON.parse(r.profile), null, 2);
+  const sky = r.sky ? `; sky views by the ${r.sky.source === 'probe' ? 'freshly measured' : r.sky.source} sky profile${r.sky.refused ? ` (${r.sky.refused}; measured anew)` : ''}` : '';
+  $('routingsource').textContent += sky;
+  const shown = (p) => JSON.stringify(JSON.parse(p), null, 2);
+  $('routingprofile').textContent = shown(r.profile) + (r.sky ? `\n\nSky views:\n${shown(r.sky.profile)}` : '');
 }
 
 async function settings() {

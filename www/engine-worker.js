@@ -10,7 +10,7 @@
 //   { id, op: 'cancel' }                           → aborts a running annual or map
 // Errors come back as { id, error: message, code }; progress of an annual as { id, progress: [done, total] }.
 // The engine clips on its own pool of workers and routes `auto` by a measured profile, as
-// createEngine does anywhere (create's options take `workers` and `profile` too).
+// createEngine does anywhere (create's options take `workers`, `profile` and `skyProfile` too).
 import { createEngine } from './sunlit.js';
 
 let engine = null;
@@ -37,7 +37,7 @@ const ops = {
     const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
     const year = await need(engine, 'create').annual(need(model, 'fromMeshes or loadFiles'), settings, { onProgress, signal: running.signal });
     try {
-      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv(), profile: year.profile, profileSource: year.profileSource };
+      return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv(), profile: year.profile, profileSource: year.profileSource, skyProfile: year.skyProfile, skyProfileSource: year.skyProfileSource };
     } finally {
       year.free();
     }

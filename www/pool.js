@@ -102,23 +102,27 @@ export class ClipPool {
     });
   }
 
-  /** Makes `source` (what built the engine's model) the pool's model; resolves when every
-   * worker holds it. The same source twice loads once. */
+  /** Makes `source` the pool's model; resolves when every worker holds it. The same source twice
+   * loads once. `source`: { kind, args } (clip-worker.js's kinds: 'scene' takes the engine's
+   * encoded scene, 'files', 'arrays' and 'meshes' what built the engine's model), or { kind,
+   * encode } where encode() gives the args once the workers have started (sunlit.js encodes the
+   * scene then; the encoding is copied to each worker and not kept here). */
   use(source) {
     if (this.#broken) return Promise.reject(this.#broken);
     if (source === this.#source && this.#loading) return this.#loading;
     this.#source = source;
-    this.#loading = this.start().then(() =>
-      Promise.all(
+    this.#loading = this.start().then(() => {
+      const message = { type: 'load', source: source.encode ? { kind: source.kind, args: source.encode() } : source };
+      return Promise.all(
         this.#workers.map(
           (slot) =>
             new Promise((resolve, reject) => {
               slot.pending = { resolve, reject };
-              slot.worker.postMessage({ type: 'load', source });
+              slot.worker.postMessage(message);
             }),
         ),
-      ),
-    );
+      );
+    });
     this.#loading.catch(() => {
       this.#source = null;
       this.#loading = null;

@@ -17,6 +17,7 @@ export interface SunlitError extends Error {
     | 'gpu'
     | 'device-lost'
     | 'cancelled'
+    | 'scene-bytes'
     | 'no-webgpu'
     | 'worker'
     | 'too-large'
@@ -82,6 +83,9 @@ export function createEngine(options?: {
    * the routing. One that does not parse, or was measured for another model or device, is
    * refused (Annual.profileRefused says why) and measured anew. */
   profile?: string | object;
+  /** The same for the sky views (a year with weather), as Annual.skyProfile gives it: sky views
+   * are routed by their own profile, measured on sky views and kept under their own key. */
+  skyProfile?: string | object;
 }): Promise<SunlitEngine>;
 
 /** An EPW weather file's LOCATION record (throws naming `name` and the reason). */
@@ -198,7 +202,14 @@ export interface SunlitEngine {
   readonly workerMemoryBytes: (number | undefined)[];
   /** How the last 'auto' year was routed: its profile key, the profile (JSON), where the profile
    * came from, and why a profile handed in was refused; null before one. */
-  readonly routing: { key: string; profile: string; source: 'pinned' | 'cache' | 'probe'; refused?: string } | null;
+  readonly routing: {
+    key: string;
+    profile: string;
+    source: 'pinned' | 'cache' | 'probe';
+    refused?: string;
+    /** The sky views' (a year with weather), under their own key; null without them. */
+    sky: { key: string; profile: string; source: 'pinned' | 'cache' | 'probe'; refused?: string } | null;
+  } | null;
   /** Why the pool could not start (clipping then runs in the engine's thread), or null. */
   readonly poolError: string | null;
   /** Has the pool's workers build their copies of the model now (else the first year does). */
@@ -372,6 +383,11 @@ export interface Annual {
   readonly profileSource: 'pinned' | 'cache' | 'probe' | undefined;
   /** Why a profile handed in was refused, naming it and the reason (it was measured anew). */
   readonly profileRefused: string | undefined;
+  /** The profile 'auto' routed the sky views by (a year with weather; pin it with
+   * createEngine({ skyProfile })), where it came from, and why one handed in was refused. */
+  readonly skyProfile: string | undefined;
+  readonly skyProfileSource: 'pinned' | 'cache' | 'probe' | undefined;
+  readonly skyProfileRefused: string | undefined;
   /** Annual direct (beam) irradiation Σ DNI·cosθ·fraction·Δt per receiver, kWh/m², from the EPW's
    * direct normal irradiance (each hour's value held over its timesteps); undefined without an
    * EPW. Throws naming the file and line when the EPW's hourly records are unreadable. */

@@ -43,11 +43,12 @@ function coded(message, code, names = {}) {
 /** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps) and starts
  * the pool of clipping workers. `engine`: 'auto' (default), 'gpu' or 'exact'; `workers`: the
  * pool's size (default navigator.hardwareConcurrency; 0 clips in this thread); `profile`: an
- * `auto` profile (JSON text or object, as `year.profile` gives it) to route by instead of the
- * cached or measured one (sunlit.d.ts). Without WebGPU the engine still clips (`hasGpu` false);
+ * `auto` profile (JSON text or object, as `year.profile` gives it) to route the sun views by
+ * instead of the cached or measured one (sunlit.d.ts); `skyProfile`: the same for the sky views
+ * (as `year.skyProfile` gives it), which are routed by their own profile as natively. Without WebGPU the engine still clips (`hasGpu` false);
  * only `engine: 'gpu'` is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
  * for another engine name or pool size. */
-export async function createEngine({ resolution, accuracy, device, engine, workers, profile } = {}) {
+export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile } = {}) {
   const size = workers === undefined ? defaultWorkers() : Number(workers);
   if (!Number.isInteger(size) || size < 0) {
     throw coded(`workers: ${workers} is not a whole number of at least 0`, 'bad-option', { option: 'workers' });
@@ -75,8 +76,8 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
       made = await open(false)();
     }
   }
-  const pinned = profile === undefined || profile === null ? undefined : typeof profile === 'string' ? profile : JSON.stringify(profile);
-  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, pinned);
+  const text = (p) => (p === undefined || p === null ? undefined : typeof p === 'string' ? p : JSON.stringify(p));
+  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, { sun: text(profile), sky: text(skyProfile) });
 }
 
 /** An EPW's LOCATION record: { latitude, longitude, timeZone, elevation, name }. */
@@ -88,7 +89,7 @@ export async function epwLocation(text, name = 'EPW') {
 /** Model files above this many bytes cannot be read within wasm32's 4 GiB: an instance keeps
  * its peak (wasm memory never shrinks): the file's bytes, the parsed scene, the GPU upload's
  * staging and the exact engine's index. Measured on nyt-blocks' 95 MB glb (docs/page-speed.md):
- * 1,568 MB in the engine's instance under `auto` (16.5×), 1,312 MB in each clipping worker. */
+ * 1,568 MB in the engine's instance under `auto` (16.5×), 1,253 MB in each clipping worker. */
 const MEMORY_PER_BYTE = 17;
 const WASM32_BYTES = 4 * 2 ** 30;
 const MAX_MODEL_BYTES = Math.floor(WASM32_BYTES / MEMORY_PER_BYTE);
@@ -124,11 +125,13 @@ function abortError() {
   return new DOMException('cancelled', 'AbortError');
 }
 
-/** What built each model, so the pool's workers can build their own copy of it. */
+/** Each model's source for the pool's workers: its scene, encoded when the pool first needs it
+ * (Model.sceneBytes), so a worker decodes the scene instead of reading the model files again
+ * (docs/page-speed.md). Nothing of the model's input (a glb's bytes) is kept for it. */
 const sources = new WeakMap();
 
-function remember(model, kind, args) {
-  sources.set(model, { kind, args });
+function remember(model) {
+  sources.set(model, { kind: 'scene', encode: () => [model.sceneBytes()] });
   return model;
 }
 
@@ -155,8 +158,9 @@ class SunlitEngine {
     return this.#pool?.size ?? 0;
   }
 
-  /** How the last `auto` run routed: { key, profile (JSON), source ('pinned', 'cache', 'probe'),
-   * refused (why a profile handed in was not used) }, or null before one. */
+  /** How the last `auto` run routed its sun views: { key, profile (JSON), source ('pinned',
+   * 'cache', 'probe'), refused (why a profile handed in was not used), sky (the same for its sky
+   * views, under their own key; null for a year without weather) }, or null before one. */
   get routing() {
     return this.#routed;
   }
@@ -201,23 +205,28 @@ class SunlitEngine {
     }
     const pool = source ? this.#pool : null;
     const workers = pool?.size ?? 1;
-    const key = this.engine === 'auto' ? this.#engine.profileKey(model, workers) : undefined;
-    let profile = this.#pinned;
-    let profileSource = 'pinned';
-    if (profile === undefined && key !== undefined) {
-      profile = await cachedProfile(key);
-      profileSource = 'cache';
-    }
-    const routing = { workers, profile, profileSource };
+    const auto = this.engine === 'auto';
+    // Sun and sky views each have their own profile, kept under their own key (the sky's says
+    // `sky views`), so a sun profile is never taken for a sky one (src/web/choice.rs).
+    const key = auto ? { sun: this.#engine.profileKey(model, workers), sky: this.#engine.skyProfileKey(model, workers) } : undefined;
+    const given = async (views) => {
+      if (this.#pinned[views] !== undefined) return [this.#pinned[views], 'pinned'];
+      return [key === undefined ? undefined : await cachedProfile(key[views]), 'cache'];
+    };
+    const [profile, profileSource] = await given('sun');
+    const [skyProfile, skyProfileSource] = await given('sky');
+    const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
     if (pool) routing.clip = (packed) => pool.clip(packed, signal);
     return { routing, key };
   }
 
-  /** Keeps what `auto` routed by, and caches a freshly measured profile. */
+  /** Keeps what `auto` routed by, and caches each freshly measured profile under its key. */
   async #keepRouting(year, key) {
     if (key === undefined || year.profile === undefined) return;
-    this.#routed = { key, profile: year.profile, source: year.profileSource, refused: year.profileRefused };
-    if (year.profileSource === 'probe') await storeProfile(key, year.profile);
+    const sky = year.skyProfile === undefined ? null : { key: key.sky, profile: year.skyProfile, source: year.skyProfileSource, refused: year.skyProfileRefused };
+    this.#routed = { key: key.sun, profile: year.profile, source: year.profileSource, refused: year.profileRefused, sky };
+    if (year.profileSource === 'probe') await storeProfile(key.sun, year.profile);
+    if (sky?.source === 'probe') await storeProfile(key.sky, sky.profile);
   }
 
   /** The GPU adapter in use. */
@@ -249,13 +258,13 @@ class SunlitEngine {
       if (error instanceof WebAssembly.RuntimeError) throw tooLarge(names, bytes, error);
       throw error;
     }
-    return remember(model, 'files', [names, contents, receivers, north, foliage, transmittance]);
+    return remember(model);
   }
 
   /** A model from typed arrays (see sunlit.d.ts). */
   fromArrays({ positions, indices, triangleReceivers, names, yUp = false }) {
     const args = [Float32Array.from(positions), Uint32Array.from(indices), Int32Array.from(triangleReceivers), names.map(String), !!yUp];
-    return remember(this.#engine.fromArrays(...args), 'arrays', args);
+    return remember(this.#engine.fromArrays(...args));
   }
 
   /** A model from meshes and their placements (instancing kept; see sunlit.d.ts, and three.js). */
@@ -271,7 +280,7 @@ class SunlitEngine {
       Uint8Array.from(receivers, (r) => (r ? 1 : 0)),
       !!yUp,
     ];
-    return remember(this.#engine.fromMeshes(...args), 'meshes', args);
+    return remember(this.#engine.fromMeshes(...args));
   }
 
   /** Every receiver's sunlit fraction for one sun: [x, y, z] or { azimuth, altitude }. */

@@ -10,7 +10,9 @@
 //!   ([`adapter_threads_key`], [`cpu_key`]) with the pool's size as the clipping threads. A
 //!   profile handed in (pinned by the caller, or the page's IndexedDB cache) is used when it
 //!   parses and belongs to this model and device ([`profile_for`]); otherwise it is refused by
-//!   name (see [`Chosen::refused`]) and measured anew. Routing is [`Profile::route`]: a pure
+//!   name (see [`Chosen::refused`]) and measured anew. Sun and sky views ([`ViewKind`]) each
+//!   have their own profile, handed in, kept and measured apart, the sky's keys ending in
+//!   `; sky views` ([`views_key`]), as natively. Routing is [`Profile::route`]: a pure
 //!   function of the loads, the profile and the run's size, so the same inputs with the same
 //!   profile give the same answers byte for byte, whatever the pool's size.
 
@@ -24,10 +26,10 @@ use crate::count::exact::engine::{ExactEngine, ViewLoad};
 use crate::count::gpu::CounterOptions;
 use crate::count::hybrid::{
     EngineKind, PROBE_EXACT_VIEWS, Profile, Route, Split, adapter_threads_key, cpu_key, gpu_worth_probing, probe_exact, probe_gpu,
-    probe_views, profile_for, scene_key,
+    probe_views, profile_for, views_key,
 };
 use crate::count::lanes::Lane;
-use crate::count::{Engine, ViewAnswer, ViewRequest, check_receivers};
+use crate::count::{Engine, ViewAnswer, ViewKind, ViewRequest, check_receivers};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 
@@ -41,12 +43,14 @@ pub(super) struct Routing {
     pool: Option<Function>,
     /// Threads that clip: the pool's workers (1 without a pool).
     threads: usize,
-    /// A profile's JSON text and where it came from (`pinned`, `cache`).
-    given: Option<(String, String)>,
+    /// Per kind of views (sun, sky: [`kind_index`]), a profile's JSON text and where it came
+    /// from (`pinned`, `cache`).
+    given: [Option<(String, String)>; 2],
 }
 
 impl Routing {
-    /// Reads `{ clip, workers, profile, profileSource }` (each optional) from the JS object.
+    /// Reads `{ clip, workers, profile, profileSource, skyProfile, skyProfileSource }` (each
+    /// optional) from the JS object: `profile` routes the sun views, `skyProfile` the sky views.
     pub(super) fn from_js(value: &JsValue) -> Result<Self> {
         if value.is_undefined() || value.is_null() {
             return Ok(Self { threads: 1, ..Default::default() });
@@ -61,25 +65,45 @@ impl Routing {
             Some(w) => return Err(Error::argument("workers", format!("{w} is not a whole number of at least 1"))),
             None => 1,
         };
-        let source = get("profileSource").and_then(|s| s.as_string()).unwrap_or_else(|| "pinned".into());
         let text = |p: JsValue| p.as_string().unwrap_or_else(|| js_sys::JSON::stringify(&p).ok().map(String::from).unwrap_or_default());
-        let given = get("profile").map(|p| (text(p), source));
-        Ok(Self { pool, threads, given })
+        let given = |profile: &str, source: &str| {
+            let source = get(source).and_then(|s| s.as_string()).unwrap_or_else(|| "pinned".into());
+            get(profile).map(|p| (text(p), source))
+        };
+        Ok(Self { pool, threads, given: [given("profile", "profileSource"), given("skyProfile", "skyProfileSource")] })
     }
 }
 
+/// Where a kind of views keeps its state here: sun views 0, sky views 1.
+fn kind_index(views: ViewKind) -> usize {
+    match views {
+        ViewKind::Sun => 0,
+        ViewKind::Sky => 1,
+    }
+}
+
+/// What `auto` learns about one kind of views ([`ViewKind`]): sun and sky views cost the
+/// engines differently, so each kind is routed by its own profile, as natively.
+struct Routed {
+    /// The profile's keys: with the adapter, and exact-only (when the side allows one); the
+    /// sky's say `sky views` ([`views_key`]), so a sun profile is never taken for a sky one.
+    keys: (String, Option<String>),
+    profile: OnceCell<(Profile, &'static str)>,
+    refused: RefCell<Option<String>>,
+}
+
 /// The chosen engine over one model for one call: its exact engine (made on first use), its GPU
-/// lane (none without WebGPU), the caller's routing, and what routing learnt.
+/// lane (none without WebGPU), the caller's routing, and what routing learnt per kind of views.
 pub(super) struct Chosen<'a> {
     kind: EngineKind,
     scene: &'a Scene,
     exact: &'a OnceCell<ExactEngine>,
     lane: Option<Lane<'a>>,
     routing: &'a Routing,
-    /// The profile's keys: with the adapter, and exact-only (when the side allows one).
-    keys: (String, Option<String>),
-    profile: OnceCell<(Profile, &'static str)>,
-    refused: RefCell<Option<String>>,
+    /// Per kind of views ([`kind_index`]).
+    routed: [Routed; 2],
+    /// The kind of views being asked for now ([`Engine::views_of`]).
+    views: Cell<ViewKind>,
     /// Why the pool failed, as the pool said it (its `code`, the worker's index), for the caller.
     pool_error: RefCell<Option<JsValue>>,
     run_views: Cell<usize>,
@@ -95,19 +119,28 @@ impl<'a> Chosen<'a> {
         options: &CounterOptions,
         routing: &'a Routing,
     ) -> Self {
-        let keys = profile_keys(scene, lane.as_ref().map(|l| l.counter.adapter_info()), options, routing.threads);
+        let adapter = lane.as_ref().map(|l| l.counter.adapter_info());
+        let routed = |views| Routed {
+            keys: profile_keys(scene, views, adapter, options, routing.threads),
+            profile: OnceCell::new(),
+            refused: RefCell::new(None),
+        };
         Self {
             kind,
             scene,
             exact,
             lane,
             routing,
-            keys,
-            profile: OnceCell::new(),
-            refused: RefCell::new(None),
+            routed: [routed(ViewKind::Sun), routed(ViewKind::Sky)],
+            views: Cell::new(ViewKind::Sun),
             pool_error: RefCell::new(None),
             run_views: Cell::new(0),
         }
+    }
+
+    /// What routing learnt about the kind of views being asked for now.
+    fn now(&self) -> &Routed {
+        &self.routed[kind_index(self.views.get())]
     }
 
     fn exact(&self) -> &ExactEngine {
@@ -124,18 +157,20 @@ impl<'a> Chosen<'a> {
     /// (the pool walks them as it clips): a profile without a GPU cost, or no GPU, and nothing
     /// see-through in the scene. [`Profile::route`] would send every view to the exact engine.
     fn clips_everything(&self) -> bool {
-        let exact_only = self.profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.lane.is_none());
+        let exact_only = self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.lane.is_none());
         exact_only && self.scene.see_through_triangles == 0
     }
 
-    /// The profile `auto` routed by, as JSON, and where it came from (`pinned`, `cache`, `probe`).
-    pub(super) fn profile(&self) -> Option<(String, &'static str)> {
-        self.profile.get().and_then(|(p, source)| serde_json::to_string(p).ok().map(|t| (t, *source)))
+    /// The profile `auto` routed `views` by, as JSON, and where it came from (`pinned`, `cache`,
+    /// `probe`).
+    pub(super) fn profile(&self, views: ViewKind) -> Option<(String, &'static str)> {
+        let routed = &self.routed[kind_index(views)];
+        routed.profile.get().and_then(|(p, source)| serde_json::to_string(p).ok().map(|t| (t, *source)))
     }
 
-    /// Why a profile handed in was refused (it was then measured anew).
-    pub(super) fn refused(&self) -> Option<String> {
-        self.refused.borrow().clone()
+    /// Why a profile handed in for `views` was refused (it was then measured anew).
+    pub(super) fn refused(&self, views: ViewKind) -> Option<String> {
+        self.routed[kind_index(views)].refused.borrow().clone()
     }
 
     /// The pool's own error, when the pool failed: the caller gets it as the pool threw it.
@@ -143,23 +178,26 @@ impl<'a> Chosen<'a> {
         self.pool_error.borrow_mut().take()
     }
 
-    /// The profile for these views: the one handed in if it fits, else measured on them.
+    /// The profile for these views (of the kind being asked for): the one handed in for that
+    /// kind if it fits, else measured on them.
     async fn routing_profile(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<&Profile> {
-        if let Some((p, _)) = self.profile.get() {
+        let now = self.now();
+        if let Some((p, _)) = now.profile.get() {
             return Ok(p);
         }
-        let keys: Vec<&str> = [Some(self.keys.0.as_str()), self.keys.1.as_deref()].into_iter().flatten().collect();
-        let found = self.routing.given.as_ref().map(|(text, source)| (profile_for(text, &given_name(source), &keys), source));
+        let keys: Vec<&str> = [Some(now.keys.0.as_str()), now.keys.1.as_deref()].into_iter().flatten().collect();
+        let given = self.routing.given[kind_index(self.views.get())].as_ref();
+        let found = given.map(|(text, source)| (profile_for(text, &given_name(source, self.views.get()), &keys), source));
         let chosen = match found {
             Some((Ok(p), source)) => (p, if source == "cache" { "cache" } else { "pinned" }),
             Some((Err(e), _)) => {
-                *self.refused.borrow_mut() = Some(e.to_string());
+                *now.refused.borrow_mut() = Some(e.to_string());
                 (self.measure(requests, loads).await?, "probe")
             }
             None => (self.measure(requests, loads).await?, "probe"),
         };
-        let _ = self.profile.set(chosen);
-        self.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
+        let _ = now.profile.set(chosen);
+        now.profile.get().map(|(p, _)| p).ok_or_else(|| Error::argument("engine", "profile went missing"))
     }
 
     /// The native calibration on this page: the exact engine timed on one thread (a pool
@@ -172,9 +210,10 @@ impl<'a> Chosen<'a> {
             Some(lane) if gpu_worth_probing(mean_us, loads) => Some(probe_gpu(std::slice::from_ref(lane), requests, loads).await?),
             _ => None,
         };
-        let device = match (&gpu, &self.keys.1) {
+        let keys = &self.now().keys;
+        let device = match (&gpu, &keys.1) {
             (None, Some(cpu)) => cpu.clone(),
-            _ => self.keys.0.clone(),
+            _ => keys.0.clone(),
         };
         Ok(Profile { device, exact, gpu, gpu_startup_seconds: gpu.map(|_| 0.0) })
     }
@@ -204,24 +243,43 @@ impl<'a> Chosen<'a> {
     }
 }
 
-/// How a refusal names a profile handed in: the pinned one, or the page's stored one (where).
-fn given_name(source: &str) -> String {
-    match source {
+/// How a refusal names a profile handed in: the pinned one, or the page's stored one (where),
+/// and for which views when they are the sky's.
+fn given_name(source: &str, views: ViewKind) -> String {
+    let name = match source {
         "cache" => "the profile stored in IndexedDB (database 'sunlit', store 'engine-profiles')".into(),
         other => format!("the {other} profile"),
+    };
+    match views {
+        ViewKind::Sun => name,
+        ViewKind::Sky => format!("{name} for sky views"),
     }
 }
 
-/// The keys a profile of this model may carry: measured with the adapter, and exact-only.
-fn profile_keys(scene: &Scene, adapter: Option<&wgpu::AdapterInfo>, options: &CounterOptions, threads: usize) -> (String, Option<String>) {
-    let scene = scene_key(scene);
+/// The keys a profile of this model's `views` may carry: measured with the adapter, and
+/// exact-only.
+fn profile_keys(
+    scene: &Scene,
+    views: ViewKind,
+    adapter: Option<&wgpu::AdapterInfo>,
+    options: &CounterOptions,
+    threads: usize,
+) -> (String, Option<String>) {
+    let scene = views_key(scene, views);
     let with_adapter = format!("{}; {scene}", adapter_threads_key(adapter, options, threads));
     (with_adapter, cpu_key(options, threads).map(|k| format!("{k}; {scene}")))
 }
 
-/// The key under which the page keeps this model's profile: the adapter's (None: no WebGPU).
-pub(super) fn store_key(scene: &Scene, adapter: Option<&wgpu::AdapterInfo>, options: &CounterOptions, threads: usize) -> String {
-    profile_keys(scene, adapter, options, threads).0
+/// The key under which the page keeps this model's profile for `views`: the adapter's (None:
+/// no WebGPU).
+pub(super) fn store_key(
+    scene: &Scene,
+    views: ViewKind,
+    adapter: Option<&wgpu::AdapterInfo>,
+    options: &CounterOptions,
+    threads: usize,
+) -> String {
+    profile_keys(scene, views, adapter, options, threads).0
 }
 
 impl Engine for Chosen<'_> {
@@ -231,7 +289,7 @@ impl Engine for Chosen<'_> {
         // 0.5 s slower than `exact` on blaas-louvres' year (2.7 s against 2.1 s, bench-web).
         let gpu_routed = match self.kind {
             EngineKind::Gpu => true,
-            EngineKind::Auto => self.profile.get().is_some_and(|(p, _)| p.gpu.is_some()),
+            EngineKind::Auto => self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_some()),
             EngineKind::Exact => false,
         };
         match &self.lane {
@@ -242,6 +300,10 @@ impl Engine for Chosen<'_> {
 
     fn expect(&self, views: usize) {
         self.run_views.set(views);
+    }
+
+    fn views_of(&self, kind: ViewKind) {
+        self.views.set(kind);
     }
 
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {

@@ -42,6 +42,15 @@ impl Clipper {
         Ok(Self::of(&loaded.scene))
     }
 
+    /// From the engine's scene as `Model.sceneBytes` encodes it ([`Scene::to_bytes`]): no model
+    /// file is read again. The bytes are dropped once decoded, the scene once indexed.
+    #[wasm_bindgen(js_name = fromScene)]
+    pub fn from_scene(bytes: Vec<u8>) -> Result<Clipper, JsValue> {
+        let scene = Scene::from_bytes(&bytes).map_err(js_error)?;
+        drop(bytes);
+        Ok(Self::of(&scene))
+    }
+
     /// As `Engine.fromArrays`.
     #[wasm_bindgen(js_name = fromArrays)]
     pub fn from_arrays(

@@ -5,7 +5,8 @@
 // was measured for another model is refused by name and measured anew; one worker's failure is
 // reported with its index and code; Cancel in the middle of a pooled year rejects with an
 // AbortError and the engine then computes the same year again; a browser without WebGPU still
-// computes (clipping), and only the GPU engine is refused there.
+// computes (clipping), and only the GPU engine is refused there. The sky views of a year with
+// weather are routed by their own profile, kept under their own key.
 import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 import { serve } from '../../scripts/serve.mjs';
@@ -150,6 +151,73 @@ test('auto measures a profile once, caches it, and a pinned profile gives the sa
   // (the profile's GPU cost is absent or dearer on SwiftShader), so auto's CSV is exact's.
   const profile = JSON.parse(r.measured.profile);
   if (profile.gpu === null) assert.equal(r.measured.csv, r.exact.csv);
+});
+
+/** An EPW (Denver's location, made-up hourly beam and diffuse) so that a year counts sky views. */
+function weatherEpw() {
+  const lines = ['LOCATION,Golden,CO,USA,test,724666,39.74,-105.18,-7.0,1829', 'DESIGN CONDITIONS,0', 'TYPICAL/EXTREME PERIODS,0',
+    'GROUND TEMPERATURES,0', 'HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0', 'COMMENTS 1,', 'COMMENTS 2,', 'DATA PERIODS,1,1,Data,Sunday,1/1,12/31'];
+  const days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+  let n = 0;
+  days.forEach((count, m) => {
+    for (let d = 1; d <= count; d++) {
+      for (let h = 1; h <= 24; h++) {
+        const dni = 200 + ((n++ * 37) % 600);
+        lines.push(`1999,${m + 1},${d},${h},60,x,20,10,50,101000,0,1300,300,500,${dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0`);
+      }
+    }
+  });
+  return `${lines.join('\n')}\n`;
+}
+
+test('auto routes the sky views by their own profile, kept under their own key; a sun profile is refused for them', async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(
+    async ({ scene, year }) => {
+      eval(scene);
+      const { createEngine } = await import('/sunlit.js');
+      const run = async (options) => {
+        const engine = await createEngine({ resolution: 128, workers: 2, ...options });
+        const model = engine.fromArrays(louvredBlock());
+        const y = await engine.annual(model, year);
+        const out = {
+          csv: y.csv(),
+          profile: y.profile,
+          sky: { profile: y.skyProfile, source: y.skyProfileSource, refused: y.skyProfileRefused },
+          routing: engine.routing,
+        };
+        engine.close();
+        return out;
+      };
+      const measured = await run({});
+      const cached = await run({});
+      const pinned = await run({ profile: measured.profile, skyProfile: measured.sky.profile });
+      const sunForSky = await run({ profile: measured.profile, skyProfile: measured.profile });
+      return { measured, cached, pinned, sunForSky };
+    },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: { ...YEAR, epw: weatherEpw(), epwName: 'golden.epw' } },
+  );
+  await p.close();
+  assert.deepEqual(errors, []);
+  // The sky views were priced on sky views (the native P.sky.json twin), not by the sun's profile.
+  assert.equal(r.measured.sky.source, 'probe');
+  assert.match(JSON.parse(r.measured.sky.profile).device, /; sky views$/);
+  assert.doesNotMatch(JSON.parse(r.measured.profile).device, /sky views/);
+  assert.match(r.measured.routing.sky.key, /2 CPU threads; 128²; scene \d+ triangles, 5 receivers; sky views$/);
+  assert.match(r.measured.routing.key, /5 receivers$/);
+  // The next engine finds each kind's profile under its own key.
+  assert.equal(r.cached.sky.source, 'cache');
+  assert.equal(r.cached.sky.profile, r.measured.sky.profile);
+  assert.equal(r.cached.routing.source, 'cache');
+  assert.equal(r.cached.profile, r.measured.profile);
+  assert.equal(r.cached.csv, r.measured.csv);
+  assert.equal(r.pinned.sky.source, 'pinned');
+  assert.equal(r.pinned.routing.source, 'pinned');
+  assert.equal(r.pinned.csv, r.measured.csv);
+  // A sun profile pinned for the sky views belongs to other views: refused by name, measured anew.
+  assert.equal(r.sunForSky.routing.source, 'pinned');
+  assert.equal(r.sunForSky.sky.source, 'probe');
+  assert.match(r.sunForSky.sky.refused, /the pinned profile for sky views was measured for '.*5 receivers', not this model and device \('.*; sky views'\)/);
 });
 
 test('one worker failing is reported with its index and code; a missing module says it could not start', async () => {
