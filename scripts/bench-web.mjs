@@ -1,6 +1,6 @@
 // Times one model's year in headless Chromium (WebGPU on SwiftShader) through the JS API, with
 // the default engine and with each engine forced, and the same year with the native CLI:
-//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides LIST] [--load-only]
+//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides LIST] [--load-only]
 // Sides (default all): default (auto, the default pool; a first visit: it probes its profile),
 // default-cached (auto with the profile a first run measured, as a returning visit), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto). Each side
@@ -26,12 +26,18 @@ const flag = (name, fallback) => {
   return value;
 };
 const runs = Number(flag('--runs', '1'));
+// --timesteps N: EnergyPlus timesteps an hour of the year (the refinement's views grow with it).
+const timesteps = Number(flag('--timesteps', '4'));
+if (!Number.isInteger(timesteps) || timesteps < 1 || timesteps > 60) {
+  console.error(`bench-web: --timesteps must be a whole number of timesteps an hour from 1 to 60, got ${timesteps}`);
+  process.exit(2);
+}
 // --load-only: the model's load and the pool's copies, no year (where the memory goes, quickly).
 const loadOnly = args.includes('--load-only') && Boolean(args.splice(args.indexOf('--load-only'), 1));
 const sides = flag('--sides', 'default,exact,gpu,exact-1,native').split(',');
 const [model, samples = '27x19', resolution = '512'] = args;
 if (!model) {
-  console.error('usage: node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--sides default,exact,gpu,exact-1,native] [--load-only]');
+  console.error('usage: node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides default,exact,gpu,exact-1,native] [--load-only]');
   process.exit(2);
 }
 const [days, perDay] = samples.split('x').map(Number);
@@ -100,7 +106,7 @@ async function browserRun(side) {
     });
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
     const result = await page.evaluate(
-      async ({ name, file, days, perDay, resolution, place, options, loadOnly }) => {
+      async ({ name, file, days, perDay, resolution, place, options, loadOnly, timesteps }) => {
         const { createEngine, wasmMemoryBytes } = await import('/sunlit.js');
         const engine = await createEngine({ resolution, ...options });
         const bytes = new Uint8Array(await (await fetch(`/pkg/bench-model-${file}.glb`)).arrayBuffer());
@@ -126,7 +132,7 @@ async function browserRun(side) {
           engine.close();
           return out;
         }
-        const year = await engine.annual(model, { ...place, timestepsPerHour: 4, daysPerYear: days, samplesPerDay: perDay }, {
+        const year = await engine.annual(model, { ...place, timestepsPerHour: timesteps, daysPerYear: days, samplesPerDay: perDay }, {
           onProgress: (done, total) => {
             views = Math.max(views, done);
             // Every 30 s to the bench's stderr (the console), and at the end.
@@ -156,7 +162,7 @@ async function browserRun(side) {
         engine.close();
         return out;
       },
-      { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side], loadOnly },
+      { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side], loadOnly, timesteps },
     );
     peak = peakOf(peak, treeRss(process.pid));
     return { side: `page-${side}`, ...result, peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
@@ -172,7 +178,7 @@ function nativeRun() {
   const bin = join(ROOT, 'target/release/sunlit');
   statSync(bin);
   const t0 = performance.now();
-  execFileSync(bin, ['annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', '4',
+  execFileSync(bin, ['annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
     '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'] });
   return { side: 'native', total_s: (performance.now() - t0) / 1000 };
 }
