@@ -13,6 +13,7 @@ import { after, before, test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 import { serve } from '../../scripts/serve.mjs';
 import { launch } from './chromium.mjs';
+import { SYDNEY, syntheticEpw } from './epw.mjs';
 
 const ROOT = fileURLToPath(new URL('../../', import.meta.url));
 const EXAMPLE = join(ROOT, 'www/pkg/office.glb');
@@ -446,27 +447,9 @@ test('a browser without WebGPU is told only the GPU engine is missing, and still
   }
 });
 
-/** An EPW for Sydney (LOCATION differs from the form's Golden) whose direct normal irradiance
- * varies from hour to hour. */
-function sydneyEpw() {
-  const lines = ['LOCATION,Sydney,NSW,AUS,test,947670,-33.87,151.21,10.0,39', 'DESIGN CONDITIONS,0', 'TYPICAL/EXTREME PERIODS,0',
-    'GROUND TEMPERATURES,0', 'HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0', 'COMMENTS 1,', 'COMMENTS 2,', 'DATA PERIODS,1,1,Data,Sunday,1/1,12/31'];
-  const days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
-  let n = 0;
-  days.forEach((count, m) => {
-    for (let d = 1; d <= count; d++) {
-      for (let h = 1; h <= 24; h++) {
-        const dni = 200 + ((n++ * 37) % 600);
-        lines.push(`1999,${m + 1},${d},${h},60,x,20,10,50,101000,0,1300,300,500,${dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0`);
-      }
-    }
-  });
-  return `${lines.join('\n')}\n`;
-}
-
 test('with an EPW: its location in the form, irradiation columns and colours, equal to the API', { timeout: 600_000 }, async () => {
   assert.match(await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb/);
-  const epwText = sydneyEpw();
+  const epwText = syntheticEpw(SYDNEY);
   const epwPath = join(WORK, 'sydney.epw');
   writeFileSync(epwPath, epwText);
   await page.setInputFiles('#epw', epwPath);

@@ -11,6 +11,7 @@ import assert from 'node:assert/strict';
 import { after, before, test } from 'node:test';
 import { serve } from '../../scripts/serve.mjs';
 import { launch } from './chromium.mjs';
+import { GOLDEN, syntheticEpw } from './epw.mjs';
 
 let server;
 let origin;
@@ -153,23 +154,6 @@ test('auto measures a profile once, caches it, and a pinned profile gives the sa
   if (profile.gpu === null) assert.equal(r.measured.csv, r.exact.csv);
 });
 
-/** An EPW (Denver's location, made-up hourly beam and diffuse) so that a year counts sky views. */
-function weatherEpw() {
-  const lines = ['LOCATION,Golden,CO,USA,test,724666,39.74,-105.18,-7.0,1829', 'DESIGN CONDITIONS,0', 'TYPICAL/EXTREME PERIODS,0',
-    'GROUND TEMPERATURES,0', 'HOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0', 'COMMENTS 1,', 'COMMENTS 2,', 'DATA PERIODS,1,1,Data,Sunday,1/1,12/31'];
-  const days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
-  let n = 0;
-  days.forEach((count, m) => {
-    for (let d = 1; d <= count; d++) {
-      for (let h = 1; h <= 24; h++) {
-        const dni = 200 + ((n++ * 37) % 600);
-        lines.push(`1999,${m + 1},${d},${h},60,x,20,10,50,101000,0,1300,300,500,${dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0`);
-      }
-    }
-  });
-  return `${lines.join('\n')}\n`;
-}
-
 test('auto routes the sky views by their own profile, kept under their own key; a sun profile is refused for them', async () => {
   const { p, errors } = await apiPage();
   const r = await p.evaluate(
@@ -195,7 +179,7 @@ test('auto routes the sky views by their own profile, kept under their own key; 
       const sunForSky = await run({ profile: measured.profile, skyProfile: measured.profile });
       return { measured, cached, pinned, sunForSky };
     },
-    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: { ...YEAR, epw: weatherEpw(), epwName: 'golden.epw' } },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: { ...YEAR, epw: syntheticEpw(GOLDEN), epwName: 'golden.epw' } },
   );
   await p.close();
   assert.deepEqual(errors, []);
