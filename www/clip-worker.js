@@ -8,13 +8,9 @@ import init, { Clipper } from './pkg/sunlit_wasm.js';
 let clipper = null;
 let memory = null;
 
-/** A Clipper from the engine's encoded scene (what sunlit.js sends), or from what built the
- * engine's model (files, arrays or meshes). */
+/** A Clipper from the engine's encoded scene (what sunlit.js sends). */
 function build({ kind, args }) {
   if (kind === 'scene') return Clipper.fromScene(...args);
-  if (kind === 'files') return Clipper.fromFiles(...args);
-  if (kind === 'arrays') return Clipper.fromArrays(...args);
-  if (kind === 'meshes') return Clipper.fromMeshes(...args);
   throw Object.assign(new Error(`unknown model source '${kind}'`), { code: 'bad-option' });
 }
 

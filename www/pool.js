@@ -103,9 +103,8 @@ export class ClipPool {
   }
 
   /** Makes `source` the pool's model; resolves when every worker holds it. The same source twice
-   * loads once. `source`: { kind, args } (clip-worker.js's kinds: 'scene' takes the engine's
-   * encoded scene, 'files', 'arrays' and 'meshes' what built the engine's model), or { kind,
-   * encode } where encode() gives the args once the workers have started (sunlit.js encodes the
+   * loads once. `source`: { kind, args } (clip-worker.js's one kind, 'scene', takes the
+   * engine's encoded scene), or { kind, encode } where encode() gives the args once the workers have started (sunlit.js encodes the
    * scene then; the encoding is copied to each worker and not kept here). */
   use(source) {
     if (this.#broken) return Promise.reject(this.#broken);

@@ -45,7 +45,8 @@ function coded(message, code, names = {}) {
  * pool's size (default navigator.hardwareConcurrency; 0 clips in this thread); `profile`: an
  * `auto` profile (JSON text or object, as `year.profile` gives it) to route the sun views by
  * instead of the cached or measured one (sunlit.d.ts); `skyProfile`: the same for the sky views
- * (as `year.skyProfile` gives it), which are routed by their own profile as natively. Without WebGPU the engine still clips (`hasGpu` false);
+ * (as `year.skyProfile` gives it), which are routed by their own profile as natively. Without
+ * WebGPU the engine still clips (`hasGpu` false);
  * only `engine: 'gpu'` is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
  * for another engine name or pool size. */
 export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile } = {}) {
