@@ -23,7 +23,8 @@
 //!
 //! Cost: each edge is tested only against polygons whose bounding boxes overlap its own (all of
 //! them when there are few, a grid of square buckets about a typical polygon wide when there are
-//! many, as leaves give; square whatever the window's shape, since a façade's window may be 10:1),
+//! many, as leaves give; square whatever the window's shape, since a façade's window may be 10:1;
+//! a polygon over many buckets, a wall's shadow, in coarse buckets of 4 × 4 of them),
 //! so a view with `n` shadows of bounded overlap costs about `n` times their edges. A cover that
 //! runs from an edge's start or to its end moves the counters without an event (a leaf's edges
 //! lie across a receiver triangle end to end), so most edges sort only their leaf neighbours'
@@ -48,8 +49,13 @@ const BUCKET_PER_TYPICAL: f64 = 1.0;
 const BUCKETS_PER_POLYGON: f64 = 1.0;
 const MAX_BUCKETS: usize = 1 << 16;
 /// A polygon over more buckets than this (a receiver triangle, a wall's shadow) is kept out of
-/// them and tested by its box alone: in every bucket it would be met again by every query.
+/// them, in coarse buckets of [`COARSE`]² buckets each: in every bucket it would be met again by
+/// every query.
 const BIG_SPAN: usize = 16;
+/// Buckets per coarse bucket's side. A heavy sky view has a few dozen big polygons, and nine in
+/// ten of them are far from any one leaf; tested by box alone they cost as many box tests as
+/// every edge's own scan.
+const COARSE: usize = 4;
 
 type Point = [i64; 2];
 
@@ -163,8 +169,10 @@ pub(super) struct Boundary {
     /// Scratch for [`Self::build_buckets`]: each cell's next free slot.
     next_slot: Vec<u32>,
     buckets: Buckets,
-    /// Polygons over more than [`BIG_SPAN`] buckets, not in any.
-    big: Vec<u32>,
+    /// Polygons over more than [`BIG_SPAN`] buckets, not in any: per coarse bucket its range of
+    /// `big_items` (prefix sums), the polygons whose boxes span it.
+    big_start: Vec<u32>,
+    big_items: Vec<u32>,
     /// Per polygon: the buckets its box spans, `[x0, y0, x1, y1]` (found once a build).
     spans: Vec<[usize; 4]>,
     /// Per polygon: whether it is kept (scratch for [`Self::drop_covered`]).
@@ -389,17 +397,19 @@ impl Boundary {
         if b.n[0] == 0 {
             return (0..self.polys.len()).find(|&q| self.covers(q, p));
         }
-        // A container's bounds hold `lo`, so it is in that point's cell or among the big ones
-        // (a container of a big polygon spans at least as many cells, so is big too).
+        // A container's bounds hold `lo`, so it is in that point's cell or, if big, in that point's
+        // coarse cell (a container of a big polygon spans at least as many cells, so is big too).
         let [cx, cy, _, _] = self.spans[p];
         let cell = cy * b.n[0] + cx;
         let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
+        let coarse = (cy / COARSE) * b.coarse_columns() + cx / COARSE;
+        let big = &self.big_items[self.big_start[coarse] as usize..self.big_start[coarse + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
         let (lo, hi) = (self.polys[p].lo, self.polys[p].hi);
         // Receivers (big, around most boxes) never contain: skipped before the call.
         let boxed = |q: usize| !self.polys[q].receiver && box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
         let found = |list: &[u32]| list.iter().map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p));
-        found(&self.big).or_else(|| found(bucketed))
+        found(big).or_else(|| found(bucketed))
     }
 
     /// Polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
@@ -416,14 +426,8 @@ impl Boundary {
             self.stamp.fill(0);
             self.epoch = 1;
         }
-        for k in 0..self.big.len() {
-            let q = self.big[k];
-            let poly = &self.polys[q as usize];
-            if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                self.candidates.push(Near::of(q as usize, poly));
-            }
-        }
         let [x0, y0, x1, y1] = self.spans[own];
+        self.collect_big(own, lo, hi);
         for cy in y0..=y1 {
             for cx in x0..=x1 {
                 let cell = cy * b.n[0] + cx;
@@ -442,6 +446,30 @@ impl Boundary {
         // Not in push order, but the sums do not depend on the order the counters move in.
     }
 
+    /// The big polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
+    /// A big polygon lies in every coarse bucket its box spans, so it may share several with
+    /// `own`; it is taken in one: the coarse bucket holding the two boxes' common lower corner
+    /// (per axis the later of their first coarse buckets, as buckets are found by a monotone
+    /// division: scanned here exactly when it is `own`'s first or the other's).
+    fn collect_big(&mut self, own: usize, lo: Point, hi: Point) {
+        let columns = self.buckets.coarse_columns();
+        let [x0, y0, x1, y1] = self.spans[own].map(|c| c / COARSE);
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let coarse = cy * columns + cx;
+                for k in self.big_start[coarse]..self.big_start[coarse + 1] {
+                    let q = self.big_items[k as usize] as usize;
+                    let [qx, qy, _, _] = self.spans[q].map(|c| c / COARSE);
+                    let met_here = (cx == x0 || cx == qx) && (cy == y0 || cy == qy);
+                    let poly = &self.polys[q];
+                    if met_here && q != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
+                        self.candidates.push(Near::of(q, poly));
+                    }
+                }
+            }
+        }
+    }
+
     /// Buckets the polygons by their boxes when there are many (else `buckets.n = [0, 0]`).
     fn build_buckets(&mut self) {
         let n = self.polys.len();
@@ -457,13 +485,11 @@ impl Boundary {
         let cells = buckets.n[0] * buckets.n[1];
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
-        self.big.clear();
         self.spans.clear();
-        for (i, p) in self.polys.iter().enumerate() {
+        for p in &self.polys {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
             self.spans.push([c0[0], c0[1], c1[0], c1[1]]);
             if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
-                self.big.push(i as u32);
                 continue;
             }
             for cy in c0[1]..=c1[1] {
@@ -494,6 +520,43 @@ impl Boundary {
             }
         }
         self.next_slot = next;
+        self.build_coarse();
+    }
+
+    /// Fills the coarse buckets with the big polygons (as [`Self::build_buckets`] fills its own).
+    fn build_coarse(&mut self) {
+        let columns = self.buckets.coarse_columns();
+        let cells = columns * self.buckets.n[1].div_ceil(COARSE);
+        let is_big = |&[x0, y0, x1, y1]: &[usize; 4]| (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN;
+        let coarse = |span: &[usize; 4]| span.map(|c| c / COARSE);
+        self.big_start.clear();
+        self.big_start.resize(cells + 1, 0);
+        for [x0, y0, x1, y1] in self.spans.iter().filter(|s| is_big(s)).map(coarse) {
+            for cy in y0..=y1 {
+                for cx in x0..=x1 {
+                    self.big_start[cy * columns + cx + 1] += 1;
+                }
+            }
+        }
+        for c in 0..cells {
+            self.big_start[c + 1] += self.big_start[c];
+        }
+        self.big_items.clear();
+        self.big_items.resize(self.big_start[cells] as usize, 0);
+        let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
+        next.clear();
+        next.extend_from_slice(&self.big_start[..cells]);
+        for (i, span) in self.spans.iter().enumerate().filter(|(_, s)| is_big(s)) {
+            let [x0, y0, x1, y1] = coarse(span);
+            for cy in y0..=y1 {
+                for cx in x0..=x1 {
+                    let cell = cy * columns + cx;
+                    self.big_items[next[cell] as usize] = i as u32;
+                    next[cell] += 1;
+                }
+            }
+        }
+        self.next_slot = next;
     }
 
     /// The median of the polygons' longer box sides (the typical leaf's shadow among many).
@@ -518,6 +581,11 @@ impl Buckets {
         let size = ((typical as f64 * BUCKET_PER_TYPICAL).max(fewest) as i64).max(1);
         let along = |k: usize| (extent[k] / size + 1) as usize;
         Self { n: [along(0), along(1)], origin: lo, size }
+    }
+
+    /// Coarse buckets per row.
+    fn coarse_columns(&self) -> usize {
+        self.n[0].div_ceil(COARSE)
     }
 
     /// The cell holding grid point `p` (clamped to the grid of cells).
