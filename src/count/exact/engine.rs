@@ -463,7 +463,14 @@ impl ExactEngine {
             objects::convex_hull(&mut s.flat, &mut s.hull);
             std::mem::swap(&mut s.flat, &mut s.hull);
         }
-        clip_to_window(&outline.window, &s.flat, &mut s.window_a, &mut s.window_b);
+        // Inside the window (most shadows of a view), clipping would give the polygon back as it is.
+        let inside = outline.window.min.cmple(lo).all() && hi.cmple(outline.window.max).all();
+        if inside {
+            s.window_a.clear();
+            s.window_a.extend_from_slice(&s.flat);
+        } else {
+            clip_to_window(&outline.window, &s.flat, &mut s.window_a, &mut s.window_b);
+        }
         let polygon = &s.window_a;
         if polygon.len() < 3 {
             return;
