@@ -483,80 +483,19 @@ impl Boundary {
         let buckets = Buckets::over(lo, extent, self.typical_side(), n);
         self.buckets = buckets;
         let cells = buckets.n[0] * buckets.n[1];
-        self.cell_start.clear();
-        self.cell_start.resize(cells + 1, 0);
         self.spans.clear();
-        for p in &self.polys {
+        self.spans.extend(self.polys.iter().map(|p| {
             let (c0, c1) = (buckets.cell(p.lo), buckets.cell(p.hi));
-            self.spans.push([c0[0], c0[1], c1[0], c1[1]]);
-            if (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) > BIG_SPAN {
-                continue;
-            }
-            for cy in c0[1]..=c1[1] {
-                for cx in c0[0]..=c1[0] {
-                    self.cell_start[cy * buckets.n[0] + cx + 1] += 1;
-                }
-            }
-        }
-        for c in 0..cells {
-            self.cell_start[c + 1] += self.cell_start[c];
-        }
-        self.cell_items.clear();
-        self.cell_items.resize(self.cell_start[cells] as usize, 0);
-        // Fill each cell from its start, in push order.
-        let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
-        next.clear();
-        next.extend_from_slice(&self.cell_start[..cells]);
-        for (i, &[x0, y0, x1, y1]) in self.spans.iter().enumerate() {
-            if (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN {
-                continue;
-            }
-            for cy in y0..=y1 {
-                for cx in x0..=x1 {
-                    let cell = cy * buckets.n[0] + cx;
-                    self.cell_items[next[cell] as usize] = i as u32;
-                    next[cell] += 1;
-                }
-            }
-        }
-        self.next_slot = next;
-        self.build_coarse();
-    }
-
-    /// Fills the coarse buckets with the big polygons (as [`Self::build_buckets`] fills its own).
-    fn build_coarse(&mut self) {
-        let columns = self.buckets.coarse_columns();
-        let cells = columns * self.buckets.n[1].div_ceil(COARSE);
-        let is_big = |&[x0, y0, x1, y1]: &[usize; 4]| (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN;
-        let coarse = |span: &[usize; 4]| span.map(|c| c / COARSE);
-        self.big_start.clear();
-        self.big_start.resize(cells + 1, 0);
-        for [x0, y0, x1, y1] in self.spans.iter().filter(|s| is_big(s)).map(coarse) {
-            for cy in y0..=y1 {
-                for cx in x0..=x1 {
-                    self.big_start[cy * columns + cx + 1] += 1;
-                }
-            }
-        }
-        for c in 0..cells {
-            self.big_start[c + 1] += self.big_start[c];
-        }
-        self.big_items.clear();
-        self.big_items.resize(self.big_start[cells] as usize, 0);
-        let mut next: Vec<u32> = std::mem::take(&mut self.next_slot);
-        next.clear();
-        next.extend_from_slice(&self.big_start[..cells]);
-        for (i, span) in self.spans.iter().enumerate().filter(|(_, s)| is_big(s)) {
-            let [x0, y0, x1, y1] = coarse(span);
-            for cy in y0..=y1 {
-                for cx in x0..=x1 {
-                    let cell = cy * columns + cx;
-                    self.big_items[next[cell] as usize] = i as u32;
-                    next[cell] += 1;
-                }
-            }
-        }
-        self.next_slot = next;
+            [c0[0], c0[1], c1[0], c1[1]]
+        }));
+        let spans = &self.spans;
+        let small = || spans.iter().enumerate().filter(|(_, s)| !is_big(s)).map(|(i, &s)| (i as u32, s));
+        fill_cells(buckets.n[0], cells, small, &mut self.cell_start, &mut self.cell_items, &mut self.next_slot);
+        // The big ones in coarse buckets of COARSE × COARSE buckets.
+        let columns = buckets.coarse_columns();
+        let coarse_cells = columns * buckets.n[1].div_ceil(COARSE);
+        let big = || spans.iter().enumerate().filter(|(_, s)| is_big(s)).map(|(i, s)| (i as u32, s.map(|c| c / COARSE)));
+        fill_cells(columns, coarse_cells, big, &mut self.big_start, &mut self.big_items, &mut self.next_slot);
     }
 
     /// The median of the polygons' longer box sides (the typical leaf's shadow among many).
@@ -592,6 +531,50 @@ impl Buckets {
     fn cell(&self, p: Point) -> [usize; 2] {
         let c = |k: usize| (((p[k] - self.origin[k]) / self.size).max(0) as usize).min(self.n[k] - 1);
         [c(0), c(1)]
+    }
+}
+
+/// Whether a polygon over these buckets (`[x0, y0, x1, y1]`) is kept out of them (see [`BIG_SPAN`]).
+fn is_big(&[x0, y0, x1, y1]: &[usize; 4]) -> bool {
+    (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_SPAN
+}
+
+/// A counting sort of polygons into the cells of a grid `columns` wide: `start` gets per cell
+/// its range of `items` (prefix sums), `items` each cell's polygons in the order `spans` gives
+/// them. `spans` yields each polygon's index and the cells its box spans, `[x0, y0, x1, y1]`,
+/// once to count and once to fill; `next` is scratch.
+fn fill_cells<I: Iterator<Item = (u32, [usize; 4])>>(
+    columns: usize,
+    cells: usize,
+    spans: impl Fn() -> I,
+    start: &mut Vec<u32>,
+    items: &mut Vec<u32>,
+    next: &mut Vec<u32>,
+) {
+    start.clear();
+    start.resize(cells + 1, 0);
+    for (_, [x0, y0, x1, y1]) in spans() {
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                start[cy * columns + cx + 1] += 1;
+            }
+        }
+    }
+    for c in 0..cells {
+        start[c + 1] += start[c];
+    }
+    items.clear();
+    items.resize(start[cells] as usize, 0);
+    next.clear();
+    next.extend_from_slice(&start[..cells]);
+    for (i, [x0, y0, x1, y1]) in spans() {
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let cell = cy * columns + cx;
+                items[next[cell] as usize] = i;
+                next[cell] += 1;
+            }
+        }
     }
 }
 
