@@ -22,8 +22,7 @@ const NO_OBJECT: u32 = u32::MAX;
 pub(super) struct PlacedObjects {
     /// Per position: its convex object, or [`NO_OBJECT`].
     of: Vec<u32>,
-    /// Per object (convex or not; a non-convex one has none): its triangle positions, a range of
-    /// `triangles`.
+    /// Per object (only convex ones are numbered): its triangle positions, a range of `triangles`.
     ranges: Vec<Range<u32>>,
     triangles: Vec<u32>,
     /// Per object: its distinct corners (bit for bit), a range of `corners`.
@@ -67,14 +66,14 @@ impl PlacedObjects {
         Self { of, ranges, triangles: object_triangles, corner_ranges, corners, cap_ranges, caps, cap_corners }
     }
 
-    /// Objects numbered (convex or not): the size of a per-object stamp.
+    /// Objects numbered (every convex one): the size of a per-object stamp.
     pub(super) fn len(&self) -> usize {
         self.ranges.len()
     }
 
     /// Convex objects (those whose shadows are merged).
     pub(super) fn convex(&self) -> usize {
-        self.ranges.iter().filter(|r| !r.is_empty()).count()
+        self.len()
     }
 
     /// The convex object of the triangle at `position`, if any.
@@ -129,7 +128,8 @@ fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
 /// is not used as convex.
 const UNKNOWN_CAPS: u32 = u32::MAX;
 
-/// Per object of every placement (in [`PlacedObjects`]' order): its caps as a range of
+/// Per object of every placement (placement by placement, as numbered before
+/// [`renumber_by_position`]): its caps as a range of
 /// the second list, each cap a range of the third, each corner `3 · position + corner` of a
 /// triangle at that position of `sources`.
 fn object_caps(scene: &Scene, mesh_objects: &[MeshObjects], sources: &[(usize, u32)]) -> (Vec<Range<u32>>, Vec<Range<u32>>, Vec<u32>) {
@@ -193,14 +193,15 @@ fn distinct_corners(objects: &[Range<u32>], object_triangles: &[u32], triangles:
 /// Numbers the objects in the order their first triangles come by position, as a view's walk
 /// meets them, so that what a view reads per object (its stamp, corners, caps) lies close
 /// together instead of across the whole scene (1.1× faster on a canopy's sky views); returns the
-/// new object of each position and, per new number, the old one (of `objects`). Objects with no
-/// triangle lose their number.
+/// new object of each position and, per new number, the old one (of `objects`). Objects that no
+/// position names (not convex) lose their number.
 fn renumber_by_position(of: Vec<u32>, objects: usize) -> (Vec<u32>, Vec<u32>) {
     let mut new_of_old = vec![NO_OBJECT; objects];
     let mut numbered = Vec::new();
     let of = of
         .into_iter()
         .map(|o| {
+            // `NO_OBJECT` (not convex) lies beyond every number and stays as it is.
             let Some(new) = new_of_old.get_mut(o as usize) else { return NO_OBJECT };
             if *new == NO_OBJECT {
                 *new = numbered.len() as u32;
