@@ -41,7 +41,7 @@ use crate::scene::{Receiver, Scene};
 mod boundary;
 pub mod engine;
 mod objects;
-mod placed;
+pub(crate) mod placed;
 pub mod rays;
 
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).

@@ -7,6 +7,7 @@
 //! polygon-clipping reference ([`exact`]) that tests hold the GPU to. A caller can hand any view
 //! to either.
 
+pub mod certify;
 pub mod cull;
 pub mod exact;
 pub mod gpu;

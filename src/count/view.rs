@@ -65,7 +65,7 @@ pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, 
 }
 
 /// Two unit vectors completing `w` to a right-handed orthonormal basis.
-fn perpendicular_basis(w: DVec3) -> (DVec3, DVec3) {
+pub(crate) fn perpendicular_basis(w: DVec3) -> (DVec3, DVec3) {
     let helper = if w.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
     let u = helper.cross(w).normalize();
     (u, w.cross(u))
@@ -113,7 +113,7 @@ fn rotated_extents(points: &[DVec2], angle: f64) -> (DVec2, DVec2) {
 }
 
 /// Andrew's monotone chain; returns the hull counter-clockwise without repeating the first point.
-fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
+pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
     let mut p: Vec<DVec2> = points.to_vec();
     p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     p.dedup();

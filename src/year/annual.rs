@@ -24,6 +24,7 @@
 
 use glam::DVec3;
 
+use crate::count::certify::Certifier;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
@@ -32,6 +33,7 @@ use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
+use crate::year::certified::{self, Rough};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::year::season::{LeafCalendar, Phase};
@@ -461,13 +463,12 @@ async fn spline_year(
     }
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
     let rough = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
-    let requests: Vec<ViewRequest> = rough
-        .iter()
-        .map(|(_, column, sun, day)| ViewRequest::new(*column as u32, *sun).with_leaves(calendar.fraction(*day) as f32))
-        .collect();
+    let rough = if rough.is_empty() { rough } else { settle_by_certificate(scene, rough, schedule) };
+    let requests: Vec<ViewRequest> =
+        rough.iter().map(|r| ViewRequest::new(r.column as u32, r.sun).with_leaves(calendar.fraction(r.day) as f32)).collect();
     let refined = views.count(&requests, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
-    for ((row, column, _, _), v) in rough.into_iter().zip(refined) {
-        schedule.set(row, column, as_energyplus(v));
+    for (r, v) in rough.into_iter().zip(refined) {
+        schedule.set(r.row, r.column, as_energyplus(v));
     }
     let surfaces = regimes
         .iter()
@@ -475,6 +476,15 @@ async fn spline_year(
         .map(|(g, f)| FittedSurfaces { map: g.map, splines: f.into_iter().map(|p| p.map(|p| p.spline)).collect() })
         .collect();
     Ok(FittedYear::new(scene, location, *calendar, surfaces, regime_of, schedule.timesteps.days()))
+}
+
+/// Sets the refined timesteps that a certificate proves dark or lit ([`certified`]) and returns
+/// the rest, to count.
+fn settle_by_certificate(scene: &Scene, rough: Vec<Rough>, schedule: &mut Schedule) -> Vec<Rough> {
+    let asked = rough.len();
+    let (rest, dark, lit) = certified::settle(&Certifier::new(scene), rough, schedule);
+    log::info!("refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit, {} counted", rest.len());
+    rest
 }
 
 /// The views the sample grids need, and where each count goes.
@@ -603,6 +613,10 @@ struct Cell {
     spread: f64,
     /// The lowest of them.
     lowest: f64,
+    /// The highest of them.
+    highest: f64,
+    /// Its first sample day and sample time (indices): which cell it is.
+    at: (usize, usize),
     /// Their bilinear interpolation at (day, τ) (τ outside the outermost nodes is held at the node).
     bilinear: f64,
 }
@@ -621,14 +635,14 @@ impl SampleCells {
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
         let v = if j1 > j0 { ((tau - self.taus[j0]) / (self.taus[j1] - self.taus[j0])).clamp(0.0, 1.0) } else { 0.0 };
         let bilinear = (1.0 - u) * ((1.0 - v) * corners[0] + v * corners[1]) + u * ((1.0 - v) * corners[2] + v * corners[3]);
-        Cell { spread: hi - lo, lowest: lo, bilinear }
+        Cell { spread: hi - lo, lowest: lo, highest: hi, bilinear, at: (k0, j0) }
     }
 }
 
 /// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
-/// where dark) and returns the (row, column, sun, day) cells to count directly: those whose sample
-/// cell spreads more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]) or where
-/// the spline leaves its cell's bilinear interpolation ([`KINK`]).
+/// where dark) and returns the timesteps to count directly: those whose sample cell spreads
+/// more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]) or where the spline
+/// leaves its cell's bilinear interpolation ([`KINK`]).
 fn evaluate(
     scene: &Scene,
     location: &Location,
@@ -636,13 +650,14 @@ fn evaluate(
     regime_of: &dyn Fn(f64) -> usize,
     refine: f64,
     schedule: &mut Schedule,
-) -> Vec<(usize, usize, DVec3, f64)> {
+) -> Vec<Rough> {
     let mut rough = Vec::new();
     let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
     for day in 1..=schedule.timesteps.days() {
         let pieces: Vec<Vec<(f64, f64)>> =
             scene.receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
-        let regime = &regimes[regime_of(day as f64)];
+        let g = regime_of(day as f64);
+        let regime = &regimes[g];
         let grid_day = regime.map.grid_day(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = schedule.timesteps.instant(row);
@@ -655,12 +670,13 @@ fn evaluate(
                     continue;
                 }
                 let Some((fit, tau)) = fit_at(&pieces[column], column, instant.hour) else { continue };
-                if let Some(fit) = &regime.fits[fit] {
-                    let value = fit.spline.eval(grid_day, tau);
+                if let Some(piece) = &regime.fits[fit] {
+                    let value = piece.spline.eval(grid_day, tau);
                     schedule.set(row, column, as_energyplus(value));
-                    let cell = regime.cells.cell(&fit.samples, grid_day, tau);
+                    let cell = regime.cells.cell(&piece.samples, grid_day, tau);
                     if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
-                        rough.push((row, column, sun, day as f64));
+                        let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
+                        rough.push(Rough { row, column, sun, day, cell, corners });
                     }
                 }
             }

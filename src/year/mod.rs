@@ -5,11 +5,13 @@
 //! resolver of a run's settings that the CLI and the web share ([`settings`]), the B-spline
 //! surface over (day, time of day) through the samples ([`spline`]), and the annual run that ties
 //! them to an [`Engine`](crate::count::Engine): what to count, fitting, refining where shadow
-//! edges sweep too fast, and surviving a lost GPU device ([`annual`]); and the fitted surfaces kept
+//! edges sweep too fast, and surviving a lost GPU device ([`annual`]), with the refined steps that a certificate proves dark
+//! or lit set without a view ([`certified`]); and the fitted surfaces kept
 //! to evaluate at any instant ([`fitted`], a viewer's time slider). It knows nothing of pixels
 //! (that is [`crate::count`]) or of files (that is [`crate::export`]).
 
 pub mod annual;
+mod certified;
 pub mod fitted;
 pub mod samples;
 pub mod season;

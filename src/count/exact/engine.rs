@@ -58,19 +58,19 @@ struct Outline {
 pub struct ExactEngine {
     outlines: Vec<Option<Outline>>,
     frames: Vec<Option<PlaneFrame>>,
-    culling: Culling,
+    pub(crate) culling: Culling,
     /// Per triangle position (the culling's order): the world triangle, as the reference makes it.
-    triangles: Vec<[DVec3; 3]>,
+    pub(crate) triangles: Vec<[DVec3; 3]>,
     /// Per position: the receiver it belongs to ([`NO_RECEIVER`] for shading geometry).
-    owner: Vec<u32>,
+    pub(crate) owner: Vec<u32>,
     /// Per position: its veil (leaf rank already shifted by its instance).
-    veils: Vec<Veil>,
+    pub(crate) veils: Vec<Veil>,
     /// The convex objects among those triangles.
-    objects: PlacedObjects,
+    pub(crate) objects: PlacedObjects,
     /// Prefix counts of see-through triangles by position (the exact engine counts them as opaque).
     see_through_before: Vec<u32>,
-    bounds: (DVec3, DVec3),
-    origin: DVec3,
+    pub(crate) bounds: (DVec3, DVec3),
+    pub(crate) origin: DVec3,
     area_eps: f64,
 }
 
@@ -445,7 +445,7 @@ impl ExactEngine {
     }
 
     /// A corner `3 · position + k`: corner `k` of the triangle at that position.
-    fn corner(&self, c: u32) -> DVec3 {
+    pub(crate) fn corner(&self, c: u32) -> DVec3 {
         self.triangles[c as usize / 3][c as usize % 3]
     }
 
@@ -613,14 +613,14 @@ where
 }
 
 /// Threads for exact views: every core natively, one on the web (no threads to block there).
-fn worker_threads() -> usize {
+pub(crate) fn worker_threads() -> usize {
     if cfg!(target_arch = "wasm32") { 1 } else { std::thread::available_parallelism().map_or(1, |n| n.get()) }
 }
 
 /// `job(i, scratch)` for every `i < n`, over `threads` threads taking `chunk` items at a time, in
 /// item order whatever thread ran each.
 #[cfg(not(target_arch = "wasm32"))]
-fn parallel_chunks<S, T: Send + Default + Clone>(
+pub(crate) fn parallel_chunks<S, T: Send + Default + Clone>(
     n: usize,
     threads: usize,
     chunk: usize,
@@ -658,7 +658,7 @@ fn parallel_chunks<S, T: Send + Default + Clone>(
 
 /// One thread on the web.
 #[cfg(target_arch = "wasm32")]
-fn parallel_chunks<S, T: Send + Default + Clone>(
+pub(crate) fn parallel_chunks<S, T: Send + Default + Clone>(
     n: usize,
     _threads: usize,
     _chunk: usize,

@@ -19,7 +19,7 @@ const NO_OBJECT: u32 = u32::MAX;
 
 /// Every placement's convex objects, by triangle position.
 #[derive(Debug, Default)]
-pub(super) struct PlacedObjects {
+pub(crate) struct PlacedObjects {
     /// Per position: its convex object, or [`NO_OBJECT`].
     of: Vec<u32>,
     /// Per object (only convex ones are numbered): its triangle positions, a range of `triangles`.
@@ -77,7 +77,7 @@ impl PlacedObjects {
     }
 
     /// The convex object of the triangle at `position`, if any.
-    pub(super) fn of(&self, position: usize) -> Option<u32> {
+    pub(crate) fn of(&self, position: usize) -> Option<u32> {
         Some(self.of[position]).filter(|&o| o != NO_OBJECT)
     }
 
@@ -87,12 +87,12 @@ impl PlacedObjects {
     }
 
     /// Object `o`'s distinct corners.
-    pub(super) fn corners(&self, o: u32) -> &[u32] {
+    pub(crate) fn corners(&self, o: u32) -> &[u32] {
         slice(&self.corners, &self.corner_ranges[o as usize])
     }
 
     /// Whether object `o` has open caps.
-    pub(super) fn has_caps(&self, o: u32) -> bool {
+    pub(crate) fn has_caps(&self, o: u32) -> bool {
         !self.cap_ranges[o as usize].is_empty()
     }
 

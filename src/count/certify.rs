@@ -1,0 +1,246 @@
+//! Certificates: proofs, without counting a view, that a receiver is wholly dark or wholly lit
+//! at every sun direction of a set (the timesteps of one cell of the year's sample grid).
+//!
+//! Owns the two proofs and which casters may take part in them. They are geometry over the
+//! scene's casters, so they live with the counting stage and share its index (the exact engine's
+//! culling, world triangles and convex objects, [`super::exact`]); they do not depend on how
+//! either engine counts, so the GPU, the exact reference and the page use the same ones. The
+//! year ([`crate::year`]) only decides which steps to ask about.
+//!
+//! Both start from a [`DirectionCone`] holding every sun of the set ([`cone`]).
+//! - **Dark**: one opaque convex caster `O` lies wholly in front of the receiver's plane and, at
+//!   every generator of the cone, the receiver's vertices project (along that direction) inside
+//!   `O`'s projection by a margin. From a point outside a convex body the directions that hit it
+//!   form a convex cone, so a receiver point hit at every generator is hit at every direction
+//!   in between: the receiver is wholly shaded at every sun of the set. The fraction is 0.
+//! - **Lit**: no triangle but the receiver's own lies in the volume its points sweep along the
+//!   cone's directions (`R + K`, convex, since the receiver's triangles and the cone are). A
+//!   triangle `T` misses it when it lies behind the receiver's plane (within the exact engine's
+//!   tolerance, as both engines treat it), below the receiver's lowest point while every sun is
+//!   up, or when a plane through the origin separates the cone from the vectors `T − R` (a face
+//!   of either cone in the chart). Every such triangle counts, see-through or leaf or not: the
+//!   fraction is then exactly 1.
+//! - Otherwise: no certificate, and the steps are counted.
+//!
+//! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
+//! objects: a closed convex polyhedron of at most 64 triangles, or a flat convex polygon),
+//! opaque (no foliage, no transmittance) and without open caps. A caster that is not convex,
+//! open, seen edge-on (its projection has no area) or see-through never proves a step dark; it
+//! only stops a step being proved lit.
+
+pub mod cone;
+
+use glam::{DVec2, DVec3};
+
+pub use cone::DirectionCone;
+
+use crate::count::MIN_COS_INCIDENCE;
+use crate::count::exact::engine::{ExactEngine, parallel_chunks, worker_threads};
+use crate::count::view::{self, convex_hull, perpendicular_basis};
+use crate::scene::{NO_RECEIVER, Scene};
+
+/// What a certificate proves for every sun of its set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Certificate {
+    /// Wholly shaded: fraction 0.
+    Dark,
+    /// Nothing can shade it: fraction 1.
+    Lit,
+}
+
+/// Which certificates to look for (each costs a search; a caller skips one that its samples
+/// make unlikely).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Wanted {
+    /// Look for a convex caster that covers the receiver.
+    pub dark: bool,
+    /// Look for an empty swept volume.
+    pub lit: bool,
+}
+
+/// Margin, in scene extents, by which a covered receiver lies inside its caster's shadow and
+/// the caster in front of its plane: the GPU works in f32 relative to the scene's origin, so a
+/// shadow edge within this of the receiver's could round either way (the culling's tolerance).
+const COVER_MARGIN: f64 = 1e-6;
+
+/// Heights above a receiver's plane within this many scene extents count as on it: the exact
+/// engine's tolerance (`PLANE_EPS`), the smaller of the two engines', so what is ignored here
+/// both engines ignore.
+const PLANE_TOLERANCE: f64 = 1e-9;
+
+/// Vectors of `T − R` whose cosine with the cone's axis is below this are not charted: the
+/// separating faces of their cone are then looked for among the direction cone's faces only.
+const MIN_CHART_COS: f64 = 1e-3;
+
+/// Sets of suns certified per thread hand-out.
+const CHUNK: usize = 8;
+
+/// A receiver as the certificates need it.
+#[derive(Debug, Default)]
+struct Shape {
+    /// Its triangles' vertices.
+    points: Vec<DVec3>,
+    normal: DVec3,
+    /// A vertex: the plane's origin and the frame's origin for projections.
+    p0: DVec3,
+    lowest: f64,
+    gpu_id: u32,
+}
+
+/// The certificates of one scene. Build once, then ask [`Self::certify`].
+pub struct Certifier {
+    index: ExactEngine,
+    shapes: Vec<Shape>,
+    extent: f64,
+}
+
+impl Certifier {
+    /// Indexes `scene` (the exact engine's culling and convex objects).
+    pub fn new(scene: &Scene) -> Self {
+        let extent = (scene.bounds.1 - scene.bounds.0).length();
+        let extent = if extent.is_finite() { extent } else { 0.0 };
+        let shapes = scene
+            .receivers
+            .iter()
+            .map(|r| {
+                let points: Vec<DVec3> = r.triangles.iter().flatten().copied().collect();
+                let lowest = points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+                Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id }
+            })
+            .collect();
+        Self { index: ExactEngine::new(scene), shapes, extent }
+    }
+
+    /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
+    /// natively over every core.
+    pub fn certify_all(&self, sets: &[(usize, &[DVec3], Wanted)]) -> Vec<Option<Certificate>> {
+        let threads = worker_threads().min(sets.len().div_ceil(CHUNK)).max(1);
+        parallel_chunks(sets.len(), threads, CHUNK, || (), |i, _| self.certify(sets[i].0, sets[i].1, sets[i].2))
+    }
+
+    /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
+    /// can be proved (count those views). Every sun must be up and in front of the receiver.
+    pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+        let shape = self.shapes.get(receiver).filter(|s| !s.points.is_empty())?;
+        if !(wanted.dark || wanted.lit) || suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
+            return None;
+        }
+        let cone = DirectionCone::enclosing(suns)?;
+        // The whole cone in front of the receiver and above the horizon, not just its suns.
+        if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
+            return None;
+        }
+        let mut lit = wanted.lit;
+        let mut candidates: Vec<u32> = Vec::new();
+        let mut w = Vec::new();
+        let view = view::fit(&self.swept_corners(shape, &cone), cone.axis(), self.index.bounds, self.index.origin, 64);
+        let mut reached = Vec::new();
+        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
+        for p in reached.into_iter().flatten() {
+            if self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER {
+                continue;
+            }
+            if lit && !self.misses(shape, &cone, &self.index.triangles[p], &mut w) {
+                lit = false;
+                if !wanted.dark {
+                    return None;
+                }
+            }
+            if wanted.dark {
+                if let Some(o) = self.opaque_convex(p) {
+                    if !candidates.contains(&o) {
+                        candidates.push(o);
+                    }
+                }
+            }
+        }
+        if lit {
+            return Some(Certificate::Lit);
+        }
+        candidates.into_iter().any(|o| self.covers(shape, &cone, o)).then_some(Certificate::Dark)
+    }
+
+    /// Corners of a convex volume holding the part of `R + K` inside the scene's bounds: the
+    /// receiver's vertices and each moved along each generator far enough to leave the bounds.
+    fn swept_corners(&self, shape: &Shape, cone: &DirectionCone) -> Vec<DVec3> {
+        // A direction d of the cone is Σ λ_k g_k with Σ λ_k ≤ |d| / min_k (g_k · axis); a point
+        // of R + K in the bounds is at most the extent from its receiver point.
+        let min_cos = cone.generators().iter().map(|g| g.dot(cone.axis())).fold(1.0, f64::min);
+        let reach = (self.extent + 1.0) / min_cos * 1.01;
+        let mut out = shape.points.clone();
+        for g in cone.generators() {
+            out.extend(shape.points.iter().map(|p| *p + *g * reach));
+        }
+        out
+    }
+
+    /// The convex object at triangle position `p`, if it may prove a receiver dark: convex, no
+    /// open caps, opaque.
+    fn opaque_convex(&self, p: usize) -> Option<u32> {
+        let o = self.index.objects.of(p)?;
+        let veil = self.index.veils[p];
+        (!self.index.objects.has_caps(o) && veil.rank < 0.0 && veil.transmittance == 0.0).then_some(o)
+    }
+
+    /// Whether triangle `t` lies outside the volume the receiver sweeps along the cone (so it
+    /// shades no point of it at any of the cone's directions). `w` is scratch.
+    fn misses(&self, shape: &Shape, cone: &DirectionCone, t: &[DVec3; 3], w: &mut Vec<DVec3>) -> bool {
+        let tolerance = PLANE_TOLERANCE * (1.0 + self.extent);
+        if t.iter().all(|p| (*p - shape.p0).dot(shape.normal) <= tolerance) {
+            return true;
+        }
+        // Every generator rises (checked in `certify`), so rays from the receiver go up.
+        if t.iter().all(|p| p.z <= shape.lowest) {
+            return true;
+        }
+        w.clear();
+        w.extend(t.iter().flat_map(|a| shape.points.iter().map(move |r| *a - *r)));
+        if w.iter().any(|v| v.length_squared() == 0.0) {
+            return false;
+        }
+        // A face of the direction cone with every vector of T − R on its far side.
+        if cone.faces().iter().any(|h| w.iter().all(|v| h.dot(*v) >= 0.0)) {
+            return true;
+        }
+        // A face of the cone of T − R with every generator on its far side (T − R charted).
+        let Some(points) = w.iter().map(|v| cone.chart(*v, MIN_CHART_COS)).collect::<Option<Vec<DVec2>>>() else { return false };
+        let hull = convex_hull(&points);
+        if hull.len() < 3 {
+            return false;
+        }
+        let inside = cone.direction(hull.iter().copied().sum::<DVec2>() / hull.len() as f64);
+        (0..hull.len()).any(|k| {
+            let f = cone.direction(hull[k]).cross(cone.direction(hull[(k + 1) % hull.len()]));
+            let f = if f.dot(inside) < 0.0 { -f } else { f };
+            // The hull's own rounding is not trusted: both sides are checked.
+            cone.generators().iter().all(|g| f.dot(*g) <= 0.0) && w.iter().all(|v| f.dot(*v) >= 0.0)
+        })
+    }
+
+    /// Whether object `o` shades the whole receiver at every generator of the cone (so at every
+    /// direction of it): it lies in front of the receiver's plane, and at each generator every
+    /// receiver vertex projects inside its projection, both by [`COVER_MARGIN`].
+    fn covers(&self, shape: &Shape, cone: &DirectionCone, o: u32) -> bool {
+        let margin = COVER_MARGIN * (1.0 + self.extent);
+        let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect();
+        if corners.len() < 3 || corners.iter().any(|c| c.dot(shape.normal) <= margin) {
+            return false;
+        }
+        cone.generators().iter().all(|g| {
+            let (u, v) = perpendicular_basis(*g);
+            let flat = |p: DVec3| DVec2::new(p.dot(u), p.dot(v));
+            let hull = convex_hull(&corners.iter().map(|c| flat(*c)).collect::<Vec<_>>());
+            hull.len() >= 3
+                && shape.points.iter().all(|p| {
+                    let q = flat(*p - shape.p0);
+                    (0..hull.len()).all(|k| {
+                        let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+                        (b - a).perp_dot(q - a) >= margin * (b - a).length()
+                    })
+                })
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;

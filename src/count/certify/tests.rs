@@ -1,0 +1,117 @@
+use super::*;
+use crate::count::ViewRequest;
+use crate::scene::{SceneBuilder, SourceMesh};
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+
+/// A closed box [lo, hi], 12 triangles wound outward.
+fn block(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+    let c = |i: u32| [[lo[0], hi[0]][(i & 1) as usize], [lo[1], hi[1]][(i >> 1 & 1) as usize], [lo[2], hi[2]][(i >> 2) as usize]];
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
+}
+
+/// A south-facing window (normal −y) at y = `y`, x in [x0, x1], z in [z0, z1].
+fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
+    SourceMesh { positions: vec![[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], indices: vec![0, 1, 2, 0, 2, 3] }
+}
+
+fn golden() -> Location {
+    Location::new(39.74, -105.18, -7.0).unwrap()
+}
+
+/// Sun directions every 15 minutes over a block of days and hours, those up and in front of `normal`.
+fn suns(days: std::ops::Range<u32>, hours: (f64, f64), normal: DVec3) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for day in days {
+        for k in 0..=((hours.1 - hours.0) * 4.0).round() as usize {
+            let s = sun_direction(&golden(), f64::from(day), hours.0 + 0.25 * k as f64);
+            if s.z >= MIN_COS_INCIDENCE && s.dot(normal) > MIN_COS_INCIDENCE {
+                out.push(s);
+            }
+        }
+    }
+    out
+}
+
+/// A south-facing window 10 m north of a 30 m block: dark through winter middays (the block
+/// alone covers it); with no block, lit. The certificates say so, and the exact engine agrees at
+/// every sun.
+#[test]
+fn a_block_proves_a_window_dark_and_an_empty_street_proves_it_lit() {
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+    b.add_object("test", "BLOCK", block([-40.0, -14.0, 0.0], [40.0, -10.0, 30.0]), false);
+    let scene = b.build().unwrap();
+    let certifier = Certifier::new(&scene);
+    let winter = suns(1..14, (11.0, 13.0), -DVec3::Y);
+    let both = Wanted { dark: true, lit: true };
+    assert_eq!(certifier.certify(0, &winter, both), Some(Certificate::Dark));
+    let exact = ExactEngine::new(&scene);
+    let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
+    assert!(exact.fractions(&requests).iter().all(|f| *f == 0.0));
+    // Not looking for dark, nothing is proved: the block is in the swept volume.
+    assert_eq!(certifier.certify(0, &winter, Wanted { dark: false, lit: true }), None);
+
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+    b.add_object("test", "HOUSE", block([-1.0, 0.0, 0.0], [3.0, 8.0, 3.0]), false);
+    let ground = SourceMesh {
+        positions: vec![[-50.0, -50.0, 0.0], [50.0, -50.0, 0.0], [50.0, 50.0, 0.0], [-50.0, 50.0, 0.0]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    b.add_object("test", "GROUND", ground, false);
+    let scene = b.build().unwrap();
+    assert_eq!(Certifier::new(&scene).certify(0, &winter, both), Some(Certificate::Lit));
+}
+
+/// Brute force against the exact engine: random blocks round random windows, random cells of
+/// suns; wherever a certificate is given, every sun of its cell is counted and must agree
+/// (0 for dark, 1 for lit); and enough are given that the test means something.
+#[test]
+fn certificates_agree_with_the_exact_engine_at_every_sun_of_their_cell() {
+    let mut seed = 7u64;
+    let mut next = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut dark, mut lit, mut checked) = (0, 0, 0);
+    for _ in 0..8 {
+        let mut b = SceneBuilder::new();
+        for k in 0..4 {
+            let x = (next() * 20.0 - 10.0) as f32;
+            let z = (next() * 10.0) as f32;
+            b.add_object("test", &format!("W{k}"), window(x, x + 1.0 + next() as f32, z, z + 1.0, (next() * 4.0) as f32), true);
+        }
+        for k in 0..12 {
+            let (x, y) = ((next() * 40.0 - 25.0) as f32, (next() * 25.0 - 30.0) as f32);
+            let (w, d, h) = ((next() * 20.0 + 0.5) as f32, (next() * 6.0 + 0.5) as f32, (next() * 30.0 + 1.0) as f32);
+            b.add_object("test", &format!("B{k}"), block([x, y, 0.0], [x + w, y + d, h]), false);
+        }
+        let scene = b.build().unwrap();
+        let certifier = Certifier::new(&scene);
+        let exact = ExactEngine::new(&scene);
+        for _ in 0..60 {
+            let first = 1 + (next() * 350.0) as u32;
+            let start = 6.0 + (next() * 10.0).floor() * 0.5;
+            let receiver = (next() * 4.0) as usize;
+            let cell = suns(first..first + 14, (start, start + 1.0), scene.receivers[receiver].normal);
+            if cell.is_empty() {
+                continue;
+            }
+            let Some(certificate) = certifier.certify(receiver, &cell, Wanted { dark: true, lit: true }) else { continue };
+            let requests: Vec<ViewRequest> = cell.iter().map(|s| ViewRequest::new(receiver as u32, *s)).collect();
+            for (f, s) in exact.fractions(&requests).into_iter().zip(&cell) {
+                let want = if certificate == Certificate::Dark { 0.0 } else { 1.0 };
+                assert!((f - want).abs() < 1e-9, "{certificate:?} for receiver {receiver} at {s}: the exact engine says {f}");
+                checked += 1;
+            }
+            match certificate {
+                Certificate::Dark => dark += 1,
+                Certificate::Lit => lit += 1,
+            }
+        }
+    }
+    println!("{dark} dark and {lit} lit cells, {checked} suns checked");
+    assert!(dark >= 10 && lit >= 10, "{dark} dark and {lit} lit cells");
+}

@@ -1,0 +1,76 @@
+//! Refined timesteps settled by certificate instead of counted: where a sample cell's steps
+//! would be counted directly (the refinement rules of [`super::annual`]), the steps of one
+//! receiver in one cell are handed together to [`Certifier`], and those it proves dark or lit
+//! are set to 0 or 1 without a view.
+//!
+//! Owns only the grouping and which certificate to look for; the proofs are geometry and live
+//! with the counting stage ([`crate::count::certify`]), where the page and both engines share
+//! them. Exact either way: a certificate holds at every sun of its steps, so the schedule is what
+//! counting them would give, and a step no certificate settles is counted as before.
+
+use glam::DVec3;
+
+use crate::count::certify::{Certificate, Certifier, Wanted};
+use crate::export::Schedule;
+
+/// A timestep the refinement counts directly unless a certificate settles it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Rough {
+    pub row: usize,
+    pub column: usize,
+    pub sun: DVec3,
+    pub day: f64,
+    /// Its sample cell: regime, fitted piece (receiver and lit piece), cell's first day and τ.
+    pub cell: (usize, usize, usize, usize),
+    /// The lowest and highest of the cell's four samples.
+    pub corners: (f64, f64),
+}
+
+/// Cells with fewer steps to settle than this are counted: one view costs about what a proof
+/// does.
+const MIN_STEPS: usize = 2;
+
+/// What a settled step becomes.
+fn fraction(certificate: Certificate) -> f32 {
+    match certificate {
+        Certificate::Dark => 0.0,
+        Certificate::Lit => 1.0,
+    }
+}
+
+/// Which certificate a cell's samples make worth looking for: dark where all four are mostly
+/// dark, lit where all four are mostly lit; a cell whose samples span both holds both states.
+fn wanted((lowest, highest): (f64, f64)) -> Wanted {
+    Wanted { dark: highest < 0.5, lit: lowest > 0.5 }
+}
+
+/// Writes the steps of `rough` that a certificate settles into `schedule` and returns the rest
+/// (to count), in their order, with the numbers of steps proved dark and lit.
+pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Schedule) -> (Vec<Rough>, usize, usize) {
+    let mut order: Vec<usize> = (0..rough.len()).collect();
+    order.sort_by_key(|&i| rough[i].cell);
+    let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
+    let asked: Vec<(&[usize], Wanted)> = cells
+        .into_iter()
+        .map(|steps| (steps, wanted(rough[steps[0]].corners)))
+        .filter(|(steps, w)| steps.len() >= MIN_STEPS && (w.dark || w.lit))
+        .collect();
+    let suns: Vec<Vec<DVec3>> = asked.iter().map(|(steps, _)| steps.iter().map(|&i| rough[i].sun).collect()).collect();
+    let sets: Vec<(usize, &[DVec3], Wanted)> =
+        asked.iter().zip(&suns).map(|((steps, w), s)| (rough[steps[0]].column, s.as_slice(), *w)).collect();
+    let mut settled = vec![false; rough.len()];
+    let (mut dark, mut lit) = (0, 0);
+    for ((steps, _), certificate) in asked.iter().zip(certifier.certify_all(&sets)) {
+        let Some(certificate) = certificate else { continue };
+        for &i in *steps {
+            schedule.set(rough[i].row, rough[i].column, fraction(certificate));
+            settled[i] = true;
+        }
+        match certificate {
+            Certificate::Dark => dark += steps.len(),
+            Certificate::Lit => lit += steps.len(),
+        }
+    }
+    let rest = rough.into_iter().zip(settled).filter(|(_, s)| !s).map(|(r, _)| r).collect();
+    (rest, dark, lit)
+}
