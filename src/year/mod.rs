@@ -15,3 +15,4 @@ pub mod samples;
 pub mod season;
 pub mod settings;
 pub mod spline;
+pub mod transmitting;
