@@ -21,13 +21,16 @@ use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
+use sunlit::model::schedule::RunCalendar;
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
 use sunlit::sun::location::Location;
-use sunlit::year::annual::Progress;
+use sunlit::year::annual::{AnnualOptions, Progress};
 use sunlit::year::samples::{SamplingPlan, Timesteps};
 use sunlit::year::settings::AnnualSettings;
+use sunlit::year::settings::Resolved;
+use sunlit::year::transmitting::VaryingShades;
 use sunlit::{Error, Result, bench};
 
 #[path = "cli/sweep.rs"]
@@ -231,6 +234,11 @@ impl ModelArgs {
     fn load_all(&self, all_energyplus_surfaces: bool) -> Result<model::Loaded> {
         self.check()?;
         model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
+    }
+
+    /// The scene with EnergyPlus shades at the given transmittances.
+    fn load_with_shades(&self, shade_transmittance: Vec<(String, f64)>) -> Result<Scene> {
+        model::load(&self.models, &LoadOptions { shade_transmittance, ..self.options() })
     }
 }
 
@@ -465,6 +473,29 @@ fn fraction(args: FractionArgs) -> Result<()> {
     Ok(())
 }
 
+/// One static scene's year on the engine the arguments choose; a lost GPU device (driver reset)
+/// is recreated once and the year counted again.
+fn count_year(
+    args: &AnnualArgs,
+    scene: &Scene,
+    settings: &Resolved,
+    options: &AnnualOptions,
+    report: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<sunlit::export::Schedule> {
+    let mut engine = HybridEngine::new(scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
+    let year = |engine: &HybridEngine<'_>, report: &mut dyn FnMut(Progress) -> Result<()>| {
+        pollster::block_on(sunlit::year::annual::annual_with(engine, scene, &settings.location, options, &settings.calendar, report))
+    };
+    match year(&engine, report) {
+        Err(Error::DeviceLost(why)) => {
+            log::warn!("GPU device lost ({why}); making a new one and counting again");
+            engine.forget_gpu();
+            year(&engine, report)
+        }
+        other => other,
+    }
+}
+
 fn annual(args: AnnualArgs) -> Result<()> {
     // Everything that can be refused is refused before minutes of counting.
     let mut settings = args.settings()?;
@@ -481,7 +512,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     // The Imported form looks up every surface and the Mir- back faces of shading surfaces.
     let loaded = args.model.load_all(hook == Some(Hook::Imported))?;
-    let (scene, energyplus) = (loaded.scene, loaded.energyplus);
+    let (mut scene, energyplus) = (loaded.scene, loaded.energyplus);
     if !located {
         site_location(&mut settings, energyplus.as_ref())?;
     }
@@ -489,12 +520,26 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let mut options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
     options.timesteps = options.timesteps.leap_year(run_year(&args, energyplus.as_ref())?);
     let timesteps = options.timesteps;
+    let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap() };
+    let varying = match &energyplus {
+        Some(ep) => VaryingShades::new(&ep.file, &ep.shades, calendar)?,
+        None => None,
+    };
+    if varying.is_some() && hook == Some(Hook::Imported) {
+        return Err(Error::argument(
+            "--hook",
+            "imported: the Imported form makes every shade a receiver, and a receiver is opaque, so a shade whose transmittance schedule changes cannot be hooked that way; use --hook scheduled",
+        ));
+    }
+    if let Some(v) = &varying {
+        // Passes that take one scene (the sky views) see each varying shade at its mean τ.
+        scene = args.model.load_with_shades(v.mean_transmittance())?;
+    }
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
         (None, _) => None,
     };
-    let mut engine = HybridEngine::new(&scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let start = Instant::now();
     let bar = indicatif::ProgressBar::new(0).with_style(
         indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
@@ -506,18 +551,19 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
-    // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let mut year = |engine: &HybridEngine<'_>| {
-        pollster::block_on(sunlit::year::annual::annual_with(engine, &scene, &settings.location, &options, &settings.calendar, &mut report))
-    };
-    let schedule = match year(&engine) {
-        Err(Error::DeviceLost(why)) => {
-            log::warn!("GPU device lost ({why}); making a new one and counting again");
-            engine.forget_gpu();
-            year(&engine)?
+    let schedule = match &varying {
+        None => count_year(&args, &scene, &settings, &options, &mut report)?,
+        Some(v) => {
+            // Each varying shade opaque and removed, mixed per timestep by its τ.
+            let mut years = Vec::with_capacity(v.variants());
+            for variant in 0..v.variants() {
+                let variant_scene = args.model.load_with_shades(v.shade_transmittance(variant))?;
+                years.push(count_year(&args, &variant_scene, &settings, &options, &mut report)?);
+            }
+            v.mix(&years)?
         }
-        other => other?,
     };
+    let engine = HybridEngine::new(&scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {

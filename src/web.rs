@@ -32,6 +32,7 @@ use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::run_year::{choose, is_leap};
+use crate::model::schedule::RunCalendar;
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
@@ -41,6 +42,7 @@ use crate::sun::position::sun_direction;
 use crate::sun::weather::Weather;
 use crate::year::annual::{Progress, annual_fitted_with};
 use crate::year::settings::AnnualSettings;
+use crate::year::transmitting::VaryingShades;
 
 /// A library error as a JS `Error` whose message names the file, object or option (as the JS API
 /// spells it: `timestepsPerHour`) and the reason. Its properties: `code` ([`Error::code`], what
@@ -190,8 +192,15 @@ impl Engine {
         foliage: Option<String>,
         transmittance: Option<String>,
     ) -> Result<Model, JsValue> {
-        let loaded = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
-        self.model(loaded.scene, loaded.energyplus, loaded.notes)
+        let (loaded, variants) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
+        let model = self.model(loaded.scene, loaded.energyplus, loaded.notes)?;
+        let counter = self.counter.as_ref().filter(|_| self.kind != EngineKind::Exact);
+        let mut inner = Rc::try_unwrap(model.inner).map_err(|_| js_error(Error::argument("model", "shared while loading")))?;
+        for scene in variants {
+            let gpu = counter.map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
+            inner.variants.push(Variant { scene, gpu, exact: Default::default() });
+        }
+        Ok(Model { inner: Rc::new(inner) })
     }
 
     /// Builds a scene from typed arrays (see `model::arrays`) and uploads it.
@@ -213,7 +222,8 @@ impl Engine {
         // its scene (nyt-blocks: 1,103 MB with the upload, 620 MB without; docs/page-speed.md).
         let counter = self.counter.as_ref().filter(|_| self.kind != EngineKind::Exact);
         let gpu = counter.map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
-        Ok(Model { inner: Rc::new(ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default() }) })
+        let inner = ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default(), variants: Vec::new() };
+        Ok(Model { inner: Rc::new(inner) })
     }
 
     /// Promise of every receiver's sunlit fraction (Float64Array, receiver order) for one sun
@@ -272,9 +282,32 @@ impl Engine {
                 Ok(())
             };
             let chosen = model.chosen(kind, counter.as_deref(), &counter_options, &routing);
-            let (schedule, fitted) = annual_fitted_with(&chosen, &model.scene, &location, &options, &calendar, &mut report)
-                .await
-                .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?;
+            let (schedule, fitted) = match (&model.energyplus, model.variants.is_empty()) {
+                (Some(ep), false) => {
+                    // Shades whose τ changes in time: a year per variant (each such shade opaque
+                    // or removed), mixed per timestep; the variants' scenes are not the pool's, so
+                    // their exact share is clipped here.
+                    let run = RunCalendar { per_hour: options.timesteps.per_hour(), leap: options.timesteps.is_leap() };
+                    let varying = VaryingShades::new(&ep.file, &ep.shades, run).map_err(js_error)?;
+                    let local = choice::Routing::from_js(&JsValue::UNDEFINED).map_err(js_error)?;
+                    let mut years = Vec::new();
+                    for v in &model.variants {
+                        let lane = counter.as_deref().zip(v.gpu.as_ref()).map(|(counter, gpu)| Lane { counter, gpu });
+                        let engine = choice::Chosen::new(kind, &v.scene, &v.exact, lane, &counter_options, &local);
+                        years.push(
+                            annual_fitted_with(&engine, &v.scene, &location, &options, &calendar, &mut report).await.map_err(js_error)?.0,
+                        );
+                    }
+                    let mixed = match varying {
+                        Some(varying) => varying.mix(&years).map_err(js_error)?,
+                        None => return Err(js_error(Error::argument("model", "its shades' schedules do not change in time"))),
+                    };
+                    (mixed, None)
+                }
+                _ => annual_fitted_with(&chosen, &model.scene, &location, &options, &calendar, &mut report)
+                    .await
+                    .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?,
+            };
             let routed = |views| Routed { profile: chosen.profile(views), refused: chosen.refused(views) };
             let means = daylight_means(&schedule, &location);
             let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
@@ -302,7 +335,7 @@ fn load_files(
     north: Option<f64>,
     foliage: Option<String>,
     transmittance: Option<String>,
-) -> Result<crate::model::Loaded> {
+) -> Result<(crate::model::Loaded, Vec<Scene>)> {
     if names.len() != contents.length() as usize {
         return Err(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length())));
     }
@@ -316,7 +349,16 @@ fn load_files(
         transmittance,
         ..Default::default()
     };
-    load_bytes_all(&files, &options)
+    let mut loaded = load_bytes_all(&files, &options)?;
+    let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new())) };
+    // Which shades vary does not depend on the run's timesteps; their mean τ for the one-scene
+    // passes (the sky views) is taken over hourly values.
+    let hourly = RunCalendar { per_hour: 1, leap: false };
+    let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new())) };
+    let with = |shade_transmittance: Vec<(String, f64)>| load_bytes_all(&files, &LoadOptions { shade_transmittance, ..options.clone() });
+    loaded.scene = with(varying.mean_transmittance())?.scene;
+    let variants = (0..varying.variants()).map(|v| Ok(with(varying.shade_transmittance(v))?.scene)).collect::<Result<Vec<_>>>()?;
+    Ok((loaded, variants))
 }
 
 /// A comma-separated setting (globs, `GLOB=T` items); empty when not given.
@@ -341,6 +383,16 @@ struct ModelInner {
     exact: std::cell::OnceCell<ExactEngine>,
     /// The last points `engine.map` was asked for, indexed for shadow rays ([`map`]).
     maps: std::cell::RefCell<Option<map::MapCache>>,
+    /// With EnergyPlus shades whose transmittance changes in time: the scene with each such
+    /// shade opaque or removed, in [`VaryingShades`]'s order (empty otherwise).
+    variants: Vec<Variant>,
+}
+
+/// One of [`ModelInner::variants`]: a scene, its upload and its exact engine.
+struct Variant {
+    scene: Scene,
+    gpu: Option<GpuScene>,
+    exact: std::cell::OnceCell<ExactEngine>,
 }
 
 impl ModelInner {

@@ -63,8 +63,8 @@ fn check_cli(label: &str, case: &Case) {
     let mut models = Vec::new();
     for (name, bytes) in &case.files {
         std::fs::write(dir.join(name), bytes).unwrap();
-        // Companion files (external buffers, weather) are not models.
-        if !name.ends_with(".bin") && !name.ends_with(".epw") {
+        // Companion files (external buffers, weather, schedule files) are not models.
+        if ![".bin", ".epw", ".csv"].iter().any(|ext| name.ends_with(ext)) {
             models.push(dir.join(name).display().to_string());
         }
     }
@@ -127,7 +127,8 @@ fn run(args: &[String]) -> (Option<i32>, String) {
 /// The same model files through the library's in-memory loader.
 fn check_api(label: &str, case: &Case) {
     let Some(expected) = &case.api else { return };
-    let models: Vec<(String, Vec<u8>)> = case.files.iter().filter(|(n, _)| !n.ends_with(".bin") && !n.ends_with(".epw")).cloned().collect();
+    let models: Vec<(String, Vec<u8>)> =
+        case.files.iter().filter(|(n, _)| ![".bin", ".epw", ".csv"].iter().any(|ext| n.ends_with(ext))).cloned().collect();
     let mut options = LoadOptions::default();
     let mut args = case.args.iter();
     while let Some(a) = args.next() {
@@ -804,5 +805,60 @@ fn models_the_hook_cannot_take() {
         .with_file("floor.glb", floor)
         .args(&[hook[0], hook[1], "--receivers", "FLOOR"])
         .api(None),
+    );
+}
+
+/// A shade's `Transmittance Schedule Name` that names nothing, a transmittance outside 0..1, a
+/// `Schedule:File` that cannot be read or is too short, and a `Schedule:Compact` whose `Through`
+/// dates stop before 12/31: each refused by object, field and reason, before anything is counted.
+#[test]
+fn shade_transmittance_schedules() {
+    let base = idf();
+    let at = base.lines().count() + 1;
+    let with = |schedule: &str, objects: &str| {
+        format!("{base}Shading:Site:Detailed, TREE, {schedule}, 3, 0,-5,0, 1,-5,0, 1,-5,1;\n{objects}").into_bytes()
+    };
+    let tree = format!("Shading:Site:Detailed 'TREE' (line {at})");
+    let next = at + 1;
+    check(
+        "unknown schedule",
+        Case::model(
+            "unknown.idf",
+            with("NOPE", ""),
+            &format!("unknown.idf: {tree}: field 'Transmittance Schedule Name': 'NOPE' names no schedule in the model"),
+        ),
+    );
+    check(
+        "transmittance above 1",
+        Case::model(
+            "above.idf",
+            with("TAU", "Schedule:Constant, TAU, , 1.5;\n"),
+            &format!(
+                "above.idf: {tree}: field 'Transmittance Schedule Name': Schedule:Constant 'TAU' (line {next}) takes the value 1.5, outside 0..1 for a transmittance"
+            ),
+        ),
+    );
+    let file = |name: &str| with("TAU", &format!("Schedule:File, TAU, , {name}, 1, 0, 8760, Comma, No, 60;\n"));
+    let missing = format!(
+        "missing.idf: Schedule:File 'TAU' (line {next}): field 'File Name': 'missing.csv' cannot be read (No such file or directory (os error 2))"
+    );
+    check("missing schedule file", Case::model("missing.idf", file("missing.csv"), &missing));
+    let short = format!(
+        "short.idf: Schedule:File 'TAU' (line {next}): field 'File Name': 'short.csv' is too short: 3 values after 0 skipped rows, 8760 needed (8760 hours of 60-minute items)"
+    );
+    let unreadable_here = format!(
+        "short.idf: Schedule:File 'TAU' (line {next}): field 'File Name': 'short.csv' cannot be read (No such file or directory (os error 2))"
+    );
+    check(
+        "short schedule file",
+        Case::model("short.idf", file("short.csv"), &short).with_file("short.csv", b"0.5\n0.5\n0.5\n".to_vec()).api(Some(&unreadable_here)),
+    );
+    check(
+        "compact short of 12/31",
+        Case::model(
+            "through.idf",
+            with("TAU", "Schedule:Compact, TAU, , Through: 6/30, For: AllDays, Until: 24:00, 0.5;\n"),
+            &format!("through.idf: Schedule:Compact 'TAU' (line {next}): field 'Through': its dates end on 06/30, not on 12/31"),
+        ),
     );
 }

@@ -43,7 +43,7 @@ use super::idf::{IdfObject, object_label};
 use super::reveal::{self, Placement as SubPlacement};
 use crate::error::{Error, Result};
 use crate::geometry::{self, Plane, inside_or_on, newell, plane_deviation};
-use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
+use crate::scene::{NodeVeil, SceneBuilder, SourceMesh, SourceNode};
 use frame::{SurfaceFrame, WindowFrame, rectangle};
 use mesh::{hole_problem, reveal_problem};
 

@@ -39,6 +39,8 @@ struct ClassSpec {
     fields: &'static [(&'static str, Kind)],
     /// Whether an extensible `vertices` array of x, y, z follows the fields.
     vertices: bool,
+    /// An extensible array (its key, and each item's fields in IDD order) that follows the fields.
+    list: Option<(&'static str, &'static [(&'static str, Kind)])>,
 }
 
 const VERTEX_KEYS: [&str; 3] = ["vertex_x_coordinate", "vertex_y_coordinate", "vertex_z_coordinate"];
@@ -236,8 +238,102 @@ const FIN_PROJECTION: &[(&str, Kind)] = &[
 ];
 
 const fn spec(class: &'static str, named: bool, fields: &'static [(&'static str, Kind)], vertices: bool) -> ClassSpec {
-    ClassSpec { class, named, fields, vertices }
+    ClassSpec { class, named, fields, vertices, list: None }
 }
+
+const fn listed(
+    class: &'static str,
+    fields: &'static [(&'static str, Kind)],
+    key: &'static str,
+    items: &'static [(&'static str, Kind)],
+) -> ClassSpec {
+    ClassSpec { class, named: true, fields, vertices: false, list: Some((key, items)) }
+}
+
+const HOURS: &[(&str, Kind)] = &[
+    ("schedule_type_limits_name", Text),
+    ("hour_1", Number),
+    ("hour_2", Number),
+    ("hour_3", Number),
+    ("hour_4", Number),
+    ("hour_5", Number),
+    ("hour_6", Number),
+    ("hour_7", Number),
+    ("hour_8", Number),
+    ("hour_9", Number),
+    ("hour_10", Number),
+    ("hour_11", Number),
+    ("hour_12", Number),
+    ("hour_13", Number),
+    ("hour_14", Number),
+    ("hour_15", Number),
+    ("hour_16", Number),
+    ("hour_17", Number),
+    ("hour_18", Number),
+    ("hour_19", Number),
+    ("hour_20", Number),
+    ("hour_21", Number),
+    ("hour_22", Number),
+    ("hour_23", Number),
+    ("hour_24", Number),
+];
+
+const WEEK_DAILY: &[(&str, Kind)] = &[
+    ("sunday_schedule_day_name", Text),
+    ("monday_schedule_day_name", Text),
+    ("tuesday_schedule_day_name", Text),
+    ("wednesday_schedule_day_name", Text),
+    ("thursday_schedule_day_name", Text),
+    ("friday_schedule_day_name", Text),
+    ("saturday_schedule_day_name", Text),
+    ("holiday_schedule_day_name", Text),
+    ("summerdesignday_schedule_day_name", Text),
+    ("winterdesignday_schedule_day_name", Text),
+    ("customday1_schedule_day_name", Text),
+    ("customday2_schedule_day_name", Text),
+];
+
+const SCHEDULE_FILE: &[(&str, Kind)] = &[
+    ("schedule_type_limits_name", Text),
+    ("file_name", Text),
+    ("column_number", Number),
+    ("rows_to_skip_at_top", Number),
+    ("number_of_hours_of_data", Number),
+    ("column_separator", Text),
+    ("interpolate_to_timestep", Text),
+    ("minutes_per_item", Number),
+    ("adjust_schedule_for_daylight_savings", Text),
+    ("translate_file_with_relative_path", Text),
+];
+
+const LIMITS_ONLY: &[(&str, Kind)] = &[("schedule_type_limits_name", Text)];
+
+/// The schedule classes a shade's transmittance may use ([`super::schedule`]).
+const SCHEDULE_CLASSES: &[ClassSpec] = &[
+    spec(
+        "ScheduleTypeLimits",
+        true,
+        &[("lower_limit_value", Number), ("upper_limit_value", Number), ("numeric_type", Text), ("unit_type", Text)],
+        false,
+    ),
+    spec("Schedule:Constant", true, &[("schedule_type_limits_name", Text), ("hourly_value", Number)], false),
+    listed("Schedule:Compact", LIMITS_ONLY, "data", &[("field", Either)]),
+    listed(
+        "Schedule:Year",
+        LIMITS_ONLY,
+        "schedule_weeks",
+        &[("schedule_week_name", Text), ("start_month", Number), ("start_day", Number), ("end_month", Number), ("end_day", Number)],
+    ),
+    spec("Schedule:Week:Daily", true, WEEK_DAILY, false),
+    spec("Schedule:Day:Hourly", true, HOURS, false),
+    listed(
+        "Schedule:Day:Interval",
+        &[("schedule_type_limits_name", Text), ("interpolate_to_timestep", Text)],
+        "data",
+        &[("time", Text), ("value_until_time", Number)],
+    ),
+    spec("Schedule:File", true, SCHEDULE_FILE, false),
+];
 
 /// The classes read by [`super::building`], with their epJSON field names in IDD order.
 const CLASSES: &[ClassSpec] = &[
@@ -252,6 +348,7 @@ const CLASSES: &[ClassSpec] = &[
             ("end_month", Number),
             ("end_day_of_month", Number),
             ("end_year", Number),
+            ("day_of_week_for_start_day", Text),
         ],
         false,
     ),
@@ -339,7 +436,7 @@ pub fn parse_epjson(file: &str, text: &str) -> Result<Vec<IdfObject>> {
     let mut objects = Vec::new();
     let mut cursor = 0;
     for (class, members) in &top.0 {
-        let spec = CLASSES.iter().find(|s| s.class.eq_ignore_ascii_case(class));
+        let spec = CLASSES.iter().chain(SCHEDULE_CLASSES).find(|s| s.class.eq_ignore_ascii_case(class));
         let class_line;
         (class_line, cursor) = locate(text, cursor, class);
         for (key, value) in &members.0 {
@@ -382,6 +479,9 @@ fn convert(file: &str, spec: &ClassSpec, key: &str, value: &Value, line: usize, 
     if spec.vertices {
         append_vertices(file, &label, members.get("vertices"), &mut fields)?;
     }
+    if let Some((key, items)) = spec.list {
+        append_list(file, &label, key, items, members.get(key), &mut fields)?;
+    }
     // Omitted trailing fields are blank in IDF too; trimming them lets "autocalculate" vertex
     // counts see only the coordinates that were given.
     while fields.last().is_some_and(String::is_empty) {
@@ -402,6 +502,22 @@ fn append_vertices(file: &str, label: &str, vertices: Option<&Value>, fields: &m
                 return Err(Error::object(file, label, format!("vertex {} has no '{key}'", i + 1)));
             }
             fields.push(field_text(value, Number).map_err(|why| Error::object(file, label, format!("'{key}' of vertex {} {why}", i + 1)))?);
+        }
+    }
+    Ok(())
+}
+
+/// An extensible array's items, each's fields in IDD order (a missing one blank).
+fn append_list(file: &str, label: &str, key: &str, items: &[(&str, Kind)], list: Option<&Value>, fields: &mut Vec<String>) -> Result<()> {
+    let Some(list) = list else { return Ok(()) };
+    let Some(list) = list.as_array() else {
+        return Err(Error::object(file, label, format!("field '{key}' must be an array, not {}", describe(list))));
+    };
+    for (i, item) in list.iter().enumerate() {
+        for &(name, kind) in items {
+            let text = field_text(item.get(name), kind)
+                .map_err(|why| Error::object(file, label, format!("'{name}' of {key} item {} {why}", i + 1)))?;
+            fields.push(text);
         }
     }
     Ok(())

@@ -28,8 +28,11 @@ pub mod office_idf;
 pub mod placed;
 pub mod reveal;
 pub mod run_year;
+pub mod schedule;
+pub mod shades;
 pub mod site;
 
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 use crate::error::{Error, NoReceivers, Result};
@@ -51,6 +54,11 @@ pub struct LoadOptions {
     pub foliage: Vec<String>,
     /// (glob, t): matching nodes let t of the beam through (the last matching pattern wins).
     pub transmittance: Vec<(String, f64)>,
+    /// (EnergyPlus shading surface name, τ): that shade lets τ of the beam through (0 opaque,
+    /// 1 not a caster), whatever its transmittance schedule says. Without an entry a shade
+    /// takes its schedule's value when that never changes, and is opaque otherwise (see
+    /// [`crate::year::transmitting`] for schedules that change).
+    pub shade_transmittance: Vec<(String, f64)>,
 }
 
 /// The EnergyPlus model among the inputs, kept for hooking the schedule into a copy of it.
@@ -66,6 +74,8 @@ pub struct EnergyPlusInput {
     pub epjson: bool,
     /// Its geometry.
     pub building: building::Building,
+    /// Its shades' transmittance schedules.
+    pub shades: Vec<shades::ShadeGroup>,
 }
 
 impl EnergyPlusInput {
@@ -167,7 +177,7 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
                 if let Some(first) = &energyplus {
                     return Err(Error::model(name, format!("only one EnergyPlus model at a time ({} was given first)", first.file)));
                 }
-                energyplus = Some(read_energyplus(name, bytes, epjson)?);
+                energyplus = Some(read_energyplus(name, bytes, epjson, dir.as_deref())?);
             }
             None => models.push(match dir {
                 Some(d) => gltf_read::read_bytes_beside(name, bytes, d, options.north)?,
@@ -175,11 +185,11 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
             }),
         }
     }
-    let (scene, notes) = build(models, energyplus.as_ref().map(|e| &e.building), options)?;
+    let (scene, notes) = build(models, energyplus.as_ref(), options)?;
     Ok(Loaded { scene, energyplus, notes })
 }
 
-fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusInput> {
+fn read_energyplus(name: &str, bytes: &[u8], epjson: bool, dir: Option<&std::path::Path>) -> Result<EnergyPlusInput> {
     let text = match std::str::from_utf8(bytes) {
         Ok(text) => text.to_string(),
         // The IDF reader's message names the line and byte; epJSON must be UTF-8 just the same.
@@ -193,7 +203,8 @@ fn read_energyplus(name: &str, bytes: &[u8], epjson: bool) -> Result<EnergyPlusI
     if !building.skipped.is_empty() {
         log::info!("{name}: objects without geometry ignored: {}", building.skipped.join(", "));
     }
-    Ok(EnergyPlusInput { file: name.to_string(), text, objects, epjson, building })
+    let shades = shades::read_shade_schedules(name, &objects, dir)?;
+    Ok(EnergyPlusInput { file: name.to_string(), text, objects, epjson, building, shades })
 }
 
 fn check_options(options: &LoadOptions) -> Result<()> {
@@ -203,7 +214,26 @@ fn check_options(options: &LoadOptions) -> Result<()> {
     Ok(())
 }
 
-fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, options: &LoadOptions) -> Result<(Scene, Vec<String>)> {
+/// Each transmitting EnergyPlus shade's τ for this load, by lower-case name: the options' value,
+/// else its schedule's when that never changes (an opaque shade has no entry).
+fn shade_veils(energyplus: &EnergyPlusInput, options: &LoadOptions) -> Result<HashMap<String, f64>> {
+    let mut veils: HashMap<String, f64> = HashMap::new();
+    for group in &energyplus.shades {
+        if let Some(t) = group.constant() {
+            veils.extend(group.shades.iter().map(|s| (s.to_ascii_lowercase(), t)));
+        }
+    }
+    for (name, t) in &options.shade_transmittance {
+        if !(0.0..=1.0).contains(t) {
+            return Err(Error::argument("shade_transmittance", format!("{name}={t}: a transmittance must be in [0, 1]")));
+        }
+        veils.insert(name.to_ascii_lowercase(), *t);
+    }
+    veils.retain(|_, t| *t > 0.0);
+    Ok(veils)
+}
+
+fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: &LoadOptions) -> Result<(Scene, Vec<String>)> {
     let select = match energyplus {
         Some(_) if options.receivers.is_empty() => Selection::Context,
         _ => Selection::new(&models, options)?,
@@ -211,12 +241,22 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&building::Building>, option
     let veils = Veils::new(options)?;
     let mut builder = SceneBuilder::new();
     let mut matched = 0usize;
-    if let Some(b) = energyplus {
+    if let Some(ep) = energyplus {
+        let b = &ep.building;
+        let veils = shade_veils(ep, options)?;
         if options.all_energyplus_surfaces {
+            if let Some(shade) = veils.keys().next() {
+                return Err(Error::model(
+                    &ep.file,
+                    format!(
+                        "shade '{shade}' lets light through, but a shade is a receiver in the Imported form's columns and a receiver is opaque: hook with the Scheduled form"
+                    ),
+                ));
+            }
             b.add_all_to(&mut builder)?;
             matched += b.surfaces.len();
         } else {
-            b.add_to(&mut builder)?;
+            b.add_to_with(&mut builder, &veils)?;
             matched += b.receiver_names().len();
         }
     }

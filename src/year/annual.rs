@@ -271,7 +271,7 @@ fn as_energyplus(fraction: f64) -> f32 {
 }
 
 /// [`as_energyplus`] in f64, for the fitted surfaces' own evaluation.
-pub(super) fn energyplus_fraction(fraction: f64) -> f64 {
+pub(crate) fn energyplus_fraction(fraction: f64) -> f64 {
     let f = fraction.clamp(0.0, 1.0);
     if f < MIN_SUNLIT_FRACTION { 0.0 } else { f }
 }

@@ -17,3 +17,4 @@ pub mod samples;
 pub mod season;
 pub mod settings;
 pub mod spline;
+pub mod transmitting;

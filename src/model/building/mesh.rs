@@ -60,23 +60,35 @@ impl Building {
     /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
     /// written in the file (EnergyPlus itself reports them upper-cased).
     pub fn add_to(&self, builder: &mut SceneBuilder) -> Result<()> {
-        self.add_surfaces(builder, false)
+        self.add_surfaces(builder, false, &HashMap::new())
+    }
+
+    /// As [`Building::add_to`], with shading surfaces that let τ of the beam through (by
+    /// lower-case name): see-through casters for 0 < τ < 1, no caster at all for τ ≥ 1.
+    pub fn add_to_with(&self, builder: &mut SceneBuilder, shades: &HashMap<String, f64>) -> Result<()> {
+        self.add_surfaces(builder, false, shades)
     }
 
     /// As [`Building::add_to`], but every surface receives, and every shading surface also gets
     /// its back face `Mir-NAME` as EnergyPlus makes it: the columns EnergyPlus's `Imported`
     /// method looks up (those of its own eplusshading.csv).
     pub fn add_all_to(&self, builder: &mut SceneBuilder) -> Result<()> {
-        self.add_surfaces(builder, true)?;
+        self.add_surfaces(builder, true, &HashMap::new())?;
         for s in self.surfaces.iter().filter(|s| s.is_shading()) {
             builder.add_mirror(&s.name, &format!("Mir-{}", s.name));
         }
         Ok(())
     }
 
-    fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool) -> Result<()> {
+    fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool, shades: &HashMap<String, f64>) -> Result<()> {
         let holes = self.holes();
         for (i, surface) in self.surfaces.iter().enumerate() {
+            let transmittance = shades.get(&surface.name.to_ascii_lowercase()).copied().filter(|_| surface.is_shading());
+            if transmittance.is_some_and(|t| t >= 1.0) {
+                // Lets all the sun through: casts no shadow, so it is left out.
+                continue;
+            }
+
             let placed = self.placed(surface);
             let surface = match &placed {
                 Some(SubPlacement::InPlane(vertices)) => &EpSurface { vertices: vertices.clone(), ..surface.clone() },
@@ -88,6 +100,9 @@ impl Building {
             let triangles = triangulate(surface, holes.get(&i).map_or(&[][..], Vec::as_slice));
             let anchor = surface.vertices.first().copied().unwrap_or(DVec3::ZERO);
             let mesh = builder.add_mesh(format!("{}: {}", self.file, surface.label()), relative_mesh(&triangles, anchor));
+            if let Some(t) = transmittance {
+                builder.set_node_veil(builder.node_count(), NodeVeil { foliage: false, transmittance: t });
+            }
             builder.add_node(SourceNode {
                 name: surface.name.clone(),
                 origin: format!("{}: {}", self.file, surface.label()),

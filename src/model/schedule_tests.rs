@@ -1,0 +1,106 @@
+#![allow(clippy::unwrap_used)]
+use super::*;
+use crate::model::idf::parse_idf;
+
+const N4: RunCalendar = RunCalendar { per_hour: 4, leap: false };
+
+fn schedule(text: &str, name: &str) -> Result<Schedule> {
+    let objects = parse_idf("m.idf", text)?;
+    let schedules = Schedules::new("m.idf", &objects, None);
+    schedules.resolve(name, "Shading:Site:Detailed 'Tree' (line 1)", "Transmittance Schedule Name")
+}
+
+/// Row of (1-based day, timestep ending at `hh:mm`) with 4 timesteps an hour.
+fn row(day: usize, hh: usize, mm: usize) -> usize {
+    (day - 1) * 96 + (hh * 60 + mm) / 15 - 1
+}
+
+#[test]
+fn constant_and_compact_until_values_hold_up_to_their_time() {
+    let c = schedule("Schedule:Constant, C, , 0.2;", "c").unwrap();
+    assert_eq!(c.constant(), Some(0.2));
+    assert_eq!(c.values(N4).len(), 365 * 96);
+    let text = "Schedule:Compact, S, ,\n Through: 3/31, For: AllDays, Until: 12:00, 0.1, Until: 24:00, 0.3,\n Through: 12/31, For: Weekdays, Until: 24:00, 0.5, For: AllOtherDays, Until: 24:00, 0.7;\n RunPeriod, R, 1, 1, 2017, 12, 31, 2017;";
+    let s = schedule(text, "S").unwrap();
+    let v = s.values(N4);
+    assert_eq!(v[row(1, 12, 0)], 0.1, "the step ending at 12:00 is before the Until");
+    assert_eq!(v[row(1, 12, 15)], 0.3);
+    assert_eq!(v[row(90, 24, 0)], 0.3, "31 March");
+    // 2017 starts on a Sunday: 2 April is a Sunday, 3 April a Monday.
+    assert_eq!(v[row(92, 10, 0)], 0.7);
+    assert_eq!(v[row(93, 10, 0)], 0.5);
+}
+
+#[test]
+fn interpolation_averages_or_ramps_within_a_timestep() {
+    let text = "Schedule:Compact, S, , Through: 12/31, For: AllDays, Interpolate: Average, Until: 10:10, 0, Until: 24:00, 1;";
+    let v = schedule(text, "S").unwrap().values(N4);
+    assert_eq!(v[row(1, 10, 15)], 1.0 / 3.0);
+    let text = "Schedule:Compact, S, , Through: 12/31, For: AllDays, Interpolate: No, Until: 10:10, 0, Until: 24:00, 1;";
+    let v = schedule(text, "S").unwrap().values(N4);
+    assert_eq!(v[row(1, 10, 15)], 1.0, "No: the value holding at the step's end");
+    let text = "Schedule:Compact, S, , Through: 12/31, For: AllDays, Interpolate: Linear, Until: 12:00, 0, Until: 24:00, 1;";
+    let v = schedule(text, "S").unwrap().values(N4);
+    assert!(v[row(1, 12, 15)] > 0.0 && v[row(1, 12, 15)] < 0.03, "{}", v[row(1, 12, 15)]);
+    assert!((v[row(1, 18, 0)] - 0.5).abs() < 0.02, "{}", v[row(1, 18, 0)]);
+}
+
+#[test]
+fn year_week_and_day_schedules() {
+    let text = "Schedule:Year, Y, , W1, 1, 1, 6, 30, W2, 7, 1, 12, 31;\n\
+        Schedule:Week:Daily, W1, D1, D1, D1, D1, D1, D1, D1, D1, D1, D1, D1, D1;\n\
+        Schedule:Week:Daily, W2, D2, D2, D2, D2, D2, D2, D2, D2, D2, D2, D2, D2;\n\
+        Schedule:Day:Hourly, D1, , 0,0,0,0,0,0,0,0,0,0,0,0.5,0,0,0,0,0,0,0,0,0,0,0,0;\n\
+        Schedule:Day:Interval, D2, , No, 06:00, 1, 24:00, 0.25;";
+    let s = schedule(text, "y").unwrap();
+    let v = s.values(N4);
+    assert_eq!((v[row(1, 11, 45)], v[row(1, 12, 0)], v[row(1, 11, 0)]), (0.5, 0.5, 0.0), "hour 12 is 11:00–12:00");
+    assert_eq!((v[row(182, 6, 0)], v[row(182, 6, 15)]), (1.0, 0.25), "1 July");
+    let leap = s.values(RunCalendar { per_hour: 1, leap: true });
+    assert_eq!(leap.len(), 366 * 24);
+    let hours = vec!["0"; 24].join(",");
+    let half = format!(
+        "Schedule:Year, Y, , W1, 1, 1, 6, 30;\nSchedule:Week:Daily, W1, D,D,D,D,D,D,D,D,D,D,D,D;\nSchedule:Day:Hourly, D, , {hours};"
+    );
+    let e = schedule(&half, "Y").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Year 'Y'") && e.contains("its weeks end on 06/30, not on 12/31"), "{e}");
+    let e = schedule(&half.replace(&hours, "0"), "Y").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Day:Hourly 'D'") && e.contains("field 'Hour 2': '' is not a number"), "{e}");
+}
+
+#[test]
+fn refusals_name_object_field_and_reason() {
+    let e = schedule("Schedule:Constant, C, , 0.2;", "nope").unwrap_err().to_string();
+    assert!(e.contains("Tree") && e.contains("Transmittance Schedule Name") && e.contains("'nope' names no schedule"), "{e}");
+    let e = schedule("Schedule:Compact, S, , Through: 6/30, For: AllDays, Until: 24:00, 1;", "S").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Compact 'S'") && e.contains("end on 06/30, not on 12/31"), "{e}");
+    let e = schedule("Schedule:Constant, C, Frac, 1.5;\nScheduleTypeLimits, Frac, 0, 1, Continuous;", "C").unwrap_err().to_string();
+    assert!(e.contains("value 1.5 is outside its ScheduleTypeLimits 'Frac' (0..1)"), "{e}");
+    let e = schedule("Schedule:Constant, C, Missing, 0.5;", "C").unwrap_err().to_string();
+    assert!(e.contains("'Missing' names no ScheduleTypeLimits"), "{e}");
+    let e = schedule("Schedule:Constant, C, On, 0.5;\nScheduleTypeLimits, On, 0, 1, Discrete;", "C").unwrap_err().to_string();
+    assert!(e.contains("discrete"), "{e}");
+    let e = schedule("Schedule:Compact, S, , Through: 12/31, For: AllDays, Until: 12:00, 1;", "S").unwrap_err().to_string();
+    assert!(e.contains("not 24:00"), "{e}");
+    let e = schedule("Schedule:File, F, , /nonexistent/t.csv, 1, 0;", "F").unwrap_err().to_string();
+    assert!(e.contains("Schedule:File 'F'") && e.contains("cannot be read"), "{e}");
+}
+
+#[test]
+fn schedule_file_reads_its_column_and_refuses_a_short_file() {
+    let dir = std::env::temp_dir().join(format!("sunlit-schedule-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rows: Vec<String> = (0..8760 * 4).map(|i| format!("x,{}", if i % 96 < 48 { 0.25 } else { 0.75 })).collect();
+    std::fs::write(dir.join("t.csv"), format!("head\n{}\n", rows.join("\n"))).unwrap();
+    std::fs::write(dir.join("short.csv"), "0.5\n0.5\n").unwrap();
+    let text = "Schedule:File, F, , t.csv, 2, 1, 8760, Comma, No, 15;\nSchedule:File, G, , short.csv, 1, 0;";
+    let objects = parse_idf("m.idf", text).unwrap();
+    let schedules = Schedules::new("m.idf", &objects, Some(&dir));
+    let v = schedules.resolve("F", "x", "y").unwrap().values(N4);
+    assert_eq!((v[row(2, 12, 0)], v[row(2, 12, 15)]), (0.25, 0.75));
+    let hourly = schedules.resolve("F", "x", "y").unwrap().values(RunCalendar { per_hour: 1, leap: false });
+    assert_eq!(hourly[12], 0.75, "one timestep an hour: the value at the hour's end");
+    let e = schedules.resolve("G", "x", "y").unwrap_err().to_string();
+    assert!(e.contains("too short: 2 values") && e.contains("8760 needed"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,105 @@
+//! Shades that let part of the sun through (an EnergyPlus shade's transmittance schedule): the
+//! year counted with each such shade opaque and removed, mixed per timestep.
+//!
+//! Owns the rule that makes a time-varying τ exact without a view per timestep and τ. EnergyPlus's
+//! clipping counts a shade's shadow as (1 − τ) of it and multiplies the τ of overlapping shadows,
+//! so a receiver's sunlit fraction is multilinear in the shades' τ: with k shades (or groups of
+//! shades sharing a schedule) varying, f(t) = Σ_S Π_{g∈S} τ_g(t) · Π_{g∉S} (1 − τ_g(t)) · f_S(t),
+//! f_S being the fraction with the groups in S removed and the others opaque. Each f_S is a static
+//! scene's year, as smooth in time as any (the spline and its refinements apply unchanged), and the
+//! schedule's steps (an hourly screen, a seasonal tree) enter only through the weights. So 2^k
+//! years are counted. A shade whose τ is constant but between 0 and 1 is mixed too: the exact
+//! engine's boundary step counts a see-through caster as opaque and the GPU's per-pixel threshold
+//! is a dithered estimate, while a mix of two years of opaque or absent casters is exact on
+//! either engine. Shades always at τ = 0 are plain casters and those always at 1 are left out
+//! ([`crate::model::shades::ShadeGroup::constant`]).
+
+use crate::error::{Error, Result};
+use crate::export::Schedule;
+use crate::model::schedule::RunCalendar;
+use crate::model::shades::ShadeGroup;
+use crate::year::annual::energyplus_fraction;
+
+/// At most this many shade groups may be mixed: each doubles the years counted.
+pub const MAX_VARYING: usize = 4;
+
+/// The shades that are mixed, with τ per timestep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VaryingShades {
+    /// Per group: its shades' names and its τ at every row.
+    groups: Vec<(Vec<String>, Vec<f64>)>,
+}
+
+impl VaryingShades {
+    /// The groups of `shades` that let part of the sun through at some time; refused past
+    /// [`MAX_VARYING`] groups. None when every shade is opaque or absent all year (the scene as
+    /// loaded is then already right).
+    pub fn new(file: &str, shades: &[ShadeGroup], calendar: RunCalendar) -> Result<Option<Self>> {
+        let mixed: Vec<&ShadeGroup> = shades.iter().filter(|g| !matches!(g.constant(), Some(t) if t == 0.0 || t >= 1.0)).collect();
+        let groups: Vec<(Vec<String>, Vec<f64>)> = mixed.iter().map(|g| (g.shades.clone(), g.values(calendar))).collect();
+        if groups.len() > MAX_VARYING {
+            let names: Vec<&str> = mixed.iter().map(|g| g.schedule.name.as_str()).collect();
+            return Err(Error::model(
+                file,
+                format!(
+                    "{} transmittance schedules let part of the sun through ({}); each doubles the years sunlit counts, and at most {MAX_VARYING} may",
+                    groups.len(),
+                    names.join(", ")
+                ),
+            ));
+        }
+        Ok((!groups.is_empty()).then_some(Self { groups }))
+    }
+
+    /// How many years are counted: 2^k.
+    pub fn variants(&self) -> usize {
+        1 << self.groups.len()
+    }
+
+    /// The shades' τ in variant `v` (bit g set: group g removed, τ = 1; clear: opaque, τ = 0),
+    /// as [`crate::model::LoadOptions::shade_transmittance`] takes them.
+    pub fn shade_transmittance(&self, v: usize) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        for (g, (shades, _)) in self.groups.iter().enumerate() {
+            let t = if v >> g & 1 == 1 { 1.0 } else { 0.0 };
+            out.extend(shades.iter().map(|s| (s.clone(), t)));
+        }
+        out
+    }
+
+    /// Variant `v`'s weight at `row`.
+    fn weight(&self, v: usize, row: usize) -> f64 {
+        self.groups.iter().enumerate().map(|(g, (_, t))| if v >> g & 1 == 1 { t[row] } else { 1.0 - t[row] }).product()
+    }
+
+    /// Every variant's year (in variant order, the same columns and rows) mixed per timestep.
+    pub fn mix(&self, years: &[Schedule]) -> Result<Schedule> {
+        let Some(first) = years.first().filter(|_| years.len() == self.variants()) else {
+            return Err(Error::argument("years", format!("{} years for {} variants", years.len(), self.variants())));
+        };
+        if years.iter().any(|y| y.names != first.names || y.values.len() != first.values.len()) {
+            return Err(Error::argument("years", "the variants' years differ in columns or rows"));
+        }
+        let columns = first.names.len();
+        let mut out = Schedule { names: first.names.clone(), timesteps: first.timesteps, values: vec![0.0; first.values.len()] };
+        for (row, values) in out.values.chunks_mut(columns.max(1)).enumerate() {
+            let weights: Vec<f64> = (0..years.len()).map(|v| self.weight(v, row)).collect();
+            for (c, value) in values.iter_mut().enumerate() {
+                let f: f64 = years.iter().zip(&weights).map(|(y, w)| w * f64::from(y.values[row * columns + c])).sum();
+                *value = energyplus_fraction(f) as f32;
+            }
+        }
+        out.validate()?;
+        Ok(out)
+    }
+
+    /// Each group's mean τ over the run, for passes that take one scene (the sky views).
+    pub fn mean_transmittance(&self) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        for (shades, t) in &self.groups {
+            let mean = t.iter().sum::<f64>() / t.len().max(1) as f64;
+            out.extend(shades.iter().map(|s| (s.clone(), mean)));
+        }
+        out
+    }
+}
