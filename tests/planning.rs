@@ -88,6 +88,37 @@ fn radiance_python() -> PathBuf {
     venv
 }
 
+/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
+/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
+/// off to one side: each point's VSC within 0.5 points.
+#[test]
+fn vsc_matches_radiance_rtrace_on_boxes() {
+    let boxes = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
+    let rows = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+    let mut s = TestScene::new();
+    s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+    for (k, (lo, hi)) in boxes.iter().enumerate() {
+        s.cuboid(&format!("BOX{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
+    }
+    let scene = s.build();
+    let got = vsc::vsc(&Mapper::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
+    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("case.json");
+    let boxes_json: Vec<Value> = boxes.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
+    std::fs::write(&case, serde_json::json!({"points": rows, "boxes": boxes_json}).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planning/vsc_radiance.py");
+    let run = Command::new(radiance_python()).arg(script).arg(&case).output().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(run.status.success(), "vsc_radiance.py: {}", String::from_utf8_lossy(&run.stderr));
+    let truth: Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!((truth["horizontal"].as_f64().unwrap() - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {truth}");
+    for (i, t) in truth["vsc"].as_array().unwrap().iter().enumerate() {
+        let t = t.as_f64().unwrap();
+        assert!((got.vsc[i] - t).abs() <= 0.5, "point {i}: VSC {:.3} vs Radiance {t:.3}", got.vsc[i]);
+    }
+}
+
 fn golden_epw() -> PathBuf {
     let epw = energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw");
     assert!(epw.exists(), "{} missing from the EnergyPlus wheel", epw.display());
