@@ -377,6 +377,12 @@ const FLAGS: &[(&str, &str)] = &[
     ("irradiance", "--irradiance"),
     ("albedo", "--albedo"),
     ("sky_patches", "--sky-patches"),
+    ("day", "--day"),
+    ("required_hours", "--required-hours"),
+    ("min_period", "--min-period"),
+    ("max_periods", "--max-periods"),
+    ("window_width", "--window-width"),
+    ("epw", "--epw"),
 ];
 
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.

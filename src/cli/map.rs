@@ -15,8 +15,11 @@ use sunlit::year::season::LeafCalendar;
 
 use super::*;
 
+#[path = "map_planning.rs"]
+mod planning;
+
 #[derive(Args)]
-#[command(group = clap::ArgGroup::new("site").required(true).args(["epw", "location"]))]
+#[command(group = clap::ArgGroup::new("site").args(["epw", "location"]))]
 pub(super) struct MapArgs {
     #[command(flatten)]
     model: ModelArgs,
@@ -63,7 +66,8 @@ pub(super) struct MapArgs {
     /// Also write the receivers coloured by the value as a glb (legend in the scene's extras).
     #[arg(long, value_name = "MAP.glb")]
     glb_out: Option<PathBuf>,
-    /// Sun-hours study: bre-ground or en17037; repeatable. Reports go beside the output as
+    /// Study: bre-ground or en17037 (sun hours on areas), or the window studies bre-vsc,
+    /// bre-apsh, gb50180 (per reference point; docs/planning.md); repeatable. Reports go beside the output as
     /// POINTS.study-NAME.json and .csv.
     #[arg(long, value_name = "NAME")]
     study: Vec<String>,
@@ -80,6 +84,35 @@ pub(super) struct MapArgs {
     /// Print a JSON summary.
     #[arg(long)]
     json: bool,
+    /// Window studies (bre-vsc, bre-apsh, gb50180): the existing scene's models; each point's
+    /// former values go beside the proposed ones, with BRE's relative tests. Needs --points.
+    #[arg(long, value_name = "MODEL", num_args = 1..)]
+    before: Vec<PathBuf>,
+    /// gb50180's standard day: dahan (大寒日, the default) or dongzhi (冬至日).
+    #[arg(long, value_name = "dahan|dongzhi")]
+    day: Option<String>,
+    /// gb50180: hours a sill must reach (default 2 on dahan, 1 on dongzhi).
+    #[arg(long, value_name = "HOURS")]
+    required_hours: Option<f64>,
+    /// gb50180: only continuous periods at least this long count (minutes; default 0).
+    #[arg(long, value_name = "MINUTES")]
+    min_period: Option<f64>,
+    /// gb50180: only the longest N periods count (default all).
+    #[arg(long, value_name = "N")]
+    max_periods: Option<usize>,
+    /// gb50180: also the 满窗 (whole window) hours, the sun over the whole sill of this width (m).
+    #[arg(long, value_name = "METRES")]
+    window_width: Option<f64>,
+    /// The sky a study weighs: bre-vsc takes only cie-overcast (its definition).
+    #[arg(long, value_name = "NAME")]
+    sky_model: Option<String>,
+    /// Window studies: sky-mask diagrams (stereographic, with sun paths) for these 1-based point
+    /// rows, or all: POINTS.mask-N.svg.
+    #[arg(long, value_name = "ROWS|all")]
+    mask: Option<String>,
+    /// Window studies: a self-contained HTML report (tables with pass/fail, masks, rules).
+    #[arg(long, value_name = "REPORT.html")]
+    html: Option<PathBuf>,
 }
 
 /// What the flags ask for, checked before the model is read.
@@ -168,6 +201,23 @@ impl MapArgs {
 }
 
 pub(super) fn map(args: MapArgs) -> Result<()> {
+    if planning::wanted(&args) {
+        return planning::run(args);
+    }
+    let window_only = [
+        ("--before", !args.before.is_empty()),
+        ("--day", args.day.is_some()),
+        ("--required-hours", args.required_hours.is_some()),
+        ("--min-period", args.min_period.is_some()),
+        ("--max-periods", args.max_periods.is_some()),
+        ("--window-width", args.window_width.is_some()),
+        ("--sky-model", args.sky_model.is_some()),
+        ("--mask", args.mask.is_some()),
+        ("--html", args.html.is_some()),
+    ];
+    if let Some((flag, _)) = window_only.iter().find(|(_, given)| *given) {
+        return Err(Error::argument(*flag, format!("is taken by the window studies only ({})", planning::STUDIES.join(", "))));
+    }
     let plan = args.plan()?;
     let on_gpu = args.on_gpu()?;
     if let Some(g) = args.grid

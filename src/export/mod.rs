@@ -16,6 +16,7 @@ pub mod hook;
 pub mod irradiation;
 pub mod map_glb;
 pub mod map_table;
+pub mod planning_report;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]

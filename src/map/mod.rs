@@ -13,6 +13,8 @@
 //!   the Perez sky exactly as a receiver's is ([`crate::export::irradiation`]);
 //! - [`period`]: years at EnergyPlus timesteps, date ranges, one day at minute steps, an instant,
 //!   with the sun `sunlit annual` uses;
+//! - [`planning`]: window studies (BRE 209's VSC and APSH/WPSH, GB 50180's sunlight hours),
+//!   their pass/fail alone and against an existing scene, and each point's sky mask;
 //! - [`MapGpu`]: the same sweeps with each point answered by its texel in the GPU counter's tile
 //!   of its receiver (`gpu`, [`crate::count::gpu::masks`]): `*_gpu` methods of [`Mapper`].
 //!
@@ -34,6 +36,7 @@
 
 mod gpu;
 pub mod period;
+pub mod planning;
 pub mod points;
 pub mod sky;
 pub mod study;

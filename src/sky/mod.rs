@@ -8,11 +8,14 @@
 //! - [`views`]: every receiver's sky views, once per model (and per leaf state), and the view
 //!   factors made of them;
 //! - [`perez`]: the Perez 1990 all-weather sky, as EnergyPlus applies it;
-//! - [`energyplus`]: EnergyPlus's own 144-direction diffuse shading ratios.
+//! - [`energyplus`]: EnergyPlus's own 144-direction diffuse shading ratios;
+//! - [`luminance`]: weather-free luminance distributions (the CIE standard overcast sky, which
+//!   BRE 209's vertical sky component is defined under, and the uniform sky).
 //!
 //! Combining them with the beam per timestep is [`crate::export::irradiation`]'s.
 
 pub mod energyplus;
+pub mod luminance;
 pub mod patches;
 pub mod perez;
 pub mod views;

@@ -1,0 +1,255 @@
+//! GB 50180-2018 (urban residential area planning and design standard), 4.0.9: a dwelling's
+//! sunlight hours on its standard day, counted at the ground-floor window sill (底层窗台面).
+//!
+//! Table 4.0.9: 大寒日 (Greater Cold) ≥ 2 h or ≥ 3 h, counted 8:00–16:00 true solar time, or 冬至日
+//! (winter solstice) ≥ 1 h, counted 9:00–15:00, by climate zone and city size; its notes add
+//! housing for the elderly ≥ 2 h on 冬至日 and new dwellings in old districts ≥ 1 h on 大寒日.
+//! Local rules add a minimum continuous period (often 5 or 10 min) and a maximum number of
+//! periods summed: [`Gb50180Rule::min_period_minutes`] and [`Gb50180Rule::max_periods`] (the
+//! longest ones count, as [`SunRule::hours`] counts them).
+//!
+//! The standard day is a solar term, the day the sun reaches ecliptic longitude 300° (大寒) or
+//! 270° (冬至); its sun is computed as Chinese sunlight software does, from the term's declination
+//! sin δ = sin ε · sin λ (ε = [`OBLIQUITY_DEG`]) and the hour angle 15° · (t − 12) of true solar
+//! time t, every minute (the middle of each, [`STEP_MINUTES`]). The window in local standard time,
+//! for the report, is t − EoT − (longitude − 15° · zone)/15 with the equation of time of the
+//! day in a 365-day year (EnergyPlus's SUN3 fit, [`declination_and_equation_of_time`]).
+//!
+//! 满窗 (whole window): the window's sill is sampled across its width ([`whole_window_points`]) and
+//! an instant counts only when every sample sees the sun.
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+use crate::map::study::SunRule;
+use crate::map::{LitSeries, Mapper, Points, Sample};
+use crate::scene::Scene;
+use crate::sun::location::Location;
+use crate::sun::position::declination_and_equation_of_time;
+use crate::year::season::LeafCalendar;
+
+/// The obliquity of the ecliptic, degrees (J2000, 23°26′).
+pub const OBLIQUITY_DEG: f64 = 23.44;
+/// Minutes between instants; each stands for its minute.
+pub const STEP_MINUTES: u32 = 1;
+/// Most spacing between a whole window's sill samples, metres.
+pub const SILL_SPACING: f64 = 0.1;
+
+/// GB 50180's standard days.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StandardDay {
+    /// 大寒日, about 20 January: ecliptic longitude 300°.
+    Dahan,
+    /// 冬至日, about 21 December: ecliptic longitude 270°.
+    Dongzhi,
+}
+
+impl StandardDay {
+    /// Reads `dahan`/`大寒日`/`大寒` or `dongzhi`/`冬至日`/`冬至`; refuses another day, naming `day`.
+    pub fn parse(text: &str) -> Result<Self> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "dahan" | "大寒日" | "大寒" => Ok(Self::Dahan),
+            "dongzhi" | "冬至日" | "冬至" => Ok(Self::Dongzhi),
+            other => Err(Error::argument("day", format!("'{other}': GB 50180 evaluates 大寒日 (dahan) or 冬至日 (dongzhi) only"))),
+        }
+    }
+
+    /// The ASCII name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Dahan => "dahan",
+            Self::Dongzhi => "dongzhi",
+        }
+    }
+
+    /// The standard's name.
+    pub fn chinese(self) -> &'static str {
+        match self {
+            Self::Dahan => "大寒日",
+            Self::Dongzhi => "冬至日",
+        }
+    }
+
+    /// The sun's ecliptic longitude on the day, degrees.
+    pub fn ecliptic_longitude_deg(self) -> f64 {
+        match self {
+            Self::Dahan => 300.0,
+            Self::Dongzhi => 270.0,
+        }
+    }
+
+    /// The sun's declination on the day, degrees (大寒 −20.15°, 冬至 −23.44°).
+    pub fn declination_deg(self) -> f64 {
+        (OBLIQUITY_DEG.to_radians().sin() * self.ecliptic_longitude_deg().to_radians().sin()).asin().to_degrees()
+    }
+
+    /// The effective sunlight window, hours of true solar time.
+    pub fn window(self) -> (f64, f64) {
+        match self {
+            Self::Dahan => (8.0, 16.0),
+            Self::Dongzhi => (9.0, 15.0),
+        }
+    }
+
+    /// The day of a 365-day year it falls on (20 January, 21 December).
+    pub fn day_of_year(self) -> u32 {
+        match self {
+            Self::Dahan => 20,
+            Self::Dongzhi => 355,
+        }
+    }
+
+    /// Table 4.0.9's hours for the day (大寒日 ≥ 2 h for large cities of zones I, II, III, VII;
+    /// 冬至日 ≥ 1 h).
+    pub fn default_hours(self) -> f64 {
+        match self {
+            Self::Dahan => 2.0,
+            Self::Dongzhi => 1.0,
+        }
+    }
+}
+
+/// The rule as evaluated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gb50180Rule {
+    /// The standard day.
+    pub day: StandardDay,
+    /// Hours a point must reach.
+    pub required_hours: f64,
+    /// Only continuous periods at least this long count (minutes).
+    pub min_period_minutes: f64,
+    /// Only the longest N periods count (`None`: all).
+    pub max_periods: Option<usize>,
+    /// 满窗: the sill's width (m) over which every sample must see the sun.
+    pub whole_window: Option<f64>,
+}
+
+impl Gb50180Rule {
+    /// The day's rule with its default hours and no local additions.
+    pub fn new(day: StandardDay) -> Self {
+        Self { day, required_hours: day.default_hours(), min_period_minutes: 0.0, max_periods: None, whole_window: None }
+    }
+
+    /// Refuses parameters outside their sense, naming them.
+    pub fn check(&self) -> Result<()> {
+        if !(self.required_hours.is_finite() && self.required_hours > 0.0 && self.required_hours <= 8.0) {
+            return Err(Error::argument("required_hours", format!("{} h is not in (0, 8]", self.required_hours)));
+        }
+        if !(self.min_period_minutes.is_finite() && (0.0..=480.0).contains(&self.min_period_minutes)) {
+            return Err(Error::argument("min_period", format!("{} min is not in 0..=480", self.min_period_minutes)));
+        }
+        if self.max_periods == Some(0) {
+            return Err(Error::argument("max_periods", "0: at least one period must count"));
+        }
+        if let Some(w) = self.whole_window
+            && !(w.is_finite() && w > 0.0 && w <= 20.0)
+        {
+            return Err(Error::argument("window_width", format!("{w} m is not in (0, 20]")));
+        }
+        Ok(())
+    }
+
+    /// The period rule of [`SunRule::hours`] with this rule's minimum and longest periods.
+    fn periods(&self) -> SunRule {
+        SunRule {
+            name: "gb50180".into(),
+            source: String::new(),
+            min_altitude_deg: 0.0,
+            min_period_minutes: self.min_period_minutes,
+            longest: self.max_periods,
+            levels: vec![("pass".into(), self.required_hours)],
+            share: 1.0,
+            days: (1, 365),
+            default_day: self.day.day_of_year(),
+        }
+    }
+}
+
+/// The sun (unit, x east, y north, z up) at `latitude_deg`, declination `declination_deg` and
+/// `true_solar_hour` (12 at the meridian).
+pub fn sun_at_true_solar_time(latitude_deg: f64, declination_deg: f64, true_solar_hour: f64) -> DVec3 {
+    let (sp, cp) = latitude_deg.to_radians().sin_cos();
+    let (sd, cd) = declination_deg.to_radians().sin_cos();
+    let (sh, ch) = (15.0 * (true_solar_hour - 12.0)).to_radians().sin_cos();
+    DVec3::new(-cd * sh, cp * sd - sp * cd * ch, sp * sd + cp * cd * ch)
+}
+
+/// Local standard time (hours) of `true_solar_hour` on `day_of_year` at `location`: true solar
+/// time − equation of time − (longitude − time-zone meridian)/15.
+pub fn standard_time(location: &Location, day_of_year: u32, true_solar_hour: f64) -> f64 {
+    let (_, equation_of_time) = declination_and_equation_of_time(f64::from(day_of_year));
+    true_solar_hour - equation_of_time - (location.longitude - location.time_zone_meridian()) / 15.0
+}
+
+/// The day's instants: the middle of each minute of the window, in true solar time.
+pub fn instants(day: StandardDay) -> Vec<Sample> {
+    let (from, to) = day.window();
+    let count = ((to - from) * 60.0 / f64::from(STEP_MINUTES)).round() as usize;
+    let hours = f64::from(STEP_MINUTES) / 60.0;
+    (0..count).map(|k| Sample { day: day.day_of_year(), hour: from + (k as f64 + 0.5) * hours, hours, epw_hour: 0 }).collect()
+}
+
+/// `points` with, per point, `samples` sill samples across `width` metres (horizontal in its
+/// plane, centred on it) appended in order: point `i`'s are `n + i·samples .. n + (i+1)·samples`.
+pub fn whole_window_points(points: &Points, width: f64) -> (Points, usize) {
+    let samples = ((width / SILL_SPACING).ceil() as usize + 1).max(3);
+    let mut out = points.clone();
+    for i in 0..points.len() {
+        let (p, n) = (points.position(i), points.normal(i));
+        let across = if n.z.abs() < 0.9 { DVec3::Z.cross(n).normalize() } else { DVec3::X };
+        for k in 0..samples {
+            let offset = width * (k as f64 / (samples - 1) as f64 - 0.5);
+            out.push(p + across * offset, n, points.receivers[i]);
+        }
+    }
+    (out, samples)
+}
+
+/// Each point's hours under the rule, and with [`Gb50180Rule::whole_window`] its 满窗 hours.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Gb50180Values {
+    /// Hours per point (at the point itself).
+    pub hours: Vec<f64>,
+    /// 满窗 hours per point (every sill sample lit), when asked.
+    pub whole_window_hours: Option<Vec<f64>>,
+}
+
+/// Evaluates `rule` at `points` of `scene` at `location`; `progress(done, total)` counts minutes.
+pub fn evaluate(
+    scene: &Scene,
+    points: &Points,
+    location: &Location,
+    rule: &Gb50180Rule,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Gb50180Values> {
+    rule.check()?;
+    let n = points.len();
+    let (all, per_window) = match rule.whole_window {
+        Some(width) => whole_window_points(points, width),
+        None => (points.clone(), 0),
+    };
+    let mapper = Mapper::new(scene, &all)?;
+    let samples = instants(rule.day);
+    let leaves = LeafCalendar::for_latitude(location.latitude).fraction(f64::from(rule.day.day_of_year())) as f32;
+    let declination = rule.day.declination_deg();
+    let asks: Vec<super::Ask> =
+        samples.iter().map(|s| super::Ask { direction: sun_at_true_solar_time(location.latitude, declination, s.hour), leaves }).collect();
+    let lit = super::lit_bits(&mapper, &asks, progress);
+    let periods = rule.periods();
+    let hours = (0..n).map(|i| periods.hours(&samples, &lit, i)).collect();
+    let whole_window_hours = rule.whole_window.map(|_| {
+        let words = samples.len().div_ceil(64);
+        let mut bits = vec![0u64; n * words];
+        for i in 0..n {
+            let first = n + i * per_window;
+            for k in 0..samples.len() {
+                if (first..first + per_window).all(|j| lit.lit(j, k)) {
+                    bits[i * words + k / 64] |= 1 << (k % 64);
+                }
+            }
+        }
+        let window = LitSeries { words, instants: samples.len(), bits };
+        (0..n).map(|i| periods.hours(&samples, &window, i)).collect()
+    });
+    Ok(Gb50180Values { hours, whole_window_hours })
+}

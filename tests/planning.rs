@@ -1,0 +1,408 @@
+//! Window studies against independent truths: BRE 209's VSC against the closed form of a
+//! vertical point facing an infinitely long obstruction; APSH/WPSH against a numpy ray caster
+//! over the same EPW hours (tests/planning/apsh_truth.py, its own sun); GB 50180's sunlight
+//! hours against the analytic canyon (a sill facing a long slab); true solar time against a
+//! published equation-of-time table; the CLI's output contract, before/after and refusals.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+mod common;
+use common::energyplus::energyplus;
+use common::{TestScene, south_rect};
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::DVec3;
+use serde_json::Value;
+use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
+use sunlit::map::planning::{apsh, vsc};
+use sunlit::map::{Mapper, Points, Site, from_csv};
+use sunlit::scene::Scene;
+use sunlit::sun::location::Location;
+use sunlit::sun::weather::Weather;
+use sunlit::year::season::LeafCalendar;
+
+/// VSC (%) of a vertical point facing an infinitely long horizontal edge at elevation θ in its
+/// normal's plane. Directions d = (sin a, cos a cos ψ, cos a sin ψ) (a across the normal's
+/// vertical plane, ψ up from the normal within it), dΩ = cos a da dψ; the sky is seen for
+/// ψ > θ. With L/Lz = (1 + 2 cos a sin ψ)/3 and cos incidence cos a cos ψ:
+/// E = ∫θ^{π/2} cos ψ [∫cos²a da + 2 sin ψ ∫cos³a da]/3 dψ = [π/2 (1 − sin θ) + 4/3 cos²θ]/3,
+/// over the horizontal 7π/9.
+fn vsc_closed_form(theta: f64) -> f64 {
+    let e = (PI / 2.0 * (1.0 - theta.sin()) + 4.0 / 3.0 * theta.cos().powi(2)) / 3.0;
+    100.0 * e / (7.0 * PI / 9.0)
+}
+
+/// A south façade (receiver) x in −5..5, z in 0..6 at y = 0, and in front of it, `distance` m to
+/// the south, a 2 km long slab rising `height` m above the ground.
+fn canyon(distance: f64, height: Option<f64>) -> Scene {
+    let mut s = TestScene::new();
+    s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+    if let Some(h) = height {
+        s.cuboid("SLAB", DVec3::new(-1000.0, -distance - 2.0, 0.0), DVec3::new(1000.0, -distance, h));
+    }
+    s.build()
+}
+
+fn points(scene: &Scene, rows: &[[f64; 6]]) -> Points {
+    let mut text = String::from("x,y,z,nx,ny,nz\n");
+    for r in rows {
+        text.push_str(&r.map(|v| v.to_string()).join(","));
+        text.push('\n');
+    }
+    from_csv(scene, "test", &text, &(0..scene.receivers.len() as u32).collect::<Vec<_>>()).unwrap()
+}
+
+#[test]
+fn vsc_matches_the_closed_form_of_a_long_obstruction() {
+    assert!((vsc_closed_form(0.0) - 39.62).abs() < 0.01, "the closed form's unobstructed value is BRE's 39.6 %");
+    let open = canyon(10.0, None);
+    let v = vsc::vsc(&Mapper::new(&open, &points(&open, &[[0.0, 0.0, 1.5, 0.0, -1.0, 0.0]])).unwrap(), &mut |_, _| {});
+    assert!((v.vsc[0] - 39.6).abs() <= 0.2, "unobstructed VSC {}", v.vsc[0]);
+    assert!((v.unobstructed[0] - v.vsc[0]).abs() < 1e-9);
+    for theta_deg in [10.0f64, 25.0, 40.0, 60.0] {
+        let distance = 10.0;
+        let point_z = 1.5;
+        let scene = canyon(distance, Some(point_z + distance * theta_deg.to_radians().tan()));
+        // Three points along the façade: the same elevation, so the same VSC.
+        let rows: Vec<[f64; 6]> = [-2.0, 0.0, 2.0].iter().map(|&x| [x, 0.0, point_z, 0.0, -1.0, 0.0]).collect();
+        let v = vsc::vsc(&Mapper::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
+        let truth = vsc_closed_form(theta_deg.to_radians());
+        for (i, got) in v.vsc.iter().enumerate() {
+            assert!((got - truth).abs() <= 0.5, "θ = {theta_deg}°, point {i}: VSC {got:.3} vs closed form {truth:.3}");
+        }
+    }
+}
+
+fn radiance_python() -> PathBuf {
+    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
+    assert!(
+        venv.exists(),
+        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
+    );
+    venv
+}
+
+/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
+/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
+/// off to one side: each point's VSC within 0.5 points.
+#[test]
+fn vsc_matches_radiance_rtrace_on_boxes() {
+    let boxes = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
+    let rows = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+    let mut s = TestScene::new();
+    s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+    for (k, (lo, hi)) in boxes.iter().enumerate() {
+        s.cuboid(&format!("BOX{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
+    }
+    let scene = s.build();
+    let got = vsc::vsc(&Mapper::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
+    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("case.json");
+    let boxes_json: Vec<Value> = boxes.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
+    std::fs::write(&case, serde_json::json!({"points": rows, "boxes": boxes_json}).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planning/vsc_radiance.py");
+    let run = Command::new(radiance_python()).arg(script).arg(&case).output().unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(run.status.success(), "vsc_radiance.py: {}", String::from_utf8_lossy(&run.stderr));
+    let truth: Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!((truth["horizontal"].as_f64().unwrap() - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {truth}");
+    for (i, t) in truth["vsc"].as_array().unwrap().iter().enumerate() {
+        let t = t.as_f64().unwrap();
+        assert!((got.vsc[i] - t).abs() <= 0.5, "point {i}: VSC {:.3} vs Radiance {t:.3}", got.vsc[i]);
+    }
+}
+
+fn golden_epw() -> PathBuf {
+    let epw = energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw");
+    assert!(epw.exists(), "{} missing from the EnergyPlus wheel", epw.display());
+    epw
+}
+
+#[test]
+fn apsh_matches_a_numpy_ray_caster_on_the_same_epw_hours() {
+    let boxes = [([-10.0, -22.0, 0.0], [8.0, -12.0, 12.0]), ([15.0, -8.0, 0.0], [40.0, -5.0, 6.0])];
+    let mut s = TestScene::new();
+    s.polygon("SOUTH", &south_rect(0.0, 20.0, 0.0, 15.0, 0.0), true);
+    let north = [DVec3::new(20.0, 10.0, 0.0), DVec3::new(0.0, 10.0, 0.0), DVec3::new(0.0, 10.0, 15.0), DVec3::new(20.0, 10.0, 15.0)];
+    s.polygon("NORTH", &north, true);
+    for (k, (lo, hi)) in boxes.iter().enumerate() {
+        s.cuboid(&format!("BLOCK{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
+    }
+    let scene = s.build();
+    let rows = [
+        [2.0, 0.0, 1.5, 0.0, -1.0, 0.0],
+        [6.0, 0.0, 1.5, 0.0, -1.0, 0.0],
+        [10.0, 0.0, 4.5, 0.0, -1.0, 0.0],
+        [14.0, 0.0, 1.5, 0.0, -1.0, 0.0],
+        [18.0, 0.0, 10.5, 0.0, -1.0, 0.0],
+        [10.0, 10.0, 1.5, 0.0, 1.0, 0.0],
+    ];
+    let pts = points(&scene, &rows);
+    let epw = golden_epw();
+    let weather = Weather::from_epw(&epw).unwrap();
+    let calendar = LeafCalendar::for_latitude(weather.location.latitude);
+    let site = Site { location: &weather.location, calendar: &calendar, weather: Some(&weather), sky: None };
+    let got = apsh::apsh(&Mapper::new(&scene, &pts).unwrap(), site, &mut |_, _| {}).unwrap();
+
+    let dir = std::env::temp_dir().join(format!("sunlit-apsh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("case.json");
+    let boxes_json: Vec<Value> = boxes.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
+    std::fs::write(&case, serde_json::json!({"points": rows, "boxes": boxes_json}).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planning/apsh_truth.py");
+    let run = Command::new(radiance_python()).arg(script).arg(&epw).arg(&case).output().unwrap();
+    assert!(run.status.success(), "apsh_truth.py: {}", String::from_utf8_lossy(&run.stderr));
+    let truth: Value = serde_json::from_slice(&run.stdout).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let hours = truth["annual_hours"].as_f64().unwrap();
+    assert!((got.annual_hours - hours).abs() <= 0.01 * hours, "probable hours {} vs numpy's {hours}", got.annual_hours);
+    for (i, t) in truth["points"].as_array().unwrap().iter().enumerate() {
+        let (a, w) = (t["apsh"].as_f64().unwrap(), t["wpsh"].as_f64().unwrap());
+        assert!((got.apsh[i] - a).abs() <= 1.0, "point {i}: APSH {:.2} vs numpy {a:.2}", got.apsh[i]);
+        assert!((got.wpsh[i] - w).abs() <= 1.0, "point {i}: WPSH {:.2} vs numpy {w:.2}", got.wpsh[i]);
+    }
+    // The case can fail: the blocks take a real share of some windows' sun.
+    let south: Vec<f64> = got.apsh[..5].to_vec();
+    let (lo, hi) = south.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    assert!(hi - lo > 10.0, "the blocks shade some points: {south:?}");
+    assert_eq!(got.assessed, vec![true, true, true, true, true, false], "only windows within 90° of due south are assessed");
+}
+
+/// A sill facing south at latitude φ, a slab `distance` m away rising `k · distance` above the
+/// sill: the sill sees the sun when its profile angle clears the slab, U > k·(−N) with the sun
+/// U = sin φ sin δ + cos φ cos δ cos h, N = cos φ sin δ − sin φ cos δ cos h, i.e.
+/// cos h · cos δ (cos φ − k sin φ) > −sin δ (sin φ + k cos φ): |h| < h₀. Hours: the part of the
+/// window (|h| ≤ 15° · half-width) inside ±h₀.
+fn canyon_hours(latitude: f64, declination: f64, k: f64, half_window_hours: f64) -> f64 {
+    let (sp, cp) = latitude.to_radians().sin_cos();
+    let (sd, cd) = declination.to_radians().sin_cos();
+    let ratio = -sd * (sp + k * cp) / (cd * (cp - k * sp));
+    let h0 = ratio.clamp(-1.0, 1.0).acos().to_degrees() / 15.0;
+    2.0 * h0.min(half_window_hours)
+}
+
+#[test]
+fn gb50180_matches_the_analytic_canyon_within_a_minute() {
+    let beijing = Location::new(39.9, 116.4, 8.0).unwrap();
+    for day in [StandardDay::Dahan, StandardDay::Dongzhi] {
+        let (from, to) = day.window();
+        for k in [0.25f64, 0.4, 0.5] {
+            let distance = 20.0;
+            let sill = 0.9;
+            let scene = canyon(distance, Some(sill + k * distance));
+            let pts = points(&scene, &[[0.0, 0.0, sill, 0.0, -1.0, 0.0], [3.0, 0.0, sill, 0.0, -1.0, 0.0]]);
+            let mut rule = Gb50180Rule::new(day);
+            rule.whole_window = Some(1.5);
+            let got = gb50180::evaluate(&scene, &pts, &beijing, &rule, &mut |_, _| {}).unwrap();
+            let truth = canyon_hours(beijing.latitude, day.declination_deg(), k, (to - from) / 2.0);
+            for (i, h) in got.hours.iter().enumerate() {
+                assert!((h - truth).abs() <= 1.0 / 60.0, "{} k = {k}, point {i}: {h:.4} h vs {truth:.4} h", day.name());
+            }
+            // Along an infinitely long slab the whole sill sees what its centre sees.
+            assert_eq!(got.whole_window_hours.as_ref().unwrap(), &got.hours);
+        }
+    }
+    assert!((StandardDay::Dongzhi.declination_deg() + 23.44).abs() < 1e-9);
+    assert!((StandardDay::Dahan.declination_deg() + 20.15).abs() < 0.01, "{}", StandardDay::Dahan.declination_deg());
+    assert!(StandardDay::parse("06-21").unwrap_err().to_string().contains("day"));
+}
+
+/// True solar time = standard time + EoT + (longitude − 15° · zone)/15, with EoT from the
+/// equation-of-time table of K. Krisciunas (Texas A&M, "Equation of time", values by day of a
+/// non-leap year from Meeus's approximate formula, stated within 30 s):
+/// faculty.physics.tamu.edu/krisciunas/equation_of_time.html.
+#[test]
+fn true_solar_time_follows_a_published_equation_of_time_table() {
+    let table = [(1u32, -3.6069), (20, -10.9144), (32, -13.6686), (44, -14.5996), (60, -13.0538), (80, -7.8437), (92, -4.0191)];
+    let site = Location::new(39.9, 116.4, 8.0).unwrap();
+    for (day, eot_minutes) in table {
+        // 12:00 true solar time on the day, in standard time, from the table.
+        let expected = 12.0 - eot_minutes / 60.0 - (site.longitude - 120.0) / 15.0;
+        let got = gb50180::standard_time(&site, day, 12.0);
+        assert!((got - expected).abs() * 60.0 <= 0.75, "day {day}: {got:.4} h vs the table's {expected:.4} h");
+    }
+}
+
+fn run_map(dir: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit")).arg("map").args(args).current_dir(dir).output().unwrap()
+}
+
+/// A .gltf of one closed box `lo`..`hi` (world axes: x east, y north, z up; glTF's are x, up,
+/// south) in an embedded buffer, its node named `name`.
+fn box_gltf(name: &str, lo: DVec3, hi: DVec3) -> String {
+    use base64::Engine as _;
+    let corner = |i: usize| {
+        let w =
+            DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z });
+        [w.x as f32, w.z as f32, -w.y as f32]
+    };
+    let positions: Vec<[f32; 3]> = (0..8).map(corner).collect();
+    let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let indices: Vec<u32> = quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|c| c.to_le_bytes()).collect();
+    let pos_len = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let (min, max) = (
+        (0..3).map(|k| positions.iter().map(|p| p[k]).fold(f32::MAX, f32::min).to_string()).collect::<Vec<_>>().join(","),
+        (0..3).map(|k| positions.iter().map(|p| p[k]).fold(f32::MIN, f32::max).to_string()).collect::<Vec<_>>().join(","),
+    );
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"data:application/octet-stream;base64,{data}","byteLength":{len}}}],
+        "bufferViews":[{{"buffer":0,"byteLength":{pos_len}}},{{"buffer":0,"byteOffset":{pos_len},"byteLength":{idx_len}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[{min}],"max":[{max}]}},{{"bufferView":1,"componentType":5125,"count":36,"type":"SCALAR"}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"nodes":[{{"mesh":0,"name":"{name}"}}],"scenes":[{{"nodes":[0]}}]}}"#,
+        data = base64::engine::general_purpose::STANDARD.encode(&bin),
+        len = bin.len(),
+        idx_len = bin.len() - pos_len,
+    )
+}
+
+/// An EPW of one hour repeated with no direct normal irradiance (DHI 100, GHI 100).
+fn epw_without_dni() -> String {
+    use std::fmt::Write as _;
+    let mut text = String::from("LOCATION,Golden,CO,USA,test,0,39.74,-105.18,-7.0,1800\n");
+    text.push_str("DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n");
+    text.push_str("COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n");
+    for h in 0..8760u32 {
+        let (month, day) = sunlit::year::samples::month_day(h / 24 + 1);
+        let _ = writeln!(
+            text,
+            "1999,{month},{day},{},60,x,10,5,50,80000,0,1300,300,100,0,100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0.2,0,0",
+            h % 24 + 1
+        );
+    }
+    text
+}
+
+/// The CLI: every window study at once before and after a proposal block, the output contract
+/// (points in input order, numeric values, verdicts apart), the pictures, and the refusals
+/// (named, nothing written).
+#[test]
+fn cli_window_studies_before_and_after_and_bad_input() {
+    let dir = std::env::temp_dir().join(format!("sunlit-planning-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let office = root.join("examples/office.glb");
+    let office = office.to_str().unwrap();
+    let epw = golden_epw();
+    let epw = epw.to_str().unwrap();
+    // One point per window of the office, from a 0.5 m grid (the first point on each).
+    let out = run_map(&dir, &[office, "--grid", "0.5", "--location", "39.74,-105.18,-7", "--at", "03-21", "12:00", "-o", "grid.csv"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let grid = std::fs::read_to_string(dir.join("grid.csv")).unwrap();
+    let mut csv = String::from("x,y,z,nx,ny,nz\n");
+    let mut seen = Vec::new();
+    for line in grid.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        if f[0].starts_with("WIN_") && !seen.contains(&f[0]) {
+            seen.push(f[0]);
+            csv.push_str(&f[1..7].join(","));
+            csv.push('\n');
+        }
+    }
+    assert_eq!(seen, ["WIN_S1", "WIN_S2", "WIN_E", "WIN_N", "WIN_W"]);
+    std::fs::write(dir.join("windows.csv"), &csv).unwrap();
+    // The proposal: a 12 m block 6 m south of the office.
+    std::fs::write(dir.join("block.gltf"), box_gltf("BLOCK", DVec3::new(-10.0, -14.0, 0.0), DVec3::new(40.0, -8.0, 12.0))).unwrap();
+    let out = run_map(
+        &dir,
+        &[
+            office,
+            "block.gltf",
+            "--receivers",
+            "WIN_*",
+            "--points",
+            "windows.csv",
+            "--epw",
+            epw,
+            "--study",
+            "bre-vsc",
+            "--study",
+            "bre-apsh",
+            "--study",
+            "gb50180",
+            "--window-width",
+            "1.0",
+            "--before",
+            office,
+            "--mask",
+            "1,4",
+            "--html",
+            "report.html",
+            "-o",
+            "w.csv",
+            "--json",
+        ],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["points"], 5);
+    assert_eq!(summary["points_before"], 5);
+    let table = std::fs::read_to_string(dir.join("w.csv")).unwrap();
+    assert!(table.starts_with("receiver,x,y,z,nx,ny,nz,vsc,apsh,wpsh,hours,hours_whole_window\n"), "{table}");
+    let read = |name: &str| -> Value { serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap() };
+    let vsc = read("w.study-bre-vsc.json");
+    let apsh = read("w.study-bre-apsh.json");
+    let gb = read("w.study-gb50180.json");
+    for report in [&vsc, &apsh, &gb] {
+        let points = report["points"].as_array().unwrap();
+        assert_eq!(points.len(), 5, "one entry per input row");
+        for (p, name) in points.iter().zip(&seen) {
+            assert_eq!(p["receiver"], *name, "points in the input's order");
+            assert!(p["passes"].is_boolean() || p["passes"].is_null());
+        }
+        assert!(report["rule"].is_object() && report["source"].is_string() && report["areas"].is_array());
+    }
+    assert_eq!(gb["rule"]["day"], "大寒日");
+    assert!((gb["rule"]["declination_deg"].as_f64().unwrap() + 20.15).abs() < 0.01);
+    for p in vsc["points"].as_array().unwrap() {
+        let (now, before) = (p["vsc"].as_f64().unwrap(), p["vsc_before"].as_f64().unwrap());
+        assert!(now <= before + 1e-9 && p["vsc_ratio"].as_f64().unwrap() <= 1.0 + 1e-9);
+        assert!(p["passes_absolute"].is_boolean() && p["passes_relative"].is_boolean());
+    }
+    let s1 = &vsc["points"][0];
+    assert!(s1["vsc"].as_f64().unwrap() < s1["vsc_before"].as_f64().unwrap() - 3.0, "the block takes sky from the south windows: {s1}");
+    let north = &apsh["points"][3];
+    assert_eq!(north["assessed"], false);
+    assert!(north["passes"].is_null() && north["apsh"].is_number() && north["wpsh"].is_number());
+    let south = &apsh["points"][0];
+    assert!(south["apsh"].as_f64().unwrap() < south["apsh_before"].as_f64().unwrap());
+    let svg = std::fs::read_to_string(dir.join("w.mask-1.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("fill=\"#555\" stroke=\"none\" d=\"M"), "the block shows in the mask");
+    assert!(dir.join("w.mask-4.svg").exists() && !dir.join("w.mask-2.svg").exists());
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    assert!(html.contains("<table") && html.contains("bre-apsh") && html.contains("<svg") && html.contains("GB 50180"));
+
+    std::fs::write(dir.join("dull.epw"), epw_without_dni()).unwrap();
+    // A window far away: a receiver of the same name pattern, but none of the points on it.
+    std::fs::write(dir.join("elsewhere.gltf"), box_gltf("WIN_FAR", DVec3::new(500.0, 500.0, 0.0), DVec3::new(501.0, 501.0, 1.0))).unwrap();
+    for (args, says) in [
+        (vec!["--study", "bre-vsc", "--min-period", "5"], "--min-period"),
+        (vec!["--study", "bre-vsc", "--before", "elsewhere.gltf"], "--before"),
+        (vec!["--study", "bre-apsh", "--location", "39.74,-105.18,-7"], "--epw"),
+        (vec!["--study", "bre-apsh", "--epw", "dull.epw"], "--epw"),
+        (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--day", "06-21"], "--day"),
+        (vec!["--study", "bre-vsc", "--sky-model", "perez-all-weather"], "--sky-model"),
+        (vec!["--study", "bre-vsc", "--period", "03-21"], "--period"),
+        (vec!["--study", "bre-vsc", "--study", "bre-ground", "--location", "0,0,0"], "--study"),
+        (vec!["--study", "bre-vsc", "--mask", "9"], "--mask"),
+    ] {
+        let mut all = vec![office, "--receivers", "WIN_*", "--points", "windows.csv"];
+        all.extend(args.iter().copied());
+        all.extend(["-o", "bad.csv", "--html", "bad.html"]);
+        let out = run_map(&dir, &all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!dir.join("bad.csv").exists() && !dir.join("bad.html").exists(), "{args:?} wrote its output");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
