@@ -192,6 +192,17 @@ fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson()
     // A second run finds every tile finished.
     let again = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000"]);
     assert!(stderr(&again).contains("0 to count"), "{}", stderr(&again));
+    // A tile without its record (killed, failed): the merge lists it and fails; the next run
+    // counts only it.
+    std::fs::remove_file(tiled.join(".done/tile-1.json")).unwrap();
+    let merge = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000", "--merge"]);
+    assert_eq!(merge.status.code(), Some(1), "{}", stderr(&merge));
+    assert!(stderr(&merge).contains("1 tile(s) unfinished") && stderr(&merge).contains("tile-1"), "{}", stderr(&merge));
+    assert!(std::fs::read_to_string(tiled.join("failed.csv")).unwrap().starts_with("id,exit_code,reason\ntile-1,"));
+    let resumed = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000"]);
+    assert!(resumed.status.success() && stderr(&resumed).contains("1 to count"), "{}", stderr(&resumed));
+    assert!(!tiled.join("failed.csv").exists());
+    assert_eq!(tile_rows(&tiled), b, "the recounted tile is as before");
     // The cadastre: valid CityJSON with the values on its semantic surfaces; CSV; roofs.
     let cadastre = tiled.join("cadastre.city.json");
     let check = std::process::Command::new("cjval").arg("-s").arg(&cadastre).output();
