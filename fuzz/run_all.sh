@@ -3,7 +3,7 @@
 # Usage: fuzz/run_all.sh [TARGET[:SECONDS]…]   (default: every target for 600 s)
 cd "$(dirname "$0")" || exit 1
 mkdir -p logs
-for spec in ${*:-gltf idf epjson epw csv}; do
+for spec in ${*:-gltf idf epjson epw csv cityjson obj}; do
     t=${spec%%:*}
     secs=600
     [ "$t" != "$spec" ] && secs=${spec#*:}

@@ -55,6 +55,13 @@ if command -v npm >/dev/null; then
   done
 fi
 
+# The official CityJSON validator, cjval (a Rust binary: `cargo install`, a few minutes, once): the
+# independent check of the solar cadastre's CityJSON in tests/city.rs. `SUNLIT_CITY=1 . scripts/setup.sh`.
+if [ "${SUNLIT_CITY:-0}" = 1 ] && ! command -v cjval >/dev/null; then
+  say "installing cjval 0.10.0, the CityJSON validator (cargo install, a few minutes, once)"
+  cargo install --quiet --locked cjval --version 0.10.0 --features build-binary
+fi
+
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.
 if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   apt_install mesa-vulkan-drivers

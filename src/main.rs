@@ -22,6 +22,7 @@ use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::schedule::RunCalendar;
+use sunlit::model::obj::{ObjUnit, ObjUp};
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
@@ -42,9 +43,12 @@ use solar_cli::{solar_outputs, solar_plan};
 #[path = "cli/bench.rs"]
 mod bench_cli;
 use bench_cli::{BenchArgs, run_bench};
+#[path = "cli/district.rs"]
+mod district_cli;
 #[cfg(test)]
 #[path = "cli/docs_check.rs"]
 mod docs_check;
+use district_cli::{DistrictArgs, district};
 #[path = "cli/map.rs"]
 mod map_cli;
 use map_cli::{MapArgs, map};
@@ -75,6 +79,10 @@ enum Command {
     /// Per point: sun hours and direct irradiation over a period, or lit at an instant, on a grid
     /// or given points; sun-hours studies (bre-ground, en17037). See docs/maps.md.
     Map(MapArgs),
+    /// A solar cadastre of a city model (CityJSON): its receivers in square tiles, each counted
+    /// with the casters within a context radius, here or as a Slurm job array, merged into
+    /// DIR/cadastre.city.json, cadastre.csv and cadastre-roofs.geojson. See docs/district.md.
+    District(DistrictArgs),
 }
 
 #[derive(Args)]
@@ -187,14 +195,17 @@ impl AnnualArgs {
 
 #[derive(Args)]
 struct ModelArgs {
-    /// Model files, all casting shadows: glTF (.glb, .gltf) and at most one EnergyPlus model
-    /// (.idf, .epJSON), whose outdoor surfaces and windows are the receivers; glTF files beside
-    /// an EnergyPlus model are context (they only cast shadows).
+    /// Model files, all casting shadows: glTF (.glb, .gltf), CityJSON (.city.json, .city.jsonl),
+    /// OBJ (.obj) and at most one EnergyPlus model (.idf, .epJSON), whose outdoor surfaces and
+    /// windows are the receivers; other files beside an EnergyPlus model are context (they only
+    /// cast shadows).
     #[arg(required = true, value_name = "MODEL")]
     models: Vec<PathBuf>,
-    /// Receivers: glob over node names (EnergyPlus: surface names), case-insensitive;
-    /// repeatable. Default: the nodes marked {"sunlit": {"receiver": true}} in glTF extras, else
-    /// every named mesh node; an EnergyPlus model's outdoor surfaces and windows.
+    /// Receivers: glob over node names (EnergyPlus: surface names; CityJSON: OBJECT_ID/TYPE/INDEX
+    /// or the semantic type, e.g. RoofSurface; OBJ: groups and objects), case-insensitive;
+    /// repeatable. Default: the nodes marked {"sunlit": {"receiver": true}} in glTF extras, and
+    /// CityJSON roofs and walls, else every named mesh node; an EnergyPlus model's outdoor surfaces
+    /// and windows.
     #[arg(long = "receivers", value_name = "GLOB")]
     receivers: Vec<String>,
     /// Degrees clockwise from true north of a glTF model's north (its −Z), as EnergyPlus's
@@ -208,6 +219,18 @@ struct ModelArgs {
     /// See-through nodes (e.g. perforated screens): GLOB=T lets T (0..1) of the beam through. Repeatable.
     #[arg(long = "transmittance", value_name = "GLOB=T")]
     transmittance: Vec<String>,
+    /// CityJSON: only these buildings' surfaces receive (Building or BuildingPart ids, comma-separated).
+    #[arg(long, value_name = "ID,...")]
+    buildings: Option<String>,
+    /// CityJSON: the level of detail read (2.2, or 2 for any 2.x); default: each object's highest.
+    #[arg(long, value_name = "LOD")]
+    lod: Option<String>,
+    /// OBJ: the up axis, y (default) or z.
+    #[arg(long, value_name = "y|z")]
+    up: Option<String>,
+    /// OBJ: the unit of its coordinates: m (default), cm, mm, ft, in.
+    #[arg(long, value_name = "UNIT")]
+    unit: Option<String>,
 }
 
 impl ModelArgs {
@@ -217,12 +240,26 @@ impl ModelArgs {
             north: self.north,
             foliage: self.foliage.clone(),
             transmittance: self.transmittance.iter().map(|t| model::parse_transmittance(t)).collect::<Result<_>>().unwrap_or_default(),
+            buildings: self
+                .buildings
+                .as_deref()
+                .unwrap_or("")
+                .split(',')
+                .map(str::trim)
+                .filter(|b| !b.is_empty())
+                .map(String::from)
+                .collect(),
+            lod: self.lod.clone(),
+            up: self.up.as_deref().map(ObjUp::parse).transpose().unwrap_or_default().unwrap_or_default(),
+            unit: self.unit.as_deref().map(ObjUnit::parse).transpose().unwrap_or_default().unwrap_or_default(),
             ..Default::default()
         }
     }
 
-    /// Refuses a malformed `--transmittance` before anything is read.
+    /// Refuses a malformed `--transmittance`, `--up` or `--unit` before anything is read.
     fn check(&self) -> Result<()> {
+        self.up.as_deref().map(ObjUp::parse).transpose()?;
+        self.unit.as_deref().map(ObjUnit::parse).transpose()?;
         self.transmittance.iter().try_for_each(|t| model::parse_transmittance(t).map(drop))
     }
 
@@ -332,6 +369,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => run_bench(a),
         Command::Sweep(a) => sweep(a),
         Command::Map(a) => map(a),
+        Command::District(a) => district(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -382,6 +420,12 @@ const FLAGS: &[(&str, &str)] = &[
     ("min_period", "--min-period"),
     ("max_periods", "--max-periods"),
     ("window_width", "--window-width"),
+    ("tile", "--tile"),
+    ("context", "--context"),
+    ("buildings", "--buildings"),
+    ("lod", "--lod"),
+    ("up", "--up"),
+    ("unit", "--unit"),
     ("epw", "--epw"),
 ];
 
@@ -687,7 +731,8 @@ fn round(x: f64, digits: i32) -> f64 {
 }
 
 fn info(args: InfoArgs) -> Result<()> {
-    let scene = args.model.load()?;
+    let loaded = args.model.load_all(false)?;
+    let (scene, notes) = (loaded.scene, loaded.notes);
     let receivers: Vec<_> = scene
         .receivers
         .iter()
@@ -703,6 +748,7 @@ fn info(args: InfoArgs) -> Result<()> {
             "leaves": scene.veil_counts().0,
             "see_through_triangles": scene.veil_counts().1,
             "bounds": {"min": [lo.x, lo.y, lo.z], "max": [hi.x, hi.y, hi.z]},
+            "notes": notes,
         });
         println!("{out:#}");
         return Ok(());
@@ -720,6 +766,9 @@ fn info(args: InfoArgs) -> Result<()> {
         hi.y,
         hi.z
     );
+    for note in &notes {
+        println!("note: {note}");
+    }
     let (leaves, see_through) = scene.veil_counts();
     if leaves + see_through > 0 {
         println!("foliage: {leaves} leaves; see-through: {see_through} triangles");

@@ -260,6 +260,8 @@ pub struct SceneBuilder {
     mirrors: Vec<(String, String)>,
     /// See-through nodes, by node index: see [`SceneBuilder::set_node_veil`].
     veils: HashMap<usize, NodeVeil>,
+    /// The static mesh's origin when set ([`SceneBuilder::set_origin`]).
+    origin: Option<DVec3>,
 }
 
 impl SceneBuilder {
@@ -305,6 +307,13 @@ impl SceneBuilder {
         self.veils.insert(index, veil);
     }
 
+    /// Stores the static mesh relative to `origin` (world) instead of the input's centre: scenes
+    /// cut from one larger model (a district's tiles) then round their f32 vertices alike, so a
+    /// receiver's answers do not depend on which cut it was counted in.
+    pub fn set_origin(&mut self, origin: DVec3) {
+        self.origin = Some(origin);
+    }
+
     /// Number of nodes added so far.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
@@ -320,7 +329,7 @@ impl SceneBuilder {
             check_finite(node, &self.meshes[node.mesh].1)?;
             check_veil(node, &self.veil_of(i))?;
         }
-        let origin = input_centre(&self.nodes, &self.meshes);
+        let origin = self.origin.unwrap_or_else(|| input_centre(&self.nodes, &self.meshes));
         let mut scene = Scene {
             meshes: vec![Mesh { label: "static".into(), ..Default::default() }],
             instances: vec![Instance { mesh: 0, transform: DMat4::from_translation(origin), receiver_base: 0, leaf_shift: 0.0 }],

@@ -168,8 +168,12 @@ fn job_ids(stdout: &str) -> (String, String) {
     (id("array job "), id("merge job "))
 }
 
+/// One cluster at a time: the tests here each start their own.
+static ONE_CLUSTER: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn slurm_array_equals_the_local_sweep_and_a_cancelled_task_is_all_a_resubmission_counts() {
+    let _one = ONE_CLUSTER.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let dir = scratch("sweep-slurm");
     let cluster = Cluster::start(&dir.join("slurm"));
     let fast = variants(&dir);
@@ -250,5 +254,61 @@ fn slurm_array_equals_the_local_sweep_and_a_cancelled_task_is_all_a_resubmission
         .output()
         .unwrap();
     assert!(out3.status.success() && stderr(&out3).contains("nothing submitted"), "{}", stderr(&out3));
+    drop(cluster);
+}
+
+/// Every tile record's rows in `out`, by surface: (surface, values) at full precision.
+fn tile_rows(out: &Path) -> Vec<(String, Vec<f64>)> {
+    let mut rows = Vec::new();
+    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
+        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
+        for r in done["rows"].as_array().unwrap() {
+            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
+                .map(|k| r[k].as_f64().unwrap());
+            rows.push((r["surface"].as_str().unwrap().to_string(), values.to_vec()));
+        }
+    }
+    rows.sort_by(|a, b| a.0.cmp(&b.0));
+    rows
+}
+
+/// `sunlit district --slurm`: an array task a tile and a merge job; its cadastre equals the
+/// one-process run's (one tile holding the whole district) within 1e-9, with the exact engine and
+/// a context reaching across the district.
+#[test]
+fn slurm_district_tiles_equal_the_one_process_run() {
+    let _one = ONE_CLUSTER.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let dir = scratch("district-slurm");
+    let cluster = Cluster::start(&dir.join("slurm"));
+    let city = dir.join("district.city.json");
+    std::fs::write(&city, sunlit::model::city_write::district_cityjson(3, 3, 7)).unwrap();
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let (one, tiled) = (dir.join("one"), dir.join("tiled"));
+    let args = |out: &Path, tile: &str| -> Vec<String> {
+        let words = ["district", city.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "-o", out.to_str().unwrap(), "--tile", tile];
+        let small = ["--context", "1000", "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5"];
+        words.iter().chain(&small).map(|w| w.to_string()).collect()
+    };
+    let run = Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args(&one, "1000")).output().unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    let submit = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .args(args(&tiled, "30"))
+        .arg("--slurm")
+        .env("SLURM_CONF", &cluster.conf)
+        .output()
+        .unwrap();
+    assert!(submit.status.success(), "{}", stderr(&submit));
+    let stdout = String::from_utf8_lossy(&submit.stdout).into_owned();
+    let (array, merge) = job_ids(&stdout);
+    cluster.wait_gone(&format!("{array},{merge}"), Duration::from_secs(300));
+    assert!(tiled.join("cadastre.city.json").exists(), "the merge job wrote the cadastre; logs in {}", tiled.join(".slurm/logs").display());
+    let (a, b) = (tile_rows(&one), tile_rows(&tiled));
+    assert_eq!(a.len(), b.len());
+    for ((name, x), (other, y)) in a.iter().zip(&b) {
+        assert_eq!(name, other);
+        assert!(x.iter().zip(y).all(|(x, y)| (x - y).abs() <= 1e-9), "{name}: {x:?} against {y:?}");
+    }
+    assert!(std::fs::read_dir(tiled.join(".done")).unwrap().count() >= 4, "several tiles");
     drop(cluster);
 }

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{Error, Result};
 use crate::year::samples::Timesteps;
 
+pub mod cadastre;
 pub mod hook;
 pub mod irradiation;
 pub mod map_glb;

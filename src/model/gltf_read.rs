@@ -41,6 +41,19 @@ pub struct GltfNode {
     pub mesh: usize,
     /// Mesh → world (sunlit axes).
     pub transform: DMat4,
+    /// What a city model says of the surface (CityJSON); `None` for glTF and OBJ.
+    pub city: Option<CityTags>,
+}
+
+/// A city model surface's building and semantic type, which receiver rules select by.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CityTags {
+    /// Its root `Building`, `None` for what is not a building (it never receives).
+    pub building: Option<String>,
+    /// The CityObject holding it (a `BuildingPart`, or the building itself).
+    pub object: String,
+    /// Semantic type (`RoofSurface`, …).
+    pub kind: Option<String>,
 }
 
 impl GltfNode {
@@ -274,8 +287,9 @@ fn collect_nodes<'a>(
                     veil,
                     mesh,
                     transform: world * instance,
+                    city: None,
                 })),
-                None => out.push(GltfNode { name, named, marked, veil, mesh, transform: world }),
+                None => out.push(GltfNode { name, named, marked, veil, mesh, transform: world, city: None }),
             }
         }
         // Reversed onto the stack: children are walked in file order.

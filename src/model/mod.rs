@@ -10,8 +10,16 @@
 //! one; otherwise every named node with a mesh. Foliage and see-through nodes (the `foliage` and
 //! `transmittance` patterns, or their extras marks) are never chosen by the marks-or-names default.
 //! When the names default chooses more than [`MANY_RECEIVERS`], [`Loaded::notes`] says so.
+//!
+//! City models (CityJSON, [`cityjson`]) and OBJ ([`obj`]) are read into the same node list as
+//! glTF. A CityJSON surface is a node `OBJECT_ID/TYPE/INDEX`; `receivers` globs match its name or
+//! its semantic type (`RoofSurface`), `buildings` limits receivers to the named buildings, and by
+//! default its roofs and walls are marked as receivers. Only buildings' surfaces ever receive.
 pub mod arrays;
 pub mod building;
+#[cfg(feature = "fixtures")]
+pub mod city_write;
+pub mod cityjson;
 pub mod epjson;
 #[cfg(feature = "fixtures")]
 pub mod glb_write;
@@ -21,6 +29,7 @@ pub mod gltf_extensions;
 pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
+pub mod obj;
 #[cfg(feature = "fixtures")]
 pub mod office;
 #[cfg(feature = "fixtures")]
@@ -59,6 +68,19 @@ pub struct LoadOptions {
     /// takes its schedule's value when that never changes, and is opaque otherwise (see
     /// [`crate::year::transmitting`] for schedules that change).
     pub shade_transmittance: Vec<(String, f64)>,
+    /// City models: only these buildings' surfaces receive (ids of `Building`s or their parts);
+    /// empty: every building's.
+    pub buildings: Vec<String>,
+    /// City models: the level of detail read (`2.2`, or `2` for any 2.x); `None`: each
+    /// object's highest.
+    pub lod: Option<String>,
+    /// OBJ: which axis is up.
+    pub up: obj::ObjUp,
+    /// OBJ: the length of one unit.
+    pub unit: obj::ObjUnit,
+    /// The scene's f32 origin (world), when scenes cut from one model must round alike; `None`:
+    /// the input's centre ([`crate::scene::SceneBuilder::set_origin`]).
+    pub origin: Option<glam::DVec3>,
 }
 
 /// The EnergyPlus model among the inputs, kept for hooking the schedule into a copy of it.
@@ -135,7 +157,9 @@ pub fn is_energyplus_file(name: &str) -> bool {
 /// Whether a file name is an EnergyPlus model (by extension).
 fn energyplus_kind(name: &str) -> Option<bool> {
     let lower = name.to_ascii_lowercase();
-    if lower.ends_with(".idf") {
+    if lower.ends_with(".city.json") {
+        None
+    } else if lower.ends_with(".idf") {
         Some(false)
     } else if lower.ends_with(".epjson") || lower.ends_with(".json") {
         Some(true)
@@ -167,9 +191,20 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
     check_options(options)?;
     let mut models = Vec::new();
     let mut energyplus: Option<EnergyPlusInput> = None;
+    let mut city_notes = Vec::new();
     for ((name, bytes), dir) in files.iter().zip(dirs) {
         if dir.is_none() && is_resource(name) {
             // A .gltf's buffer or texture handed over with it (the web path); read through the .gltf.
+            continue;
+        }
+        if cityjson::is_cityjson(name, bytes) {
+            let city = cityjson::read_city(name, bytes, options.lod.as_deref())?;
+            models.push(cityjson::city_model(&city, options.north)?);
+            city_notes.push(format!("{name}: {}", city_north_note(options.north)));
+            continue;
+        }
+        if obj::is_obj(name) {
+            models.push(obj::read_obj(name, bytes, options.up, options.unit, options.north)?);
             continue;
         }
         match energyplus_kind(name) {
@@ -185,8 +220,25 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
             }),
         }
     }
-    let (scene, notes) = build(models, energyplus.as_ref(), options)?;
+    let (scene, mut notes) = build(models, energyplus.as_ref(), options)?;
+    notes.extend(city_notes);
     Ok(Loaded { scene, energyplus, notes })
+}
+
+/// A city model already read (a district's tile) into a scene, as [`load_bytes_all`] would.
+pub fn load_city(city: &cityjson::City, options: &LoadOptions) -> Result<Loaded> {
+    check_options(options)?;
+    let (scene, notes) = build(vec![cityjson::city_model(city, options.north)?], None, options)?;
+    Ok(Loaded { scene, energyplus: None, notes })
+}
+
+/// What a run over a city model says of north: its grid north is true north unless turned.
+pub fn city_north_note(north: f64) -> String {
+    if north == 0.0 {
+        "grid north is taken as true north (the model's +y; turn it with the north option)".to_string()
+    } else {
+        format!("the model's grid north (+y) is taken as {north}° clockwise from true north")
+    }
 }
 
 fn read_energyplus(name: &str, bytes: &[u8], epjson: bool, dir: Option<&std::path::Path>) -> Result<EnergyPlusInput> {
@@ -240,6 +292,9 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
     };
     let veils = Veils::new(options)?;
     let mut builder = SceneBuilder::new();
+    if let Some(origin) = options.origin {
+        builder.set_origin(origin);
+    }
     let mut matched = 0usize;
     if let Some(ep) = energyplus {
         let b = &ep.building;
@@ -265,7 +320,7 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
             &mut builder,
             |n| {
                 let explicit = matches!(select, Selection::Globs(..));
-                let hit = select.is_receiver(n) && (explicit || veils.of(n).is_opaque());
+                let hit = select.is_receiver(n) && in_buildings(n, &options.buildings) && (explicit || veils.of(n).is_opaque());
                 matched += hit as usize;
                 hit
             },
@@ -284,6 +339,18 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
         notes.push(note);
     }
     Ok((scene, notes))
+}
+
+/// Whether a node may receive under the `buildings` option: a city surface of a building (or
+/// building part) listed there, or anything when the list is empty; what is not a building never.
+fn in_buildings(node: &GltfNode, buildings: &[String]) -> bool {
+    match &node.city {
+        None => true,
+        Some(tags) => match &tags.building {
+            None => false,
+            Some(b) => buildings.is_empty() || buildings.iter().any(|id| id == b || *id == tags.object),
+        },
+    }
 }
 
 /// What the default rule chose, when it chose many, and how to narrow it.
@@ -391,7 +458,9 @@ impl Selection {
 
     fn is_receiver(&self, node: &GltfNode) -> bool {
         match self {
-            Selection::Globs(set, _) => set.is_match(&node.name),
+            Selection::Globs(set, _) => {
+                set.is_match(&node.name) || node.city.as_ref().and_then(|c| c.kind.as_deref()).is_some_and(|k| set.is_match(k))
+            }
             Selection::Marked => node.marked,
             Selection::Named => node.named,
             Selection::Context => false,

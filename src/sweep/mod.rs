@@ -5,10 +5,12 @@
 //! - [`record`]: what the output folder remembers (done and failed records, logs);
 //! - [`run`]: counting variants in child processes;
 //! - [`summary`]: the per-surface means and `summary.csv`;
-//! - [`slurm`]: the job array, its scripts and the merge job.
+//! - [`slurm`]: the job array, its scripts and the merge job;
+//! - [`district`]: a city model's tiles with their context, their records and the merged cadastre.
 //!
 //! Native only: it runs processes and writes files.
 
+pub mod district;
 pub mod manifest;
 pub mod record;
 pub mod run;

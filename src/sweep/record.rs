@@ -36,8 +36,12 @@ pub struct Fingerprint {
 impl Fingerprint {
     /// The fingerprint of `variant` now (input files that cannot be read count as size 0).
     pub fn of(variant: &Variant) -> Self {
-        let inputs = variant
-            .inputs
+        Self::new(variant.args.clone(), &variant.inputs)
+    }
+
+    /// The fingerprint of a run with `args` reading `inputs`, now.
+    pub fn new(args: Vec<String>, inputs: &[PathBuf]) -> Self {
+        let inputs = inputs
             .iter()
             .map(|p| {
                 let meta = std::fs::metadata(p).ok();
@@ -49,7 +53,7 @@ impl Fingerprint {
                 (p.display().to_string(), meta.map_or(0, |m| m.len()), modified)
             })
             .collect();
-        Self { version: env!("CARGO_PKG_VERSION").to_string(), args: variant.args.clone(), inputs }
+        Self { version: env!("CARGO_PKG_VERSION").to_string(), args, inputs }
     }
 
     /// A short hash of the fingerprint (64-bit FNV-1a of its JSON), for logs and the summary.

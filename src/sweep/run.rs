@@ -98,7 +98,8 @@ fn one(variant: &Variant, options: &RunOptions) -> std::result::Result<Option<f6
     };
     let fingerprint = Fingerprint::of(variant);
     let start = Instant::now();
-    let status = spawn_annual(&options.exe, &variant.args_into(dir), &log).map_err(|e| fail(None, e.to_string()))?;
+    let args: Vec<String> = std::iter::once("annual".to_string()).chain(variant.args_into(dir)).collect();
+    let status = spawn_sunlit(&options.exe, &args, &log).map_err(|e| fail(None, e.to_string()))?;
     if !status.success() {
         return Err(fail(status.code(), last_error(&log, status)));
     }
@@ -111,12 +112,12 @@ fn one(variant: &Variant, options: &RunOptions) -> std::result::Result<Option<f6
     Ok(Some(seconds))
 }
 
-/// Runs `exe annual ARGS` with its stderr in `log`, and waits for it.
-fn spawn_annual(exe: &Path, args: &[String], log: &Path) -> Result<std::process::ExitStatus> {
+/// Runs `exe ARGS` (a subcommand and its arguments) with its stderr in `log`, and waits for it.
+pub fn spawn_sunlit(exe: &Path, args: &[String], log: &Path) -> Result<std::process::ExitStatus> {
     let io = |source: std::io::Error, path: &Path| Error::Io { path: path.to_path_buf(), source };
     let log_file = std::fs::File::create(log).map_err(|e| io(e, log))?;
     let mut command = Command::new(exe);
-    command.arg("annual").args(args).stdin(Stdio::null()).stdout(Stdio::null()).stderr(log_file);
+    command.args(args).stdin(Stdio::null()).stdout(Stdio::null()).stderr(log_file);
     die_with_parent(&mut command);
     let mut child = command.spawn().map_err(|e| io(e, exe))?;
     child.wait().map_err(|e| io(e, exe))
@@ -147,11 +148,11 @@ fn die_with_parent(command: &mut Command) {
 fn die_with_parent(_command: &mut Command) {}
 
 /// The failed run's last `error:` line from its log, else how it ended.
-fn last_error(log: &Path, status: std::process::ExitStatus) -> String {
+pub fn last_error(log: &Path, status: std::process::ExitStatus) -> String {
     let text = std::fs::read_to_string(log).unwrap_or_default();
     let line = text.lines().rev().find(|l| l.starts_with("error:") || l.contains("interrupted") || l.contains("panicked"));
     match line {
         Some(l) => l.trim_start_matches("error:").trim().to_string(),
-        None => format!("annual ended with {status} (log: {})", log.display()),
+        None => format!("ended with {status} (log: {})", log.display()),
     }
 }

@@ -92,3 +92,25 @@ pub fn partial_files(dir: &Path) -> Vec<PathBuf> {
 pub fn record_times(out: &Path, ids: &[String]) -> Vec<Option<std::time::SystemTime>> {
     ids.iter().map(|id| std::fs::metadata(out.join(".done").join(format!("{id}.json"))).and_then(|m| m.modified()).ok()).collect()
 }
+
+/// An EPW at 46.5 N with a direct normal irradiance that varies by the hour.
+pub fn varying_epw() -> String {
+    let mut text = String::from("LOCATION,Bolzano,BZ,ITA,test,0,46.5,11.35,1.0,262\n");
+    text.push_str("DESIGN CONDITIONS,0\nTYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n");
+    text.push_str("COMMENTS 1,synthetic\nCOMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n");
+    let month_days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    let mut n = 0u32;
+    for (m, days) in month_days.iter().enumerate() {
+        for d in 1..=*days {
+            for h in 1..=24 {
+                let dni = 200 + (n * 37) % 600;
+                n += 1;
+                text.push_str(&format!(
+                    "1999,{},{d},{h},60,x,10,5,50,80000,0,1300,300,500,{dni},100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0\n",
+                    m + 1
+                ));
+            }
+        }
+    }
+    text
+}

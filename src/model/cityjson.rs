@@ -1,0 +1,461 @@
+//! CityJSON 1.1 and 2.0 reader, and CityJSONSeq (`.city.jsonl`: a header line, then one
+//! `CityJSONFeature` a line), into a [`City`]: every boundary surface of the chosen level of detail
+//! with its semantic type, in local coordinates.
+//!
+//! Owns:
+//! - the `transform`: real = v × scale + translate; `translate` is never added, so coordinates stay
+//!   local (real − translate, in f64) before anything becomes f32; [`City::offset`] adds it back
+//!   for output. Without a `transform` (allowed only for real-valued vertices) the smallest vertex
+//!   plays its part;
+//! - geometry: `MultiSurface`, `CompositeSurface`, `Solid`, `MultiSolid`, `CompositeSolid`, and
+//!   `GeometryInstance` of `geometry-templates` (matrix × template vertex + reference point);
+//! - the level of detail: the chosen `lod`, else each object's highest, one geometry an object
+//!   (so no surface is counted twice);
+//! - names `OBJECT_ID/TYPE/INDEX`: TYPE the semantic type (`Surface` without one), INDEX the
+//!   surface's position in its geometry (shells and solids flattened in file order);
+//! - buildings: a `BuildingPart` (or any child) belongs to its root `Building` for
+//!   [`CitySurface::building`]; only `Building` and `BuildingPart` surfaces may receive, the rest
+//!   (terrain, vegetation, roads) only cast shadows;
+//! - bad input as errors naming the file, the CityObject and the reason.
+//!
+//! Triangulation (rings with holes, non-planar rings) is [`city_model`]'s, into the reader-neutral
+//! [`GltfModel`]; the scene then splits a non-planar surface into planar receivers by its stated
+//! tolerance (0.5°, 1 mm: [`crate::scene`]).
+
+use std::collections::HashMap;
+
+use glam::{DMat4, DVec3};
+use serde_json::Value;
+
+use super::gltf_read::{CityTags, GltfModel, GltfNode};
+use crate::error::{Error, Result};
+use crate::geometry::{Plane, newell, triangulate};
+use crate::scene::{NodeVeil, SourceMesh};
+
+/// The versions read.
+pub const VERSIONS: [&str; 2] = ["1.1", "2.0"];
+
+/// CityObject types whose surfaces may receive.
+const BUILDING_TYPES: [&str; 2] = ["Building", "BuildingPart"];
+
+/// A city model, read.
+#[derive(Debug, Clone)]
+pub struct City {
+    /// File label.
+    pub file: String,
+    /// Its `version`.
+    pub version: String,
+    /// `metadata.referenceSystem`, as written (a URL or `EPSG:N`), kept for output.
+    pub reference_system: Option<String>,
+    /// Real coordinates = local + offset (the `transform`'s translate).
+    pub offset: DVec3,
+    /// Every boundary surface of the chosen geometries, in file order.
+    pub surfaces: Vec<CitySurface>,
+}
+
+/// One boundary surface.
+#[derive(Debug, Clone)]
+pub struct CitySurface {
+    /// `OBJECT_ID/TYPE/INDEX`.
+    pub name: String,
+    /// The CityObject whose geometry holds it.
+    pub object: String,
+    /// Its root `Building` (itself for a Building); `None` for what is not a building.
+    pub building: Option<String>,
+    /// Semantic type (`RoofSurface`, …), if any.
+    pub kind: Option<String>,
+    /// Index of its geometry in the object's `geometry` array.
+    pub geometry: usize,
+    /// Its position among the geometry's surfaces (flattened).
+    pub index: usize,
+    /// Rings in local coordinates (real − offset): the exterior, then holes.
+    pub rings: Vec<Vec<DVec3>>,
+}
+
+/// Whether a file name is a CityJSON model: `.city.json`, `.city.jsonl`, `.jsonl`, or a `.json`
+/// whose text says `"type": "CityJSON"` near its start.
+pub fn is_cityjson(name: &str, bytes: &[u8]) -> bool {
+    let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".city.json") || lower.ends_with(".jsonl") || lower.ends_with(".cityjson") {
+        return true;
+    }
+    if !lower.ends_with(".json") {
+        return false;
+    }
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
+    let squeezed: String = head.chars().filter(|c| !c.is_whitespace()).collect();
+    squeezed.contains(r#""type":"CityJSON""#)
+}
+
+/// Reads a CityJSON file or CityJSONSeq (by its lines: a header then features). `lod` picks the
+/// level of detail (exactly, or `2` for any `2.x`); `None`: each object's highest.
+pub fn read_city(file: &str, bytes: &[u8], lod: Option<&str>) -> Result<City> {
+    let text = std::str::from_utf8(bytes).map_err(|e| Error::model(file, format!("not UTF-8 text ({e})")))?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let whole: std::result::Result<Value, _> = serde_json::from_str(text);
+    let (header, features): (Value, Vec<Value>) = match whole {
+        Ok(doc) => (doc, Vec::new()),
+        Err(e) => {
+            // CityJSONSeq: every line a JSON object.
+            let first = lines.next().ok_or_else(|| Error::model(file, "the file is empty"))?;
+            let header: Value = serde_json::from_str(first).map_err(|_| Error::model(file, format!("not JSON: {e}")))?;
+            let features = lines
+                .enumerate()
+                .map(|(i, l)| serde_json::from_str(l).map_err(|e| Error::model(file, format!("line {}: not JSON: {e}", i + 2))))
+                .collect::<Result<Vec<Value>>>()?;
+            (header, features)
+        }
+    };
+    if header.get("type").and_then(Value::as_str) != Some("CityJSON") {
+        return Err(Error::model(file, "not CityJSON: its \"type\" is not \"CityJSON\""));
+    }
+    let mut reader = Reader::new(file, &header, lod)?;
+    reader.document(&header)?;
+    for (i, feature) in features.iter().enumerate() {
+        if feature.get("type").and_then(Value::as_str) != Some("CityJSONFeature") {
+            return Err(Error::model(file, format!("line {}: not a CityJSONFeature", i + 2)));
+        }
+        reader.document(feature)?;
+    }
+    Ok(reader.city)
+}
+
+/// Parsing state: the header's transform and templates, the surfaces so far.
+struct Reader<'a> {
+    city: City,
+    scale: Option<DVec3>,
+    lod: Option<&'a str>,
+    /// Template geometries and their vertices (real coordinates, relative to the reference point).
+    templates: Vec<Value>,
+    template_vertices: Vec<DVec3>,
+    /// Set once an offset is chosen (the translate, or the first document's smallest vertex).
+    offset_set: bool,
+}
+
+impl<'a> Reader<'a> {
+    fn new(file: &str, header: &Value, lod: Option<&'a str>) -> Result<Self> {
+        let version = header.get("version").and_then(Value::as_str).unwrap_or("");
+        if !VERSIONS.contains(&version) {
+            let shown = header.get("version").map_or("none".to_string(), Value::to_string);
+            return Err(Error::model(file, format!("CityJSON version {shown} is not read (read: {})", VERSIONS.join(", "))));
+        }
+        let (scale, offset) = match header.get("transform") {
+            Some(t) => {
+                let three = |key: &str| -> Result<DVec3> {
+                    let v = t.get(key).and_then(Value::as_array).filter(|a| a.len() == 3);
+                    let nums: Option<Vec<f64>> = v.map(|a| a.iter().filter_map(Value::as_f64).collect());
+                    match nums {
+                        Some(n) if n.len() == 3 && n.iter().all(|x| x.is_finite()) => Ok(DVec3::new(n[0], n[1], n[2])),
+                        _ => Err(Error::model(file, format!("transform.{key} is not three numbers"))),
+                    }
+                };
+                let scale = three("scale")?;
+                if scale.min_element() <= 0.0 {
+                    return Err(Error::model(file, format!("transform.scale {scale} is not positive")));
+                }
+                (Some(scale), Some(three("translate")?))
+            }
+            None => (None, None),
+        };
+        let reference_system = header.pointer("/metadata/referenceSystem").and_then(Value::as_str).map(str::to_string);
+        let templates = header.pointer("/geometry-templates/templates").and_then(Value::as_array).cloned().unwrap_or_default();
+        let template_vertices = header
+            .pointer("/geometry-templates/vertices-templates")
+            .and_then(Value::as_array)
+            .map(|a| {
+                a.iter()
+                    .map(|v| point(v).ok_or_else(|| Error::model(file, "a template vertex is not three numbers")))
+                    .collect::<Result<Vec<DVec3>>>()
+            })
+            .transpose()?
+            .unwrap_or_default();
+        let city = City {
+            file: file.to_string(),
+            version: version.to_string(),
+            reference_system,
+            offset: offset.unwrap_or_default(),
+            surfaces: Vec::new(),
+        };
+        Ok(Self { city, scale, lod, templates, template_vertices, offset_set: offset.is_some() })
+    }
+
+    /// One CityJSON document or CityJSONFeature: its vertices and CityObjects.
+    fn document(&mut self, doc: &Value) -> Result<()> {
+        let file = self.city.file.clone();
+        let raw = doc.get("vertices").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
+        let vertices = self.vertices(&file, raw)?;
+        let Some(objects) = doc.get("CityObjects").and_then(Value::as_object) else {
+            return Err(Error::model(file, "no \"CityObjects\" object"));
+        };
+        let parents: HashMap<&str, &str> =
+            objects.iter().filter_map(|(id, o)| Some((id.as_str(), o.pointer("/parents/0").and_then(Value::as_str)?))).collect();
+        for (id, object) in objects {
+            let kind = object.get("type").and_then(Value::as_str).unwrap_or("");
+            let building = BUILDING_TYPES.contains(&kind).then(|| root_of(id, &parents).to_string());
+            let geometries = object.get("geometry").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
+            let Some(g) = self.choose(geometries) else { continue };
+            let err = |reason: String| Error::object(&file, format!("CityObject '{id}'"), format!("geometry {g}: {reason}"));
+            let mut found = self.surfaces(&geometries[g], &vertices).map_err(err)?;
+            for (index, (kind, rings)) in found.drain(..).enumerate() {
+                let type_name = kind.clone().unwrap_or_else(|| "Surface".into());
+                self.city.surfaces.push(CitySurface {
+                    name: format!("{id}/{type_name}/{index}"),
+                    object: id.clone(),
+                    building: building.clone(),
+                    kind,
+                    geometry: g,
+                    index,
+                    rings,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The vertices in local coordinates (real − offset).
+    fn vertices(&mut self, file: &str, raw: &[Value]) -> Result<Vec<DVec3>> {
+        let mut out = Vec::with_capacity(raw.len());
+        let mut integers = true;
+        for (i, v) in raw.iter().enumerate() {
+            let p = point(v).ok_or_else(|| Error::model(file, format!("vertex {i} is not three finite numbers")))?;
+            integers &= v.as_array().is_some_and(|a| a.iter().all(|c| c.is_i64() || c.is_u64()));
+            out.push(p);
+        }
+        match self.scale {
+            Some(scale) => Ok(out.into_iter().map(|p| p * scale).collect()),
+            None if integers && !out.is_empty() => Err(Error::model(
+                file,
+                "no \"transform\", yet the vertices are integers: their scale and translation are unknown (CityJSON 1.1 and 2.0 require a transform)",
+            )),
+            None => {
+                if !self.offset_set && !out.is_empty() {
+                    self.city.offset = out.iter().copied().fold(DVec3::splat(f64::INFINITY), DVec3::min);
+                    self.offset_set = true;
+                }
+                Ok(out.into_iter().map(|p| p - self.city.offset).collect())
+            }
+        }
+    }
+
+    /// The geometry to read of an object: the chosen lod's, else the highest; `None` when none.
+    fn choose(&self, geometries: &[Value]) -> Option<usize> {
+        let lods: Vec<(usize, String)> = geometries.iter().enumerate().filter_map(|(i, g)| Some((i, self.lod_of(g)?))).collect();
+        match self.lod {
+            Some(want) => lods
+                .iter()
+                .find(|(_, l)| l == want)
+                .or_else(|| lods.iter().find(|(_, l)| !want.contains('.') && l.split('.').next() == Some(want)))
+                .map(|(i, _)| *i),
+            None => {
+                let value = |l: &str| l.parse::<f64>().unwrap_or(f64::NEG_INFINITY);
+                // The first of the highest: max_by keeps the last of equals, so compare reversed indices.
+                lods.iter().max_by(|a, b| value(&a.1).total_cmp(&value(&b.1)).then(b.0.cmp(&a.0))).map(|(i, _)| *i)
+            }
+        }
+    }
+
+    /// A geometry's lod as text (a template's for an instance); `None` for points and lines.
+    fn lod_of(&self, g: &Value) -> Option<String> {
+        let g = match g.get("type").and_then(Value::as_str)? {
+            "GeometryInstance" => self.templates.get(g.get("template")?.as_u64()? as usize)?,
+            _ => g,
+        };
+        if !matches!(
+            g.get("type").and_then(Value::as_str)?,
+            "MultiSurface" | "CompositeSurface" | "Solid" | "MultiSolid" | "CompositeSolid"
+        ) {
+            return None;
+        }
+        Some(match g.get("lod")? {
+            Value::String(s) => s.clone(),
+            other => other.to_string(),
+        })
+    }
+
+    /// A geometry's surfaces: (semantic type, rings in local coordinates).
+    fn surfaces(&self, g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, String> {
+        if g.get("type").and_then(Value::as_str) == Some("GeometryInstance") {
+            return self.instance(g, vertices);
+        }
+        flatten(g, vertices)
+    }
+
+    /// A `GeometryInstance`: the template's surfaces, each vertex M × v + reference point.
+    fn instance(&self, g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, String> {
+        let t = g.get("template").and_then(Value::as_u64).ok_or("a GeometryInstance without a template index")? as usize;
+        let template = self.templates.get(t).ok_or_else(|| format!("template {t} does not exist ({} templates)", self.templates.len()))?;
+        let r = g.pointer("/boundaries/0").and_then(Value::as_u64).ok_or("a GeometryInstance without its reference point")? as usize;
+        let reference = *vertices.get(r).ok_or_else(|| format!("vertex index {r} is out of range ({} vertices)", vertices.len()))?;
+        let m: Vec<f64> = g
+            .get("transformationMatrix")
+            .and_then(Value::as_array)
+            .map(|a| a.iter().filter_map(Value::as_f64).collect())
+            .unwrap_or_default();
+        if m.len() != 16 {
+            return Err("transformationMatrix is not 16 numbers".into());
+        }
+        // CityJSON writes the matrix row by row; glam takes columns.
+        let matrix =
+            DMat4::from_cols_array(&[m[0], m[4], m[8], m[12], m[1], m[5], m[9], m[13], m[2], m[6], m[10], m[14], m[3], m[7], m[11], m[15]]);
+        let placed: Vec<DVec3> = self.template_vertices.iter().map(|v| matrix.transform_point3(*v) + reference).collect();
+        flatten(template, &placed)
+    }
+}
+
+/// A surface as read: its semantic type and rings.
+type Surface = (Option<String>, Vec<Vec<DVec3>>);
+
+/// Three finite numbers.
+fn point(v: &Value) -> Option<DVec3> {
+    let a = v.as_array().filter(|a| a.len() == 3)?;
+    let p = DVec3::new(a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?);
+    p.is_finite().then_some(p)
+}
+
+/// The root of an object's `parents` chain (itself when it has none); a cycle stops at the start.
+fn root_of<'a>(id: &'a str, parents: &HashMap<&'a str, &'a str>) -> &'a str {
+    let mut at = id;
+    for _ in 0..parents.len() {
+        match parents.get(at) {
+            Some(&p) if p != id => at = p,
+            _ => break,
+        }
+    }
+    at
+}
+
+/// Nesting depth of surfaces in `boundaries` (and of surface values in `semantics.values`).
+fn surface_depth(kind: &str) -> std::result::Result<usize, String> {
+    match kind {
+        "MultiSurface" | "CompositeSurface" => Ok(0),
+        "Solid" => Ok(1),
+        "MultiSolid" | "CompositeSolid" => Ok(2),
+        other => Err(format!("geometry type '{other}' has no surfaces")),
+    }
+}
+
+/// A geometry's surfaces in file order, each ring checked.
+fn flatten(g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, String> {
+    let kind = g.get("type").and_then(Value::as_str).unwrap_or("");
+    let depth = surface_depth(kind)?;
+    let boundaries = g.get("boundaries").ok_or("no boundaries")?;
+    let mut surfaces = Vec::new();
+    collect(boundaries, depth, &mut surfaces).map_err(|_| format!("boundaries are not nested as a {kind}'s"))?;
+    let semantic_surfaces = g.pointer("/semantics/surfaces").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
+    let mut values = Vec::new();
+    if let Some(v) = g.pointer("/semantics/values") {
+        collect(v, depth, &mut values).map_err(|_| format!("semantics.values are not nested as a {kind}'s boundaries"))?;
+    }
+    surfaces
+        .iter()
+        .enumerate()
+        .map(|(s, surface)| {
+            let semantic = match values.get(s).copied() {
+                None | Some(Value::Null) => None,
+                Some(v) => {
+                    let k = v.as_u64().ok_or_else(|| format!("surface {s}: semantic value {v} is not an index"))? as usize;
+                    let obj = semantic_surfaces.get(k).ok_or_else(|| {
+                        format!("surface {s}: semantic value {k} points nowhere ({} semantic surfaces)", semantic_surfaces.len())
+                    })?;
+                    Some(obj.get("type").and_then(Value::as_str).unwrap_or("Surface").to_string())
+                }
+            };
+            let rings = surface.as_array().ok_or_else(|| format!("surface {s} is not a list of rings"))?;
+            let rings =
+                rings.iter().enumerate().map(|(r, ring)| read_ring(ring, vertices).map_err(|e| format!("surface {s}, ring {r}: {e}")));
+            Ok((semantic, rings.collect::<std::result::Result<Vec<_>, String>>()?))
+        })
+        .collect()
+}
+
+/// The values at nesting depth `depth` (0: the array's items), in order.
+fn collect<'v>(v: &'v Value, depth: usize, out: &mut Vec<&'v Value>) -> std::result::Result<(), ()> {
+    let items = v.as_array().ok_or(())?;
+    if depth == 0 {
+        out.extend(items);
+        return Ok(());
+    }
+    items.iter().try_for_each(|i| collect(i, depth - 1, out))
+}
+
+/// A ring's points, at least 3 distinct ones, every index in range.
+fn read_ring(ring: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<DVec3>, String> {
+    let indices = ring.as_array().ok_or("is not a list of vertex indices")?;
+    let mut points: Vec<DVec3> = Vec::with_capacity(indices.len());
+    for i in indices {
+        let k = i.as_u64().ok_or_else(|| format!("vertex index {i} is not an index"))? as usize;
+        let p = *vertices.get(k).ok_or_else(|| format!("vertex index {k} is out of range ({} vertices)", vertices.len()))?;
+        // Repeated consecutive points (and a closing repeat) add nothing.
+        if points.last() != Some(&p) {
+            points.push(p);
+        }
+    }
+    if points.len() > 1 && points.first() == points.last() {
+        points.pop();
+    }
+    let mut distinct = points.clone();
+    distinct.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
+    distinct.dedup();
+    if distinct.len() < 3 {
+        return Err(format!("has {} distinct vertices; a ring needs at least 3", distinct.len()));
+    }
+    Ok(points)
+}
+
+/// Which surfaces may receive, and which by default (`RoofSurface`, `WallSurface`).
+pub fn default_receiver(surface: &CitySurface) -> bool {
+    surface.building.is_some() && matches!(surface.kind.as_deref(), Some("RoofSurface" | "WallSurface"))
+}
+
+/// The city as the readers' common model: one node (and mesh) a surface, triangulated with its
+/// holes about its exterior ring's plane (a non-planar ring's triangles keep their 3D vertices),
+/// turned by `north_deg` about the local origin. A ring that cannot be triangulated is an error.
+pub fn city_model(city: &City, north_deg: f64) -> Result<GltfModel> {
+    let turn = DMat4::from_rotation_z(-north_deg.to_radians());
+    let mut meshes = Vec::with_capacity(city.surfaces.len());
+    let mut nodes = Vec::with_capacity(city.surfaces.len());
+    for s in &city.surfaces {
+        let mesh = surface_mesh(s).map_err(|reason| Error::object(&city.file, format!("CityObject '{}'", s.object), reason))?;
+        nodes.push(GltfNode {
+            name: s.name.clone(),
+            named: true,
+            marked: default_receiver(s),
+            veil: NodeVeil::default(),
+            mesh: meshes.len(),
+            transform: turn,
+            city: Some(CityTags { building: s.building.clone(), object: s.object.clone(), kind: s.kind.clone() }),
+        });
+        meshes.push(mesh);
+    }
+    Ok(GltfModel { file: city.file.clone(), meshes, nodes })
+}
+
+/// One surface's triangles (f32, local coordinates: already small).
+fn surface_mesh(s: &CitySurface) -> std::result::Result<SourceMesh, String> {
+    let points: Vec<DVec3> = s.rings.iter().flatten().copied().collect();
+    let mut starts = Vec::new();
+    let mut at = 0;
+    for ring in &s.rings {
+        if at > 0 {
+            starts.push(at);
+        }
+        at += ring.len();
+    }
+    let exterior = &s.rings[0];
+    let normal = newell(exterior);
+    if normal.length() == 0.0 {
+        return Err(format!("surface {} ({}) has no area", s.index, s.name));
+    }
+    let triangles = triangulate(&Plane::of_polygon(exterior), &points, &starts);
+    if triangles.is_empty() {
+        return Err(format!("surface {} ({}) could not be triangulated (a self-intersecting ring?)", s.index, s.name));
+    }
+    Ok(SourceMesh {
+        positions: points.iter().map(|p| [p.x as f32, p.y as f32, p.z as f32]).collect(),
+        indices: triangles.iter().flatten().map(|&i| i as u32).collect(),
+    })
+}
+
+#[cfg(test)]
+#[path = "cityjson_tests.rs"]
+mod tests;

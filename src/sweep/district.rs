@@ -1,0 +1,386 @@
+//! Districts: a city model's receivers split into square tiles, each tile counted against the
+//! casters within a context radius of it, locally or as a Slurm job array, then merged into one
+//! solar cadastre ([`crate::export::cadastre`]).
+//!
+//! Owns:
+//! - tiles: a building belongs to the tile holding its footprint centroid (the area-weighted
+//!   centroid of its `GroundSurface`s seen from above, else the centre of its outline's box), on a
+//!   grid of `tile` metres from the city's south-west corner; only tiles with buildings exist,
+//!   numbered row by row from the south;
+//! - context: a tile is counted with every surface (any object: buildings, terrain, trees) whose
+//!   box seen from above comes within `context` metres of the tile's square. A shadow is held
+//!   when the radius reaches every caster that can shade a receiver at any counted sun: for a
+//!   caster `H` metres above a receiver's lowest point and the lowest sun counted at altitude
+//!   `a` (EnergyPlus's sun-up rule, cos zenith ≥ 1e-5, is `a` = 0.00057°), `context ≥ H / tan a`,
+//!   and the sky views need the same down to the horizon; a radius reaching across the whole
+//!   city always holds. A smaller radius misses only low-sun shadows and distant horizon;
+//! - one f32 origin for every tile (the city's centre), so a receiver rounds alike in every cut;
+//! - records: `.done/tile-K.json` per finished tile (the inputs' fingerprint and its rows,
+//!   written atomically after counting), `.failed/tile-K.json` per failed one; the merge writes
+//!   `cadastre.city.json`, `cadastre.csv` and `cadastre-roofs.geojson` when every tile is done,
+//!   and `failed.csv` listing the rest.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use super::record::{self, Failed, Fingerprint};
+use crate::count::gpu::CounterOptions;
+use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
+use crate::error::{Error, Result};
+use crate::export::cadastre::{self, CadastreRow};
+use crate::export::irradiation::summarize;
+use crate::export::write_atomic;
+use crate::model::LoadOptions;
+use crate::model::cityjson::{City, CitySurface};
+use crate::sky::patches::SkyPatches;
+use crate::sky::views::sky_views;
+use crate::sun::weather::Weather;
+use crate::year::annual::{Progress, annual_with};
+use crate::year::settings::Resolved;
+
+/// The merged outputs' names in the output folder.
+pub const CADASTRE_CITYJSON: &str = "cadastre.city.json";
+/// The CSV beside it.
+pub const CADASTRE_CSV: &str = "cadastre.csv";
+/// The roofs' GeoJSON beside it.
+pub const CADASTRE_GEOJSON: &str = "cadastre-roofs.geojson";
+
+/// One tile: its grid cell, square and buildings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tile {
+    /// Its number (the array task index).
+    pub index: usize,
+    /// Column and row on the grid.
+    pub cell: (i64, i64),
+    /// South-west and north-east corners, local metres.
+    pub square: (DVec2, DVec2),
+    /// Its buildings' ids, sorted.
+    pub buildings: Vec<String>,
+}
+
+/// A city cut into tiles.
+#[derive(Debug, Clone)]
+pub struct Tiling {
+    /// Tile side, m.
+    pub tile: f64,
+    /// Context radius, m.
+    pub context: f64,
+    /// The tiles holding a building.
+    pub tiles: Vec<Tile>,
+    /// The f32 origin every tile's scene uses.
+    pub origin: DVec3,
+}
+
+/// A building's footprint centroid: its ground surfaces' area-weighted centroid seen from above,
+/// else the centre of its outline's box.
+pub fn footprint_centroid(surfaces: &[&CitySurface]) -> DVec2 {
+    let (mut area, mut moment) = (0.0, DVec2::ZERO);
+    for s in surfaces.iter().filter(|s| s.kind.as_deref() == Some("GroundSurface")) {
+        for (r, ring) in s.rings.iter().enumerate() {
+            let (a, c) = shoelace(ring);
+            // Holes take their area away, whatever their winding.
+            let a = if r == 0 { a.abs() } else { -a.abs() };
+            area += a;
+            moment += c * a;
+        }
+    }
+    if area > 1e-9 {
+        return moment / area;
+    }
+    let (lo, hi) = box_of(surfaces.iter().copied());
+    (lo + hi) * 0.5
+}
+
+/// Signed area and centroid of a ring seen from above.
+fn shoelace(ring: &[DVec3]) -> (f64, DVec2) {
+    let (mut a, mut c) = (0.0, DVec2::ZERO);
+    for k in 0..ring.len() {
+        let (p, q) = (ring[k].truncate(), ring[(k + 1) % ring.len()].truncate());
+        let cross = p.perp_dot(q);
+        a += cross;
+        c += (p + q) * cross;
+    }
+    if a.abs() < 1e-12 { (0.0, DVec2::ZERO) } else { (a / 2.0, c / (3.0 * a)) }
+}
+
+/// The box of surfaces seen from above.
+fn box_of<'a>(surfaces: impl Iterator<Item = &'a CitySurface>) -> (DVec2, DVec2) {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in surfaces.flat_map(|s| s.rings.iter().flatten()) {
+        lo = lo.min(p.truncate());
+        hi = hi.max(p.truncate());
+    }
+    (lo, hi)
+}
+
+/// Cuts `city` into tiles of `tile` metres with a `context` radius; `north` (degrees) turns the
+/// model as the scene will, so the shared origin is the scene's.
+pub fn tiles(city: &City, tile: f64, context: f64, north: f64) -> Result<Tiling> {
+    if !(tile.is_finite() && tile > 0.0) {
+        return Err(Error::argument("tile", format!("{tile} is not a positive size in metres")));
+    }
+    if !(context.is_finite() && context > 0.0) {
+        return Err(Error::argument("context", format!("{context} is not a positive radius in metres")));
+    }
+    let mut by_building: BTreeMap<&str, Vec<&CitySurface>> = BTreeMap::new();
+    for s in &city.surfaces {
+        if let Some(b) = &s.building {
+            by_building.entry(b.as_str()).or_default().push(s);
+        }
+    }
+    if by_building.is_empty() {
+        return Err(Error::model(&city.file, "no Building with geometry: nothing to tile"));
+    }
+    let (lo, _) = box_of(city.surfaces.iter());
+    let mut cells: BTreeMap<(i64, i64), Vec<String>> = BTreeMap::new();
+    for (id, surfaces) in &by_building {
+        let c = (footprint_centroid(surfaces) - lo) / tile;
+        cells.entry((c.y.floor() as i64, c.x.floor() as i64)).or_default().push(id.to_string());
+    }
+    let tiles = cells
+        .into_iter()
+        .enumerate()
+        .map(|(index, ((row, column), buildings))| {
+            let sw = lo + DVec2::new(column as f64, row as f64) * tile;
+            Tile { index, cell: (column, row), square: (sw, sw + DVec2::splat(tile)), buildings }
+        })
+        .collect();
+    Ok(Tiling { tile, context, tiles, origin: city_origin(city, north) })
+}
+
+/// The centre of the city's box after the north turn: where the scene builder would centre the
+/// whole city.
+fn city_origin(city: &City, north: f64) -> DVec3 {
+    let turn = glam::DMat3::from_rotation_z(-north.to_radians());
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in city.surfaces.iter().flat_map(|s| s.rings.iter().flatten()) {
+        let w = turn * *p;
+        lo = lo.min(w);
+        hi = hi.max(w);
+    }
+    if lo.x > hi.x { DVec3::ZERO } else { (lo + hi) * 0.5 }
+}
+
+/// The part of `city` a tile is counted with: every surface whose box comes within the context
+/// radius of the tile's square (its own buildings always do).
+pub fn tile_city(city: &City, tiling: &Tiling, tile: &Tile) -> City {
+    let (sw, ne) = tile.square;
+    let near = |s: &CitySurface| {
+        let (lo, hi) = box_of(std::iter::once(s));
+        let gap = (sw - hi).max(lo - ne).max(DVec2::ZERO);
+        gap.length() <= tiling.context
+    };
+    let own: std::collections::HashSet<&str> = tile.buildings.iter().map(String::as_str).collect();
+    let surfaces = city.surfaces.iter().filter(|s| s.building.as_deref().is_some_and(|b| own.contains(b)) || near(s)).cloned().collect();
+    City { surfaces, ..city.clone() }
+}
+
+/// What counting a tile needs beside the city: the readers' options (receivers, buildings, lod,
+/// north), the year's settings, the weather and sky, and the engine.
+pub struct TileSettings<'a> {
+    /// How the city is read into a scene (`buildings` narrows the receivers further).
+    pub load: LoadOptions,
+    /// Location, sampling, calendar.
+    pub settings: &'a Resolved,
+    /// The weather's hours.
+    pub weather: &'a Weather,
+    /// The sky's patches.
+    pub patches: &'a SkyPatches,
+    /// Which engine answers views.
+    pub engine: EngineKind,
+    /// The GPU's options.
+    pub counter: CounterOptions,
+    /// GPU lanes.
+    pub lanes: Option<usize>,
+}
+
+/// Counts tile `k`: its buildings' receivers against its context, the year and the sky, into
+/// cadastre rows; also the number of surfaces it was counted with.
+pub fn count_tile(
+    city: &City,
+    tiling: &Tiling,
+    k: usize,
+    s: &TileSettings,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<(Vec<CadastreRow>, usize)> {
+    let tile = tiling.tiles.get(k).ok_or_else(|| {
+        Error::argument(
+            "index",
+            format!("{k} is past the last tile ({} tiles: 0..={})", tiling.tiles.len(), tiling.tiles.len().saturating_sub(1)),
+        )
+    })?;
+    let part = tile_city(city, tiling, tile);
+    let buildings: Vec<String> = match s.load.buildings.as_slice() {
+        [] => tile.buildings.clone(),
+        asked => tile.buildings.iter().filter(|b| asked.contains(b)).cloned().collect(),
+    };
+    if buildings.is_empty() {
+        return Ok((Vec::new(), part.surfaces.len()));
+    }
+    let load = LoadOptions { buildings, origin: Some(tiling.origin), ..s.load.clone() };
+    let scene = match crate::model::load_city(&part, &load) {
+        Ok(loaded) => loaded.scene,
+        // Buildings without a chosen surface (a tile of sheds without roofs or walls).
+        Err(Error::NoReceivers(_)) => return Ok((Vec::new(), part.surfaces.len())),
+        Err(e) => return Err(e),
+    };
+    let engine = HybridEngine::new(&scene, s.engine, s.counter, s.lanes, ProfileSource::Cache)?;
+    let options = s.settings.options(None)?;
+    let location = &s.settings.location;
+    let schedule = pollster::block_on(annual_with(&engine, &scene, location, &options, &s.settings.calendar, progress))?;
+    let views = pollster::block_on(sky_views(&engine, &scene, s.patches, progress))?;
+    let summaries = summarize(&scene, &schedule, location, Some((&views, &s.settings.calendar)), Some(s.weather), &[])?;
+    let hours = cadastre::sun_hours(&schedule, location);
+    Ok((cadastre::rows(&part, &scene, &summaries, &hours)?, part.surfaces.len()))
+}
+
+/// A finished tile's record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TileDone {
+    /// The tile's number.
+    pub tile: usize,
+    /// What it was counted from.
+    pub fingerprint: Fingerprint,
+    /// Seconds it took.
+    pub seconds: f64,
+    /// Surfaces counted in it.
+    pub casters: usize,
+    /// Its receivers' rows.
+    pub rows: Vec<CadastreRow>,
+}
+
+/// The record id of tile `k`.
+pub fn tile_id(k: usize) -> String {
+    format!("tile-{k}")
+}
+
+/// The fingerprint of a district run: its defining arguments and the city file.
+pub fn fingerprint(args: &[String], city: &Path) -> Fingerprint {
+    Fingerprint::new(args.to_vec(), &[city.to_path_buf()])
+}
+
+/// Tile `k`'s record when it is finished with today's fingerprint.
+pub fn finished(dir: &Path, k: usize, fingerprint: &Fingerprint) -> Option<TileDone> {
+    let text = std::fs::read_to_string(record::done_path(dir, &tile_id(k))).ok()?;
+    let done: TileDone = serde_json::from_str(&text).ok()?;
+    (done.fingerprint == *fingerprint && done.tile == k).then_some(done)
+}
+
+/// Writes a tile's record (atomically) and clears its failure record.
+pub fn write_tile(dir: &Path, done: &TileDone) -> Result<()> {
+    let path = record::done_path(dir, &tile_id(done.tile));
+    let text = serde_json::to_vec(done).map_err(|e| Error::model(path.display().to_string(), e.to_string()))?;
+    write_atomic(&path, &text)?;
+    let _ = std::fs::remove_file(record::failed_path(dir, &tile_id(done.tile)));
+    Ok(())
+}
+
+/// Records that tile `k` failed.
+pub fn write_tile_failure(dir: &Path, k: usize, exit_code: Option<i32>, reason: &str, log: &Path) -> Result<()> {
+    let failed = Failed { id: tile_id(k), exit_code, reason: reason.to_string(), log: log.display().to_string() };
+    record::write_failed(dir, &failed)
+}
+
+/// Tiles without a finished record.
+pub fn pending(dir: &Path, tiling: &Tiling, fingerprint: &Fingerprint) -> Vec<usize> {
+    tiling.tiles.iter().map(|t| t.index).filter(|&k| finished(dir, k, fingerprint).is_none()).collect()
+}
+
+/// What the merge wrote, or which tiles it lacks.
+#[derive(Debug, Clone)]
+pub struct DistrictMerged {
+    /// The files written (empty when tiles are missing).
+    pub written: Vec<PathBuf>,
+    /// Rows merged.
+    pub surfaces: usize,
+    /// Unfinished tiles: (id, exit code, reason).
+    pub unfinished: Vec<(String, Option<i32>, String)>,
+}
+
+/// Merges every tile's rows into the cadastre's three files (atomically, only when every tile is
+/// finished), in the city's surface order; otherwise writes `failed.csv` and nothing else.
+pub fn merge(
+    dir: &Path,
+    city: &City,
+    city_bytes: &[u8],
+    tiling: &Tiling,
+    fingerprint: &Fingerprint,
+    north_note: &str,
+) -> Result<DistrictMerged> {
+    let mut rows: Vec<CadastreRow> = Vec::new();
+    let mut unfinished = Vec::new();
+    for t in &tiling.tiles {
+        match finished(dir, t.index, fingerprint) {
+            Some(done) => rows.extend(done.rows),
+            None => {
+                let id = tile_id(t.index);
+                let (code, reason) = match record::failure(dir, &id) {
+                    Some(f) => (f.exit_code, f.reason),
+                    None => (None, "no record: not run yet, or stopped before it finished".to_string()),
+                };
+                unfinished.push((id, code, reason));
+            }
+        }
+    }
+    let failed = dir.join(super::FAILED_CSV);
+    if !unfinished.is_empty() {
+        let mut text = String::from("id,exit_code,reason\n");
+        for (id, code, reason) in &unfinished {
+            text.push_str(&format!("{id},{},\"{}\"\n", code.map(|c| c.to_string()).unwrap_or_default(), reason.replace('"', "\"\"")));
+        }
+        write_atomic(&failed, text.as_bytes())?;
+        return Ok(DistrictMerged { written: Vec::new(), surfaces: rows.len(), unfinished });
+    }
+    let _ = std::fs::remove_file(&failed);
+    let position: HashMap<&str, usize> = city.surfaces.iter().enumerate().map(|(i, s)| (s.name.as_str(), i)).collect();
+    rows.sort_by_key(|r| position.get(r.surface.as_str()).copied().unwrap_or(usize::MAX));
+    let files = [
+        (dir.join(CADASTRE_CITYJSON), cadastre::cadastre_cityjson(&city.file, city_bytes, city, &rows)?),
+        (dir.join(CADASTRE_CSV), cadastre::cadastre_csv(&rows).into_bytes()),
+        (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note).into_bytes()),
+    ];
+    for (path, bytes) in &files {
+        write_atomic(path, bytes)?;
+    }
+    Ok(DistrictMerged { written: files.into_iter().map(|(p, _)| p).collect(), surfaces: rows.len(), unfinished })
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn surface(building: &str, kind: &str, ring: &[(f64, f64)]) -> CitySurface {
+        CitySurface {
+            name: format!("{building}/{kind}/0"),
+            object: building.into(),
+            building: Some(building.into()),
+            kind: Some(kind.into()),
+            geometry: 0,
+            index: 0,
+            rings: vec![ring.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()],
+        }
+    }
+
+    #[test]
+    fn buildings_go_to_the_tile_of_their_footprint_centroid() {
+        // An L-shaped ground (3 m² + 2 m²: centroid at (1.1, 1.1)) and a square far east.
+        let l = surface("a", "GroundSurface", &[(0.0, 0.0), (3.0, 0.0), (3.0, 1.0), (1.0, 1.0), (1.0, 3.0), (0.0, 3.0)]);
+        let c = footprint_centroid(&[&l]);
+        assert!((c - DVec2::splat(1.1)).length() < 1e-12, "{c}");
+        let far = surface("b", "GroundSurface", &[(25.0, 0.0), (27.0, 0.0), (27.0, 2.0), (25.0, 2.0)]);
+        let city = City { file: "c".into(), version: "2.0".into(), reference_system: None, offset: DVec3::ZERO, surfaces: vec![l, far] };
+        let tiling = tiles(&city, 10.0, 5.0, 0.0).unwrap();
+        let cells: Vec<((i64, i64), Vec<String>)> = tiling.tiles.iter().map(|t| (t.cell, t.buildings.clone())).collect();
+        assert_eq!(cells, [((0, 0), vec!["a".to_string()]), ((2, 0), vec!["b".to_string()])]);
+        // The context: b's box is 15 m east of tile 0's square, a's 13 m west of tile 1's.
+        assert_eq!(tile_city(&city, &tiling, &tiling.tiles[0]).surfaces.len(), 1);
+        let wide = tiles(&city, 10.0, 15.0, 0.0).unwrap();
+        assert_eq!(tile_city(&city, &wide, &wide.tiles[0]).surfaces.len(), 2);
+        assert!(tiles(&city, 0.0, 5.0, 0.0).unwrap_err().to_string().contains("tile"));
+        assert!(tiles(&city, 10.0, -1.0, 0.0).unwrap_err().to_string().contains("context"));
+    }
+}

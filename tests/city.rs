@@ -1,0 +1,240 @@
+//! City models in, a solar cadastre out: the CityJSON and OBJ readers through the CLI (receivers
+//! by semantic type and building, bad input refused with nothing written), the round trip of a
+//! scene written as CityJSON and read back (the exact engine's fractions agree), and
+//! `sunlit district`: tiles equal the one-process run, and the cadastre's CityJSON passes the
+//! official validator `cjval` (installed by `SUNLIT_CITY=1 . scripts/setup.sh`).
+
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+mod common;
+mod sweep_fixture;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use common::{TestScene, flat_rect};
+use glam::DVec3;
+use sunlit::count::exact::Exact;
+use sunlit::count::{Engine, ViewRequest};
+use sweep_fixture::{scratch, stderr, sunlit, varying_epw};
+
+const BLOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/city/block.city.json");
+
+fn info(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["info", "--json"];
+    all.extend(args);
+    let out = sunlit(&all);
+    assert!(out.status.success(), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn receiver_names(v: &serde_json::Value) -> Vec<String> {
+    v["receivers"].as_array().unwrap().iter().map(|r| r["name"].as_str().unwrap().to_string()).collect()
+}
+
+#[test]
+fn city_receivers_are_roofs_and_walls_by_default_and_chosen_by_type_or_building() {
+    let all = info(&[BLOCK]);
+    let names = receiver_names(&all);
+    // 1 roof + 8 walls of the courtyard block, 2 roofs + 4 walls of the house part; no ground, no tree.
+    assert_eq!(names.len(), 15, "{names:?}");
+    assert!(names.iter().all(|n| n.contains("/RoofSurface/") || n.contains("/WallSurface/")), "{names:?}");
+    assert!(all["notes"].as_array().unwrap().iter().any(|n| n.as_str().unwrap().contains("grid north is taken as true north")));
+    let roofs = receiver_names(&info(&[BLOCK, "--receivers", "RoofSurface"]));
+    assert_eq!(roofs, ["NL.B.courtyard/RoofSurface/1", "NL.B.house.part/RoofSurface/5", "NL.B.house.part/RoofSurface/6"]);
+    let house = receiver_names(&info(&[BLOCK, "--buildings", "NL.B.house"]));
+    assert_eq!(house.len(), 6, "{house:?}");
+    assert!(house.iter().all(|n| n.starts_with("NL.B.house.part/")));
+    // The courtyard roof keeps its hole: 20 × 20 − 8 × 8 m².
+    let roof = all["receivers"].as_array().unwrap().iter().find(|r| r["name"] == "NL.B.courtyard/RoofSurface/1").unwrap();
+    assert!((roof["area"].as_f64().unwrap() - 336.0).abs() < 1e-6, "{roof}");
+    // Local coordinates: the 85 km translate is gone before anything became f32.
+    assert!(all["bounds"]["max"][0].as_f64().unwrap() < 200.0, "{}", all["bounds"]);
+}
+
+#[test]
+fn obj_groups_are_names_globs_select() {
+    let dir = scratch("obj");
+    let obj = dir.join("block.obj");
+    let text = "v 0 0 0\nv 10 0 0\nv 10 0 -10\nv 0 0 -10\nv 0 3 0\nv 10 3 0\nv 10 3 -10\nv 0 3 -10\n\
+                o house\ng roof\nf 5 6 7 8\ng south\nf 1 2 6 5\n";
+    std::fs::write(&obj, text).unwrap();
+    let v = info(&[obj.to_str().unwrap(), "--receivers", "*/roof", "--unit", "cm"]);
+    assert_eq!(receiver_names(&v), ["house/roof"]);
+    let roof = &v["receivers"][0];
+    assert!((roof["area"].as_f64().unwrap() - 0.01).abs() < 1e-9, "10 cm × 10 cm: {roof}");
+    assert!((roof["normal"][2].as_f64().unwrap() - 1.0).abs() < 1e-9, "y is up by default: {roof}");
+    let z_up = info(&[obj.to_str().unwrap(), "--receivers", "house/south", "--up", "z"]);
+    assert!((z_up["receivers"][0]["normal"][2].as_f64().unwrap() - 1.0).abs() < 1e-9, "{z_up}");
+}
+
+/// Bad city and OBJ input through `annual`: the file, the object and the reason, exit 1, and no
+/// file written.
+#[test]
+fn bad_city_input_is_refused_with_nothing_written() {
+    let dir = scratch("bad-city");
+    let cases: [(&str, String, &str); 4] = [
+        (
+            "version.city.json",
+            r#"{"type":"CityJSON","version":"0.9","CityObjects":{},"vertices":[]}"#.into(),
+            "version.city.json: CityJSON version \"0.9\" is not read (read: 1.1, 2.0)",
+        ),
+        (
+            "range.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{"b":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,5]]]}]}},"vertices":[[0,0,0],[1,0,0],[0,1,0]]}"#.into(),
+            "range.city.json: CityObject 'b': geometry 0: surface 0, ring 0: vertex index 5 is out of range (3 vertices)",
+        ),
+        (
+            "integers.city.json",
+            r#"{"type":"CityJSON","version":"1.1","CityObjects":{},"vertices":[[0,0,0]]}"#.into(),
+            "integers.city.json: no \"transform\", yet the vertices are integers",
+        ),
+        ("faces.obj", "v 0 0 0\nv 1 0 0\no shed\nf 1 2 9\n".into(), "faces.obj: 'shed' (line 4): vertex index 9 is missing (2 vertices read so far)"),
+    ];
+    for (name, text, message) in cases {
+        let model = dir.join(name);
+        std::fs::write(&model, text).unwrap();
+        let csv = dir.join("out.csv");
+        let out = sunlit(&["annual", model.to_str().unwrap(), "--location", "52,5,1", "-o", csv.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        assert!(stderr(&out).contains(message), "{name}: {}", stderr(&out));
+        let left: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "csv" || e == "partial"))
+            .collect();
+        assert!(left.is_empty(), "{name}: {left:?}");
+    }
+}
+
+/// A scene of sunlit's own (boxes and a ground on a millimetre grid), written as CityJSON and read
+/// back: every receiver's exact fraction is the area-weighted mean of its triangles' surfaces.
+#[test]
+fn a_scene_written_as_cityjson_and_read_back_gives_the_same_fractions() {
+    let mut t = TestScene::new();
+    t.polygon("ground", &flat_rect(-20.0, 20.0, -20.0, 20.0, 0.0), true)
+        .cuboid("tower", DVec3::new(-3.0, 2.0, 0.0), DVec3::new(3.0, 6.0, 12.0))
+        .polygon("terrace", &flat_rect(-6.0, 6.0, -8.0, 0.5, 2.5), true);
+    let scene = t.build();
+    let text = sunlit::model::city_write::scene_cityjson(&scene);
+    let options = sunlit::model::LoadOptions { receivers: vec!["*".into()], ..Default::default() };
+    let back = sunlit::model::load_bytes(&[("own.city.json".into(), text.into_bytes())], &options).unwrap();
+    for (az, alt) in [(180.0, 30.0), (135.0, 15.0), (250.0, 50.0)] {
+        let sun = common::sun(az, alt);
+        let fractions = |s: &sunlit::scene::Scene| {
+            let requests: Vec<ViewRequest> = (0..s.receivers.len() as u32).map(|r| ViewRequest::new(r, sun)).collect();
+            pollster::block_on(Exact { scene: s }.answer(&requests)).unwrap().into_iter().map(|a| a.fraction).collect::<Vec<f64>>()
+        };
+        let (before, after) = (fractions(&scene), fractions(&back));
+        let mut sums: HashMap<String, (f64, f64)> = HashMap::new();
+        for (r, f) in back.receivers.iter().zip(&after) {
+            let building = r.name.split('/').next().unwrap().to_string();
+            let e = sums.entry(building).or_default();
+            e.0 += f * r.area;
+            e.1 += r.area;
+        }
+        for (i, (r, f)) in scene.receivers.iter().zip(&before).enumerate() {
+            let (lit, area) = sums[&format!("R{i}")];
+            assert!((area - r.area).abs() < 1e-9, "{}: area {area} against {}", r.name, r.area);
+            assert!((lit / area - f).abs() < 1e-9, "{} at ({az}, {alt}): {} read back against {f}", r.name, lit / area);
+        }
+    }
+}
+
+/// Runs `sunlit district` on `city` into `out` with the small settings every run here shares.
+fn district(city: &Path, epw: &Path, out: &Path, more: &[&str]) -> std::process::Output {
+    let mut args = vec!["district", city.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    args.extend(["--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5", "--sky-patches", "tregenza"]);
+    args.extend(more);
+    sunlit(&args)
+}
+
+/// Every tile record's rows in `out`, by surface, at full precision.
+fn tile_rows(out: &Path) -> HashMap<String, Vec<f64>> {
+    let mut rows = HashMap::new();
+    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
+        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
+        for r in done["rows"].as_array().unwrap() {
+            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
+                .map(|k| r[k].as_f64().unwrap());
+            rows.insert(r["surface"].as_str().unwrap().to_string(), values.to_vec());
+        }
+    }
+    rows
+}
+
+#[test]
+fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson() {
+    let dir = scratch("district");
+    let city = dir.join("district.city.json");
+    std::fs::write(&city, sunlit::model::city_write::district_cityjson(3, 3, 7)).unwrap();
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    // One tile holding the whole district, and tiles of 30 m whose context reaches across it
+    // (the radius that holds every shadow: docs/district.md).
+    let (one, tiled) = (dir.join("one"), dir.join("tiled"));
+    let run = district(&city, &epw, &one, &["--tile", "1000", "--context", "1000"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let run = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000", "--jobs", "2"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(stderr(&run).contains("grid north is taken as true north"), "{}", stderr(&run));
+    let tiles = std::fs::read_dir(tiled.join(".done")).unwrap().count();
+    assert!(tiles >= 4, "{tiles} tiles");
+    let (a, b) = (tile_rows(&one), tile_rows(&tiled));
+    assert_eq!(a.len(), b.len());
+    assert!(a.len() > 40, "{} surfaces", a.len());
+    for (name, values) in &a {
+        for (x, y) in values.iter().zip(&b[name]) {
+            assert!((x - y).abs() <= 1e-9, "{name}: {values:?} one-process against {:?} tiled", b[name]);
+        }
+    }
+    assert!(a.values().any(|v| v[4] > 100.0), "some surface gets real irradiation");
+    // A second run finds every tile finished.
+    let again = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000"]);
+    assert!(stderr(&again).contains("0 to count"), "{}", stderr(&again));
+    // A tile without its record (killed, failed): the merge lists it and fails; the next run
+    // counts only it.
+    std::fs::remove_file(tiled.join(".done/tile-1.json")).unwrap();
+    let merge = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000", "--merge"]);
+    assert_eq!(merge.status.code(), Some(1), "{}", stderr(&merge));
+    assert!(stderr(&merge).contains("1 tile(s) unfinished") && stderr(&merge).contains("tile-1"), "{}", stderr(&merge));
+    assert!(std::fs::read_to_string(tiled.join("failed.csv")).unwrap().starts_with("id,exit_code,reason\ntile-1,"));
+    let resumed = district(&city, &epw, &tiled, &["--tile", "30", "--context", "1000"]);
+    assert!(resumed.status.success() && stderr(&resumed).contains("1 to count"), "{}", stderr(&resumed));
+    assert!(!tiled.join("failed.csv").exists());
+    assert_eq!(tile_rows(&tiled), b, "the recounted tile is as before");
+    // The cadastre: valid CityJSON with the values on its semantic surfaces; CSV; roofs.
+    let cadastre = tiled.join("cadastre.city.json");
+    let check = std::process::Command::new("cjval").arg("-s").arg(&cadastre).output();
+    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
+    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
+    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
+    let semantics = &doc["CityObjects"]["B000000"]["geometry"][0]["semantics"];
+    let valued: Vec<&serde_json::Value> =
+        semantics["surfaces"].as_array().unwrap().iter().filter(|s| s.get("total_kwh_m2").is_some()).collect();
+    assert!(!valued.is_empty(), "{semantics}");
+    for key in ["direct_kwh_m2", "sky_diffuse_kwh_m2", "ground_reflected_kwh_m2", "sun_hours", "mean_sunlit_fraction"] {
+        assert!(valued.iter().all(|s| s[key].is_number()), "{key}: {semantics}");
+    }
+    let csv = std::fs::read_to_string(tiled.join("cadastre.csv")).unwrap();
+    assert_eq!(csv.lines().count(), a.len() + 1);
+    let roofs: serde_json::Value = serde_json::from_slice(&std::fs::read(tiled.join("cadastre-roofs.geojson")).unwrap()).unwrap();
+    let roof_rows = a.keys().filter(|n| n.contains("/RoofSurface/")).count();
+    assert_eq!(roofs["features"].as_array().unwrap().len(), roof_rows);
+    assert!(roofs["crs"]["properties"]["name"].as_str().unwrap().contains("7415"));
+}
+
+#[test]
+fn a_tile_size_or_context_that_is_not_positive_is_refused() {
+    let dir = scratch("district-bad");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    for (tile, context, flag) in [("0", "100", "--tile"), ("50", "-5", "--context"), ("nan", "100", "--tile")] {
+        let out = dir.join("out");
+        let run = district(Path::new(BLOCK), &epw, &out, &["--tile", tile, "--context", context]);
+        assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+        assert!(stderr(&run).contains(flag) && stderr(&run).contains("positive"), "{}", stderr(&run));
+        assert!(!out.exists(), "nothing written for --tile {tile} --context {context}");
+    }
+}
