@@ -33,6 +33,7 @@
 //! unobstructed; the weather's hour holds over its instants.
 
 mod gpu;
+pub mod inside;
 pub mod period;
 pub mod points;
 pub mod sky;

@@ -21,6 +21,7 @@ pub mod gltf_extensions;
 pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
+pub mod inside;
 #[cfg(feature = "fixtures")]
 pub mod office;
 #[cfg(feature = "fixtures")]
