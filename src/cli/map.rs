@@ -17,6 +17,8 @@ use super::*;
 
 #[path = "map_planning.rs"]
 mod planning;
+#[path = "map_inside.rs"]
+mod inside;
 
 #[derive(Args)]
 #[command(group = clap::ArgGroup::new("site").args(["epw", "location"]))]
@@ -81,6 +83,18 @@ pub(super) struct MapArgs {
     /// With --engine gpu: side in pixels of the square tile each receiver is rendered on.
     #[arg(long, value_name = "PIXELS", default_value_t = 512)]
     resolution: u32,
+    /// Map the inside of an EnergyPlus model's zones: points on the inside faces of their
+    /// surfaces or free in them, the beam through the windows (see docs/maps.md, "The sun inside").
+    #[arg(long)]
+    inside: bool,
+    /// With --inside: transmittance (0..1) of glazing whose construction is not a
+    /// WindowMaterial:SimpleGlazingSystem.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    glass_transmittance: Option<f64>,
+    /// With --inside and a grid: put it this many metres above each floor (default 0: on the
+    /// floors; 0.76 with --study leed-ase).
+    #[arg(long, value_name = "METRES", allow_hyphen_values = true)]
+    work_plane: Option<f64>,
     /// Print a JSON summary.
     #[arg(long)]
     json: bool,
@@ -129,7 +143,8 @@ impl MapArgs {
             let minute = parse_clock("at", &at[1])?;
             return Ok(Plan { period: Period::at(day, minute)?, rules: Vec::new(), instant: true });
         }
-        let mut rules: Vec<SunRule> = self.study.iter().map(|s| study::preset(s)).collect::<Result<_>>()?;
+        let mut rules: Vec<SunRule> =
+            self.study.iter().filter(|s| !inside::STUDIES.contains(&s.as_str())).map(|s| study::preset(s)).collect::<Result<_>>()?;
         if let Some(a) = self.min_altitude {
             if !(0.0..90.0).contains(&a) {
                 return Err(Error::argument("min_altitude", format!("{a}° is not in 0..90")));
@@ -217,6 +232,9 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     ];
     if let Some((flag, _)) = window_only.iter().find(|(_, given)| *given) {
         return Err(Error::argument(*flag, format!("is taken by the window studies only ({})", planning::STUDIES.join(", "))));
+    }
+    if args.inside || args.study.iter().any(|s| inside::STUDIES.contains(&s.as_str())) {
+        return inside::map_inside(args);
     }
     let plan = args.plan()?;
     let on_gpu = args.on_gpu()?;

@@ -35,6 +35,7 @@
 //! unobstructed; the weather's hour holds over its instants.
 
 mod gpu;
+pub mod inside;
 pub mod period;
 pub mod planning;
 pub mod points;

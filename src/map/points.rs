@@ -111,12 +111,30 @@ fn row_span(t: &[DVec2; 3], v: f64) -> Option<(f64, f64)> {
 /// the receiver's normal > 0); the nearest plane wins. `file_label` names the source in errors,
 /// which give the line: a malformed number, a normal of zero length, a point on no receiver.
 pub fn from_csv(scene: &Scene, file_label: &str, text: &str, receivers: &[u32]) -> Result<Points> {
+    let mut points = Points::default();
+    for (line, p, n) in csv_rows(file_label, text)? {
+        let Some(id) = receiver_under(scene, receivers, p, n) else {
+            return Err(Error::object(
+                file_label,
+                format!("line {line}"),
+                format!("point ({}, {}, {}) lies on no chosen receiver facing its normal (within {ON_SURFACE_TOLERANCE} m)", p.x, p.y, p.z),
+            ));
+        };
+        points.push(p, n, id);
+    }
+    Ok(points)
+}
+
+/// The rows of a points CSV (see [`from_csv`]): line number (1-based), position, unit normal.
+/// Refuses another header, a malformed row, a normal of zero length, no rows, and more than
+/// [`MAX_POINTS`].
+pub(crate) fn csv_rows(file_label: &str, text: &str) -> Result<Vec<(usize, DVec3, DVec3)>> {
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
     let header: Vec<String> = lines.next().map(|(_, l)| l.split(',').map(|f| f.trim().to_ascii_lowercase()).collect()).unwrap_or_default();
     if header != ["x", "y", "z", "nx", "ny", "nz"] {
         return Err(Error::model(file_label, format!("the header is '{}', expected 'x,y,z,nx,ny,nz'", header.join(","))));
     }
-    let mut points = Points::default();
+    let mut rows = Vec::new();
     for (index, line) in lines {
         let at = || format!("line {}", index + 1);
         let values: Vec<f64> = line
@@ -132,30 +150,19 @@ pub fn from_csv(scene: &Scene, file_label: &str, text: &str, receivers: &[u32]) 
         if n.length() < 1e-9 {
             return Err(Error::object(file_label, at(), "the normal (nx,ny,nz) has zero length"));
         }
-        let n = n.normalize();
-        let Some(id) = receiver_under(scene, receivers, p, n) else {
-            return Err(Error::object(
-                file_label,
-                at(),
-                format!(
-                    "point ({}, {}, {}) lies on no chosen receiver facing its normal (within {ON_SURFACE_TOLERANCE} m)",
-                    values[0], values[1], values[2]
-                ),
-            ));
-        };
-        points.push(p, n, id);
-        if points.len() > MAX_POINTS {
+        rows.push((index + 1, p, n.normalize()));
+        if rows.len() > MAX_POINTS {
             return Err(Error::model(file_label, format!("more than {MAX_POINTS} points")));
         }
     }
-    if points.is_empty() {
+    if rows.is_empty() {
         return Err(Error::model(file_label, "no points after the header"));
     }
-    Ok(points)
+    Ok(rows)
 }
 
 /// The receiver `p` lies on (see [`from_csv`]), if any.
-fn receiver_under(scene: &Scene, receivers: &[u32], p: DVec3, n: DVec3) -> Option<u32> {
+pub(crate) fn receiver_under(scene: &Scene, receivers: &[u32], p: DVec3, n: DVec3) -> Option<u32> {
     let mut best: Option<(f64, u32)> = None;
     for &id in receivers {
         let Some(r) = scene.receivers.get(id as usize) else { continue };

@@ -45,6 +45,7 @@ use crate::error::{Error, Result};
 use crate::geometry::{self, Plane, inside_or_on, newell, plane_deviation};
 use crate::scene::{NodeVeil, SceneBuilder, SourceMesh, SourceNode};
 use frame::{SurfaceFrame, WindowFrame, rectangle};
+pub use mesh::inside_name;
 use mesh::{hole_problem, reveal_problem};
 
 mod frame;
@@ -80,6 +81,9 @@ pub struct EpSurface {
     pub receiver: bool,
     /// Its `Sun Exposure` is `NoSun` (a window or door inherits its base surface's).
     pub no_sun: bool,
+    /// The zone it bounds, upper case as EnergyPlus keys it (a window or door takes its base
+    /// surface's); `None` for shading.
+    pub zone: Option<String>,
 }
 
 impl EpSurface {
@@ -95,6 +99,12 @@ impl EpSurface {
 
     fn is_shading(&self) -> bool {
         self.kind == SHADING
+    }
+
+    /// Whether this is a window or glass door: an opening the beam passes through, weighted by
+    /// its glass (a door is opaque).
+    pub fn is_glazing(&self) -> bool {
+        ["Window", "GlassDoor"].iter().any(|k| self.kind.eq_ignore_ascii_case(k))
     }
 }
 
@@ -655,6 +665,7 @@ impl<'a> Reader<'a> {
             line: object.line,
             receiver,
             no_sun,
+            zone: zone.clone(),
         };
         let deviation = plane_deviation(&surface.vertices);
         if deviation > PLANAR_TOLERANCE {

@@ -30,6 +30,7 @@ pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
 pub mod obj;
+pub mod inside;
 #[cfg(feature = "fixtures")]
 pub mod office;
 #[cfg(feature = "fixtures")]

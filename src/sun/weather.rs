@@ -45,6 +45,10 @@ pub const DEFAULT_ALBEDO: f64 = 0.2;
 const GHI: Field = Field { index: 13, name: "global horizontal irradiance" };
 const DNI: Field = Field { index: 14, name: "direct normal irradiance" };
 const DHI: Field = Field { index: 15, name: "diffuse horizontal irradiance" };
+/// Direct normal illuminance, lux (0-based index of field 18).
+const DIRECT_ILLUMINANCE: usize = 17;
+/// The EPW's "missing" for illuminance fields.
+const MISSING_ILLUMINANCE: f64 = 999_999.0;
 const ALBEDO: Field = Field { index: 32, name: "albedo" };
 
 /// The EPW `LOCATION` record's fields (0-based) read here, with the names errors use.
@@ -92,6 +96,10 @@ pub struct Weather {
     hours: Vec<Hour>,
     /// 29 February's 24 hours, when the file has them.
     leap_day: Option<Vec<Hour>>,
+    /// Direct normal illuminance (lux, EPW field 18) per hour of the 365-day year; `None` for an
+    /// hour whose field is missing (999999), absent or unreadable, and for a weather made by
+    /// [`Weather::constant`]. Kept apart from [`Hour`]: only the sun-inside studies read it.
+    direct_lux: Vec<Option<f64>>,
 }
 
 impl Weather {
@@ -106,6 +114,7 @@ impl Weather {
     pub fn from_epw_text(file_label: &str, text: &str) -> Result<Self> {
         let location = location_from_text(file_label, text)?;
         let (mut hours, mut leap_day) = (Vec::with_capacity(YEAR_HOURS), Vec::new());
+        let mut direct_lux = Vec::with_capacity(YEAR_HOURS);
         for (index, line) in text.lines().enumerate().skip(EPW_HEADER_LINES) {
             let line = line.trim();
             if line.is_empty() {
@@ -121,6 +130,7 @@ impl Weather {
                 leap_day.push(hour);
             } else {
                 hours.push(hour);
+                direct_lux.push(illuminance(&fields));
             }
         }
         if hours.len() != YEAR_HOURS || !(leap_day.is_empty() || leap_day.len() == 24) {
@@ -132,12 +142,12 @@ impl Weather {
                 ),
             ));
         }
-        Ok(Self { location, hours, leap_day: (!leap_day.is_empty()).then_some(leap_day) })
+        Ok(Self { location, hours, leap_day: (!leap_day.is_empty()).then_some(leap_day), direct_lux })
     }
 
     /// The same hour all year, at `location`: for tests and what-if cases.
     pub fn constant(location: Location, hour: Hour) -> Self {
-        Self { location, hours: vec![hour; YEAR_HOURS], leap_day: None }
+        Self { location, hours: vec![hour; YEAR_HOURS], leap_day: None, direct_lux: Vec::new() }
     }
 
     /// Every hour's albedo replaced by `albedo` (a given ground reflectance); refused outside 0..=1.
@@ -145,6 +155,19 @@ impl Weather {
         check_albedo(albedo)?;
         self.hours.iter_mut().chain(self.leap_day.iter_mut().flatten()).for_each(|h| h.albedo = albedo);
         Ok(self)
+    }
+
+    /// Direct normal illuminance (lux) of hour `hour` (0..8760) of the 365-day year, where the
+    /// EPW gives it (field 18; missing is 999999).
+    pub fn direct_normal_illuminance(&self, hour: usize) -> Option<f64> {
+        self.direct_lux.get(hour).copied().flatten()
+    }
+
+    /// The same weather with every hour's direct normal illuminance set (lux, 8760 of them, or
+    /// `None` per hour): what-if cases and tests.
+    pub fn with_direct_illuminance(mut self, lux: Vec<Option<f64>>) -> Self {
+        self.direct_lux = lux;
+        self
     }
 
     /// The hour that holds at `row` of a schedule with `timesteps` (see the module doc).
@@ -180,6 +203,14 @@ pub fn check_albedo(albedo: f64) -> Result<()> {
 /// One data record's solar fields, or why not.
 fn read_hour(fields: &[&str]) -> std::result::Result<Hour, String> {
     Ok(Hour { dni: irradiance(fields, DNI)?, dhi: irradiance(fields, DHI)?, ghi: irradiance(fields, GHI)?, albedo: albedo(fields)? })
+}
+
+/// Direct normal illuminance (EPW field 18, lux): `None` when absent, unreadable, negative or
+/// missing (999999). Never an error: only the sun-inside studies read it, and they fall back to a
+/// stated luminous efficacy.
+fn illuminance(fields: &[&str]) -> Option<f64> {
+    let value: f64 = fields.get(DIRECT_ILLUMINANCE)?.parse().ok()?;
+    (value.is_finite() && (0.0..MISSING_ILLUMINANCE).contains(&value)).then_some(value)
 }
 
 /// A radiation field as W/m², or why not.

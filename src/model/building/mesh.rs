@@ -3,6 +3,11 @@
 
 use super::*;
 
+/// The receiver name of a zone surface's inside face (see [`Building::add_inside_to`]).
+pub fn inside_name(surface: &str) -> String {
+    format!("{surface}:inside")
+}
+
 /// Why a subsurface cannot be a hole in `base`, if it cannot.
 pub(super) fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String> {
     let plane = Plane::of_polygon(&base.vertices);
@@ -60,29 +65,64 @@ impl Building {
     /// clipping (earcut) in the surface's plane. Receiver names are the EnergyPlus names as
     /// written in the file (EnergyPlus itself reports them upper-cased).
     pub fn add_to(&self, builder: &mut SceneBuilder) -> Result<()> {
-        self.add_surfaces(builder, false, &HashMap::new())
+        self.add_surfaces(builder, false, &HashMap::new(), |_| false)
     }
 
     /// As [`Building::add_to`], with shading surfaces that let τ of the beam through (by
     /// lower-case name): see-through casters for 0 < τ < 1, no caster at all for τ ≥ 1.
     pub fn add_to_with(&self, builder: &mut SceneBuilder, shades: &HashMap<String, f64>) -> Result<()> {
-        self.add_surfaces(builder, false, shades)
+        self.add_surfaces(builder, false, shades, |_| false)
+    }
+
+    /// The rooms' side of the model: every surface but glazing (windows and glass doors, whose
+    /// openings stay open: the caller weights the beam through them) casts and receives on its
+    /// outside face, and every zone surface also gets its inside face as the receiver
+    /// `NAME:inside` (a mirror: same triangles, normal into the zone, never shaded by itself).
+    /// Refuses a window or door that does not lie in its base surface: its opening would be
+    /// left uncut, and the room sealed.
+    pub fn add_inside_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        if let Some((hole, why)) = self.misplaced_openings().into_iter().next() {
+            return Err(Error::object(&self.file, hole.label(), why));
+        }
+        self.add_surfaces(builder, true, &HashMap::new(), EpSurface::is_glazing)?;
+        for s in self.surfaces.iter().filter(|s| s.zone.is_some() && !s.is_shading() && !s.is_glazing()) {
+            builder.add_mirror(&s.name, &inside_name(&s.name));
+        }
+        Ok(())
+    }
+
+    /// Windows and doors that cannot be cut out of their base surface, with why.
+    fn misplaced_openings(&self) -> Vec<(&EpSurface, String)> {
+        self.surfaces
+            .iter()
+            .filter(|s| s.is_fenestration())
+            .filter_map(|hole| {
+                let base = hole.base.as_deref().and_then(|b| self.surface(b))?;
+                hole_problem(base, hole).map(|why| (hole, why))
+            })
+            .collect()
     }
 
     /// As [`Building::add_to`], but every surface receives, and every shading surface also gets
     /// its back face `Mir-NAME` as EnergyPlus makes it: the columns EnergyPlus's `Imported`
     /// method looks up (those of its own eplusshading.csv).
     pub fn add_all_to(&self, builder: &mut SceneBuilder) -> Result<()> {
-        self.add_surfaces(builder, true, &HashMap::new())?;
+        self.add_surfaces(builder, true, &HashMap::new(), |_| false)?;
         for s in self.surfaces.iter().filter(|s| s.is_shading()) {
             builder.add_mirror(&s.name, &format!("Mir-{}", s.name));
         }
         Ok(())
     }
 
-    fn add_surfaces(&self, builder: &mut SceneBuilder, all: bool, shades: &HashMap<String, f64>) -> Result<()> {
+    fn add_surfaces(
+        &self,
+        builder: &mut SceneBuilder,
+        all: bool,
+        shades: &HashMap<String, f64>,
+        skip: impl Fn(&EpSurface) -> bool,
+    ) -> Result<()> {
         let holes = self.holes();
-        for (i, surface) in self.surfaces.iter().enumerate() {
+        for (i, surface) in self.surfaces.iter().enumerate().filter(|(_, s)| !skip(s)) {
             let transmittance = shades.get(&surface.name.to_ascii_lowercase()).copied().filter(|_| surface.is_shading());
             if transmittance.is_some_and(|t| t >= 1.0) {
                 // Lets all the sun through: casts no shadow, so it is left out.

@@ -1,0 +1,229 @@
+//! `sunlit map --inside`, the CLI's edge of [`sunlit::map::inside`]: the rooms of one EnergyPlus
+//! model, their points, and the instant, period or LEED ASE outputs. The library owns the rooms,
+//! the glass, the sums and the rule.
+
+use sunlit::map::inside::{
+    self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
+};
+use sunlit::model::inside::{Rooms, inside_scene, rooms};
+
+use super::*;
+
+/// The studies `--inside` answers.
+pub(super) const STUDIES: [&str; 2] = ["leed-ase", "bre-nsl"];
+
+/// What the flags ask of the inside, checked before the model is read.
+enum Ask {
+    /// One instant.
+    At(Period),
+    /// Sums over a period.
+    Period(Period),
+    /// LEED v4.1 ASE over the year.
+    Ase,
+    /// BRE 209's No-Sky Line.
+    Nsl,
+}
+
+fn ask(args: &MapArgs) -> Result<Ask> {
+    if !args.inside {
+        return Err(Error::argument("study", "leed-ase and bre-nsl map the inside of rooms: add --inside"));
+    }
+    if args.study.len() > 1 {
+        return Err(Error::argument("study", "one study of the inside at a time (their work planes differ)"));
+    }
+    if let Some(other) = args.study.iter().find(|s| !STUDIES.contains(&s.as_str())) {
+        return Err(Error::argument("study", format!("'{other}' is not a study of the inside (known: {})", STUDIES.join(", "))));
+    }
+    if args.engine != "auto" && args.engine != "exact" {
+        return Err(Error::argument(
+            "engine",
+            "the inside is mapped by the exact engine's rays only (free planes are no geometry to draw)",
+        ));
+    }
+    if args.study.iter().any(|s| s == "bre-nsl") {
+        if args.period.is_some() || args.at.is_some() {
+            return Err(Error::argument("study", "bre-nsl is geometry (which points see sky); drop --period and --at"));
+        }
+        return Ok(Ask::Nsl);
+    }
+    if !args.study.is_empty() {
+        if args.epw.is_none() {
+            return Err(Error::argument("study", "leed-ase needs --epw (direct normal illuminance, or irradiance)"));
+        }
+        if args.period.is_some() || args.step.is_some() || args.from.is_some() || args.to.is_some() {
+            return Err(Error::argument("study", "leed-ase is the year at hourly steps; drop --period, --step, --from and --to"));
+        }
+        return Ok(Ask::Ase);
+    }
+    let plan = args.plan()?;
+    Ok(if plan.instant { Ask::At(plan.period) } else { Ask::Period(plan.period) })
+}
+
+pub(super) fn map_inside(args: MapArgs) -> Result<()> {
+    let ask = ask(&args)?;
+    if let Some(g) = args.grid
+        && !(g.is_finite() && g > 0.0)
+    {
+        return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
+    }
+    let (location, weather) = match (&args.epw, &args.location) {
+        (Some(epw), _) => {
+            let weather = Weather::from_epw(epw)?;
+            (weather.location.clone(), Some(weather))
+        }
+        (None, Some(text)) => (Location::parse(text)?, None),
+        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+    };
+    check_writable(&args.output)?;
+    if let Some(glb) = &args.glb_out {
+        check_writable(glb)?;
+    }
+    let loaded = args.model.load_all(false)?;
+    let Some(ep) = loaded.energyplus.as_ref().filter(|_| args.model.models.len() == 1) else {
+        return Err(Error::argument("inside", "maps the zones of one EnergyPlus model (IDF or epJSON), given alone"));
+    };
+    let mut scene = inside_scene(ep)?;
+    let rooms = rooms(ep, args.glass_transmittance)?;
+    let (default_spacing, default_height) = match ask {
+        Ask::Ase => (ASE_SPACING, WORK_PLANE_HEIGHT),
+        Ask::Nsl => (0.5, NSL_WORK_PLANE),
+        _ => (0.5, 0.0),
+    };
+    let at = match &args.points {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+            rooms_map::room_points_csv(&mut scene, &rooms, &path.display().to_string(), &text)?
+        }
+        None => {
+            let spacing = args.grid.unwrap_or(default_spacing);
+            let height = args.work_plane.unwrap_or(default_height);
+            rooms_map::floor_grid(&mut scene, &rooms, spacing, height)?
+        }
+    };
+    let start = Instant::now();
+    let mapper = Mapper::new(&scene, &at.points)?;
+    let calendar = LeafCalendar::for_latitude(location.latitude);
+    let site = Site { location: &location, calendar: &calendar, weather: weather.as_ref(), sky: None };
+    let mut summary = json!({});
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let (csv, glb) = match ask {
+        Ask::At(period) => instant(&scene, &rooms, &mapper, &at, &period, &location, &calendar, &mut summary),
+        Ask::Period(period) => {
+            let samples = period.samples();
+            let values = rooms_map::accumulate(&mapper, &rooms, &at, &samples, site, &mut |_, _| {});
+            summary["instants"] = json!(values.instants);
+            summary["efficacy_hours"] = json!(values.efficacy_hours);
+            let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
+            if let (Some(b), Some(l)) = (&values.beam_kwh_m2, &values.direct_klux_h) {
+                columns.push(Column { name: "beam_kwh_m2", values: b, decimals: 4 });
+                columns.push(Column { name: "direct_klux_h", values: l, decimals: 4 });
+            }
+            let csv = points_csv(&scene, &at.points, &columns);
+            let glb = values.beam_kwh_m2.clone().map_or(("sun_hours", "h", values.sun_hours.clone()), |b| ("beam_kwh_m2", "kWh/m²", b));
+            (csv, glb)
+        }
+        Ask::Ase => {
+            let samples = rooms_map::occupied_hours(&Period::annual(1)?.samples());
+            let result = rooms_map::leed_ase(&mapper, &rooms, &at, &samples, site, &mut |_, _| {})?;
+            let report = ase_report(&args, &location, &result, &at);
+            summary["studies"] = json!([{"study": "leed-ase", "areas": report["areas"].clone()}]);
+            files.push((args.study_path("leed-ase", "json"), format!("{report:#}\n").into_bytes()));
+            let columns = [Column { name: "hours_over_1000_lux", values: &result.hours, decimals: 1 }];
+            (points_csv(&scene, &at.points, &columns), ("hours_over_1000_lux", "h", result.hours.clone()))
+        }
+        Ask::Nsl => {
+            let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;
+            let (sees, areas) = rooms_map::no_sky_line(&mapper, &rooms, &at, &patches, &mut |_, _| {});
+            let areas: Vec<Value> =
+                areas.iter().map(|a| json!({"zone": a.zone, "points": a.points, "sees_sky": round(a.sees_sky, 3)})).collect();
+            let report = json!({
+                "study": "bre-nsl",
+                "source": "BRE 209 (3rd ed., 2022), the No-Sky Line: the share of a room's working plane that can see sky (a point sees sky when one of its sky sub-patch directions is clear)",
+                "work_plane_m": args.work_plane.unwrap_or(NSL_WORK_PLANE),
+                "sky_patches": patches.name(),
+                "inputs": {"models": args.model.models},
+                "areas": areas,
+            });
+            summary["studies"] = json!([{"study": "bre-nsl", "areas": report["areas"].clone()}]);
+            files.push((args.study_path("bre-nsl", "json"), format!("{report:#}\n").into_bytes()));
+            let sees: Vec<f64> = sees.iter().map(|&s| f64::from(u8::from(s))).collect();
+            (points_csv(&scene, &at.points, &[Column { name: "sees_sky", values: &sees, decimals: 0 }]), ("sees_sky", "", sees.clone()))
+        }
+    };
+    files.insert(0, (args.output.clone(), csv.into_bytes()));
+    if let Some(path) = &args.glb_out {
+        files.push((path.clone(), map_glb(&scene, &at.points, &glb.2, glb.0, glb.1)));
+    }
+    for (path, bytes) in &files {
+        write_atomic(path, bytes)?;
+    }
+    summary["points"] = json!(at.points.len());
+    summary["rooms"] = json!(rooms.rooms.len());
+    summary["seconds"] = json!(round(start.elapsed().as_secs_f64(), 3));
+    summary["engine"] = json!({"exact_rays": at.points.len(), "gpu_masks": 0});
+    summary["written"] = json!(files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>());
+    if args.json {
+        println!("{summary:#}");
+    } else {
+        eprintln!("{} points in {} rooms → {}", at.points.len(), rooms.rooms.len(), args.output.display());
+    }
+    Ok(())
+}
+
+/// One instant: the points' `lit` and glass weights, and each inside face's sun patch.
+#[allow(clippy::too_many_arguments)]
+fn instant(
+    scene: &Scene,
+    rooms: &Rooms,
+    mapper: &Mapper,
+    at: &RoomPoints,
+    period: &Period,
+    location: &Location,
+    calendar: &LeafCalendar,
+    summary: &mut Value,
+) -> (String, (&'static str, &'static str, Vec<f64>)) {
+    let s = period.samples()[0];
+    let sun = sunlit::sun::position::sun_direction(location, sunlit::year::annual::shading_sun_day(s.day), s.hour);
+    let leaves = calendar.fraction(f64::from(s.day)) as f32;
+    let values = rooms_map::instant(mapper, rooms, at, sun, leaves);
+    let columns = [
+        Column { name: "lit", values: &values.lit, decimals: 0 },
+        Column { name: "solar_transmittance", values: &values.solar_transmittance, decimals: 4 },
+        Column { name: "visible_transmittance", values: &values.visible_transmittance, decimals: 4 },
+    ];
+    let up = sun.z >= sunlit::count::MIN_COS_INCIDENCE;
+    let patches = if up { rooms_map::sun_patches(scene, rooms, sun, leaves) } else { Vec::new() };
+    summary["sun_up"] = json!(up);
+    summary["lit_points"] = json!(values.lit.iter().filter(|&&v| v >= 0.5).count());
+    summary["sun_patches"] = json!(
+        patches
+            .iter()
+            .map(|p| json!({"surface": p.surface, "zone": p.zone, "area_m2": round(p.area_m2, 6), "fraction": round(p.fraction, 6)}))
+            .collect::<Vec<_>>()
+    );
+    (points_csv(scene, &at.points, &columns), ("lit", "", values.lit.clone()))
+}
+
+/// `POINTS.study-leed-ase.json`: the rule, its inputs and per room `zone`, `points` and `ase` (%).
+fn ase_report(args: &MapArgs, location: &Location, result: &rooms_map::AseResult, at: &RoomPoints) -> Value {
+    json!({
+        "study": "leed-ase",
+        "source": format!(
+            "LEED v4.1 Annual Sunlight Exposure, IES LM-83-12 ASE{ASE_LUX:.0},{ASE_HOURS:.0}: share of the work plane with more than {ASE_HOURS:.0} occupied hours above {ASE_LUX:.0} lux of direct sun (blinds ignored)"
+        ),
+        "occupied": format!("{:02}:00-{:02}:00 local standard time, every day; no daylight saving shift", OCCUPIED.0 as u32, OCCUPIED.1 as u32),
+        "occupied_hours": result.occupied,
+        "illuminance": format!("EPW direct normal illuminance (field 18) × visible transmittance × cos incidence; {BEAM_EFFICACY} lm/W × direct normal irradiance for hours without it"),
+        "efficacy_hours": result.efficacy_hours,
+        "inputs": {
+            "models": args.model.models,
+            "points": args.points.as_ref().map_or(
+                json!({"grid_spacing_m": args.grid.unwrap_or(ASE_SPACING), "work_plane_m": args.work_plane.unwrap_or(WORK_PLANE_HEIGHT)}),
+                |p| json!({"file": p})
+            ),
+            "site": {"latitude": location.latitude, "longitude": location.longitude, "time_zone": location.time_zone},
+        },
+        "areas": result.areas.iter().map(|a| json!({"zone": a.zone, "points": a.points, "ase": round(a.ase, 3)})).collect::<Vec<_>>(),
+        "point_count": at.points.len(),
+    })
+}

@@ -1,0 +1,457 @@
+//! The sun inside rooms: points on the inside faces of a model's zones or free in them (a work
+//! plane), the beam through the windows, sun patches at an instant, sums over a period, LEED
+//! v4.1's Annual Sunlight Exposure and BRE 209's No-Sky Line.
+//!
+//! A view through a window is a request to the same engines: the scene is the building with its
+//! glazing left out ([`crate::model::inside::inside_scene`]), so an opening is a hole in its wall
+//! and the exact engine's shadow rays decide, as outside, whether a point sees the sun; walls,
+//! frames, doors, overhangs stay opaque. The glass then weights the beam: a lit point's ray
+//! leaves its room through one of the room's openings, and the beam is multiplied by the
+//! transmittance of each opening of the room the ray crosses ([`crate::model::inside::Glazing`]).
+//! `lit` stays geometry (lit through glass is lit); the weights are separate values.
+//!
+//! Free points (not on an inside face) get a plane of their own: a receiver that is no geometry
+//! (no triangle carries its id, so it casts nothing and the GPU cannot draw it), through the
+//! points with their normal. The work plane of a floor is that floor's inside face raised by the
+//! height. A shadow ray from a point needs only what lies in front of its plane, which is what
+//! the engine clips to.
+//!
+//! Illuminance of the direct sun on a point: the EPW's direct normal illuminance (field 18) ×
+//! visible transmittance × cos incidence × visibility, or, for an hour without it, the direct
+//! normal irradiance × [`BEAM_EFFICACY`].
+
+use glam::{DVec2, DVec3};
+
+use super::points::{csv_rows, receiver_under};
+use super::{Mapper, Points, Sample, Site, grid};
+use crate::count::ViewRequest;
+use crate::count::exact::engine::ExactEngine;
+use crate::error::{Error, Result};
+use crate::geometry::triangle_area;
+use crate::model::inside::Rooms;
+use crate::scene::{Receiver, ReceiverDraw, Scene};
+use crate::sun::weather::Weather;
+use crate::year::samples::Timesteps;
+
+/// IES LM-83-12's work plane height (m): 30 in above the floor.
+pub const WORK_PLANE_HEIGHT: f64 = 0.76;
+/// IES LM-83-12's grid spacing (m): 2 ft.
+pub const ASE_SPACING: f64 = 0.6;
+/// ASE's direct-sun illuminance threshold (lux): a point counts an hour above it.
+pub const ASE_LUX: f64 = 1000.0;
+/// ASE's hours: a point is sunlit when it gets more than this many hours above [`ASE_LUX`].
+pub const ASE_HOURS: f64 = 250.0;
+/// Occupied hours for ASE, local standard time (LM-83: 08:00–18:00 local clock time; no
+/// daylight saving shift is applied, see docs/maps.md).
+pub const OCCUPIED: (f64, f64) = (8.0, 18.0);
+/// Luminous efficacy of the direct beam (lm/W) for hours whose EPW gives no direct normal
+/// illuminance: a round mid-range value for clear-sky beam light.
+pub const BEAM_EFFICACY: f64 = 100.0;
+/// Free points of one room are one plane when their normals agree this closely (cosine)…
+const SAME_NORMAL: f64 = 1.0 - 1e-9;
+/// …and their heights along it within this (m).
+const SAME_PLANE: f64 = 1e-6;
+/// A free plane's rectangle reaches this far (m) past its outermost points.
+const PLANE_MARGIN: f64 = 0.01;
+
+/// Map points inside rooms, and the room (index into [`Rooms::rooms`]) each lies in.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RoomPoints {
+    /// The points (their receivers: inside faces or free planes).
+    pub points: Points,
+    /// Per point, its room.
+    pub room: Vec<u32>,
+}
+
+/// A grid at `spacing` on every room's floors, `height` m above them (0: on the floor's inside
+/// face). A raised grid lies on a plane of its own per floor, named `FLOOR:work-plane`, added to
+/// `scene`. Refuses a room without a floor, naming its zone.
+pub fn floor_grid(scene: &mut Scene, rooms: &Rooms, spacing: f64, height: f64) -> Result<RoomPoints> {
+    if !(height.is_finite() && height >= 0.0) {
+        return Err(Error::argument("work_plane", format!("{height} m: a work plane height must be 0 or more metres")));
+    }
+    let mut out = RoomPoints::default();
+    for (k, room) in rooms.rooms.iter().enumerate() {
+        if room.floors.is_empty() {
+            return Err(Error::argument("rooms", format!("zone '{}' has no floor to put a grid on", room.name)));
+        }
+        for floor in &room.floors {
+            let (id, r) = scene.receiver(floor).ok_or_else(|| Error::argument("rooms", format!("'{floor}' is not a receiver")))?;
+            let id = if height > 0.0 {
+                let raised = r.triangles.iter().map(|t| t.map(|p| p + DVec3::Z * height)).collect();
+                let (name, origin, normal) = (format!("{}:work-plane", r.name.trim_end_matches(":inside")), r.origin.clone(), r.normal);
+                add_plane(scene, name, origin, raised, normal)
+            } else {
+                id
+            };
+            let mut points = grid(scene, spacing, &[id])?;
+            out.room.extend(std::iter::repeat_n(k as u32, points.len()));
+            append(&mut out.points, &mut points);
+            out.points.spacing = Some(spacing);
+        }
+    }
+    Ok(out)
+}
+
+/// Points from a CSV (`x,y,z,nx,ny,nz`, as [`super::from_csv`] reads): a point on a room's
+/// inside face (within [`super::points::ON_SURFACE_TOLERANCE`], facing its way) belongs to that
+/// face, any other to the room it lies in, on a plane of its own shared with the room's other
+/// free points in the same plane. Refuses a point in no room, naming file and line.
+pub fn room_points_csv(scene: &mut Scene, rooms: &Rooms, file_label: &str, text: &str) -> Result<RoomPoints> {
+    let inside: Vec<(u32, u32)> = rooms
+        .rooms
+        .iter()
+        .enumerate()
+        .flat_map(|(k, room)| room.inside.iter().map(move |name| (k as u32, name)))
+        .filter_map(|(k, name)| scene.receiver(name).map(|(id, _)| (id, k)))
+        .collect();
+    let ids: Vec<u32> = inside.iter().map(|(id, _)| *id).collect();
+    let mut out = RoomPoints::default();
+    // Free points: (room, normal, height along it, [(index in out, position)]).
+    let mut free: Vec<(u32, DVec3, f64, Vec<usize>)> = Vec::new();
+    for (line, p, n) in csv_rows(file_label, text)? {
+        if let Some(id) = receiver_under(scene, &ids, p, n) {
+            let room = inside.iter().find(|(r, _)| *r == id).map_or(0, |(_, k)| *k);
+            out.points.push(p, n, id);
+            out.room.push(room);
+            continue;
+        }
+        let Some(room) = rooms.rooms.iter().position(|r| r.contains(p)) else {
+            return Err(Error::object(file_label, format!("line {line}"), format!("point ({}, {}, {}) lies in no zone", p.x, p.y, p.z)));
+        };
+        let (room, h) = (room as u32, n.dot(p));
+        let i = out.points.len();
+        out.points.push(p, n, u32::MAX);
+        out.room.push(room);
+        match free.iter_mut().find(|(r, m, g, _)| *r == room && m.dot(n) >= SAME_NORMAL && (g - h).abs() <= SAME_PLANE) {
+            Some((_, _, _, members)) => members.push(i),
+            None => free.push((room, n, h, vec![i])),
+        }
+    }
+    for (k, (room, normal, _, members)) in free.into_iter().enumerate() {
+        let at: Vec<DVec3> = members.iter().map(|&i| out.points.position(i)).collect();
+        let name = format!("{} free plane {}", rooms.rooms[room as usize].name, k + 1);
+        let id = add_plane(scene, name, format!("{file_label}: free points"), rectangle_around(&at, normal), normal);
+        for i in members {
+            out.points.receivers[i] = id;
+        }
+    }
+    Ok(out)
+}
+
+/// Two triangles covering `points` (in the plane through them with `normal`), with a margin.
+fn rectangle_around(points: &[DVec3], normal: DVec3) -> Vec<[DVec3; 3]> {
+    let (e1, e2) = (normal.any_orthonormal_vector(), normal.cross(normal.any_orthonormal_vector()));
+    let origin = points[0];
+    let flat = |p: &DVec3| DVec2::new((*p - origin).dot(e1), (*p - origin).dot(e2));
+    let (lo, hi) = points.iter().map(flat).fold((DVec2::MAX, DVec2::MIN), |(lo, hi), q| (lo.min(q), hi.max(q)));
+    let (lo, hi) = (lo - DVec2::splat(PLANE_MARGIN), hi + DVec2::splat(PLANE_MARGIN));
+    let at = |u: f64, v: f64| origin + e1 * u + e2 * v;
+    let (a, b, c, d) = (at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y));
+    // Counter-clockwise about `normal` (e1 × e2 = normal).
+    vec![[a, b, c], [a, c, d]]
+}
+
+/// Adds a receiver that is no geometry (see the module doc); returns its id.
+fn add_plane(scene: &mut Scene, name: String, origin: String, triangles: Vec<[DVec3; 3]>, normal: DVec3) -> u32 {
+    let id = scene.receivers.len() as u32;
+    let area = triangles.iter().map(triangle_area).sum();
+    scene.receivers.push(Receiver { name, origin, triangles, normal, area, draw: ReceiverDraw { instance: 0, indices: 0..0 }, gpu_id: id });
+    id
+}
+
+fn append(into: &mut Points, from: &mut Points) {
+    into.positions.append(&mut from.positions);
+    into.normals.append(&mut from.normals);
+    into.receivers.append(&mut from.receivers);
+}
+
+/// Per point, the glass between it and the sun: the product of the transmittances (solar,
+/// visible) of its room's openings its ray to the sun crosses.
+pub fn through_glass(rooms: &Rooms, room: u32, p: DVec3, sun: DVec3) -> (f64, f64) {
+    let Some(room) = rooms.rooms.get(room as usize) else { return (1.0, 1.0) };
+    room.glazing
+        .iter()
+        .map(|&g| &rooms.glazing[g])
+        .filter(|g| g.crossed_by(p, sun))
+        .fold((1.0, 1.0), |(s, v), g| (s * g.solar, v * g.visible))
+}
+
+/// One instant inside: per point its geometric visibility (`lit`: 1 lit, also through glass; 0
+/// shaded) and the glass's weights on it (solar, visible; 0 where shaded).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InsideInstant {
+    /// 1 lit, 0 shaded (visibility ≥ 0.5, as outside).
+    pub lit: Vec<f64>,
+    /// Solar transmittance of the glass the beam came through (1 with no glass); 0 shaded.
+    pub solar_transmittance: Vec<f64>,
+    /// Visible transmittance likewise.
+    pub visible_transmittance: Vec<f64>,
+}
+
+/// The points' lit state and glass weights for the sun along `sun` at leaf fraction `leaves`.
+pub fn instant(mapper: &Mapper, rooms: &Rooms, at: &RoomPoints, sun: DVec3, leaves: f32) -> InsideInstant {
+    let visibility = mapper.visibility(sun, leaves);
+    let mut out = InsideInstant::default();
+    for (i, v) in visibility.into_iter().enumerate() {
+        let lit = v >= 0.5;
+        let (s, t) = if lit { through_glass(rooms, at.room[i], at.points.position(i), sun) } else { (0.0, 0.0) };
+        out.lit.push(f64::from(u8::from(lit)));
+        out.solar_transmittance.push(s * f64::from(v));
+        out.visible_transmittance.push(t * f64::from(v));
+    }
+    out
+}
+
+/// One inside face's sun patch at an instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Patch {
+    /// The inside face (`NAME:inside`).
+    pub surface: String,
+    /// Its zone.
+    pub zone: String,
+    /// Sunlit area (m²), geometry (the glass's weight not applied), by the exact engine.
+    pub area_m2: f64,
+    /// Sunlit fraction of the face's net area.
+    pub fraction: f64,
+}
+
+/// The sun patch on every inside face of every room (those with a patch), by the exact engine's
+/// clipping (the same request as a sunlit fraction outside, the receiver an inside face).
+pub fn sun_patches(scene: &Scene, rooms: &Rooms, sun: DVec3, leaves: f32) -> Vec<Patch> {
+    let faces: Vec<(u32, &str)> = rooms
+        .rooms
+        .iter()
+        .flat_map(|room| room.inside.iter().map(move |face| (face, room.name.as_str())))
+        .filter_map(|(face, zone)| scene.receiver(face).map(|(id, _)| (id, zone)))
+        .collect();
+    let requests: Vec<ViewRequest> = faces.iter().map(|&(receiver, _)| ViewRequest { receiver, sun, leaves }).collect();
+    let fractions = ExactEngine::new(scene).fractions(&requests);
+    faces
+        .iter()
+        .zip(fractions)
+        .filter(|(_, f)| *f > 0.0)
+        .map(|(&(id, zone), fraction)| {
+            let r = &scene.receivers[id as usize];
+            Patch { surface: r.name.clone(), zone: zone.to_string(), area_m2: fraction * r.area, fraction }
+        })
+        .collect()
+}
+
+/// Per point sums inside over a period.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InsideValues {
+    /// Hours the sun is seen (geometry: through glass counts in full).
+    pub sun_hours: Vec<f64>,
+    /// Beam irradiation through the glass (kWh/m²): DNI · cos incidence · solar transmittance.
+    pub beam_kwh_m2: Option<Vec<f64>>,
+    /// Direct-sun illuminance summed over time (klux·h): see the module doc.
+    pub direct_klux_h: Option<Vec<f64>>,
+    /// Instants in the period.
+    pub instants: usize,
+    /// Sun-up hours whose EPW had no direct normal illuminance ([`BEAM_EFFICACY`] used).
+    pub efficacy_hours: usize,
+}
+
+/// The direct beam at an instant: DNI (W/m²) and direct normal illuminance (lux), the latter
+/// from [`BEAM_EFFICACY`] when the EPW has none.
+fn beam(weather: &Weather, s: &Sample) -> (f64, f64) {
+    let dni = Timesteps::new(1).map_or(0.0, |t| weather.at(t, s.epw_hour).dni);
+    match weather.direct_normal_illuminance(s.epw_hour) {
+        Some(lux) => (dni, lux),
+        None => (dni, dni * BEAM_EFFICACY),
+    }
+}
+
+/// Instants of `samples` whose EPW hour has no direct normal illuminance.
+fn efficacy_hours(weather: &Weather, samples: &[Sample]) -> usize {
+    samples.iter().filter(|s| weather.direct_normal_illuminance(s.epw_hour).is_none()).count()
+}
+
+/// Sun hours, and with weather the beam irradiation and direct-sun illuminance through the
+/// glass, per point over `samples`.
+pub fn accumulate(
+    mapper: &Mapper,
+    rooms: &Rooms,
+    at: &RoomPoints,
+    samples: &[Sample],
+    site: Site<'_>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> InsideValues {
+    let n = at.points.len();
+    let weather = site.weather;
+    let parts = mapper.sweep(
+        samples,
+        site,
+        false,
+        progress,
+        || (vec![0.0; n], vec![0.0; n], vec![0.0; n]),
+        |(hours, beam_sum, lux_sum), _, s, sun, g, vis| {
+            let light = weather.map(|w| beam(w, s));
+            for (&i, &v) in g.members.iter().zip(vis).filter(|(_, v)| **v > 0.0) {
+                let i = i as usize;
+                hours[i] += f64::from(v) * s.hours;
+                if let Some((dni, lux)) = light {
+                    let (ts, tv) = through_glass(rooms, at.room[i], at.points.position(i), sun);
+                    let cos = mapper.normals[i].dot(sun).max(0.0) * f64::from(v) * s.hours;
+                    beam_sum[i] += dni * cos * ts / 1000.0;
+                    lux_sum[i] += lux * cos * tv / 1000.0;
+                }
+            }
+        },
+    );
+    let mut out = InsideValues {
+        sun_hours: vec![0.0; n],
+        beam_kwh_m2: weather.map(|_| vec![0.0; n]),
+        direct_klux_h: weather.map(|_| vec![0.0; n]),
+        instants: samples.len(),
+        efficacy_hours: 0,
+    };
+    for (hours, beam_sum, lux_sum) in parts {
+        super::add_into(&mut out.sun_hours, &hours);
+        if let (Some(b), Some(l)) = (out.beam_kwh_m2.as_mut(), out.direct_klux_h.as_mut()) {
+            super::add_into(b, &beam_sum);
+            super::add_into(l, &lux_sum);
+        }
+    }
+    out.efficacy_hours = weather.map_or(0, |w| efficacy_hours(w, samples));
+    out
+}
+
+/// One room's Annual Sunlight Exposure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AseArea {
+    /// The zone.
+    pub zone: String,
+    /// Its points.
+    pub points: usize,
+    /// Share of its points (so of its area: a grid's points stand for equal areas) with more
+    /// than [`ASE_HOURS`] occupied hours above [`ASE_LUX`] of direct sun, in %.
+    pub ase: f64,
+}
+
+/// ASE1000,250 over a year.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AseResult {
+    /// Per point, occupied hours above [`ASE_LUX`].
+    pub hours: Vec<f64>,
+    /// Per room with points, in the rooms' order.
+    pub areas: Vec<AseArea>,
+    /// Occupied instants counted (hourly: 3,650 in a 365-day year).
+    pub occupied: usize,
+    /// Occupied hours whose EPW had no direct normal illuminance ([`BEAM_EFFICACY`] used).
+    pub efficacy_hours: usize,
+}
+
+/// The year's occupied instants: EnergyPlus's hourly instants (mid-hour, local standard time)
+/// within [`OCCUPIED`].
+pub fn occupied_hours(samples: &[Sample]) -> Vec<Sample> {
+    samples.iter().filter(|s| s.hour >= OCCUPIED.0 && s.hour < OCCUPIED.1).copied().collect()
+}
+
+/// LEED v4.1's ASE1000,250 (IES LM-83-12) per room: per point, the occupied hours of `samples`
+/// (see [`occupied_hours`]) when its direct-sun illuminance through the glass (visible
+/// transmittance) exceeds [`ASE_LUX`]; per room the share of its points over [`ASE_HOURS`].
+/// Refuses a site without weather.
+pub fn leed_ase(
+    mapper: &Mapper,
+    rooms: &Rooms,
+    at: &RoomPoints,
+    samples: &[Sample],
+    site: Site<'_>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<AseResult> {
+    let Some(weather) = site.weather else {
+        return Err(Error::argument("weather", "LEED ASE needs a weather file: its direct normal illuminance"));
+    };
+    let n = at.points.len();
+    let parts = mapper.sweep(
+        samples,
+        site,
+        false,
+        progress,
+        || vec![0.0; n],
+        |over, _, s, sun, g, vis| {
+            let (_, lux) = beam(weather, s);
+            if lux <= ASE_LUX {
+                return;
+            }
+            for (&i, &v) in g.members.iter().zip(vis).filter(|(_, v)| **v > 0.0) {
+                let i = i as usize;
+                let cos = mapper.normals[i].dot(sun).max(0.0);
+                let (_, tv) = through_glass(rooms, at.room[i], at.points.position(i), sun);
+                if lux * cos * tv * f64::from(v) > ASE_LUX {
+                    over[i] += s.hours;
+                }
+            }
+        },
+    );
+    let mut hours = vec![0.0; n];
+    for part in parts {
+        super::add_into(&mut hours, &part);
+    }
+    let areas = rooms
+        .rooms
+        .iter()
+        .enumerate()
+        .filter_map(|(k, room)| {
+            let mine: Vec<f64> = at.room.iter().zip(&hours).filter(|(r, _)| **r == k as u32).map(|(_, h)| *h).collect();
+            let over = mine.iter().filter(|&&h| h > ASE_HOURS).count();
+            (!mine.is_empty()).then(|| AseArea {
+                zone: room.name.clone(),
+                points: mine.len(),
+                ase: 100.0 * over as f64 / mine.len() as f64,
+            })
+        })
+        .collect();
+    Ok(AseResult { hours, areas, occupied: samples.len(), efficacy_hours: efficacy_hours(weather, samples) })
+}
+
+/// BRE 209's working plane height in dwellings (m), where its No-Sky Line is drawn.
+pub const NSL_WORK_PLANE: f64 = 0.85;
+
+/// A point sees sky when its view factor to the visible sky exceeds this (a share of the sky
+/// hemisphere's, so a sliver of one sub-patch counts).
+const SEES_SKY: f64 = 1e-9;
+
+/// One room's No-Sky Line result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NslArea {
+    /// The zone.
+    pub zone: String,
+    /// Its points.
+    pub points: usize,
+    /// Share of its points that see sky (in front of the No-Sky Line), in %.
+    pub sees_sky: f64,
+}
+
+/// BRE 209's No-Sky Line per room: which points see any of the sky through the openings, by
+/// each point's own sky views ([`super::point_sky`]: every sky patch cut into 6 × 6 sub-patches,
+/// each asked along its own direction, so a point sees sky when one sub-patch direction is clear;
+/// a point within a sub-patch's width of the line may be put on its wrong side). Glass does not
+/// matter: a point behind a window sees the sky it sees. Foliage counts in full leaf.
+pub fn no_sky_line(
+    mapper: &Mapper,
+    rooms: &Rooms,
+    at: &RoomPoints,
+    patches: &crate::sky::patches::SkyPatches,
+    progress: &mut dyn FnMut(usize, usize),
+) -> (Vec<bool>, Vec<NslArea>) {
+    let sky = super::point_sky(mapper, patches, progress);
+    let sees: Vec<bool> = (0..at.points.len()).map(|i| sky.isotropic(i, 1.0) > SEES_SKY).collect();
+    let areas = rooms
+        .rooms
+        .iter()
+        .enumerate()
+        .filter_map(|(k, room)| {
+            let mine: Vec<bool> = at.room.iter().zip(&sees).filter(|(r, _)| **r == k as u32).map(|(_, s)| *s).collect();
+            let seeing = mine.iter().filter(|&&s| s).count();
+            (!mine.is_empty()).then(|| NslArea {
+                zone: room.name.clone(),
+                points: mine.len(),
+                sees_sky: 100.0 * seeing as f64 / mine.len() as f64,
+            })
+        })
+        .collect();
+    (sees, areas)
+}

@@ -1,0 +1,245 @@
+//! The rooms of an EnergyPlus model, for the sun inside: each zone with the inside faces of its
+//! surfaces, and its windows as openings with glass.
+//!
+//! Owns what the model says about the inside: which zone a surface bounds, which openings are
+//! glazing (windows and glass doors; a door is opaque), and the glass's normal-incidence
+//! transmittances, solar and visible. A window's construction of one
+//! `WindowMaterial:SimpleGlazingSystem` layer gives them: visible from its Visible Transmittance
+//! field (the solar value where it is blank), solar from its U-factor and SHGC by EnergyPlus's
+//! simple glazing correlation (Engineering Reference, "Simple Window Model", step 4: one formula
+//! for U > 4.5 W/m²K, one for U < 3.4, linear in U between). Any other construction takes the
+//! caller's `glass` value for both. EnergyPlus's angular dependence of the simple glazing model
+//! (its curves A–J chosen by U and SHGC) is not applied: the glass lets its normal-incidence
+//! value through at every angle.
+//!
+//! The scene ([`inside_scene`]) is the building's surfaces with the glazing left out, so an
+//! opening is a hole in its wall: the engines see the beam pass and the map weights it by the
+//! glass ([`Rooms`]); walls, frames and doors stay opaque.
+
+use glam::{DVec2, DVec3};
+
+use super::EnergyPlusInput;
+use super::building::{EpSurface, inside_name};
+use crate::error::{Error, Result};
+use crate::geometry::{Plane, inside_or_on, newell, triangulate};
+use crate::scene::{Scene, SceneBuilder};
+
+/// A ray within this distance (m) of an opening's outline crosses it: the engine counts a point
+/// whose ray grazes an edge as lit, and map points are f32 (about 1e-5 m at 100 m).
+const CROSSING_TOLERANCE: f64 = 1e-4;
+
+/// An opening with glass, in world coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Glazing {
+    /// The EnergyPlus name.
+    pub name: String,
+    /// The zone it lets the sun into (its base surface's).
+    pub zone: String,
+    /// Its outline (counter-clockwise seen from outside).
+    pub vertices: Vec<DVec3>,
+    /// Its plane, for ray crossings.
+    pub plane: Plane,
+    /// Its outline in `plane`'s coordinates.
+    pub outline: Vec<DVec2>,
+    /// Solar transmittance at normal incidence (beam irradiation).
+    pub solar: f64,
+    /// Visible transmittance at normal incidence (illuminance).
+    pub visible: f64,
+    /// Its base surface's other side is another zone (Outside Boundary Condition Surface or Zone).
+    pub interzone: bool,
+}
+
+impl Glazing {
+    /// Whether the ray from `p` along `dir` crosses this opening (ahead of `p`).
+    pub fn crossed_by(&self, p: DVec3, dir: DVec3) -> bool {
+        let across = self.plane.normal.dot(dir);
+        if across.abs() < 1e-12 {
+            return false;
+        }
+        let t = self.plane.normal.dot(self.plane.origin - p) / across;
+        t > 0.0 && inside_or_on(self.plane.project(p + dir * t), &self.outline, CROSSING_TOLERANCE)
+    }
+}
+
+/// One zone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Room {
+    /// The zone's name, upper case as EnergyPlus reports it.
+    pub name: String,
+    /// Receiver names of its surfaces' inside faces (`NAME:inside`).
+    pub inside: Vec<String>,
+    /// Those of its floors.
+    pub floors: Vec<String>,
+    /// Indices into [`Rooms::glazing`] of its openings with glass.
+    pub glazing: Vec<usize>,
+    /// Its boundary as triangles, openings filled: which points lie in it.
+    shell: Vec<[DVec3; 3]>,
+}
+
+impl Room {
+    /// Whether `p` lies inside the zone's boundary (a ray's crossings counted; a point on the
+    /// boundary may go either way).
+    pub fn contains(&self, p: DVec3) -> bool {
+        // An irrational-looking direction, so the ray does not graze edges of axis-aligned rooms.
+        let dir = DVec3::new(0.5773, 0.5879, 0.5664).normalize();
+        self.shell.iter().filter(|t| ray_hits_triangle(p, dir, t)).count() % 2 == 1
+    }
+}
+
+/// The zones and openings of a model.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Rooms {
+    /// Zones in the order their first surface is written.
+    pub rooms: Vec<Room>,
+    /// Every window and glass door.
+    pub glazing: Vec<Glazing>,
+}
+
+/// The building's surfaces with glazing left out and every zone surface's inside face a
+/// receiver (`NAME:inside`): see [`super::building::Building::add_inside_to`].
+pub fn inside_scene(input: &EnergyPlusInput) -> Result<Scene> {
+    let mut builder = SceneBuilder::new();
+    input.building.add_inside_to(&mut builder)?;
+    builder.build()
+}
+
+/// The model's zones and openings. `glass` is the transmittance of glazing whose construction
+/// gives none (see the module doc); refused outside 0..=1, and needed only when such glazing
+/// exists (the error names the window).
+pub fn rooms(input: &EnergyPlusInput, glass: Option<f64>) -> Result<Rooms> {
+    if let Some(t) = glass
+        && !(0.0..=1.0).contains(&t)
+    {
+        return Err(Error::argument("glass_transmittance", format!("{t} is outside 0..=1")));
+    }
+    let surfaces = &input.building.surfaces;
+    let mut rooms: Vec<Room> = Vec::new();
+    for zone in surfaces.iter().filter(|s| !s.is_fenestration()).filter_map(|s| s.zone.as_ref()) {
+        if !rooms.iter().any(|r| r.name == *zone) {
+            rooms.push(Room { name: zone.clone(), inside: Vec::new(), floors: Vec::new(), glazing: Vec::new(), shell: Vec::new() });
+        }
+    }
+    let mut glazing = Vec::new();
+    for s in surfaces {
+        let Some(room) = s.zone.as_ref().and_then(|z| rooms.iter_mut().find(|r| r.name == *z)) else { continue };
+        if s.is_glazing() {
+            room.glazing.push(glazing.len());
+            glazing.push(glazing_of(input, s, glass)?);
+            continue;
+        }
+        room.inside.push(inside_name(&s.name));
+        if s.kind.eq_ignore_ascii_case("Floor") {
+            room.floors.push(inside_name(&s.name));
+        }
+        // Openings are cut from their walls but fill them again here: the shell is closed.
+        if !s.is_fenestration() {
+            room.shell.extend(fan(&s.vertices));
+        }
+    }
+    Ok(Rooms { rooms, glazing })
+}
+
+/// A polygon's triangles (ear clipping in its plane).
+fn fan(vertices: &[DVec3]) -> Vec<[DVec3; 3]> {
+    let plane = Plane::of_polygon(vertices);
+    triangulate(&plane, vertices, &[]).into_iter().map(|t| t.map(|i| vertices[i])).collect()
+}
+
+/// Möller–Trumbore: whether the ray from `p` along `dir` crosses triangle `t` ahead of `p`.
+fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3]) -> bool {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let h = dir.cross(e2);
+    let a = e1.dot(h);
+    if a.abs() < 1e-12 {
+        return false;
+    }
+    let s = p - t[0];
+    let u = s.dot(h) / a;
+    let q = s.cross(e1);
+    let v = dir.dot(q) / a;
+    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && e2.dot(q) / a > 0.0
+}
+
+fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Result<Glazing> {
+    let (solar, visible) = match simple_glazing(input, s)? {
+        Some(t) => t,
+        None => {
+            let Some(t) = glass else {
+                return Err(Error::object(
+                    &input.file,
+                    s.label(),
+                    "has no WindowMaterial:SimpleGlazingSystem construction to take a transmittance from: give a glass transmittance",
+                ));
+            };
+            (t, t)
+        }
+    };
+    let interzone = input
+        .building
+        .surface(s.base.as_deref().unwrap_or_default())
+        .is_some_and(|b| b.outside_boundary.eq_ignore_ascii_case("Surface") || b.outside_boundary.eq_ignore_ascii_case("Zone"));
+    let plane = Plane::through(s.vertices[0], newell(&s.vertices));
+    let outline = s.vertices.iter().map(|&p| plane.project(p)).collect();
+    Ok(Glazing {
+        name: s.name.clone(),
+        zone: s.zone.clone().unwrap_or_default(),
+        vertices: s.vertices.clone(),
+        plane,
+        outline,
+        solar,
+        visible,
+        interzone,
+    })
+}
+
+/// (solar, visible) normal-incidence transmittance from a window's construction, when it is one
+/// `WindowMaterial:SimpleGlazingSystem` layer; refuses values outside 0..=1, naming the material.
+fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64, f64)>> {
+    let Some(object) = input.objects.iter().find(|o| o.is(&s.class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(&s.name))) else {
+        return Ok(None);
+    };
+    // Construction Name: field 3 of FenestrationSurface:Detailed, field 2 of Window and GlazedDoor.
+    let field = if object.is("FenestrationSurface:Detailed") { 2 } else { 1 };
+    let named = |class: &str, name: &str| {
+        input.objects.iter().find(|o| o.is(class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(name.trim())))
+    };
+    let Some(construction) = named("Construction", object.field(field)) else { return Ok(None) };
+    let layers: Vec<&str> = (1..).map(|i| construction.field(i)).take_while(|f| !f.trim().is_empty()).collect();
+    let [layer] = layers.as_slice() else { return Ok(None) };
+    let Some(material) = named("WindowMaterial:SimpleGlazingSystem", layer) else { return Ok(None) };
+    let value = |i: usize, what: &str| -> Result<Option<f64>> {
+        let text = material.field(i).trim();
+        if text.is_empty() {
+            return Ok(None);
+        }
+        text.parse::<f64>().map(Some).map_err(|_| Error::object(&input.file, material.label(), format!("{what} '{text}' is not a number")))
+    };
+    let in_unit = |v: f64, what: &str| -> Result<f64> {
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err(Error::object(&input.file, material.label(), format!("{what} {v} is outside 0..=1")))
+        }
+    };
+    let u = value(1, "U-Factor")?.unwrap_or(0.0);
+    let shgc = in_unit(value(2, "Solar Heat Gain Coefficient")?.unwrap_or(0.0), "Solar Heat Gain Coefficient")?;
+    let solar = solar_transmittance(u, shgc).clamp(0.0, 1.0);
+    let visible = match value(3, "Visible Transmittance")? {
+        Some(v) => in_unit(v, "Visible Transmittance")?,
+        None => solar,
+    };
+    Ok(Some((solar, visible)))
+}
+
+/// EnergyPlus's simple glazing solar transmittance at normal incidence from U (W/m²K) and SHGC.
+pub fn solar_transmittance(u: f64, shgc: f64) -> f64 {
+    let high_u = if shgc < 0.7206 { 0.939998 * shgc * shgc + 0.20332 * shgc } else { 1.30415 * shgc - 0.30515 };
+    let low_u = if shgc <= 0.15 { 0.41040 * shgc } else { 0.085775 * shgc * shgc + 0.963954 * shgc - 0.084958 };
+    if u > 4.5 {
+        high_u
+    } else if u < 3.4 {
+        low_u
+    } else {
+        low_u + (high_u - low_u) * (u - 3.4) / (4.5 - 3.4)
+    }
+}

@@ -1,0 +1,278 @@
+//! The sun inside rooms (`sunlit::map::inside`, `map --inside`): a box room with one south window
+//! against the analytic sun patch, an independent numpy ray caster (points, and LEED ASE on the
+//! Golden EPW's hours), and the refusals.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+mod common;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use glam::DVec3;
+use serde_json::{Value, json};
+use sunlit::map::Mapper;
+use sunlit::map::inside::{self, RoomPoints};
+use sunlit::map::{Period, Site};
+use sunlit::model::inside::{Rooms, inside_scene, rooms};
+use sunlit::model::{self, LoadOptions};
+use sunlit::scene::Scene;
+use sunlit::sun::location::Location;
+use sunlit::sun::position::sun_direction;
+use sunlit::sun::weather::Weather;
+use sunlit::year::annual::shading_sun_day;
+use sunlit::year::season::LeafCalendar;
+
+/// Room 4 m (x) × 5 m (y) × 3 m, window x 1–3 m, z 1–2.5 m in the south wall (y = 0).
+const ROOM: [f64; 3] = [4.0, 5.0, 3.0];
+const WINDOW: [f64; 4] = [1.0, 3.0, 1.0, 2.5];
+/// Overhang x 0.5–3.5 m, 0.8 m deep, at z 2.7 m.
+const OVERHANG: [f64; 4] = [0.5, 3.5, 0.8, 2.7];
+const VT: f64 = 0.7;
+
+fn surface(name: &str, kind: &str, boundary: &str, corners: &[[f64; 3]]) -> String {
+    let v: Vec<String> = corners.iter().map(|c| format!("{},{},{}", c[0], c[1], c[2])).collect();
+    let sun = if boundary == "Outdoors" { "SunExposed,WindExposed" } else { "NoSun,NoWind" };
+    format!("BuildingSurface:Detailed,{name},{kind},Opaque,Office,,{boundary},,{sun},,{},{};\n", corners.len(), v.join(","))
+}
+
+/// The box room's IDF; `window` gives the window's corners (x0, x1, z0, z1) and `extra` more objects.
+fn room_idf(window: [f64; 4], overhang: bool, extra: &str) -> String {
+    let [w, d, h] = ROOM;
+    let [x0, x1, z0, z1] = window;
+    let mut idf = String::from(
+        "Version,25.2;\nBuilding,Box,0,Suburbs,0.04,0.4,FullInteriorAndExterior,25,6;\n\
+         GlobalGeometryRules,UpperLeftCorner,Counterclockwise,Relative;\nZone,Office,0,0,0,0;\n\
+         Construction,Opaque,Layer;\nConstruction,Glass,SimpleGlass;\n\
+         WindowMaterial:SimpleGlazingSystem,SimpleGlass,2.0,0.6,0.7;\n",
+    );
+    idf += &surface("South", "Wall", "Outdoors", &[[0.0, 0.0, h], [0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, 0.0, h]]);
+    idf += &surface("North", "Wall", "Outdoors", &[[w, d, h], [w, d, 0.0], [0.0, d, 0.0], [0.0, d, h]]);
+    idf += &surface("East", "Wall", "Outdoors", &[[w, 0.0, h], [w, 0.0, 0.0], [w, d, 0.0], [w, d, h]]);
+    idf += &surface("West", "Wall", "Outdoors", &[[0.0, d, h], [0.0, d, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, h]]);
+    idf += &surface("Floor", "Floor", "Ground", &[[w, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, d, 0.0], [w, d, 0.0]]);
+    idf += &surface("Roof", "Roof", "Outdoors", &[[0.0, 0.0, h], [w, 0.0, h], [w, d, h], [0.0, d, h]]);
+    idf += &format!("FenestrationSurface:Detailed,Win,Window,Glass,South,,,,1,4,{x0},0,{z1},{x0},0,{z0},{x1},0,{z0},{x1},0,{z1};\n");
+    if overhang {
+        let [ox0, ox1, depth, oz] = OVERHANG;
+        idf += &format!("Shading:Building:Detailed,Overhang,,4,{ox0},0,{oz},{ox0},{},{oz},{ox1},{},{oz},{ox1},0,{oz};\n", -depth, -depth);
+    }
+    idf + extra
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-inside-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn load(idf: &str) -> sunlit::Result<(Scene, Rooms)> {
+    let loaded = model::load_bytes_all(&[("room.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default())?;
+    let ep = loaded.energyplus.unwrap();
+    Ok((inside_scene(&ep)?, rooms(&ep, None)?))
+}
+
+/// The sun patch the window casts on the floor: the window projected along the sun onto z = 0,
+/// area × |n_window · s| / |n_floor · s|.
+fn analytic_floor_patch(sun: DVec3) -> f64 {
+    let [x0, x1, z0, z1] = WINDOW;
+    (x1 - x0) * (z1 - z0) * sun.y.abs() / sun.z
+}
+
+#[test]
+fn floor_sun_patch_matches_the_analytic_projection_of_the_window() {
+    let (scene, rooms) = load(&room_idf(WINDOW, false, "")).unwrap();
+    for sun in [DVec3::new(0.2, -0.8, 0.7), DVec3::new(-0.3, -0.6, 0.9), DVec3::new(0.0, -0.5, 0.8)] {
+        let sun = sun.normalize();
+        let patches = inside::sun_patches(&scene, &rooms, sun, 1.0);
+        let floor = patches.iter().find(|p| p.surface == "Floor:inside").unwrap();
+        let expected = analytic_floor_patch(sun);
+        eprintln!("sun {sun}: floor patch {} m², analytic {expected} m²", floor.area_m2);
+        assert!((floor.area_m2 - expected).abs() <= 0.005 * expected, "sun {sun}: {} m² against {expected} m²", floor.area_m2);
+        // Only the floor is lit: the beam misses the side walls and the window's own wall.
+        assert_eq!(patches.len(), 1, "{patches:?}");
+    }
+    // A sun behind the window's wall lights nothing inside.
+    assert!(inside::sun_patches(&scene, &rooms, DVec3::new(0.0, 0.6, 0.8), 1.0).is_empty());
+}
+
+fn python() -> PathBuf {
+    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
+    assert!(
+        venv.exists(),
+        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
+    );
+    venv
+}
+
+fn numpy_reference(query: &Value) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/reference.py");
+    let mut child = Command::new(python()).arg(script).stdin(Stdio::piped()).stdout(Stdio::piped()).spawn().unwrap();
+    child.stdin.take().unwrap().write_all(query.to_string().as_bytes()).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "reference.py failed");
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn positions(at: &RoomPoints) -> Vec<[f64; 3]> {
+    (0..at.points.len()).map(|i| at.points.position(i).to_array()).collect()
+}
+
+#[test]
+fn work_plane_grid_agrees_with_a_numpy_ray_caster() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.1, 0.76).unwrap();
+    assert_eq!(at.points.len(), 40 * 50);
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let suns: Vec<DVec3> = [[0.2, -0.8, 0.7], [-0.5, -0.5, 0.5], [0.1, -0.9, 0.45], [0.35, -0.7, 0.6]]
+        .iter()
+        .map(|s| DVec3::from_array(*s).normalize())
+        .collect();
+    let query = json!({"window": WINDOW, "overhang": OVERHANG, "points": positions(&at), "normal": [0, 0, 1],
+        "suns": suns.iter().map(|s| s.to_array()).collect::<Vec<_>>()});
+    let reference = numpy_reference(&query);
+    for (k, &sun) in suns.iter().enumerate() {
+        let ours = inside::instant(&mapper, &rooms, &at, sun, 1.0);
+        let theirs: Vec<f64> = reference["lit"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let differ = ours.lit.iter().zip(&theirs).filter(|(a, b)| a != b).count();
+        let lit = theirs.iter().filter(|&&v| v == 1.0).count();
+        assert!(lit > 100, "sun {sun}: the reference lights only {lit} points");
+        eprintln!("sun {sun}: {lit} points lit by numpy, {differ} of {} differ", at.points.len());
+        assert!(differ * 100 <= at.points.len(), "sun {sun}: {differ} of {} points differ", at.points.len());
+        // Lit through glass: the weight is the glass's visible transmittance.
+        for (i, (l, t)) in ours.lit.iter().zip(&ours.visible_transmittance).enumerate() {
+            assert!(
+                (l * VT - t).abs() < 1e-12,
+                "sun {sun}: point {} lit {l} with visible transmittance {t}, numpy {}",
+                at.points.position(i),
+                theirs[i]
+            );
+        }
+    }
+}
+
+/// Golden, CO TMY3 from the EnergyPlus wheel (as the other EPW tests find it).
+fn golden_epw() -> PathBuf {
+    let epw = common::energyplus::energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw");
+    assert!(epw.exists(), "{} missing", epw.display());
+    epw
+}
+
+#[test]
+fn leed_ase_matches_a_numpy_ray_caster_on_the_golden_epw() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, inside::ASE_SPACING, inside::WORK_PLANE_HEIGHT).unwrap();
+    let weather = Weather::from_epw(&golden_epw()).unwrap();
+    let location: Location = weather.location.clone();
+    let calendar = LeafCalendar::evergreen();
+    let site = Site { location: &location, calendar: &calendar, weather: Some(&weather), sky: None };
+    let samples = inside::occupied_hours(&Period::annual(1).unwrap().samples());
+    assert_eq!(samples.len(), 3650);
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let ours = inside::leed_ase(&mapper, &rooms, &at, &samples, site, &mut |_, _| {}).unwrap();
+    assert_eq!(ours.efficacy_hours, 0, "Golden's EPW has direct normal illuminance every hour");
+    let suns: Vec<[f64; 3]> = samples.iter().map(|s| sun_direction(&location, shading_sun_day(s.day), s.hour).to_array()).collect();
+    let lux: Vec<f64> = samples.iter().map(|s| weather.direct_normal_illuminance(s.epw_hour).unwrap()).collect();
+    let query = json!({"window": WINDOW, "overhang": OVERHANG, "points": positions(&at), "normal": [0, 0, 1],
+        "suns": suns, "lux": lux, "vt": VT});
+    let reference = numpy_reference(&query);
+    let hours: Vec<f64> = reference["hours_over"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let theirs = 100.0 * hours.iter().filter(|&&h| h > inside::ASE_HOURS).count() as f64 / hours.len() as f64;
+    let area = &ours.areas[0];
+    assert_eq!(area.zone, "OFFICE");
+    assert!(theirs > 5.0 && theirs < 95.0, "the case should split the room: numpy's ASE is {theirs} %");
+    eprintln!("ASE {} % against numpy's {theirs} % ({} points)", area.ase, hours.len());
+    assert!((area.ase - theirs).abs() <= 1.0, "ASE {} % against numpy's {theirs} %", area.ase);
+}
+
+#[test]
+fn bad_rooms_are_refused_naming_the_object() {
+    // A window that sticks out of its wall.
+    let err = load(&room_idf([3.0, 4.5, 1.0, 2.5], false, "")).unwrap_err().to_string();
+    assert!(err.contains("Win") && err.contains("not within its base surface"), "{err}");
+    // A glazing transmittance outside 0..1.
+    let idf = room_idf(WINDOW, false, "").replace("SimpleGlass,2.0,0.6,0.7", "SimpleGlass,2.0,0.6,1.3");
+    let err = load(&idf).unwrap_err().to_string();
+    assert!(err.contains("SimpleGlass") && err.contains("Visible Transmittance 1.3"), "{err}");
+    // A zone without a floor (its floor given to another zone).
+    let idf = room_idf(WINDOW, false, "Zone,Attic,0,0,0,0;\n")
+        + &surface("AtticRoof", "Roof", "Outdoors", &[[0.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 5.0, 4.0], [0.0, 5.0, 4.0]])
+            .replace("Office", "Attic");
+    let (mut scene, rooms) = load(&idf).unwrap();
+    let err = inside::floor_grid(&mut scene, &rooms, 0.6, 0.76).unwrap_err().to_string();
+    assert!(err.contains("ATTIC") && err.contains("no floor"), "{err}");
+    // A free point outside every room.
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, "")).unwrap();
+    let err =
+        inside::room_points_csv(&mut scene, &rooms, "p.csv", "x,y,z,nx,ny,nz\n2,2,0.76,0,0,1\n9,2,0.76,0,0,1\n").unwrap_err().to_string();
+    assert!(err.contains("p.csv") && err.contains("line 3") && err.contains("no zone"), "{err}");
+}
+
+fn sunlit(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).output().unwrap()
+}
+
+#[test]
+fn map_inside_cli_writes_lit_weights_patches_and_ase() {
+    let idf = scratch("room.idf");
+    std::fs::write(&idf, room_idf(WINDOW, false, "")).unwrap();
+    let csv = scratch("at.csv");
+    let out = sunlit(&[
+        "map",
+        idf.to_str().unwrap(),
+        "--inside",
+        "--grid",
+        "0.25",
+        "--location",
+        "40,-105,-7",
+        "--at",
+        "03-21",
+        "12:00",
+        "-o",
+        csv.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let location = Location::parse("40,-105,-7").unwrap();
+    let sun = sun_direction(&location, shading_sun_day(80), 12.0);
+    let floor = summary["sun_patches"].as_array().unwrap().iter().find(|p| p["surface"] == "Floor:inside").unwrap().clone();
+    let expected = analytic_floor_patch(sun);
+    let area = floor["area_m2"].as_f64().unwrap();
+    assert!((area - expected).abs() <= 0.005 * expected, "{area} m² against {expected} m²");
+    assert_eq!(floor["zone"], "OFFICE");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("receiver,x,y,z,nx,ny,nz,lit,solar_transmittance,visible_transmittance\n"), "{}", &text[..80]);
+    assert!(text.lines().any(|l| l.starts_with("Floor:inside,") && l.contains(",1,")), "no lit floor point");
+
+    // Refused before anything is written: a glass transmittance outside 0..1, a study without --inside.
+    let bad = scratch("bad.csv");
+    for args in [
+        vec!["--inside", "--glass-transmittance", "1.5", "--location", "40,-105,-7"],
+        vec!["--study", "leed-ase", "--location", "40,-105,-7"],
+    ] {
+        let mut all = vec!["map", idf.to_str().unwrap(), "-o", bad.to_str().unwrap()];
+        all.extend(args);
+        let out = sunlit(&all);
+        assert!(!out.status.success());
+        assert!(!bad.exists());
+    }
+}
+
+#[test]
+fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
+    let patches = sunlit::sky::patches::SkyPatches::parse("tregenza").unwrap();
+    let share = |idf: &str| {
+        let (mut scene, rooms) = load(idf).unwrap();
+        let at = inside::floor_grid(&mut scene, &rooms, 0.5, inside::NSL_WORK_PLANE).unwrap();
+        let mapper = Mapper::new(&scene, &at.points).unwrap();
+        inside::no_sky_line(&mapper, &rooms, &at, &patches, &mut |_, _| {}).1[0].sees_sky
+    };
+    assert_eq!(share(&room_idf(WINDOW, false, "")), 100.0);
+    // A 50 m high screen 0.3 m in front of the window hides every piece of sky.
+    let screen = "Shading:Site:Detailed,Screen,,4,-50,-0.3,50,-50,-0.3,0,54,-0.3,0,54,-0.3,50;\n";
+    assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
+}
