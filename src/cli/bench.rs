@@ -103,14 +103,14 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
     let info = counter.adapter_info();
     let limits = counter.limits();
     eprintln!(
-        "adapter: {} ({:?}, {:?}), {} views per submission; limits: texture side {}, storage binding {} MiB, buffer {} MiB",
+        "adapter: {} ({:?}, {:?}), {} views per submission; limits: texture side {}, storage binding {} MiB, buffer {} bytes",
         info.name,
         info.backend,
         info.device_type,
         counter.tiles_per_batch(),
         limits.max_texture_dimension_2d,
         limits.max_storage_buffer_binding_size >> 20,
-        limits.max_buffer_size >> 20
+        limits.max_buffer_size
     );
     let start = Instant::now();
     let now = move || start.elapsed().as_secs_f64();

@@ -107,14 +107,15 @@ impl LimitsProfile {
 }
 
 /// The limits the counter depends on as lavapipe reports them (Debian 12's Mesa 22.3.6 through
-/// wgpu 30, measured with `sunlit bench --limits adapter` printing its adapter's limits): a 16,384
-/// texture side and 128 MiB storage bindings; the rest as WebGPU's core limits, which lavapipe
-/// exceeds but the counter does not use beyond.
+/// wgpu 30; `sunlit bench --engine gpu MODEL` prints them on its adapter line): a 16,384 texture
+/// side, 128 MiB storage bindings and buffers up to 2^31 − 1 bytes; the rest as WebGPU's core
+/// limits, which lavapipe meets or exceeds.
 pub fn lavapipe_limits() -> wgpu::Limits {
     wgpu::Limits {
         max_texture_dimension_1d: 16_384,
         max_texture_dimension_2d: 16_384,
         max_storage_buffer_binding_size: 128 << 20,
+        max_buffer_size: (1 << 31) - 1,
         ..wgpu::Limits::default()
     }
 }
