@@ -27,6 +27,8 @@ PY
 }
 profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 run synthetic 40 bench --suns 64 "${gpu_flags[@]}"
+# The host's cost a view alone (wgpu's no-op backend), to set beside the real GPU's.
+run nyt-blocks-noop 60 bench nyt-blocks --engine gpu --backend noop --lanes 1 --views 20000
 for m in blaas-louvres blaas-trees-summer nyt-self nyt-flat; do
   run "$m-gpu" 40 bench "$m" --engine gpu --check 50 "${gpu_flags[@]}"
   run "$m-exact" 40 bench "$m" --engine exact

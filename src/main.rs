@@ -16,7 +16,7 @@ use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
 use sunlit::count::exact::Exact;
-use sunlit::count::gpu::{Counter, CounterOptions};
+use sunlit::count::gpu::{Backend, Counter, CounterOptions, LimitsProfile};
 use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};

@@ -17,6 +17,47 @@ pub(crate) fn instance() -> wgpu::Instance {
     wgpu::Instance::new(desc)
 }
 
+/// wgpu's no-op backend, reporting `limits` (`None`: the largest) and every feature: passes are
+/// recorded but never run, so only the host's work is timed. Native only; the browser has none.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn noop_instance(limits: Option<wgpu::Limits>) -> Result<wgpu::Instance> {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    desc.backends = wgpu::Backends::NOOP;
+    desc.backend_options.noop = wgpu::NoopBackendOptions { limits, ..wgpu::NoopBackendOptions::enabled() };
+    Ok(wgpu::Instance::new(desc))
+}
+
+/// The browser offers no no-op backend: asking for it is a parameter error.
+#[cfg(target_arch = "wasm32")]
+pub(crate) fn noop_instance(_limits: Option<wgpu::Limits>) -> Result<wgpu::Instance> {
+    Err(crate::error::Error::argument("backend", "the no-op backend exists only natively, not in the browser"))
+}
+
+/// A stopwatch for host-time accounting: natively a monotonic clock; on the web, where
+/// `Instant::now` panics and the counter must not depend on the page's clock, it always reads 0.
+pub(crate) struct Stopwatch {
+    #[cfg(not(target_arch = "wasm32"))]
+    start: std::time::Instant,
+}
+
+impl Stopwatch {
+    /// Starts timing.
+    pub(crate) fn start() -> Self {
+        Self {
+            #[cfg(not(target_arch = "wasm32"))]
+            start: std::time::Instant::now(),
+        }
+    }
+
+    /// Nanoseconds since [`Self::start`] (0 on the web).
+    pub(crate) fn nanos(&self) -> u64 {
+        #[cfg(not(target_arch = "wasm32"))]
+        return self.start.elapsed().as_nanos().min(u64::MAX as u128) as u64;
+        #[cfg(target_arch = "wasm32")]
+        0
+    }
+}
+
 /// What to tell a user who has no adapter at all.
 pub(crate) fn no_adapter_hint() -> &'static str {
     if cfg!(target_arch = "wasm32") {

@@ -278,6 +278,37 @@ fn bench_lists_writes_and_times_generated_models() {
     fails_with(&sunlit(&["bench", "--write", &path]), &["--write", "one generated model"]);
 }
 
+/// `bench --backend noop` times the host alone: it plans and records the same views as a real
+/// device (the same views rendered, tiles and triangles), reports the host's stages, and refuses
+/// what would act on the zeros it reads back. `--limits` asks a real device for less.
+#[test]
+fn bench_on_the_noop_backend_times_the_same_views_on_the_host() {
+    let quick = ["bench", "blaas-buildings", "--engine", "gpu", "--samples", "3x3", "--resolution", "64", "--views", "40", "--lanes", "1"];
+    let line = |extra: &[&str]| -> serde_json::Value {
+        let out = sunlit(&[&quick[..], extra].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let real = line(&[]);
+    let noop = line(&["--backend", "noop"]);
+    for key in ["views_rendered", "tiles_rendered", "mean_triangles_per_tile"] {
+        assert!(real[key].as_f64().unwrap() > 0.0, "{key} in {real}");
+        assert_eq!(noop[key], real[key], "{key}: noop {noop} against {real}");
+    }
+    let stages = &noop["host_stages_seconds"];
+    for stage in ["planning", "encoding", "submitting", "waiting", "unpacking"] {
+        assert!(stages[stage].as_f64().is_some_and(|s| s >= 0.0), "{stage} in {noop}");
+    }
+    assert!(stages["planning"].as_f64().unwrap() > 0.0, "{noop}");
+    // WebGPU's core limits on lavapipe: a smaller atlas at most, the same views.
+    assert_eq!(line(&["--limits", "webgpu"])["views_rendered"], real["views_rendered"]);
+    fails_with(&sunlit(&[&quick[..], &["--backend", "noop", "--check", "5"]].concat()), &["--check", "noop"]);
+    fails_with(&sunlit(&[&quick[..], &["--backend", "noop", "--accuracy", "0.01"]].concat()), &["--accuracy", "noop"]);
+    fails_with(&sunlit(&["bench", "blaas-buildings", "--backend", "noop"]), &["--backend", "--engine gpu"]);
+    fails_with(&sunlit(&[&quick[..], &["--backend", "vulkan"]].concat()), &["--backend", "'vulkan'"]);
+    fails_with(&sunlit(&[&quick[..], &["--limits", "huge"]].concat()), &["--limits", "'huge'"]);
+}
+
 /// An EnergyPlus model's own Site:Location is its location when neither --epw nor --location is
 /// given: the CLI says so, and the CSV is the one --location with the same coordinates gives.
 #[test]

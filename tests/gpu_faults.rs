@@ -26,7 +26,7 @@ fn options() -> AnnualOptions {
 
 /// A small atlas (4 views per submission), so a year takes many submissions and progress reports.
 fn counter() -> Counter {
-    pollster::block_on(Counter::new(CounterOptions { resolution: 64, max_atlas: 128, accuracy: None }))
+    pollster::block_on(Counter::new(CounterOptions { resolution: 64, max_atlas: 128, accuracy: None, ..Default::default() }))
         .expect("a GPU adapter (lavapipe: apt-get install mesa-vulkan-drivers) — GPU tests never skip")
 }
 

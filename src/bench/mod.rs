@@ -12,7 +12,7 @@ use glam::DVec3;
 
 use crate::count::ViewRequest;
 use crate::count::gpu::plan::planned_triangles;
-use crate::count::gpu::{Counted, Counter, GpuScene};
+use crate::count::gpu::{Counted, Counter, GpuScene, HostStages};
 use crate::count::lanes::{Lane, fractions_side_by_side};
 use crate::error::Result;
 use crate::scene::{Scene, SceneBuilder, SourceMesh};
@@ -140,7 +140,7 @@ pub async fn time_views(counter: &Counter, case: &str, scene: &Scene, suns: &[DV
     let start = now();
     let counted = counter.fractions(&gpu, &requests).await?;
     let seconds = now() - start;
-    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    let rendered = counted.iter().filter(|c| c.side > 0).count();
     Ok(Timing {
         case: case.to_string(),
         triangles: scene.triangle_count(),
@@ -190,9 +190,22 @@ pub struct ViewTiming {
     /// Rendered views by the tile side they were last counted at (one side without an
     /// accuracy target; with one, how far adaptive counting had to go).
     pub sides: BTreeMap<u32, usize>,
+    /// The host's time by stage during the timed count, summed over the lanes.
+    pub host_stages: HostStages,
     /// Every timed view's count.
     #[serde(skip)]
     pub counted: Vec<Counted>,
+}
+
+/// The lanes' host stages added up.
+fn lanes_host_stages(lanes: &[Lane<'_>]) -> HostStages {
+    lanes.iter().map(|l| l.counter.host_stages()).fold(HostStages::default(), |a, b| HostStages {
+        planning: a.planning + b.planning,
+        encoding: a.encoding + b.encoding,
+        submitting: a.submitting + b.submitting,
+        waiting: a.waiting + b.waiting,
+        unpacking: a.unpacking + b.unpacking,
+    })
 }
 
 /// Times counting `requests` over the lanes (side by side); one warm-up batch a lane first.
@@ -204,11 +217,20 @@ pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: im
     let start = now();
     let rendered_so_far = || lanes.iter().fold((0, 0), |(t, n), l| (t + l.counter.rendered().0, n + l.counter.rendered().1));
     let before = rendered_so_far();
+    let stages_before = lanes_host_stages(lanes);
     let counted = fractions_side_by_side(lanes, requests).await?;
     let seconds = now() - start;
     let after = rendered_so_far();
+    let stages_after = lanes_host_stages(lanes);
+    let host_stages = HostStages {
+        planning: stages_after.planning - stages_before.planning,
+        encoding: stages_after.encoding - stages_before.encoding,
+        submitting: stages_after.submitting - stages_before.submitting,
+        waiting: stages_after.waiting - stages_before.waiting,
+        unpacking: stages_after.unpacking - stages_before.unpacking,
+    };
     let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);
-    let rendered = counted.iter().filter(|c| c.covered > 0).count();
+    let rendered = counted.iter().filter(|c| c.side > 0).count();
     let start = now();
     let (drawn, planned) = planned_triangles(gpu, requests, counter.resolution());
     let planning_seconds = now() - start;
@@ -221,6 +243,7 @@ pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: im
         planning_seconds,
         mean_triangles_drawn: drawn as f64 / planned.max(1) as f64,
         tiles_rendered: tiles,
+        host_stages,
         mean_triangles_per_tile: triangles as f64 / tiles.max(1) as f64,
         sides: counted.iter().filter(|c| c.side > 0).fold(BTreeMap::new(), |mut m, c| {
             *m.entry(c.side).or_insert(0) += 1;

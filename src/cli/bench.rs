@@ -47,6 +47,17 @@ pub(super) struct BenchArgs {
     lanes: Option<usize>,
     #[command(flatten)]
     engine: EngineArgs,
+    /// The GPU counter's adapter: `platform` (Vulkan, Metal, DX12) or `noop`, wgpu's no-op backend,
+    /// whose passes are recorded but never run: `seconds / views_rendered` is then the host's cost
+    /// a view. Counts read back as zeros there, so it takes neither --check nor --accuracy, and
+    /// only with --engine gpu.
+    #[arg(long, value_name = "platform|noop", default_value = "platform")]
+    backend: String,
+    /// Ask the device for no more than these limits: `adapter` (all it offers), `lavapipe`
+    /// (Mesa's CPU driver as measured here) or `webgpu` (WebGPU's core limits, what a browser
+    /// grants), so the fallbacks those devices take are timed on any adapter.
+    #[arg(long, value_name = "adapter|lavapipe|webgpu", default_value = "adapter")]
+    limits: String,
     /// Time each model's sky pass instead: every receiver's sky views over the given patch
     /// scheme (`tregenza` or `reinhart:N`), once, on the chosen engine.
     #[arg(long, value_name = "SCHEME")]
@@ -78,15 +89,29 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
     if let Some(scheme) = &args.sky {
         return bench_sky(&args, scheme);
     }
+    let options = counter_options(&args)?;
     if !args.models.is_empty() && args.engine.kind()? != EngineKind::Gpu {
+        if options.backend == Backend::Noop {
+            return Err(Error::argument("--backend", "noop times the GPU counter alone: use it with --engine gpu"));
+        }
         let start = Instant::now();
         return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
     }
     let made = Instant::now();
-    let counter = pollster::block_on(Counter::new(CounterOptions { max_atlas: args.atlas, ..args.pixels.options() }))?;
+    let counter = pollster::block_on(Counter::new(options))?;
     let startup = made.elapsed().as_secs_f64();
     let info = counter.adapter_info();
-    eprintln!("adapter: {} ({:?}, {:?}), {} views per submission", info.name, info.backend, info.device_type, counter.tiles_per_batch());
+    let limits = counter.limits();
+    eprintln!(
+        "adapter: {} ({:?}, {:?}), {} views per submission; limits: texture side {}, storage binding {} MiB, buffer {} bytes",
+        info.name,
+        info.backend,
+        info.device_type,
+        counter.tiles_per_batch(),
+        limits.max_texture_dimension_2d,
+        limits.max_storage_buffer_binding_size >> 20,
+        limits.max_buffer_size
+    );
     let start = Instant::now();
     let now = move || start.elapsed().as_secs_f64();
     if !args.models.is_empty() {
@@ -108,6 +133,32 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
         println!("{}", serde_json::to_string(&t).map_err(|e| Error::Io { path: "stdout".into(), source: e.into() })?);
     }
     Ok(())
+}
+
+/// The counter's options from the pixel, atlas, backend and limits flags. The no-op backend reads
+/// back zeros, so anything that acts on counts (checks, adaptive recounts) is refused with it.
+fn counter_options(args: &BenchArgs) -> Result<CounterOptions> {
+    let backend = match args.backend.as_str() {
+        "platform" => Backend::Platform,
+        "noop" => Backend::Noop,
+        other => return Err(Error::argument("--backend", format!("'{other}' is not platform or noop"))),
+    };
+    let limits = match args.limits.as_str() {
+        "adapter" => LimitsProfile::Adapter,
+        "lavapipe" => LimitsProfile::Lavapipe,
+        "webgpu" => LimitsProfile::WebGpuCore,
+        other => return Err(Error::argument("--limits", format!("'{other}' is not adapter, lavapipe or webgpu"))),
+    };
+    let options = CounterOptions { max_atlas: args.atlas, backend, limits, ..args.pixels.options() };
+    if backend == Backend::Noop {
+        if args.check > 0 {
+            return Err(Error::argument("--check", "the noop backend counts nothing to check: drop --check or use --backend platform"));
+        }
+        if options.accuracy.is_some() {
+            return Err(Error::argument("--accuracy", "adaptive counting recounts by the counts, which the noop backend does not make"));
+        }
+    }
+    Ok(options)
 }
 
 /// Times each model over its sampling plan's views on the GPU alone (`--engine gpu`); one JSON line
@@ -165,6 +216,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             "estimated_seconds_all_views": estimated,
             "views_per_second": t.views_per_second,
             "planning_seconds": t.planning_seconds,
+            "host_stages_seconds": t.host_stages,
+            "seconds_per_rendered_view": t.seconds / t.rendered.max(1) as f64,
             "mean_triangles_drawn": t.mean_triangles_drawn.round(),
             "tiles_rendered": t.tiles_rendered,
             "mean_triangles_per_tile": t.mean_triangles_per_tile.round(),
@@ -201,7 +254,10 @@ fn bench_model(name: &str, location: &str) -> Result<(Scene, Location, Option<us
 /// engine, engine start-up apart; one JSON line a model.
 fn bench_sky(args: &BenchArgs, scheme: &str) -> Result<()> {
     let patches = sunlit::sky::patches::SkyPatches::parse(scheme)?;
-    let options = CounterOptions { max_atlas: args.atlas, ..args.pixels.options() };
+    let options = counter_options(args)?;
+    if options.backend == Backend::Noop {
+        return Err(Error::argument("--backend", "noop times the GPU counter's sun views alone, not a sky pass"));
+    }
     for name in &args.models {
         let t0 = Instant::now();
         let (scene, _, shading) = bench_model(name, &args.location)?;
@@ -246,7 +302,7 @@ fn bench_plan(samples: &str) -> Result<(usize, usize, SamplingPlan)> {
 fn bench_hybrid(args: &BenchArgs, now: impl Fn() -> f64 + Copy) -> Result<()> {
     let (days, per_day, plan) = bench_plan(&args.samples)?;
     let kind = args.engine.kind()?;
-    let options = CounterOptions { max_atlas: args.atlas, ..args.pixels.options() };
+    let options = counter_options(args)?;
     for name in &args.models {
         let t0 = now();
         let (scene, location, shading) = bench_model(name, &args.location)?;

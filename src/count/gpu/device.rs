@@ -10,7 +10,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use super::CounterOptions;
+use super::{Backend, CounterOptions};
 use crate::error::{Error, GpuError, Result};
 use crate::platform;
 
@@ -26,12 +26,20 @@ pub(super) struct Opened {
 /// Opens the platform's default adapter and a device with all its limits, refusing options the
 /// device cannot meet (a resolution above its texture size) before allocating anything.
 pub(super) async fn open(options: &CounterOptions) -> Result<Opened> {
-    let instance = platform::instance();
+    let profile = options.limits.limits();
+    let instance = match options.backend {
+        Backend::Platform => platform::instance(),
+        Backend::Noop => platform::noop_instance(profile.clone())?,
+    };
     let adapter = instance
         .request_adapter(&wgpu::RequestAdapterOptions::default())
         .await
         .map_err(|e| GpuError::NoAdapter { hint: platform::no_adapter_hint().into(), reason: e.to_string() })?;
-    let limits = adapter.limits();
+    // A profile asks for no more than the named class offers, and never more than the adapter.
+    let limits = match &profile {
+        Some(profile) => adapter.limits().or_worse_values_from(profile),
+        None => adapter.limits(),
+    };
     let resolution = options.resolution;
     if !(16..=limits.max_texture_dimension_2d).contains(&resolution) {
         return Err(Error::argument(

@@ -3,6 +3,7 @@
 //! of them, depth-tested, into red) and the count pass, one submission per batch.
 
 use std::ops::Range;
+use std::sync::atomic::Ordering;
 
 use super::masks::{GpuPoints, MaskBatch};
 use super::pipelines::{
@@ -15,6 +16,7 @@ use super::{Counter, GpuScene};
 use crate::count::ViewRequest;
 use crate::count::group::MAX_MEMBERS;
 use crate::error::Result;
+use crate::platform::Stopwatch;
 
 pub(super) struct Atlas {
     pub(super) ids: wgpu::TextureView,
@@ -104,6 +106,7 @@ impl Counter {
         passes: Passes<'_>,
     ) -> Result<usize> {
         let Passes { count, masks } = passes;
+        let encoding = Stopwatch::start();
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
         let mut members: Vec<u32> = Vec::with_capacity(batch.len());
@@ -141,7 +144,11 @@ impl Counter {
         if let Some((points, mask_batch, first_word)) = masks {
             self.encode_masks(&mut encoder, points, mask_batch, first_word);
         }
-        self.queue.submit([encoder.finish()]);
+        let commands = encoder.finish();
+        self.stages.encoding.fetch_add(encoding.nanos(), Ordering::Relaxed);
+        let submitting = Stopwatch::start();
+        self.queue.submit([commands]);
+        self.stages.submitting.fetch_add(submitting.nanos(), Ordering::Relaxed);
         Ok(members.len())
     }
 

@@ -63,10 +63,62 @@ use self::plan::{SceneLayout, Tile, finer_side, fit_tile, plan_tiles, sides, til
 use self::upload::{GpuMesh, StaticChunk};
 use super::{ViewAnswer, ViewRequest};
 use crate::error::Result;
+use crate::platform::Stopwatch;
 
 /// The side adaptive counting starts at: ~2,000 pixels on the receiver, enough that a view
 /// without shadow edges is within 0.001 and the edge count is a fair guide for the others.
 pub const ADAPTIVE_FIRST_SIDE: u32 = 64;
+
+/// Which adapter a [`Counter`] opens.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Backend {
+    /// The platform's: the browser's WebGPU, natively Vulkan, Metal or DX12 (`WGPU_BACKEND`).
+    #[default]
+    Platform,
+    /// wgpu's no-op backend (native only): passes are recorded and submitted but never run and
+    /// reads return zeros, so what a count costs is the host's work alone. Its counts are
+    /// meaningless; only `sunlit bench` uses it, to time the host.
+    Noop,
+}
+
+/// Which limits the device is asked for: all the adapter offers, or no more than a named
+/// device class offers, so the paths that class would take (smaller atlases, more buffer chunks)
+/// are measured on any adapter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LimitsProfile {
+    /// Everything the adapter offers.
+    #[default]
+    Adapter,
+    /// Mesa's lavapipe as measured here (Debian 12, Mesa 22.3.6): see [`lavapipe_limits`].
+    Lavapipe,
+    /// WebGPU's core limits (what a browser grants without asking): [`wgpu::Limits::default`].
+    WebGpuCore,
+}
+
+impl LimitsProfile {
+    /// The profile's limits, `None` for the adapter's own.
+    pub fn limits(self) -> Option<wgpu::Limits> {
+        match self {
+            LimitsProfile::Adapter => None,
+            LimitsProfile::Lavapipe => Some(lavapipe_limits()),
+            LimitsProfile::WebGpuCore => Some(wgpu::Limits::default()),
+        }
+    }
+}
+
+/// The limits the counter depends on as lavapipe reports them (Debian 12's Mesa 22.3.6 through
+/// wgpu 30; `sunlit bench --engine gpu MODEL` prints them on its adapter line): a 16,384 texture
+/// side, 128 MiB storage bindings and buffers up to 2^31 − 1 bytes; the rest as WebGPU's core
+/// limits, which lavapipe meets or exceeds.
+pub fn lavapipe_limits() -> wgpu::Limits {
+    wgpu::Limits {
+        max_texture_dimension_1d: 16_384,
+        max_texture_dimension_2d: 16_384,
+        max_storage_buffer_binding_size: 128 << 20,
+        max_buffer_size: (1 << 31) - 1,
+        ..wgpu::Limits::default()
+    }
+}
 
 /// Settings of a [`Counter`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -80,11 +132,15 @@ pub struct CounterOptions {
     /// [`ADAPTIVE_FIRST_SIDE`] first and again, at a side up to `resolution`, only where the
     /// estimated error is larger ([`error_estimate`]). `None`: every view at `resolution`.
     pub accuracy: Option<f64>,
+    /// Which adapter to open.
+    pub backend: Backend,
+    /// Which limits to ask the device for.
+    pub limits: LimitsProfile,
 }
 
 impl Default for CounterOptions {
     fn default() -> Self {
-        Self { resolution: 512, max_atlas: 2048, accuracy: None }
+        Self { resolution: 512, max_atlas: 2048, accuracy: None, backend: Backend::Platform, limits: LimitsProfile::Adapter }
     }
 }
 
@@ -100,6 +156,46 @@ pub fn error_estimate(covered: u32, edges: u32) -> f64 {
         return f64::INFINITY;
     }
     (3.0 * (edges as f64).sqrt() + 1.0) / covered as f64
+}
+
+/// The host's time a [`Counter`] has spent counting, by stage, in seconds (natively; the web
+/// build has no clock here and reports zeros). What is left of a count's wall time beyond their
+/// sum is the GPU's own work that the host did not wait for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct HostStages {
+    /// Fitting views, culling what each draws and packing tiles (CPU only).
+    pub planning: f64,
+    /// Writing each batch's buffers and recording its passes.
+    pub encoding: f64,
+    /// `Queue::submit`.
+    pub submitting: f64,
+    /// Waiting for a readback to map (the GPU finishing, and the round trip).
+    pub waiting: f64,
+    /// Turning the counts read back into fractions.
+    pub unpacking: f64,
+}
+
+/// [`HostStages`] as a counter accumulates them, in nanoseconds, from any lane's thread.
+#[derive(Default)]
+struct StageClock {
+    planning: AtomicU64,
+    encoding: AtomicU64,
+    submitting: AtomicU64,
+    waiting: AtomicU64,
+    unpacking: AtomicU64,
+}
+
+impl StageClock {
+    fn read(&self) -> HostStages {
+        let s = |a: &AtomicU64| a.load(Ordering::Relaxed) as f64 * 1e-9;
+        HostStages {
+            planning: s(&self.planning),
+            encoding: s(&self.encoding),
+            submitting: s(&self.submitting),
+            waiting: s(&self.waiting),
+            unpacking: s(&self.unpacking),
+        }
+    }
 }
 
 /// One counted view. A view that needed no render (sun down, facing away, or nothing in front
@@ -155,6 +251,8 @@ pub struct Counter {
     /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
     tiles_rendered: AtomicU64,
     triangles_drawn: AtomicU64,
+    /// Host time by stage since the counter was made (benchmarks).
+    stages: StageClock,
     faults: Faults,
 }
 
@@ -190,6 +288,7 @@ impl Counter {
             batch,
             tiles_rendered: AtomicU64::new(0),
             triangles_drawn: AtomicU64::new(0),
+            stages: StageClock::default(),
             faults,
         };
         counter.check_errors("setting up the GPU")?;
@@ -199,6 +298,11 @@ impl Counter {
     /// The adapter in use (name, backend, device type).
     pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
         &self.info
+    }
+
+    /// The limits its device was opened with (the adapter's, or a [`LimitsProfile`]'s).
+    pub fn limits(&self) -> wgpu::Limits {
+        self.device.limits()
     }
 
     /// The options it was made with.
@@ -222,6 +326,11 @@ impl Counter {
         (self.tiles_rendered.load(Ordering::Relaxed), self.triangles_drawn.load(Ordering::Relaxed))
     }
 
+    /// Host time spent by stage since this counter was made (native builds; zeros on the web).
+    pub fn host_stages(&self) -> HostStages {
+        self.stages.read()
+    }
+
     /// The first GPU failure since the last check, as the error of stage `doing`.
     fn check_errors(&self, doing: &str) -> Result<()> {
         self.faults.check(doing, self.options.resolution)
@@ -239,12 +348,15 @@ impl Counter {
         let mut out = vec![Counted::default(); requests.len()];
         let ladder = sides(&self.options);
         let first = ladder.first().copied().unwrap_or(self.options.resolution);
+        let planning = Stopwatch::start();
         let tiles = plan_tiles(&scene.layout, requests, first, &mut out)?;
+        self.stages.planning.fetch_add(planning.nanos(), Ordering::Relaxed);
         // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
         let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
         while let Some((side, tiles)) = waiting.pop_first() {
             self.count_tiles(scene, requests, &tiles, side, &mut out, None).await?;
             let Some(target) = self.options.accuracy else { continue };
+            let planning = Stopwatch::start();
             for tile in tiles {
                 let worst = tile.requests.iter().map(|&i| out[i].error_estimate()).fold(0.0, f64::max);
                 if let Some(next) = finer_side(&ladder, side, worst, target) {
@@ -252,6 +364,7 @@ impl Counter {
                     waiting.entry(next).or_default().push(Tile { view, ..tile });
                 }
             }
+            self.stages.planning.fetch_add(planning.nanos(), Ordering::Relaxed);
         }
         Ok(out)
     }

@@ -11,7 +11,7 @@ use super::plan::{Tile, tiles_at};
 use super::{Counted, Counter, GpuScene};
 use crate::count::ViewRequest;
 use crate::error::{GpuError, Result};
-use crate::platform;
+use crate::platform::{self, Stopwatch};
 
 /// Batches read back per map: bounds latency and memory while keeping the GPU fed.
 pub(super) const BATCHES_PER_READBACK: usize = 32;
@@ -94,7 +94,10 @@ impl Counter {
             if !count {
                 continue;
             }
+            let waiting = Stopwatch::start();
             let counts = platform::read_buffer(&self.device, &self.batch.readback, entries as u64 * COUNTS_PER_MEMBER * 4).await;
+            self.stages.waiting.fetch_add(waiting.nanos(), Ordering::Relaxed);
+            let unpacking = Stopwatch::start();
             // A failed read on a lost device is the loss, not a read error.
             self.check_errors("counting pixels")?;
             let counts = counts?;
@@ -110,6 +113,7 @@ impl Counter {
                 o.pixel_area = pixel_area;
                 o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
             }
+            self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
         }
         Ok(())
     }
