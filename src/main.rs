@@ -44,6 +44,8 @@ use bench_cli::{BenchArgs, run_bench};
 mod docs_check;
 #[path = "cli/map.rs"]
 mod map_cli;
+#[path = "cli/progress.rs"]
+mod progress;
 use map_cli::{MapArgs, map};
 
 #[derive(Parser)]
@@ -496,25 +498,20 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let mut engine = HybridEngine::new(&scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let start = Instant::now();
-    let bar = indicatif::ProgressBar::new(0).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
-            .map_err(|e| Error::argument("progress", e.to_string()))?,
-    );
-    bar.set_message(if args.dense { "dense" } else { "sampling" });
-    let mut report = |p: Progress| {
-        bar.set_length(p.total as u64);
-        bar.set_position(p.done as u64);
-        Ok(())
-    };
+    let mut meter = progress::Meter::new(if args.dense { "dense year" } else { "year" }, "views")?;
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    let mut year = |engine: &HybridEngine<'_>| {
-        pollster::block_on(sunlit::year::annual::annual_with(engine, &scene, &settings.location, &options, &settings.calendar, &mut report))
+    let year = |engine: &HybridEngine<'_>, meter: &mut progress::Meter| {
+        pollster::block_on(sunlit::year::annual::annual_with(engine, &scene, &settings.location, &options, &settings.calendar, &mut |p| {
+            meter.report(p);
+            Ok(())
+        }))
     };
-    let schedule = match year(&engine) {
+    let schedule = match year(&engine, &mut meter) {
         Err(Error::DeviceLost(why)) => {
             log::warn!("GPU device lost ({why}); making a new one and counting again");
             engine.forget_gpu();
-            year(&engine)?
+            meter.stage("year, counted again", "views");
+            year(&engine, &mut meter)?
         }
         other => other?,
     };
@@ -525,13 +522,10 @@ fn annual(args: AnnualArgs) -> Result<()> {
         _ => None,
     };
     let solar_files = match &solar {
-        Some(plan) => {
-            bar.set_message("sky");
-            solar_outputs(plan, &engine, &scene, &settings, &schedule, &args, &mut report)?
-        }
+        Some(plan) => solar_outputs(plan, &engine, &scene, &settings, &schedule, &args, &mut meter)?,
         None => Vec::new(),
     };
-    bar.finish_and_clear();
+    meter.finish();
     sunlit::export::write_atomic(&args.output, &bytes)?;
     for (path, bytes) in &solar_files {
         sunlit::export::write_atomic(path, bytes)?;
@@ -554,7 +548,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         timesteps.rows(),
         schedule.names.len(),
         start.elapsed().as_secs_f64(),
-        bar.length().unwrap_or(0)
+        meter.counted()
     );
     Ok(())
 }

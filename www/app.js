@@ -232,7 +232,9 @@ worker.onmessage = ({ data: msg }) => {
   } else if (msg.type === 'progress') {
     $('progress').max = msg.total || 1;
     $('progress').value = msg.done;
-    status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}`);
+    // A year's timesteps the spline interpolates are decided without counting: say how many views were counted.
+    const counted = msg.counted !== undefined && msg.counted !== msg.done ? ` decided (${msg.counted.toLocaleString()} counted)` : '';
+    status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}${counted}`);
   } else if (msg.type === 'loading') {
     showLoading(msg);
   } else if (msg.type === 'notice') {

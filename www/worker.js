@@ -109,11 +109,11 @@ async function computeOnce({ settings, engine: made, csvName }) {
   running = new AbortController();
   const started = performance.now();
   let last = 0;
-  const onProgress = (done, total) => {
+  const onProgress = (done, total, counted) => {
     const now = performance.now();
     if (now - last > 100 || done === total) {
       last = now;
-      postMessage({ type: 'progress', done, total });
+      postMessage({ type: 'progress', done, total, counted });
     }
   };
   const annual = await e.annual(m, settings, { onProgress, signal: running.signal });
