@@ -223,6 +223,7 @@ function showError(msg) {
 
 worker.onmessage = ({ data: msg }) => {
   if (msg.type === 'ready') {
+    worker.postMessage({ type: 'warm', engine: engineOptions() });
     if (!msg.webgpu) noWebGPU();
     else status('Ready. Choose a model, drop one here, or load the example.');
     $('compute').disabled = !state.model || state.busy;
