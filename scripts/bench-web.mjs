@@ -1,9 +1,12 @@
 // Times one model's year in headless Chromium (WebGPU on SwiftShader) through the JS API, with
 // the default engine and with each engine forced, and the same year with the native CLI:
-//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides LIST] [--load-only]
+//   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides LIST] [--load-only] [--interleave]
 // Sides (default all): default (auto, the default pool; a first visit: it probes its profile),
 // default-cached (auto with the profile a first run measured, as a returning visit), exact, gpu, exact-1 (one clipping
-// worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto). Each side
+// worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto),
+// native-first (the same with an empty profile cache: it probes, as the page's first visit does;
+// SUNLIT_BIN names another binary than target/release/sunlit), page (the page itself: open it,
+// choose the model, Compute; from opening to "Done", as a new visitor waits). Each side
 // runs N times (default 1) in a fresh browser and prints one JSON line per run, then one summary
 // line per side with the median seconds; the browser's lines also carry the peak resident memory
 // of Chromium's processes (sampled from /proc every 200 ms; in all and by process type), the wasm
@@ -11,7 +14,8 @@
 // of each clipping worker once it built the model. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
+import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { basename, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { serve } from './serve.mjs';
@@ -34,6 +38,8 @@ if (!Number.isInteger(timesteps) || timesteps < 1 || timesteps > 60) {
 }
 // --load-only: the model's load and the pool's copies, no year (where the memory goes, quickly).
 const loadOnly = args.includes('--load-only') && Boolean(args.splice(args.indexOf('--load-only'), 1));
+// --interleave: the sides take turns run by run, for paired ratios (below).
+const interleave = args.includes('--interleave') && Boolean(args.splice(args.indexOf('--interleave'), 1));
 const sides = flag('--sides', 'default,exact,gpu,exact-1,native').split(',');
 const [model, samples = '27x19', resolution = '512'] = args;
 if (!model) {
@@ -107,8 +113,11 @@ async function browserRun(side) {
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
     const result = await page.evaluate(
       async ({ name, file, days, perDay, resolution, place, options, loadOnly, timesteps }) => {
+        // A first visit starts here: the module's import, the wasm's compile, the device, the pool.
+        const tImport = performance.now();
         const { createEngine, wasmMemoryBytes } = await import('/sunlit.js');
         const engine = await createEngine({ resolution, ...options });
+        const created = performance.now();
         const bytes = new Uint8Array(await (await fetch(`/pkg/bench-model-${file}.glb`)).arrayBuffer());
         const t0 = performance.now();
         const model = engine.loadFiles([{ name, bytes }]);
@@ -133,8 +142,13 @@ async function browserRun(side) {
           return out;
         }
         const year = await engine.annual(model, { ...place, timestepsPerHour: timesteps, daysPerYear: days, samplesPerDay: perDay }, {
-          onProgress: (done, total) => {
-            views = Math.max(views, done);
+          onProgress: (done, total, counted) => {
+            // Views an engine counted (not those settled without counting), summed over the
+            // year and its sky views: a new stage starts with another total or fewer done.
+            if (total !== globalThis.stage?.total || done < globalThis.stage.done) {
+              views += globalThis.stage?.counted ?? 0;
+            }
+            globalThis.stage = { total, done, counted };
             // Every 30 s to the bench's stderr (the console), and at the end.
             const now = performance.now();
             if (now - (globalThis.lastProgress ?? 0) > 30_000 || done === total) {
@@ -144,11 +158,16 @@ async function browserRun(side) {
           },
         });
         const t3 = performance.now();
+        views += globalThis.stage?.counted ?? 0;
         const out = {
+          create_s: (created - tImport) / 1000,
           load_s: (t1 - t0) / 1000,
           workers_load_s: (t2 - t1) / 1000,
           annual_s: (t3 - t2) / 1000,
           total_s: (t3 - t0) / 1000,
+          // What a first visit waits for: the engine's start, then load, workers and year (the
+          // model's fetch left out: the native run reads a local file).
+          first_visit_s: (created - tImport + t3 - t0) / 1000,
           views,
           receivers: year.names.length,
           triangles: model.triangles,
@@ -174,13 +193,52 @@ async function browserRun(side) {
   }
 }
 
-function nativeRun() {
-  const bin = join(ROOT, 'target/release/sunlit');
+/** The page itself as a new visitor uses it (side `page`): open it, choose the model in its Model
+ * input, press Compute as soon as it is loaded, with the form's settings set to the bench's.
+ * `first_visit_s`: from opening the page to its "Done"; `compute_s`: from Compute to "Done". */
+async function pageRun() {
+  const server = await serve(0);
+  const browser = await launch();
+  try {
+    const page = await browser.newPage();
+    const status = async (pattern) => {
+      await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent), pattern.source, { timeout: 3_600_000 });
+      return page.textContent('#status');
+    };
+    const t0 = performance.now();
+    await page.goto(`http://127.0.0.1:${server.address().port}/`);
+    await status(/^Ready/);
+    const ready = performance.now();
+    const fields = { latitude: place.latitude, longitude: place.longitude, timezone: place.timeZone, days, perday: perDay, resolution };
+    for (const [id, value] of Object.entries(fields)) await page.fill(`#${id}`, String(value));
+    await page.selectOption('#timesteps', String(timesteps));
+    await page.setInputFiles('#model', model);
+    const loaded = await status(/^Loaded|^Could not/);
+    if (!loaded.startsWith('Loaded')) throw new Error(loaded);
+    const t1 = performance.now();
+    await page.click('#compute');
+    const done = await status(/^Done in|^Could not/);
+    if (!done.startsWith('Done in')) throw new Error(done);
+    const t2 = performance.now();
+    return { side: 'page', ready_s: (ready - t0) / 1000, load_s: (t1 - ready) / 1000, compute_s: (t2 - t1) / 1000, total_s: (t2 - t0) / 1000, first_visit_s: (t2 - t0) / 1000, status: done };
+  } finally {
+    await browser.close();
+    server.close();
+  }
+}
+
+/** The CLI's year; `fresh`: with an empty profile cache, so `auto` probes as on a first run. */
+function nativeRun(fresh) {
+  const bin = process.env.SUNLIT_BIN ?? join(ROOT, 'target/release/sunlit');
   statSync(bin);
+  const cache = fresh ? mkdtempSync(join(tmpdir(), 'sunlit-bench-cache-')) : undefined;
+  const env = cache ? { ...process.env, XDG_CACHE_HOME: cache } : process.env;
   const t0 = performance.now();
   execFileSync(bin, ['annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
-    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'] });
-  return { side: 'native', total_s: (performance.now() - t0) / 1000 };
+    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
+  const total = (performance.now() - t0) / 1000;
+  if (cache) rmSync(cache, { recursive: true, force: true });
+  return { side: fresh ? 'native-first' : 'native', total_s: total };
 }
 
 const median = (xs) => {
@@ -188,18 +246,30 @@ const median = (xs) => {
   return s.length % 2 ? s[(s.length - 1) / 2] : (s[s.length / 2 - 1] + s[s.length / 2]) / 2;
 };
 const head = { model: basename(model), samples, resolution: Number(resolution) };
+// With --interleave the sides take turns run by run (A B A B …), and each side's first-visit
+// (or total) seconds are also divided by the last side's total of the same round: a paired
+// ratio, which a machine whose speed drifts (a shared one) does not skew as much.
+const bySide = Object.fromEntries(sides.map((side) => [side, { times: [], visits: [] }]));
 for (const side of sides) {
-  const times = [];
   if (side === 'default-cached') {
     // A returning visitor: the profile is already in IndexedDB. One unmeasured run probes it;
     // every timed run then routes by it (pinned), so the probe's cost is left out as a cache hit.
     const first = await browserRun('default');
     ENGINES['default-cached'] = { profile: first.profile };
   }
-  for (let r = 0; r < runs; r++) {
-    const result = side === 'native' ? nativeRun() : await browserRun(side);
-    times.push(result.total_s);
-    console.log(JSON.stringify({ ...head, run: r + 1, ...result }));
-  }
-  console.log(JSON.stringify({ ...head, side, runs, median_s: Number(median(times).toFixed(2)) }));
+}
+const rounds = Array.from({ length: runs }, (_, r) => r);
+const order = interleave ? rounds.flatMap((r) => sides.map((side) => [side, r])) : sides.flatMap((side) => rounds.map((r) => [side, r]));
+for (const [side, r] of order) {
+  const result = side.startsWith('native') ? nativeRun(side === 'native-first') : side === 'page' ? await pageRun() : await browserRun(side);
+  bySide[side].times.push(result.total_s);
+  bySide[side].visits.push(result.first_visit_s ?? result.total_s);
+  console.log(JSON.stringify({ ...head, run: r + 1, ...result }));
+}
+const yardstick = bySide[sides[sides.length - 1]].times;
+for (const side of sides) {
+  const { times, visits } = bySide[side];
+  const firstVisit = side.startsWith('native') ? {} : { median_first_visit_s: Number(median(visits).toFixed(2)) };
+  const paired = interleave && side !== sides[sides.length - 1] ? { median_ratio_to_last: Number(median(visits.map((v, i) => v / yardstick[i])).toFixed(2)) } : {};
+  console.log(JSON.stringify({ ...head, side, runs, median_s: Number(median(times).toFixed(2)), ...firstVisit, ...paired }));
 }

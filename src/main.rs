@@ -51,6 +51,8 @@ mod docs_check;
 use district_cli::{DistrictArgs, district};
 #[path = "cli/map.rs"]
 mod map_cli;
+#[path = "cli/progress.rs"]
+mod progress;
 use map_cli::{MapArgs, map};
 
 #[derive(Parser)]
@@ -530,17 +532,22 @@ fn count_year(
     scene: &Scene,
     settings: &Resolved,
     options: &AnnualOptions,
-    report: &mut dyn FnMut(Progress) -> Result<()>,
+    meter: &mut progress::Meter,
 ) -> Result<sunlit::export::Schedule> {
     let mut engine = HybridEngine::new(scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
-    let year = |engine: &HybridEngine<'_>, report: &mut dyn FnMut(Progress) -> Result<()>| {
-        pollster::block_on(sunlit::year::annual::annual_with(engine, scene, &settings.location, options, &settings.calendar, report))
+    let year = |engine: &HybridEngine<'_>, meter: &mut progress::Meter| {
+        pollster::block_on(sunlit::year::annual::annual_with(engine, scene, &settings.location, options, &settings.calendar, &mut |p| {
+            meter.report(p);
+            Ok(())
+        }))
     };
-    match year(&engine, report) {
+    // A lost GPU device (driver reset) is recreated once; the year is counted again.
+    match year(&engine, meter) {
         Err(Error::DeviceLost(why)) => {
             log::warn!("GPU device lost ({why}); making a new one and counting again");
             engine.forget_gpu();
-            year(&engine, report)
+            meter.stage("year, counted again", "views");
+            year(&engine, meter)
         }
         other => other,
     }
@@ -591,24 +598,18 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (None, _) => None,
     };
     let start = Instant::now();
-    let bar = indicatif::ProgressBar::new(0).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} views, {eta} left")
-            .map_err(|e| Error::argument("progress", e.to_string()))?,
-    );
-    bar.set_message(if args.dense { "dense" } else { "sampling" });
-    let mut report = |p: Progress| {
-        bar.set_length(p.total as u64);
-        bar.set_position(p.done as u64);
-        Ok(())
-    };
+    let mut meter = progress::Meter::new(if args.dense { "dense year" } else { "year" }, "views")?;
     let schedule = match &varying {
-        None => count_year(&args, &scene, &settings, &options, &mut report)?,
+        None => count_year(&args, &scene, &settings, &options, &mut meter)?,
         Some(v) => {
             // Each varying shade opaque and removed, mixed per timestep by its τ.
             let mut years = Vec::with_capacity(v.variants());
             for variant in 0..v.variants() {
+                if variant > 0 {
+                    meter.stage(&format!("year with shades' variant {} of {}", variant + 1, v.variants()), "views");
+                }
                 let variant_scene = args.model.load_with_shades(v.shade_transmittance(variant))?;
-                years.push(count_year(&args, &variant_scene, &settings, &options, &mut report)?);
+                years.push(count_year(&args, &variant_scene, &settings, &options, &mut meter)?);
             }
             v.mix(&years)?
         }
@@ -621,13 +622,10 @@ fn annual(args: AnnualArgs) -> Result<()> {
         _ => None,
     };
     let solar_files = match &solar {
-        Some(plan) => {
-            bar.set_message("sky");
-            solar_outputs(plan, &engine, &scene, &settings, &schedule, &args, &mut report)?
-        }
+        Some(plan) => solar_outputs(plan, &engine, &scene, &settings, &schedule, &args, &mut meter)?,
         None => Vec::new(),
     };
-    bar.finish_and_clear();
+    meter.finish();
     sunlit::export::write_atomic(&args.output, &bytes)?;
     for (path, bytes) in &solar_files {
         sunlit::export::write_atomic(path, bytes)?;
@@ -650,7 +648,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         timesteps.rows(),
         schedule.names.len(),
         start.elapsed().as_secs_f64(),
-        bar.length().unwrap_or(0)
+        meter.counted()
     );
     Ok(())
 }

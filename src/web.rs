@@ -248,7 +248,8 @@ impl Engine {
     }
 
     /// Promise of the year's schedule ([`Annual`]). `settings` is a plain object (see
-    /// [`AnnualSettings`]); `progress(done, total)` is called as views are counted; an aborted
+    /// [`AnnualSettings`]); `progress(done, total, counted)` is called as views are decided (counted, or
+    /// settled without counting: see [`Progress`]), stage by stage (the year, then its sky views); an aborted
     /// `signal` rejects the promise with an `Error` whose `code` is `cancelled`. `routing`: the
     /// pool of clipping workers and a profile to try ([`choice::Routing`]); a failing pool's
     /// error comes back as the pool threw it.
@@ -277,7 +278,8 @@ impl Engine {
                 }
                 if let Some(f) = &progress {
                     // A throwing progress callback is the caller's bug, not a reason to stop.
-                    let _ = f.call2(&JsValue::NULL, &JsValue::from(p.done as f64), &JsValue::from(p.total as f64));
+                    let (done, total, counted) = (p.done as f64, p.total as f64, p.counted() as f64);
+                    let _ = f.call3(&JsValue::NULL, &JsValue::from(done), &JsValue::from(total), &JsValue::from(counted));
                 }
                 Ok(())
             };

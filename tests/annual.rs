@@ -7,8 +7,9 @@ mod common;
 
 use std::process::Command;
 
-use common::*;
 use glam::DVec3;
+
+use common::*;
 use sunlit::count::lanes::Lane;
 use sunlit::export::Schedule;
 use sunlit::model::{LoadOptions, load_bytes, office::office};
@@ -234,7 +235,7 @@ fn exact_year(scene: &Scene, method: Method) -> (Schedule, usize) {
         &options,
         &calendar,
         &mut |p| {
-            views = views.max(p.total);
+            views = p.counted();
             Ok(())
         },
     ))
@@ -304,4 +305,131 @@ fn certificates_keep_every_minute_of_sun_in_a_canyon_of_blocks() {
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
     assert!(mean <= 0.005, "mean |Δ| {mean}");
     assert!(spline_views * 2 < dense_views, "{spline_views} views against {dense_views} dense");
+}
+
+/// The exact reference, tallying the views it is asked to count.
+struct Tally<'a> {
+    exact: sunlit::count::exact::Exact<'a>,
+    asked: std::cell::Cell<usize>,
+}
+
+impl<'a> Tally<'a> {
+    fn new(scene: &'a Scene) -> Self {
+        Tally { exact: sunlit::count::exact::Exact { scene }, asked: std::cell::Cell::new(0) }
+    }
+}
+
+impl sunlit::count::Engine for Tally<'_> {
+    fn batch(&self) -> usize {
+        self.exact.batch()
+    }
+
+    async fn answer(&self, requests: &[sunlit::count::ViewRequest]) -> sunlit::Result<Vec<sunlit::count::ViewAnswer>> {
+        self.asked.set(self.asked.get() + requests.len());
+        self.exact.answer(requests).await
+    }
+}
+
+/// Every progress report of the year for `scene` at `method` (hourly, evergreen), and the views
+/// the engine was asked for.
+fn reported_year(scene: &Scene, method: Method) -> (Vec<sunlit::year::annual::Progress>, usize) {
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine: DEFAULT_REFINE };
+    let calendar = sunlit::year::season::LeafCalendar::evergreen();
+    let engine = Tally::new(scene);
+    let mut reports = Vec::new();
+    pollster::block_on(sunlit::year::annual::annual_with(&engine, scene, &golden(), &options, &calendar, &mut |p| {
+        reports.push(p);
+        Ok(())
+    }))
+    .unwrap();
+    (reports, engine.asked.get())
+}
+
+/// A year's progress tells the truth: its total is fixed from the first report (the samples and
+/// every facing sun-up timestep, which is what `--dense` counts), `done` never goes back and ends
+/// at the total, and the views it says were counted are those the engine was asked for: the
+/// timesteps the spline settles are done but not counted.
+#[test]
+fn a_years_progress_counts_what_the_engine_counted() {
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 2.0, 1.0, 2.0, 0.0), true);
+    s.polygon("FIN", &[DVec3::new(2.2, 0.0, 0.5), DVec3::new(2.2, -1.5, 0.5), DVec3::new(2.2, -1.5, 2.5), DVec3::new(2.2, 0.0, 2.5)], true);
+    s.polygon("OVERHANG", &flat_rect(-1.0, 3.0, -0.6, 0.0, 2.2), false);
+    let scene = s.build();
+    let (dense, dense_asked) = reported_year(&scene, Method::Dense);
+    let (spline, spline_asked) = reported_year(&scene, Method::Spline(SamplingPlan::new(9, 7).unwrap()));
+    for (reports, asked, what) in [(&dense, dense_asked, "dense"), (&spline, spline_asked, "spline")] {
+        let last = reports.last().unwrap();
+        println!("{what}: {} reports, last {last:?}, engine asked for {asked}", reports.len());
+        assert!(reports.iter().all(|p| p.total == last.total), "{what}: the total is fixed from the start");
+        assert!(reports.windows(2).all(|w| w[0].done <= w[1].done && w[0].counted() <= w[1].counted()), "{what}: never goes back");
+        assert_eq!((last.done, last.may_settle), (last.total, 0), "{what}: ends at its total");
+        assert_eq!(last.counted(), asked, "{what}: the views counted are the engine's");
+    }
+    let last = spline.last().unwrap();
+    assert_eq!(dense.last().unwrap().settled, 0, "dense counts every view");
+    assert!(last.settled > 0 && spline_asked < dense_asked, "the spline settles most timesteps: {last:?}");
+    // Its total: the samples (counted while every timestep may yet be settled), then every
+    // timestep the dense year counts.
+    let samples = spline.iter().filter(|p| p.may_settle > 0).map(|p| p.done).max().unwrap();
+    assert_eq!(samples + dense_asked, last.total);
+    assert!(spline.iter().all(|p| p.may_settle == 0 || p.may_settle == dense_asked));
+}
+
+/// With stderr in a file (a Slurm task's log, CI), `sunlit annual` writes plain progress lines
+/// (the interval shortened here so a small run shows several), and its closing line's views are
+/// those an engine counted over the year, the sky views and EnergyPlus's diffuse directions:
+/// what the library's own stages asked of an engine that tallies them.
+#[test]
+fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
+    let dir = scratch("progress");
+    let model = dir.join("office.glb");
+    std::fs::write(&model, office(2).to_glb()).unwrap();
+    let (csv, summary, log) = (dir.join("out.csv"), dir.join("summary.json"), dir.join("log.txt"));
+    let status = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .args([
+            "annual",
+            model.to_str().unwrap(),
+            "--location",
+            "39.74,-105.18,-7",
+            "--receivers",
+            "WIN_S1",
+            "--receivers",
+            "WIN_E",
+            "--engine",
+            "exact",
+        ])
+        .args(["--days-per-year", "9", "--samples-per-day", "7", "--timesteps-per-hour", "1", "--summary", summary.to_str().unwrap()])
+        .args(["-o", csv.to_str().unwrap()])
+        .env("SUNLIT_PROGRESS_EVERY_MS", "0")
+        .env("XDG_RUNTIME_DIR", runtime_dir())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .status()
+        .unwrap();
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(status.success(), "{text}");
+    let lines = |stage: &str| text.lines().filter(|l| l.starts_with(&format!("{stage}: "))).collect::<Vec<_>>();
+    let (year, sky, ratios) = (lines("year"), lines("sky views"), lines("EnergyPlus's diffuse ratios"));
+    assert!(year.len() >= 3 && !sky.is_empty() && !ratios.is_empty(), "{text}");
+    assert!(year[0].contains(" of ") && year[0].contains("views (") && year[0].contains("elapsed"), "{}", year[0]);
+    assert!(year.last().unwrap().contains("(100 %)") && year.last().unwrap().ends_with("done"), "{text}");
+    assert!(year.iter().any(|l| l.contains(" to ") && l.ends_with(" left")), "a range while the samples are counted: {text}");
+    let closing = text.lines().find(|l| l.contains("views counted")).unwrap();
+    let said: usize = closing.rsplit("; ").next().unwrap().split(' ').next().unwrap().parse().unwrap();
+
+    let options = LoadOptions { receivers: vec!["WIN_S1".into(), "WIN_E".into()], ..Default::default() };
+    let scene = load_bytes(&[("office.glb".into(), office(2).to_glb())], &options).unwrap();
+    let engine = Tally::new(&scene);
+    let plan = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
+        refine: DEFAULT_REFINE,
+    };
+    let calendar = sunlit::year::season::LeafCalendar::evergreen();
+    let mut quiet = |_: sunlit::year::annual::Progress| -> sunlit::Result<()> { Ok(()) };
+    pollster::block_on(sunlit::year::annual::annual_with(&engine, &scene, &golden(), &plan, &calendar, &mut quiet)).unwrap();
+    let patches = sunlit::sky::patches::SkyPatches::tregenza();
+    pollster::block_on(sunlit::sky::views::sky_views(&engine, &scene, &patches, &mut quiet)).unwrap();
+    pollster::block_on(sunlit::sky::energyplus::ratios(&engine, &scene, &mut quiet)).unwrap();
+    assert_eq!(said, engine.asked.get(), "{closing}");
 }

@@ -126,7 +126,7 @@ fn year(scene: &Scene, method: Method, refine: f64) -> (Schedule, usize) {
     let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine };
     let mut views = 0;
     let schedule = pollster::block_on(annual_with_leaves(&counter, &gpu, scene, &golden(), &options, &NORTHERN, &mut |p| {
-        views = p.total;
+        views = p.counted();
         Ok(())
     }))
     .unwrap();

@@ -223,6 +223,7 @@ function showError(msg) {
 
 worker.onmessage = ({ data: msg }) => {
   if (msg.type === 'ready') {
+    worker.postMessage({ type: 'warm', engine: engineOptions() });
     if (!msg.webgpu) noWebGPU();
     else status('Ready. Choose a model, drop one here, or load the example.');
     $('compute').disabled = !state.model || state.busy;
@@ -232,7 +233,9 @@ worker.onmessage = ({ data: msg }) => {
   } else if (msg.type === 'progress') {
     $('progress').max = msg.total || 1;
     $('progress').value = msg.done;
-    status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}`);
+    // A year's timesteps the spline interpolates are decided without counting: say how many views were counted.
+    const counted = msg.counted !== undefined && msg.counted !== msg.done ? ` decided (${msg.counted.toLocaleString()} counted)` : '';
+    status(`Counting views: ${msg.done.toLocaleString()} of ${msg.total.toLocaleString()}${counted}`);
   } else if (msg.type === 'loading') {
     showLoading(msg);
   } else if (msg.type === 'notice') {

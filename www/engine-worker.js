@@ -8,7 +8,7 @@
 //   { id, op: 'annual', settings }                 → { id, result: { names, means, irradiation, csv } }
 //   { id, op: 'map', options, csv, glb }           → { id, result: SunlitMap }  (engine.map's typed arrays, transferred)
 //   { id, op: 'cancel' }                           → aborts a running annual or map
-// Errors come back as { id, error: message, code }; progress of an annual as { id, progress: [done, total] }.
+// Errors come back as { id, error: message, code }; progress of an annual as { id, progress: [done, total, counted] }.
 // The engine clips on its own pool of workers and routes `auto` by a measured profile, as
 // createEngine does anywhere (create's options take `workers`, `profile` and `skyProfile` too).
 import { createEngine } from './sunlit.js';
@@ -34,7 +34,7 @@ const ops = {
   fractions: ({ sun }) => need(engine, 'create').fractions(need(model, 'fromMeshes or loadFiles'), sun),
   async annual({ id, settings }) {
     running = new AbortController();
-    const onProgress = (done, total) => postMessage({ id, progress: [done, total] });
+    const onProgress = (done, total, counted) => postMessage({ id, progress: [done, total, counted] });
     const year = await need(engine, 'create').annual(need(model, 'fromMeshes or loadFiles'), settings, { onProgress, signal: running.signal });
     try {
       return { names: year.names, means: year.means, irradiation: year.irradiation, csv: year.csv(), profile: year.profile, profileSource: year.profileSource, skyProfile: year.skyProfile, skyProfileSource: year.skyProfileSource };

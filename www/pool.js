@@ -32,6 +32,9 @@ export class ClipPool {
   #url;
   #size;
   #workers = [];
+  /** Every worker spawned, ready or not: the pool starts with its engine, so it may be closed
+   * before its workers are ready. */
+  #spawned = [];
   #started = null;
   #source = null;
   #loading = null;
@@ -82,6 +85,7 @@ export class ClipPool {
         reject(coded(`clipping worker ${index} could not start: ${error?.message ?? error}`, 'worker', { worker: index, workerCode: 'start' }));
         return;
       }
+      this.#spawned.push(worker);
       const slot = { index, worker, busy: null, pending: null };
       worker.onerror = (event) => {
         event.preventDefault?.();
@@ -213,7 +217,8 @@ export class ClipPool {
 
   /** Stops every worker (their memory is freed). */
   terminate() {
-    for (const slot of this.#workers) slot?.worker.terminate();
+    for (const worker of this.#spawned) worker.terminate();
+    this.#spawned = [];
     this.#workers = [];
     this.#source = null;
     this.#loading = null;

@@ -180,8 +180,11 @@ export interface AnnualSettings {
 }
 
 export interface AnnualRunOptions {
-  /** Called as views are counted. */
-  onProgress?: (done: number, total: number) => void;
+  /** Called as the run goes, stage by stage (the year, then its sky views with weather): `done`
+   * of `total` views decided, of which `counted` were counted by an engine (the rest were settled
+   * without counting, e.g. timesteps the spline interpolates). A year's `total` is fixed from its
+   * first call; `done` jumps once its samples are fitted. */
+  onProgress?: (done: number, total: number, counted: number) => void;
   /** Aborting rejects the run with an AbortError at the next progress report. */
   signal?: AbortSignal;
 }

@@ -62,23 +62,37 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
       { option: 'engine' },
     );
   if (device === undefined && !hasWebGPU() && wantsGpu) throw noGpu();
-  await ready();
-  const open = (gpu) => () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine), gpu);
+  // The pool's workers start now (each compiles the wasm and starts its instance), while this
+  // thread starts its own and opens the GPU device: a first visit waits for the slower of the
+  // two, not their sum (docs/page-speed.md, "The first visit"). A worker that cannot start is
+  // said by the first call that needs the pool (#routing), which then clips in this thread.
+  const pool = size > 0 ? new ClipPool(size) : null;
+  pool?.start().catch(() => {});
   let made;
-  if (device !== undefined) made = await onDevice(device, open(true));
-  else if (!hasWebGPU()) made = await open(false)();
-  else {
-    try {
-      made = await open(true)();
-    } catch (error) {
-      // WebGPU present but no adapter (a blocklisted GPU, flags off): clip without it.
-      if (error?.gpu !== 'no-adapter') throw error;
-      if (wantsGpu) throw noGpu();
-      made = await open(false)();
-    }
+  try {
+    made = await openEngine({ resolution, accuracy, device, engine, wantsGpu, noGpu });
+  } catch (error) {
+    pool?.terminate();
+    throw error;
   }
   const text = (p) => (p === undefined || p === null ? undefined : typeof p === 'string' ? p : JSON.stringify(p));
-  return new SunlitEngine(made, size > 0 ? new ClipPool(size) : null, { sun: text(profile), sky: text(skyProfile) });
+  return new SunlitEngine(made, pool, { sun: text(profile), sky: text(skyProfile) });
+}
+
+/** The wasm engine on `device`, on a device of its own, or clipping only where there is none. */
+async function openEngine({ resolution, accuracy, device, engine, wantsGpu, noGpu }) {
+  await ready();
+  const open = (gpu) => () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine), gpu);
+  if (device !== undefined) return onDevice(device, open(true));
+  if (!hasWebGPU()) return open(false)();
+  try {
+    return await open(true)();
+  } catch (error) {
+    // WebGPU present but no adapter (a blocklisted GPU, flags off): clip without it.
+    if (error?.gpu !== 'no-adapter') throw error;
+    if (wantsGpu) throw noGpu();
+    return open(false)();
+  }
 }
 
 /** An EPW's LOCATION record: { latitude, longitude, timeZone, elevation, name }. */

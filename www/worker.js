@@ -1,8 +1,8 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: load, compute, map, mapFile, cancel, epw. Messages out:
-// loaded, progress, notice, result, mapResult, mapFile, epwLocation, error (with the error's
-// `code`, and `gpu: true` when the device failed twice and a retry may help). Errors are told
-// apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
+// page stays responsive. Messages in: warm (make the engine now), load, compute, map, mapFile,
+// cancel, epw. Messages out: loaded, progress, notice, result, mapResult, mapFile, epwLocation,
+// error (with the error's `code`, and `gpu: true` when the device failed twice and a retry may
+// help). Errors are told apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
 
 let engine = null;
@@ -11,16 +11,45 @@ let files = null;
 let loadOptions = null;
 let running = null;
 
+/** An engine being made: { options, promise }, so that a load arriving while the page's
+ * warm-up still makes the engine waits for that one instead of making a second. */
+let making = null;
+
+const fits = (made, options) => made.resolution === options.resolution && made.engine === options.engine;
+
 /** The engine for these options ({ resolution, engine }), made again when either changes. */
 async function engineFor(options) {
-  if (!engine || engine.resolution !== options.resolution || engine.engine !== options.engine) {
-    engine?.close();
-    engine = null;
-    model?.free();
-    model = null;
-    engine = await createEngine(options);
-  }
-  return engine;
+  if (engine && fits(engine, options)) return engine;
+  if (making && fits(making.options, options)) return making.promise;
+  engine?.close();
+  engine = null;
+  model?.free();
+  model = null;
+  const promise = createEngine(options).then(
+    (made) => {
+      // Superseded by other options while it was made: not the engine any more.
+      if (making?.promise !== promise) {
+        made.close();
+        throw Object.assign(new Error('the engine was replaced'), { code: 'cancelled' });
+      }
+      making = null;
+      engine = made;
+      return made;
+    },
+    (error) => {
+      if (making?.promise === promise) making = null;
+      throw error;
+    },
+  );
+  making = { options, promise };
+  return promise;
+}
+
+/** Makes the engine (its GPU device, its clipping workers) before the first model arrives, while
+ * the visitor picks one: the first year then waits for neither (docs/page-speed.md, "The first
+ * visit"). A failure is said by the load that needs the engine, which tries again. */
+function warm({ engine: options }) {
+  engineFor(options).catch(() => {});
 }
 
 function modelOn(e) {
@@ -109,11 +138,11 @@ async function computeOnce({ settings, engine: made, csvName }) {
   running = new AbortController();
   const started = performance.now();
   let last = 0;
-  const onProgress = (done, total) => {
+  const onProgress = (done, total, counted) => {
     const now = performance.now();
     if (now - last > 100 || done === total) {
       last = now;
-      postMessage({ type: 'progress', done, total });
+      postMessage({ type: 'progress', done, total, counted });
     }
   };
   const annual = await e.annual(m, settings, { onProgress, signal: running.signal });
@@ -235,6 +264,7 @@ onmessage = async ({ data }) => {
     else if (data.type === 'map') await map(data);
     else if (data.type === 'mapFile') mapFile(data);
     else if (data.type === 'epw') await epw(data);
+    else if (data.type === 'warm') warm(data);
   } catch (error) {
     fail(error, data.type);
   } finally {

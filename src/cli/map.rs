@@ -13,6 +13,7 @@ use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::weather::{Weather, check_albedo};
 use sunlit::year::season::LeafCalendar;
 
+use super::progress::Meter;
 use super::*;
 
 #[path = "map_planning.rs"]
@@ -281,20 +282,11 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     let gpu = counter.as_ref().map(|c| MapGpu::new(c, &scene, &points)).transpose()?;
     let calendar = LeafCalendar::for_latitude(location.latitude);
     let samples = plan.period.samples();
-    let bar = indicatif::ProgressBar::new(samples.len() as u64).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} instants, {eta} left")
-            .map_err(|e| Error::argument("progress", e.to_string()))?,
-    );
-    bar.set_message(format!("{} points", points.len()));
-    let mut report = |done: usize, total: usize| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    };
     // Each point's own sky views, once (geometry only), when irradiation is summed.
     let sky_start = Instant::now();
-    bar.set_message(format!("{} points: sky views ({} patches)", points.len(), patches.len()));
-    let sky = (weather.is_some() && !plan.instant).then(|| point_sky(&mapper, &patches, &mut report));
-    bar.set_message(format!("{} points", points.len()));
+    let mut meter = Meter::new(&format!("{} points: sky views ({} patches)", points.len(), patches.len()), "patch views")?;
+    let sky = (weather.is_some() && !plan.instant).then(|| point_sky(&mapper, &patches, &mut meter.counts()));
+    meter.stage(&format!("{} points", points.len()), "instants");
     let sky_seconds = sky_start.elapsed().as_secs_f64();
     let site = Site { location: &location, calendar: &calendar, weather: weather.as_ref(), sky: sky.as_ref() };
 
@@ -315,16 +307,17 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         (csv, lit, "lit", "")
     } else {
         let values = match &gpu {
-            Some(g) => pollster::block_on(mapper.accumulate_gpu(g, &samples, site, &mut report))?,
-            None => mapper.accumulate(&samples, site, &mut report)?,
+            Some(g) => pollster::block_on(mapper.accumulate_gpu(g, &samples, site, &mut meter.counts()))?,
+            None => mapper.accumulate(&samples, site, &mut meter.counts())?,
         };
         let csv = points_csv(&scene, &points, &value_columns(&values));
         summary["sun_up_instants"] = json!(values.sun_up);
         let mut studies = Vec::new();
         for rule in &plan.rules {
+            meter.stage(&format!("{} points: {}", points.len(), rule.name), "instants");
             let series = match &gpu {
-                Some(g) => pollster::block_on(mapper.lit_series_gpu(g, &samples, site, rule.min_altitude_deg, &mut report))?,
-                None => mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut report),
+                Some(g) => pollster::block_on(mapper.lit_series_gpu(g, &samples, site, rule.min_altitude_deg, &mut meter.counts()))?,
+                None => mapper.lit_series(&samples, site, rule.min_altitude_deg, &mut meter.counts()),
             };
             let day = plan.period.single_day().unwrap_or(rule.default_day);
             let result = study::evaluate(rule, day, &samples, &series, &points.receivers);
@@ -343,7 +336,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         let (name, unit, v) = glb_value(values);
         (csv, v, name, unit)
     };
-    bar.finish_and_clear();
+    meter.finish();
     files.insert(0, (args.output.clone(), csv.into_bytes()));
     if let Some(glb) = &args.glb_out {
         files.push((glb.clone(), map_glb(&scene, &points, &glb_values, glb_name, glb_unit)));

@@ -20,6 +20,7 @@ use sunlit::year::annual::Progress;
 use sunlit::year::settings::Resolved;
 use sunlit::{Error, Result};
 
+use super::progress::Meter;
 use super::{AnnualArgs, check_writable};
 
 /// Writes a summary as JSON or CSV.
@@ -84,10 +85,14 @@ pub fn solar_outputs(
     settings: &Resolved,
     schedule: &Schedule,
     args: &AnnualArgs,
-    report: &mut dyn FnMut(Progress) -> Result<()>,
+    meter: &mut Meter,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>> {
     let start = std::time::Instant::now();
-    let views = pollster::block_on(sky_views(engine, scene, &plan.patches, report))?;
+    meter.stage("sky views", "views");
+    let views = pollster::block_on(sky_views(engine, scene, &plan.patches, &mut |p| {
+        meter.report(p);
+        Ok(())
+    }))?;
     eprintln!(
         "sky views: {} receivers × {} patches ({}) in {:.2} s",
         scene.receivers.len(),
@@ -102,7 +107,11 @@ pub fn solar_outputs(
     }
     if let Some((path, format)) = &plan.summary {
         let start = std::time::Instant::now();
-        let ratios = energyplus_ratios(engine, scene, args, report)?;
+        meter.stage("EnergyPlus's diffuse ratios", "views");
+        let ratios = energyplus_ratios(engine, scene, args, &mut |p| {
+            meter.report(p);
+            Ok(())
+        })?;
         eprintln!("EnergyPlus's diffuse shading ratios (144 directions) in {:.2} s", start.elapsed().as_secs_f64());
         let summaries = irradiation::summarize(
             scene,

@@ -170,11 +170,11 @@ pub(crate) async fn count(
 
 async fn count_sky(engine: &impl Engine, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
     let mut out = Vec::with_capacity(requests.len());
-    progress(Progress { done: 0, total: requests.len() })?;
+    progress(Progress::counting(0, requests.len()))?;
     engine.expect(requests.len());
     for chunk in requests.chunks(engine.batch().max(1) * BATCHES_PER_REPORT) {
         out.extend(engine.answer(chunk).await?.into_iter().map(|a| a.fraction));
-        progress(Progress { done: out.len(), total: requests.len() })?;
+        progress(Progress::counting(out.len(), requests.len()))?;
     }
     Ok(out)
 }

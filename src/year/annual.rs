@@ -84,13 +84,36 @@ pub const KINK: f64 = 0.03;
 /// example office (N = 1) it takes the 27×19 RMS error from 0.017 to 0.006 for 37% more views.
 pub const DEFAULT_REFINE: f64 = 0.3;
 
-/// Views counted so far, of the total the run needs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// A run's work so far, in views (one receiver at one sun or sky direction). Most views are
+/// counted by the engine; some are *settled* without it: a timestep the spline interpolates
+/// (or a cell proven dark or lit) is work the run had to decide, but no view was counted for it.
+/// A year's total is fixed from its start (its samples and every sun-up timestep a surface faces),
+/// so a report can say how far the run is and how long it may take before the fit has said
+/// which timesteps will be counted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Progress {
-    /// Views counted.
+    /// Views decided: counted or settled.
     pub done: usize,
-    /// Views to count.
+    /// Views to decide in all.
     pub total: usize,
+    /// Of `done`, the views settled without counting.
+    pub settled: usize,
+    /// Of the views not yet done, how many may still be settled without counting (a year's
+    /// timesteps before its samples are fitted): the time left lies between that of counting
+    /// `total - done - may_settle` views and that of counting `total - done`.
+    pub may_settle: usize,
+}
+
+impl Progress {
+    /// `done` of `total` views counted, every one of them by the engine.
+    pub fn counting(done: usize, total: usize) -> Self {
+        Progress { done, total, ..Default::default() }
+    }
+
+    /// Views an engine counted (`done` less the settled ones).
+    pub fn counted(&self) -> usize {
+        self.done.saturating_sub(self.settled)
+    }
 }
 
 /// Atlas submissions per progress report: often enough that a cancel (an `Err` from the progress
@@ -231,12 +254,12 @@ impl<E: Engine> Views<'_, E> {
     /// Counts many views (each at its own leaf fraction), reporting progress as it goes.
     async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
-        progress(Progress { done: 0, total: requests.len() })?;
+        progress(Progress::counting(0, requests.len()))?;
         self.engine.expect(requests.len());
         let per_report = self.engine.batch().max(1) * BATCHES_PER_REPORT;
         for chunk in requests.chunks(per_report) {
             out.extend(self.engine.answer(chunk).await?.into_iter().map(|c| c.fraction));
-            progress(Progress { done: out.len(), total: requests.len() })?;
+            progress(Progress::counting(out.len(), requests.len()))?;
         }
         Ok(out)
     }
@@ -294,23 +317,56 @@ async fn dense_year(
 ) -> Result<()> {
     let mut requests = Vec::new();
     let mut cells = Vec::new();
-    for (row, instant) in schedule.timesteps.instants().enumerate() {
-        let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
-        if !sun_is_up(sun) {
-            continue;
-        }
-        for (column, r) in scene.receivers.iter().enumerate() {
-            if !is_dark(r.normal, sun) {
-                requests.push(ViewRequest::new(column as u32, sun).with_leaves(calendar.fraction(instant.day as f64) as f32));
-                cells.push((row, column));
-            }
-        }
+    for (row, column, sun, day) in facing_timesteps(scene, location, schedule.timesteps) {
+        requests.push(ViewRequest::new(column as u32, sun).with_leaves(calendar.fraction(f64::from(day)) as f32));
+        cells.push((row, column));
     }
     let values = views.count(&requests, progress).await?;
     for ((row, column), v) in cells.into_iter().zip(values) {
         schedule.set(row, column, as_energyplus(v));
     }
     Ok(())
+}
+
+/// Every sun-up timestep at which a receiver faces the sun, as (row, receiver, sun, calendar
+/// day): the views a dense year counts, and those a spline year settles or counts.
+fn facing_timesteps<'a>(
+    scene: &'a Scene,
+    location: &'a Location,
+    timesteps: Timesteps,
+) -> impl Iterator<Item = (usize, usize, DVec3, u32)> + 'a {
+    timesteps.instants().enumerate().flat_map(move |(row, instant)| {
+        let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
+        let up = sun_is_up(sun);
+        scene
+            .receivers
+            .iter()
+            .enumerate()
+            .filter(move |(_, r)| up && !is_dark(r.normal, sun))
+            .map(move |(column, _)| (row, column, sun, instant.day))
+    })
+}
+
+/// A spline year's work as [`Progress`] reports it: its sample views, then its facing timesteps
+/// ([`facing_timesteps`]), each of which the fit either settles (interpolated, or proven dark
+/// or lit) or leaves to count. The total is known before the first view is counted.
+#[derive(Debug, Clone, Copy)]
+struct YearWork {
+    samples: usize,
+    timesteps: usize,
+}
+
+impl YearWork {
+    /// While the samples are counted, any timestep may still be settled.
+    fn sampling(self, p: Progress) -> Progress {
+        Progress { done: p.done, total: self.samples + self.timesteps, settled: 0, may_settle: self.timesteps }
+    }
+
+    /// Once the fit leaves `to_count` timesteps to count, the others are settled; `p` counts those.
+    fn refining(self, to_count: usize, p: Progress) -> Progress {
+        let settled = self.timesteps.saturating_sub(to_count);
+        Progress { done: self.samples + settled + p.done, total: self.samples + settled + to_count, settled, may_settle: 0 }
+    }
 }
 
 /// One fit of the year: its sample days, their leaf fractions and the grid the fit lives on.
@@ -449,9 +505,8 @@ async fn spline_year(
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
     let SampleViews { requests, cells } = sample_views(scene, location, &regimes, &taus);
-    // Progress counts the samples and then the refined timesteps, whose number is known later.
-    let total = requests.len();
-    let counted = views.count(&requests, &mut |p| progress(Progress { done: p.done, total: total.max(p.total) })).await?;
+    let work = YearWork { samples: requests.len(), timesteps: facing_timesteps(scene, location, schedule.timesteps).count() };
+    let counted = views.count(&requests, &mut |p| progress(work.sampling(p))).await?;
     let mut samples: Vec<Vec<Option<f64>>> =
         regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
     for (request, g, cell) in cells {
@@ -466,7 +521,8 @@ async fn spline_year(
     let rough = if rough.is_empty() { rough } else { settle_by_certificate(scene, rough, schedule) };
     let requests: Vec<ViewRequest> =
         rough.iter().map(|r| ViewRequest::new(r.column as u32, r.sun).with_leaves(calendar.fraction(r.day) as f32)).collect();
-    let refined = views.count(&requests, &mut |p| progress(Progress { done: total + p.done, total: total + p.total })).await?;
+    // Certified timesteps are settled like interpolated ones: done, not counted.
+    let refined = views.count(&requests, &mut |p| progress(work.refining(requests.len(), p))).await?;
     for (r, v) in rough.into_iter().zip(refined) {
         schedule.set(r.row, r.column, as_energyplus(v));
     }
