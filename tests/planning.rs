@@ -1,5 +1,6 @@
 //! Window studies against independent truths: BRE 209's VSC against the closed form of a
-//! vertical point facing an infinitely long obstruction; APSH/WPSH against a numpy ray caster
+//! vertical point facing an infinitely long obstruction and against Radiance's `rtrace -I`
+//! (tests/planning/vsc_radiance.py); APSH/WPSH against a numpy ray caster
 //! over the same EPW hours (tests/planning/apsh_truth.py, its own sun); GB 50180's sunlight
 //! hours against the analytic canyon (a sill facing a long slab); true solar time against a
 //! published equation-of-time table; the CLI's output contract, before/after and refusals.
