@@ -9,7 +9,7 @@
 
 mod common;
 use common::energyplus::energyplus;
-use common::{TestScene, south_rect};
+use common::{TestScene, radiance_python, south_rect};
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -75,18 +75,6 @@ fn vsc_matches_the_closed_form_of_a_long_obstruction() {
             assert!((got - truth).abs() <= 0.5, "θ = {theta_deg}°, point {i}: VSC {got:.3} vs closed form {truth:.3}");
         }
     }
-}
-
-fn radiance_python() -> PathBuf {
-    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
-    assert!(
-        venv.exists(),
-        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
-    );
-    venv
 }
 
 /// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
