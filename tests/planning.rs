@@ -1,5 +1,6 @@
 //! Window studies against independent truths: BRE 209's VSC against the closed form of a
-//! vertical point facing an infinitely long obstruction; APSH/WPSH against a numpy ray caster
+//! vertical point facing an infinitely long obstruction and against Radiance's `rtrace -I`
+//! (tests/planning/vsc_radiance.py); APSH/WPSH against a numpy ray caster
 //! over the same EPW hours (tests/planning/apsh_truth.py, its own sun); GB 50180's sunlight
 //! hours against the analytic canyon (a sill facing a long slab); true solar time against a
 //! published equation-of-time table; the CLI's output contract, before/after and refusals.
@@ -8,7 +9,7 @@
 
 mod common;
 use common::energyplus::energyplus;
-use common::{TestScene, south_rect};
+use common::{TestScene, radiance_python, south_rect};
 
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
@@ -74,18 +75,6 @@ fn vsc_matches_the_closed_form_of_a_long_obstruction() {
             assert!((got - truth).abs() <= 0.5, "θ = {theta_deg}°, point {i}: VSC {got:.3} vs closed form {truth:.3}");
         }
     }
-}
-
-fn radiance_python() -> PathBuf {
-    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
-    assert!(
-        venv.exists(),
-        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
-    );
-    venv
 }
 
 /// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE

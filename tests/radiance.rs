@@ -31,7 +31,7 @@
 
 mod common;
 use common::energyplus::energyplus;
-use common::runtime_dir;
+use common::{radiance_python, runtime_dir};
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -49,20 +49,6 @@ use sunlit::year::annual::shading_sun_day;
 /// The ground reflectance given to both (sunlit's `--albedo`, gendaymtx's `-g`): the EPW's own
 /// albedo varies by the hour, gendaymtx takes one.
 const ALBEDO: f64 = 0.2;
-
-/// The Python with pyradiance: `SUNLIT_RADIANCE_PYTHON`, else .venv-rad's. Panics saying how to
-/// get it.
-fn radiance_python() -> PathBuf {
-    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
-    assert!(
-        venv.exists(),
-        "Radiance (pyradiance) not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
-    );
-    venv
-}
 
 /// Golden, CO TMY3, from the EnergyPlus wheel (which `npm test` installs too).
 pub fn golden_epw() -> PathBuf {

@@ -140,29 +140,34 @@ fn before_points(before: &Scene, path: &std::path::Path, text: &str, points: usi
     Ok((kept, index))
 }
 
-/// One scene's values per study, in [`STUDIES`]' keys.
+/// One scene's values per study, in [`STUDIES`]' keys, and the seconds each took.
 #[derive(Default)]
 struct Values {
     vsc: Option<vsc::VscValues>,
     apsh: Option<apsh::ApshValues>,
     gb: Option<gb50180::Gb50180Values>,
+    seconds: Vec<(String, f64)>,
 }
 
 fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_>>, gb: Option<&Gb50180Rule>) -> Result<Values> {
-    let mapper = Mapper::new(scene, points)?;
-    let mut values = Values::default();
+    let start = Instant::now();
+    // gb50180 indexes its own points (with its sill samples); the BRE studies share this index.
+    let mapper = args.study.iter().any(|s| s != "gb50180").then(|| Mapper::new(scene, points)).transpose()?;
+    let mut values = Values { seconds: vec![("index".into(), start.elapsed().as_secs_f64())], ..Values::default() };
     for study in &args.study {
-        match study.as_str() {
-            "bre-vsc" => values.vsc = Some(vsc::vsc(&mapper, &mut |_, _| {})),
-            "bre-apsh" => {
+        let start = Instant::now();
+        match (study.as_str(), &mapper) {
+            ("bre-vsc", Some(mapper)) => values.vsc = Some(vsc::vsc(mapper, &mut |_, _| {})),
+            ("bre-apsh", Some(mapper)) => {
                 let site = site.ok_or_else(|| Error::argument("--epw", "bre-apsh needs a weather file"))?;
-                values.apsh = Some(apsh::apsh(&mapper, site, &mut |_, _| {})?);
+                values.apsh = Some(apsh::apsh(mapper, site, &mut |_, _| {})?);
             }
             _ => {
                 let (site, rule) = site.zip(gb).ok_or_else(|| Error::argument("--location", "gb50180 needs the site"))?;
                 values.gb = Some(gb50180::evaluate(scene, points, site.location, rule, &mut |_, _| {})?);
             }
         }
+        values.seconds.push((study.clone(), start.elapsed().as_secs_f64()));
     }
     Ok(values)
 }
@@ -317,6 +322,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     }
     let start = Instant::now();
     let scene = args.model.load()?;
+    let load_seconds = start.elapsed().as_secs_f64();
     let points = args.points(&scene)?;
     let masks = mask_rows(args.mask.as_deref(), points.len())?;
     let before = if args.before.is_empty() {
@@ -386,6 +392,11 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         "points": points.len(),
         "points_before": before.as_ref().map(|(_, p, _)| p.len()),
         "seconds": round(seconds, 3),
+        "seconds_by_part": {
+            "load": round(load_seconds, 3),
+            "proposed": now.seconds.iter().map(|(k, v)| (k.clone(), json!(round(*v, 3)))).collect::<serde_json::Map<_, _>>(),
+            "existing": former.as_ref().map(|f| f.seconds.iter().map(|(k, v)| (k.clone(), json!(round(*v, 3)))).collect::<serde_json::Map<_, _>>()),
+        },
         "studies": tables.iter().map(|t| json!({
             "study": t.study,
             "assessed": (0..points.len()).filter(|&i| t.passes(i).is_some()).count(),

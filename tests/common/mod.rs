@@ -139,3 +139,17 @@ pub fn closed_form_perez(n: DVec3, sun: DVec3, dni: f64, dhi: f64, elevation: f6
     let circumsolar = if sun.z < 85f64.to_radians().cos() && sin_tilt < 0.1 { 1.0 } else { a / b };
     dhi * ((1.0 - f1) * (1.0 + n.z) / 2.0 + f1 * circumsolar + f2 * sin_tilt).max(0.0)
 }
+
+/// The Python with pyradiance: `SUNLIT_RADIANCE_PYTHON`, else .venv-rad's. Panics saying how to
+/// get it.
+pub fn radiance_python() -> PathBuf {
+    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
+    assert!(
+        venv.exists(),
+        "Radiance (pyradiance) not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
+    );
+    venv
+}
