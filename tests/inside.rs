@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 use glam::DVec3;
 use serde_json::{Value, json};
 use sunlit::map::Mapper;
-use sunlit::map::inside::{self, RoomPoints};
+use sunlit::map::inside::{self, InsideMap, RoomPoints};
 use sunlit::map::{Period, Site};
 use sunlit::model::inside::{Rooms, inside_scene, rooms};
 use sunlit::model::{self, LoadOptions};
@@ -135,7 +135,7 @@ fn work_plane_grid_agrees_with_a_numpy_ray_caster() {
         "suns": suns.iter().map(|s| s.to_array()).collect::<Vec<_>>()});
     let reference = numpy_reference(&query);
     for (k, &sun) in suns.iter().enumerate() {
-        let ours = inside::instant(&mapper, &rooms, &at, sun, 1.0);
+        let ours = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0);
         let theirs: Vec<f64> = reference["lit"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
         let differ = ours.lit.iter().zip(&theirs).filter(|(a, b)| a != b).count();
         let lit = theirs.iter().filter(|&&v| v == 1.0).count();
@@ -172,7 +172,7 @@ fn leed_ase_matches_a_numpy_ray_caster_on_the_golden_epw() {
     let samples = inside::occupied_hours(&Period::annual(1).unwrap().samples());
     assert_eq!(samples.len(), 3650);
     let mapper = Mapper::new(&scene, &at.points).unwrap();
-    let ours = inside::leed_ase(&mapper, &rooms, &at, &samples, site, &mut |_, _| {}).unwrap();
+    let ours = inside::leed_ase(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &samples, site, &mut |_, _| {}).unwrap();
     assert_eq!(ours.efficacy_hours, 0, "Golden's EPW has direct normal illuminance every hour");
     let suns: Vec<[f64; 3]> = samples.iter().map(|s| sun_direction(&location, shading_sun_day(s.day), s.hour).to_array()).collect();
     let lux: Vec<f64> = samples.iter().map(|s| weather.direct_normal_illuminance(s.epw_hour).unwrap()).collect();
@@ -269,7 +269,7 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
         let (mut scene, rooms) = load(idf).unwrap();
         let at = inside::floor_grid(&mut scene, &rooms, 0.5, inside::NSL_WORK_PLANE).unwrap();
         let mapper = Mapper::new(&scene, &at.points).unwrap();
-        inside::no_sky_line(&mapper, &rooms, &at, &patches, &mut |_, _| {}).1[0].sees_sky
+        inside::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &patches, &mut |_, _| {}).1[0].sees_sky
     };
     assert_eq!(share(&room_idf(WINDOW, false, "")), 100.0);
     // A 50 m high screen 0.3 m in front of the window hides every piece of sky.
