@@ -276,3 +276,26 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
     let screen = "Shading:Site:Detailed,Screen,,4,-50,-0.3,50,-50,-0.3,0,54,-0.3,0,54,-0.3,50;\n";
     assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
 }
+
+#[test]
+fn free_csv_points_answer_as_the_work_plane_grid_does() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let grid = inside::floor_grid(&mut scene, &rooms, 0.2, 0.76).unwrap();
+    let mut text = String::from("x,y,z,nx,ny,nz\n");
+    for p in positions(&grid) {
+        text += &format!("{},{},{},0,0,1\n", p[0], p[1], p[2]);
+    }
+    // On a fresh scene: the CSV's points are free (on no inside face) and get a plane of their own.
+    let (mut fresh, _) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let free = inside::room_points_csv(&mut fresh, &rooms, "plane.csv", &text).unwrap();
+    assert_eq!(free.points.len(), grid.points.len());
+    assert!(fresh.receivers[free.points.receivers[0] as usize].name.contains("free plane"));
+    let (a, b) = (Mapper::new(&scene, &grid.points).unwrap(), Mapper::new(&fresh, &free.points).unwrap());
+    for sun in [DVec3::new(0.2, -0.8, 0.7), DVec3::new(-0.4, -0.6, 0.5)] {
+        let sun = sun.normalize();
+        let on_grid = inside::instant(InsideMap { mapper: &a, rooms: &rooms, at: &grid }, sun, 1.0);
+        let on_free = inside::instant(InsideMap { mapper: &b, rooms: &rooms, at: &free }, sun, 1.0);
+        assert!(on_grid.lit.iter().sum::<f64>() > 50.0);
+        assert_eq!(on_grid, on_free, "sun {sun}");
+    }
+}
