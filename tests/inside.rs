@@ -299,3 +299,35 @@ fn free_csv_points_answer_as_the_work_plane_grid_does() {
         assert_eq!(on_grid, on_free, "sun {sun}");
     }
 }
+
+/// EnergyPlus 25.2's own simple glazing numbers (eplusout.eio's WindowConstruction: solar and
+/// visible transmittance at normal incidence) against the glass `rooms` reads, for U 2.0 / SHGC
+/// 0.6 / VT 0.7 and U 5.0 / SHGC 0.4 / VT 0.5 (tests/inside/glass.idf, a one-day run).
+#[test]
+fn simple_glazing_transmittance_matches_energyplus() {
+    let idf = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/glass.idf");
+    let out = scratch("glass-run");
+    let run = Command::new(common::energyplus::energyplus())
+        .args(["-w", golden_epw().to_str().unwrap(), "-d", out.to_str().unwrap(), idf.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
+    let eio = std::fs::read_to_string(out.join("eplusout.eio")).unwrap();
+    let text = std::fs::read_to_string(&idf).unwrap();
+    let loaded = model::load_bytes_all(&[("glass.idf".to_string(), text.into_bytes())], &LoadOptions::default()).unwrap();
+    let ours = rooms(&loaded.energyplus.unwrap(), None).unwrap();
+    for (window, construction) in [("Win", "GLASS"), ("Win2", "GLASS2")] {
+        let row: Vec<f64> = eio
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("WindowConstruction,{construction},")))
+            .unwrap()
+            .split(',')
+            .filter_map(|f| f.trim().parse().ok())
+            .collect();
+        let (solar, visible) = (row[row.len() - 2], row[row.len() - 1]);
+        let g = ours.glazing.iter().find(|g| g.name == window).unwrap();
+        eprintln!("{window}: solar {} (EnergyPlus {solar}), visible {} (EnergyPlus {visible})", g.solar, g.visible);
+        assert!((g.solar - solar).abs() <= 0.005, "{window}: solar {} against EnergyPlus's {solar}", g.solar);
+        assert!((g.visible - visible).abs() <= 0.005, "{window}: visible {} against EnergyPlus's {visible}", g.visible);
+    }
+}
