@@ -331,3 +331,42 @@ fn simple_glazing_transmittance_matches_energyplus() {
         assert!((g.visible - visible).abs() <= 0.005, "{window}: visible {} against EnergyPlus's {visible}", g.visible);
     }
 }
+
+/// A day's sums are the instants' answers added up: beam = Σ DNI · cos · solar weight · hours,
+/// illuminance = Σ lux · cos · visible weight · hours, and without the EPW's illuminance the
+/// stated efficacy (every instant counted in `efficacy_hours`).
+#[test]
+fn a_days_sums_add_up_the_instants() {
+    use sunlit::sun::weather::Hour;
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, 0.76).unwrap();
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let map = InsideMap { mapper: &mapper, rooms: &rooms, at: &at };
+    let location = Location::new(39.74, -105.18, -7.0).unwrap();
+    let plain = Weather::constant(location.clone(), Hour { dni: 800.0, dhi: 100.0, ghi: 600.0, albedo: 0.2 });
+    let lit = plain.clone().with_direct_illuminance(vec![Some(90_000.0); 8760]);
+    let calendar = LeafCalendar::evergreen();
+    let samples = Period::day(355, 9 * 60, 15 * 60, 10).unwrap().samples();
+    let (mut beam, mut klux) = (vec![0.0; at.points.len()], vec![0.0; at.points.len()]);
+    for s in &samples {
+        let sun = sun_direction(&location, shading_sun_day(s.day), s.hour);
+        let one = inside::instant(map, sun, 1.0);
+        for i in 0..at.points.len() {
+            beam[i] += 800.0 * sun.z * one.solar_transmittance[i] * s.hours / 1000.0;
+            klux[i] += 90_000.0 * sun.z * one.visible_transmittance[i] * s.hours / 1000.0;
+        }
+    }
+    let site = Site { location: &location, calendar: &calendar, weather: Some(&lit), sky: None };
+    let sums = inside::accumulate(map, &samples, site, &mut |_, _| {});
+    assert!(beam.iter().sum::<f64>() > 10.0, "the winter sun reaches the work plane");
+    assert_eq!(sums.efficacy_hours, 0);
+    for i in 0..at.points.len() {
+        assert!((sums.beam_kwh_m2.as_ref().unwrap()[i] - beam[i]).abs() < 1e-9);
+        assert!((sums.direct_klux_h.as_ref().unwrap()[i] - klux[i]).abs() < 1e-9);
+    }
+    let site = Site { weather: Some(&plain), ..site };
+    let sums = inside::accumulate(map, &samples, site, &mut |_, _| {});
+    assert_eq!(sums.efficacy_hours, samples.len());
+    let efficacy = klux.iter().zip(sums.direct_klux_h.unwrap()).map(|(k, d)| k / 90_000.0 * 800.0 * inside::BEAM_EFFICACY - d);
+    assert!(efficacy.map(f64::abs).fold(0.0, f64::max) < 1e-9);
+}
