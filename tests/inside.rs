@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 use glam::DVec3;
 use serde_json::{Value, json};
 use sunlit::map::Mapper;
-use sunlit::map::inside::{self, RoomPoints};
+use sunlit::map::inside::{self, InsideMap, RoomPoints};
 use sunlit::map::{Period, Site};
 use sunlit::model::inside::{Rooms, inside_scene, rooms};
 use sunlit::model::{self, LoadOptions};
@@ -135,7 +135,7 @@ fn work_plane_grid_agrees_with_a_numpy_ray_caster() {
         "suns": suns.iter().map(|s| s.to_array()).collect::<Vec<_>>()});
     let reference = numpy_reference(&query);
     for (k, &sun) in suns.iter().enumerate() {
-        let ours = inside::instant(&mapper, &rooms, &at, sun, 1.0);
+        let ours = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0);
         let theirs: Vec<f64> = reference["lit"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
         let differ = ours.lit.iter().zip(&theirs).filter(|(a, b)| a != b).count();
         let lit = theirs.iter().filter(|&&v| v == 1.0).count();
@@ -172,7 +172,7 @@ fn leed_ase_matches_a_numpy_ray_caster_on_the_golden_epw() {
     let samples = inside::occupied_hours(&Period::annual(1).unwrap().samples());
     assert_eq!(samples.len(), 3650);
     let mapper = Mapper::new(&scene, &at.points).unwrap();
-    let ours = inside::leed_ase(&mapper, &rooms, &at, &samples, site, &mut |_, _| {}).unwrap();
+    let ours = inside::leed_ase(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &samples, site, &mut |_, _| {}).unwrap();
     assert_eq!(ours.efficacy_hours, 0, "Golden's EPW has direct normal illuminance every hour");
     let suns: Vec<[f64; 3]> = samples.iter().map(|s| sun_direction(&location, shading_sun_day(s.day), s.hour).to_array()).collect();
     let lux: Vec<f64> = samples.iter().map(|s| weather.direct_normal_illuminance(s.epw_hour).unwrap()).collect();
@@ -269,10 +269,104 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
         let (mut scene, rooms) = load(idf).unwrap();
         let at = inside::floor_grid(&mut scene, &rooms, 0.5, inside::NSL_WORK_PLANE).unwrap();
         let mapper = Mapper::new(&scene, &at.points).unwrap();
-        inside::no_sky_line(&mapper, &rooms, &at, &patches, &mut |_, _| {}).1[0].sees_sky
+        inside::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &patches, &mut |_, _| {}).1[0].sees_sky
     };
     assert_eq!(share(&room_idf(WINDOW, false, "")), 100.0);
     // A 50 m high screen 0.3 m in front of the window hides every piece of sky.
     let screen = "Shading:Site:Detailed,Screen,,4,-50,-0.3,50,-50,-0.3,0,54,-0.3,0,54,-0.3,50;\n";
     assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
+}
+
+#[test]
+fn free_csv_points_answer_as_the_work_plane_grid_does() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let grid = inside::floor_grid(&mut scene, &rooms, 0.2, 0.76).unwrap();
+    let mut text = String::from("x,y,z,nx,ny,nz\n");
+    for p in positions(&grid) {
+        text += &format!("{},{},{},0,0,1\n", p[0], p[1], p[2]);
+    }
+    // On a fresh scene: the CSV's points are free (on no inside face) and get a plane of their own.
+    let (mut fresh, _) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let free = inside::room_points_csv(&mut fresh, &rooms, "plane.csv", &text).unwrap();
+    assert_eq!(free.points.len(), grid.points.len());
+    assert!(fresh.receivers[free.points.receivers[0] as usize].name.contains("free plane"));
+    let (a, b) = (Mapper::new(&scene, &grid.points).unwrap(), Mapper::new(&fresh, &free.points).unwrap());
+    for sun in [DVec3::new(0.2, -0.8, 0.7), DVec3::new(-0.4, -0.6, 0.5)] {
+        let sun = sun.normalize();
+        let on_grid = inside::instant(InsideMap { mapper: &a, rooms: &rooms, at: &grid }, sun, 1.0);
+        let on_free = inside::instant(InsideMap { mapper: &b, rooms: &rooms, at: &free }, sun, 1.0);
+        assert!(on_grid.lit.iter().sum::<f64>() > 50.0);
+        assert_eq!(on_grid, on_free, "sun {sun}");
+    }
+}
+
+/// EnergyPlus 25.2's own simple glazing numbers (eplusout.eio's WindowConstruction: solar and
+/// visible transmittance at normal incidence) against the glass `rooms` reads, for U 2.0 / SHGC
+/// 0.6 / VT 0.7 and U 5.0 / SHGC 0.4 / VT 0.5 (tests/inside/glass.idf, a one-day run).
+#[test]
+fn simple_glazing_transmittance_matches_energyplus() {
+    let idf = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/glass.idf");
+    let out = scratch("glass-run");
+    let run = Command::new(common::energyplus::energyplus())
+        .args(["-w", golden_epw().to_str().unwrap(), "-d", out.to_str().unwrap(), idf.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
+    let eio = std::fs::read_to_string(out.join("eplusout.eio")).unwrap();
+    let text = std::fs::read_to_string(&idf).unwrap();
+    let loaded = model::load_bytes_all(&[("glass.idf".to_string(), text.into_bytes())], &LoadOptions::default()).unwrap();
+    let ours = rooms(&loaded.energyplus.unwrap(), None).unwrap();
+    for (window, construction) in [("Win", "GLASS"), ("Win2", "GLASS2")] {
+        let row: Vec<f64> = eio
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("WindowConstruction,{construction},")))
+            .unwrap()
+            .split(',')
+            .filter_map(|f| f.trim().parse().ok())
+            .collect();
+        let (solar, visible) = (row[row.len() - 2], row[row.len() - 1]);
+        let g = ours.glazing.iter().find(|g| g.name == window).unwrap();
+        eprintln!("{window}: solar {} (EnergyPlus {solar}), visible {} (EnergyPlus {visible})", g.solar, g.visible);
+        assert!((g.solar - solar).abs() <= 0.005, "{window}: solar {} against EnergyPlus's {solar}", g.solar);
+        assert!((g.visible - visible).abs() <= 0.005, "{window}: visible {} against EnergyPlus's {visible}", g.visible);
+    }
+}
+
+/// A day's sums are the instants' answers added up: beam = Σ DNI · cos · solar weight · hours,
+/// illuminance = Σ lux · cos · visible weight · hours, and without the EPW's illuminance the
+/// stated efficacy (every instant counted in `efficacy_hours`).
+#[test]
+fn a_days_sums_add_up_the_instants() {
+    use sunlit::sun::weather::Hour;
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, 0.76).unwrap();
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let map = InsideMap { mapper: &mapper, rooms: &rooms, at: &at };
+    let location = Location::new(39.74, -105.18, -7.0).unwrap();
+    let plain = Weather::constant(location.clone(), Hour { dni: 800.0, dhi: 100.0, ghi: 600.0, albedo: 0.2 });
+    let lit = plain.clone().with_direct_illuminance(vec![Some(90_000.0); 8760]);
+    let calendar = LeafCalendar::evergreen();
+    let samples = Period::day(355, 9 * 60, 15 * 60, 10).unwrap().samples();
+    let (mut beam, mut klux) = (vec![0.0; at.points.len()], vec![0.0; at.points.len()]);
+    for s in &samples {
+        let sun = sun_direction(&location, shading_sun_day(s.day), s.hour);
+        let one = inside::instant(map, sun, 1.0);
+        for i in 0..at.points.len() {
+            beam[i] += 800.0 * sun.z * one.solar_transmittance[i] * s.hours / 1000.0;
+            klux[i] += 90_000.0 * sun.z * one.visible_transmittance[i] * s.hours / 1000.0;
+        }
+    }
+    let site = Site { location: &location, calendar: &calendar, weather: Some(&lit), sky: None };
+    let sums = inside::accumulate(map, &samples, site, &mut |_, _| {});
+    assert!(beam.iter().sum::<f64>() > 10.0, "the winter sun reaches the work plane");
+    assert_eq!(sums.efficacy_hours, 0);
+    for i in 0..at.points.len() {
+        assert!((sums.beam_kwh_m2.as_ref().unwrap()[i] - beam[i]).abs() < 1e-9);
+        assert!((sums.direct_klux_h.as_ref().unwrap()[i] - klux[i]).abs() < 1e-9);
+    }
+    let site = Site { weather: Some(&plain), ..site };
+    let sums = inside::accumulate(map, &samples, site, &mut |_, _| {});
+    assert_eq!(sums.efficacy_hours, samples.len());
+    let efficacy = klux.iter().zip(sums.direct_klux_h.unwrap()).map(|(k, d)| k / 90_000.0 * 800.0 * inside::BEAM_EFFICACY - d);
+    assert!(efficacy.map(f64::abs).fold(0.0, f64::max) < 1e-9);
 }

@@ -210,6 +210,28 @@ impl MapArgs {
         Ok(kind == EngineKind::Gpu)
     }
 
+    /// The site and its weather (with `--albedo` applied), once the output paths are known to be
+    /// writable.
+    fn site(&self) -> Result<(Location, Option<Weather>)> {
+        let (location, weather) = match (&self.epw, &self.location) {
+            (Some(epw), _) => {
+                let weather = Weather::from_epw(epw)?;
+                let weather = match self.albedo {
+                    Some(albedo) => weather.with_albedo(albedo)?,
+                    None => weather,
+                };
+                (weather.location.clone(), Some(weather))
+            }
+            (None, Some(text)) => (Location::parse(text)?, None),
+            (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
+        };
+        check_writable(&self.output)?;
+        if let Some(glb) = &self.glb_out {
+            check_writable(glb)?;
+        }
+        Ok((location, weather))
+    }
+
     fn study_path(&self, name: &str, extension: &str) -> PathBuf {
         let stem = self.output.file_stem().map_or("map".into(), |s| s.to_string_lossy().into_owned());
         self.output.with_file_name(format!("{stem}.study-{name}.{extension}"))
@@ -254,22 +276,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     if args.sky_patches.is_some() && args.epw.is_none() {
         return Err(Error::argument("sky_patches", "needs a weather file (--epw): the sky's light comes from it"));
     }
-    let (location, weather) = match (&args.epw, &args.location) {
-        (Some(epw), _) => {
-            let weather = Weather::from_epw(epw)?;
-            let weather = match args.albedo {
-                Some(albedo) => weather.with_albedo(albedo)?,
-                None => weather,
-            };
-            (weather.location.clone(), Some(weather))
-        }
-        (None, Some(text)) => (Location::parse(text)?, None),
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
-    check_writable(&args.output)?;
-    if let Some(glb) = &args.glb_out {
-        check_writable(glb)?;
-    }
+    let (location, weather) = args.site()?;
     let scene = args.model.load()?;
     let points = args.points(&scene)?;
     let start = Instant::now();

@@ -3,9 +3,9 @@
 //! the glass, the sums and the rule.
 
 use sunlit::map::inside::{
-    self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
+    self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, InsideMap, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
 };
-use sunlit::model::inside::{Rooms, inside_scene, rooms};
+use sunlit::model::inside::{inside_scene, rooms};
 
 use super::*;
 
@@ -66,18 +66,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
     {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
-    let (location, weather) = match (&args.epw, &args.location) {
-        (Some(epw), _) => {
-            let weather = Weather::from_epw(epw)?;
-            (weather.location.clone(), Some(weather))
-        }
-        (None, Some(text)) => (Location::parse(text)?, None),
-        (None, None) => return Err(Error::argument("location", "give --epw FILE or --location LAT,LON,TZ")),
-    };
-    check_writable(&args.output)?;
-    if let Some(glb) = &args.glb_out {
-        check_writable(glb)?;
-    }
+    let (location, weather) = args.site()?;
     let loaded = args.model.load_all(false)?;
     let Some(ep) = loaded.energyplus.as_ref().filter(|_| args.model.models.len() == 1) else {
         return Err(Error::argument("inside", "maps the zones of one EnergyPlus model (IDF or epJSON), given alone"));
@@ -102,15 +91,16 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
     };
     let start = Instant::now();
     let mapper = Mapper::new(&scene, &at.points)?;
+    let map = InsideMap { mapper: &mapper, rooms: &rooms, at: &at };
     let calendar = LeafCalendar::for_latitude(location.latitude);
     let site = Site { location: &location, calendar: &calendar, weather: weather.as_ref(), sky: None };
     let mut summary = json!({});
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     let (csv, glb) = match ask {
-        Ask::At(period) => instant(&scene, &rooms, &mapper, &at, &period, &location, &calendar, &mut summary),
+        Ask::At(period) => instant(&scene, map, &period, &location, &calendar, &mut summary),
         Ask::Period(period) => {
             let samples = period.samples();
-            let values = rooms_map::accumulate(&mapper, &rooms, &at, &samples, site, &mut |_, _| {});
+            let values = rooms_map::accumulate(map, &samples, site, &mut |_, _| {});
             summary["instants"] = json!(values.instants);
             summary["efficacy_hours"] = json!(values.efficacy_hours);
             let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
@@ -124,7 +114,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         }
         Ask::Ase => {
             let samples = rooms_map::occupied_hours(&Period::annual(1)?.samples());
-            let result = rooms_map::leed_ase(&mapper, &rooms, &at, &samples, site, &mut |_, _| {})?;
+            let result = rooms_map::leed_ase(map, &samples, site, &mut |_, _| {})?;
             let report = ase_report(&args, &location, &result, &at);
             summary["studies"] = json!([{"study": "leed-ase", "areas": report["areas"].clone()}]);
             files.push((args.study_path("leed-ase", "json"), format!("{report:#}\n").into_bytes()));
@@ -133,7 +123,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         }
         Ask::Nsl => {
             let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;
-            let (sees, areas) = rooms_map::no_sky_line(&mapper, &rooms, &at, &patches, &mut |_, _| {});
+            let (sees, areas) = rooms_map::no_sky_line(map, &patches, &mut |_, _| {});
             let areas: Vec<Value> =
                 areas.iter().map(|a| json!({"zone": a.zone, "points": a.points, "sees_sky": round(a.sees_sky, 3)})).collect();
             let report = json!({
@@ -171,12 +161,9 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
 }
 
 /// One instant: the points' `lit` and glass weights, and each inside face's sun patch.
-#[allow(clippy::too_many_arguments)]
 fn instant(
     scene: &Scene,
-    rooms: &Rooms,
-    mapper: &Mapper,
-    at: &RoomPoints,
+    map: InsideMap<'_>,
     period: &Period,
     location: &Location,
     calendar: &LeafCalendar,
@@ -185,14 +172,14 @@ fn instant(
     let s = period.samples()[0];
     let sun = sunlit::sun::position::sun_direction(location, sunlit::year::annual::shading_sun_day(s.day), s.hour);
     let leaves = calendar.fraction(f64::from(s.day)) as f32;
-    let values = rooms_map::instant(mapper, rooms, at, sun, leaves);
+    let values = rooms_map::instant(map, sun, leaves);
     let columns = [
         Column { name: "lit", values: &values.lit, decimals: 0 },
         Column { name: "solar_transmittance", values: &values.solar_transmittance, decimals: 4 },
         Column { name: "visible_transmittance", values: &values.visible_transmittance, decimals: 4 },
     ];
     let up = sun.z >= sunlit::count::MIN_COS_INCIDENCE;
-    let patches = if up { rooms_map::sun_patches(scene, rooms, sun, leaves) } else { Vec::new() };
+    let patches = if up { rooms_map::sun_patches(scene, map.rooms, sun, leaves) } else { Vec::new() };
     summary["sun_up"] = json!(up);
     summary["lit_points"] = json!(values.lit.iter().filter(|&&v| v >= 0.5).count());
     summary["sun_patches"] = json!(
@@ -201,7 +188,7 @@ fn instant(
             .map(|p| json!({"surface": p.surface, "zone": p.zone, "area_m2": round(p.area_m2, 6), "fraction": round(p.fraction, 6)}))
             .collect::<Vec<_>>()
     );
-    (points_csv(scene, &at.points, &columns), ("lit", "", values.lit.clone()))
+    (points_csv(scene, &map.at.points, &columns), ("lit", "", values.lit.clone()))
 }
 
 /// `POINTS.study-leed-ase.json`: the rule, its inputs and per room `zone`, `points` and `ase` (%).

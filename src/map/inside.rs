@@ -166,6 +166,17 @@ fn append(into: &mut Points, from: &mut Points) {
     into.receivers.append(&mut from.receivers);
 }
 
+/// What the inside's sweeps read: the points' rays, their rooms and where they lie.
+#[derive(Clone, Copy)]
+pub struct InsideMap<'a> {
+    /// The points indexed for the exact engine's rays (made from `at.points`).
+    pub mapper: &'a Mapper,
+    /// The zones and their glazing.
+    pub rooms: &'a Rooms,
+    /// The points and their rooms.
+    pub at: &'a RoomPoints,
+}
+
 /// Per point, the glass between it and the sun: the product of the transmittances (solar,
 /// visible) of its room's openings its ray to the sun crosses.
 pub fn through_glass(rooms: &Rooms, room: u32, p: DVec3, sun: DVec3) -> (f64, f64) {
@@ -190,7 +201,8 @@ pub struct InsideInstant {
 }
 
 /// The points' lit state and glass weights for the sun along `sun` at leaf fraction `leaves`.
-pub fn instant(mapper: &Mapper, rooms: &Rooms, at: &RoomPoints, sun: DVec3, leaves: f32) -> InsideInstant {
+pub fn instant(map: InsideMap<'_>, sun: DVec3, leaves: f32) -> InsideInstant {
+    let InsideMap { mapper, rooms, at } = map;
     let visibility = mapper.visibility(sun, leaves);
     let mut out = InsideInstant::default();
     for (i, v) in visibility.into_iter().enumerate() {
@@ -270,14 +282,8 @@ fn efficacy_hours(weather: &Weather, samples: &[Sample]) -> usize {
 
 /// Sun hours, and with weather the beam irradiation and direct-sun illuminance through the
 /// glass, per point over `samples`.
-pub fn accumulate(
-    mapper: &Mapper,
-    rooms: &Rooms,
-    at: &RoomPoints,
-    samples: &[Sample],
-    site: Site<'_>,
-    progress: &mut dyn FnMut(usize, usize),
-) -> InsideValues {
+pub fn accumulate(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> InsideValues {
+    let InsideMap { mapper, rooms, at } = map;
     let n = at.points.len();
     let weather = site.weather;
     let parts = mapper.sweep(
@@ -353,14 +359,8 @@ pub fn occupied_hours(samples: &[Sample]) -> Vec<Sample> {
 /// (see [`occupied_hours`]) when its direct-sun illuminance through the glass (visible
 /// transmittance) exceeds [`ASE_LUX`]; per room the share of its points over [`ASE_HOURS`].
 /// Refuses a site without weather.
-pub fn leed_ase(
-    mapper: &Mapper,
-    rooms: &Rooms,
-    at: &RoomPoints,
-    samples: &[Sample],
-    site: Site<'_>,
-    progress: &mut dyn FnMut(usize, usize),
-) -> Result<AseResult> {
+pub fn leed_ase(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<AseResult> {
+    let InsideMap { mapper, rooms, at } = map;
     let Some(weather) = site.weather else {
         return Err(Error::argument("weather", "LEED ASE needs a weather file: its direct normal illuminance"));
     };
@@ -431,12 +431,11 @@ pub struct NslArea {
 /// a point within a sub-patch's width of the line may be put on its wrong side). Glass does not
 /// matter: a point behind a window sees the sky it sees. Foliage counts in full leaf.
 pub fn no_sky_line(
-    mapper: &Mapper,
-    rooms: &Rooms,
-    at: &RoomPoints,
+    map: InsideMap<'_>,
     patches: &crate::sky::patches::SkyPatches,
     progress: &mut dyn FnMut(usize, usize),
 ) -> (Vec<bool>, Vec<NslArea>) {
+    let InsideMap { mapper, rooms, at } = map;
     let sky = super::point_sky(mapper, patches, progress);
     let sees: Vec<bool> = (0..at.points.len()).map(|i| sky.isotropic(i, 1.0) > SEES_SKY).collect();
     let areas = rooms
