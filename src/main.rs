@@ -363,6 +363,7 @@ fn main() -> ExitCode {
     quiet_mesa_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     exit_cleanly_on_ctrl_c();
+    end_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Fraction(a) => fraction(a),
@@ -434,6 +435,19 @@ const FLAGS: &[(&str, &str)] = &[
 /// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
 fn flag(param: &str) -> String {
     FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
+}
+
+/// `sunlit info MODEL | head` closes the pipe while sunlit still prints: Rust ignores SIGPIPE, so
+/// `println!` would panic on the write error. Restoring the default action ends the process
+/// quietly at that write, as `cat` or `grep` end; nothing is being written to a file then (every
+/// file sunlit writes goes through a temporary file and a rename, and stdout is never one).
+fn end_quietly_on_a_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default has no preconditions; it runs at
+    // start-up, before any other thread exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }
 
 /// Ctrl-C (SIGINT, SIGTERM): remove the temporary file of an output being written, so nothing

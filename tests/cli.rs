@@ -278,6 +278,29 @@ fn bench_lists_writes_and_times_generated_models() {
     fails_with(&sunlit(&["bench", "--write", &path]), &["--write", "one generated model"]);
 }
 
+/// `sunlit info MODEL | head -1`: the reader closes the pipe while sunlit still prints its table;
+/// sunlit ends quietly (SIGPIPE's default action), not with a panic.
+#[test]
+fn a_closed_stdout_pipe_ends_quietly() {
+    let dir = scratch("pipe");
+    let path = dir.join("trees.glb").display().to_string();
+    assert!(sunlit(&["bench", "blaas-trees-summer", "--write", &path]).status.success());
+    for _ in 0..3 {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+            .args(["info", &path])
+            .env("XDG_RUNTIME_DIR", runtime_dir())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Read nothing: the first write past the pipe's buffer meets a closed pipe.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked") && out.status.code() != Some(101), "{:?}: {err}", out.status);
+    }
+}
+
 /// `bench --backend noop` times the host alone: it plans and records the same views as a real
 /// device (the same views rendered, tiles and triangles), reports the host's stages, and refuses
 /// what would act on the zeros it reads back. `--limits` asks a real device for less.
