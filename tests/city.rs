@@ -16,7 +16,7 @@ use common::{TestScene, flat_rect};
 use glam::DVec3;
 use sunlit::count::exact::Exact;
 use sunlit::count::{Engine, ViewRequest};
-use sweep_fixture::{scratch, stderr, sunlit, varying_epw};
+use sweep_fixture::{scratch, stderr, sunlit, tile_rows, varying_epw};
 
 const BLOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/city/block.city.json");
 
@@ -147,20 +147,6 @@ fn district(city: &Path, epw: &Path, out: &Path, more: &[&str]) -> std::process:
     args.extend(["--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5", "--sky-patches", "tregenza"]);
     args.extend(more);
     sunlit(&args)
-}
-
-/// Every tile record's rows in `out`, by surface, at full precision.
-fn tile_rows(out: &Path) -> HashMap<String, Vec<f64>> {
-    let mut rows = HashMap::new();
-    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
-        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
-        for r in done["rows"].as_array().unwrap() {
-            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
-                .map(|k| r[k].as_f64().unwrap());
-            rows.insert(r["surface"].as_str().unwrap().to_string(), values.to_vec());
-        }
-    }
-    rows
 }
 
 #[test]
