@@ -48,6 +48,8 @@ fn city_receivers_are_roofs_and_walls_by_default_and_chosen_by_type_or_building(
     // The courtyard roof keeps its hole: 20 × 20 − 8 × 8 m².
     let roof = all["receivers"].as_array().unwrap().iter().find(|r| r["name"] == "NL.B.courtyard/RoofSurface/1").unwrap();
     assert!((roof["area"].as_f64().unwrap() - 336.0).abs() < 1e-6, "{roof}");
+    let text = sunlit(&["info", BLOCK]);
+    assert!(!String::from_utf8_lossy(&text.stdout).contains("-0.000"), "{}", String::from_utf8_lossy(&text.stdout));
     // Local coordinates: the 85 km translate is gone before anything became f32.
     assert!(all["bounds"]["max"][0].as_f64().unwrap() < 200.0, "{}", all["bounds"]);
 }
