@@ -787,8 +787,10 @@ fn info(args: InfoArgs) -> Result<()> {
     }
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);
     println!("{:<width$}  {:>10}  normal (x east, y north, z up)", "surface", "area m²");
+    // Rounded first, then + 0.0: a component a hair below zero prints as +0.000, never -0.000.
+    let tidy = |v: f64| round(v, 3) + 0.0;
     for r in &scene.receivers {
-        println!("{:<width$}  {:>10.3}  ({:+.3}, {:+.3}, {:+.3})", r.name, r.area, r.normal.x, r.normal.y, r.normal.z);
+        println!("{:<width$}  {:>10.3}  ({:+.3}, {:+.3}, {:+.3})", r.name, r.area, tidy(r.normal.x), tidy(r.normal.y), tidy(r.normal.z));
     }
     Ok(())
 }

@@ -16,7 +16,7 @@ use common::{TestScene, flat_rect};
 use glam::DVec3;
 use sunlit::count::exact::Exact;
 use sunlit::count::{Engine, ViewRequest};
-use sweep_fixture::{scratch, stderr, sunlit, varying_epw};
+use sweep_fixture::{scratch, stderr, sunlit, tile_rows, varying_epw};
 
 const BLOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/city/block.city.json");
 
@@ -48,6 +48,8 @@ fn city_receivers_are_roofs_and_walls_by_default_and_chosen_by_type_or_building(
     // The courtyard roof keeps its hole: 20 × 20 − 8 × 8 m².
     let roof = all["receivers"].as_array().unwrap().iter().find(|r| r["name"] == "NL.B.courtyard/RoofSurface/1").unwrap();
     assert!((roof["area"].as_f64().unwrap() - 336.0).abs() < 1e-6, "{roof}");
+    let text = sunlit(&["info", BLOCK]);
+    assert!(!String::from_utf8_lossy(&text.stdout).contains("-0.000"), "{}", String::from_utf8_lossy(&text.stdout));
     // Local coordinates: the 85 km translate is gone before anything became f32.
     assert!(all["bounds"]["max"][0].as_f64().unwrap() < 200.0, "{}", all["bounds"]);
 }
@@ -147,20 +149,6 @@ fn district(city: &Path, epw: &Path, out: &Path, more: &[&str]) -> std::process:
     args.extend(["--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5", "--sky-patches", "tregenza"]);
     args.extend(more);
     sunlit(&args)
-}
-
-/// Every tile record's rows in `out`, by surface, at full precision.
-fn tile_rows(out: &Path) -> HashMap<String, Vec<f64>> {
-    let mut rows = HashMap::new();
-    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
-        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
-        for r in done["rows"].as_array().unwrap() {
-            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
-                .map(|k| r[k].as_f64().unwrap());
-            rows.insert(r["surface"].as_str().unwrap().to_string(), values.to_vec());
-        }
-    }
-    rows
 }
 
 #[test]

@@ -257,21 +257,6 @@ fn slurm_array_equals_the_local_sweep_and_a_cancelled_task_is_all_a_resubmission
     drop(cluster);
 }
 
-/// Every tile record's rows in `out`, by surface: (surface, values) at full precision.
-fn tile_rows(out: &Path) -> Vec<(String, Vec<f64>)> {
-    let mut rows = Vec::new();
-    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
-        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
-        for r in done["rows"].as_array().unwrap() {
-            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
-                .map(|k| r[k].as_f64().unwrap());
-            rows.push((r["surface"].as_str().unwrap().to_string(), values.to_vec()));
-        }
-    }
-    rows.sort_by(|a, b| a.0.cmp(&b.0));
-    rows
-}
-
 /// `sunlit district --slurm`: an array task a tile and a merge job; its cadastre equals the
 /// one-process run's (one tile holding the whole district) within 1e-9, with the exact engine and
 /// a context reaching across the district.

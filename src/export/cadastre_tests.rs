@@ -58,3 +58,20 @@ fn the_csv_and_roofs() {
     assert_eq!(rings[0][0], serde_json::json!([85120.0, 447340.0]));
     assert_eq!(geojson["crs"]["properties"]["name"], "https://www.opengis.net/def/crs/EPSG/0/7415");
 }
+
+#[test]
+fn a_sequence_becomes_one_document_with_its_indices_moved() {
+    let header =
+        r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[0.01,0.01,0.01],"translate":[0,0,0]},"CityObjects":{},"vertices":[]}"#;
+    let feature = |id: &str| {
+        format!(
+            r#"{{"type":"CityJSONFeature","id":"{id}","CityObjects":{{"{id}":{{"type":"Building","geometry":[{{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,2]]]}}]}}}},"vertices":[[0,0,0],[100,0,0],[0,100,0]]}}"#
+        )
+    };
+    let text = format!("{header}\n{}\n{}\n", feature("a"), feature("b"));
+    let doc = single_document("s.city.jsonl", text.as_bytes()).unwrap();
+    assert_eq!(doc["type"], "CityJSON");
+    assert_eq!(doc["vertices"].as_array().unwrap().len(), 6);
+    assert_eq!(doc["CityObjects"]["a"]["geometry"][0]["boundaries"], serde_json::json!([[[0, 1, 2]]]));
+    assert_eq!(doc["CityObjects"]["b"]["geometry"][0]["boundaries"], serde_json::json!([[[3, 4, 5]]]));
+}

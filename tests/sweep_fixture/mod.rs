@@ -114,3 +114,18 @@ pub fn varying_epw() -> String {
     }
     text
 }
+
+/// A district run's tile records in `out`: each surface's area, direct, sky-diffuse,
+/// ground-reflected and total irradiation, sun hours and mean fraction, at full precision.
+pub fn tile_rows(out: &Path) -> std::collections::BTreeMap<String, Vec<f64>> {
+    let mut rows = std::collections::BTreeMap::new();
+    for entry in std::fs::read_dir(out.join(".done")).unwrap() {
+        let done: serde_json::Value = serde_json::from_slice(&std::fs::read(entry.unwrap().path()).unwrap()).unwrap();
+        for r in done["rows"].as_array().unwrap() {
+            let values = ["area", "direct", "sky_diffuse", "ground_reflected", "total", "sun_hours", "mean_fraction"]
+                .map(|k| r[k].as_f64().unwrap());
+            rows.insert(r["surface"].as_str().unwrap().to_string(), values.to_vec());
+        }
+    }
+    rows
+}
