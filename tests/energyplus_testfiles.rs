@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::energyplus::{DarkLit, columns, dark_lit, energyplus};
+use common::energyplus::{DarkLit, columns, dark_lit, energyplus, sunlit_annual};
 
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
@@ -117,16 +117,7 @@ fn run_model(dir: &Path, name: &str, text: &str) -> (PathBuf, String) {
 /// `sunlit annual IDF --epw (Chicago) -o DIR/shading.csv EXTRA…` with the exact clipper; the
 /// command's output (the caller checks its status).
 fn sunlit(idf: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_sunlit"))
-        .arg("annual")
-        .arg(idf)
-        .arg("--epw")
-        .arg(weather())
-        .args(["--engine", "exact", "-o"])
-        .arg(csv)
-        .args(extra)
-        .output()
-        .unwrap()
+    sunlit_annual(idf, &weather(), csv, extra)
 }
 
 fn sunlit_ok(idf: &Path, csv: &Path, extra: &[&str]) -> String {
