@@ -551,14 +551,21 @@ fn annual(args: AnnualArgs) -> Result<()> {
         bar.set_position(p.done as u64);
         Ok(())
     };
+    // Views counted over every year counted (the bar shows one year at a time).
+    let mut views = 0;
     let schedule = match &varying {
-        None => count_year(&args, &scene, &settings, &options, &mut report)?,
+        None => {
+            let year = count_year(&args, &scene, &settings, &options, &mut report)?;
+            views += bar.length().unwrap_or(0);
+            year
+        }
         Some(v) => {
-            // Each varying shade opaque and removed, mixed per timestep by its τ.
+            // Each transmitting shade opaque and removed, mixed per timestep by its τ.
             let mut years = Vec::with_capacity(v.variants());
             for variant in 0..v.variants() {
                 let variant_scene = args.model.load_with_shades(v.shade_transmittance(variant))?;
                 years.push(count_year(&args, &variant_scene, &settings, &options, &mut report)?);
+                views += bar.length().unwrap_or(0);
             }
             v.mix(&years)?
         }
@@ -600,7 +607,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         timesteps.rows(),
         schedule.names.len(),
         start.elapsed().as_secs_f64(),
-        bar.length().unwrap_or(0)
+        views
     );
     Ok(())
 }
