@@ -616,7 +616,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let schedule = match &varying {
         None => count_year(&args, &scene, &settings, &options, &mut meter)?,
         Some(v) => {
-            // Each varying shade opaque and removed, mixed per timestep by its τ.
+            // Each transmitting shade opaque and removed, mixed per timestep by its τ.
             let mut years = Vec::with_capacity(v.variants());
             for variant in 0..v.variants() {
                 if variant > 0 {

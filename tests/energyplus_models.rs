@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::energyplus::{DarkLit, columns, dark_lit, energyplus};
+use common::energyplus::{DarkLit, columns, dark_lit, energyplus, sunlit_annual};
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw")
@@ -142,16 +142,7 @@ fn run_energyplus(idf: &Path, out: &Path) {
 
 /// `sunlit annual MODEL --epw (Chicago) --engine exact -o CSV EXTRA…` at its default settings.
 fn sunlit(model: &Path, csv: &Path, extra: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
-        .arg("annual")
-        .arg(model)
-        .arg("--epw")
-        .arg(weather())
-        .args(["--engine", "exact", "-o"])
-        .arg(csv)
-        .args(extra)
-        .output()
-        .unwrap();
+    let out = sunlit_annual(model, &weather(), csv, extra);
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(out.status.success(), "sunlit annual {}: {stderr}", model.display());
     stderr

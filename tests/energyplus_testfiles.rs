@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::energyplus::{columns, energyplus};
+use common::energyplus::{DarkLit, columns, dark_lit, energyplus, sunlit_annual};
 
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
@@ -117,16 +117,7 @@ fn run_model(dir: &Path, name: &str, text: &str) -> (PathBuf, String) {
 /// `sunlit annual IDF --epw (Chicago) -o DIR/shading.csv EXTRA…` with the exact clipper; the
 /// command's output (the caller checks its status).
 fn sunlit(idf: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_sunlit"))
-        .arg("annual")
-        .arg(idf)
-        .arg("--epw")
-        .arg(weather())
-        .args(["--engine", "exact", "-o"])
-        .arg(csv)
-        .args(extra)
-        .output()
-        .unwrap()
+    sunlit_annual(idf, &weather(), csv, extra)
 }
 
 fn sunlit_ok(idf: &Path, csv: &Path, extra: &[&str]) -> String {
@@ -520,8 +511,9 @@ fn leap_weather(dir: &Path) -> PathBuf {
 }
 
 /// Per surface: name, steps dark in one and lit in the other against the clipping run and
-/// against the hooked run, mean |Δ| over lit steps against the clipping run.
-type SurfaceStats = (String, usize, usize, f64);
+/// against the hooked run (EnergyPlus's own one-step glitches apart), mean |Δ| over lit steps
+/// against the clipping run.
+type SurfaceStats = (String, DarkLit, DarkLit, f64);
 
 /// One configuration of the sun check: a test file as an annual run with given settings.
 struct SunCase {
@@ -567,9 +559,8 @@ fn sun_case(case: &SunCase) -> Vec<SurfaceStats> {
         assert_eq!(clip.len(), hook.len());
         let skip = (case.first_day - 1) * 24 * case.n;
         let a = &ours[name][skip..skip + clip.len()];
-        let disagree = |b: &[f64]| a.iter().zip(b).filter(|(x, y)| (**x > 0.0) != (**y > 0.0)).count();
         let (mean, _) = lit_mean_difference(a, clip);
-        stats.push((name.clone(), disagree(clip), disagree(hook), mean));
+        stats.push((name.clone(), dark_lit(a, clip), dark_lit(a, hook), mean));
     }
     stats
 }
@@ -622,13 +613,18 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
     for (label, stats) in &results {
         assert!(stats.len() >= 15, "{label}: {} surfaces", stats.len());
         for (name, clip, hook, mean) in stats {
-            println!("{label} {name}: dark/lit disagreements {clip} (clipping), {hook} (hooked); mean |Δ| {mean:.4}");
+            println!(
+                "{label} {name}: dark/lit disagreements {} (clipping), {} (hooked); EnergyPlus one-step glitches {} (clipping), {} (hooked); mean |Δ| {mean:.4}",
+                clip.disagreements, hook.disagreements, clip.glitches, hook.glitches
+            );
             worst = worst.max(*mean);
         }
     }
+    let glitches: usize = results.iter().flat_map(|(_, s)| s.iter()).map(|(_, c, h, _)| c.glitches + h.glitches).sum();
+    println!("EnergyPlus one-step glitches (clipping and hooked runs, all cases): {glitches}");
     for (label, stats) in &results {
         for (name, clip, hook, mean) in stats {
-            assert_eq!((*clip, *hook), (0, 0), "{label} {name}: steps dark in one and lit in the other");
+            assert_eq!((clip.disagreements, hook.disagreements), (0, 0), "{label} {name}: steps dark in one and lit in the other");
             assert!(*mean <= 0.005, "{label} {name}: mean |Δ| {mean}");
         }
     }
@@ -664,10 +660,13 @@ fn medium_office_sun_and_dark_steps_match_energyplus_reported_fractions() {
     assert!(stats.len() >= 30, "{}: {} surfaces", case.label, stats.len());
     let worst = stats.iter().map(|s| s.3).fold(0.0f64, f64::max);
     for (name, clip, hook, mean) in &stats {
-        println!("{} {name}: dark/lit disagreements {clip} (clipping), {hook} (hooked); mean |Δ| {mean:.4}", case.label);
+        println!(
+            "{} {name}: dark/lit disagreements {} (clipping), {} (hooked); EnergyPlus one-step glitches {} (clipping), {} (hooked); mean |Δ| {mean:.4}",
+            case.label, clip.disagreements, hook.disagreements, clip.glitches, hook.glitches
+        );
     }
     for (name, clip, hook, mean) in &stats {
-        assert_eq!((*clip, *hook), (0, 0), "{} {name}: steps dark in one and lit in the other", case.label);
+        assert_eq!((clip.disagreements, hook.disagreements), (0, 0), "{} {name}: steps dark in one and lit in the other", case.label);
         assert!(*mean <= 0.005, "{} {name}: mean |Δ| {mean}", case.label);
     }
     println!("{}: largest per-surface mean |Δ| against EnergyPlus's clipping: {worst:.4}", case.label);

@@ -103,3 +103,52 @@ impl VaryingShades {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::model::idf::parse_idf;
+    use crate::model::shades::read_shade_schedules;
+    use crate::year::samples::Timesteps;
+
+    /// Two shades, one at a constant 0.25 and one at 0 until noon and 1 after (hourly, N = 1),
+    /// and a third at 0 all year (an ordinary caster, not mixed).
+    fn varying() -> VaryingShades {
+        let text = "Shading:Site:Detailed, A, HALF, 3, 0,0,0, 1,0,0, 1,0,1;\n\
+            Shading:Site:Detailed, B, NOON, 3, 0,1,0, 1,1,0, 1,1,1;\n\
+            Shading:Site:Detailed, C, ZERO, 3, 0,2,0, 1,2,0, 1,2,1;\n\
+            Schedule:Constant, HALF, , 0.25;\nSchedule:Constant, ZERO, , 0;\n\
+            Schedule:Compact, NOON, , Through: 12/31, For: AllDays, Until: 12:00, 0, Until: 24:00, 1;";
+        let objects = parse_idf("m.idf", text).unwrap();
+        let groups = read_shade_schedules("m.idf", &objects, None).unwrap();
+        VaryingShades::new("m.idf", &groups, RunCalendar { per_hour: 1, leap: false }).unwrap().unwrap()
+    }
+
+    #[test]
+    fn variants_remove_each_mixed_shade_in_turn() {
+        let v = varying();
+        assert_eq!(v.variants(), 4, "A and B mixed, C an ordinary caster");
+        assert_eq!(v.shade_transmittance(0), [("A".to_string(), 0.0), ("B".to_string(), 0.0)]);
+        assert_eq!(v.shade_transmittance(3), [("A".to_string(), 1.0), ("B".to_string(), 1.0)]);
+        let means = v.mean_transmittance();
+        assert_eq!(means[0], ("A".to_string(), 0.25));
+        assert_eq!(means[1], ("B".to_string(), 0.5));
+    }
+
+    #[test]
+    fn the_mix_is_multilinear_in_the_transmittances() {
+        let v = varying();
+        let timesteps = Timesteps::new(1).unwrap();
+        // One column: 0.1 with both opaque, 0.3 with A removed, 0.6 with B removed, 1 with both.
+        let years: Vec<Schedule> = [0.1f32, 0.3, 0.6, 1.0]
+            .iter()
+            .map(|&f| Schedule { names: vec!["W".into()], timesteps, values: vec![f; timesteps.rows()] })
+            .collect();
+        let mixed = v.mix(&years).unwrap();
+        // Morning (B opaque): 0.75·0.1 + 0.25·0.3; afternoon (B removed): 0.75·0.6 + 0.25·1.
+        assert!((mixed.get(5, 0) - 0.15).abs() < 1e-6, "{}", mixed.get(5, 0));
+        assert!((mixed.get(17, 0) - 0.7).abs() < 1e-6, "{}", mixed.get(17, 0));
+        assert!(v.mix(&years[..3]).is_err(), "one year per variant");
+    }
+}

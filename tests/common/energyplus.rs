@@ -69,3 +69,20 @@ pub fn dark_lit(ours: &[f64], theirs: &[f64]) -> DarkLit {
     }
     out
 }
+
+/// `sunlit annual MODEL --epw WEATHER --engine exact -o CSV EXTRA…`: the command's output (the
+/// caller checks its status).
+#[allow(dead_code)] // Not every test file that uses `common` runs sunlit on an EnergyPlus model.
+pub fn sunlit_annual(model: &Path, weather: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
+    #[allow(clippy::unwrap_used)] // A test helper: failing to start the binary fails the test.
+    std::process::Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .arg("annual")
+        .arg(model)
+        .arg("--epw")
+        .arg(weather)
+        .args(["--engine", "exact", "-o"])
+        .arg(csv)
+        .args(extra)
+        .output()
+        .unwrap()
+}
