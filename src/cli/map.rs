@@ -16,10 +16,10 @@ use sunlit::year::season::LeafCalendar;
 use super::progress::Meter;
 use super::*;
 
-#[path = "map_planning.rs"]
-mod planning;
 #[path = "map_inside.rs"]
 mod inside;
+#[path = "map_planning.rs"]
+mod planning;
 
 #[derive(Args)]
 #[command(group = clap::ArgGroup::new("site").args(["epw", "location"]))]

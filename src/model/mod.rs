@@ -29,8 +29,8 @@ pub mod gltf_extensions;
 pub mod gltf_instancing;
 pub mod gltf_read;
 pub mod idf;
-pub mod obj;
 pub mod inside;
+pub mod obj;
 #[cfg(feature = "fixtures")]
 pub mod office;
 #[cfg(feature = "fixtures")]
