@@ -23,10 +23,13 @@
 //! - Otherwise: no certificate, and the steps are counted.
 //!
 //! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
-//! objects: a closed convex polyhedron of at most 64 triangles, or a flat convex polygon),
-//! opaque (no foliage, no transmittance) and without open caps. A caster that is not convex,
-//! open, seen edge-on (its projection has no area) or see-through never proves a step dark; it
-//! only stops a step being proved lit.
+//! objects: a closed convex polyhedron or a flat convex polygon; up to 64 triangles any such,
+//! up to 65,536 if they lie in at most 64 planes and share corners bit for bit, as a panelled
+//! block does), opaque (no foliage, no transmittance). One with open caps (a block without a
+//! floor) qualifies only for a receiver strictly inside every cap's plane (above the ground),
+//! since a ray could otherwise pass through the openings. A caster that is not convex, open to
+//! the receiver, seen edge-on (its projection has no area) or see-through never proves a step
+//! dark; it only stops a step being proved lit.
 
 pub mod cone;
 
@@ -174,12 +177,29 @@ impl Certifier {
         out
     }
 
-    /// The convex object at triangle position `p`, if it may prove a receiver dark: convex, no
-    /// open caps, opaque.
+    /// The convex object at triangle position `p`, if it may prove a receiver dark: convex and
+    /// opaque.
     fn opaque_convex(&self, p: usize) -> Option<u32> {
         let o = self.index.objects.of(p)?;
         let veil = self.index.veils[p];
-        (!self.index.objects.has_caps(o) && veil.rank < 0.0 && veil.transmittance == 0.0).then_some(o)
+        (veil.rank < 0.0 && veil.transmittance == 0.0).then_some(o)
+    }
+
+    /// Whether the receiver lies strictly inside the plane of each of object `o`'s open caps
+    /// (by `margin`): a ray from it then crosses each cap's plane outward if at all, so it
+    /// enters the convex solid through a triangle, never through an opening. A block without a
+    /// floor, for any receiver above the ground.
+    fn caps_face_away(&self, shape: &Shape, o: u32, margin: f64) -> bool {
+        let corners = self.index.objects.corners(o);
+        let centre = corners.iter().map(|&c| self.index.corner(c) - shape.p0).sum::<DVec3>() / corners.len().max(1) as f64;
+        self.index.objects.caps(o).all(|cap| {
+            let at: Vec<DVec3> = cap.iter().map(|&c| self.index.corner(c) - shape.p0).collect();
+            // Newell's normal of the cap's loop, turned away from the solid.
+            let newell = (0..at.len()).fold(DVec3::ZERO, |n, i| n + at[i].cross(at[(i + 1) % at.len()]));
+            let Some(m) = newell.try_normalize() else { return false };
+            let m = if m.dot(centre - at[0]) > 0.0 { -m } else { m };
+            shape.points.iter().all(|p| m.dot(*p - shape.p0 - at[0]) < -margin)
+        })
     }
 
     /// Whether triangle `t` lies outside the volume the receiver sweeps along the cone (so it
@@ -224,6 +244,9 @@ impl Certifier {
         let margin = COVER_MARGIN * (1.0 + self.extent);
         let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect();
         if corners.len() < 3 || corners.iter().any(|c| c.dot(shape.normal) <= margin) {
+            return false;
+        }
+        if self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin) {
             return false;
         }
         cone.generators().iter().all(|g| {
