@@ -149,12 +149,8 @@ impl Certifier {
                     return None;
                 }
             }
-            if wanted.dark {
-                if let Some(o) = self.opaque_convex(p) {
-                    if !candidates.contains(&o) {
-                        candidates.push(o);
-                    }
-                }
+            if let Some(o) = self.opaque_convex(p).filter(|o| wanted.dark && !candidates.contains(o)) {
+                candidates.push(o);
             }
         }
         if lit {

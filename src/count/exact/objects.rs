@@ -182,17 +182,8 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
         if length <= tol * size {
             return Convexity::No;
         }
-        let normal = normal / length;
-        let (mut below, mut above) = (false, false);
-        for p in &points {
-            let h = normal.dot(*p - t[0]);
-            below |= h < -tol;
-            above |= h > tol;
-        }
-        if below && above {
-            return Convexity::No;
-        }
-        flat &= !below && !above;
+        let Some(in_plane) = one_side(normal / length, t[0], &points, tol) else { return Convexity::No };
+        flat &= in_plane;
     }
     closed_or_caps(tris, &points, flat, &uses, (&corners, &first), tol)
 }
@@ -288,18 +279,22 @@ pub(super) fn large_convexity(tris: &[[DVec3; 3]]) -> Convexity {
     }
     let mut flat = true;
     for (n, q) in &faces {
-        let (mut below, mut above) = (false, false);
-        for p in &corners {
-            let h = n.dot(*p - *q);
-            below |= h < -tol;
-            above |= h > tol;
-        }
-        if below && above {
-            return Convexity::No;
-        }
-        flat &= !below && !above;
+        let Some(in_plane) = one_side(*n, *q, &corners, tol) else { return Convexity::No };
+        flat &= in_plane;
     }
     closed_or_caps(tris, &points, flat, &uses, (&corners, &first), tol)
+}
+
+/// Whether `points` lie on one side of the plane through `q` with unit normal `n` (within
+/// `tol`): None if on both, else whether all lie in it.
+fn one_side(n: DVec3, q: DVec3, points: &[DVec3], tol: f64) -> Option<bool> {
+    let (mut below, mut above) = (false, false);
+    for p in points {
+        let h = n.dot(*p - q);
+        below |= h < -tol;
+        above |= h > tol;
+    }
+    (!(below && above)).then_some(!below && !above)
 }
 
 /// Splits every edge used once at the corners of other once-used edges lying on it, so that a
