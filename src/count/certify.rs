@@ -75,6 +75,10 @@ const PLANE_TOLERANCE: f64 = 1e-9;
 /// separating faces of their cone are then looked for among the direction cone's faces only.
 const MIN_CHART_COS: f64 = 1e-3;
 
+/// A lit proof is not looked for where the swept volume reaches more triangles than this (a
+/// city's street seen along a low sun): its cost would exceed the views it saves.
+const MAX_SWEPT: usize = 20_000;
+
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
 
@@ -133,30 +137,40 @@ impl Certifier {
         if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
             return None;
         }
-        let mut lit = wanted.lit;
-        let mut candidates: Vec<u32> = Vec::new();
-        let mut w = Vec::new();
-        let view = view::fit(&self.swept_corners(shape, &cone), cone.axis(), self.index.bounds, self.index.origin, 64);
-        let mut reached = Vec::new();
-        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
-        for p in reached.into_iter().flatten() {
-            if self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER {
-                continue;
-            }
-            if lit && !self.misses(shape, &cone, &self.index.triangles[p], &mut w) {
-                lit = false;
-                if !wanted.dark {
-                    return None;
-                }
-            }
-            if let Some(o) = self.opaque_convex(p).filter(|o| wanted.dark && !candidates.contains(o)) {
-                candidates.push(o);
-            }
-        }
-        if lit {
+        if wanted.lit && self.swept_is_empty(shape, &cone) {
             return Some(Certificate::Lit);
         }
+        if !wanted.dark {
+            return None;
+        }
+        // A caster that covers the receiver at every sun is hit by the ray from each receiver
+        // point along the cone's axis: it has a triangle in that one view's prism.
+        let mut candidates: Vec<u32> = Vec::new();
+        let view = view::fit(&shape.points, cone.axis(), self.index.bounds, self.index.origin, 64);
+        self.index.culling.visit_triangles(&view.view_proj, |r| {
+            for p in r {
+                if let Some(o) = self.opaque_convex(p).filter(|o| self.index.owner[p] != shape.gpu_id && !candidates.contains(o)) {
+                    candidates.push(o);
+                }
+            }
+        });
         candidates.into_iter().any(|o| self.covers(shape, &cone, o)).then_some(Certificate::Dark)
+    }
+
+    /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;
+    /// false (no proof) as well where that volume reaches more than [`MAX_SWEPT`] triangles.
+    fn swept_is_empty(&self, shape: &Shape, cone: &DirectionCone) -> bool {
+        let view = view::fit(&self.swept_corners(shape, cone), cone.axis(), self.index.bounds, self.index.origin, 64);
+        let mut reached = Vec::new();
+        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
+        if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
+            return false;
+        }
+        let mut w = Vec::new();
+        reached.into_iter().flatten().all(|p| {
+            (self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER)
+                || self.misses(shape, cone, &self.index.triangles[p], &mut w)
+        })
     }
 
     /// Corners of a convex volume holding the part of `R + K` inside the scene's bounds: the
