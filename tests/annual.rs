@@ -243,6 +243,23 @@ fn exact_year(scene: &Scene, method: Method) -> (Schedule, usize) {
     (schedule, views)
 }
 
+/// The default year against counting every timestep, exact engine, Timestep 4: (views, dense
+/// views, steps lit in the dense year, steps dark in one and lit in the other, mean |Δ|).
+fn against_dense(scene: &Scene, label: &str) -> (usize, usize, usize, usize, f64) {
+    let (dense, dense_views) = exact_year(scene, Method::Dense);
+    let (spline, spline_views) = exact_year(scene, Method::Spline(SamplingPlan::default()));
+    let (mut disagree, mut lit) = (0, 0);
+    for (a, b) in spline.values.iter().zip(&dense.values) {
+        disagree += usize::from((*a > 0.0) != (*b > 0.0));
+        lit += usize::from(*b > 0.0);
+    }
+    let (mean, rms, max) = compare(&spline, &dense).unwrap();
+    println!(
+        "{label}: {spline_views} views against {dense_views} dense; lit steps {lit}; dark/lit disagreements {disagree}; mean |Δ| {mean:.4}, RMS {rms:.4}, max {max:.4}"
+    );
+    (spline_views, dense_views, lit, disagree, mean)
+}
+
 /// A window at the bottom of a street canyon, 6 m from a 12 m wall with a 0.1 m slot in it 1 m
 /// east of the window's axis: lit over the wall at summer middays and otherwise only for minutes
 /// a day through the slot, mostly between the samples, so many of its sample cells are dark at
@@ -256,18 +273,8 @@ fn a_slot_of_sun_in_a_dark_canyon_is_not_lost() {
     s.polygon("WIN", &south_rect(1.8, 2.2, 0.0, 1.0, 0.0), true);
     s.polygon("WALL_W", &south_rect(-30.0, 2.95, 0.0, 12.0, -6.0), false);
     s.polygon("WALL_E", &south_rect(3.05, 30.0, 0.0, 12.0, -6.0), false);
-    let scene = s.build();
-    let (dense, dense_views) = exact_year(&scene, Method::Dense);
-    let (spline, spline_views) = exact_year(&scene, Method::Spline(SamplingPlan::default()));
-    let (mut disagree, mut lit) = (0, 0);
-    for (a, b) in spline.values.iter().zip(&dense.values) {
-        disagree += usize::from((*a > 0.0) != (*b > 0.0));
-        lit += usize::from(*b > 0.0);
-    }
-    let (mean, rms, max) = compare(&spline, &dense).unwrap();
-    println!(
-        "canyon slot: {spline_views} views against {dense_views} dense; lit steps {lit}; dark/lit disagreements {disagree}; mean |Δ| {mean:.4}, RMS {rms:.4}, max {max:.4}"
-    );
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon slot");
+    assert!(spline_views < dense_views);
     assert!(lit > 500, "the window is lit at {lit} steps");
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
     assert!(mean <= 0.005, "mean |Δ| {mean}");
@@ -289,18 +296,7 @@ fn certificates_keep_every_minute_of_sun_in_a_canyon_of_blocks() {
     s.polygon("ASIDE", &south_rect(1.8, 2.2, 0.0, 1.0, 0.0), true);
     s.cuboid("BLOCK_W", DVec3::new(-40.0, -16.0, 0.0), DVec3::new(2.95, -6.0, 12.0));
     s.cuboid("BLOCK_E", DVec3::new(3.05, -16.0, 0.0), DVec3::new(40.0, -6.0, 12.0));
-    let scene = s.build();
-    let (dense, dense_views) = exact_year(&scene, Method::Dense);
-    let (spline, spline_views) = exact_year(&scene, Method::Spline(SamplingPlan::default()));
-    let (mut disagree, mut lit) = (0, 0);
-    for (a, b) in spline.values.iter().zip(&dense.values) {
-        disagree += usize::from((*a > 0.0) != (*b > 0.0));
-        lit += usize::from(*b > 0.0);
-    }
-    let (mean, _, max) = compare(&spline, &dense).unwrap();
-    println!(
-        "canyon of blocks: {spline_views} views against {dense_views} dense; lit steps {lit}; dark/lit disagreements {disagree}; mean |Δ| {mean:.4}, max {max:.4}"
-    );
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon of blocks");
     assert!(lit > 10_000, "the windows are lit at {lit} steps");
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
     assert!(mean <= 0.005, "mean |Δ| {mean}");

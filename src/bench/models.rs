@@ -41,7 +41,7 @@ pub struct BenchModel {
 }
 
 /// Every generated model: (name, description).
-pub const CATALOGUE: [(&str, &str); 9] = [
+pub const CATALOGUE: [(&str, &str); 10] = [
     ("blaas-self", "Blaas-like office, Bolzano: 10 zones, 62 receivers, self-shading only"),
     ("blaas-louvres", "blaas-self + 467 louvre slats (instanced): 467 shading surfaces"),
     ("blaas-buildings", "blaas-louvres + 34 neighbouring buildings: 1,045 shading surfaces"),
@@ -51,6 +51,7 @@ pub const CATALOGUE: [(&str, &str); 9] = [
     ("nyt-flat", "nyt-self + 194,544 flat rods, supports and spire: 220,843 shading surfaces"),
     ("nyt-rods", "nyt-self + 194,544 hexagonal rods, supports and spire: 1,193,563 shading surfaces"),
     ("nyt-blocks", "nyt-rods + surrounding blocks: 1,305,782 shading surfaces"),
+    ("canyon-slots", "street canyon, Golden CO: 120 windows facing 12 m across a street of 24 convex blocks with slots"),
 ];
 
 /// Generates the model called `name` (see [`CATALOGUE`]).
@@ -64,6 +65,9 @@ pub fn generate(name: &str) -> Result<BenchModel> {
     let location = if name.starts_with("blaas") {
         g.blaas(name);
         Location::new(46.50, 11.35, 1.0)?
+    } else if *name == "canyon-slots" {
+        g.canyon();
+        Location::new(39.74, -105.18, -7.0)?
     } else {
         g.nyt(name);
         Location::new(40.756, -73.990, -5.0)?
@@ -372,6 +376,36 @@ impl Generator {
             let lo = Vec3::new(220.0 * i as f32 - 90.0, 100.0 * j as f32 - 30.0, 0.0);
             block(&mut m, lo, Vec3::new(180.0, 60.0, 0.0), floors, FLOOR, 30, &mut budget);
             self.shading(&format!("BLOCK_{}", n + 1), m);
+        }
+    }
+}
+
+impl Generator {
+    /// A street canyon running east–west: on its north side a street front (a closed box) with
+    /// 4 floors × 30 windows facing south (the receivers, 1 cm proud of its face); across the 12 m
+    /// street, 24 closed boxes 12 m deep, 10–30 m high and 3–8 m long, one after the other with
+    /// slots of 0.05–0.5 m between them. Every caster is convex, so certificates can settle the
+    /// windows' dark cells; the slots light them for minutes a day.
+    fn canyon(&mut self) {
+        let mut rng = SplitMix64(2011);
+        for f in 0..4 {
+            for k in 0..30 {
+                let mut m = Mesh::default();
+                let (x, z) = (-45.0 + 3.0 * k as f32, 1.0 + 3.5 * f as f32);
+                m.rect(Vec3::new(x, -0.01, z), Vec3::X, Vec3::Z, (0.0, 1.5, 0.0, 1.5));
+                self.receiver(&format!("F{}_WIN_{}", f + 1, k + 1), m);
+            }
+        }
+        let mut front = Mesh::default();
+        front.cuboid(Vec3::new(-60.0, 0.0, 0.0), Vec3::new(120.0, 15.0, 15.0));
+        self.shading("STREET_FRONT", front);
+        let mut x = -60.0;
+        for k in 0..24 {
+            let length = rng.range(3.0, 8.0) as f32;
+            let mut m = Mesh::default();
+            m.cuboid(Vec3::new(x, -24.0, 0.0), Vec3::new(length, 12.0, rng.range(10.0, 30.0) as f32));
+            self.shading(&format!("BLOCK_{}", k + 1), m);
+            x += length + rng.range(0.05, 0.5) as f32;
         }
     }
 }

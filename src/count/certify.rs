@@ -23,10 +23,13 @@
 //! - Otherwise: no certificate, and the steps are counted.
 //!
 //! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
-//! objects: a closed convex polyhedron of at most 64 triangles, or a flat convex polygon),
-//! opaque (no foliage, no transmittance) and without open caps. A caster that is not convex,
-//! open, seen edge-on (its projection has no area) or see-through never proves a step dark; it
-//! only stops a step being proved lit.
+//! objects: a closed convex polyhedron or a flat convex polygon; up to 64 triangles any such,
+//! up to 65,536 if they lie in at most 64 planes and share corners bit for bit, as a panelled
+//! block does), opaque (no foliage, no transmittance). One with open caps (a block without a
+//! floor) qualifies only for a receiver strictly inside every cap's plane (above the ground),
+//! since a ray could otherwise pass through the openings. A caster that is not convex, open to
+//! the receiver, seen edge-on (its projection has no area) or see-through never proves a step
+//! dark; it only stops a step being proved lit.
 
 pub mod cone;
 
@@ -71,6 +74,10 @@ const PLANE_TOLERANCE: f64 = 1e-9;
 /// Vectors of `T − R` whose cosine with the cone's axis is below this are not charted: the
 /// separating faces of their cone are then looked for among the direction cone's faces only.
 const MIN_CHART_COS: f64 = 1e-3;
+
+/// A lit proof is not looked for where the swept volume reaches more triangles than this (a
+/// city's street seen along a low sun): its cost would exceed the views it saves.
+const MAX_SWEPT: usize = 20_000;
 
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
@@ -130,34 +137,40 @@ impl Certifier {
         if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
             return None;
         }
-        let mut lit = wanted.lit;
-        let mut candidates: Vec<u32> = Vec::new();
-        let mut w = Vec::new();
-        let view = view::fit(&self.swept_corners(shape, &cone), cone.axis(), self.index.bounds, self.index.origin, 64);
-        let mut reached = Vec::new();
-        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
-        for p in reached.into_iter().flatten() {
-            if self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER {
-                continue;
-            }
-            if lit && !self.misses(shape, &cone, &self.index.triangles[p], &mut w) {
-                lit = false;
-                if !wanted.dark {
-                    return None;
-                }
-            }
-            if wanted.dark {
-                if let Some(o) = self.opaque_convex(p) {
-                    if !candidates.contains(&o) {
-                        candidates.push(o);
-                    }
-                }
-            }
-        }
-        if lit {
+        if wanted.lit && self.swept_is_empty(shape, &cone) {
             return Some(Certificate::Lit);
         }
+        if !wanted.dark {
+            return None;
+        }
+        // A caster that covers the receiver at every sun is hit by the ray from each receiver
+        // point along the cone's axis: it has a triangle in that one view's prism.
+        let mut candidates: Vec<u32> = Vec::new();
+        let view = view::fit(&shape.points, cone.axis(), self.index.bounds, self.index.origin, 64);
+        self.index.culling.visit_triangles(&view.view_proj, |r| {
+            for p in r {
+                if let Some(o) = self.opaque_convex(p).filter(|o| self.index.owner[p] != shape.gpu_id && !candidates.contains(o)) {
+                    candidates.push(o);
+                }
+            }
+        });
         candidates.into_iter().any(|o| self.covers(shape, &cone, o)).then_some(Certificate::Dark)
+    }
+
+    /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;
+    /// false (no proof) as well where that volume reaches more than [`MAX_SWEPT`] triangles.
+    fn swept_is_empty(&self, shape: &Shape, cone: &DirectionCone) -> bool {
+        let view = view::fit(&self.swept_corners(shape, cone), cone.axis(), self.index.bounds, self.index.origin, 64);
+        let mut reached = Vec::new();
+        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
+        if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
+            return false;
+        }
+        let mut w = Vec::new();
+        reached.into_iter().flatten().all(|p| {
+            (self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER)
+                || self.misses(shape, cone, &self.index.triangles[p], &mut w)
+        })
     }
 
     /// Corners of a convex volume holding the part of `R + K` inside the scene's bounds: the
@@ -174,12 +187,29 @@ impl Certifier {
         out
     }
 
-    /// The convex object at triangle position `p`, if it may prove a receiver dark: convex, no
-    /// open caps, opaque.
+    /// The convex object at triangle position `p`, if it may prove a receiver dark: convex and
+    /// opaque.
     fn opaque_convex(&self, p: usize) -> Option<u32> {
         let o = self.index.objects.of(p)?;
         let veil = self.index.veils[p];
-        (!self.index.objects.has_caps(o) && veil.rank < 0.0 && veil.transmittance == 0.0).then_some(o)
+        (veil.rank < 0.0 && veil.transmittance == 0.0).then_some(o)
+    }
+
+    /// Whether the receiver lies strictly inside the plane of each of object `o`'s open caps
+    /// (by `margin`): a ray from it then crosses each cap's plane outward if at all, so it
+    /// enters the convex solid through a triangle, never through an opening. A block without a
+    /// floor, for any receiver above the ground.
+    fn caps_face_away(&self, shape: &Shape, o: u32, margin: f64) -> bool {
+        let corners = self.index.objects.corners(o);
+        let centre = corners.iter().map(|&c| self.index.corner(c) - shape.p0).sum::<DVec3>() / corners.len().max(1) as f64;
+        self.index.objects.caps(o).all(|cap| {
+            let at: Vec<DVec3> = cap.iter().map(|&c| self.index.corner(c) - shape.p0).collect();
+            // Newell's normal of the cap's loop, turned away from the solid.
+            let newell = (0..at.len()).fold(DVec3::ZERO, |n, i| n + at[i].cross(at[(i + 1) % at.len()]));
+            let Some(m) = newell.try_normalize() else { return false };
+            let m = if m.dot(centre - at[0]) > 0.0 { -m } else { m };
+            shape.points.iter().all(|p| m.dot(*p - shape.p0 - at[0]) < -margin)
+        })
     }
 
     /// Whether triangle `t` lies outside the volume the receiver sweeps along the cone (so it
@@ -224,6 +254,9 @@ impl Certifier {
         let margin = COVER_MARGIN * (1.0 + self.extent);
         let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect();
         if corners.len() < 3 || corners.iter().any(|c| c.dot(shape.normal) <= margin) {
+            return false;
+        }
+        if self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin) {
             return false;
         }
         cone.generators().iter().all(|g| {

@@ -115,3 +115,39 @@ fn certificates_agree_with_the_exact_engine_at_every_sun_of_their_cell() {
     println!("{dark} dark and {lit} lit cells, {checked} suns checked");
     assert!(dark >= 10 && lit >= 10, "{dark} dark and {lit} lit cells");
 }
+
+/// A panelled block without a floor (hundreds of triangles, one open cap) proves a window above
+/// the ground dark, as a closed box would; a window at ground level, on the cap's plane, is not
+/// proved (a ray could pass under the walls), and the exact engine agrees with what is proved.
+#[test]
+fn a_panelled_block_without_a_floor_proves_a_window_above_the_ground_dark() {
+    let mut m = SourceMesh::default();
+    for (o, side) in
+        [([-40.0f32, -14.0], [80.0f32, 0.0]), ([40.0, -14.0], [0.0, 4.0]), ([40.0, -10.0], [-80.0, 0.0]), ([-40.0, -10.0], [0.0, -4.0])]
+    {
+        for f in 0..10 {
+            for c in 0..8 {
+                let at = |s: f32, z: f32| [o[0] + side[0] * s, o[1] + side[1] * s, z];
+                let (s0, s1, z0, z1) = (c as f32 / 8.0, (c + 1) as f32 / 8.0, 3.0 * f as f32, 3.0 * (f + 1) as f32);
+                let base = m.positions.len() as u32;
+                m.positions.extend([at(s0, z0), at(s1, z0), at(s1, z1), at(s0, z1)]);
+                m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+            }
+        }
+    }
+    let base = m.positions.len() as u32;
+    m.positions.extend([[-40.0, -14.0, 30.0], [-40.0, -10.0, 30.0], [40.0, -10.0, 30.0], [40.0, -14.0, 30.0]]);
+    m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+    b.add_object("test", "FOOT", window(4.0, 6.0, 0.0, 1.0, 0.0), true);
+    b.add_object("test", "BLOCK", m, false);
+    let scene = b.build().unwrap();
+    let certifier = Certifier::new(&scene);
+    let winter = suns(1..14, (11.0, 13.0), -DVec3::Y);
+    let both = Wanted { dark: true, lit: true };
+    assert_eq!(certifier.certify(0, &winter, both), Some(Certificate::Dark));
+    assert_eq!(certifier.certify(1, &winter, both), None);
+    let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
+    assert!(ExactEngine::new(&scene).fractions(&requests).iter().all(|f| *f == 0.0));
+}

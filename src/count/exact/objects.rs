@@ -21,7 +21,10 @@
 //! shadow in every view where no two caps' projections overlap and no part of the object lies
 //! behind the plane (whose cut would be one more opening). The engine checks that per view
 //! (`ExactEngine::caps_overlap`) and otherwise casts the object's triangles one by one.
-//! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) are not tested and stay per-triangle.
+//! Larger objects (above [`MAX_CONVEX_TRIANGLES`]) take a linear test instead
+//! ([`large_convexity`]): corners are one only when equal bit for bit, and the triangles must
+//! lie in at most [`MAX_LARGE_FACES`] planes (a panelled facade, a block of panelled walls and
+//! its roof); others stay per-triangle.
 
 use std::collections::HashMap;
 
@@ -29,6 +32,13 @@ use glam::{DVec2, DVec3};
 
 /// Objects with more triangles than this are not tested for convexity (the test is quadratic).
 pub(super) const MAX_CONVEX_TRIANGLES: usize = 64;
+/// Objects with more triangles than this are not tested at all.
+const MAX_LARGE_TRIANGLES: usize = 1 << 16;
+/// A large object is convex only if its triangles lie in at most this many planes.
+const MAX_LARGE_FACES: usize = 64;
+/// Two triangles of a large object share a plane when their unit normals' dot product is
+/// above 1 minus this (and their offsets agree within the tolerance).
+const SAME_PLANE_COS: f64 = 1e-9;
 /// Relative tolerance (of the object's size) of the convexity and flatness tests.
 const CONVEX_TOLERANCE: f64 = 1e-9;
 /// Tolerance of the same tests relative to the object's largest coordinate: positions are `f32`,
@@ -102,7 +112,11 @@ pub(super) fn group(triangles: &[[[f32; 3]; 3]], keys: &[u64]) -> MeshObjects {
     let mut out = MeshObjects { object_of, ..Default::default() };
     for m in &members {
         let tris: Vec<[DVec3; 3]> = m.iter().map(|&t| triangles[t as usize].map(|p| DVec3::from_array(p.map(f64::from)))).collect();
-        let convexity = if tris.len() <= MAX_CONVEX_TRIANGLES { convexity(&tris) } else { Convexity::No };
+        let convexity = match tris.len() {
+            n if n <= MAX_CONVEX_TRIANGLES => convexity(&tris),
+            n if n <= MAX_LARGE_TRIANGLES => large_convexity(&tris),
+            _ => Convexity::No,
+        };
         out.convex.push(convexity != Convexity::No);
         let first_cap = out.caps.len() as u32;
         if let Convexity::Caps(caps) = convexity {
@@ -160,20 +174,7 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
         });
         welded.push(c);
     }
-    // Edges by their welded corners, undirected: how many triangles use each.
-    let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
-    for c in welded.chunks_exact(3) {
-        for k in 0..3 {
-            let (a, b) = (c[k], c[(k + 1) % 3]);
-            if a == b {
-                return Convexity::No;
-            }
-            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    if uses.values().any(|&u| u > 2) {
-        return Convexity::No;
-    }
+    let Some(uses) = edge_uses(&welded) else { return Convexity::No };
     let mut flat = true;
     for t in tris {
         let normal = (t[1] - t[0]).cross(t[2] - t[0]);
@@ -181,20 +182,41 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
         if length <= tol * size {
             return Convexity::No;
         }
-        let normal = normal / length;
-        let (mut below, mut above) = (false, false);
-        for p in &points {
-            let h = normal.dot(*p - t[0]);
-            below |= h < -tol;
-            above |= h > tol;
-        }
-        if below && above {
-            return Convexity::No;
-        }
-        flat &= !below && !above;
+        let Some(in_plane) = one_side(normal / length, t[0], &points, tol) else { return Convexity::No };
+        flat &= in_plane;
     }
+    closed_or_caps(tris, &points, flat, &uses, (&corners, &first), tol)
+}
+
+/// Edges by their welded corners, undirected: how many triangles use each; None where a
+/// triangle has two equal corners or an edge is used more than twice.
+fn edge_uses(welded: &[usize]) -> Option<HashMap<(usize, usize), u32>> {
+    let mut uses: HashMap<(usize, usize), u32> = HashMap::new();
+    for c in welded.chunks_exact(3) {
+        for k in 0..3 {
+            let (a, b) = (c[k], c[(k + 1) % 3]);
+            if a == b {
+                return None;
+            }
+            *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    uses.values().all(|&u| u <= 2).then_some(uses)
+}
+
+/// The end of both convexity tests, once every triangle's plane has the object on one side
+/// (`flat` when on none): a flat convex polygon, a closed polyhedron, or one with convex caps.
+/// `corners` are the welded corners and, for each, the index in `points` of its first point.
+fn closed_or_caps(
+    tris: &[[DVec3; 3]],
+    points: &[DVec3],
+    flat: bool,
+    uses: &HashMap<(usize, usize), u32>,
+    (corners, first): (&[DVec3], &[usize]),
+    tol: f64,
+) -> Convexity {
     if flat {
-        return if flat_polygon_is_covered(tris, &points) { Convexity::Closed } else { Convexity::No };
+        return if flat_polygon_is_covered(tris, points) { Convexity::Closed } else { Convexity::No };
     }
     let mut open: Vec<(usize, usize)> = uses.iter().filter(|(_, u)| **u == 1).map(|(e, _)| *e).collect();
     // In a fixed order, so every run finds the same loops.
@@ -205,12 +227,108 @@ pub(super) fn convexity(tris: &[[DVec3; 3]]) -> Convexity {
     let Some(loops) = edge_loops(&open, corners.len()) else { return Convexity::No };
     let caps_are_faces = loops.iter().all(|l| {
         let loop_points: Vec<DVec3> = l.iter().map(|&c| corners[c]).collect();
-        is_convex_face(&loop_points, &points, tol)
+        is_convex_face(&loop_points, points, tol)
     });
     if !caps_are_faces {
         return Convexity::No;
     }
     Convexity::Caps(loops.iter().map(|l| l.iter().map(|&c| first[c]).collect()).collect())
+}
+
+/// [`convexity`] in linear time, for objects of many triangles: corners are one only when equal
+/// bit for bit (as the grouping joins them), and the triangles' planes are merged into faces, at
+/// most [`MAX_LARGE_FACES`], so each corner is tested against each face rather than each
+/// triangle. A panelled block without a floor is convex with one cap; anything else that is
+/// convex but rounds its shared corners apart is refused (it stays per-triangle).
+pub(super) fn large_convexity(tris: &[[DVec3; 3]]) -> Convexity {
+    let points: Vec<DVec3> = tris.iter().flatten().copied().collect();
+    let Some(size) = extent(&points) else { return Convexity::No };
+    let magnitude = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let tol = (CONVEX_TOLERANCE * size).max(F32_ROUNDINGS * magnitude).max(f64::MIN_POSITIVE);
+    let mut index: HashMap<[u64; 3], usize> = HashMap::with_capacity(points.len());
+    let (mut corners, mut first) = (Vec::new(), Vec::new());
+    let welded: Vec<usize> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            *index.entry(p.to_array().map(f64::to_bits)).or_insert_with(|| {
+                corners.push(*p);
+                first.push(i);
+                corners.len() - 1
+            })
+        })
+        .collect();
+    let Some(mut uses) = edge_uses(&welded) else { return Convexity::No };
+    if !close_t_junctions(&mut uses, &corners, tol) {
+        return Convexity::No;
+    }
+    let mut faces: Vec<(DVec3, DVec3)> = Vec::new();
+    for t in tris {
+        let normal = (t[1] - t[0]).cross(t[2] - t[0]);
+        let length = normal.length();
+        if length <= tol * size {
+            return Convexity::No;
+        }
+        let n = normal / length;
+        if !faces.iter().any(|(m, q)| m.dot(n) > 1.0 - SAME_PLANE_COS && m.dot(t[0] - *q).abs() <= tol) {
+            if faces.len() == MAX_LARGE_FACES {
+                return Convexity::No;
+            }
+            faces.push((n, t[0]));
+        }
+    }
+    let mut flat = true;
+    for (n, q) in &faces {
+        let Some(in_plane) = one_side(*n, *q, &corners, tol) else { return Convexity::No };
+        flat &= in_plane;
+    }
+    closed_or_caps(tris, &points, flat, &uses, (&corners, &first), tol)
+}
+
+/// Whether `points` lie on one side of the plane through `q` with unit normal `n` (within
+/// `tol`): None if on both, else whether all lie in it.
+fn one_side(n: DVec3, q: DVec3, points: &[DVec3], tol: f64) -> Option<bool> {
+    let (mut below, mut above) = (false, false);
+    for p in points {
+        let h = n.dot(*p - q);
+        below |= h < -tol;
+        above |= h > tol;
+    }
+    (!(below && above)).then_some(!below && !above)
+}
+
+/// Splits every edge used once at the corners of other once-used edges lying on it, so that a
+/// long edge meeting a row of short ones (a roof quad over a wall of panels: a T-junction seam,
+/// not an opening) is closed piece by piece: each piece is then used twice. False where a
+/// piece ends up used more than twice (overlapping triangles).
+fn close_t_junctions(uses: &mut HashMap<(usize, usize), u32>, corners: &[DVec3], tol: f64) -> bool {
+    let open: Vec<(usize, usize)> = uses.iter().filter(|(_, u)| **u == 1).map(|(e, _)| *e).collect();
+    let mut on_open: Vec<usize> = open.iter().flat_map(|&(a, b)| [a, b]).collect();
+    on_open.sort_unstable();
+    on_open.dedup();
+    for (a, b) in open {
+        let (pa, pb) = (corners[a], corners[b]);
+        let Some(along) = (pb - pa).try_normalize() else { continue };
+        let length = (pb - pa).length();
+        let mut inner: Vec<(f64, usize)> = on_open
+            .iter()
+            .filter_map(|&c| {
+                let t = (corners[c] - pa).dot(along);
+                let off = (corners[c] - pa).reject_from_normalized(along).length();
+                (t > tol && t < length - tol && off <= tol).then_some((t, c))
+            })
+            .collect();
+        if inner.is_empty() {
+            continue;
+        }
+        inner.sort_by(|x, y| x.0.total_cmp(&y.0));
+        uses.remove(&(a, b));
+        let chain: Vec<usize> = std::iter::once(a).chain(inner.into_iter().map(|(_, c)| c)).chain(std::iter::once(b)).collect();
+        for w in chain.windows(2) {
+            *uses.entry((w[0].min(w[1]), w[0].max(w[1]))).or_insert(0) += 1;
+        }
+    }
+    uses.values().all(|&u| u <= 2)
 }
 
 /// The closed loops formed by `edges` (undirected, between welded corners below `corners`),
@@ -368,6 +486,57 @@ pub(super) fn convex_hull(points: &mut [DVec2], hull: &mut Vec<DVec2>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A w × d × h block of panels (n along each side, one per metre of height), with a roof of
+    /// one quad and no floor, as the benchmark's city blocks are built; `notch` pushes one
+    /// panel of the south face 1 m in, which makes it concave.
+    fn panelled_block(w: f64, d: f64, h: usize, n: usize, notch: bool) -> Vec<[DVec3; 3]> {
+        let mut out = Vec::new();
+        let mut quad = |a: DVec3, b: DVec3, c: DVec3, e: DVec3| out.extend([[a, b, c], [a, c, e]]);
+        let walls = [
+            (DVec3::ZERO, DVec3::X * w),
+            (DVec3::X * w, DVec3::Y * d),
+            (DVec3::new(w, d, 0.0), -DVec3::X * w),
+            (DVec3::Y * d, -DVec3::Y * d),
+        ];
+        for (k, (o, side)) in walls.iter().enumerate() {
+            for f in 0..h {
+                for c in 0..n {
+                    let (s0, s1) = (c as f64 / n as f64, (c + 1) as f64 / n as f64);
+                    let (z0, z1) = (DVec3::Z * f as f64, DVec3::Z * (f + 1) as f64);
+                    let dent = if notch && k == 0 && c == 1 && f == 1 { DVec3::Y } else { DVec3::ZERO };
+                    quad(
+                        *o + *side * s0 + z0 + dent,
+                        *o + *side * s1 + z0 + dent,
+                        *o + *side * s1 + z1 + dent,
+                        *o + *side * s0 + z1 + dent,
+                    );
+                }
+            }
+        }
+        let top = DVec3::Z * h as f64;
+        quad(top, top + DVec3::Y * d, top + DVec3::new(w, d, 0.0), top + DVec3::X * w);
+        out
+    }
+
+    /// Large objects take the linear test: a panelled block without a floor is convex with one
+    /// cap (its floor's outline), a panelled facade is flat and convex, and a block with one
+    /// panel pushed in is neither; the small test agrees where both apply.
+    #[test]
+    fn panelled_blocks_are_convex_with_a_cap_and_a_dented_one_is_not() {
+        let block = panelled_block(8.0, 4.0, 6, 4, false);
+        assert!(block.len() > MAX_CONVEX_TRIANGLES);
+        assert!(matches!(large_convexity(&block), Convexity::Caps(ref caps) if caps.len() == 1));
+        assert_eq!(large_convexity(&panelled_block(8.0, 4.0, 6, 4, true)), Convexity::No);
+        let facade: Vec<[DVec3; 3]> = block[..2 * 6 * 4].to_vec();
+        assert_eq!(large_convexity(&facade), Convexity::Closed);
+        let small = panelled_block(8.0, 4.0, 2, 2, false);
+        assert!(small.len() <= MAX_CONVEX_TRIANGLES);
+        // The small test refuses the roof's T-junctions; the large one closes them.
+        assert_eq!(convexity(&small), Convexity::No);
+        assert!(matches!(large_convexity(&small), Convexity::Caps(ref caps) if caps.len() == 1));
+        assert_eq!(large_convexity(&cube()), Convexity::Closed);
+    }
 
     fn cube() -> Vec<[DVec3; 3]> {
         let c = |i: usize| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64);

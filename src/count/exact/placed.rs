@@ -97,7 +97,7 @@ impl PlacedObjects {
     }
 
     /// Object `o`'s caps, each its corners in order.
-    pub(super) fn caps(&self, o: u32) -> impl Iterator<Item = &[u32]> {
+    pub(crate) fn caps(&self, o: u32) -> impl Iterator<Item = &[u32]> {
         let range = &self.cap_ranges[o as usize];
         self.caps[range.start as usize..range.end as usize].iter().map(|cap| slice(&self.cap_corners, cap))
     }
