@@ -541,14 +541,19 @@ fn fraction(args: FractionArgs) -> Result<()> {
 
 /// One static scene's year on the engine the arguments choose; a lost GPU device (driver reset)
 /// is recreated once and the year counted again.
+/// `annual`'s engine for `scene`, as its flags ask.
+fn new_engine<'a>(args: &AnnualArgs, scene: &'a Scene) -> Result<HybridEngine<'a>> {
+    HybridEngine::new(scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())
+}
+
+/// The year of `scene` on `engine` (the caller keeps the engine for the sky views after it).
 fn count_year(
-    args: &AnnualArgs,
+    engine: &mut HybridEngine<'_>,
     scene: &Scene,
     settings: &Resolved,
     options: &AnnualOptions,
     meter: &mut progress::Meter,
 ) -> Result<sunlit::export::Schedule> {
-    let mut engine = HybridEngine::new(scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let year = |engine: &HybridEngine<'_>, meter: &mut progress::Meter| {
         pollster::block_on(sunlit::year::annual::annual_with(engine, scene, &settings.location, options, &settings.calendar, &mut |p| {
             meter.report(p);
@@ -556,12 +561,12 @@ fn count_year(
         }))
     };
     // A lost GPU device (driver reset) is recreated once; the year is counted again.
-    match year(&engine, meter) {
+    match year(engine, meter) {
         Err(Error::DeviceLost(why)) => {
             log::warn!("GPU device lost ({why}); making a new one and counting again");
             engine.forget_gpu();
             meter.stage("year, counted again", "views");
-            year(&engine, meter)
+            year(engine, meter)
         }
         other => other,
     }
@@ -612,9 +617,11 @@ fn annual(args: AnnualArgs) -> Result<()> {
         (None, _) => None,
     };
     let start = Instant::now();
+    // One engine for the year and the sky views after it (its cost model is probed once).
+    let mut engine = new_engine(&args, &scene)?;
     let mut meter = progress::Meter::new(if args.dense { "dense year" } else { "year" }, "views")?;
     let schedule = match &varying {
-        None => count_year(&args, &scene, &settings, &options, &mut meter)?,
+        None => count_year(&mut engine, &scene, &settings, &options, &mut meter)?,
         Some(v) => {
             // Each transmitting shade opaque and removed, mixed per timestep by its τ.
             let mut years = Vec::with_capacity(v.variants());
@@ -623,12 +630,12 @@ fn annual(args: AnnualArgs) -> Result<()> {
                     meter.stage(&format!("year with shades' variant {} of {}", variant + 1, v.variants()), "views");
                 }
                 let variant_scene = args.model.load_with_shades(v.shade_transmittance(variant))?;
-                years.push(count_year(&args, &variant_scene, &settings, &options, &mut meter)?);
+                let mut variant_engine = new_engine(&args, &variant_scene)?;
+                years.push(count_year(&mut variant_engine, &variant_scene, &settings, &options, &mut meter)?);
             }
             v.mix(&years)?
         }
     };
-    let engine = HybridEngine::new(&scene, args.engine.kind()?, args.pixels.options(), args.lanes, args.engine.source())?;
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
