@@ -369,6 +369,24 @@ impl Culling {
         out
     }
 
+    /// Every triangle relative to the scene origin and its receiver id ([`NO_RECEIVER`] for a
+    /// caster), in the order [`Self::visit_triangles`] and [`Self::list_ranges`] index.
+    pub fn triangles(&self) -> (&[[Vec3; 3]], &[u32]) {
+        (&self.triangles, &self.ids)
+    }
+
+    /// A draw list as ranges of [`Self::triangles`] (what a compute rasterizer reads).
+    pub fn list_ranges(&self, list: &DrawList) -> Vec<Range<u32>> {
+        let mut out = list.static_triangles.clone();
+        for (mesh, slots) in &list.instances {
+            let Some(g) = self.groups.iter().find(|g| g.mesh == *mesh) else { continue };
+            let n = g.triangles_per_instance as u32;
+            let first = g.first_triangle as u32 + (slots.start - g.slots.start) * n;
+            out.push(first..first + slots.len() as u32 * n);
+        }
+        out
+    }
+
     fn any_shades(&self, prism: &Prism, own: u32, range: Range<usize>) -> bool {
         self.triangles[range.clone()].iter().zip(&self.ids[range]).any(|(t, id)| (*id != own || own == NO_RECEIVER) && prism.may_shade(t))
     }

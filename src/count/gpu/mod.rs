@@ -38,6 +38,7 @@
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
 
+pub mod compute;
 mod device;
 mod encode;
 #[cfg(feature = "test-hooks")]
@@ -79,6 +80,18 @@ pub enum Backend {
     /// reads return zeros, so what a count costs is the host's work alone. Its counts are
     /// meaningless; only `sunlit bench` uses it, to time the host.
     Noop,
+}
+
+/// Which kernel counts a view's pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Kernel {
+    /// The graphics pipeline: the members' masks and the scene rendered into an atlas tile, then
+    /// a compute pass counting the tile's pixels.
+    #[default]
+    Raster,
+    /// The compute rasterizer ([`compute`]): triangles binned into 32×32 tiles and rasterized in
+    /// workgroup memory with the hardware's rules; no atlas.
+    Compute,
 }
 
 /// Which limits the device is asked for: all the adapter offers, or no more than a named
@@ -136,11 +149,20 @@ pub struct CounterOptions {
     pub backend: Backend,
     /// Which limits to ask the device for.
     pub limits: LimitsProfile,
+    /// Which kernel counts.
+    pub kernel: Kernel,
 }
 
 impl Default for CounterOptions {
     fn default() -> Self {
-        Self { resolution: 512, max_atlas: 2048, accuracy: None, backend: Backend::Platform, limits: LimitsProfile::Adapter }
+        Self {
+            resolution: 512,
+            max_atlas: 2048,
+            accuracy: None,
+            backend: Backend::Platform,
+            limits: LimitsProfile::Adapter,
+            kernel: Kernel::Raster,
+        }
     }
 }
 
@@ -254,6 +276,8 @@ pub struct Counter {
     /// Host time by stage since the counter was made (benchmarks).
     stages: StageClock,
     faults: Faults,
+    /// The compute kernel's passes and bins (`None` with the raster kernel).
+    compute: Option<compute::ComputeState>,
 }
 
 /// A scene uploaded to a [`Counter`]'s device.
@@ -266,6 +290,9 @@ pub struct GpuScene {
     layout: SceneLayout,
     render_bind: wgpu::BindGroup,
     count_bind: wgpu::BindGroup,
+    /// The triangles as the compute kernel reads them (`None` with the raster kernel, or where
+    /// they do not fit its bindings).
+    compute: Option<compute::ComputeScene>,
 }
 
 impl Counter {
@@ -278,6 +305,7 @@ impl Counter {
         // Buffers hold a batch at the smallest side used.
         let smallest = sides(&options).first().copied().unwrap_or(options.resolution);
         let batch = BatchBuffers::new(&device, &pipelines, atlas_side, smallest);
+        let compute = compute::ComputeState::new(&device, options.kernel);
         let counter = Self {
             device,
             queue,
@@ -290,6 +318,7 @@ impl Counter {
             triangles_drawn: AtomicU64::new(0),
             stages: StageClock::default(),
             faults,
+            compute,
         };
         counter.check_errors("setting up the GPU")?;
         Ok(counter)

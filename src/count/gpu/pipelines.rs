@@ -173,7 +173,7 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_
     }
 }
 
-fn compute_pipeline(
+pub(super) fn compute_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     label: &str,
@@ -244,7 +244,7 @@ fn mask_bind_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+pub(super) fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -257,7 +257,7 @@ fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) 
     }
 }
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+pub(super) fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -307,5 +307,9 @@ pub(super) fn attachment(device: &wgpu::Device, label: &str, side: u32, format: 
 }
 
 /// WGSL sources, for validation in tests.
-pub const SHADERS: [(&str, &str); 3] =
-    [("sun_view.wgsl", SUN_VIEW_WGSL), ("count_pixels.wgsl", COUNT_PIXELS_WGSL), ("point_masks.wgsl", POINT_MASKS_WGSL)];
+pub const SHADERS: [(&str, &str); 4] = [
+    ("sun_view.wgsl", SUN_VIEW_WGSL),
+    ("count_pixels.wgsl", COUNT_PIXELS_WGSL),
+    ("point_masks.wgsl", POINT_MASKS_WGSL),
+    ("compute_raster.wgsl", super::compute::COMPUTE_RASTER_WGSL),
+];

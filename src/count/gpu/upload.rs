@@ -126,7 +126,8 @@ impl Counter {
             ],
         });
         self.check_errors("uploading the scene")?;
-        Ok(GpuScene { meshes, static_chunks, layout, render_bind, count_bind })
+        let compute = self.upload_compute(scene, &layout);
+        Ok(GpuScene { meshes, static_chunks, layout, render_bind, count_bind, compute })
     }
 
     /// Refuses, before allocating, a scene whose buffers exceed this device's limits: wgpu would

@@ -1,0 +1,404 @@
+// The compute rasterizer: counts the same pixels as sun_view.wgsl + count_pixels.wgsl without the
+// graphics pipeline, in two compute passes over a batch of tiles (a tile = one view):
+//
+// 1. bin_main, a workgroup per view: each lane takes the view's culled triangles in turn,
+//    transforms and snaps them as the raster path's hardware would, and appends the triangle to
+//    the list of every 32×32 raster tile its bounding box touches (a singly linked list per
+//    raster tile, nodes from one pool taken with one atomicAdd). A pool too small for the batch
+//    still counts what it needed in heads[0] and drops the rest: the host reads that count and
+//    runs the batch again with a pool that large, so a list is never truncated.
+// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the tile's list,
+//    taking every other triangle; each lane owns one row and steps across it. Per pixel an
+//    atomicMin in workgroup memory on a word packing quantized depth (high 29 bits) and class
+//    (low 3 bits: member k of the view, or CASTER), so the nearest triangle wins and, at equal
+//    quantized depth, a member beats a caster. Members also set their bit of the pixel's
+//    coverage (no depth test, as the raster path's mask pass). Then the tile's visible, covered
+//    and shadow-edge pixels are counted per member, with one global atomicAdd a count a tile.
+//
+// Raster rules as the hardware's (Vulkan, as lavapipe and D3D/Metal do it): the viewport
+// transform into atlas pixels, vertices snapped to 1/256 pixel (8 subpixel bits, round to
+// nearest even), coverage sampled at pixel centres, a pixel on an edge drawn only when the edge
+// is a top or left edge, depth clipped to [0, 1] per pixel. Edge functions are evaluated exactly
+// in 64-bit integers, emulated on two u32 words (core WGSL has no i64), so no pixel depends on
+// float rounding; only the depth does (a plane in f32, like the hardware's interpolation).
+// Depth: z in [0, 1] × 2^29, truncated: two surfaces closer than 2^-29 of the view's depth range
+// (the scene's extent along the sun: 2 nm on a 1 km scene) count as tied, and the member wins.
+
+const TILE: u32 = 32u;
+const NONE: u32 = 0xffffffffu;
+const CASTER: u32 = 7u;
+// The most members a view counts (the library's group::MAX_MEMBERS).
+const MAX_MEMBERS: u32 = 4u;
+// Snapped coordinates are clamped to ±2^29 subpixels (±2^21 pixels), so differences fit an i32.
+const CLAMP: f32 = 536870912.0;
+
+struct View {
+    view_proj: mat4x4<f32>,
+    // Top-left pixel of the view's tile in the (virtual) atlas: the raster path's viewport.
+    tile: vec2<u32>,
+    side: u32,
+    // Leaf fraction: leaves of a lower (shifted) rank cast shadows.
+    leaves: f32,
+    first_member: u32,
+    member_count: u32,
+    // The view's culled triangles: ranges[first_range ..][.. range_count], (start, count) each.
+    first_range: u32,
+    range_count: u32,
+    // Where the view's raster tiles' list heads start in heads (after heads[0], the pool count).
+    first_head: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+struct Params {
+    // Nodes the pool holds.
+    capacity: u32,
+    // Non-zero: count shadow-edge pairs too.
+    count_edges: u32,
+    // Non-zero (tests only): where in heads each pixel's class and coverage are also written,
+    // view after view, row by row: the class (member k, CASTER, or 6 for nothing) | cover << 3.
+    dump: u32,
+    _pad1: u32,
+}
+
+// Triangle t's corners at positions[9t ..][.. 9], scene coordinates relative to the origin.
+@group(0) @binding(0) var<storage, read> positions: array<f32>;
+// Triangle t: (receiver id or NONE, leaf rank shifted by its placement as f32 bits (negative: not
+// a leaf), transmittance bits, dither seed).
+@group(0) @binding(1) var<storage, read> attributes: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read> views: array<View>;
+@group(0) @binding(3) var<storage, read> ranges: array<vec2<u32>>;
+@group(0) @binding(4) var<storage, read> members: array<u32>;
+// counts[3m], counts[3m + 1], counts[3m + 2]: visible, covered, edge pairs of member entry m.
+@group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
+// heads[0]: pool nodes asked for; heads[1 + first_head + raster tile]: 1 + its first node, 0 if none.
+@group(0) @binding(6) var<storage, read_write> heads: array<atomic<u32>>;
+// Node n: (triangle, 1 + next node or 0).
+@group(0) @binding(7) var<storage, read_write> nodes: array<vec2<u32>>;
+@group(0) @binding(8) var<uniform> params: Params;
+
+// ---- 64-bit integers as (low, high) u32 words, two's complement ----
+
+fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.x + b.x;
+    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
+}
+
+fn neg64(a: vec2<u32>) -> vec2<u32> {
+    return add64(vec2<u32>(~a.x, ~a.y), vec2<u32>(1u, 0u));
+}
+
+// a · b exactly, |a|, |b| < 2^31.
+fn mul64(a: i32, b: i32) -> vec2<u32> {
+    let ua = u32(abs(a));
+    let ub = u32(abs(b));
+    let a0 = ua & 0xffffu;
+    let a1 = ua >> 16u;
+    let b0 = ub & 0xffffu;
+    let b1 = ub >> 16u;
+    let p00 = a0 * b0;
+    let p01 = a0 * b1;
+    let p10 = a1 * b0;
+    let mid = p01 + p10;
+    let mid_carry = select(0u, 1u, mid < p01);
+    let lo = p00 + (mid << 16u);
+    let hi = a1 * b1 + (mid >> 16u) + (mid_carry << 16u) + select(0u, 1u, lo < p00);
+    let p = vec2<u32>(lo, hi);
+    if (a < 0) != (b < 0) {
+        return neg64(p);
+    }
+    return p;
+}
+
+fn negative64(a: vec2<u32>) -> bool {
+    return i32(a.y) < 0;
+}
+
+// ---- a triangle as the hardware sees it ----
+
+struct Setup {
+    // Snapped corners, subpixels relative to the view's tile, in [0, 1, 2] order with positive area.
+    x: vec3<i32>,
+    y: vec3<i32>,
+    // Depth plane: z = z0 + dzdx (px - x0) + dzdy (py - y0), pixels.
+    z0: f32,
+    dzdx: f32,
+    dzdy: f32,
+    // False: dropped (a leaf not in leaf, zero area, or wholly outside depth [0, 1]).
+    live: bool,
+}
+
+// Clip → atlas pixels as the viewport transform does, snapped to 1/256 pixel, made relative to
+// the tile's corner (exactly, in integers).
+fn snap(clip: vec4<f32>, view: View) -> vec3<f32> {
+    let half = f32(view.side) * 0.5;
+    let fx = clip.x * half + (f32(view.tile.x) + half);
+    let fy = -clip.y * half + (f32(view.tile.y) + half);
+    let sx = clamp(round(fx * 256.0), -CLAMP, CLAMP) - f32(view.tile.x) * 256.0;
+    let sy = clamp(round(fy * 256.0), -CLAMP, CLAMP) - f32(view.tile.y) * 256.0;
+    return vec3<f32>(sx, sy, clip.z);
+}
+
+fn setup(t: u32, view: View) -> Setup {
+    var s: Setup;
+    s.live = false;
+    let a = attributes[t];
+    let rank = bitcast<f32>(a.y);
+    if rank >= 0.0 && rank >= view.leaves {
+        return s;
+    }
+    var p: array<vec3<f32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let o = 9u * t + 3u * k;
+        let world = vec4<f32>(positions[o], positions[o + 1u], positions[o + 2u], 1.0);
+        p[k] = snap(view.view_proj * world, view);
+    }
+    if max(p[0].z, max(p[1].z, p[2].z)) < 0.0 || min(p[0].z, min(p[1].z, p[2].z)) > 1.0 {
+        return s;
+    }
+    var x = vec3<i32>(i32(p[0].x), i32(p[1].x), i32(p[2].x));
+    var y = vec3<i32>(i32(p[0].y), i32(p[1].y), i32(p[2].y));
+    var z = vec3<f32>(p[0].z, p[1].z, p[2].z);
+    let area = add64(mul64(x.y - x.x, y.z - y.x), neg64(mul64(y.y - y.x, x.z - x.x)));
+    if area.x == 0u && area.y == 0u {
+        return s;
+    }
+    if negative64(area) {
+        x = x.xzy;
+        y = y.xzy;
+        z = z.xzy;
+    }
+    // The depth plane from the snapped corners, in pixels.
+    let e1 = vec3<f32>(f32(x.y - x.x) / 256.0, f32(y.y - y.x) / 256.0, z.y - z.x);
+    let e2 = vec3<f32>(f32(x.z - x.x) / 256.0, f32(y.z - y.x) / 256.0, z.z - z.x);
+    let n = cross(e1, e2);
+    s.x = x;
+    s.y = y;
+    s.z0 = z.x;
+    s.dzdx = -n.x / n.z;
+    s.dzdy = -n.y / n.z;
+    s.live = true;
+    return s;
+}
+
+// ---- pass 1: binning ----
+
+@compute @workgroup_size(64)
+fn bin_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let view = views[group.y];
+    let per_row = (view.side + TILE - 1u) / TILE;
+    let span = i32(TILE * 256u);
+    for (var r = 0u; r < view.range_count; r++) {
+        let range = ranges[view.first_range + r];
+        for (var i = lane; i < range.y; i += 64u) {
+            let t = range.x + i;
+            let s = setup(t, view);
+            if !s.live {
+                continue;
+            }
+            // Raster tiles the bounding box touches (pixel centres lie at 128 + 256·k).
+            let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
+            let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
+            let last = i32(per_row) - 1;
+            let t0 = clamp(lo / span, vec2<i32>(0), vec2<i32>(last));
+            let t1 = clamp(hi / span, vec2<i32>(0), vec2<i32>(last));
+            if hi.x < 0 || hi.y < 0 || lo.x / span > last || lo.y / span > last {
+                continue;
+            }
+            for (var ty = t0.y; ty <= t1.y; ty++) {
+                for (var tx = t0.x; tx <= t1.x; tx++) {
+                    let n = atomicAdd(&heads[0], 1u);
+                    if n >= params.capacity {
+                        continue;
+                    }
+                    let head = 1u + view.first_head + u32(ty) * per_row + u32(tx);
+                    let next = atomicExchange(&heads[head], n + 1u);
+                    nodes[n] = vec2<u32>(t, next);
+                }
+            }
+        }
+    }
+}
+
+// ---- pass 2: rasterizing and counting a raster tile ----
+
+var<workgroup> depth: array<atomic<u32>, 1024>;
+var<workgroup> cover: array<atomic<u32>, 1024>;
+// Per member: visible, covered, edge pairs.
+var<workgroup> totals: array<atomic<u32>, 12>;
+
+// PCG hash (Jarzynski & Olano 2020), as sun_view.wgsl's.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// Draws triangle t's pixels in one row of a raster tile: row `row` of tile (tx, ty).
+fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
+    let py = i32((tile0.y + row) * 256u + 128u);
+    let px0 = i32(tile0.x * 256u + 128u);
+    let a = attributes[t];
+    var kind = CASTER;
+    for (var k = 0u; k < view.member_count; k++) {
+        if a.x == members[view.first_member + k] {
+            kind = k;
+        }
+    }
+    let transmittance = bitcast<f32>(a.z);
+    // Edge functions at the row's first pixel centre and their step a pixel right; a pixel is
+    // in when all three are >= 0 after a bias of -1 on edges that are neither top nor left.
+    var e: array<vec2<u32>, 3>;
+    var step: array<vec2<u32>, 3>;
+    for (var k = 0u; k < 3u; k++) {
+        let k1 = (k + 1u) % 3u;
+        let dx = s.x[k1] - s.x[k];
+        let dy = s.y[k1] - s.y[k];
+        let top_left = (dy == 0 && dx > 0) || dy < 0;
+        e[k] = add64(mul64(dx, py - s.y[k]), neg64(mul64(dy, px0 - s.x[k])));
+        if !top_left {
+            e[k] = add64(e[k], vec2<u32>(NONE, NONE));
+        }
+        step[k] = neg64(mul64(dy, 256));
+    }
+    let y = tile0.y + row;
+    for (var x = 0u; x < TILE; x++) {
+        let inside = !negative64(e[0]) && !negative64(e[1]) && !negative64(e[2]);
+        let lx = tile0.x + x;
+        if inside && lx < view.side && y < view.side {
+            let cx = f32(lx) + 0.5 - f32(s.x.x) / 256.0;
+            let cy = f32(y) + 0.5 - f32(s.y.x) / 256.0;
+            let z = s.z0 + s.dzdx * cx + s.dzdy * cy;
+            var kept = z >= 0.0 && z <= 1.0;
+            if kept && transmittance > 0.0 {
+                let h = pcg((view.tile.x + lx) ^ pcg((view.tile.y + y) ^ pcg(a.w)));
+                kept = f32(h >> 8u) * (1.0 / 16777216.0) >= transmittance;
+            }
+            if kept {
+                let q = min(u32(z * 536870912.0), 0x1fffffffu);
+                let at = row * TILE + x;
+                atomicMin(&depth[at], (q << 3u) | kind);
+                if kind != CASTER {
+                    atomicOr(&cover[at], 1u << kind);
+                }
+            }
+        }
+        for (var k = 0u; k < 3u; k++) {
+            e[k] = add64(e[k], step[k]);
+        }
+    }
+}
+
+// The next node after n (0: the end).
+fn next_node(n: u32) -> u32 {
+    if n == 0u {
+        return 0u;
+    }
+    return nodes[n - 1u].y;
+}
+
+@compute @workgroup_size(64)
+fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let view = views[group.y];
+    let per_row = (view.side + TILE - 1u) / TILE;
+    if group.x >= per_row * per_row {
+        return;
+    }
+    let tile0 = vec2<u32>(group.x % per_row, group.x / per_row) * TILE;
+    for (var i = lane; i < TILE * TILE; i += 64u) {
+        atomicStore(&depth[i], NONE);
+        atomicStore(&cover[i], 0u);
+    }
+    if lane < 12u {
+        atomicStore(&totals[lane], 0u);
+    }
+    workgroupBarrier();
+    let row = lane % TILE;
+    var node = atomicLoad(&heads[1u + view.first_head + group.x]);
+    if lane >= TILE {
+        node = next_node(node);
+    }
+    while node != 0u {
+        let t = nodes[node - 1u].x;
+        let s = setup(t, view);
+        if s.live {
+            draw_row(t, view, s, tile0, row);
+        }
+        node = next_node(next_node(node));
+    }
+    workgroupBarrier();
+    if params.dump != 0u {
+        dump_tile(view, tile0, lane, group.y);
+    }
+    count_tile(view, tile0, lane);
+}
+
+// Counts the tile's pixels per member into totals, then adds them to the view's counts.
+fn count_tile(view: View, tile0: vec2<u32>, lane: u32) {
+    let n = min(view.member_count, MAX_MEMBERS);
+    var visible: array<u32, MAX_MEMBERS>;
+    var covered: array<u32, MAX_MEMBERS>;
+    var edges: array<u32, MAX_MEMBERS>;
+    for (var i = lane; i < TILE * TILE; i += 64u) {
+        let x = i % TILE;
+        let y = i / TILE;
+        if tile0.x + x >= view.side || tile0.y + y >= view.side {
+            continue;
+        }
+        let word = atomicLoad(&depth[i]);
+        let bits = atomicLoad(&cover[i]);
+        var right_word = NONE;
+        var right_bits = 0u;
+        if x + 1u < TILE {
+            right_word = atomicLoad(&depth[i + 1u]);
+            right_bits = atomicLoad(&cover[i + 1u]);
+        }
+        var below_word = NONE;
+        var below_bits = 0u;
+        if y + 1u < TILE {
+            below_word = atomicLoad(&depth[i + TILE]);
+            below_bits = atomicLoad(&cover[i + TILE]);
+        }
+        for (var k = 0u; k < n; k++) {
+            let lit = is_visible(word, k);
+            visible[k] += select(0u, 1u, lit);
+            let on = (bits & (1u << k)) != 0u;
+            covered[k] += select(0u, 1u, on);
+            if params.count_edges != 0u && on {
+                let right_on = (right_bits & (1u << k)) != 0u;
+                let below_on = (below_bits & (1u << k)) != 0u;
+                edges[k] += select(0u, 1u, right_on && lit != is_visible(right_word, k));
+                edges[k] += select(0u, 1u, below_on && lit != is_visible(below_word, k));
+            }
+        }
+    }
+    for (var k = 0u; k < n; k++) {
+        atomicAdd(&totals[3u * k], visible[k]);
+        atomicAdd(&totals[3u * k + 1u], covered[k]);
+        atomicAdd(&totals[3u * k + 2u], edges[k]);
+    }
+    workgroupBarrier();
+    if lane < 3u * n {
+        let total = atomicLoad(&totals[lane]);
+        if total != 0u {
+            atomicAdd(&counts[3u * view.first_member + lane], total);
+        }
+    }
+}
+
+fn dump_tile(view: View, tile0: vec2<u32>, lane: u32, slot: u32) {
+    for (var i = lane; i < TILE * TILE; i += 64u) {
+        let x = tile0.x + i % TILE;
+        let y = tile0.y + i / TILE;
+        if x < view.side && y < view.side {
+            let word = atomicLoad(&depth[i]);
+            let kind = select(word & 7u, 6u, word == NONE);
+            atomicStore(&heads[params.dump + (slot * view.side + y) * view.side + x], kind | (atomicLoad(&cover[i]) << 3u));
+        }
+    }
+}
+
+fn is_visible(word: u32, k: u32) -> bool {
+    return word != NONE && (word & 7u) == k;
+}
