@@ -16,7 +16,7 @@ use clap::{Args, Parser, Subcommand};
 use serde_json::json;
 
 use sunlit::count::exact::Exact;
-use sunlit::count::gpu::{Backend, Counter, CounterOptions, LimitsProfile};
+use sunlit::count::gpu::{Backend, Counter, CounterOptions, Kernel, LimitsProfile};
 use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
@@ -304,10 +304,12 @@ impl PixelArgs {
 /// Which engine answers views (fraction, annual, bench).
 #[derive(Args)]
 struct EngineArgs {
-    /// auto: each view on the cheaper of exact clipping and GPU pixels, by a cost model measured
-    /// once on this device (see docs/design.md, "Hybrid engine"); gpu: pixels only; exact: clipping only
-    /// (see-through nodes count as opaque there).
-    #[arg(long, value_name = "auto|gpu|exact", default_value = "auto")]
+    /// auto: each view on the cheapest of exact clipping, GPU pixels and the compute rasterizer,
+    /// by a cost model measured once on this device (see docs/design.md, "Hybrid engine"); gpu:
+    /// pixels only (the graphics pipeline); compute: pixels only, counted by the compute
+    /// rasterizer (no graphics pipeline); exact: clipping only (see-through nodes count as opaque
+    /// there).
+    #[arg(long, value_name = "auto|gpu|exact|compute", default_value = "auto")]
     engine: String,
     /// The cost model `auto` routes by: read from FILE when it exists, else measured and written
     /// there (pins the routing); sky views have their own beside it (FILE with `.sky` before its
@@ -319,7 +321,7 @@ struct EngineArgs {
 impl EngineArgs {
     fn kind(&self) -> Result<EngineKind> {
         EngineKind::parse(&self.engine)
-            .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))
+            .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact, compute", self.engine)))
     }
 
     fn source(&self) -> ProfileSource {
@@ -529,6 +531,10 @@ fn fraction(args: FractionArgs) -> Result<()> {
         (EngineKind::Auto, _) => format!("auto: exact clipping or GPU pixels at {0}×{0}, per view", args.pixels.resolution),
         (EngineKind::Gpu, None) => format!("GPU pixel counting, {0}×{0}", args.pixels.resolution),
         (EngineKind::Gpu, Some(a)) => format!("GPU pixel counting, up to {0}×{0} for ±{a}", args.pixels.resolution),
+        (EngineKind::Compute, None) => format!("GPU pixel counting by the compute rasterizer, {0}×{0}", args.pixels.resolution),
+        (EngineKind::Compute, Some(a)) => {
+            format!("GPU pixel counting by the compute rasterizer, up to {0}×{0} for ±{a}", args.pixels.resolution)
+        }
     };
     println!("sun azimuth {:.2}°, altitude {:.2}° ({method})", sun.azimuth, sun.altitude);
     let width = scene.receivers.iter().map(|r| r.name.len()).max().unwrap_or(4).max(7);

@@ -23,7 +23,7 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
 use crate::count::exact::engine::ExactEngine;
-use crate::count::gpu::{Counter, CounterOptions, GpuScene};
+use crate::count::gpu::{Counter, CounterOptions, GpuScene, Kernel};
 use crate::count::hybrid::EngineKind;
 use crate::count::lanes::Lane;
 use crate::count::{Engine as _, ViewKind, ViewRequest};
@@ -112,13 +112,19 @@ impl Engine {
         gpu: Option<bool>,
     ) -> Result<Engine, JsValue> {
         let kind = engine.as_deref().map_or(Ok(EngineKind::Auto), EngineKind::parse).map_err(js_error)?;
-        let options =
-            CounterOptions { resolution: resolution.unwrap_or(CounterOptions::default().resolution), accuracy, ..Default::default() };
+        // The page's GPU lane counts with the compute rasterizer when asked for it by name.
+        let kernel = if kind == EngineKind::Compute { Kernel::Compute } else { Kernel::Raster };
+        let options = CounterOptions {
+            resolution: resolution.unwrap_or(CounterOptions::default().resolution),
+            accuracy,
+            kernel,
+            ..Default::default()
+        };
         if gpu == Some(false) {
-            if kind == EngineKind::Gpu {
+            if kind.gpu_only() {
                 return Err(js_error(Error::argument(
                     "engine",
-                    "'gpu' needs WebGPU, which this browser does not offer; 'exact' and 'auto' clip without it",
+                    format!("'{}' needs WebGPU, which this browser does not offer; 'exact' and 'auto' clip without it", kind.name()),
                 )));
             }
             if let Some(a) = accuracy

@@ -273,6 +273,31 @@ fn bench_lists_writes_and_times_generated_models() {
     }
     assert_eq!(line["shading_polygons"], 1045);
     assert!(line["max_abs_error"].as_f64().unwrap() < 0.05, "{line}");
+    // The compute rasterizer counts the same views by name, checked alike.
+    let out = sunlit(&[
+        "bench",
+        "blaas-buildings",
+        "--engine",
+        "compute",
+        "--samples",
+        "3x3",
+        "--resolution",
+        "64",
+        "--views",
+        "40",
+        "--check",
+        "5",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let compute: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(compute["engine"], "compute", "{compute}");
+    let rendered = compute["views_rendered"].as_u64().unwrap();
+    assert!(rendered > 0 && rendered + compute["views_skipped"].as_u64().unwrap() == compute["views_timed"].as_u64().unwrap(), "{compute}");
+    assert_eq!(compute["bin_pool_reruns"], 0, "{compute}");
+    assert!(compute["max_abs_error"].as_f64().unwrap() < 0.05, "{compute}");
+    let help = String::from_utf8_lossy(&sunlit(&["bench", "--help"]).stdout).to_string();
+    assert!(help.contains("--engine <auto|gpu|exact|compute>"), "{help}");
+    fails_with(&sunlit(&["bench", "blaas-self", "--engine", "pixels"]), &["--engine", "auto, gpu, exact, compute"]);
     fails_with(&sunlit(&["bench", "no-such-model"]), &["no-such-model", "blaas-self"]);
     fails_with(&sunlit(&["bench", "--samples", "27by19", "blaas-self"]), &["--samples", "27by19"]);
     fails_with(&sunlit(&["bench", "--write", &path]), &["--write", "one generated model"]);

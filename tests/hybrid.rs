@@ -77,6 +77,8 @@ fn pinned(gpu_cheap: bool) -> ProfileSource {
         exact: Cost { per_view_us: exact, per_triangle_us: 0.0 },
         gpu: Some(Cost { per_view_us: gpu, per_triangle_us: 0.0 }),
         gpu_startup_seconds: Some(0.0),
+        compute: None,
+        compute_startup_seconds: None,
     };
     let path = temp_dir().join(if gpu_cheap { "gpu.json" } else { "exact.json" });
     write_profile(&path, &profile).unwrap();
@@ -109,6 +111,37 @@ fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
         partly += usize::from(*want > 0.02 && *want < 0.98);
     }
     assert!(partly >= 10, "only {partly} views partly shaded");
+}
+
+/// A profile whose compute rasterizer is the cheapest engine routes the loaded views to it, and
+/// they get its counts: the same as `--engine compute` gives them, within the tolerance of the
+/// exact reference.
+#[test]
+fn auto_routes_to_the_compute_kernel_where_it_is_cheapest() {
+    let scene = louvred_walls();
+    let profile = Profile {
+        device: "test".into(),
+        exact: Cost { per_view_us: 1e6, per_triangle_us: 0.0 },
+        gpu: Some(Cost { per_view_us: 1e5, per_triangle_us: 0.0 }),
+        gpu_startup_seconds: Some(0.0),
+        compute: Some(Cost { per_view_us: 1.0, per_triangle_us: 0.0 }),
+        compute_startup_seconds: Some(0.0),
+    };
+    let path = temp_dir().join("compute.json");
+    write_profile(&path, &profile).unwrap();
+    let auto = HybridEngine::new(&scene, EngineKind::Auto, options(), Some(1), ProfileSource::File(path)).unwrap();
+    let routed = pollster::block_on(auto.count(&requests(&scene))).unwrap();
+    let stats = auto.stats();
+    assert!(stats.compute_views > 0 && stats.gpu_views == 0, "{stats:?}");
+    let alone = HybridEngine::new(&scene, EngineKind::Compute, options(), Some(1), ProfileSource::Probe).unwrap();
+    let by_compute = pollster::block_on(alone.count(&requests(&scene))).unwrap();
+    let reference = exact::sunlit_fractions(&scene, &requests(&scene));
+    for (i, want) in reference.iter().enumerate() {
+        if routed[i].side.is_some() {
+            assert_eq!(routed[i], by_compute[i], "view {i}: routed to the compute kernel, its answer");
+        }
+        assert!((by_compute[i].fraction - want).abs() < GPU_TOLERANCE, "view {i}: compute {} vs {want}", by_compute[i].fraction);
+    }
 }
 
 /// Sky views are priced on views of their own kind: a pinned profile that sends every loaded sun

@@ -90,9 +90,9 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
         return bench_sky(&args, scheme);
     }
     let options = counter_options(&args)?;
-    if !args.models.is_empty() && args.engine.kind()? != EngineKind::Gpu {
+    if !args.models.is_empty() && !args.engine.kind()?.gpu_only() {
         if options.backend == Backend::Noop {
-            return Err(Error::argument("--backend", "noop times the GPU counter alone: use it with --engine gpu"));
+            return Err(Error::argument("--backend", "noop times the GPU counter alone: use it with --engine gpu or compute"));
         }
         let start = Instant::now();
         return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
@@ -149,7 +149,8 @@ fn counter_options(args: &BenchArgs) -> Result<CounterOptions> {
         "webgpu" => LimitsProfile::WebGpuCore,
         other => return Err(Error::argument("--limits", format!("'{other}' is not adapter, lavapipe or webgpu"))),
     };
-    let options = CounterOptions { max_atlas: args.atlas, backend, limits, ..args.pixels.options() };
+    let kernel = if args.engine.kind()? == EngineKind::Compute { Kernel::Compute } else { Kernel::Raster };
+    let options = CounterOptions { max_atlas: args.atlas, backend, limits, kernel, ..args.pixels.options() };
     if backend == Backend::Noop {
         if args.check > 0 {
             return Err(Error::argument("--check", "the noop backend counts nothing to check: drop --check or use --backend platform"));
@@ -198,7 +199,7 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
         let estimated = t.seconds * all.len() as f64 / t.views.max(1) as f64;
         let mut line = json!({
             "model": name,
-            "engine": EngineKind::Gpu.name(),
+            "engine": args.engine.kind()?.name(),
             "gpu_startup_seconds": startup + upload_seconds,
             "receivers": scene.receivers.len(),
             "shading_polygons": shading,
@@ -217,6 +218,10 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             "views_per_second": t.views_per_second,
             "planning_seconds": t.planning_seconds,
             "host_stages_seconds": t.host_stages,
+            // The compute kernel's node pool (0 with the raster kernel) and the batches it made
+            // count again by overflowing.
+            "bin_pool_nodes": counters.iter().map(|c| c.bin_pool().0).max(),
+            "bin_pool_reruns": counters.iter().map(|c| c.bin_pool().1).sum::<u64>(),
             "seconds_per_rendered_view": t.seconds / t.rendered.max(1) as f64,
             "mean_triangles_drawn": t.mean_triangles_drawn.round(),
             "tiles_rendered": t.tiles_rendered,

@@ -207,6 +207,10 @@ impl MapArgs {
     fn on_gpu(&self) -> Result<bool> {
         let kind = EngineKind::parse(&self.engine)
             .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", self.engine)))?;
+        if kind == EngineKind::Compute {
+            // Map points are read from the raster kernel's atlas, which the compute kernel has not.
+            return Err(Error::argument("--engine", "'compute' draws no atlas for map points to read: use gpu, exact or auto"));
+        }
         Ok(kind == EngineKind::Gpu)
     }
 

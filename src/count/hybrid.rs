@@ -28,7 +28,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use super::exact::engine::{ExactEngine, ViewLoad};
-use super::gpu::{Counter, CounterOptions, GpuScene};
+use super::gpu::{Counter, CounterOptions, GpuScene, Kernel};
 use super::lanes::{Lane, Lanes, default_lanes};
 use super::{Engine, ViewAnswer, ViewKind, ViewRequest, check_receivers, cos_incidence};
 use crate::error::{Error, GpuError, Result};
@@ -65,16 +65,19 @@ pub enum EngineKind {
     Gpu,
     /// Exact polygon clipping only (see-through geometry counts as opaque).
     Exact,
+    /// GPU pixel counting by the compute rasterizer only ([`crate::count::gpu::compute`]).
+    Compute,
 }
 
 impl EngineKind {
-    /// `auto`, `gpu` or `exact`.
+    /// `auto`, `gpu`, `exact` or `compute`.
     pub fn parse(text: &str) -> Result<Self> {
         match text.trim().to_ascii_lowercase().as_str() {
             "auto" => Ok(Self::Auto),
             "gpu" => Ok(Self::Gpu),
             "exact" => Ok(Self::Exact),
-            other => Err(Error::argument("engine", format!("'{other}' is not one of auto, gpu, exact"))),
+            "compute" => Ok(Self::Compute),
+            other => Err(Error::argument("engine", format!("'{other}' is not one of auto, gpu, exact, compute"))),
         }
     }
 
@@ -84,7 +87,13 @@ impl EngineKind {
             Self::Auto => "auto",
             Self::Gpu => "gpu",
             Self::Exact => "exact",
+            Self::Compute => "compute",
         }
+    }
+
+    /// Whether it counts on a GPU only (no exact engine is made).
+    pub fn gpu_only(&self) -> bool {
+        matches!(self, Self::Gpu | Self::Compute)
     }
 }
 
@@ -116,6 +125,13 @@ pub struct Profile {
     pub gpu: Option<Cost>,
     /// Seconds to make the GPU device(s) and upload a scene, when measured.
     pub gpu_startup_seconds: Option<f64>,
+    /// The compute rasterizer at the profile's side; `None` until measured (profiles kept
+    /// before it existed have none, and route as they did).
+    #[serde(default)]
+    pub compute: Option<Cost>,
+    /// Seconds to make its device(s) and upload the scene, when measured.
+    #[serde(default)]
+    pub compute_startup_seconds: Option<f64>,
 }
 
 /// Where a view is answered.
@@ -125,40 +141,65 @@ pub enum Route {
     Exact,
     /// GPU pixel counting.
     Gpu,
+    /// GPU pixel counting by the compute rasterizer.
+    Compute,
 }
 
 impl Profile {
-    /// Routes views with these loads, a batch of a run of `run_views` views in all (the GPU's
+    /// Routes views with these loads, a batch of a run of `run_views` views in all (a GPU kernel's
     /// start-up is paid once a run, so this batch's saving is weighed as the run's: scaled by
     /// `run_views` over the batch's views): see the module doc. A pure function of its inputs.
     pub fn route(&self, loads: &[ViewLoad], run_views: usize) -> Vec<Route> {
         let mut routes: Vec<Route> = loads.iter().map(|&l| self.route_one(l)).collect();
-        let needed = loads.iter().any(|l| l.see_through > 0);
-        let saving_us: f64 = loads
-            .iter()
-            .zip(&routes)
-            .filter(|(_, r)| **r == Route::Gpu)
-            .map(|(&l, _)| self.exact.of(l) - self.gpu.map_or(0.0, |g| g.of(l)))
-            .sum();
         let runs_per_batch = (run_views as f64 / loads.len().max(1) as f64).max(1.0);
-        let startup_us = 1e6 * self.gpu_startup_seconds.unwrap_or(ASSUMED_GPU_STARTUP);
-        if !needed && saving_us * runs_per_batch < startup_us {
-            routes.iter_mut().for_each(|r| *r = Route::Exact);
+        // The compute kernel first: views it would save too little on go where they would go
+        // without it; then the raster kernel's against clipping alone, as before.
+        let kernels = [(Route::Compute, self.compute, self.compute_startup_seconds), (Route::Gpu, self.gpu, self.gpu_startup_seconds)];
+        let bare = Profile { compute: None, compute_startup_seconds: None, ..self.clone() };
+        for (route, cost, startup) in kernels {
+            let without = |l: ViewLoad| if route == Route::Compute { bare.route_one(l) } else { Route::Exact };
+            let needed = loads.iter().zip(&routes).any(|(l, r)| *r == route && l.see_through > 0 && without(*l) == Route::Exact);
+            let saving_us: f64 = loads
+                .iter()
+                .zip(&routes)
+                .filter(|(_, r)| **r == route)
+                .map(|(&l, _)| self.cost_of(without(l), l) - cost.map_or(0.0, |c| c.of(l)))
+                .sum();
+            let startup_us = 1e6 * startup.unwrap_or(ASSUMED_GPU_STARTUP);
+            if !needed && saving_us * runs_per_batch < startup_us {
+                for (r, &l) in routes.iter_mut().zip(loads) {
+                    if *r == route {
+                        *r = without(l);
+                    }
+                }
+            }
         }
         routes
     }
 
-    /// Where one view goes on its own load (before [`Self::route`]'s rule for the whole batch).
+    /// Where one view goes on its own load (before [`Self::route`]'s rule for the whole batch):
+    /// the engine with the lowest modelled cost; a view with see-through geometry to the
+    /// cheaper GPU kernel (the exact engine counts it as opaque).
     pub fn route_one(&self, load: ViewLoad) -> Route {
         if load.triangles == 0 {
             return Route::Exact;
         }
-        if load.see_through > 0 {
-            return Route::Gpu;
-        }
-        match self.gpu {
-            Some(gpu) if gpu.of(load) < self.exact.of(load) => Route::Gpu,
+        let kernels = [(Route::Gpu, self.gpu), (Route::Compute, self.compute)];
+        let cheapest_gpu = kernels.iter().filter_map(|(r, c)| c.map(|c| (*r, c.of(load)))).min_by(|a, b| a.1.total_cmp(&b.1));
+        match cheapest_gpu {
+            Some((r, _)) if load.see_through > 0 => r,
+            None if load.see_through > 0 => Route::Gpu,
+            Some((r, us)) if us < self.exact.of(load) => r,
             _ => Route::Exact,
+        }
+    }
+
+    /// Modelled µs of a view of `load` on `route` (0 for a kernel not measured).
+    fn cost_of(&self, route: Route, load: ViewLoad) -> f64 {
+        match route {
+            Route::Exact => self.exact.of(load),
+            Route::Gpu => self.gpu.map_or(0.0, |c| c.of(load)),
+            Route::Compute => self.compute.map_or(0.0, |c| c.of(load)),
         }
     }
 }
@@ -186,6 +227,7 @@ fn unanswered(scene: &Scene, requests: &[ViewRequest]) -> Vec<ViewAnswer> {
 enum Counted {
     Exact(Vec<f64>),
     Gpu(Vec<ViewAnswer>),
+    Compute(Vec<ViewAnswer>),
 }
 
 /// Requests split by route, natively and on the web alike: each part with its indices in the
@@ -202,6 +244,10 @@ pub struct Split {
     pub gpu_idx: Vec<usize>,
     /// The requests routed to the GPU.
     pub gpu_reqs: Vec<ViewRequest>,
+    /// Where the compute kernel's part sits in the original order.
+    pub compute_idx: Vec<usize>,
+    /// The requests routed to the compute kernel.
+    pub compute_reqs: Vec<ViewRequest>,
 }
 
 impl Split {
@@ -210,7 +256,8 @@ impl Split {
         let (exact_idx, exact_reqs) = routed_to(requests, routes, Route::Exact);
         let exact_loads = loads.map_or_else(Vec::new, |l| exact_idx.iter().map(|&i| l[i]).collect());
         let (gpu_idx, gpu_reqs) = routed_to(requests, routes, Route::Gpu);
-        Self { exact_idx, exact_reqs, exact_loads, gpu_idx, gpu_reqs }
+        let (compute_idx, compute_reqs) = routed_to(requests, routes, Route::Compute);
+        Self { exact_idx, exact_reqs, exact_loads, gpu_idx, gpu_reqs, compute_idx, compute_reqs }
     }
 
     /// The exact part's fractions.
@@ -221,12 +268,24 @@ impl Split {
     /// The answers in the requests' order: exact ones carry their fraction and cosine (error 0),
     /// the GPU's their pixel counts too.
     pub fn merge(&self, scene: &Scene, requests: &[ViewRequest], exact: Vec<f64>, gpu: Vec<ViewAnswer>) -> Vec<ViewAnswer> {
+        self.merge_all(scene, requests, exact, gpu, Vec::new())
+    }
+
+    /// [`Self::merge`] with the compute kernel's answers too.
+    pub fn merge_all(
+        &self,
+        scene: &Scene,
+        requests: &[ViewRequest],
+        exact: Vec<f64>,
+        gpu: Vec<ViewAnswer>,
+        compute: Vec<ViewAnswer>,
+    ) -> Vec<ViewAnswer> {
         let mut out = unanswered(scene, requests);
         for (&i, fraction) in self.exact_idx.iter().zip(exact) {
             out[i].fraction = fraction;
             out[i].error_estimate = Some(0.0);
         }
-        for (&i, answer) in self.gpu_idx.iter().zip(gpu) {
+        for (&i, answer) in self.gpu_idx.iter().zip(gpu).chain(self.compute_idx.iter().zip(compute)) {
             out[i] = answer;
         }
         out
@@ -249,12 +308,16 @@ pub enum ProfileSource {
 pub struct EngineStats {
     /// Views answered exactly (including dark views and views with nothing in front).
     pub exact_views: usize,
-    /// Views counted on the GPU.
+    /// Views counted on the GPU (by the raster kernel).
     pub gpu_views: usize,
+    /// Views counted by the compute rasterizer.
+    pub compute_views: usize,
     /// Wall seconds the exact engine worked.
     pub exact_seconds: f64,
     /// Wall seconds the GPU lanes worked.
     pub gpu_seconds: f64,
+    /// Wall seconds the compute kernel's lanes worked.
+    pub compute_seconds: f64,
     /// Seconds spent calibrating (probing both engines).
     pub calibration_seconds: f64,
     /// Seconds spent making GPU devices and uploading the scene.
@@ -270,6 +333,8 @@ pub struct HybridEngine<'a> {
     source: ProfileSource,
     exact: Option<ExactEngine>,
     gpu: OnceCell<Vec<(Counter, GpuScene)>>,
+    /// The compute kernel's lanes, made when a view first needs them.
+    compute: OnceCell<Vec<(Counter, GpuScene)>>,
     /// Per kind of views ([`ViewKind`], sun first), the profile `auto` routes them by.
     profiles: [OnceCell<(Profile, &'static str)>; 2],
     /// The kind of views being asked for now.
@@ -291,7 +356,7 @@ impl<'a> HybridEngine<'a> {
         {
             return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
         }
-        let exact = (kind != EngineKind::Gpu).then(|| ExactEngine::new(scene));
+        let exact = (!kind.gpu_only()).then(|| ExactEngine::new(scene));
         Ok(Self {
             scene,
             kind,
@@ -300,6 +365,7 @@ impl<'a> HybridEngine<'a> {
             source,
             exact,
             gpu: OnceCell::new(),
+            compute: OnceCell::new(),
             profiles: [OnceCell::new(), OnceCell::new()],
             views: Default::default(),
             stats: Default::default(),
@@ -307,9 +373,10 @@ impl<'a> HybridEngine<'a> {
         })
     }
 
-    /// Uses `lanes` (counters with `scene` uploaded) instead of making them when first needed.
+    /// Uses `lanes` (counters with `scene` uploaded) instead of making them when first needed:
+    /// the compute kernel's with [`EngineKind::Compute`], else the raster kernel's.
     pub fn with_lanes(self, lanes: Vec<(Counter, GpuScene)>) -> Self {
-        let _ = self.gpu.set(lanes);
+        let _ = if self.kind == EngineKind::Compute { self.compute.set(lanes) } else { self.gpu.set(lanes) };
         self
     }
 
@@ -337,9 +404,9 @@ impl<'a> HybridEngine<'a> {
         self.stats.get()
     }
 
-    /// The GPU lanes, if made.
+    /// The GPU lanes, if made (the compute kernel's with [`EngineKind::Compute`]).
     pub fn lanes(&self) -> Option<&[(Counter, GpuScene)]> {
-        self.gpu.get().map(Vec::as_slice)
+        if self.kind == EngineKind::Compute { self.compute.get() } else { self.gpu.get() }.map(Vec::as_slice)
     }
 
     /// The exact engine (absent with [`EngineKind::Gpu`]).
@@ -350,6 +417,7 @@ impl<'a> HybridEngine<'a> {
     /// Drops the GPU lanes (after a lost device); the next view that needs one makes them anew.
     pub fn forget_gpu(&mut self) {
         self.gpu = OnceCell::new();
+        self.compute = OnceCell::new();
     }
 
     fn add_stats(&self, f: impl FnOnce(&mut EngineStats)) {
@@ -359,15 +427,22 @@ impl<'a> HybridEngine<'a> {
     }
 
     async fn gpu_lanes(&self) -> Result<&[(Counter, GpuScene)]> {
-        if let Some(lanes) = self.gpu.get() {
+        self.lanes_of(Kernel::Raster).await
+    }
+
+    /// The lanes of one kernel, made (and the scene uploaded) the first time they are asked for.
+    async fn lanes_of(&self, kernel: Kernel) -> Result<&[(Counter, GpuScene)]> {
+        let cell = if kernel == Kernel::Compute { &self.compute } else { &self.gpu };
+        if let Some(lanes) = cell.get() {
             return Ok(lanes);
         }
         let start = now();
-        let first = Counter::new(self.options).await?;
+        let options = CounterOptions { kernel, ..self.options };
+        let first = Counter::new(options).await?;
         let n = self.lanes_wanted.unwrap_or_else(|| default_lanes(first.adapter_info()));
         let mut counters = vec![first];
         for _ in 1..n {
-            counters.push(Counter::new(self.options).await?);
+            counters.push(Counter::new(options).await?);
         }
         let lanes = counters
             .into_iter()
@@ -378,14 +453,15 @@ impl<'a> HybridEngine<'a> {
             .collect::<Result<Vec<_>>>()?;
         let seconds = now() - start;
         self.add_stats(|s| s.gpu_startup_seconds += seconds);
-        let _ = self.gpu.set(lanes);
-        self.gpu.get().map(Vec::as_slice).ok_or_else(|| Error::Gpu(GpuError::Device("GPU lanes went missing".into())))
+        let _ = cell.set(lanes);
+        cell.get().map(Vec::as_slice).ok_or_else(|| Error::Gpu(GpuError::Device("GPU lanes went missing".into())))
     }
 
     /// Answers `requests`, each on the engine the choice (and for `auto` the profile) routes it to.
     pub async fn count(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         check_receivers(self.scene.receivers.len(), requests)?;
         let routes = match (self.kind, &self.exact) {
+            (EngineKind::Compute, _) => vec![Route::Compute; requests.len()],
             (EngineKind::Gpu, _) | (_, None) => vec![Route::Gpu; requests.len()],
             (EngineKind::Exact, Some(_)) => vec![Route::Exact; requests.len()],
             (EngineKind::Auto, Some(exact)) => {
@@ -398,8 +474,9 @@ impl<'a> HybridEngine<'a> {
                 // Either path routes every view the same way.
                 let stats = self.stats();
                 if let Some(profile) = stored
-                    && (profile.gpu.is_none()
-                        || (stats.gpu_views == 0 && (stats.exact_views > 0 || !sample_may_go_to_gpu(exact, profile, requests))))
+                    && ((profile.gpu.is_none() && profile.compute.is_none())
+                        || (stats.gpu_views + stats.compute_views == 0
+                            && (stats.exact_views > 0 || !sample_may_go_to_gpu(exact, profile, requests))))
                 {
                     return self.count_in_one_walk(exact, profile, requests).await;
                 }
@@ -422,7 +499,7 @@ impl<'a> HybridEngine<'a> {
     /// first would send it, with the same answer. The GPU's views wait for the whole walk.
     async fn count_in_one_walk(&self, exact: &ExactEngine, profile: &Profile, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         let start = now();
-        let walked = exact.fractions_unless(requests, |load| profile.route_one(load) == Route::Gpu);
+        let walked = exact.fractions_unless(requests, |load| profile.route_one(load) != Route::Exact);
         let seconds = now() - start;
         let loads: Vec<ViewLoad> = walked.iter().map(|(load, _)| *load).collect();
         let routes = profile.route(&loads, self.run_views.get());
@@ -456,11 +533,14 @@ impl<'a> HybridEngine<'a> {
     /// (the exact engine then does not walk again where nothing was in front).
     async fn count_routed_loaded(&self, requests: &[ViewRequest], routes: &[Route], loads: Option<&[ViewLoad]>) -> Result<Vec<ViewAnswer>> {
         let split = Split::new(requests, routes, loads);
-        let lanes: Vec<Lane<'_>> = if split.gpu_reqs.is_empty() {
-            Vec::new()
-        } else {
-            self.gpu_lanes().await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect()
+        let lanes_for = async |kernel, reqs: &[ViewRequest]| -> Result<Vec<Lane<'_>>> {
+            if reqs.is_empty() {
+                return Ok(Vec::new());
+            }
+            Ok(self.lanes_of(kernel).await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect())
         };
+        let lanes = lanes_for(Kernel::Raster, &split.gpu_reqs).await?;
+        let compute_lanes = lanes_for(Kernel::Compute, &split.compute_reqs).await?;
         let exact = match (&self.exact, split.exact_reqs.is_empty()) {
             (_, true) => None,
             (Some(e), false) => Some(e),
@@ -470,6 +550,7 @@ impl<'a> HybridEngine<'a> {
         enum Part<'p> {
             Exact(&'p ExactEngine),
             Gpu,
+            Compute,
         }
         let mut parts = Vec::new();
         if let Some(e) = exact {
@@ -478,19 +559,23 @@ impl<'a> HybridEngine<'a> {
         if !split.gpu_reqs.is_empty() {
             parts.push(Part::Gpu);
         }
+        if !split.compute_reqs.is_empty() {
+            parts.push(Part::Compute);
+        }
         let results = platform::side_by_side(&parts, |part| {
-            let (part, lanes, split) = (*part, &lanes, &split);
+            let (part, lanes, compute_lanes, split) = (*part, &lanes, &compute_lanes, &split);
             async move {
                 let start = now();
                 let counted = match part {
                     Part::Exact(e) => Ok(Counted::Exact(split.exact_fractions(e))),
                     Part::Gpu => Lanes(lanes).answer(&split.gpu_reqs).await.map(Counted::Gpu),
+                    Part::Compute => Lanes(compute_lanes).answer(&split.compute_reqs).await.map(Counted::Compute),
                 };
                 (counted, now() - start)
             }
         })
         .await;
-        let (mut exact_fractions, mut gpu_answers) = (Vec::new(), Vec::new());
+        let (mut exact_fractions, mut gpu_answers, mut compute_answers) = (Vec::new(), Vec::new(), Vec::new());
         for (counted, seconds) in results {
             match counted? {
                 Counted::Exact(fractions) => {
@@ -507,9 +592,16 @@ impl<'a> HybridEngine<'a> {
                         s.gpu_seconds += seconds;
                     });
                 }
+                Counted::Compute(answers) => {
+                    compute_answers = answers;
+                    self.add_stats(|s| {
+                        s.compute_views += split.compute_idx.len();
+                        s.compute_seconds += seconds;
+                    });
+                }
             }
         }
-        Ok(split.merge(self.scene, requests, exact_fractions, gpu_answers))
+        Ok(split.merge_all(self.scene, requests, exact_fractions, gpu_answers, compute_answers))
     }
 
     /// The scene's size and the kind of views, as the profile's key names them: a profile is
@@ -578,7 +670,14 @@ impl<'a> HybridEngine<'a> {
         let start = now();
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact_cost, mean_us) = probe_exact(exact, requests, loads, &probe, cpu_threads());
-        let mut profile = Profile { device: String::new(), exact: exact_cost, gpu: None, gpu_startup_seconds: None };
+        let mut profile = Profile {
+            device: String::new(),
+            exact: exact_cost,
+            gpu: None,
+            gpu_startup_seconds: None,
+            compute: None,
+            compute_startup_seconds: None,
+        };
         let mut made_now = 0.0;
         if gpu_worth_probing(mean_us, loads) {
             let before = self.stats().gpu_startup_seconds;
@@ -588,6 +687,13 @@ impl<'a> HybridEngine<'a> {
             // the same to a later run that finds this profile: it is the run's, not 0.
             profile.gpu_startup_seconds = Some(if made_now > 0.0 { made_now } else { before });
             profile.gpu = Some(probe_gpu(&lanes, requests, loads).await?);
+            // The compute kernel on devices of its own, probed on the same views.
+            let before = self.stats().gpu_startup_seconds;
+            let lanes: Vec<Lane<'_>> = self.lanes_of(Kernel::Compute).await?.iter().map(|(counter, gpu)| Lane { counter, gpu }).collect();
+            let compute_made = self.stats().gpu_startup_seconds - before;
+            made_now += compute_made;
+            profile.compute_startup_seconds = Some(compute_made);
+            profile.compute = Some(probe_gpu(&lanes, requests, loads).await?);
         }
         let device = match (&profile.gpu, cpu_key(&self.options, cpu_threads())) {
             (None, Some(cpu)) => cpu,
@@ -627,7 +733,7 @@ const GPU_SAMPLE_VIEWS: usize = 64;
 /// own load ([`Profile::route_one`]). A guess that only picks how the batch is walked.
 fn sample_may_go_to_gpu(exact: &ExactEngine, profile: &Profile, requests: &[ViewRequest]) -> bool {
     let step = (requests.len() / GPU_SAMPLE_VIEWS).max(1);
-    requests.iter().step_by(step).any(|&r| profile.route_one(exact.load(r)) == Route::Gpu)
+    requests.iter().step_by(step).any(|&r| profile.route_one(exact.load(r)) != Route::Exact)
 }
 
 /// Indices of up to `n` views with something in their prism, spread evenly over their loads.

@@ -215,7 +215,8 @@ impl<'a> Chosen<'a> {
             (None, Some(cpu)) => cpu.clone(),
             _ => keys.0.clone(),
         };
-        Ok(Profile { device, exact, gpu, gpu_startup_seconds: gpu.map(|_| 0.0) })
+        // The page probes its one lane's kernel (the raster kernel under `auto`).
+        Ok(Profile { device, exact, gpu, gpu_startup_seconds: gpu.map(|_| 0.0), compute: None, compute_startup_seconds: None })
     }
 
     /// Starts the pool on `requests` (its promise runs while the GPU counts).
@@ -288,7 +289,7 @@ impl Engine for Chosen<'_> {
         // of. Each batch is a round trip to the pool, so `auto` clipping by the atlas's batch was
         // 0.5 s slower than `exact` on blaas-louvres' year (2.7 s against 2.1 s, bench-web).
         let gpu_routed = match self.kind {
-            EngineKind::Gpu => true,
+            EngineKind::Gpu | EngineKind::Compute => true,
             EngineKind::Auto => self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_some()),
             EngineKind::Exact => false,
         };
@@ -309,7 +310,7 @@ impl Engine for Chosen<'_> {
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         check_receivers(self.scene.receivers.len(), requests)?;
         let (routes, loads) = match self.kind {
-            EngineKind::Gpu => return self.lane()?.answer(requests).await,
+            EngineKind::Gpu | EngineKind::Compute => return self.lane()?.answer(requests).await,
             EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto if self.clips_everything() => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto => {

@@ -28,6 +28,8 @@ fn routing_follows_the_cheaper_modelled_cost() {
         exact: Cost { per_view_us: 10.0, per_triangle_us: 1.0 },
         gpu: Some(Cost { per_view_us: 500.0, per_triangle_us: 0.1 }),
         gpu_startup_seconds: Some(0.0),
+        compute: None,
+        compute_startup_seconds: None,
     };
     // Break-even at 10 + n = 500 + 0.1 n, n ≈ 544.
     let loads = [load(0), load(100), load(544), load(545), load(5_000), ViewLoad { triangles: 3, see_through: 1 }];
@@ -57,8 +59,36 @@ fn a_line_fits_its_samples() {
 
 #[test]
 fn engine_names_parse() {
-    for kind in [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact] {
+    for kind in [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact, EngineKind::Compute] {
         assert_eq!(EngineKind::parse(kind.name()).unwrap(), kind);
     }
-    assert!(EngineKind::parse("pixels").unwrap_err().to_string().contains("auto, gpu, exact"));
+    assert!(EngineKind::parse("pixels").unwrap_err().to_string().contains("auto, gpu, exact, compute"));
+}
+
+#[test]
+fn routing_picks_the_cheapest_of_three_engines() {
+    let profile = Profile {
+        device: "test".into(),
+        exact: Cost { per_view_us: 10.0, per_triangle_us: 1.0 },
+        gpu: Some(Cost { per_view_us: 500.0, per_triangle_us: 0.1 }),
+        gpu_startup_seconds: Some(0.0),
+        compute: Some(Cost { per_view_us: 100.0, per_triangle_us: 0.5 }),
+        compute_startup_seconds: Some(0.0),
+    };
+    // exact < compute below 180 triangles (10 + n = 100 + 0.5 n); compute < gpu below 1,000
+    // (100 + 0.5 n = 500 + 0.1 n); gpu above.
+    let loads = [load(100), load(179), load(181), load(999), load(1_001), ViewLoad { triangles: 50, see_through: 2 }];
+    let want = [Route::Exact, Route::Exact, Route::Compute, Route::Compute, Route::Gpu, Route::Compute];
+    assert_eq!(profile.route(&loads, 0), want, "see-through: the cheaper GPU kernel");
+    // A compute start-up its saving does not pay: its views go where they would without it
+    // (999 triangles: the raster kernel, 599.9 µs against 1,009 clipped; the see-through view
+    // still needs a GPU kernel: the raster one).
+    let slow_compute = Profile { compute_startup_seconds: Some(10.0), ..profile.clone() };
+    let want = [Route::Exact, Route::Exact, Route::Exact, Route::Gpu, Route::Gpu, Route::Gpu];
+    assert_eq!(slow_compute.route(&loads, 0), want);
+    // A profile kept before the compute kernel existed reads without it and routes as before.
+    let old = r#"{"device":"d","exact":{"per_view_us":10.0,"per_triangle_us":1.0},"gpu":null,"gpu_startup_seconds":null}"#;
+    let read: Profile = serde_json::from_str(old).unwrap();
+    assert_eq!(read.compute, None);
+    assert!(read.route(&loads[..5], 1_000_000).iter().all(|r| *r == Route::Exact));
 }
