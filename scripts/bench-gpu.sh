@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# sunlit bench on a real GPU: every engine (exact, gpu, auto with a fresh and a cached profile) on
-# the generated bench models, one JSON line a run with its wall time, into OUT (default
-# target/bench-gpu). Needs a Vulkan driver for the GPU (NVIDIA's ICD); SUNLIT= names the binary
-# (default target/release/sunlit, built if missing). ATLAS= and LANES= pass --atlas/--lanes to the
-# GPU runs. BUDGET= seconds after which the remaining runs are skipped (default 480).
+# sunlit bench on a real GPU: every engine (compute, exact, gpu, auto with a fresh and a cached
+# profile) on the generated bench models, one JSON line a run with its wall time, into OUT
+# (default target/bench-gpu). Needs a Vulkan driver for the GPU (NVIDIA's ICD); SUNLIT= names the
+# binary (default target/release/sunlit, built if missing). ATLAS= and LANES= pass --atlas/--lanes
+# to the GPU runs. BUDGET= seconds after which the remaining runs are skipped (default 480).
+# VIEWS=N times an even spread of N views a model instead of all (a quick try on lavapipe).
+# The issue's targets come first (the compute rasterizer on all of nyt-blocks' and
+# blaas-trees-summer's views, and exact clipping on the same machine beside them), so a short
+# lease records them before anything else.
 # Used for docs/benchmarks-gpu.md (an H100 and an H200 lent for one session: see there).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -12,6 +16,7 @@ B=${SUNLIT:-target/release/sunlit}
 OUT=${OUT:-target/bench-gpu}; mkdir -p "$OUT"
 T0=$(date +%s)
 gpu_flags=(); [ -n "${ATLAS:-}" ] && gpu_flags+=(--atlas "$ATLAS"); [ -n "${LANES:-}" ] && gpu_flags+=(--lanes "$LANES")
+views=(); [ -n "${VIEWS:-}" ] && views=(--views "$VIEWS")
 run() { # label timeout args...
   local label=$1 t=$2; shift 2
   if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-480}" ]; then echo "skip $label" >> "$OUT/stderr.txt"; return; fi
@@ -26,16 +31,24 @@ print(json.dumps({"label": label, "rc": int(rc), "wall": round(float(e) - float(
 PY
 }
 profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
+# The targets: nyt-blocks 27×19 (353,780 views) best GPU kernel ≤ 8 s and ≥ 4× exact on 16
+# cores; blaas-trees-summer (16,492 views) ≤ 0.5 s.
+run nyt-blocks-compute-all 150 bench nyt-blocks --engine compute --check 30 "${views[@]}" "${gpu_flags[@]}"
+run blaas-trees-summer-compute 40 bench blaas-trees-summer --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"
+run nyt-blocks-exact-all 150 bench nyt-blocks --engine exact "${views[@]}"
 run synthetic 40 bench --suns 64 "${gpu_flags[@]}"
 # The host's cost a view alone (wgpu's no-op backend), to set beside the real GPU's.
 run nyt-blocks-noop 60 bench nyt-blocks --engine gpu --backend noop --lanes 1 --views 20000
+run nyt-blocks-noop-compute 60 bench nyt-blocks --engine compute --backend noop --lanes 1 --views 20000
 for m in blaas-louvres blaas-trees-summer nyt-self nyt-flat; do
-  run "$m-gpu" 40 bench "$m" --engine gpu --check 50 "${gpu_flags[@]}"
-  run "$m-exact" 40 bench "$m" --engine exact
-  run "$m-auto-first" 40 bench "$m" --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
-  run "$m-auto" 40 bench "$m" --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"
+  run "$m-compute" 40 bench "$m" --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"
+  run "$m-gpu" 40 bench "$m" --engine gpu --check 50 "${views[@]}" "${gpu_flags[@]}"
+  run "$m-exact" 40 bench "$m" --engine exact "${views[@]}"
+  run "$m-auto-first" 40 bench "$m" --engine-profile "$profiles/$m.json" "${views[@]}" "${gpu_flags[@]}"
+  run "$m-auto" 40 bench "$m" --engine-profile "$profiles/$m.json" "${views[@]}" "${gpu_flags[@]}"
 done
 m=nyt-blocks
+run "$m-compute-3000" 60 bench $m --engine compute --views 3000 --check 30 "${gpu_flags[@]}"
 run "$m-gpu-3000" 60 bench $m --engine gpu --views 3000 --check 30 "${gpu_flags[@]}"
 run "$m-exact-3000" 60 bench $m --engine exact --views 3000
 run "$m-auto-first-3000" 60 bench $m --views 3000 --engine-profile "$profiles/$m.json" "${gpu_flags[@]}"

@@ -237,8 +237,21 @@ fn pcg(v: u32) -> u32 {
 
 // Draws triangle t's pixels in one row of a raster tile: row `row` of tile (tx, ty).
 fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
-    let py = i32((tile0.y + row) * 256u + 128u);
-    let px0 = i32(tile0.x * 256u + 128u);
+    let y = tile0.y + row;
+    let py = i32(y * 256u + 128u);
+    // Only the pixel centres within the triangle's bounding box: the row, and its first and last
+    // columns (floor and ceiling divisions by 256 as arithmetic shifts).
+    let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
+    let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
+    if py < lo.y || py > hi.y || y >= view.side {
+        return;
+    }
+    let first = max(-((128 - lo.x) >> 8u) - i32(tile0.x), 0);
+    let last = min(((hi.x - 128) >> 8u) - i32(tile0.x), i32(min(TILE, view.side - tile0.x)) - 1);
+    if first > last {
+        return;
+    }
+    let px0 = (i32(tile0.x) + first) * 256 + 128;
     let a = attributes[t];
     var kind = CASTER;
     for (var k = 0u; k < view.member_count; k++) {
@@ -262,11 +275,10 @@ fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
         }
         step[k] = neg64(mul64(dy, 256));
     }
-    let y = tile0.y + row;
-    for (var x = 0u; x < TILE; x++) {
+    for (var x = u32(first); x <= u32(last); x++) {
         let inside = !negative64(e[0]) && !negative64(e[1]) && !negative64(e[2]);
         let lx = tile0.x + x;
-        if inside && lx < view.side && y < view.side {
+        if inside {
             let cx = f32(lx) + 0.5 - f32(s.x.x) / 256.0;
             let cy = f32(y) + 0.5 - f32(s.y.x) / 256.0;
             let z = s.z0 + s.dzdx * cx + s.dzdy * cy;

@@ -260,7 +260,7 @@ fn kernels_side_by_side(scene: &Scene, requests: &[ViewRequest], side: u32) -> (
 /// on the GPU where the compute kernel reads corners placed once on the host, and interpolates
 /// depth its own way; either moves a snapped corner by a subpixel now and then, which flips the
 /// pixels whose centres lie within that subpixel of an edge.
-const DIFFERING_PIXELS_BOUND: usize = 64;
+const DIFFERING_PIXELS_BOUND: usize = 16;
 
 #[test]
 fn bench_views_compute_raster_and_exact_agree() {

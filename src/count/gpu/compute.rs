@@ -363,7 +363,8 @@ impl Counter {
         self.queue.submit([encoder.finish()]);
         let read = crate::platform::read_buffer(&self.device, &target, bytes).await?;
         self.check_errors("reading the compute dump")?;
-        Ok(bytemuck::try_cast_slice(&read).map_err(|e| GpuError::Readback(e.to_string()))?.to_vec())
+        // The mapped bytes' Vec need not be aligned for u32: copied, not cast in place.
+        Ok(bytemuck::pod_collect_to_vec(&read))
     }
 
     /// Runs the compute kernel on `triangles` given in the pixels of one view of side `side` (x
@@ -429,7 +430,7 @@ impl Counter {
                 crate::platform::read_buffer(&self.device, &self.batch.readback, super::encode::POOL_BYTES + count_bytes(members.len()))
                     .await?;
             self.check_errors("compute test")?;
-            let words: &[u32] = bytemuck::try_cast_slice(&read).map_err(|e| GpuError::Readback(e.to_string()))?;
+            let words: Vec<u32> = bytemuck::pod_collect_to_vec(&read);
             if words[0] > self.bin_pool().0 {
                 self.grow_pool(words[0] as u64)?;
                 continue;
