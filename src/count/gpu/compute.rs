@@ -81,6 +81,26 @@ pub(super) struct ComputeScene {
     attributes: wgpu::Buffer,
 }
 
+impl ComputeScene {
+    /// Uploads triangles' corners (9 floats each) and attributes.
+    fn new(device: &wgpu::Device, positions: &[f32], attributes: &[[u32; 4]]) -> Self {
+        let init = |label, contents: &[u8]| {
+            use wgpu::util::DeviceExt;
+            // A binding may not be empty.
+            let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        Self {
+            positions: init("triangle positions", bytemuck::cast_slice(positions)),
+            attributes: init("triangle attributes", bytemuck::cast_slice(attributes)),
+        }
+    }
+}
+
 /// The per-batch buffers, grown as batches need.
 pub(super) struct ComputeBins {
     views: wgpu::Buffer,
@@ -193,19 +213,7 @@ impl Counter {
             );
             return None;
         }
-        let init = |label, contents: &[u8]| {
-            use wgpu::util::DeviceExt;
-            let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
-            self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        Some(ComputeScene {
-            positions: init("triangle positions", bytemuck::cast_slice(&positions)),
-            attributes: init("triangle attributes", bytemuck::cast_slice(&attributes)),
-        })
+        Some(ComputeScene::new(&self.device, &positions, &attributes))
     }
 
     /// Whether this batch is counted by the compute kernel: it is this counter's kernel, the
@@ -215,8 +223,7 @@ impl Counter {
     }
 
     /// Records the batch's two compute passes; the members' counts land in the batch's counts
-    /// buffer as the count pass's do, and the pool's count in `pool` (4 bytes at `pool_offset`).
-    #[allow(clippy::too_many_arguments)] // The batch as submit_batch holds it.
+    /// buffer as the count pass's do, and the pool's count in `pool` (4 bytes: buffer, offset).
     pub(super) fn encode_compute(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -380,19 +387,7 @@ impl Counter {
     ) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
         let positions: Vec<f32> = triangles.iter().flatten().flatten().copied().collect();
         let attributes: Vec<[u32; 4]> = ids.iter().map(|&id| [id, (-1.0f32).to_bits(), 0, 0]).collect();
-        let init = |label, contents: &[u8]| {
-            use wgpu::util::DeviceExt;
-            let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };
-            self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let scene = ComputeScene {
-            positions: init("test positions", bytemuck::cast_slice(&positions)),
-            attributes: init("test attributes", bytemuck::cast_slice(&attributes)),
-        };
+        let scene = ComputeScene::new(&self.device, &positions, &attributes);
         let s = 2.0 / side as f32;
         let view_proj = glam::Mat4::from_cols(
             glam::Vec4::new(s, 0., 0., 0.),
