@@ -62,6 +62,23 @@ if [ "${SUNLIT_CITY:-0}" = 1 ] && ! command -v cjval >/dev/null; then
   cargo install --quiet --locked cjval --version 0.10.0 --features build-binary
 fi
 
+# pvlib and NREL-PySAM (SAM's models) in a cached venv: the tools that read `annual --pvlib` and
+# `--sam`, for tests/pv.rs, which skips without them. `SUNLIT_PV=1 . scripts/setup.sh`.
+if [ "${SUNLIT_PV:-0}" = 1 ]; then
+  pv_venv="${SUNLIT_PV_VENV:-$PWD/.venv-pv}"
+  if [ ! -x "$pv_venv/bin/python" ]; then
+    if ! python3 -m venv "$pv_venv" 2>/dev/null; then
+      apt_install python3-venv
+      python3 -m venv "$pv_venv"
+    fi
+  fi
+  if [ "$("$pv_venv/bin/python" -c "import importlib.metadata as m; print(m.version('pvlib'), m.version('nrel-pysam'))" 2>/dev/null)" != "0.16.1 7.1.1.post1" ]; then
+    say "installing pvlib 0.16.1 and NREL-PySAM 7.1.1 (pip, ~600 MB with pandas and scipy)"
+    "$pv_venv/bin/pip" install --quiet "pvlib==0.16.1" "nrel-pysam==7.1.1.post1"
+  fi
+  export SUNLIT_PV_PYTHON="$pv_venv/bin/python"
+fi
+
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.
 if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   apt_install mesa-vulkan-drivers

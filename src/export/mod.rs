@@ -18,6 +18,7 @@ pub mod irradiation;
 pub mod map_glb;
 pub mod map_table;
 pub mod planning_report;
+pub mod pv;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]
