@@ -435,6 +435,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("window_width", "--window-width"),
     ("tile", "--tile"),
     ("context", "--context"),
+    ("min_kwh_m2", "--min-kwh-m2"),
     ("buildings", "--buildings"),
     ("lod", "--lod"),
     ("up", "--up"),

@@ -56,6 +56,10 @@ pub struct CadastreRow {
     pub sun_hours: f64,
     /// Mean sunlit fraction over the sun-up timesteps.
     pub mean_fraction: f64,
+    /// With a grid and a threshold: the roof's area whose total reaches it, m²
+    /// ([`super::cadastre_points`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub usable_area: Option<f64>,
 }
 
 impl CadastreRow {
@@ -82,7 +86,7 @@ pub fn sun_hours(schedule: &Schedule, location: &Location) -> Vec<f64> {
 }
 
 /// The surface a receiver stands for: its name, or the name before `#k` of a planar part.
-fn surface_of<'a>(receiver: &'a str, surfaces: &HashMap<&str, &CitySurface>) -> Option<&'a str> {
+pub(crate) fn surface_of<'a>(receiver: &'a str, surfaces: &HashMap<&str, &CitySurface>) -> Option<&'a str> {
     if surfaces.contains_key(receiver) {
         return Some(receiver);
     }
@@ -132,6 +136,7 @@ pub fn rows(city: &City, scene: &Scene, summaries: &[SurfaceSummary], hours: &[f
                 total: mean(s[3]),
                 sun_hours: mean(s[4]),
                 mean_fraction: mean(s[5]),
+                usable_area: None,
             }
         })
         .collect())
@@ -140,15 +145,16 @@ pub fn rows(city: &City, scene: &Scene, summaries: &[SurfaceSummary], hours: &[f
 /// The CSV: a header, then one line per surface (names cannot hold commas: CityJSON ids with
 /// one are quoted).
 pub fn cadastre_csv(rows: &[CadastreRow]) -> String {
-    let mut text = format!("surface,building,area_m2,{}\n", ATTRIBUTES.join(","));
-    let field = |s: &str| if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() };
+    // The usable area's column only when a grid gave one.
+    let usable = rows.iter().any(|r| r.usable_area.is_some());
+    let mut text = format!("surface,building,area_m2,{}{}\n", ATTRIBUTES.join(","), if usable { ",usable_area_m2" } else { "" });
     for r in rows {
         let v = r.values();
-        let _ = writeln!(
+        let _ = write!(
             text,
             "{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6}",
-            field(&r.surface),
-            field(&r.building),
+            csv_field(&r.surface),
+            csv_field(&r.building),
             r.area,
             v[0],
             v[1],
@@ -157,8 +163,17 @@ pub fn cadastre_csv(rows: &[CadastreRow]) -> String {
             v[4],
             v[5]
         );
+        if usable {
+            let _ = write!(text, ",{}", r.usable_area.map(|a| format!("{:.4}", rounded(a))).unwrap_or_default());
+        }
+        text.push('\n');
     }
     text.replace("-0.0000,", "0.0000,")
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+pub(crate) fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
 }
 
 /// The input as one CityJSON document: itself, or a CityJSONSeq's header with every feature's
@@ -206,15 +221,20 @@ fn shift_indices(v: &mut Value, base: u64) {
     }
 }
 
+/// A geometry's valued surfaces: surface index → (attribute, value) pairs.
+type SurfaceValues<'a> = HashMap<usize, Vec<(&'a str, f64)>>;
+
 /// The city model with the cadastre's values on its surfaces (see the module doc).
 pub fn cadastre_cityjson(file: &str, bytes: &[u8], city: &City, rows: &[CadastreRow]) -> Result<Vec<u8>> {
     let mut doc = single_document(file, bytes)?;
     let by_name: HashMap<&str, &CitySurface> = city.surfaces.iter().map(|s| (s.name.as_str(), s)).collect();
     // (object, geometry) → (surface index → values).
-    let mut valued: HashMap<(&str, usize), HashMap<usize, [f64; 6]>> = HashMap::new();
+    let mut valued: HashMap<(&str, usize), SurfaceValues> = HashMap::new();
     for r in rows {
         if let Some(s) = by_name.get(r.surface.as_str()).filter(|s| s.kind.is_some()) {
-            valued.entry((s.object.as_str(), s.geometry)).or_default().insert(s.index, r.values());
+            let mut pairs: Vec<(&str, f64)> = ATTRIBUTES.iter().copied().zip(r.values()).collect();
+            pairs.extend(r.usable_area.map(|a| ("usable_area_m2", a)));
+            valued.entry((s.object.as_str(), s.geometry)).or_default().insert(s.index, pairs);
         }
     }
     let Some(objects) = doc.get_mut("CityObjects").and_then(Value::as_object_mut) else {
@@ -232,7 +252,7 @@ pub fn cadastre_cityjson(file: &str, bytes: &[u8], city: &City, rows: &[Cadastre
 }
 
 /// Gives each valued surface of `geometry` a semantic surface of its own with the values.
-fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
+fn put_values(geometry: &mut Value, values: &SurfaceValues) {
     let depth = match geometry.get("type").and_then(Value::as_str) {
         Some("MultiSurface" | "CompositeSurface") => 0,
         Some("Solid") => 1,
@@ -253,7 +273,7 @@ fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
         // Indices into the old list would point astray in the new one.
         own.remove("parent");
         own.remove("children");
-        for (key, v) in ATTRIBUTES.iter().zip(values[&s]) {
+        for &(key, v) in &values[&s] {
             own.insert(key.to_string(), json!(rounded(v)));
         }
         flat[s] = json!(surfaces.len());
@@ -268,7 +288,7 @@ fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
 }
 
 /// Six decimals, and never −0.
-fn rounded(v: f64) -> f64 {
+pub(crate) fn rounded(v: f64) -> f64 {
     let r = (v * 1e6).round() / 1e6;
     if r == 0.0 { 0.0 } else { r }
 }
@@ -331,23 +351,31 @@ pub fn roofs_geojson(city: &City, rows: &[CadastreRow], north_note: &str) -> Str
             for (key, v) in ATTRIBUTES.iter().zip(r.values()) {
                 properties.insert(key.to_string(), json!(rounded(v)));
             }
+            if let Some(a) = r.usable_area {
+                properties.insert("usable_area_m2".into(), json!(rounded(a)));
+            }
             Some(json!({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": rings}, "properties": properties}))
         })
         .collect();
-    let crs = city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
-    let mut text = json!({
-        "type": "FeatureCollection",
-        "crs": {"type": "name", "properties": {"name": crs}},
-        "sunlit": {
-            "note": "coordinates in the city model's reference system, not WGS84 (not reprojected)",
-            "north": north_note,
-            "units": {"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"},
-        },
-        "features": features,
-    })
-    .to_string();
+    let mut text = json!({"type": "FeatureCollection", "crs": geojson_crs(city), "sunlit": geojson_note(north_note), "features": features})
+        .to_string();
     text.push('\n');
     text
+}
+
+/// The `crs` member: the city model's reference system, as GeoJSON before RFC 7946 named one.
+pub fn geojson_crs(city: &City) -> Value {
+    let crs = city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
+    json!({"type": "name", "properties": {"name": crs}})
+}
+
+/// The `sunlit` member: the coordinates' system, north and units.
+pub fn geojson_note(north_note: &str) -> Value {
+    json!({
+        "note": "coordinates in the city model's reference system, not WGS84 (not reprojected)",
+        "north": north_note,
+        "units": {"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"},
+    })
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ fn row(surface: &str, building: &str, total: f64) -> CadastreRow {
         total,
         sun_hours: -0.0,
         mean_fraction: 0.5,
+        usable_area: None,
     }
 }
 

@@ -13,6 +13,7 @@ use crate::error::{Error, Result};
 use crate::year::samples::Timesteps;
 
 pub mod cadastre;
+pub mod cadastre_points;
 pub mod hook;
 pub mod irradiation;
 pub mod map_glb;
