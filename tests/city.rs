@@ -210,7 +210,11 @@ fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson()
     let roofs: serde_json::Value = serde_json::from_slice(&std::fs::read(tiled.join("cadastre-roofs.geojson")).unwrap()).unwrap();
     let roof_rows = a.keys().filter(|n| n.contains("/RoofSurface/")).count();
     assert_eq!(roofs["features"].as_array().unwrap().len(), roof_rows);
-    assert!(roofs["crs"]["properties"]["name"].as_str().unwrap().contains("7415"));
+    // RFC 7946: WGS84, reprojected from the model's EPSG:7415 (RD New + NAP), so in the Netherlands.
+    assert!(roofs.get("crs").is_none() && roofs["sunlit"]["note"].as_str().unwrap().contains("EPSG:7415"), "{}", roofs["sunlit"]);
+    let corner = &roofs["features"][0]["geometry"]["coordinates"][0][0];
+    let (lon, lat) = (corner[0].as_f64().unwrap(), corner[1].as_f64().unwrap());
+    assert!((3.0..7.5).contains(&lon) && (50.5..53.7).contains(&lat), "{corner}");
 }
 
 #[test]

@@ -12,8 +12,8 @@
 //!   values as attributes ([`ATTRIBUTES`]), since a semantic object may be shared by many surfaces.
 //!   A surface without a semantic type stays as it was (CityJSON needs a type): its values are in
 //!   the CSV;
-//! - the GeoJSON: each roof's outline seen from above, in the model's reference system (not
-//!   reprojected to WGS84: see [`roofs_geojson`]).
+//! - the GeoJSON: each roof's outline seen from above, in WGS84 when sunlit knows the model's
+//!   reference system, else in the model's with a note ([`GeoPlacer`]).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -25,6 +25,7 @@ use super::Schedule;
 use super::irradiation::SurfaceSummary;
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
+use crate::export::wgs84::ToWgs84;
 use crate::model::cityjson::{City, CitySurface};
 use crate::scene::Scene;
 use crate::sun::location::Location;
@@ -319,63 +320,85 @@ fn nest_like(boundaries: &Value, depth: usize, flat: &[Value], at: &mut usize) -
 }
 
 /// Roofs as GeoJSON: each `RoofSurface` row's outline seen from above (exterior counter-clockwise,
-/// holes clockwise, as RFC 7946 asks), its values as properties. The coordinates stay in the city
-/// model's reference system (`crs_note` says which): RFC 7946 wants WGS84, but reprojecting needs
-/// a projection library and the definition of every reference system a city may use, which
-/// sunlit does not carry; a `crs` member names the system, as GeoJSON before RFC 7946 did.
-pub fn roofs_geojson(city: &City, rows: &[CadastreRow], north_note: &str) -> String {
+/// holes clockwise, as RFC 7946 asks), its values as properties, in WGS84 when sunlit knows the
+/// model's reference system ([`GeoPlacer`]).
+pub fn roofs_geojson(city: &City, rows: &[CadastreRow], north_note: &str) -> Result<String> {
+    let placer = GeoPlacer::new(city);
     let by_name: HashMap<&str, &CitySurface> = city.surfaces.iter().map(|s| (s.name.as_str(), s)).collect();
-    let features: Vec<Value> = rows
-        .iter()
-        .filter_map(|r| {
-            let s = by_name.get(r.surface.as_str()).filter(|s| s.kind.as_deref() == Some("RoofSurface"))?;
-            let rings: Vec<Value> = s
-                .rings
-                .iter()
-                .enumerate()
-                .map(|(i, ring)| {
-                    let mut xy: Vec<[f64; 2]> = ring.iter().map(|p| [p.x + city.offset.x, p.y + city.offset.y]).collect();
-                    let area: f64 =
-                        (0..xy.len()).map(|k| xy[k][0] * xy[(k + 1) % xy.len()][1] - xy[(k + 1) % xy.len()][0] * xy[k][1]).sum();
-                    if (area < 0.0) == (i == 0) {
-                        xy.reverse();
-                    }
-                    xy.push(xy[0]);
-                    json!(xy.iter().map(|p| [rounded(p[0]), rounded(p[1])]).collect::<Vec<_>>())
-                })
-                .collect();
-            let mut properties = Map::new();
-            properties.insert("surface".into(), json!(r.surface));
-            properties.insert("building".into(), json!(r.building));
-            properties.insert("area_m2".into(), json!(rounded(r.area)));
-            for (key, v) in ATTRIBUTES.iter().zip(r.values()) {
-                properties.insert(key.to_string(), json!(rounded(v)));
-            }
-            if let Some(a) = r.usable_area {
-                properties.insert("usable_area_m2".into(), json!(rounded(a)));
-            }
-            Some(json!({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": rings}, "properties": properties}))
-        })
-        .collect();
-    let mut text = json!({"type": "FeatureCollection", "crs": geojson_crs(city), "sunlit": geojson_note(north_note), "features": features})
-        .to_string();
-    text.push('\n');
-    text
+    let mut features: Vec<Value> = Vec::new();
+    for r in rows {
+        let Some(s) = by_name.get(r.surface.as_str()).filter(|s| s.kind.as_deref() == Some("RoofSurface")) else { continue };
+        let rings: Vec<Value> = s
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(i, ring)| {
+                let mut xy: Vec<[f64; 2]> = ring.iter().map(|p| [p.x + city.offset.x, p.y + city.offset.y]).collect();
+                let area: f64 = (0..xy.len()).map(|k| xy[k][0] * xy[(k + 1) % xy.len()][1] - xy[(k + 1) % xy.len()][0] * xy[k][1]).sum();
+                if (area < 0.0) == (i == 0) {
+                    xy.reverse();
+                }
+                xy.push(xy[0]);
+                xy.iter().map(|p| placer.place(p[0], p[1], None)).collect::<Result<Vec<Value>>>().map(Value::Array)
+            })
+            .collect::<Result<_>>()?;
+        let mut properties = Map::new();
+        properties.insert("surface".into(), json!(r.surface));
+        properties.insert("building".into(), json!(r.building));
+        properties.insert("area_m2".into(), json!(rounded(r.area)));
+        for (key, v) in ATTRIBUTES.iter().zip(r.values()) {
+            properties.insert(key.to_string(), json!(rounded(v)));
+        }
+        if let Some(a) = r.usable_area {
+            properties.insert("usable_area_m2".into(), json!(rounded(a)));
+        }
+        features.push(json!({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": rings}, "properties": properties}));
+    }
+    Ok(placer.collection(features, north_note))
 }
 
-/// The `crs` member: the city model's reference system, as GeoJSON before RFC 7946 named one.
-pub fn geojson_crs(city: &City) -> Value {
-    let crs = city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
-    json!({"type": "name", "properties": {"name": crs}})
+/// Where a GeoJSON puts a city model's point: WGS84 longitude and latitude (RFC 7946) when sunlit
+/// knows the model's reference system ([`ToWgs84`]), else the model's own coordinates with a
+/// `crs` member naming its system, as GeoJSON before RFC 7946 did, and a note saying why.
+pub struct GeoPlacer<'a> {
+    city: &'a City,
+    wgs84: std::result::Result<ToWgs84, String>,
 }
 
-/// The `sunlit` member: the coordinates' system, north and units.
-pub fn geojson_note(north_note: &str) -> Value {
-    json!({
-        "note": "coordinates in the city model's reference system, not WGS84 (not reprojected)",
-        "north": north_note,
-        "units": {"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"},
-    })
+impl<'a> GeoPlacer<'a> {
+    /// The placer for `city`'s reference system.
+    pub fn new(city: &'a City) -> Self {
+        Self { city, wgs84: ToWgs84::new(city.reference_system.as_deref()).map_err(|e| e.to_string()) }
+    }
+
+    /// A position: `[lon, lat]` (degrees) in WGS84, else `[x, y]` or `[x, y, z]` in the model's
+    /// system (z only given there: heights are not WGS84's); six decimals.
+    pub fn place(&self, x: f64, y: f64, z: Option<f64>) -> Result<Value> {
+        match &self.wgs84 {
+            Ok(w) => Ok(json!(w.lon_lat(x, y)?.map(rounded))),
+            Err(_) => Ok(json!([x, y].into_iter().chain(z).map(rounded).collect::<Vec<f64>>())),
+        }
+    }
+
+    /// The feature collection with its `sunlit` member (and `crs` when not WGS84), as text.
+    pub fn collection(&self, features: Vec<Value>, north_note: &str) -> String {
+        let units = json!({"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"});
+        let mut doc = match &self.wgs84 {
+            Ok(w) => json!({"type": "FeatureCollection", "sunlit": {
+                "note": format!("WGS84 longitude and latitude (RFC 7946), reprojected from EPSG:{} with proj4rs", w.epsg),
+                "north": north_note, "units": units}}),
+            Err(why) => {
+                let crs = self.city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
+                json!({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": crs}}, "sunlit": {
+                    "note": format!("coordinates in the city model's reference system, not WGS84: {why}"),
+                    "north": north_note, "units": units}})
+            }
+        };
+        doc["features"] = Value::Array(features);
+        let mut text = doc.to_string();
+        text.push('\n');
+        text
+    }
 }
 
 #[cfg(test)]

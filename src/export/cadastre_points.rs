@@ -16,7 +16,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value, json};
 
-use super::cadastre::{CadastreRow, rounded, surface_of};
+use super::cadastre::{CadastreRow, GeoPlacer, rounded, surface_of};
 use crate::error::{Error, Result};
 use crate::map::{MapValues, Points};
 use crate::model::cityjson::{City, CitySurface};
@@ -114,9 +114,9 @@ pub fn points_csv(points: &[PointRow]) -> String {
     text
 }
 
-/// The points as GeoJSON `Point`s (x, y, z in the city model's coordinates, as the roofs'), their
-/// values as properties.
-pub fn points_geojson(points: &[PointRow], crs: &Value, sunlit: &Value) -> String {
+/// The points as GeoJSON `Point`s, placed as the roofs' ([`GeoPlacer`]: WGS84 when the model's
+/// system is known), their values as properties.
+pub fn points_geojson(points: &[PointRow], placer: &GeoPlacer, north_note: &str) -> Result<String> {
     let features: Vec<Value> = points
         .iter()
         .map(|p| {
@@ -126,11 +126,9 @@ pub fn points_geojson(points: &[PointRow], crs: &Value, sunlit: &Value) -> Strin
             for (key, v) in POINT_COLUMNS.iter().zip(p.values()) {
                 properties.insert(key.to_string(), json!(rounded(v)));
             }
-            let xyz: Vec<f64> = p.position.iter().map(|&v| rounded(v)).collect();
-            json!({"type": "Feature", "geometry": {"type": "Point", "coordinates": xyz}, "properties": properties})
+            let [x, y, z] = p.position;
+            Ok(json!({"type": "Feature", "geometry": {"type": "Point", "coordinates": placer.place(x, y, Some(z))?}, "properties": properties}))
         })
-        .collect();
-    let mut text = json!({"type": "FeatureCollection", "crs": crs, "sunlit": sunlit, "features": features}).to_string();
-    text.push('\n');
-    text
+        .collect::<Result<_>>()?;
+    Ok(placer.collection(features, north_note))
 }

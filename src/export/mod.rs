@@ -20,6 +20,7 @@ pub mod map_glb;
 pub mod map_table;
 pub mod planning_report;
 pub mod pv;
+pub mod wgs84;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]

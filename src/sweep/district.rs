@@ -424,12 +424,12 @@ pub fn merge(
     let mut files = vec![
         (dir.join(CADASTRE_CITYJSON), cadastre::cadastre_cityjson(&city.file, city_bytes, city, &rows)?),
         (dir.join(CADASTRE_CSV), cadastre::cadastre_csv(&rows).into_bytes()),
-        (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note).into_bytes()),
+        (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note)?.into_bytes()),
     ];
     if !points.is_empty() {
-        let (crs, note) = (cadastre::geojson_crs(city), cadastre::geojson_note(north_note));
+        let placer = cadastre::GeoPlacer::new(city);
         files.push((dir.join(POINTS_CSV), cadastre_points::points_csv(&points).into_bytes()));
-        files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &crs, &note).into_bytes()));
+        files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &placer, north_note)?.into_bytes()));
     }
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
