@@ -143,6 +143,14 @@ fn a_scene_written_as_cityjson_and_read_back_gives_the_same_fractions() {
     }
 }
 
+/// The official validator `cjval` finds `path` valid.
+fn assert_valid_cityjson(path: &Path) {
+    let check = std::process::Command::new("cjval").arg("-s").arg(path).output();
+    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
+    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
+    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+}
+
 /// Runs `sunlit district` on `city` into `out` with the small settings every run here shares.
 fn district(city: &Path, epw: &Path, out: &Path, more: &[&str]) -> std::process::Output {
     let mut args = vec!["district", city.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "-o", out.to_str().unwrap()];
@@ -193,10 +201,7 @@ fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson()
     assert_eq!(tile_rows(&tiled), b, "the recounted tile is as before");
     // The cadastre: valid CityJSON with the values on its semantic surfaces; CSV; roofs.
     let cadastre = tiled.join("cadastre.city.json");
-    let check = std::process::Command::new("cjval").arg("-s").arg(&cadastre).output();
-    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
-    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
-    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+    assert_valid_cityjson(&cadastre);
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
     let semantics = &doc["CityObjects"]["B000000"]["geometry"][0]["semantics"];
     let valued: Vec<&serde_json::Value> =
@@ -336,10 +341,7 @@ fn roof_grids_and_usable_area_against_an_open_and_a_half_covered_roof() {
     let geo: serde_json::Value = serde_json::from_slice(&std::fs::read(covered.join("cadastre-points.geojson")).unwrap()).unwrap();
     assert_eq!(geo["features"].as_array().unwrap().len(), 100);
     let cadastre = covered.join("cadastre.city.json");
-    let check = std::process::Command::new("cjval").arg("-s").arg(&cadastre).output();
-    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
-    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
-    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+    assert_valid_cityjson(&cadastre);
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
     let surfaces = doc["CityObjects"]["A"]["geometry"][0]["semantics"]["surfaces"].as_array().unwrap().clone();
     assert!(surfaces.iter().any(|s| s["usable_area_m2"] == 50.0), "{surfaces:?}");
