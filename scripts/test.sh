@@ -4,7 +4,7 @@
 # and the page end to end with Playwright. GPU tests never skip: without an adapter they fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SUNLIT_ENERGYPLUS=1 SUNLIT_RADIANCE=1 SUNLIT_CITY=1 SUNLIT_WEB=1 SUNLIT_BROWSER=1 . scripts/setup.sh
+SUNLIT_ENERGYPLUS=1 SUNLIT_RADIANCE=1 SUNLIT_CITY=1 SUNLIT_PV=1 SUNLIT_WEB=1 SUNLIT_BROWSER=1 . scripts/setup.sh
 
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings

@@ -143,6 +143,14 @@ struct AnnualArgs {
     /// timestep, in the schedule CSV's layout (needs --epw; written atomically).
     #[arg(long, value_name = "FILE.csv")]
     irradiance: Option<PathBuf>,
+    /// Also write each receiver's beam shaded fraction per timestep on pvlib's time index
+    /// (docs/district.md shows the pvlib code that reads it).
+    #[arg(long, value_name = "FILE.csv")]
+    pvlib: Option<PathBuf>,
+    /// Also write SAM pvsamv1's shading inputs (subarray1_shading_*) for the receivers taken as
+    /// one array, as JSON (needs --epw).
+    #[arg(long, value_name = "FILE.json")]
+    sam: Option<PathBuf>,
     /// Ground reflectance (0..1) for every hour; default: the EPW's albedo (field 33), 0.2 where
     /// it is missing.
     #[arg(long, value_name = "R")]
@@ -418,6 +426,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("study", "--study"),
     ("min_altitude", "--min-altitude"),
     ("irradiance", "--irradiance"),
+    ("pvlib", "--pvlib"),
+    ("sam", "--sam"),
     ("albedo", "--albedo"),
     ("sky_patches", "--sky-patches"),
     ("day", "--day"),
@@ -427,6 +437,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("window_width", "--window-width"),
     ("tile", "--tile"),
     ("context", "--context"),
+    ("min_kwh_m2", "--min-kwh-m2"),
     ("buildings", "--buildings"),
     ("lod", "--lod"),
     ("up", "--up"),
@@ -588,7 +599,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     let hook = args.hook.as_deref().map(Hook::parse).transpose()?;
     check_writable(&args.output)?;
-    let solar = solar_plan(&args)?;
+    let mut solar = solar_plan(&args)?;
     if let Some(out) = &args.idf_out {
         check_writable(out)?;
     }
@@ -600,7 +611,11 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     let settings = settings.resolve()?;
     let mut options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
-    options.timesteps = options.timesteps.leap_year(run_year(&args, energyplus.as_ref())?);
+    let chosen_year = run_year(&args, energyplus.as_ref())?;
+    if let Some(plan) = &mut solar {
+        plan.year = chosen_year;
+    }
+    options.timesteps = options.timesteps.leap_year(chosen_year.is_some_and(sunlit::model::run_year::is_leap));
     let timesteps = options.timesteps;
     let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap() };
     let varying = match &energyplus {
@@ -694,9 +709,9 @@ fn site_location(settings: &mut AnnualSettings, energyplus: Option<&model::Energ
     Ok(())
 }
 
-/// Whether the run's year is a leap year (`--year`, else the model's RunPeriod, else the EPW's
-/// Feb 29), saying which year was chosen and why.
-fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> Result<bool> {
+/// The run's year (`--year`, else the model's RunPeriod, else the EPW's Feb 29), saying which year
+/// was chosen and why; `None` (a year of 365 days) when none says.
+fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> Result<Option<i32>> {
     use sunlit::model::run_year::{YearSource, choose, is_leap};
     let epw = match &args.epw {
         Some(path) => {
@@ -704,7 +719,7 @@ fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> R
         }
         None => None,
     };
-    let Some((year, source)) = choose(args.year, energyplus.map(|e| e.objects.as_slice()), epw.as_deref()) else { return Ok(false) };
+    let Some((year, source)) = choose(args.year, energyplus.map(|e| e.objects.as_slice()), epw.as_deref()) else { return Ok(None) };
     let leap = is_leap(year);
     let from = match source {
         YearSource::Given => "--year".to_string(),
@@ -713,7 +728,7 @@ fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> R
     };
     let days = if leap { "a leap year: 366 days, 8784 hours" } else { "365 days, 8760 hours" };
     eprintln!("year: {year} (from {from}), {days}");
-    Ok(leap)
+    Ok(Some(year))
 }
 
 /// The model's text with the CSV hooked in. The CSV is named by its absolute path, so EnergyPlus

@@ -143,6 +143,14 @@ fn a_scene_written_as_cityjson_and_read_back_gives_the_same_fractions() {
     }
 }
 
+/// The official validator `cjval` finds `path` valid.
+fn assert_valid_cityjson(path: &Path) {
+    let check = std::process::Command::new("cjval").arg("-s").arg(path).output();
+    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
+    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
+    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+}
+
 /// Runs `sunlit district` on `city` into `out` with the small settings every run here shares.
 fn district(city: &Path, epw: &Path, out: &Path, more: &[&str]) -> std::process::Output {
     let mut args = vec!["district", city.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "-o", out.to_str().unwrap()];
@@ -193,10 +201,7 @@ fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson()
     assert_eq!(tile_rows(&tiled), b, "the recounted tile is as before");
     // The cadastre: valid CityJSON with the values on its semantic surfaces; CSV; roofs.
     let cadastre = tiled.join("cadastre.city.json");
-    let check = std::process::Command::new("cjval").arg("-s").arg(&cadastre).output();
-    let check = check.expect("cjval, the official CityJSON validator, is missing: run SUNLIT_CITY=1 . scripts/setup.sh");
-    let verdict = String::from_utf8_lossy(&check.stdout).into_owned() + &String::from_utf8_lossy(&check.stderr);
-    assert!(check.status.success() && verdict.contains("valid") && !verdict.contains("invalid"), "{verdict}");
+    assert_valid_cityjson(&cadastre);
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
     let semantics = &doc["CityObjects"]["B000000"]["geometry"][0]["semantics"];
     let valued: Vec<&serde_json::Value> =
@@ -210,7 +215,11 @@ fn district_tiles_equal_the_one_process_run_and_the_cadastre_is_valid_cityjson()
     let roofs: serde_json::Value = serde_json::from_slice(&std::fs::read(tiled.join("cadastre-roofs.geojson")).unwrap()).unwrap();
     let roof_rows = a.keys().filter(|n| n.contains("/RoofSurface/")).count();
     assert_eq!(roofs["features"].as_array().unwrap().len(), roof_rows);
-    assert!(roofs["crs"]["properties"]["name"].as_str().unwrap().contains("7415"));
+    // RFC 7946: WGS84, reprojected from the model's EPSG:7415 (RD New + NAP), so in the Netherlands.
+    assert!(roofs.get("crs").is_none() && roofs["sunlit"]["note"].as_str().unwrap().contains("EPSG:7415"), "{}", roofs["sunlit"]);
+    let corner = &roofs["features"][0]["geometry"]["coordinates"][0][0];
+    let (lon, lat) = (corner[0].as_f64().unwrap(), corner[1].as_f64().unwrap());
+    assert!((3.0..7.5).contains(&lon) && (50.5..53.7).contains(&lat), "{corner}");
 }
 
 #[test]
@@ -225,4 +234,115 @@ fn a_tile_size_or_context_that_is_not_positive_is_refused() {
         assert!(stderr(&run).contains(flag) && stderr(&run).contains("positive"), "{}", stderr(&run));
         assert!(!out.exists(), "nothing written for --tile {tile} --context {context}");
     }
+    for (more, flag, why) in
+        [(["--grid", "0", "--min-kwh-m2", "1"], "--grid", "positive"), (["--grid", "1", "--min-kwh-m2", "-3"], "--min-kwh-m2", "0 or more")]
+    {
+        let out = dir.join("out");
+        let mut args = vec!["--tile", "50", "--context", "50"];
+        args.extend(more);
+        let run = district(Path::new(BLOCK), &epw, &out, &args);
+        assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+        assert!(stderr(&run).contains(flag) && stderr(&run).contains(why), "{}", stderr(&run));
+        assert!(!out.exists(), "nothing written for {more:?}");
+    }
+}
+
+/// A CityJSON 2.0 city of boxes `(id, [x0, y0, z0], [x1, y1, z1])`, each a `Building` with an
+/// LoD2 `Solid`: roof, ground and four walls, millimetre vertices.
+fn boxes_city(boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
+    let mut vertices: Vec<[i64; 3]> = Vec::new();
+    let mut objects = serde_json::Map::new();
+    for (id, lo, hi) in boxes {
+        let base = vertices.len();
+        for k in 0..8 {
+            let pick = |axis: usize| if k >> axis & 1 == 1 { hi[axis] } else { lo[axis] };
+            vertices.push([0, 1, 2].map(|a| (pick(a) * 1000.0).round() as i64));
+        }
+        // Corners by bits (x, y, z); each face counter-clockwise seen from outside.
+        let faces: [([usize; 4], &str); 6] = [
+            ([4, 5, 7, 6], "RoofSurface"),
+            ([0, 2, 3, 1], "GroundSurface"),
+            ([0, 1, 5, 4], "WallSurface"),
+            ([2, 6, 7, 3], "WallSurface"),
+            ([0, 4, 6, 2], "WallSurface"),
+            ([1, 3, 7, 5], "WallSurface"),
+        ];
+        let boundaries: Vec<Vec<Vec<usize>>> = faces.iter().map(|(f, _)| vec![f.iter().map(|i| base + i).collect()]).collect();
+        let values: Vec<usize> =
+            faces.iter().map(|(_, t)| ["RoofSurface", "GroundSurface", "WallSurface"].iter().position(|k| k == t).unwrap()).collect();
+        objects.insert(
+            id.to_string(),
+            serde_json::json!({"type": "Building", "geometry": [{"type": "Solid", "lod": "2.2", "boundaries": [boundaries],
+                "semantics": {"surfaces": [{"type": "RoofSurface"}, {"type": "GroundSurface"}, {"type": "WallSurface"}], "values": [values]}}]}),
+        );
+    }
+    serde_json::json!({"type": "CityJSON", "version": "2.0", "transform": {"scale": [0.001, 0.001, 0.001], "translate": [85000.0, 446000.0, 0.0]},
+        "metadata": {"referenceSystem": "https://www.opengis.net/def/crs/EPSG/0/7415"}, "CityObjects": objects, "vertices": vertices})
+    .to_string()
+}
+
+/// The points of a district run's `cadastre-points.csv`: (y in the model, total kWh/m²).
+fn points(out: &Path) -> Vec<(f64, f64)> {
+    let text = std::fs::read_to_string(out.join("cadastre-points.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "surface,building,x,y,z,direct_kwh_m2,sky_diffuse_kwh_m2,ground_reflected_kwh_m2,total_kwh_m2,sun_hours"
+    );
+    lines.map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap_or(f64::NAN)).collect::<Vec<f64>>()).map(|v| (v[3], v[8])).collect()
+}
+
+/// `--grid` and `--min-kwh-m2` against two analytic cases: a flat roof alone (every point alike,
+/// all its area usable), and the same roof with a canopy 1 cm over its south half (sun and sky
+/// reach under it only below about 1°): the north half keeps the open roof's year, the south half
+/// gets almost nothing, so a threshold at half the open total makes exactly half the roof usable.
+#[test]
+fn roof_grids_and_usable_area_against_an_open_and_a_half_covered_roof() {
+    let dir = scratch("district-grid");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let roof = ("A", [0.0, 0.0, 0.0], [10.0, 10.0, 3.0]);
+    let canopy = ("S", [-1.0, -1.0, 3.01], [11.0, 5.0, 3.015]);
+    let run = |name: &str, boxes: &[(&str, [f64; 3], [f64; 3])], min: &str| {
+        let city = dir.join(format!("{name}.city.json"));
+        std::fs::write(&city, boxes_city(boxes)).unwrap();
+        let out = dir.join(name);
+        let more =
+            ["--tile", "100", "--context", "100", "--buildings", "A", "--receivers", "RoofSurface", "--grid", "1", "--min-kwh-m2", min];
+        let r = district(&city, &epw, &out, &more);
+        assert!(r.status.success(), "{}", stderr(&r));
+        out
+    };
+    let open = run("open", &[roof], "0");
+    let open_points = points(&open);
+    assert_eq!(open_points.len(), 100, "a 10 m roof at 1 m");
+    let total = open_points[0].1;
+    assert!(total > 100.0 && open_points.iter().all(|p| (p.1 - total).abs() < 1e-3), "every point alike: {open_points:?}");
+    let csv = std::fs::read_to_string(open.join("cadastre.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",usable_area_m2") && csv.lines().nth(1).unwrap().ends_with(",100.0000"), "{csv}");
+
+    let min = format!("{}", total / 2.0);
+    let covered = run("covered", &[roof, canopy], &min);
+    let covered_points = points(&covered);
+    assert_eq!(covered_points.len(), 100);
+    for &(y, t) in &covered_points {
+        // The model's y: the translate added back.
+        let y = y - 446_000.0;
+        if y > 5.0 {
+            assert!((t - total).abs() < 0.01 * total, "north half at y {y}: {t} against the open {total}");
+        } else {
+            assert!(t < 0.05 * total, "south half at y {y}: {t} against the open {total}");
+        }
+    }
+    let csv = std::fs::read_to_string(covered.join("cadastre.csv")).unwrap();
+    assert!(csv.lines().nth(1).unwrap().ends_with(",50.0000"), "half the roof: {csv}");
+    let roofs: serde_json::Value = serde_json::from_slice(&std::fs::read(covered.join("cadastre-roofs.geojson")).unwrap()).unwrap();
+    assert_eq!(roofs["features"][0]["properties"]["usable_area_m2"], 50.0, "{roofs}");
+    let geo: serde_json::Value = serde_json::from_slice(&std::fs::read(covered.join("cadastre-points.geojson")).unwrap()).unwrap();
+    assert_eq!(geo["features"].as_array().unwrap().len(), 100);
+    let cadastre = covered.join("cadastre.city.json");
+    assert_valid_cityjson(&cadastre);
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
+    let surfaces = doc["CityObjects"]["A"]["geometry"][0]["semantics"]["surfaces"].as_array().unwrap().clone();
+    assert!(surfaces.iter().any(|s| s["usable_area_m2"] == 50.0), "{surfaces:?}");
 }

@@ -6,7 +6,7 @@
 use sunlit::count::gpu::CounterOptions;
 use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::weather::Weather;
-use sunlit::sweep::district::{self, TileDone, TileSettings, Tiling};
+use sunlit::sweep::district::{self, TileCount, TileDone, TileSettings, Tiling};
 use sunlit::sweep::{record, run, slurm};
 
 use super::*;
@@ -65,6 +65,14 @@ pub(super) struct DistrictArgs {
     /// Sky patches: tregenza or reinhart:N.
     #[arg(long, value_name = "SCHEME", default_value = "tregenza")]
     sky_patches: String,
+    /// Per-point maps on roofs: a grid of points M metres apart on every roof, each point's year
+    /// in cadastre-points.csv and .geojson.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    grid: Option<f64>,
+    /// With --grid: each roof's usable area, where a point's total irradiation is at least this
+    /// many kWh/m² (usable_area_m2 in the CSV, GeoJSON and CityJSON).
+    #[arg(long, value_name = "KWH", requires = "grid", allow_negative_numbers = true)]
+    min_kwh_m2: Option<f64>,
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
@@ -112,8 +120,13 @@ impl DistrictArgs {
         for r in &self.receivers {
             words.extend(["--receivers".into(), r.clone()]);
         }
-        let optional =
-            [("--buildings", self.buildings.clone()), ("--lod", self.lod.clone()), ("--albedo", self.albedo.map(|a| a.to_string()))];
+        let optional = [
+            ("--buildings", self.buildings.clone()),
+            ("--lod", self.lod.clone()),
+            ("--albedo", self.albedo.map(|a| a.to_string())),
+            ("--grid", self.grid.map(|g| g.to_string())),
+            ("--min-kwh-m2", self.min_kwh_m2.map(|m| m.to_string())),
+        ];
         for (flag, value) in optional {
             if let Some(v) = value {
                 words.extend([flag.to_string(), v]);
@@ -149,6 +162,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     let engine = EngineKind::parse(&args.engine)
         .map_err(|_| Error::argument("--engine", format!("'{}' is not one of auto, gpu, exact", args.engine)))?;
     let patches = SkyPatches::parse(&args.sky_patches)?;
+    let grid = args.grid.map(|g| district::RoofGrid::new(g, args.min_kwh_m2)).transpose()?;
     let weather = Weather::from_epw(&epw_path)?;
     let weather = match args.albedo {
         Some(a) => weather.with_albedo(a)?,
@@ -179,6 +193,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
             engine,
             counter: CounterOptions { resolution: args.resolution, ..Default::default() },
             lanes: None,
+            grid,
         };
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }
@@ -226,10 +241,10 @@ fn count_one(
     let start = Instant::now();
     let log = record::log_path(dir, &district::tile_id(k));
     match district::count_tile(city, tiling, k, tile, &mut |_| Ok(())) {
-        Ok((rows, casters)) => {
+        Ok(TileCount { rows, points, casters }) => {
             let seconds = start.elapsed().as_secs_f64();
-            eprintln!("tile {k}: {} surfaces against {casters} in {seconds:.1} s", rows.len());
-            district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows })
+            eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
+            district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points })
         }
         Err(e) => {
             let _ = district::write_tile_failure(dir, k, Some(1), &e.render(&flag), &log);

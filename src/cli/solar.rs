@@ -1,5 +1,6 @@
-//! `sunlit annual`'s solar outputs: the per-surface summary (`--summary`) and the per-timestep
-//! irradiance (`--irradiance`), with their flags `--albedo` and `--sky-patches`.
+//! `sunlit annual`'s solar outputs: the per-surface summary (`--summary`), the per-timestep
+//! irradiance (`--irradiance`) and what PV tools read (`--pvlib`, `--sam`), with their flags
+//! `--albedo` and `--sky-patches`.
 //!
 //! A thin edge like the rest of the CLI: it reads the flags and the weather before any counting
 //! (so a bad value is refused with nothing written), then asks the library for the sky views
@@ -11,8 +12,10 @@ use std::path::PathBuf;
 use sunlit::count::hybrid::HybridEngine;
 use sunlit::export::Schedule;
 use sunlit::export::irradiation::{self, EnergyPlusRatios, Solar};
+use sunlit::export::pv;
 use sunlit::model;
 use sunlit::scene::Scene;
+use sunlit::sky::directions::direction_fractions;
 use sunlit::sky::patches::SkyPatches;
 use sunlit::sky::views::sky_views;
 use sunlit::sun::weather::{Weather, check_albedo};
@@ -32,6 +35,10 @@ pub struct SolarPlan {
     weather: Option<Weather>,
     summary: Option<(PathBuf, SummaryFormat)>,
     irradiance: Option<PathBuf>,
+    pvlib: Option<PathBuf>,
+    sam: Option<PathBuf>,
+    /// The run's year once chosen (labels the PV outputs' time index).
+    pub year: Option<i32>,
 }
 
 /// `--summary`'s and `--irradiance`'s files, the patch scheme, and the EPW's solar data (read
@@ -61,7 +68,16 @@ pub fn solar_plan(args: &AnnualArgs) -> Result<Option<SolarPlan>> {
         }
         check_writable(path)?;
     }
-    if summary.is_none() && args.irradiance.is_none() {
+    if let Some(path) = &args.pvlib {
+        check_writable(path)?;
+    }
+    if let Some(path) = &args.sam {
+        if args.epw.is_none() {
+            return Err(Error::argument("sam", "needs a weather file (--epw) for the diffuse loss"));
+        }
+        check_writable(path)?;
+    }
+    if summary.is_none() && args.irradiance.is_none() && args.pvlib.is_none() && args.sam.is_none() {
         return Ok(None);
     }
     let weather = match &args.epw {
@@ -74,7 +90,15 @@ pub fn solar_plan(args: &AnnualArgs) -> Result<Option<SolarPlan>> {
         }
         None => None,
     };
-    Ok(Some(SolarPlan { patches, weather, summary, irradiance: args.irradiance.clone() }))
+    Ok(Some(SolarPlan {
+        patches,
+        weather,
+        summary,
+        irradiance: args.irradiance.clone(),
+        pvlib: args.pvlib.clone(),
+        sam: args.sam.clone(),
+        year: None,
+    }))
 }
 
 /// The files the plan writes and their bytes, made before anything is written.
@@ -87,6 +111,15 @@ pub fn solar_outputs(
     args: &AnnualArgs,
     meter: &mut Meter,
 ) -> Result<Vec<(PathBuf, Vec<u8>)>> {
+    let year = plan.year.unwrap_or(pv::DEFAULT_YEAR);
+    let mut out = Vec::new();
+    if let Some(path) = &plan.pvlib {
+        out.push((path.clone(), pv::pvlib_csv(scene, schedule, &settings.location, year)?));
+    }
+    // The pvlib CSV needs the fractions alone, not the sky.
+    if plan.summary.is_none() && plan.irradiance.is_none() && plan.sam.is_none() {
+        return Ok(out);
+    }
     let start = std::time::Instant::now();
     meter.stage("sky views", "views");
     let views = pollster::block_on(sky_views(engine, scene, &plan.patches, &mut |p| {
@@ -100,10 +133,21 @@ pub fn solar_outputs(
         plan.patches.name(),
         start.elapsed().as_secs_f64()
     );
-    let mut out = Vec::new();
     if let (Some(path), Some(weather)) = (&plan.irradiance, &plan.weather) {
         let solar = Solar { weather, sky: &views, calendar: &settings.calendar };
         out.push((path.clone(), irradiation::irradiance_csv(scene, schedule, &settings.location, &solar)?));
+    }
+    if let (Some(path), Some(weather)) = (&plan.sam, &plan.weather) {
+        meter.stage("SAM's azimuth × altitude table", "views");
+        let directions: Vec<_> = pv::azal_directions().into_iter().map(|d| d.2).collect();
+        let azal_fractions = pollster::block_on(direction_fractions(engine, scene, &directions, &mut |p| {
+            meter.report(p);
+            Ok(())
+        }))?;
+        let summaries =
+            irradiation::summarize(scene, schedule, &settings.location, Some((&views, &settings.calendar)), Some(weather), &[])?;
+        let inputs = pv::SamInputs { year, azal_fractions: &azal_fractions, summaries: &summaries };
+        out.push((path.clone(), pv::sam_json(scene, schedule, &settings.location, &inputs)?));
     }
     if let Some((path, format)) = &plan.summary {
         let start = std::time::Instant::now();

@@ -12,8 +12,8 @@
 //!   values as attributes ([`ATTRIBUTES`]), since a semantic object may be shared by many surfaces.
 //!   A surface without a semantic type stays as it was (CityJSON needs a type): its values are in
 //!   the CSV;
-//! - the GeoJSON: each roof's outline seen from above, in the model's reference system (not
-//!   reprojected to WGS84: see [`roofs_geojson`]).
+//! - the GeoJSON: each roof's outline seen from above, in WGS84 when sunlit knows the model's
+//!   reference system, else in the model's with a note ([`GeoPlacer`]).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -25,6 +25,7 @@ use super::Schedule;
 use super::irradiation::SurfaceSummary;
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
+use crate::export::wgs84::ToWgs84;
 use crate::model::cityjson::{City, CitySurface};
 use crate::scene::Scene;
 use crate::sun::location::Location;
@@ -56,6 +57,10 @@ pub struct CadastreRow {
     pub sun_hours: f64,
     /// Mean sunlit fraction over the sun-up timesteps.
     pub mean_fraction: f64,
+    /// With a grid and a threshold: the roof's area whose total reaches it, m²
+    /// ([`super::cadastre_points`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub usable_area: Option<f64>,
 }
 
 impl CadastreRow {
@@ -82,7 +87,7 @@ pub fn sun_hours(schedule: &Schedule, location: &Location) -> Vec<f64> {
 }
 
 /// The surface a receiver stands for: its name, or the name before `#k` of a planar part.
-fn surface_of<'a>(receiver: &'a str, surfaces: &HashMap<&str, &CitySurface>) -> Option<&'a str> {
+pub(crate) fn surface_of<'a>(receiver: &'a str, surfaces: &HashMap<&str, &CitySurface>) -> Option<&'a str> {
     if surfaces.contains_key(receiver) {
         return Some(receiver);
     }
@@ -132,6 +137,7 @@ pub fn rows(city: &City, scene: &Scene, summaries: &[SurfaceSummary], hours: &[f
                 total: mean(s[3]),
                 sun_hours: mean(s[4]),
                 mean_fraction: mean(s[5]),
+                usable_area: None,
             }
         })
         .collect())
@@ -140,15 +146,16 @@ pub fn rows(city: &City, scene: &Scene, summaries: &[SurfaceSummary], hours: &[f
 /// The CSV: a header, then one line per surface (names cannot hold commas: CityJSON ids with
 /// one are quoted).
 pub fn cadastre_csv(rows: &[CadastreRow]) -> String {
-    let mut text = format!("surface,building,area_m2,{}\n", ATTRIBUTES.join(","));
-    let field = |s: &str| if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() };
+    // The usable area's column only when a grid gave one.
+    let usable = rows.iter().any(|r| r.usable_area.is_some());
+    let mut text = format!("surface,building,area_m2,{}{}\n", ATTRIBUTES.join(","), if usable { ",usable_area_m2" } else { "" });
     for r in rows {
         let v = r.values();
-        let _ = writeln!(
+        let _ = write!(
             text,
             "{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.6}",
-            field(&r.surface),
-            field(&r.building),
+            csv_field(&r.surface),
+            csv_field(&r.building),
             r.area,
             v[0],
             v[1],
@@ -157,8 +164,17 @@ pub fn cadastre_csv(rows: &[CadastreRow]) -> String {
             v[4],
             v[5]
         );
+        if usable {
+            let _ = write!(text, ",{}", r.usable_area.map(|a| format!("{:.4}", rounded(a))).unwrap_or_default());
+        }
+        text.push('\n');
     }
     text.replace("-0.0000,", "0.0000,")
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+pub(crate) fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
 }
 
 /// The input as one CityJSON document: itself, or a CityJSONSeq's header with every feature's
@@ -206,15 +222,20 @@ fn shift_indices(v: &mut Value, base: u64) {
     }
 }
 
+/// A geometry's valued surfaces: surface index → (attribute, value) pairs.
+type SurfaceValues<'a> = HashMap<usize, Vec<(&'a str, f64)>>;
+
 /// The city model with the cadastre's values on its surfaces (see the module doc).
 pub fn cadastre_cityjson(file: &str, bytes: &[u8], city: &City, rows: &[CadastreRow]) -> Result<Vec<u8>> {
     let mut doc = single_document(file, bytes)?;
     let by_name: HashMap<&str, &CitySurface> = city.surfaces.iter().map(|s| (s.name.as_str(), s)).collect();
     // (object, geometry) → (surface index → values).
-    let mut valued: HashMap<(&str, usize), HashMap<usize, [f64; 6]>> = HashMap::new();
+    let mut valued: HashMap<(&str, usize), SurfaceValues> = HashMap::new();
     for r in rows {
         if let Some(s) = by_name.get(r.surface.as_str()).filter(|s| s.kind.is_some()) {
-            valued.entry((s.object.as_str(), s.geometry)).or_default().insert(s.index, r.values());
+            let mut pairs: Vec<(&str, f64)> = ATTRIBUTES.iter().copied().zip(r.values()).collect();
+            pairs.extend(r.usable_area.map(|a| ("usable_area_m2", a)));
+            valued.entry((s.object.as_str(), s.geometry)).or_default().insert(s.index, pairs);
         }
     }
     let Some(objects) = doc.get_mut("CityObjects").and_then(Value::as_object_mut) else {
@@ -232,7 +253,7 @@ pub fn cadastre_cityjson(file: &str, bytes: &[u8], city: &City, rows: &[Cadastre
 }
 
 /// Gives each valued surface of `geometry` a semantic surface of its own with the values.
-fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
+fn put_values(geometry: &mut Value, values: &SurfaceValues) {
     let depth = match geometry.get("type").and_then(Value::as_str) {
         Some("MultiSurface" | "CompositeSurface") => 0,
         Some("Solid") => 1,
@@ -253,7 +274,7 @@ fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
         // Indices into the old list would point astray in the new one.
         own.remove("parent");
         own.remove("children");
-        for (key, v) in ATTRIBUTES.iter().zip(values[&s]) {
+        for &(key, v) in &values[&s] {
             own.insert(key.to_string(), json!(rounded(v)));
         }
         flat[s] = json!(surfaces.len());
@@ -268,7 +289,7 @@ fn put_values(geometry: &mut Value, values: &HashMap<usize, [f64; 6]>) {
 }
 
 /// Six decimals, and never −0.
-fn rounded(v: f64) -> f64 {
+pub(crate) fn rounded(v: f64) -> f64 {
     let r = (v * 1e6).round() / 1e6;
     if r == 0.0 { 0.0 } else { r }
 }
@@ -299,55 +320,85 @@ fn nest_like(boundaries: &Value, depth: usize, flat: &[Value], at: &mut usize) -
 }
 
 /// Roofs as GeoJSON: each `RoofSurface` row's outline seen from above (exterior counter-clockwise,
-/// holes clockwise, as RFC 7946 asks), its values as properties. The coordinates stay in the city
-/// model's reference system (`crs_note` says which): RFC 7946 wants WGS84, but reprojecting needs
-/// a projection library and the definition of every reference system a city may use, which
-/// sunlit does not carry; a `crs` member names the system, as GeoJSON before RFC 7946 did.
-pub fn roofs_geojson(city: &City, rows: &[CadastreRow], north_note: &str) -> String {
+/// holes clockwise, as RFC 7946 asks), its values as properties, in WGS84 when sunlit knows the
+/// model's reference system ([`GeoPlacer`]).
+pub fn roofs_geojson(city: &City, rows: &[CadastreRow], north_note: &str) -> Result<String> {
+    let placer = GeoPlacer::new(city);
     let by_name: HashMap<&str, &CitySurface> = city.surfaces.iter().map(|s| (s.name.as_str(), s)).collect();
-    let features: Vec<Value> = rows
-        .iter()
-        .filter_map(|r| {
-            let s = by_name.get(r.surface.as_str()).filter(|s| s.kind.as_deref() == Some("RoofSurface"))?;
-            let rings: Vec<Value> = s
-                .rings
-                .iter()
-                .enumerate()
-                .map(|(i, ring)| {
-                    let mut xy: Vec<[f64; 2]> = ring.iter().map(|p| [p.x + city.offset.x, p.y + city.offset.y]).collect();
-                    let area: f64 =
-                        (0..xy.len()).map(|k| xy[k][0] * xy[(k + 1) % xy.len()][1] - xy[(k + 1) % xy.len()][0] * xy[k][1]).sum();
-                    if (area < 0.0) == (i == 0) {
-                        xy.reverse();
-                    }
-                    xy.push(xy[0]);
-                    json!(xy.iter().map(|p| [rounded(p[0]), rounded(p[1])]).collect::<Vec<_>>())
-                })
-                .collect();
-            let mut properties = Map::new();
-            properties.insert("surface".into(), json!(r.surface));
-            properties.insert("building".into(), json!(r.building));
-            properties.insert("area_m2".into(), json!(rounded(r.area)));
-            for (key, v) in ATTRIBUTES.iter().zip(r.values()) {
-                properties.insert(key.to_string(), json!(rounded(v)));
+    let mut features: Vec<Value> = Vec::new();
+    for r in rows {
+        let Some(s) = by_name.get(r.surface.as_str()).filter(|s| s.kind.as_deref() == Some("RoofSurface")) else { continue };
+        let rings: Vec<Value> = s
+            .rings
+            .iter()
+            .enumerate()
+            .map(|(i, ring)| {
+                let mut xy: Vec<[f64; 2]> = ring.iter().map(|p| [p.x + city.offset.x, p.y + city.offset.y]).collect();
+                let area: f64 = (0..xy.len()).map(|k| xy[k][0] * xy[(k + 1) % xy.len()][1] - xy[(k + 1) % xy.len()][0] * xy[k][1]).sum();
+                if (area < 0.0) == (i == 0) {
+                    xy.reverse();
+                }
+                xy.push(xy[0]);
+                xy.iter().map(|p| placer.place(p[0], p[1], None)).collect::<Result<Vec<Value>>>().map(Value::Array)
+            })
+            .collect::<Result<_>>()?;
+        let mut properties = Map::new();
+        properties.insert("surface".into(), json!(r.surface));
+        properties.insert("building".into(), json!(r.building));
+        properties.insert("area_m2".into(), json!(rounded(r.area)));
+        for (key, v) in ATTRIBUTES.iter().zip(r.values()) {
+            properties.insert(key.to_string(), json!(rounded(v)));
+        }
+        if let Some(a) = r.usable_area {
+            properties.insert("usable_area_m2".into(), json!(rounded(a)));
+        }
+        features.push(json!({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": rings}, "properties": properties}));
+    }
+    Ok(placer.collection(features, north_note))
+}
+
+/// Where a GeoJSON puts a city model's point: WGS84 longitude and latitude (RFC 7946) when sunlit
+/// knows the model's reference system ([`ToWgs84`]), else the model's own coordinates with a
+/// `crs` member naming its system, as GeoJSON before RFC 7946 did, and a note saying why.
+pub struct GeoPlacer<'a> {
+    city: &'a City,
+    wgs84: std::result::Result<ToWgs84, String>,
+}
+
+impl<'a> GeoPlacer<'a> {
+    /// The placer for `city`'s reference system.
+    pub fn new(city: &'a City) -> Self {
+        Self { city, wgs84: ToWgs84::new(city.reference_system.as_deref()).map_err(|e| e.to_string()) }
+    }
+
+    /// A position: `[lon, lat]` (degrees) in WGS84, else `[x, y]` or `[x, y, z]` in the model's
+    /// system (z only given there: heights are not WGS84's); six decimals.
+    pub fn place(&self, x: f64, y: f64, z: Option<f64>) -> Result<Value> {
+        match &self.wgs84 {
+            Ok(w) => Ok(json!(w.lon_lat(x, y)?.map(rounded))),
+            Err(_) => Ok(json!([x, y].into_iter().chain(z).map(rounded).collect::<Vec<f64>>())),
+        }
+    }
+
+    /// The feature collection with its `sunlit` member (and `crs` when not WGS84), as text.
+    pub fn collection(&self, features: Vec<Value>, north_note: &str) -> String {
+        let units = json!({"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"});
+        let mut doc = match &self.wgs84 {
+            Ok(w) => json!({"type": "FeatureCollection", "sunlit": {
+                "note": format!("WGS84 longitude and latitude (RFC 7946), reprojected from EPSG:{} with proj4rs", w.epsg),
+                "north": north_note, "units": units}}),
+            Err(why) => {
+                let crs = self.city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
+                json!({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name": crs}}, "sunlit": {
+                    "note": format!("coordinates in the city model's reference system, not WGS84: {why}"),
+                    "north": north_note, "units": units}})
             }
-            Some(json!({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": rings}, "properties": properties}))
-        })
-        .collect();
-    let crs = city.reference_system.clone().unwrap_or_else(|| "unknown (the city model names none)".into());
-    let mut text = json!({
-        "type": "FeatureCollection",
-        "crs": {"type": "name", "properties": {"name": crs}},
-        "sunlit": {
-            "note": "coordinates in the city model's reference system, not WGS84 (not reprojected)",
-            "north": north_note,
-            "units": {"irradiation": "kWh/m2", "sun_hours": "h", "area": "m2"},
-        },
-        "features": features,
-    })
-    .to_string();
-    text.push('\n');
-    text
+        };
+        doc["features"] = Value::Array(features);
+        let mut text = doc.to_string();
+        text.push('\n');
+        text
+    }
 }
 
 #[cfg(test)]

@@ -13,11 +13,14 @@ use crate::error::{Error, Result};
 use crate::year::samples::Timesteps;
 
 pub mod cadastre;
+pub mod cadastre_points;
 pub mod hook;
 pub mod irradiation;
 pub mod map_glb;
 pub mod map_table;
 pub mod planning_report;
+pub mod pv;
+pub mod wgs84;
 
 /// Sunlit fractions of named surfaces at every timestep of a year.
 #[derive(Debug, Clone, PartialEq)]

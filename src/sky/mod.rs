@@ -9,11 +9,13 @@
 //!   factors made of them;
 //! - [`perez`]: the Perez 1990 all-weather sky, as EnergyPlus applies it;
 //! - [`energyplus`]: EnergyPlus's own 144-direction diffuse shading ratios;
+//! - [`directions`]: fractions for given sun directions (SAM's azimuth × altitude table);
 //! - [`luminance`]: weather-free luminance distributions (the CIE standard overcast sky, which
 //!   BRE 209's vertical sky component is defined under, and the uniform sky).
 //!
 //! Combining them with the beam per timestep is [`crate::export::irradiation`]'s.
 
+pub mod directions;
 pub mod energyplus;
 pub mod luminance;
 pub mod patches;

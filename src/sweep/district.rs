@@ -17,8 +17,10 @@
 //! - one f32 origin for every tile (the city's centre), so a receiver rounds alike in every cut;
 //! - records: `.done/tile-K.json` per finished tile (the inputs' fingerprint and its rows,
 //!   written atomically after counting), `.failed/tile-K.json` per failed one; the merge writes
-//!   `cadastre.city.json`, `cadastre.csv` and `cadastre-roofs.geojson` when every tile is done,
-//!   and `failed.csv` listing the rest.
+//!   `cadastre.city.json`, `cadastre.csv` and `cadastre-roofs.geojson` (with a grid, also the
+//!   roofs' points) when every tile is done, and `failed.csv` listing the rest;
+//! - per-point maps on roofs ([`RoofGrid`]): a tile's roofs gridded and each point's year counted
+//!   with the map's exact rays ([`crate::map`]), each roof's usable area from its points.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -31,10 +33,13 @@ use crate::count::gpu::CounterOptions;
 use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use crate::error::{Error, Result};
 use crate::export::cadastre::{self, CadastreRow};
+use crate::export::cadastre_points::{self, PointRow};
 use crate::export::irradiation::summarize;
 use crate::export::write_atomic;
+use crate::map::{Mapper, Period, Site, point_sky};
 use crate::model::LoadOptions;
 use crate::model::cityjson::{City, CitySurface};
+use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
 use crate::sky::views::sky_views;
 use crate::sun::weather::Weather;
@@ -47,6 +52,32 @@ pub const CADASTRE_CITYJSON: &str = "cadastre.city.json";
 pub const CADASTRE_CSV: &str = "cadastre.csv";
 /// The roofs' GeoJSON beside it.
 pub const CADASTRE_GEOJSON: &str = "cadastre-roofs.geojson";
+/// With a grid: the roofs' points as CSV…
+pub const POINTS_CSV: &str = "cadastre-points.csv";
+/// … and as GeoJSON.
+pub const POINTS_GEOJSON: &str = "cadastre-points.geojson";
+
+/// Per-point maps on roofs: the grid's spacing, and the threshold of a roof's usable area.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoofGrid {
+    /// Metres between points.
+    pub spacing: f64,
+    /// Total irradiation a point needs to count towards its roof's usable area, kWh/m².
+    pub min_kwh_m2: Option<f64>,
+}
+
+impl RoofGrid {
+    /// Refuses a spacing that is not positive and a threshold that is not a number ≥ 0.
+    pub fn new(spacing: f64, min_kwh_m2: Option<f64>) -> Result<Self> {
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return Err(Error::argument("spacing", format!("{spacing} m: a grid spacing must be a positive number of metres")));
+        }
+        if let Some(m) = min_kwh_m2.filter(|m| !(m.is_finite() && *m >= 0.0)) {
+            return Err(Error::argument("min_kwh_m2", format!("{m} is not a number of kWh/m² (0 or more)")));
+        }
+        Ok(Self { spacing, min_kwh_m2 })
+    }
+}
 
 /// One tile: its grid cell, square and buildings.
 #[derive(Debug, Clone, PartialEq)]
@@ -195,17 +226,29 @@ pub struct TileSettings<'a> {
     pub counter: CounterOptions,
     /// GPU lanes.
     pub lanes: Option<usize>,
+    /// Per-point maps on the roofs.
+    pub grid: Option<RoofGrid>,
+}
+
+/// What a tile counted.
+pub struct TileCount {
+    /// One row per receiving surface.
+    pub rows: Vec<CadastreRow>,
+    /// With a grid: its roofs' points.
+    pub points: Vec<PointRow>,
+    /// Surfaces it was counted with.
+    pub casters: usize,
 }
 
 /// Counts tile `k`: its buildings' receivers against its context, the year and the sky, into
-/// cadastre rows; also the number of surfaces it was counted with.
+/// cadastre rows (and with a grid, its roofs' points).
 pub fn count_tile(
     city: &City,
     tiling: &Tiling,
     k: usize,
     s: &TileSettings,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
-) -> Result<(Vec<CadastreRow>, usize)> {
+) -> Result<TileCount> {
     let tile = tiling.tiles.get(k).ok_or_else(|| {
         Error::argument(
             "index",
@@ -217,14 +260,15 @@ pub fn count_tile(
         [] => tile.buildings.clone(),
         asked => tile.buildings.iter().filter(|b| asked.contains(b)).cloned().collect(),
     };
+    let empty = TileCount { rows: Vec::new(), points: Vec::new(), casters: part.surfaces.len() };
     if buildings.is_empty() {
-        return Ok((Vec::new(), part.surfaces.len()));
+        return Ok(empty);
     }
     let load = LoadOptions { buildings, origin: Some(tiling.origin), ..s.load.clone() };
     let scene = match crate::model::load_city(&part, &load) {
         Ok(loaded) => loaded.scene,
         // Buildings without a chosen surface (a tile of sheds without roofs or walls).
-        Err(Error::NoReceivers(_)) => return Ok((Vec::new(), part.surfaces.len())),
+        Err(Error::NoReceivers(_)) => return Ok(empty),
         Err(e) => return Err(e),
     };
     let engine = HybridEngine::new(&scene, s.engine, s.counter, s.lanes, ProfileSource::Cache)?;
@@ -234,7 +278,39 @@ pub fn count_tile(
     let views = pollster::block_on(sky_views(&engine, &scene, s.patches, progress))?;
     let summaries = summarize(&scene, &schedule, location, Some((&views, &s.settings.calendar)), Some(s.weather), &[])?;
     let hours = cadastre::sun_hours(&schedule, location);
-    Ok((cadastre::rows(&part, &scene, &summaries, &hours)?, part.surfaces.len()))
+    let mut rows = cadastre::rows(&part, &scene, &summaries, &hours)?;
+    let points = match s.grid {
+        Some(grid) => roof_points(&part, &scene, grid, s, &mut rows)?,
+        None => Vec::new(),
+    };
+    Ok(TileCount { rows, points, casters: part.surfaces.len() })
+}
+
+/// The grid on the scene's roofs, each point's year counted directly (never interpolated: the
+/// map's exact rays, [`crate::map`]), and each row's usable area.
+fn roof_points(city: &City, scene: &Scene, grid: RoofGrid, s: &TileSettings, rows: &mut [CadastreRow]) -> Result<Vec<PointRow>> {
+    let roofs: std::collections::HashSet<&str> =
+        city.surfaces.iter().filter(|c| c.kind.as_deref() == Some("RoofSurface")).map(|c| c.name.as_str()).collect();
+    let on_roofs: Vec<u32> = scene
+        .receivers
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| roofs.contains(r.name.as_str()) || r.name.rsplit_once('#').is_some_and(|(base, _)| roofs.contains(base)))
+        .map(|(i, _)| i as u32)
+        .collect();
+    let points = crate::map::grid(scene, grid.spacing, &on_roofs)?;
+    if points.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mapper = Mapper::new(scene, &points)?;
+    let sky = point_sky(&mapper, s.patches, &mut |_, _| {});
+    let samples = Period::annual(s.settings.options(None)?.timesteps.per_hour())?.samples();
+    let site = Site { location: &s.settings.location, calendar: &s.settings.calendar, weather: Some(s.weather), sky: Some(&sky) };
+    let values = mapper.accumulate(&samples, site, &mut |_, _| {})?;
+    // Scene positions are the model's turned by north; the model's own add the offset back.
+    let back = glam::DMat3::from_rotation_z(s.load.north.to_radians());
+    let to_model = |p: DVec3| back * p + city.offset;
+    cadastre_points::point_rows(city, scene, &points, &values, grid.min_kwh_m2, rows, to_model)
 }
 
 /// A finished tile's record.
@@ -250,6 +326,9 @@ pub struct TileDone {
     pub casters: usize,
     /// Its receivers' rows.
     pub rows: Vec<CadastreRow>,
+    /// With a grid: its roofs' points.
+    #[serde(default)]
+    pub points: Vec<PointRow>,
 }
 
 /// The record id of tile `k`.
@@ -311,10 +390,14 @@ pub fn merge(
     north_note: &str,
 ) -> Result<DistrictMerged> {
     let mut rows: Vec<CadastreRow> = Vec::new();
+    let mut points: Vec<PointRow> = Vec::new();
     let mut unfinished = Vec::new();
     for t in &tiling.tiles {
         match finished(dir, t.index, fingerprint) {
-            Some(done) => rows.extend(done.rows),
+            Some(done) => {
+                rows.extend(done.rows);
+                points.extend(done.points);
+            }
             None => {
                 let id = tile_id(t.index);
                 let (code, reason) = match record::failure(dir, &id) {
@@ -337,11 +420,17 @@ pub fn merge(
     let _ = std::fs::remove_file(&failed);
     let position: HashMap<&str, usize> = city.surfaces.iter().enumerate().map(|(i, s)| (s.name.as_str(), i)).collect();
     rows.sort_by_key(|r| position.get(r.surface.as_str()).copied().unwrap_or(usize::MAX));
-    let files = [
+    points.sort_by_key(|p| position.get(p.surface.as_str()).copied().unwrap_or(usize::MAX));
+    let mut files = vec![
         (dir.join(CADASTRE_CITYJSON), cadastre::cadastre_cityjson(&city.file, city_bytes, city, &rows)?),
         (dir.join(CADASTRE_CSV), cadastre::cadastre_csv(&rows).into_bytes()),
-        (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note).into_bytes()),
+        (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note)?.into_bytes()),
     ];
+    if !points.is_empty() {
+        let placer = cadastre::GeoPlacer::new(city);
+        files.push((dir.join(POINTS_CSV), cadastre_points::points_csv(&points).into_bytes()));
+        files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &placer, north_note)?.into_bytes()));
+    }
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
     }

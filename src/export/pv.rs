@@ -1,0 +1,285 @@
+//! What PV tools read: the beam shaded fraction of a selected set of receivers, per timestep, for
+//! pvlib (a CSV on pvlib's time index) and for SAM's detailed PV model `pvsamv1` (its
+//! `subarray1_shading_*` inputs as JSON).
+//!
+//! Owns the definitions (docs/district.md shows the pvlib and PySAM code that reads them):
+//! - **beam shaded fraction** of a receiver at a timestep: 1 − its sunlit fraction while the sun
+//!   is up and in front of it (cos zenith and cos incidence ≥ [`MIN_COS_INCIDENCE`], the
+//!   fractions' own rule); 0 otherwise, as there is no beam to lose;
+//! - **a set's beam loss** (SAM's one array): 1 − Σ area·fraction·cos θ / Σ area·cos θ over its
+//!   receivers facing the sun, i.e. the share of the set's unshaded beam that is shaded (for one
+//!   receiver, its shaded fraction); 0 when no receiver faces the sun;
+//! - **pvlib's time index**: each row labelled with the start of its timestep in local standard
+//!   time with the UTC offset (`2023-01-01T00:00:00+01:00`), as `pvlib.iotools.read_epw` labels
+//!   the EPW's hours (hour − 1). The value holds for the whole timestep; it was counted at its
+//!   middle (one timestep an hour) or its end (more), the sun the shading schedules use;
+//! - **SAM**: `subarray1_shading_timestep` (8760 × N rows of one column, beam loss %; a leap
+//!   year's Feb 29 is left out, as SAM's years have 365 days), `_mxh` (12 × 24, each month's and
+//!   clock hour's mean loss over its timesteps with the sun in front), `_azal` (SAM's table: first
+//!   row azimuths 0..360° clockwise from north, first column altitudes, the rest beam loss % for
+//!   a sun there, counted by the engine for each direction, [`azal_directions`]) and `_diff`
+//!   (the sky-diffuse loss %: 1 − shaded / unshaded Perez sky diffuse over the year). Only the
+//!   timestep table and the diffuse loss are enabled: SAM multiplies every enabled beam table,
+//!   so the other two are there to be enabled instead, never beside it.
+
+use std::fmt::Write as _;
+
+use glam::DVec3;
+use serde_json::json;
+
+use super::Schedule;
+use super::irradiation::SurfaceSummary;
+use crate::count::MIN_COS_INCIDENCE;
+use crate::error::{Error, Result};
+use crate::model::run_year::is_leap;
+use crate::scene::Scene;
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
+use crate::year::samples::month_day_of;
+
+/// SAM's azimuth × altitude table: azimuths every this many degrees from 0 to 360.
+pub const AZAL_AZIMUTH_STEP: u32 = 10;
+/// … and altitudes every this many degrees from 0 to 90.
+pub const AZAL_ALTITUDE_STEP: u32 = 10;
+/// The sun of the table's 0° row is counted this high: at 0° there is no beam on a roof, and a
+/// loss of 0 there would pull SAM's interpolation towards no shade near the horizon.
+pub const AZAL_LOWEST_ALTITUDE: f64 = 1.0;
+
+/// The year labelling the time index when the run names none (`--year`, an EnergyPlus
+/// RunPeriod's or a leap weather file's): one of 365 days, as such a run's.
+pub const DEFAULT_YEAR: i32 = 2023;
+
+/// The versions whose readers the layouts were checked against (tests/pv.rs).
+pub const CHECKED_AGAINST: &str = "pvlib 0.16.1, NREL-PySAM 7.1.1.post1 (pvsamv1)";
+
+/// The local standard time of a schedule row's start, ISO 8601 with the UTC offset.
+fn timestamp(year: i32, leap: bool, row: usize, per_hour: u32, time_zone: f64) -> String {
+    let n = per_hour as usize;
+    let day = (row / (24 * n)) as u32 + 1;
+    let minutes = (row % (24 * n)) * 60 / n;
+    let (month, dom) = month_day_of(day, leap);
+    let offset = (time_zone * 60.0).round() as i64;
+    let sign = if offset < 0 { '-' } else { '+' };
+    format!(
+        "{year:04}-{month:02}-{dom:02}T{:02}:{:02}:00{sign}{:02}:{:02}",
+        minutes / 60,
+        minutes % 60,
+        offset.abs() / 60,
+        offset.abs() % 60
+    )
+}
+
+/// The sun (unit vector) at each row, or `None` while it is down.
+fn suns(schedule: &Schedule, location: &Location) -> Vec<Option<DVec3>> {
+    schedule
+        .timesteps
+        .instants()
+        .map(|i| Some(sun_direction(location, shading_sun_day(i.day), i.hour)).filter(|s| s.z >= MIN_COS_INCIDENCE))
+        .collect()
+}
+
+fn check(scene: &Scene, schedule: &Schedule, year: i32) -> Result<()> {
+    if scene.receivers.len() != schedule.names.len() {
+        return Err(Error::argument("schedule", format!("{} columns for {} receivers", schedule.names.len(), scene.receivers.len())));
+    }
+    if is_leap(year) != schedule.timesteps.is_leap() {
+        let days = schedule.timesteps.days();
+        return Err(Error::argument("year", format!("{year} does not have the schedule's {days} days")));
+    }
+    Ok(())
+}
+
+/// A receiver's beam shaded fraction at a row (see the module doc).
+fn shaded(normal: DVec3, sun: Option<DVec3>, fraction: f32) -> f64 {
+    match sun {
+        Some(s) if normal.dot(s) >= MIN_COS_INCIDENCE => 1.0 - f64::from(fraction).clamp(0.0, 1.0),
+        _ => 0.0,
+    }
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+fn field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
+}
+
+/// The pvlib CSV: `time`, then one column per receiver (its name) of beam shaded fractions, one
+/// row per timestep of `year` (see the module doc).
+pub fn pvlib_csv(scene: &Scene, schedule: &Schedule, location: &Location, year: i32) -> Result<Vec<u8>> {
+    check(scene, schedule, year)?;
+    let suns = suns(schedule, location);
+    let columns = schedule.names.len();
+    let mut text = String::with_capacity(suns.len() * (32 + 8 * columns));
+    text.push_str("time");
+    for name in &schedule.names {
+        text.push(',');
+        text.push_str(&field(name));
+    }
+    text.push('\n');
+    let (leap, per_hour) = (schedule.timesteps.is_leap(), schedule.timesteps.per_hour());
+    for (row, sun) in suns.iter().enumerate() {
+        text.push_str(&timestamp(year, leap, row, per_hour, location.time_zone));
+        for (c, receiver) in scene.receivers.iter().enumerate() {
+            let v = shaded(receiver.normal, *sun, schedule.get(row, c));
+            // Six decimals; never "-0".
+            let _ = write!(text, ",{}", if v == 0.0 { "0".to_string() } else { format!("{v:.6}") });
+        }
+        text.push('\n');
+    }
+    Ok(text.into_bytes())
+}
+
+/// The set's beam loss (0..1) for a sun, from each receiver's fraction (see the module doc);
+/// `None` when no receiver faces it.
+fn set_loss(scene: &Scene, sun: DVec3, fraction: impl Fn(usize) -> f64) -> Option<f64> {
+    let (mut lit, mut all) = (0.0, 0.0);
+    for (c, r) in scene.receivers.iter().enumerate() {
+        let cos = r.normal.dot(sun);
+        if cos >= MIN_COS_INCIDENCE && sun.z >= MIN_COS_INCIDENCE {
+            lit += r.area * cos * fraction(c).clamp(0.0, 1.0);
+            all += r.area * cos;
+        }
+    }
+    (all > 0.0).then(|| (1.0 - lit / all).clamp(0.0, 1.0))
+}
+
+/// The sun directions of SAM's azimuth × altitude table, row by row (altitude) then azimuth:
+/// `(azimuth°, altitude°, unit vector)`, x east, y north, z up.
+pub fn azal_directions() -> Vec<(f64, f64, DVec3)> {
+    let mut out = Vec::new();
+    for alt in (0..=90).step_by(AZAL_ALTITUDE_STEP as usize) {
+        for az in (0..=360).step_by(AZAL_AZIMUTH_STEP as usize) {
+            let (a, h) = (f64::from(az), f64::from(alt));
+            let (az_r, alt_r) = (a.to_radians(), h.max(AZAL_LOWEST_ALTITUDE).to_radians());
+            out.push((a, h, DVec3::new(az_r.sin() * alt_r.cos(), az_r.cos() * alt_r.cos(), alt_r.sin())));
+        }
+    }
+    out
+}
+
+/// Rounds a percentage to 4 decimals, never −0.
+fn percent(loss: f64) -> f64 {
+    let p = (loss * 1e6).round() / 1e4;
+    if p == 0.0 { 0.0 } else { p }
+}
+
+/// What [`sam_json`] is made from besides the schedule.
+pub struct SamInputs<'a> {
+    /// The run's year (its length must be the schedule's).
+    pub year: i32,
+    /// The engine's fraction for each receiver (inner) and each of [`azal_directions`] (outer).
+    pub azal_fractions: &'a [Vec<f64>],
+    /// Each receiver's summary, with weather (the diffuse loss).
+    pub summaries: &'a [SurfaceSummary],
+}
+
+/// SAM's `pvsamv1` shading inputs for the scene's receivers taken as one array, as JSON:
+/// `{"sunlit": {…what and how…}, "Shading": {"subarray1_shading_…": …}}`; `Shading` is what
+/// PySAM's `Pvsamv1.Shading.assign` takes.
+pub fn sam_json(scene: &Scene, schedule: &Schedule, location: &Location, inputs: &SamInputs) -> Result<Vec<u8>> {
+    check(scene, schedule, inputs.year)?;
+    let directions = azal_directions();
+    if inputs.azal_fractions.len() != directions.len() {
+        return Err(Error::argument("azal_fractions", format!("{} directions, not {}", inputs.azal_fractions.len(), directions.len())));
+    }
+    let suns = suns(schedule, location);
+    let per_hour = schedule.timesteps.per_hour() as usize;
+    let leap = schedule.timesteps.is_leap();
+    let mut timestep = Vec::with_capacity(8760 * per_hour);
+    let mut mxh = [[(0.0f64, 0usize); 24]; 12];
+    for (row, sun) in suns.iter().enumerate() {
+        let day = (row / (24 * per_hour)) as u32 + 1;
+        let (month, dom) = month_day_of(day, leap);
+        let loss = sun.and_then(|s| set_loss(scene, s, |c| f64::from(schedule.get(row, c))));
+        if let Some(l) = loss {
+            let cell = &mut mxh[month as usize - 1][(row / per_hour) % 24];
+            cell.0 += l;
+            cell.1 += 1;
+        }
+        if !(month == 2 && dom == 29) {
+            timestep.push(json!([percent(loss.unwrap_or(0.0))]));
+        }
+    }
+    let mxh: Vec<Vec<f64>> =
+        mxh.iter().map(|m| m.iter().map(|&(s, n)| if n == 0 { 0.0 } else { percent(s / n as f64) }).collect()).collect();
+    let azal = azal_table(scene, &directions, inputs.azal_fractions);
+    let diffuse = diffuse_loss(inputs.summaries)?;
+    let names: Vec<&str> = schedule.names.iter().map(String::as_str).collect();
+    let area: f64 = scene.receivers.iter().map(|r| r.area).sum();
+    let doc = json!({
+        "sunlit": {
+            "what": "pvsamv1 shading inputs for the surfaces below taken as one array (subarray 1): beam loss % = 100·(1 − shaded beam / unshaded beam)",
+            "surfaces": names,
+            "area_m2": area,
+            "year": inputs.year,
+            "timesteps_per_hour": per_hour,
+            "enabled": "subarray1_shading_timestep and _diff; _mxh and _azal are alternatives to the timestep table (SAM multiplies every enabled beam table)",
+            "checked_against": CHECKED_AGAINST,
+        },
+        "Shading": {
+            "subarray1_shading_en_timestep": 1,
+            "subarray1_shading_timestep": timestep,
+            "subarray1_shading_en_mxh": 0,
+            "subarray1_shading_mxh": mxh,
+            "subarray1_shading_en_azal": 0,
+            "subarray1_shading_azal": azal,
+            "subarray1_shading_en_diff": 1,
+            "subarray1_shading_diff": percent(diffuse),
+        },
+    });
+    let mut text = serde_json::to_vec(&doc).map_err(|e| Error::model("SAM shading", e.to_string()))?;
+    text.push(b'\n');
+    Ok(text)
+}
+
+/// SAM's azimuth × altitude table: `[[0, az…], [alt, loss%…], …]`.
+fn azal_table(scene: &Scene, directions: &[(f64, f64, DVec3)], fractions: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let columns = (360 / AZAL_AZIMUTH_STEP + 1) as usize;
+    let mut table = vec![std::iter::once(0.0).chain(directions.iter().take(columns).map(|d| d.0)).collect::<Vec<f64>>()];
+    for (row, chunk) in directions.chunks(columns).enumerate() {
+        let mut line = vec![chunk[0].1];
+        for (k, &(_, _, sun)) in chunk.iter().enumerate() {
+            let f = &fractions[row * columns + k];
+            line.push(percent(set_loss(scene, sun, |c| f.get(c).copied().unwrap_or(0.0)).unwrap_or(0.0)));
+        }
+        table.push(line);
+    }
+    table
+}
+
+/// The set's sky-diffuse loss (0..1) over the year: 1 − Σ area·shaded / Σ area·unshaded.
+fn diffuse_loss(summaries: &[SurfaceSummary]) -> Result<f64> {
+    let (mut shaded, mut unshaded) = (0.0, 0.0);
+    for s in summaries {
+        let need = |v: Option<f64>| v.ok_or_else(|| Error::argument("epw", "SAM's diffuse loss needs weather (irradiation)"));
+        let sky = need(s.sky_diffuse)?;
+        // The unshaded total less the unshaded beam and the (never shaded) ground-reflected part.
+        let open = need(s.unshaded_total)? - need(s.unshaded_irradiation)? - need(s.ground_reflected)?;
+        shaded += s.area * sky;
+        unshaded += s.area * open;
+    }
+    Ok(if unshaded > 0.0 { (1.0 - shaded / unshaded).clamp(0.0, 1.0) } else { 0.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timestamps_start_each_timestep_in_local_standard_time() {
+        assert_eq!(timestamp(2023, false, 0, 1, 1.0), "2023-01-01T00:00:00+01:00");
+        assert_eq!(timestamp(2023, false, 8759, 1, -5.0), "2023-12-31T23:00:00-05:00");
+        assert_eq!(timestamp(2024, true, 59 * 24, 1, 5.5), "2024-02-29T00:00:00+05:30");
+        assert_eq!(timestamp(2023, false, 5, 4, 0.0), "2023-01-01T01:15:00+00:00");
+    }
+
+    #[test]
+    fn azal_rows_run_from_the_horizon_up_and_azimuths_clockwise_from_north() {
+        let d = azal_directions();
+        assert_eq!(d.len(), 10 * 37);
+        let east = d.iter().find(|x| x.0 == 90.0 && x.1 == 0.0).unwrap().2;
+        assert!(east.x > 0.99 && east.z > 0.0 && east.z < 0.02);
+        let south_60 = d.iter().find(|x| x.0 == 180.0 && x.1 == 60.0).unwrap().2;
+        assert!((south_60.z - 60f64.to_radians().sin()).abs() < 1e-12 && south_60.y < 0.0);
+    }
+}
