@@ -6,10 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
+use common::inside::{golden_epw, numpy_reference};
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 use serde_json::{Value, json};
 use sunlit::model::inside::rooms;
@@ -35,10 +35,6 @@ const EAST_WINDOW: [f64; 4] = [5.0, 7.5, 0.9, 2.4];
 /// Days whose beam is kept in the test's weather (clear days in the Golden TMY3: 15 December,
 /// 31 March).
 const DAYS: [u32; 2] = [349, 90];
-
-fn golden_epw() -> PathBuf {
-    common::energyplus::energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sunlit-interior-beam-{}", std::process::id()));
@@ -133,27 +129,6 @@ fn day_of_year(month: u32, day: u32) -> u32 {
 
 fn load(idf: &str) -> EnergyPlusInput {
     model::load_bytes_all(&[("l.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default()).unwrap().energyplus.unwrap()
-}
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
-    assert!(
-        venv.exists(),
-        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
-    );
-    venv
-}
-
-fn numpy_reference(query: &Value) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/reference.py");
-    let mut child = Command::new(python()).arg(script).stdin(Stdio::piped()).stdout(Stdio::piped()).spawn().unwrap();
-    child.stdin.take().unwrap().write_all(query.to_string().as_bytes()).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success(), "reference.py failed");
-    serde_json::from_slice(&out.stdout).unwrap()
 }
 
 /// Per inside face of the L, the beam summed over the two days' timesteps (Σ W/m²) by sunlit's
@@ -310,4 +285,29 @@ fn interzone_windows_are_skipped_by_name() {
     );
     assert_eq!(beam.balances.len(), 1);
     assert!(beam.balances[0].window != "Through");
+}
+
+/// What `--interior-beam` cannot do is refused by name before any counting, and nothing is
+/// written: no `--idf-out`, no `--epw`, or the Imported hook.
+#[test]
+fn interior_beam_refusals_name_the_flag_and_write_nothing() {
+    let (idf, epw) = (scratch("refused.idf"), scratch("refused.epw"));
+    std::fs::write(&idf, l_room_idf()).unwrap();
+    std::fs::write(&epw, two_day_epw()).unwrap();
+    let (csv, hooked) = (scratch("refused.csv"), scratch("refused-hooked.idf"));
+    let cases: [(&[&str], &str); 3] = [
+        (&["--epw", epw.to_str().unwrap()], "add --idf-out"),
+        (&["--location", "39.74,-105.18,-7", "--idf-out", hooked.to_str().unwrap()], "needs --epw"),
+        (&["--epw", epw.to_str().unwrap(), "--idf-out", hooked.to_str().unwrap(), "--hook", "imported"], "Imported"),
+    ];
+    for (args, why) in cases {
+        let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+            .args(["annual", idf.to_str().unwrap(), "-o", csv.to_str().unwrap(), "--interior-beam"])
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("--interior-beam") && stderr.contains(why), "{args:?}: {stderr}");
+        assert!(!csv.exists() && !hooked.exists() && !scratch("refused.interior-beam.csv").exists(), "{args:?} wrote a file");
+    }
 }
