@@ -83,9 +83,9 @@ pub fn beam_outputs(
         notes.push(format!("interior beam: interzone windows skipped (no exterior beam of their own): {}", beam.skipped.join(", ")));
     }
     notes.push(
-        "interior beam: the schedules tie the hooked model to this weather file. Design days and sizing periods run \
-         EnergyPlus's own clipping and interior distribution, and the schedules still add this EPW's beam for the same \
-         calendar day (EnergyPlus reads them in every environment): size with the original model"
+        "interior beam: the schedules tie the hooked model to this weather file. Design days and sizing periods read \
+         them too: this EPW's beam for the same calendar day replaces EnergyPlus's own on every hooked face there, so \
+         size with the original model"
             .to_string(),
     );
     Ok((interior_beam_csv(&beam, timesteps).into_bytes(), interior_beam_objects(&name, &beam, timesteps), notes))
