@@ -40,6 +40,9 @@ use sweep_cli::{SweepArgs, sweep};
 #[path = "cli/solar.rs"]
 mod solar_cli;
 use solar_cli::{solar_outputs, solar_plan};
+#[path = "cli/interior_beam.rs"]
+mod interior_beam_cli;
+use interior_beam_cli::{beam_outputs, beam_plan};
 #[path = "cli/bench.rs"]
 mod bench_cli;
 use bench_cli::{BenchArgs, run_bench};
@@ -168,6 +171,16 @@ struct AnnualArgs {
     /// default scheduled (a model before Version 9.3 cannot be hooked).
     #[arg(long, value_name = "FORM")]
     hook: Option<String>,
+    /// With --idf-out (scheduled) and --epw: also hand EnergyPlus the beam through each exterior
+    /// window onto its zone's inside faces, per timestep, as SurfaceProperty:SolarIncidentInside
+    /// schedules read from OUTPUT with .interior-beam.csv for .csv (what the Scheduled method
+    /// loses under FullInteriorAndExterior; see docs/energyplus-fidelity.md).
+    #[arg(long)]
+    interior_beam: bool,
+    /// With --interior-beam: the solar transmittance (0..1) of windows whose construction gives
+    /// none sunlit reads (one simple glazing layer or one spectral-average pane).
+    #[arg(long, value_name = "T", requires = "interior_beam")]
+    glass_transmittance: Option<f64>,
     /// Foliage keeps its leaves all year.
     #[arg(long, conflicts_with_all = ["leaf_out", "leaf_fall"])]
     evergreen: bool,
@@ -632,6 +645,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
         // Passes that take one scene (the sky views) see each varying shade at its mean τ.
         scene = args.model.load_with_shades(v.mean_transmittance())?;
     }
+    let beam = beam_plan(&args, hook, energyplus.as_ref())?;
     let hooked = match (&args.idf_out, &energyplus) {
         (Some(_), None) => return Err(Error::argument("--idf-out", "needs an EnergyPlus model (.idf or .epJSON) among the inputs")),
         (Some(_), Some(ep)) => Some(sunlit::export::hook::hook_for(ep, &scene, hook, timesteps)?),
@@ -659,8 +673,17 @@ fn annual(args: AnnualArgs) -> Result<()> {
     };
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
-    let patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
+    let mut patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
         (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form)?)),
+        _ => None,
+    };
+    let beam_files = match (&beam, energyplus.as_ref(), patched.as_mut()) {
+        (Some(plan), Some(ep), Some((_, _, text))) => {
+            meter.stage("interior beam", "views");
+            let (csv, objects, notes) = beam_outputs(plan, ep, &settings.location, timesteps)?;
+            text.push_str(&objects);
+            Some((plan.csv.clone(), csv, notes))
+        }
         _ => None,
     };
     let solar_files = match &solar {
@@ -672,6 +695,13 @@ fn annual(args: AnnualArgs) -> Result<()> {
     for (path, bytes) in &solar_files {
         sunlit::export::write_atomic(path, bytes)?;
         eprintln!("wrote {}", path.display());
+    }
+    if let Some((path, bytes, notes)) = &beam_files {
+        sunlit::export::write_atomic(path, bytes)?;
+        eprintln!("wrote {} (the beam onto inside faces, W/m²)", path.display());
+        for note in notes {
+            eprintln!("note: {note}");
+        }
     }
     if let Some((out, form, text)) = patched {
         sunlit::export::write_atomic(out, text.as_bytes())?;

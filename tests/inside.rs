@@ -4,10 +4,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
+use common::inside::{golden_epw, numpy_reference};
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 use glam::DVec3;
 use serde_json::{Value, json};
@@ -96,27 +96,6 @@ fn floor_sun_patch_matches_the_analytic_projection_of_the_window() {
     assert!(inside::sun_patches(&scene, &rooms, DVec3::new(0.0, 0.6, 0.8), 1.0).is_empty());
 }
 
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("SUNLIT_RADIANCE_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv-rad/bin/python");
-    assert!(
-        venv.exists(),
-        "numpy's Python not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
-    );
-    venv
-}
-
-fn numpy_reference(query: &Value) -> Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/reference.py");
-    let mut child = Command::new(python()).arg(script).stdin(Stdio::piped()).stdout(Stdio::piped()).spawn().unwrap();
-    child.stdin.take().unwrap().write_all(query.to_string().as_bytes()).unwrap();
-    let out = child.wait_with_output().unwrap();
-    assert!(out.status.success(), "reference.py failed");
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
 fn positions(at: &RoomPoints) -> Vec<[f64; 3]> {
     (0..at.points.len()).map(|i| at.points.position(i).to_array()).collect()
 }
@@ -155,12 +134,6 @@ fn work_plane_grid_agrees_with_a_numpy_ray_caster() {
 }
 
 /// Golden, CO TMY3 from the EnergyPlus wheel (as the other EPW tests find it).
-fn golden_epw() -> PathBuf {
-    let epw = common::energyplus::energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw");
-    assert!(epw.exists(), "{} missing", epw.display());
-    epw
-}
-
 #[test]
 fn leed_ase_matches_a_numpy_ray_caster_on_the_golden_epw() {
     let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();

@@ -348,7 +348,8 @@ pub fn schedule_name(surface: &str) -> String {
     format!("SUNLIT {surface}")
 }
 
-fn object(out: &mut String, class: &str, fields: &[&str]) {
+/// Writes one IDF object, a field a line.
+pub(crate) fn object(out: &mut String, class: &str, fields: &[&str]) {
     let _ = write!(out, "{class},");
     for (i, f) in fields.iter().enumerate() {
         let end = if i + 1 == fields.len() { ';' } else { ',' };

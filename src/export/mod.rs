@@ -5,6 +5,8 @@
 //! timestep ` MM/DD HH:MM,v1,v2,…,` with 8 decimals and a trailing comma, exactly 8760·N rows.
 //! A schedule is checked before anything is written (row count, names, values in [0, 1]), and
 //! files are written to a temporary sibling and renamed, so a failure never leaves a partial file.
+//! Beside it, [`hook`] patches an EnergyPlus model to read the CSV, and [`interior_beam`] writes
+//! the beam onto inside faces that a hooked model reads too.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -15,6 +17,7 @@ use crate::year::samples::Timesteps;
 pub mod cadastre;
 pub mod cadastre_points;
 pub mod hook;
+pub mod interior_beam;
 pub mod irradiation;
 pub mod map_glb;
 pub mod map_table;

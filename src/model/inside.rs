@@ -8,7 +8,8 @@
 //! field (the solar value where it is blank), solar from its U-factor and SHGC by EnergyPlus's
 //! simple glazing correlation (Engineering Reference, "Simple Window Model", step 4: one formula
 //! for U > 4.5 W/m²K, one for U < 3.4, linear in U between). Any other construction takes the
-//! caller's `glass` value for both. EnergyPlus's angular dependence of the simple glazing model
+//! caller's `glass` value for both, except one `WindowMaterial:Glazing` pane given by spectral
+//! averages, whose normal-incidence fields are read as they are. EnergyPlus's angular dependence of the simple glazing model
 //! (its curves A–J chosen by U and SHGC) is not applied: the glass lets its normal-incidence
 //! value through at every angle.
 //!
@@ -45,11 +46,25 @@ pub struct Glazing {
     pub solar: f64,
     /// Visible transmittance at normal incidence (illuminance).
     pub visible: f64,
+    /// Front solar reflectance at normal incidence of one uncoated pane, which gives the solar
+    /// transmittance's angular dependence ([`Glazing::solar_at`]); None: the normal value holds
+    /// at every angle.
+    pub solar_reflectance: Option<f64>,
     /// Its base surface's other side is another zone (Outside Boundary Condition Surface or Zone).
     pub interzone: bool,
 }
 
 impl Glazing {
+    /// Solar transmittance for a beam at `cos_incidence` to the glass's normal: one uncoated
+    /// pane's (see [`pane_transmittance`]) where the pane's reflectance is known, else the normal
+    /// value.
+    pub fn solar_at(&self, cos_incidence: f64) -> f64 {
+        match self.solar_reflectance {
+            Some(r) => pane_transmittance(self.solar, r, cos_incidence),
+            None => self.solar,
+        }
+    }
+
     /// Whether the ray from `p` along `dir` crosses this opening (ahead of `p`).
     pub fn crossed_by(&self, p: DVec3, dir: DVec3) -> bool {
         let across = self.plane.normal.dot(dir);
@@ -100,6 +115,14 @@ pub struct Rooms {
 pub fn inside_scene(input: &EnergyPlusInput) -> Result<Scene> {
     let mut builder = SceneBuilder::new();
     input.building.add_inside_to(&mut builder)?;
+    builder.build()
+}
+
+/// As [`inside_scene`] with only the glazing named `window` open (see
+/// [`super::building::Building::add_inside_through`]).
+pub fn inside_scene_through(input: &EnergyPlusInput, window: &str) -> Result<Scene> {
+    let mut builder = SceneBuilder::new();
+    input.building.add_inside_through(&mut builder, window)?;
     builder.build()
 }
 
@@ -161,7 +184,7 @@ fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3]) -> bool {
 }
 
 fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Result<Glazing> {
-    let (solar, visible) = match simple_glazing(input, s)? {
+    let (solar, visible, solar_reflectance) = match simple_glazing(input, s)? {
         Some(t) => t,
         None => {
             let Some(t) = glass else {
@@ -171,7 +194,7 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
                     "has no WindowMaterial:SimpleGlazingSystem construction to take a transmittance from: give a glass transmittance",
                 ));
             };
-            (t, t)
+            (t, t, None)
         }
     };
     let interzone = input
@@ -188,24 +211,25 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
         outline,
         solar,
         visible,
+        solar_reflectance,
         interzone,
     })
 }
 
 /// (solar, visible) normal-incidence transmittance from a window's construction, when it is one
-/// `WindowMaterial:SimpleGlazingSystem` layer; refuses values outside 0..=1, naming the material.
-fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64, f64)>> {
-    let Some(object) = input.objects.iter().find(|o| o.is(&s.class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(&s.name))) else {
-        return Ok(None);
-    };
-    // Construction Name: field 3 of FenestrationSurface:Detailed, field 2 of Window and GlazedDoor.
-    let field = if object.is("FenestrationSurface:Detailed") { 2 } else { 1 };
+/// `WindowMaterial:SimpleGlazingSystem` layer or one spectral-average pane (then with the pane's
+/// front solar reflectance); refuses values outside 0..=1, naming the material.
+fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64, f64, Option<f64>)>> {
+    let Some(name) = construction_of(input, s) else { return Ok(None) };
     let named = |class: &str, name: &str| {
         input.objects.iter().find(|o| o.is(class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(name.trim())))
     };
-    let Some(construction) = named("Construction", object.field(field)) else { return Ok(None) };
+    let Some(construction) = named("Construction", &name) else { return Ok(None) };
     let layers: Vec<&str> = (1..).map(|i| construction.field(i)).take_while(|f| !f.trim().is_empty()).collect();
     let [layer] = layers.as_slice() else { return Ok(None) };
+    if let Some(glass) = named("WindowMaterial:Glazing", layer) {
+        return one_pane(input, glass);
+    }
     let Some(material) = named("WindowMaterial:SimpleGlazingSystem", layer) else { return Ok(None) };
     let value = |i: usize, what: &str| -> Result<Option<f64>> {
         let text = material.field(i).trim();
@@ -228,7 +252,65 @@ fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64,
         Some(v) => in_unit(v, "Visible Transmittance")?,
         None => solar,
     };
-    Ok(Some((solar, visible)))
+    Ok(Some((solar, visible, None)))
+}
+
+/// The construction a surface names, as written (None for a surface read from no object with
+/// one, such as a shading surface).
+pub fn construction_of(input: &EnergyPlusInput, s: &EpSurface) -> Option<String> {
+    let object = input.objects.iter().find(|o| o.is(&s.class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(&s.name)))?;
+    // Construction Name: the third field of the two classes that name a surface type first, the
+    // second of every other surface class (Wall:Detailed, Window, Door, Window:Interzone, …).
+    let field = if object.is("FenestrationSurface:Detailed") || object.is("BuildingSurface:Detailed") { 2 } else { 1 };
+    Some(object.field(field).trim().to_string()).filter(|c| !c.is_empty())
+}
+
+/// (solar, visible) normal-incidence transmittance and front solar reflectance of one
+/// `WindowMaterial:Glazing` pane given by its spectral averages; None for spectral data, which
+/// sunlit does not integrate.
+fn one_pane(input: &EnergyPlusInput, glass: &crate::model::idf::IdfObject) -> Result<Option<(f64, f64, Option<f64>)>> {
+    if !glass.field(1).trim().eq_ignore_ascii_case("SpectralAverage") {
+        return Ok(None);
+    }
+    let value = |i: usize, what: &str| -> Result<f64> {
+        let text = glass.field(i).trim();
+        text.parse::<f64>()
+            .ok()
+            .filter(|v| (0.0..=1.0).contains(v))
+            .ok_or_else(|| Error::object(&input.file, glass.label(), format!("{what} '{text}' is not a number in 0..=1")))
+    };
+    Ok(Some((
+        value(4, "Solar Transmittance at Normal Incidence")?,
+        value(7, "Visible Transmittance at Normal Incidence")?,
+        Some(value(5, "Front Side Solar Reflectance at Normal Incidence")?),
+    )))
+}
+
+/// The beam transmittance at `cos_incidence` of an uncoated pane whose normal-incidence
+/// transmittance and reflectance are `tau` and `rho`: the slab's one-interface reflectance `r`
+/// and internal transmittance `t` are solved from them (τ = (1−r)²t / (1−r²t²), ρ = r + rτt),
+/// the refractive index follows from `r`, and at the angle each polarisation's Fresnel
+/// reflectance and the longer path through the glass give the slab's transmittance again; the
+/// two polarisations are averaged. This is the physics of EnergyPlus's uncoated glass
+/// (WindowManager `TransAndReflAtPhi`), which fits a polynomial through it.
+pub fn pane_transmittance(tau: f64, rho: f64, cos_incidence: f64) -> f64 {
+    let c = cos_incidence.clamp(0.0, 1.0);
+    if tau <= 0.0 || c <= 0.0 {
+        return 0.0;
+    }
+    let beta = tau * tau - rho * rho + 2.0 * rho + 1.0;
+    let r = (beta - (beta * beta - 4.0 * (2.0 - rho) * rho).max(0.0).sqrt()) / (2.0 * (2.0 - rho));
+    if r <= 1e-9 {
+        return tau;
+    }
+    let q = (1.0 - r) * (1.0 - r);
+    let t = ((q * q + 4.0 * r * r * tau * tau).sqrt() - q) / (2.0 * r * r * tau);
+    let n = (1.0 + r.sqrt()) / (1.0 - r.sqrt());
+    let ct = (1.0 - (1.0 - c * c) / (n * n)).sqrt();
+    let path = t.powf(1.0 / ct);
+    let slab = |reflectance: f64| (1.0 - reflectance).powi(2) * path / (1.0 - (reflectance * path).powi(2));
+    let (rs, rp) = (((c - n * ct) / (c + n * ct)).powi(2), ((n * c - ct) / (n * c + ct)).powi(2));
+    0.5 * (slab(rs) + slab(rp))
 }
 
 /// EnergyPlus's simple glazing solar transmittance at normal incidence from U (W/m²K) and SHGC.
@@ -241,5 +323,38 @@ pub fn solar_transmittance(u: f64, shgc: f64) -> f64 {
         low_u
     } else {
         low_u + (high_u - low_u) * (u - 3.4) / (4.5 - 3.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pane_transmittance;
+
+    /// A slab with interface reflectance `r` and internal transmittance `t`, seen at normal
+    /// incidence: (τ, ρ) by the multiple-reflection sums.
+    fn slab(r: f64, t: f64) -> (f64, f64) {
+        let tau = (1.0 - r).powi(2) * t / (1.0 - r * r * t * t);
+        (tau, r + r * tau * t)
+    }
+
+    #[test]
+    fn a_pane_gives_back_its_normal_transmittance_and_falls_off_with_angle() {
+        // EnergyPlus's CLEAR 6MM-like pane (τ 0.775, ρ 0.071) and a slab made from known r, t.
+        for (tau, rho) in [(0.775, 0.071), slab(0.0426, 0.92)] {
+            assert!((pane_transmittance(tau, rho, 1.0) - tau).abs() < 1e-9, "{tau} {rho}");
+            let mut last = tau;
+            for k in (0..10).rev() {
+                let at = pane_transmittance(tau, rho, f64::from(k) / 10.0);
+                assert!(at <= last + 1e-12 && at >= 0.0, "{tau}: not falling at cos {}", f64::from(k) / 10.0);
+                last = at;
+            }
+            assert_eq!(pane_transmittance(tau, rho, 0.0), 0.0);
+        }
+        // Glass of index 1.526 (r 0.04336) without absorption: at 60° Fresnel's reflectances are
+        // 0.18548 (s) and 0.00145 (p), the slab lets (1−R)/(1+R) of each through, 0.68708 and
+        // 0.99711, their mean 0.84210 (worked by hand from Snell's and Fresnel's laws).
+        let (tau, rho) = slab(0.043_361_55, 1.0 - 1e-12);
+        let at60 = pane_transmittance(tau, rho, 0.5);
+        assert!((at60 - 0.842_10).abs() < 1e-3, "{at60}");
     }
 }

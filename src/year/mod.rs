@@ -7,12 +7,14 @@
 //! them to an [`Engine`](crate::count::Engine): what to count, fitting, refining where shadow
 //! edges sweep too fast, and surviving a lost GPU device ([`annual`]), with the refined steps that a certificate proves dark
 //! or lit set without a view ([`certified`]); and the fitted surfaces kept
-//! to evaluate at any instant ([`fitted`], a viewer's time slider). It knows nothing of pixels
+//! to evaluate at any instant ([`fitted`], a viewer's time slider); and the beam that exterior
+//! windows let onto their zones' inside faces at every timestep ([`interior_beam`]). It knows nothing of pixels
 //! (that is [`crate::count`]) or of files (that is [`crate::export`]).
 
 pub mod annual;
 mod certified;
 pub mod fitted;
+pub mod interior_beam;
 pub mod samples;
 pub mod season;
 pub mod settings;

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod energyplus;
+pub mod inside;
 
 use std::path::PathBuf;
 

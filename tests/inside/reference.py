@@ -10,6 +10,16 @@ points: [[x, y, z]...], normal: [nx, ny, nz], suns: [[sx, sy, sz]...], lux: [...
 vt: float}
 stdout: JSON {lit: [[0|1 per point] per sun]} without lux; with lux (one per sun)
 {hours_over: [per point hours with lux * vt * cos * lit > 1000]}.
+
+Second mode, any closed room of planar polygons (an L-shaped zone): stdin JSON {faces: [{name,
+vertices: [[x, y, z]...], holes: [window outlines in it]}...] (the room's boundary; a wall's
+outline includes its windows, its samples leave them out),
+windows: [{vertices, tau}...], beams: [[sx, sy, sz, dni]...], spacing: float}. Each face is
+sampled on a square grid of that spacing in its own plane (cell centres inside the polygon); a
+sample sees the sun through a window when its ray meets the window's polygon before any face
+(a hit on a face inside a window's outline is the window). stdout: JSON {incident: {name: sum
+over beams of dni * tau * cos * lit share}} with cos against the face's inward normal (faces
+are listed counter-clockwise seen from outside, as EnergyPlus lists them).
 """
 import json
 import sys
@@ -34,8 +44,87 @@ def lit(points, sun, window, overhang):
     return through
 
 
+def frame(vertices):
+    """Origin, in-plane axes and unit normal of a planar polygon (Newell's normal)."""
+    v = np.asarray(vertices, dtype=float)
+    n = np.zeros(3)
+    for a, b in zip(v, np.roll(v, -1, axis=0)):
+        n += np.cross(a, b)
+    n /= np.linalg.norm(n)
+    u = v[1] - v[0]
+    u -= n * (u @ n)
+    u /= np.linalg.norm(u)
+    return v[0], u, np.cross(n, u), n
+
+
+def inside_2d(pts, poly):
+    """Even-odd test of 2D points against a 2D polygon."""
+    x, y = pts[:, 0], pts[:, 1]
+    out = np.zeros(len(pts), dtype=bool)
+    for (x1, y1), (x2, y2) in zip(poly, np.roll(poly, -1, axis=0)):
+        crosses = (y1 > y) != (y2 > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xs = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+        out ^= crosses & (x < xs)
+    return out
+
+
+def hits(points, sun, vertices):
+    """Distance along `sun` at which each point's ray meets the polygon (inf where it misses)."""
+    o, u, w, n = frame(vertices)
+    d = sun @ n
+    t = np.full(len(points), np.inf)
+    if abs(d) < 1e-12:
+        return t
+    tt = ((o - points) @ n) / d
+    at = points + tt[:, None] * sun - o
+    flat = np.stack([at @ u, at @ w], axis=1)
+    poly = np.stack([(np.asarray(vertices) - o) @ u, (np.asarray(vertices) - o) @ w], axis=1)
+    ok = (tt > 1e-9) & inside_2d(flat, poly)
+    t[ok] = tt[ok]
+    return t
+
+
+def room(q):
+    faces, windows, spacing = q["faces"], q["windows"], q["spacing"]
+    out = {}
+    for f in faces:
+        o, u, w, n = frame(f["vertices"])
+        n = -n  # listed counter-clockwise seen from outside (as EnergyPlus lists them): inward
+        v = np.asarray(f["vertices"], dtype=float) - o
+        poly = np.stack([v @ u, v @ w], axis=1)
+        lo, hi = poly.min(axis=0), poly.max(axis=0)
+        gu = np.arange(lo[0] + spacing / 2, hi[0], spacing)
+        gw = np.arange(lo[1] + spacing / 2, hi[1], spacing)
+        grid = np.array([(a, b) for a in gu for b in gw])
+        grid = grid[inside_2d(grid, poly)]
+        for hole in f.get("holes", []):
+            h = np.asarray(hole, dtype=float) - o
+            grid = grid[~inside_2d(grid, np.stack([h @ u, h @ w], axis=1))]
+        pts = o + grid[:, :1] * u + grid[:, 1:] * w + n * 1e-7
+        total = 0.0
+        for sx, sy, sz, dni in q["beams"]:
+            sun = np.array([sx, sy, sz])
+            cos = sun @ n
+            if cos <= 0:
+                continue
+            walls = [hits(pts, sun, g["vertices"]) for g in faces if g is not f]
+            for win in windows:
+                tw = hits(pts, sun, win["vertices"])
+                # Lit: the ray leaves through the window and meets no face, inside or out (the
+                # building shades its own windows), but the wall that holds the window, there.
+                blocked = np.any([np.isfinite(t) & (np.abs(t - tw) > 1e-9) for t in walls], axis=0)
+                lit = np.isfinite(tw) & ~blocked
+                total += dni * win["tau"] * cos * lit.mean()
+        out[f["name"]] = total
+    return {"incident": out}
+
+
 def main():
     q = json.load(sys.stdin)
+    if "faces" in q:
+        json.dump(room(q), sys.stdout)
+        return
     points = np.array(q["points"], dtype=float)
     suns = np.array(q["suns"], dtype=float)
     normal = np.array(q["normal"], dtype=float)

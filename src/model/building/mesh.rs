@@ -81,10 +81,22 @@ impl Building {
     /// Refuses a window or door that does not lie in its base surface: its opening would be
     /// left uncut, and the room sealed.
     pub fn add_inside_to(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_inside_open(builder, EpSurface::is_glazing)
+    }
+
+    /// As [`Building::add_inside_to`], with only the glazing named `window` open: every other
+    /// window and glass door casts as if opaque, so the beam reaching an inside face came through
+    /// that one window (EnergyPlus's interior beam is counted per exterior window).
+    pub fn add_inside_through(&self, builder: &mut SceneBuilder, window: &str) -> Result<()> {
+        self.add_inside_open(builder, |s| s.is_glazing() && s.name.eq_ignore_ascii_case(window))
+    }
+
+    /// The inside scene with the openings `open` picks left out (holes in their walls).
+    fn add_inside_open(&self, builder: &mut SceneBuilder, open: impl Fn(&EpSurface) -> bool) -> Result<()> {
         if let Some((hole, why)) = self.misplaced_openings().into_iter().next() {
             return Err(Error::object(&self.file, hole.label(), why));
         }
-        self.add_surfaces(builder, true, &HashMap::new(), EpSurface::is_glazing)?;
+        self.add_surfaces(builder, true, &HashMap::new(), open)?;
         for s in self.surfaces.iter().filter(|s| s.zone.is_some() && !s.is_shading() && !s.is_glazing()) {
             builder.add_mirror(&s.name, &inside_name(&s.name));
         }

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""The interior beam's figures on 4ZoneWithShading_Simple_1 (docs/energyplus-fidelity.md).
+
+Usage: scripts/eplus-interior-beam.py SUNLIT ENERGYPLUS EPW OUTDIR
+
+The test file set to FullInteriorAndExterior and run annually with EnergyPlus's own clipping
+(Timestep updates); then hooked by `sunlit annual --idf-out` without and with
+`--interior-beam`, each hooked copy fed EnergyPlus's *own* reported sunlit fractions (so only
+the Scheduled method's own gap is left), and run. Prints annual site energy against the clipping
+run, and per inside surface the annual beam EnergyPlus's clipping reports (`Surface Inside Face
+Exterior Windows Incident Beam Solar Radiation Rate per Area`) against sunlit's schedule.
+"""
+import csv
+import os
+import subprocess
+import sys
+
+sunlit, energyplus, epw, out = sys.argv[1:5]
+here = os.path.dirname(os.path.abspath(__file__))
+os.makedirs(out, exist_ok=True)
+
+
+def model():
+    t = open(os.path.join(here, "../tests/energyplus_testfiles/4ZoneWithShading_Simple_1.idf")).read()
+    dd = "    Yes,                     !- Run Simulation for Sizing Periods\n    No,                      !- Run Simulation for Weather File Run Periods"
+    wf = "    No,                      !- Run Simulation for Sizing Periods\n    Yes,                     !- Run Simulation for Weather File Run Periods"
+    assert dd in t and "FullExterior," in t, "the test file is not in the layout expected here"
+    t = t.replace(dd, wf, 1)
+    t = t.replace("FullExterior,", "FullInteriorAndExterior,", 1)
+    t += "\nShadowCalculation, PolygonClipping, Timestep, 1, 15000, SutherlandHodgman, 512, SimpleSkyDiffuseModeling, Yes;\n"
+    t += "Output:Table:SummaryReports, AllSummary;\nOutputControl:Table:Style, Comma;\n"
+    t += "Output:Variable, *, Surface Outside Face Sunlit Fraction, Timestep;\n"
+    t += "Output:Variable, *, Surface Inside Face Exterior Windows Incident Beam Solar Radiation Rate per Area, Timestep;\n"
+    return t
+
+
+def run(idf, d):
+    subprocess.run([energyplus, "-r", "-w", epw, "-d", d, idf], check=True, capture_output=True)
+
+
+def columns(path):
+    rows = list(csv.reader(open(path)))
+    head = [h.strip().upper() for h in rows[0]]
+    return {head[i]: [float(r[i]) for r in rows[1:] if i < len(r) and r[i].strip()] for i in range(1, len(head))}
+
+
+def site(d):
+    for line in open(os.path.join(d, "eplustbl.csv"), errors="replace"):
+        f = line.split(",")
+        if len(f) > 2 and f[1] == "Total Site Energy":
+            return float(f[2])
+
+
+def own_fractions(shading, hooked, clip, name):
+    """The hooked copy re-pointed at EnergyPlus's reported fractions in sunlit's CSV layout."""
+    theirs = columns(os.path.join(clip, "eplusout.csv"))
+    lines = open(shading).read().splitlines()
+    names = [n.upper() for n in lines[0].split(",")[1:] if n]
+    cols = [theirs[n + ":SURFACE OUTSIDE FACE SUNLIT FRACTION [](TIMESTEP)"] for n in names]
+    text = [lines[0]] + [line.split(",")[0] + "".join(",%.8f" % c[r] for c in cols) for r, line in enumerate(lines[1:])]
+    own = os.path.join(out, name + "-own.csv")
+    open(own, "w").write("\n".join(text) + "\n")
+    idf = open(hooked).read().replace(os.path.realpath(shading), os.path.realpath(own))
+    path = os.path.join(out, name + "-own.idf")
+    open(path, "w").write(idf)
+    return path
+
+
+clip_idf = os.path.join(out, "clipping.idf")
+open(clip_idf, "w").write(model())
+clip = os.path.join(out, "clipping")
+run(clip_idf, clip)
+gaps = {}
+for name, extra in (("scheduled", []), ("interior-beam", ["--interior-beam"])):
+    shading, hooked = os.path.join(out, name + ".csv"), os.path.join(out, name + ".idf")
+    subprocess.run([sunlit, "annual", clip_idf, "--epw", epw, "--engine", "exact", "-o", shading, "--idf-out", hooked] + extra,
+                   check=True, capture_output=True)
+    run(own_fractions(shading, hooked, clip, name), os.path.join(out, name))
+    gaps[name] = 100 * (site(os.path.join(out, name)) - site(clip)) / site(clip)
+    print(f"{name}: site energy {site(os.path.join(out, name))} GJ against the clipping run's {site(clip)} GJ: {gaps[name]:+.3f} %")
+theirs = columns(os.path.join(clip, "eplusout.csv"))
+ours = columns(os.path.join(out, "interior-beam.interior-beam.csv"))
+key = ":SURFACE INSIDE FACE EXTERIOR WINDOWS INCIDENT BEAM SOLAR RADIATION RATE PER AREA [W/M2](TIMESTEP)"
+print("inside face, annual incident beam kWh/m2: EnergyPlus's clipping, sunlit")
+for name, values in ours.items():
+    if name + key in theirs:
+        e, s = sum(theirs[name + key]) / 4000, sum(values) / 4000
+        if e > 0.5 or s > 0.5:
+            print(f"{name:22s} {e:8.2f} {s:8.2f} ({100 * (s - e) / e:+.1f} %)")

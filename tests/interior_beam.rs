@@ -1,0 +1,313 @@
+//! EnergyPlus's interior beam computed by sunlit (`sunlit::year::interior_beam`, `annual
+//! --interior-beam`) on an L-shaped zone, where EnergyPlus's own FullInterior distribution warns
+//! (CHKBKS) and is unreliable: the beam per inside face against an independent numpy ray caster
+//! (tests/inside/reference.py, room mode), EnergyPlus 25.2 taking the hooked model, and
+//! interzone windows skipped by name.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+mod common;
+use common::inside::{golden_epw, numpy_reference};
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::{Value, json};
+use sunlit::model::inside::rooms;
+use sunlit::model::{self, EnergyPlusInput, LoadOptions};
+use sunlit::sun::position::sun_direction;
+use sunlit::sun::weather::Weather;
+use sunlit::year::annual::shading_sun_day;
+use sunlit::year::interior_beam::interior_beam;
+use sunlit::year::samples::Timesteps;
+
+/// The L's outline seen from above, counter-clockwise: an 8 × 8 m square without its north-east
+/// 4 × 4 m quarter. 3 m high.
+const OUTLINE: [[f64; 2]; 6] = [[0.0, 0.0], [8.0, 0.0], [8.0, 4.0], [4.0, 4.0], [4.0, 8.0], [0.0, 8.0]];
+const HEIGHT: f64 = 3.0;
+const WALLS: [&str; 6] = ["S", "E1", "N1", "E2", "N2", "W"];
+/// South window (x0, x1, z0, z1) in wall S (y = 0), west window (y0, y1, z0, z1) in wall W
+/// (x = 0), east window (y0, y1, z0, z1) in the inner corner's wall E2 (x = 4): the east arm
+/// (walls S, E1, N1) lies in front of E2's plane, which EnergyPlus's back-surface check (CHKBKS)
+/// warns about.
+const SOUTH_WINDOW: [f64; 4] = [1.0, 7.0, 0.8, 2.4];
+const WEST_WINDOW: [f64; 4] = [5.0, 7.0, 0.9, 2.2];
+const EAST_WINDOW: [f64; 4] = [5.0, 7.5, 0.9, 2.4];
+/// Days whose beam is kept in the test's weather (clear days in the Golden TMY3: 15 December,
+/// 31 March).
+const DAYS: [u32; 2] = [349, 90];
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sunlit-interior-beam-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn corners(points: &[[f64; 3]]) -> String {
+    points.iter().map(|c| format!("{},{},{}", c[0], c[1], c[2])).collect::<Vec<_>>().join(",")
+}
+
+/// Wall `k` from outline corner k to k+1: upper-left first, counter-clockwise seen from outside.
+fn wall(k: usize) -> [[f64; 3]; 4] {
+    let (a, b) = (OUTLINE[k], OUTLINE[(k + 1) % OUTLINE.len()]);
+    [[a[0], a[1], HEIGHT], [a[0], a[1], 0.0], [b[0], b[1], 0.0], [b[0], b[1], HEIGHT]]
+}
+
+fn floor() -> Vec<[f64; 3]> {
+    OUTLINE.iter().rev().map(|p| [p[0], p[1], 0.0]).collect()
+}
+
+fn roof() -> Vec<[f64; 3]> {
+    OUTLINE.iter().map(|p| [p[0], p[1], HEIGHT]).collect()
+}
+
+fn south_window() -> [[f64; 3]; 4] {
+    let [x0, x1, z0, z1] = SOUTH_WINDOW;
+    [[x0, 0.0, z1], [x0, 0.0, z0], [x1, 0.0, z0], [x1, 0.0, z1]]
+}
+
+fn west_window() -> [[f64; 3]; 4] {
+    let [y0, y1, z0, z1] = WEST_WINDOW;
+    [[0.0, y1, z1], [0.0, y1, z0], [0.0, y0, z0], [0.0, y0, z1]]
+}
+
+fn east_window() -> [[f64; 3]; 4] {
+    let [y0, y1, z0, z1] = EAST_WINDOW;
+    [[4.0, y0, z1], [4.0, y0, z0], [4.0, y1, z0], [4.0, y1, z1]]
+}
+
+/// The L-shaped office as an EnergyPlus 25.2 model: FullInteriorAndExterior, Timestep 4, a
+/// RunPeriod over `DAYS`' December day, two simple glazings.
+fn l_room_idf() -> String {
+    let mut idf = String::from(
+        "Version,25.2;\nSimulationControl,No,No,No,No,Yes;\nBuilding,L,0,Suburbs,0.04,0.4,FullInteriorAndExterior,25,6;\n\
+         GlobalGeometryRules,UpperLeftCorner,Counterclockwise,Relative;\nTimestep,4;\n\
+         RunPeriod,Winter,12,14,,12,16,,Tuesday,Yes,Yes,No,Yes,Yes;\n\
+         Material,Layer,Rough,0.1,1.0,1000,1000;\nZone,Office,0,0,0,0;\nConstruction,Opaque,Layer;\n\
+         Construction,Glass,SimpleGlass;\nConstruction,Glass2,SimpleGlass2;\n\
+         WindowMaterial:SimpleGlazingSystem,SimpleGlass,2.0,0.6,0.7;\nWindowMaterial:SimpleGlazingSystem,SimpleGlass2,5.0,0.4,0.5;\n\
+         Output:Variable,*,Surface Inside Face Exterior Windows Incident Beam Solar Radiation Rate per Area,Timestep;\n",
+    );
+    let surface = |name: &str, kind: &str, boundary: &str, c: &[[f64; 3]]| {
+        let sun = if boundary == "Outdoors" { "SunExposed,WindExposed" } else { "NoSun,NoWind" };
+        format!("BuildingSurface:Detailed,{name},{kind},Opaque,Office,,{boundary},,{sun},,{},{};\n", c.len(), corners(c))
+    };
+    for (k, name) in WALLS.iter().enumerate() {
+        idf += &surface(name, "Wall", "Outdoors", &wall(k));
+    }
+    idf += &surface("Floor", "Floor", "Ground", &floor());
+    idf += &surface("Roof", "Roof", "Outdoors", &roof());
+    idf += &format!("FenestrationSurface:Detailed,WinS,Window,Glass,S,,,,1,4,{};\n", corners(&south_window()));
+    idf += &format!("FenestrationSurface:Detailed,WinW,Window,Glass2,W,,,,1,4,{};\n", corners(&west_window()));
+    idf += &format!("FenestrationSurface:Detailed,WinE,Window,Glass,E2,,,,1,4,{};\n", corners(&east_window()));
+    idf
+}
+
+/// The Golden EPW with its direct normal irradiance kept only on `DAYS` (0 elsewhere), so a
+/// year of timesteps asks the engine about two days.
+fn two_day_epw() -> String {
+    let text = std::fs::read_to_string(golden_epw()).unwrap();
+    let mut out = String::new();
+    for (i, line) in text.lines().enumerate() {
+        if i < 8 {
+            out += line;
+        } else {
+            let mut f: Vec<String> = line.split(',').map(str::to_string).collect();
+            let day = day_of_year(f[1].parse().unwrap(), f[2].parse().unwrap());
+            if !DAYS.contains(&day) {
+                f[14] = "0".into();
+            }
+            out += &f.join(",");
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn day_of_year(month: u32, day: u32) -> u32 {
+    [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334][month as usize - 1] + day
+}
+
+fn load(idf: &str) -> EnergyPlusInput {
+    model::load_bytes_all(&[("l.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default()).unwrap().energyplus.unwrap()
+}
+
+/// Per inside face of the L, the beam summed over the two days' timesteps (Σ W/m²) by sunlit's
+/// exact engine through each window, against numpy rays from a 4 cm grid on every face: within
+/// 2 % on every face the beam reaches (and nothing on the others). The L's inner corner walls
+/// (N1, E2) shade the room behind them, which EnergyPlus's convex-zone FullInterior cannot do.
+#[test]
+fn l_shaped_zone_beam_per_face_agrees_with_numpy_rays() {
+    let ep = load(&l_room_idf());
+    let rooms = rooms(&ep, None).unwrap();
+    let weather = Weather::from_epw_text("two-days.epw", &two_day_epw()).unwrap();
+    let timesteps = Timesteps::new(4).unwrap();
+    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, timesteps).unwrap();
+    assert_eq!(beam.faces.len(), 8, "six walls, floor and roof");
+    assert!(beam.skipped.is_empty());
+
+    let beams: Vec<[f64; 4]> = (0..timesteps.rows())
+        .filter_map(|r| {
+            let at = timesteps.instant(r);
+            let sun = sun_direction(&weather.location, shading_sun_day(at.day), at.hour);
+            let dni = weather.at(timesteps, r).dni;
+            (sun.z > 0.0 && dni > 0.0).then_some([sun.x, sun.y, sun.z, dni])
+        })
+        .collect();
+    let tau = |name: &str| rooms.glazing.iter().find(|g| g.name == name).unwrap().solar;
+    let holes = |name: &str| match name {
+        "S" => vec![south_window().to_vec()],
+        "W" => vec![west_window().to_vec()],
+        "E2" => vec![east_window().to_vec()],
+        _ => vec![],
+    };
+    let mut faces: Vec<Value> = WALLS.iter().enumerate().map(|(k, n)| json!({"name": n, "vertices": wall(k), "holes": holes(n)})).collect();
+    faces.push(json!({"name": "Floor", "vertices": floor()}));
+    faces.push(json!({"name": "Roof", "vertices": roof()}));
+    let query = json!({
+        "faces": faces,
+        "windows": [
+            {"vertices": south_window(), "tau": tau("WinS")},
+            {"vertices": west_window(), "tau": tau("WinW")},
+            {"vertices": east_window(), "tau": tau("WinE")},
+        ],
+        "beams": beams,
+        "spacing": 0.04,
+    });
+    let reference = numpy_reference(&query);
+    let largest = reference["incident"].as_object().unwrap().values().map(|v| v.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(largest > 2e3, "the beam reaches the room ({largest})");
+    let mut reached = 0;
+    for face in &beam.faces {
+        let ours: f64 = face.watts_m2.iter().sum();
+        let theirs = reference["incident"][&face.surface].as_f64().unwrap();
+        eprintln!("{}: sunlit {ours:.1}, numpy {theirs:.1} (Σ W/m² over the steps)", face.surface);
+        if theirs > 0.01 * largest {
+            reached += 1;
+            assert!((ours - theirs).abs() <= 0.02 * theirs, "{}: {ours} against {theirs}", face.surface);
+        } else {
+            assert!((ours - theirs).abs() <= 0.005 * largest, "{}: {ours} against {theirs}", face.surface);
+        }
+    }
+    assert!(reached >= 4, "the beam lands on floor and several walls ({reached} faces)");
+}
+
+/// The hooked L runs to completion in EnergyPlus 25.2 (which reports CHKBKS as severe errors for
+/// its own distribution in this zone, in both runs, and carries on), and the balance takes back
+/// exactly the beam the faces got.
+#[test]
+fn l_shaped_zone_hooked_run_completes() {
+    let (idf, epw, csv, hooked) = (scratch("l.idf"), scratch("two-days.epw"), scratch("l.csv"), scratch("l-hooked.idf"));
+    std::fs::write(&idf, l_room_idf()).unwrap();
+    std::fs::write(&epw, two_day_epw()).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+        .args(["annual", idf.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "--engine", "exact", "--days-per-year", "9"])
+        .args(["--samples-per-day", "9", "-o", csv.to_str().unwrap(), "--idf-out", hooked.to_str().unwrap(), "--interior-beam"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("interior beam: 8 inside faces of 1 zones"), "{stderr}");
+    let text = std::fs::read_to_string(&hooked).unwrap();
+    assert_eq!(text.matches("SurfaceProperty:SolarIncidentInside,").count(), 9, "8 faces and the balance");
+
+    // The balance column is minus the faces' beam (W) over the window's area, row by row.
+    let beam_csv = std::fs::read_to_string(scratch("l.interior-beam.csv")).unwrap();
+    let header: Vec<&str> = beam_csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(header.last(), Some(&"WinS"));
+    let ep = load(&l_room_idf());
+    let area = |name: &str| {
+        let s = ep.building.surface(name).unwrap();
+        let windows: f64 = ep.building.surfaces.iter().filter(|w| w.base.as_deref() == Some(name)).map(|w| polygon_area(&w.vertices)).sum();
+        polygon_area(&s.vertices) - windows
+    };
+    let mut lit_rows = 0;
+    for line in beam_csv.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').skip(1).map(|x| x.parse().unwrap()).collect();
+        let faces: f64 = header[1..header.len() - 1].iter().zip(&v).map(|(n, w)| w * area(n)).sum();
+        let balance = v[v.len() - 1] * polygon_area(&ep.building.surface("WinS").unwrap().vertices);
+        // The CSV rounds to 1 mW/m²: about 0.1 W over the faces' 200 m².
+        assert!((faces + balance).abs() <= 0.2 + 1e-3 * faces, "{line}");
+        lit_rows += usize::from(faces > 0.0);
+    }
+    assert!(lit_rows > 40, "{lit_rows} rows with beam");
+
+    let run = |model: &Path, out: &Path| {
+        let status = Command::new(common::energyplus::energyplus())
+            .args(["-w", epw.to_str().unwrap(), "-d", out.to_str().unwrap(), model.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = std::fs::read_to_string(out.join("eplusout.err")).unwrap_or_default();
+        assert!(status.status.success() && err.contains("EnergyPlus Completed Successfully"), "EnergyPlus on {}:\n{err}", model.display());
+        // Its only severe errors: CHKBKS, its own check that the zone is convex for its own
+        // FullInterior distribution (back surfaces in front of the window's wall E2).
+        let severe: Vec<&str> = err.lines().filter(|l| l.contains("** Severe  **")).collect();
+        assert!(severe.iter().all(|l| l.contains("(CHKBKS)")), "EnergyPlus on {}:\n{err}", model.display());
+        severe.len()
+    };
+    assert!(run(&idf, &scratch("l-own")) > 0, "EnergyPlus's own FullInterior calls the L unfit (CHKBKS)");
+    run(&hooked, &scratch("l-hooked"));
+}
+
+fn polygon_area(v: &[glam::DVec3]) -> f64 {
+    let mut sum = glam::DVec3::ZERO;
+    for (i, a) in v.iter().enumerate() {
+        sum += a.cross(v[(i + 1) % v.len()]);
+    }
+    sum.length() / 2.0
+}
+
+/// An interzone window lets no exterior beam of its own: it is skipped by name, and a zone whose
+/// only glazing is interzone gets no interior beam (no faces, no balance).
+#[test]
+fn interzone_windows_are_skipped_by_name() {
+    let mut idf = l_room_idf();
+    // A second zone north of the L's east arm, behind wall N1 (y = 4, x 4–8), with a window into it.
+    idf += "Zone,Store,0,0,0,0;\n";
+    let store = |name: &str, kind: &str, boundary: &str, object: &str, c: &[[f64; 3]]| {
+        format!("BuildingSurface:Detailed,{name},{kind},Opaque,Store,,{boundary},{object},NoSun,NoWind,,{},{};\n", c.len(), corners(c))
+    };
+    idf = idf.replace(
+        "BuildingSurface:Detailed,N1,Wall,Opaque,Office,,Outdoors,,SunExposed,WindExposed,",
+        "BuildingSurface:Detailed,N1,Wall,Opaque,Office,,Surface,N1b,NoSun,NoWind,",
+    );
+    idf += &store("N1b", "Wall", "Surface", "N1", &[[4.0, 4.0, HEIGHT], [4.0, 4.0, 0.0], [8.0, 4.0, 0.0], [8.0, 4.0, HEIGHT]]);
+    idf += &store("Fl2", "Floor", "Ground", "", &[[8.0, 4.0, 0.0], [4.0, 4.0, 0.0], [4.0, 8.0, 0.0], [8.0, 8.0, 0.0]]);
+    idf += "FenestrationSurface:Detailed,Through,Window,Glass,N1,,,,1,4,7,4,2,7,4,1,5,4,1,5,4,2;\n";
+    let ep = load(&idf);
+    let rooms = rooms(&ep, None).unwrap();
+    let weather = Weather::from_epw_text("two-days.epw", &two_day_epw()).unwrap();
+    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, Timesteps::new(1).unwrap()).unwrap();
+    assert_eq!(beam.skipped, vec!["Through".to_string()]);
+    assert!(
+        beam.faces.iter().all(|f| f.zone.eq_ignore_ascii_case("Office")),
+        "{:?}",
+        beam.faces.iter().map(|f| &f.zone).collect::<Vec<_>>()
+    );
+    assert_eq!(beam.balances.len(), 1);
+    assert!(beam.balances[0].window != "Through");
+}
+
+/// What `--interior-beam` cannot do is refused by name before any counting, and nothing is
+/// written: no `--idf-out`, no `--epw`, or the Imported hook.
+#[test]
+fn interior_beam_refusals_name_the_flag_and_write_nothing() {
+    let (idf, epw) = (scratch("refused.idf"), scratch("refused.epw"));
+    std::fs::write(&idf, l_room_idf()).unwrap();
+    std::fs::write(&epw, two_day_epw()).unwrap();
+    let (csv, hooked) = (scratch("refused.csv"), scratch("refused-hooked.idf"));
+    let cases: [(&[&str], &str); 3] = [
+        (&["--epw", epw.to_str().unwrap()], "add --idf-out"),
+        (&["--location", "39.74,-105.18,-7", "--idf-out", hooked.to_str().unwrap()], "needs --epw"),
+        (&["--epw", epw.to_str().unwrap(), "--idf-out", hooked.to_str().unwrap(), "--hook", "imported"], "Imported"),
+    ];
+    for (args, why) in cases {
+        let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+            .args(["annual", idf.to_str().unwrap(), "-o", csv.to_str().unwrap(), "--interior-beam"])
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("--interior-beam") && stderr.contains(why), "{args:?}: {stderr}");
+        assert!(!csv.exists() && !hooked.exists() && !scratch("refused.interior-beam.csv").exists(), "{args:?} wrote a file");
+    }
+}
