@@ -77,6 +77,11 @@ mod tests {
         let summer =
             periods("Version, 25.2;\nRunPeriod, R, 3, 15, 2006, 10, 20, 2006, Sunday;\nShadowCalculation, PolygonClipping, Periodic, 7;\n");
         assert_eq!(summer, Some(ShadingPeriods { days: 7, first_day: 74, run_days: 220 }));
+        let json = r#"{"Version": {"Version 1": {"version_identifier": "25.2"}}, "ShadowCalculation": {"ShadowCalculation 1": {"shading_calculation_method": "PolygonClipping", "shading_calculation_update_frequency_method": "Timestep", "shading_calculation_update_frequency": 1}}}"#;
+        let objects = crate::model::epjson::parse_epjson("m.epJSON", json).unwrap();
+        assert_eq!(periodic_update(&objects), None, "epJSON: read by field name");
+        let periodic = json.replace("\"Timestep\"", "\"Periodic\"").replace("frequency\": 1", "frequency\": 7");
+        assert_eq!(periodic_update(&crate::model::epjson::parse_epjson("m.epJSON", &periodic).unwrap()), year(7));
         let old = periods("Version, 8.4;\nRunPeriod, R, 3, 15, 10, 20, UseWeatherFile;\nShadowCalculation, AverageOverDaysInFrequency;\n");
         assert_eq!(old, Some(ShadingPeriods { days: 20, first_day: 74, run_days: 220 }));
     }
