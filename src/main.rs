@@ -623,7 +623,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
         site_location(&mut settings, energyplus.as_ref())?;
     }
     let settings = settings.resolve()?;
-    let mut options = settings.options(energyplus.as_ref().and_then(|e| e.timesteps()))?;
+    let periods = energyplus.as_ref().and_then(|e| model::shading_update::periodic_update(&e.objects));
+    let mut options = settings.model_options(energyplus.as_ref().and_then(|e| e.timesteps()), periods)?;
+    if let Some(p) = periods {
+        eprintln!(
+            "shading: the model updates EnergyPlus's shading every {} days (Periodic), so each period's days get one sun, the means of \
+             its declination and equation of time, as in EnergyPlus's own calculation; a hooked model keeps that update",
+            p.days
+        );
+    }
     let chosen_year = run_year(&args, energyplus.as_ref())?;
     if let Some(plan) = &mut solar {
         plan.year = chosen_year;
@@ -674,7 +682,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let mut patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
-        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form)?)),
+        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form, periods)?)),
         _ => None,
     };
     let beam_files = match (&beam, energyplus.as_ref(), patched.as_mut()) {
@@ -763,7 +771,14 @@ fn run_year(args: &AnnualArgs, energyplus: Option<&model::EnergyPlusInput>) -> R
 
 /// The model's text with the CSV hooked in. The CSV is named by its absolute path, so EnergyPlus
 /// finds it wherever it is started from and wherever the hooked model is moved to.
-fn patch_model(ep: &model::EnergyPlusInput, csv: &std::path::Path, columns: &[String], timesteps: Timesteps, hook: Hook) -> Result<String> {
+fn patch_model(
+    ep: &model::EnergyPlusInput,
+    csv: &std::path::Path,
+    columns: &[String],
+    timesteps: Timesteps,
+    hook: Hook,
+    periods: Option<sunlit::sun::periods::ShadingPeriods>,
+) -> Result<String> {
     let folder = std::fs::canonicalize(csv.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new(".")))
         .map_err(|source| Error::Io { path: csv.to_path_buf(), source })?;
     let csv_text = match csv.file_name() {
@@ -777,7 +792,7 @@ fn patch_model(ep: &model::EnergyPlusInput, csv: &std::path::Path, columns: &[St
             format!("'{csv_text}': an IDF field cannot hold ',', ';' or '!'; choose a path without them"),
         ));
     }
-    sunlit::export::hook::patch_model(ep, &HookPlan { csv: &csv_text, columns, timesteps, hook })
+    sunlit::export::hook::patch_model(ep, &HookPlan { csv: &csv_text, columns, timesteps, hook, periods })
 }
 
 /// Fails early, before any counting, when the output folder cannot take the file.

@@ -33,6 +33,7 @@ use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
 use crate::model::run_year::{choose, is_leap};
 use crate::model::schedule::RunCalendar;
+use crate::model::shading_update::periodic_update;
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
@@ -272,7 +273,9 @@ impl Engine {
             let routing = choice::Routing::from_js(&routing).map_err(js_error)?;
             let given = settings_from_js(&settings).map_err(js_error)?;
             let settings = given.resolve().map_err(js_error)?;
-            let mut options = settings.options(model.energyplus.as_ref().and_then(EnergyPlusInput::timesteps)).map_err(js_error)?;
+            let energyplus = model.energyplus.as_ref();
+            let periods = energyplus.and_then(|ep| periodic_update(&ep.objects));
+            let mut options = settings.model_options(energyplus.and_then(EnergyPlusInput::timesteps), periods).map_err(js_error)?;
             options.timesteps = options.timesteps.leap_year(is_leap_run(&given, model.energyplus.as_ref()));
             let (location, calendar) = (settings.location, settings.calendar);
             // A model that cannot be hooked (e.g. a Version before 9.3) still has its year
@@ -644,7 +647,9 @@ impl Annual {
             return Err(js_error(Error::argument("hookedModel", "no EnergyPlus model (.idf or .epJSON) was loaded")));
         };
         let hook = hook.clone()?;
-        let plan = HookPlan { csv: csv_name, columns: &self.schedule.names, timesteps: self.schedule.timesteps, hook };
+        // The year was counted for the model's Periodic suns, if it updates periodically.
+        let periods = periodic_update(&ep.objects);
+        let plan = HookPlan { csv: csv_name, columns: &self.schedule.names, timesteps: self.schedule.timesteps, hook, periods };
         patch_model(ep, &plan).map_err(js_error)
     }
 }

@@ -11,8 +11,9 @@
 //!
 //! Both are written in the `ShadowCalculation` layout EnergyPlus has had since 9.3 (method first);
 //! older models are refused by name (9.0–9.2 had the method in another field, before 9.0 there was
-//! none). Either way the shading calculation is updated every timestep (in Periodic mode a schedule is read only on the first
-//! day of each period), the schedules are not shifted for daylight saving (the CSV is in standard
+//! none). Either way the shading calculation is updated as the CSV was counted: every timestep, or
+//! for a CSV counted for the model's own Periodic suns ([`crate::sun::periods`]) with the model's
+//! Periodic update (EnergyPlus reads a schedule only on the first day of each period), the schedules are not shifted for daylight saving (the CSV is in standard
 //! time, as EnergyPlus's own), and the model's Timestep must match the CSV's.
 
 use std::fmt::Write as _;
@@ -22,6 +23,7 @@ use crate::geometry::{self, Plane, is_convex};
 use crate::model::EnergyPlusInput;
 use crate::model::idf::IdfObject;
 use crate::scene::Scene;
+use crate::sun::periods::ShadingPeriods;
 use crate::year::samples::Timesteps;
 
 /// How EnergyPlus is told to use the CSV.
@@ -102,15 +104,6 @@ pub fn scheduled_method_gap(ep: &EnergyPlusInput, columns: &[String]) -> Vec<Str
             ep.objects.iter().find(|o| o.is("Building")).map_or("", |o| o.field(5).trim())
         ));
     }
-    if let Some(days) = periodic_update(ep) {
-        out.push(format!(
-            "the model as written updates EnergyPlus's own shading every {days} days (Periodic): its own clipping then uses one \
-             sun, averaged over each period, for every day of it, which moves plane crossings and sunsets by up to a timestep \
-             (measured on a Timestep 6 box with west windows under overhangs, Chicago: 225-336 steps a year dark in one and lit \
-             in the other per west surface, mean |difference| 0.021-0.029 over lit steps); the hooked model updates every \
-             timestep with each day's own sun, as sunlit's fractions do (docs/energyplus-fidelity.md)"
-        ));
-    }
     let set_back = hooked.iter().filter(|s| ep.building.reveal_depth(s).is_some()).count();
     if set_back > 0 {
         out.push(format!(
@@ -120,17 +113,6 @@ pub fn scheduled_method_gap(ep: &EnergyPlusInput, columns: &[String]) -> Vec<Str
         ));
     }
     out
-}
-
-/// The model's own shading update period in days, when it is Periodic with more than one day:
-/// its `ShadowCalculation` (9.3 and later: Update Frequency Method, then Update Frequency), or
-/// EnergyPlus's defaults (Periodic, 20 days) without one.
-fn periodic_update(ep: &EnergyPlusInput) -> Option<u32> {
-    let (method, days) = match ep.objects.iter().find(|o| o.is("ShadowCalculation")) {
-        Some(o) => (o.field(1).trim().to_ascii_lowercase(), o.field(2).trim().parse::<u32>().unwrap_or(20)),
-        None => (String::new(), 20),
-    };
-    (matches!(method.as_str(), "" | "periodic") && days > 1).then_some(days)
 }
 
 /// What to hook in: the CSV as the model will find it and its columns.
@@ -144,6 +126,9 @@ pub struct HookPlan<'a> {
     pub timesteps: Timesteps,
     /// The form.
     pub hook: Hook,
+    /// The model's Periodic shading update when the CSV was counted for its suns
+    /// ([`crate::sun::periods`]): the hooked model keeps it. `None`: every timestep.
+    pub periods: Option<ShadingPeriods>,
 }
 
 /// Schedule type limits of the fraction schedules, so EnergyPlus validates them (0..1).
@@ -313,6 +298,18 @@ fn check_run_period(o: &IdfObject) -> std::result::Result<(), String> {
     Ok(())
 }
 
+/// The hooked model's update method and frequency: the model's own Periodic update when the
+/// CSV was counted for its suns (each period's fractions are the same every day of it, and
+/// EnergyPlus reads them on the period's first day, with that period's sun for dark and lit and for
+/// the beam's angle), else every timestep (in Periodic mode a schedule is read only on the first
+/// day of each period, so a CSV counted for each day's own sun needs Timestep updates).
+fn update_fields(plan: &HookPlan) -> (&'static str, u32) {
+    match plan.periods {
+        Some(p) => ("Periodic", p.days),
+        None => ("Timestep", 1),
+    }
+}
+
 /// The objects the hook adds, as IDF text.
 fn hook_objects(existing: Option<&IdfObject>, plan: &HookPlan) -> String {
     let mut fields: Vec<String> = match existing {
@@ -321,8 +318,9 @@ fn hook_objects(existing: Option<&IdfObject>, plan: &HookPlan) -> String {
     };
     fields.resize(fields.len().max(8), String::new());
     fields[0] = if plan.hook == Hook::Scheduled { "Scheduled" } else { "Imported" }.into();
-    fields[1] = "Timestep".into();
-    fields[2] = "1".into();
+    let (update, days) = update_fields(plan);
+    fields[1] = update.into();
+    fields[2] = days.to_string();
     fields[7] = "No".into();
     let mut out = format!("\n! ---- Added by sunlit: EnergyPlus takes its sunlit fractions from {} ----\n", plan.csv);
     object(&mut out, "ShadowCalculation", &fields.iter().map(String::as_str).collect::<Vec<_>>());
@@ -372,8 +370,9 @@ pub fn patch_epjson(file: &str, text: &str, plan: &HookPlan) -> Result<String> {
     let Some(model) = root.as_object_mut() else { return Err(Error::model(file, "the top level is not a JSON object")) };
     let mut calc = model.get("ShadowCalculation").and_then(Value::as_object).and_then(|m| m.values().next()).cloned().unwrap_or(json!({}));
     calc["shading_calculation_method"] = json!(if plan.hook == Hook::Scheduled { "Scheduled" } else { "Imported" });
-    calc["shading_calculation_update_frequency_method"] = json!("Timestep");
-    calc["shading_calculation_update_frequency"] = json!(1);
+    let (update, days) = update_fields(plan);
+    calc["shading_calculation_update_frequency_method"] = json!(update);
+    calc["shading_calculation_update_frequency"] = json!(days);
     calc["output_external_shading_calculation_results"] = json!("No");
     model.insert("ShadowCalculation".into(), json!({ "ShadowCalculation 1": calc }));
     model.remove("Schedule:File:Shading");
@@ -443,7 +442,7 @@ pub fn hook_for(ep: &EnergyPlusInput, scene: &Scene, hook: Option<Hook>, timeste
     }
     // The model checks (version, Timestep, existing local environments) before any counting.
     let columns: Vec<String> = scene.receivers.iter().map(|r| r.name.clone()).collect();
-    check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form })?;
+    check_model(&ep.file, &ep.objects, &HookPlan { csv: "", columns: &columns, timesteps, hook: form, periods: None })?;
     Ok(form)
 }
 
@@ -460,26 +459,28 @@ mod tests {
     const MODEL: &str = "Version, 25.2;\n! keep me\nTimestep, 4;\nShadowCalculation,\n  PolygonClipping, Periodic, 20, 15000,\n  SutherlandHodgman, 512, DetailedSkyDiffuseModeling, Yes;\nZone, Z;\n";
 
     fn plan(columns: &[String]) -> HookPlan<'_> {
-        HookPlan { csv: "shading.csv", columns, timesteps: Timesteps::new(4).unwrap(), hook: Hook::Scheduled }
+        HookPlan { csv: "shading.csv", columns, timesteps: Timesteps::new(4).unwrap(), hook: Hook::Scheduled, periods: None }
     }
 
-    /// The model's own Periodic update (given, or EnergyPlus's default without a
-    /// ShadowCalculation) is named; Timestep updates and Periodic every day are not.
+    /// A CSV counted for the model's Periodic suns is hooked with the same update (EnergyPlus
+    /// reads each period's first day), in IDF and in epJSON; without it, every timestep.
     #[test]
-    fn a_periodic_shading_update_is_named() {
-        let input = |text: &str| {
-            let objects = parse_idf("m.idf", text).unwrap();
-            let building = crate::model::building::read_building("m.idf", &objects).unwrap();
-            EnergyPlusInput { file: "m.idf".into(), text: text.into(), objects, epjson: false, building, shades: Vec::new() }
-        };
-        let periodic = |text: &str| periodic_update(&input(text));
-        assert_eq!(periodic(MODEL), Some(20));
-        assert_eq!(periodic("Version, 25.2;\nZone, Z;\n"), Some(20), "EnergyPlus's default");
-        assert_eq!(periodic(&MODEL.replace("Periodic, 20", "Periodic, 7")), Some(7));
-        assert_eq!(periodic(&MODEL.replace("Periodic, 20", "Periodic, 1")), None);
-        assert_eq!(periodic(&MODEL.replace("Periodic, 20", "Timestep, 1")), None);
-        let notes = scheduled_method_gap(&input(MODEL), &[]);
-        assert!(notes.iter().any(|n| n.contains("every 20 days (Periodic)")), "{notes:?}");
+    fn a_periodic_csv_keeps_the_models_update() {
+        let columns = vec!["WALL_S".to_string()];
+        let periods = Some(ShadingPeriods { days: 7, first_day: 1, run_days: 365 });
+        let objects = parse_idf("m.idf", MODEL).unwrap();
+        let out = patch_idf("m.idf", MODEL, &objects, &HookPlan { periods, ..plan(&columns) }).unwrap();
+        let patched = parse_idf("out.idf", &out).unwrap();
+        let calc = patched.iter().find(|o| o.is("ShadowCalculation")).unwrap();
+        assert_eq!(&calc.fields[..3], ["Scheduled", "Periodic", "7"]);
+        let text = r#"{"Version": {"Version 1": {"version_identifier": "25.2"}}}"#;
+        let json: serde_json::Value =
+            serde_json::from_str(&patch_epjson("m.epJSON", text, &HookPlan { periods, ..plan(&columns) }).unwrap()).unwrap();
+        let calc = &json["ShadowCalculation"]["ShadowCalculation 1"];
+        assert_eq!(
+            (calc["shading_calculation_update_frequency_method"].as_str(), calc["shading_calculation_update_frequency"].as_u64()),
+            (Some("Periodic"), Some(7))
+        );
     }
 
     #[test]

@@ -338,6 +338,17 @@ const SCHEDULE_CLASSES: &[ClassSpec] = &[
 /// The classes read by [`super::building`], with their epJSON field names in IDD order.
 const CLASSES: &[ClassSpec] = &[
     spec("Version", false, &[("version_identifier", Text)], false),
+    // Its update, for EnergyPlus's Periodic sun (`super::shading_update`).
+    spec(
+        "ShadowCalculation",
+        false,
+        &[
+            ("shading_calculation_method", Text),
+            ("shading_calculation_update_frequency_method", Text),
+            ("shading_calculation_update_frequency", Number),
+        ],
+        false,
+    ),
     spec(
         "RunPeriod",
         true,

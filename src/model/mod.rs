@@ -40,6 +40,7 @@ pub mod reveal;
 pub mod run_year;
 pub mod schedule;
 pub mod shades;
+pub mod shading_update;
 pub mod site;
 
 use std::collections::HashMap;

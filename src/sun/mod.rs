@@ -3,10 +3,12 @@
 //! Owns the convention every other stage uses: the vector points *towards* the sun.
 //! Where the sun is at a given place and time lives in the submodules:
 //! - [`location`]: the site (latitude, longitude, time zone) and its ranges;
+//! - [`periods`]: the one sun EnergyPlus's Periodic shading update uses for every day of a period;
 //! - [`position`]: solar declination, equation of time, sun directions and daylight hours as EnergyPlus computes them.
 //! - [`weather`]: the EPW weather file: the site, hourly direct normal, diffuse and global horizontal irradiance and albedo.
 
 pub mod location;
+pub mod periods;
 pub mod position;
 pub mod weather;
 

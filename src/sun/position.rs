@@ -52,6 +52,12 @@ pub fn declination_and_equation_of_time(day_of_year: f64) -> (f64, f64) {
 /// horizontal components when the sun is down, the full vector is returned at night too.
 pub fn sun_direction(location: &Location, day_of_year: f64, standard_hour: f64) -> DVec3 {
     let (sin_declination, equation_of_time) = declination_and_equation_of_time(day_of_year);
+    sun_direction_from(location, sin_declination, equation_of_time, standard_hour)
+}
+
+/// As [`sun_direction`], for a sine of declination and an equation of time (hours) given directly
+/// (a period's means: [`super::periods`]).
+pub fn sun_direction_from(location: &Location, sin_declination: f64, equation_of_time: f64, standard_hour: f64) -> DVec3 {
     let cos_declination = (1.0 - sin_declination * sin_declination).sqrt();
     let hour_angle = hour_angle_degrees(location, equation_of_time, standard_hour).to_radians();
     let (sin_latitude, cos_latitude) = location.latitude.to_radians().sin_cos();

@@ -46,6 +46,9 @@ pub enum Method {
     Spline(SamplingPlan),
     /// Count every sun-up timestep directly (slow; the reference).
     Dense,
+    /// EnergyPlus's Periodic shading update: one sun a period, counted directly
+    /// ([`super::periodic`]).
+    Periodic(crate::sun::periods::ShadingPeriods),
 }
 
 /// Settings of an annual run.
@@ -210,6 +213,10 @@ pub async fn annual_fitted_with<E: Engine>(
             dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?;
             None
         }
+        Method::Periodic(periods) => {
+            super::periodic::periodic_year(&views, scene, location, periods, &calendar, &mut schedule, progress).await?;
+            None
+        }
     };
     schedule.validate()?;
     Ok((schedule, fitted))
@@ -246,13 +253,13 @@ fn borrowed(lanes: &[(Counter, GpuScene)]) -> Vec<Lane<'_>> {
 }
 
 /// The engine that turns view requests into fractions, with progress reports between chunks.
-struct Views<'a, E: Engine> {
+pub(super) struct Views<'a, E: Engine> {
     engine: &'a E,
 }
 
 impl<E: Engine> Views<'_, E> {
     /// Counts many views (each at its own leaf fraction), reporting progress as it goes.
-    async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
+    pub(super) async fn count(&self, requests: &[ViewRequest], progress: &mut dyn FnMut(Progress) -> Result<()>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(requests.len());
         progress(Progress::counting(0, requests.len()))?;
         self.engine.expect(requests.len());
@@ -289,7 +296,7 @@ pub fn shading_sun_day(day: u32) -> f64 {
 
 /// A fraction as EnergyPlus stores its own: clamped to [0, 1], and 0 below 1e-5 (SolarShading.cc
 /// zeroes sunlit fractions under 1e-5, so a sliver that small is dark in its heat balance too).
-fn as_energyplus(fraction: f64) -> f32 {
+pub(super) fn as_energyplus(fraction: f64) -> f32 {
     energyplus_fraction(fraction) as f32
 }
 

@@ -18,6 +18,7 @@ use super::samples::{SamplingPlan, Timesteps};
 use super::season::{LeafCalendar, parse_period};
 use crate::error::{Error, Result};
 use crate::sun::location::Location;
+use crate::sun::periods::ShadingPeriods;
 
 /// EnergyPlus's own default Timestep (rows per hour) where neither the caller nor the model says.
 pub const DEFAULT_TIMESTEPS_PER_HOUR: u32 = 4;
@@ -133,6 +134,18 @@ impl Resolved {
     /// The annual run's options, timesteps as [`Self::timesteps`] gives them.
     pub fn options(&self, model_timesteps: Option<u32>) -> Result<AnnualOptions> {
         Ok(AnnualOptions { timesteps: self.timesteps(model_timesteps)?, method: self.method, refine: self.refine })
+    }
+
+    /// The options for an EnergyPlus model whose own shading updates periodically (`periods`,
+    /// [`crate::model::shading_update::periodic_update`]): its suns, one a period, whatever the
+    /// method asked ([`Method::Periodic`]), since those are the suns EnergyPlus's own clipping
+    /// and a hooked model keeping that update use.
+    pub fn model_options(&self, model_timesteps: Option<u32>, periods: Option<ShadingPeriods>) -> Result<AnnualOptions> {
+        let options = self.options(model_timesteps)?;
+        Ok(match periods {
+            Some(p) => AnnualOptions { method: Method::Periodic(p), ..options },
+            None => options,
+        })
     }
 }
 
