@@ -14,6 +14,7 @@ pub mod gpu;
 pub mod group;
 pub mod hybrid;
 pub mod lanes;
+pub mod rays;
 pub mod view;
 
 use std::future::Future;
