@@ -18,8 +18,8 @@ use std::process::Command;
 use glam::DVec3;
 use serde_json::Value;
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{apsh, vsc};
-use sunlit::map::{Mapper, Points, Site, from_csv};
+use sunlit::map::planning::{Windows, apsh, vsc};
+use sunlit::map::{Points, Site, from_csv};
 use sunlit::scene::Scene;
 use sunlit::sun::location::Location;
 use sunlit::sun::weather::Weather;
@@ -60,7 +60,7 @@ fn points(scene: &Scene, rows: &[[f64; 6]]) -> Points {
 fn vsc_matches_the_closed_form_of_a_long_obstruction() {
     assert!((vsc_closed_form(0.0) - 39.62).abs() < 0.01, "the closed form's unobstructed value is BRE's 39.6 %");
     let open = canyon(10.0, None);
-    let v = vsc::vsc(&Mapper::new(&open, &points(&open, &[[0.0, 0.0, 1.5, 0.0, -1.0, 0.0]])).unwrap(), &mut |_, _| {});
+    let v = vsc::vsc(&Windows::new(&open, &points(&open, &[[0.0, 0.0, 1.5, 0.0, -1.0, 0.0]])).unwrap(), &mut |_, _| {});
     assert!((v.vsc[0] - 39.6).abs() <= 0.2, "unobstructed VSC {}", v.vsc[0]);
     assert!((v.unobstructed[0] - v.vsc[0]).abs() < 1e-9);
     for theta_deg in [10.0f64, 25.0, 40.0, 60.0] {
@@ -69,7 +69,7 @@ fn vsc_matches_the_closed_form_of_a_long_obstruction() {
         let scene = canyon(distance, Some(point_z + distance * theta_deg.to_radians().tan()));
         // Three points along the façade: the same elevation, so the same VSC.
         let rows: Vec<[f64; 6]> = [-2.0, 0.0, 2.0].iter().map(|&x| [x, 0.0, point_z, 0.0, -1.0, 0.0]).collect();
-        let v = vsc::vsc(&Mapper::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
+        let v = vsc::vsc(&Windows::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
         let truth = vsc_closed_form(theta_deg.to_radians());
         for (i, got) in v.vsc.iter().enumerate() {
             assert!((got - truth).abs() <= 0.5, "θ = {theta_deg}°, point {i}: VSC {got:.3} vs closed form {truth:.3}");
@@ -90,7 +90,7 @@ fn vsc_matches_radiance_rtrace_on_boxes() {
         s.cuboid(&format!("BOX{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
     }
     let scene = s.build();
-    let got = vsc::vsc(&Mapper::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
+    let got = vsc::vsc(&Windows::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
     let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let case = dir.join("case.json");
@@ -106,6 +106,43 @@ fn vsc_matches_radiance_rtrace_on_boxes() {
         let t = t.as_f64().unwrap();
         assert!((got.vsc[i] - t).abs() <= 0.5, "point {i}: VSC {:.3} vs Radiance {t:.3}", got.vsc[i]);
     }
+}
+
+/// The shadow rays ([`Windows::new`] on an opaque scene) against the exact engine's shadows
+/// ([`Windows::by_shadows`]) on a street of boxes, slats and tilted plates seen from two walls'
+/// windows: every VSC within 0.05 points (directions only on a shadow's edge may differ).
+#[test]
+fn shadow_rays_answer_as_the_exact_engines_shadows() {
+    let mut s = TestScene::new();
+    s.polygon("SOUTH", &south_rect(0.0, 20.0, 0.0, 15.0, 0.0), true);
+    let east = [DVec3::new(22.0, -12.0, 0.0), DVec3::new(22.0, -2.0, 0.0), DVec3::new(22.0, -2.0, 12.0), DVec3::new(22.0, -12.0, 12.0)];
+    s.polygon("EAST", &east, true);
+    s.cuboid("BLOCK", DVec3::new(-10.0, -22.0, 0.0), DVec3::new(8.0, -12.0, 12.0));
+    s.cuboid("TOWER", DVec3::new(30.0, -15.0, 0.0), DVec3::new(36.0, -9.0, 40.0));
+    for k in 0..12 {
+        let z = 2.0 + 1.1 * f64::from(k);
+        s.cuboid(&format!("SLAT{k}"), DVec3::new(9.0, -1.2, z), DVec3::new(19.0, -0.6, z + 0.08));
+    }
+    let plate = [DVec3::new(12.0, -9.0, 3.0), DVec3::new(20.0, -9.0, 3.0), DVec3::new(20.0, -5.0, 9.0), DVec3::new(12.0, -5.0, 9.0)];
+    s.polygon("PLATE", &plate, false);
+    let scene = s.build();
+    let rows = [
+        [2.0, 0.0, 1.5, 0.0, -1.0, 0.0],
+        [10.0, 0.0, 4.5, 0.0, -1.0, 0.0],
+        [14.0, 0.0, 7.3, 0.0, -1.0, 0.0],
+        [18.0, 0.0, 13.0, 0.0, -1.0, 0.0],
+        [22.0, -4.0, 2.0, 1.0, 0.0, 0.0],
+        [22.0, -10.0, 9.0, 1.0, 0.0, 0.0],
+    ];
+    let pts = points(&scene, &rows);
+    let rays = Windows::new(&scene, &pts).unwrap();
+    assert!(rays.by_rays(), "an opaque scene is answered by rays");
+    let shadows = Windows::by_shadows(&scene, &pts).unwrap();
+    let (a, b) = (vsc::vsc(&rays, &mut |_, _| {}), vsc::vsc(&shadows, &mut |_, _| {}));
+    for i in 0..rows.len() {
+        assert!((a.vsc[i] - b.vsc[i]).abs() <= 0.05, "point {i}: rays {:.4} vs shadows {:.4}", a.vsc[i], b.vsc[i]);
+    }
+    assert!(a.vsc.iter().zip(&a.unobstructed).any(|(v, u)| u - v > 5.0), "the casters take sky: {:?}", a.vsc);
 }
 
 fn golden_epw() -> PathBuf {
@@ -138,7 +175,7 @@ fn apsh_matches_a_numpy_ray_caster_on_the_same_epw_hours() {
     let weather = Weather::from_epw(&epw).unwrap();
     let calendar = LeafCalendar::for_latitude(weather.location.latitude);
     let site = Site { location: &weather.location, calendar: &calendar, weather: Some(&weather), sky: None };
-    let got = apsh::apsh(&Mapper::new(&scene, &pts).unwrap(), site, &mut |_, _| {}).unwrap();
+    let got = apsh::apsh(&Windows::new(&scene, &pts).unwrap(), site, &mut |_, _| {}).unwrap();
 
     let dir = std::env::temp_dir().join(format!("sunlit-apsh-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -8,8 +8,8 @@ use serde_json::{Value, json};
 use sunlit::export::planning_report::{StudyTable, SunPath, mask_svg, report_html, study_csv, study_json};
 use sunlit::map::planning::compare::{self, Verdict};
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{apsh, mask, vsc};
-use sunlit::map::{Mapper, Points, Site};
+use sunlit::map::planning::{Windows, apsh, mask, vsc};
+use sunlit::map::{Points, Site};
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
 
@@ -152,15 +152,15 @@ struct Values {
 fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_>>, gb: Option<&Gb50180Rule>) -> Result<Values> {
     let start = Instant::now();
     // gb50180 indexes its own points (with its sill samples); the BRE studies share this index.
-    let mapper = args.study.iter().any(|s| s != "gb50180").then(|| Mapper::new(scene, points)).transpose()?;
+    let windows = args.study.iter().any(|s| s != "gb50180").then(|| Windows::new(scene, points)).transpose()?;
     let mut values = Values { seconds: vec![("index".into(), start.elapsed().as_secs_f64())], ..Values::default() };
     for study in &args.study {
         let start = Instant::now();
-        match (study.as_str(), &mapper) {
-            ("bre-vsc", Some(mapper)) => values.vsc = Some(vsc::vsc(mapper, &mut |_, _| {})),
-            ("bre-apsh", Some(mapper)) => {
+        match (study.as_str(), &windows) {
+            ("bre-vsc", Some(windows)) => values.vsc = Some(vsc::vsc(windows, &mut |_, _| {})),
+            ("bre-apsh", Some(windows)) => {
                 let site = site.ok_or_else(|| Error::argument("--epw", "bre-apsh needs a weather file"))?;
-                values.apsh = Some(apsh::apsh(mapper, site, &mut |_, _| {})?);
+                values.apsh = Some(apsh::apsh(windows, site, &mut |_, _| {})?);
             }
             _ => {
                 let (site, rule) = site.zip(gb).ok_or_else(|| Error::argument("--location", "gb50180 needs the site"))?;

@@ -5,7 +5,8 @@
 //! [`cos_incidence`] and the facing-away rule. Two engines implement it: the GPU pixel counter
 //! ([`gpu`], native and web; [`lanes`] shares views over several devices) and the exact CPU
 //! polygon-clipping reference ([`exact`]) that tests hold the GPU to. A caller can hand any view
-//! to either.
+//! to either. [`rays`] answers single points by shadow rays, for studies that ask few points
+//! about many directions.
 
 pub mod certify;
 pub mod cull;
@@ -14,6 +15,7 @@ pub mod gpu;
 pub mod group;
 pub mod hybrid;
 pub mod lanes;
+pub mod rays;
 pub mod view;
 
 use std::future::Future;

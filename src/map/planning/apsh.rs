@@ -16,10 +16,12 @@
 
 use glam::DVec3;
 
-use super::{Ask, sweep_directions};
+use super::{Ask, Windows};
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
-use crate::map::{Mapper, Period, Site};
+use crate::map::{Period, Site};
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
 use crate::year::samples::Timesteps;
 
 /// WMO's threshold of direct normal irradiance for an hour of sunshine, W/m².
@@ -58,7 +60,7 @@ pub fn in_winter(day: u32) -> bool {
 /// The probable sunlight hours of `site`'s weather: each hour's sun (mid-hour) and whether it is
 /// a winter one. Refuses a site without weather, and weather none of whose hours reach the
 /// threshold (a file without direct normal irradiance).
-pub fn probable_hours(mapper: &Mapper, site: Site<'_>) -> Result<(Vec<Ask>, Vec<bool>)> {
+pub fn probable_hours(site: Site<'_>) -> Result<(Vec<Ask>, Vec<bool>)> {
     let weather = site.weather.ok_or_else(|| {
         Error::argument("epw", "bre-apsh needs a weather file: its probable sunlight hours come from the direct normal irradiance")
     })?;
@@ -66,7 +68,7 @@ pub fn probable_hours(mapper: &Mapper, site: Site<'_>) -> Result<(Vec<Ask>, Vec<
     let mut asks = Vec::new();
     let mut winter = Vec::new();
     for s in Period::annual(1)?.samples() {
-        let sun = mapper.sun(site, &s);
+        let sun = sun_direction(site.location, shading_sun_day(s.day), s.hour);
         if sun.z >= MIN_COS_INCIDENCE && weather.at(hourly, s.epw_hour).dni >= SUNSHINE_THRESHOLD {
             asks.push(Ask { direction: sun, leaves: site.calendar.fraction(f64::from(s.day)) as f32 });
             winter.push(in_winter(s.day));
@@ -82,20 +84,17 @@ pub fn probable_hours(mapper: &Mapper, site: Site<'_>) -> Result<(Vec<Ask>, Vec<
 }
 
 /// Every point's APSH and WPSH under `site`'s weather; `progress(done, total)` counts hours.
-pub fn apsh(mapper: &Mapper, site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<ApshValues> {
-    let (asks, winter) = probable_hours(mapper, site)?;
-    let n = mapper.points;
-    let parts = sweep_directions(
-        mapper,
+pub fn apsh(windows: &Windows, site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<ApshValues> {
+    let (asks, winter) = probable_hours(site)?;
+    let n = windows.len();
+    let parts = windows.sweep(
         &asks,
         progress,
         || (vec![0.0f64; n], vec![0.0f64; n]),
-        |(year, cold), k, g, vis| {
-            for (&i, &v) in g.members.iter().zip(vis) {
-                year[i as usize] += f64::from(v);
-                if winter[k] {
-                    cold[i as usize] += f64::from(v);
-                }
+        |(year, cold), k, i, v| {
+            year[i] += f64::from(v);
+            if winter[k] {
+                cold[i] += f64::from(v);
             }
         },
     );
@@ -109,7 +108,7 @@ pub fn apsh(mapper: &Mapper, site: Site<'_>, progress: &mut dyn FnMut(usize, usi
     Ok(ApshValues {
         apsh: percent(year),
         wpsh: percent(cold),
-        assessed: mapper.normals.iter().map(|&n| faces_the_equator(n, site.location.latitude)).collect(),
+        assessed: (0..n).map(|i| faces_the_equator(windows.normal(i), site.location.latitude)).collect(),
         annual_hours,
         winter_hours: winter.iter().filter(|&&w| w).count() as f64,
     })

@@ -22,7 +22,7 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::map::study::SunRule;
-use crate::map::{LitSeries, Mapper, Points, Sample};
+use crate::map::{LitSeries, Points, Sample};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::declination_and_equation_of_time;
@@ -228,13 +228,13 @@ pub fn evaluate(
         Some(width) => whole_window_points(points, width),
         None => (points.clone(), 0),
     };
-    let mapper = Mapper::new(scene, &all)?;
+    let windows = super::Windows::new(scene, &all)?;
     let samples = instants(rule.day);
     let leaves = LeafCalendar::for_latitude(location.latitude).fraction(f64::from(rule.day.day_of_year())) as f32;
     let declination = rule.day.declination_deg();
     let asks: Vec<super::Ask> =
         samples.iter().map(|s| super::Ask { direction: sun_at_true_solar_time(location.latitude, declination, s.hour), leaves }).collect();
-    let lit = super::lit_bits(&mapper, &asks, progress);
+    let lit = super::lit_bits(&windows, &asks, progress);
     let periods = rule.periods();
     let hours = (0..n).map(|i| periods.hours(&samples, &lit, i)).collect();
     let whole_window_hours = rule.whole_window.map(|_| {

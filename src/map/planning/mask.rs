@@ -4,9 +4,9 @@
 
 use glam::DVec3;
 
-use super::{Ask, lit_bits};
+use super::{Ask, Windows, lit_bits};
 use crate::error::Result;
-use crate::map::{Mapper, Points};
+use crate::map::Points;
 use crate::scene::Scene;
 use crate::sky::patches::direction;
 
@@ -78,11 +78,11 @@ fn centres(rows: usize, columns: usize) -> Vec<DVec3> {
 /// The sky masks of `points` (all of them; pass only those a picture is asked for) on `scene`,
 /// trees bare.
 pub fn sky_masks(scene: &Scene, points: &Points) -> Result<Vec<SkyMask>> {
-    let mapper = Mapper::new(scene, points)?;
+    let windows = Windows::new(scene, points)?;
     let (rows, columns) = ((90.0 / ALTITUDE_STEP) as usize, (360.0 / AZIMUTH_STEP) as usize);
     let dirs = centres(rows, columns);
     let asks: Vec<Ask> = dirs.iter().map(|&d| Ask { direction: d, leaves: 0.0 }).collect();
-    let lit = lit_bits(&mapper, &asks, &mut |_, _| {});
+    let lit = lit_bits(&windows, &asks, &mut |_, _| {});
     Ok((0..points.len())
         .map(|i| {
             let normal = points.normal(i);

@@ -9,15 +9,14 @@
 //! sub-patches, ∫ cos dΩ in closed form over each sub-patch ([`Patch::weight`]) and the luminance
 //! at its cos-weighted direction (L is linear in sin γ, so a 2° row's mean is its middle's to
 //! 1e-4). Visibility is asked along each sub-patch's centre, by the exact shadow rays, for every
-//! point at once ([`sweep_directions`]); a sub-patch whose centre is behind the point's receiver
+//! point ([`Windows`]); a sub-patch whose centre is behind the point's receiver
 //! is skipped (it lies within 1° of the plane, where cos < 0.02: under 0.05 % of the VSC).
 
 use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::{Ask, sweep_directions};
-use crate::map::Mapper;
+use super::{Ask, Windows};
 use crate::sky::luminance::LuminanceSky;
 use crate::sky::patches::{Patch, SkyPatches};
 
@@ -63,25 +62,14 @@ pub fn sub_patches() -> Vec<Patch> {
 
 /// Every point's VSC (bare trees: BRE's overcast sky is a winter sky, and leaves only add
 /// obstruction in summer). `progress(done, total)` counts sub-patches.
-pub fn vsc(mapper: &Mapper, progress: &mut dyn FnMut(usize, usize)) -> VscValues {
+pub fn vsc(windows: &Windows, progress: &mut dyn FnMut(usize, usize)) -> VscValues {
     let sky = LuminanceSky::CieOvercast;
     let fine = sub_patches();
     let mut shares = Shares { index: HashMap::new(), tables: Vec::new() };
-    let class: Vec<usize> = mapper.normals.iter().map(|&n| shares.of(n, &fine, sky)).collect();
+    let class: Vec<usize> = (0..windows.len()).map(|i| shares.of(windows.normal(i), &fine, sky)).collect();
     let asks: Vec<Ask> = fine.iter().map(|p| Ask { direction: p.direction, leaves: 0.0 }).collect();
-    let n = mapper.points;
-    let parts = sweep_directions(
-        mapper,
-        &asks,
-        progress,
-        || vec![0.0f64; n],
-        |acc, k, g, vis| {
-            for (&i, &v) in g.members.iter().zip(vis) {
-                let i = i as usize;
-                acc[i] += shares.tables[class[i]][k] * f64::from(v);
-            }
-        },
-    );
+    let n = windows.len();
+    let parts = windows.sweep(&asks, progress, || vec![0.0f64; n], |acc, k, i, v| acc[i] += shares.tables[class[i]][k] * f64::from(v));
     let mut values = vec![0.0; n];
     for part in parts {
         crate::map::add_into(&mut values, &part);
@@ -89,7 +77,7 @@ pub fn vsc(mapper: &Mapper, progress: &mut dyn FnMut(usize, usize)) -> VscValues
     // The unobstructed sum over the same sub-patches the rays ask (centre in front of the plane).
     let unobstructed = (0..n)
         .map(|i| {
-            let normal = mapper.normals[i];
+            let normal = windows.normal(i);
             fine.iter()
                 .zip(&shares.tables[class[i]])
                 .filter(|(p, _)| normal.dot(p.direction) > crate::count::MIN_COS_INCIDENCE)
