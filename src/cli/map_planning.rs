@@ -8,7 +8,7 @@ use serde_json::{Value, json};
 use sunlit::export::planning_report::{StudyTable, SunPath, mask_svg, report_html, study_csv, study_json};
 use sunlit::map::planning::compare::{self, Verdict};
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{Windows, apsh, mask, vsc};
+use sunlit::map::planning::{SceneRays, Windows, apsh, mask, vsc};
 use sunlit::map::{Points, Site};
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -151,8 +151,10 @@ struct Values {
 
 fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_>>, gb: Option<&Gb50180Rule>) -> Result<Values> {
     let start = Instant::now();
-    // gb50180 indexes its own points (with its sill samples); the BRE studies share this index.
-    let windows = args.study.iter().any(|s| s != "gb50180").then(|| Windows::new(scene, points)).transpose()?;
+    // One tree for the scene; gb50180 places its own points (with its sill samples) on it, and
+    // the BRE studies share these.
+    let tree = SceneRays::new(scene);
+    let windows = args.study.iter().any(|s| s != "gb50180").then(|| Windows::on(scene, &tree, points)).transpose()?;
     let mut values = Values { seconds: vec![("index".into(), start.elapsed().as_secs_f64())], ..Values::default() };
     for study in &args.study {
         let start = Instant::now();
@@ -164,7 +166,7 @@ fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_
             }
             _ => {
                 let (site, rule) = site.zip(gb).ok_or_else(|| Error::argument("--location", "gb50180 needs the site"))?;
-                values.gb = Some(gb50180::evaluate(scene, points, site.location, rule, &mut |_, _| {})?);
+                values.gb = Some(gb50180::evaluate_on(scene, &tree, points, site.location, rule, &mut |_, _| {})?);
             }
         }
         values.seconds.push((study.clone(), start.elapsed().as_secs_f64()));

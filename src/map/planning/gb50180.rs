@@ -222,13 +222,25 @@ pub fn evaluate(
     rule: &Gb50180Rule,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Gb50180Values> {
+    evaluate_on(scene, &super::SceneRays::new(scene), points, location, rule, progress)
+}
+
+/// [`evaluate`] with the scene's tree already built (shared with the other window studies).
+pub fn evaluate_on(
+    scene: &Scene,
+    tree: &super::SceneRays,
+    points: &Points,
+    location: &Location,
+    rule: &Gb50180Rule,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Gb50180Values> {
     rule.check()?;
     let n = points.len();
     let (all, per_window) = match rule.whole_window {
         Some(width) => whole_window_points(points, width),
         None => (points.clone(), 0),
     };
-    let windows = super::Windows::new(scene, &all)?;
+    let windows = super::Windows::on(scene, tree, &all)?;
     let samples = instants(rule.day);
     let leaves = LeafCalendar::for_latitude(location.latitude).fraction(f64::from(rule.day.day_of_year())) as f32;
     let declination = rule.day.declination_deg();

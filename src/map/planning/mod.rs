@@ -18,6 +18,7 @@ pub mod gb50180;
 pub mod mask;
 pub mod vsc;
 
+use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::DVec3;
@@ -37,6 +38,19 @@ pub struct Ask {
     pub leaves: f32,
 }
 
+/// One scene's shadow-ray tree, built once and shared by every point set asked of that scene;
+/// `None` inside where its casters are see-through (the points then take the exact engine's
+/// shadows, see [`Windows::by_shadows`]).
+#[derive(Clone)]
+pub struct SceneRays(Option<Arc<RayCaster>>);
+
+impl SceneRays {
+    /// Indexes every triangle of `scene` (the costly part of [`Windows::new`]).
+    pub fn new(scene: &Scene) -> Self {
+        Self(RayCaster::new(scene).map(Arc::new))
+    }
+}
+
 /// The points a window study asks about, indexed once for all its directions.
 ///
 /// Opaque scenes (foliage included) are answered by shadow rays ([`RayCaster`]): a study asks a
@@ -52,7 +66,7 @@ pub struct Windows {
 
 enum Caster {
     Rays {
-        rays: RayCaster,
+        rays: Arc<RayCaster>,
         /// Each point projected into its receiver's plane (where the shadow path puts it).
         origins: Vec<DVec3>,
         /// Each point's receiver's normal (which directions it faces) and id (which triangles
@@ -65,7 +79,13 @@ enum Caster {
 impl Windows {
     /// Indexes `points` on `scene`; refuses a point whose receiver is not in the scene.
     pub fn new(scene: &Scene, points: &Points) -> Result<Self> {
-        let Some(rays) = RayCaster::new(scene) else { return Self::by_shadows(scene, points) };
+        Self::on(scene, &SceneRays::new(scene), points)
+    }
+
+    /// Indexes `points` on `scene` with its already built tree, so that several studies (and
+    /// gb50180's sill samples) of one scene share one tree instead of each building its own.
+    pub fn on(scene: &Scene, tree: &SceneRays, points: &Points) -> Result<Self> {
+        let Some(rays) = tree.0.clone() else { return Self::by_shadows(scene, points) };
         let normals = (0..points.len()).map(|i| points.normal(i)).collect();
         let mut origins = Vec::with_capacity(points.len());
         let mut planes = Vec::with_capacity(points.len());
