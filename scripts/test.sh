@@ -6,6 +6,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SUNLIT_ENERGYPLUS=1 SUNLIT_RADIANCE=1 SUNLIT_CITY=1 SUNLIT_PV=1 SUNLIT_WEB=1 SUNLIT_BROWSER=1 . scripts/setup.sh
 
+# A full run's builds and venvs take about 6 GiB; a full disk otherwise shows up late, as a
+# linker's bus error, so say how much there is up front.
+free_gib=$(df -Pk . | awk 'NR==2 {print int($4 / 1048576)}')
+echo "sunlit test: ${free_gib} GiB free on $(df -P . | awk 'NR==2 {print $6}')"
+[ "$free_gib" -ge 8 ] || echo "sunlit test: warning: under 8 GiB free; the build may run out of disk" >&2
+
 cargo fmt --check
 cargo clippy --all-targets --quiet -- -D warnings
 cargo clippy --lib --quiet --target wasm32-unknown-unknown -- -D warnings
