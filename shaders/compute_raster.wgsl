@@ -7,11 +7,13 @@
 //    workgroups as its triangles need, not one). Each lane transforms and snaps its triangles as
 //    the raster path's hardware would and appends each to the list of every 32×32 raster tile
 //    its bounding box touches (a singly linked list per raster tile, nodes from one pool taken
-//    with one atomicAdd). A triangle whose box touches more than LARGE_TILES raster tiles goes
-//    once into its view's list of large triangles instead (two nodes: the triangle, and its box
-//    in raster tiles), so a triangle takes at most LARGE_TILES nodes and the pool a batch needs
-//    is bounded by LARGE_TILES × its triangles (large triangles, the usual case on a view fitted
-//    to a window, no longer take a node per tile). A pool too small for the batch still counts
+//    with one atomicAdd). A triangle whose box touches more raster tiles than large_tiles (a
+//    quarter of the view's, at least LARGE_TILES) goes once into its view's list of large
+//    triangles instead (two nodes: the triangle, and its box in raster tiles), so a triangle
+//    takes at most large_tiles nodes and the pool a batch needs is bounded by that × its
+//    triangles (large triangles, the usual case on a view fitted to a window, no longer take a
+//    node per tile). Every raster tile walks the large list, so only triangles over a quarter of
+//    the view go there: a tile then rejects at most ~3 boxes for each it draws. A pool too small for the batch still counts
 //    what it needed in heads[0] and drops the rest: the host reads that count and runs the batch
 //    again with a pool that large, so a list is never truncated.
 // 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the tile's list and
@@ -42,9 +44,15 @@ const MAX_MEMBERS: u32 = 4u;
 const CLAMP: f32 = 536870912.0;
 // Triangles a binning job takes (4 a lane); the library's compute::JOB_TRIANGLES.
 const JOB: u32 = 256u;
-// A triangle whose box touches more raster tiles goes to its view's large list; the library's
-// compute::LARGE_TILES.
+// The fewest raster tiles a triangle's box may touch and go to its view's large list; the
+// library's compute::LARGE_TILES (see large_tiles).
 const LARGE_TILES: u32 = 8u;
+
+// Raster tiles a triangle's box may touch and be binned into each, in a view of `per_row`²
+// raster tiles: a quarter of them, at least LARGE_TILES (the library's compute::node_bound).
+fn large_tiles(per_row: u32) -> u32 {
+    return max(LARGE_TILES, per_row * per_row / 4u);
+}
 
 struct View {
     view_proj: mat4x4<f32>,
@@ -260,7 +268,7 @@ fn bin(t: u32, view: View) {
     let t0 = clamp(lo / span, vec2<i32>(0), vec2<i32>(last));
     let t1 = clamp(hi / span, vec2<i32>(0), vec2<i32>(last));
     let box = t1 - t0 + vec2<i32>(1);
-    if u32(box.x * box.y) > LARGE_TILES {
+    if u32(box.x * box.y) > large_tiles(per_row) {
         let n = atomicAdd(&heads[0], 2u);
         if n + 1u >= params.capacity {
             return;

@@ -12,7 +12,7 @@
 //! Batches ([`Counter::count_tiles_compute`]): the kernel fills no atlas, so a batch is as many
 //! views as its buffers allow ([`MAX_BATCH_VIEWS`], and the node pool within [`POOL_BUDGET`]),
 //! counted in one submission and read back with the pool's count. The pool is sized before each
-//! batch from the nodes a triangle took in the batch before ([`LARGE_TILES`] a triangle at most,
+//! batch from the nodes a triangle took in the batch before ([`node_bound`] a triangle at most,
 //! the bound the first batch is sized by), so in steady state no batch is counted twice; a batch
 //! that still needed more is counted again with a pool that large (never truncated).
 
@@ -38,10 +38,18 @@ pub const DEPTH_BITS: u32 = 29;
 const FIRST_CAPACITY: u32 = 1 << 18;
 /// Triangles one binning workgroup takes (the shader's JOB).
 pub const JOB_TRIANGLES: u32 = 256;
-/// Raster tiles a triangle's box may touch and still be binned into each (the shader's
-/// LARGE_TILES); a larger one takes two nodes in its view's large list. So a triangle takes at
-/// most this many nodes.
+/// The fewest raster tiles a triangle's box may touch and go to its view's large list (the
+/// shader's LARGE_TILES; see [`node_bound`]).
 pub const LARGE_TILES: u32 = 8;
+
+/// Raster tiles a triangle's box may touch and still be binned into each, in a view of side
+/// `side` (the shader's large_tiles): a quarter of the view's raster tiles, at least
+/// [`LARGE_TILES`]; a larger one takes two nodes in its view's large list. So a triangle takes
+/// at most this many nodes. Every raster tile walks the large list, so it holds only triangles
+/// over a quarter of the view (a tile rejects at most ~3 boxes for each it draws).
+pub fn node_bound(side: u32) -> u32 {
+    LARGE_TILES.max(side.div_ceil(RASTER_TILE).pow(2) / 4)
+}
 /// The most views a batch counts: at 512² that is 262,144 raster workgroups, enough to keep a
 /// data-centre GPU's SMs busy, and the batch's own buffers stay small (the heads 1 MiB).
 pub const MAX_BATCH_VIEWS: usize = 1024;
@@ -140,7 +148,8 @@ pub(super) struct ComputeBins {
     readback: wgpu::Buffer,
     /// Nodes `nodes` holds.
     pub(super) capacity: u32,
-    /// Nodes a triangle took in the last batch counted ([`LARGE_TILES`], the bound, before any).
+    /// Nodes a triangle took in the last batch counted (infinite before any: the bound,
+    /// [`node_bound`], is planned for).
     per_triangle: f64,
     /// Batches counted again because the pool was too small (benchmarks and tests).
     pub(super) reruns: u64,
@@ -174,7 +183,7 @@ impl ComputeBins {
             ),
             readback: buffer(device, "compute readback", 0, READBACK),
             capacity,
-            per_triangle: LARGE_TILES as f64,
+            per_triangle: f64::INFINITY,
             reruns: 0,
             batches: 0,
             views_counted: 0,
@@ -392,7 +401,7 @@ impl Counter {
         let mut bins = self.bins()?;
         let limit = pool_limit(&self.device);
         let budget = POOL_BUDGET.min(limit) / 8;
-        let per_triangle = (bins.per_triangle * POOL_MARGIN).min(LARGE_TILES as f64);
+        let per_triangle = (bins.per_triangle * POOL_MARGIN).min(node_bound(side) as f64);
         let heads_per_view = side.div_ceil(RASTER_TILE).pow(2) as u64 + 1;
         let most = most.min(bins.max_views).min((limit / 4 / heads_per_view) as usize).max(1);
         let (mut n, mut triangles) = (0usize, 0u64);
@@ -440,7 +449,8 @@ impl Counter {
             if batch.triangles > 0 {
                 // Up at once, down by halves: one batch whose views culled most of their
                 // triangles does not leave the next one's pool too small.
-                bins.per_triangle = (needed as f64 / batch.triangles as f64).max(bins.per_triangle / 2.0);
+                let floor = if bins.per_triangle.is_finite() { bins.per_triangle / 2.0 } else { 0.0 };
+                bins.per_triangle = (needed as f64 / batch.triangles as f64).max(floor);
             }
             bins.batches += 1;
             bins.views_counted += batch.views.len() as u64;
