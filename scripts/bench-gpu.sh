@@ -8,7 +8,12 @@
 # VIEWS=N times an even spread of N views a model instead of all (a quick try on lavapipe).
 # The issue's targets come first (the compute rasterizer on all of nyt-blocks' and
 # blaas-trees-summer's views, and exact clipping on the same machine beside them), so a short
-# lease records them before anything else.
+# lease records them before anything else. The compute kernel's first line is the one to set
+# beside the H200's 2026-11-28 figure (1,335 µs a nyt-blocks view, 5 batches counted twice, 16
+# views a submission): its JSON has bin_pool_reruns, bin_pool_nodes and
+# compute_views_per_submission (the batches are no longer the atlas's 16 views).
+# BEFORE=path/to/an/older/sunlit adds that binary's compute run on the same spread right after,
+# for a before/after on the same lease.
 # Used for docs/benchmarks-gpu.md (an H100 and an H200 lent for one session: see there).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -41,6 +46,7 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # on the same even spread of 20,040 nyt-blocks views (extrapolated), then every view.
 if [ -z "${VIEWS:-}" ]; then
   run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views 20040 --check 30 "${gpu_flags[@]}"
+  [ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views 20040 "${gpu_flags[@]}"
   run nyt-blocks-gpu-20040 60 bench nyt-blocks --engine gpu --views 20040 "${gpu_flags[@]}"
   run nyt-blocks-exact-20040 60 bench nyt-blocks --engine exact --views 20040
 fi

@@ -1,19 +1,30 @@
 // The compute rasterizer: counts the same pixels as sun_view.wgsl + count_pixels.wgsl without the
-// graphics pipeline, in two compute passes over a batch of tiles (a tile = one view):
+// graphics pipeline, in two compute passes over a batch of views (hundreds a batch: there is no
+// atlas to fill, only buffers):
 //
-// 1. bin_main, a workgroup per view: each lane takes the view's culled triangles in turn,
-//    transforms and snaps them as the raster path's hardware would, and appends the triangle to
-//    the list of every 32×32 raster tile its bounding box touches (a singly linked list per
-//    raster tile, nodes from one pool taken with one atomicAdd). A pool too small for the batch
-//    still counts what it needed in heads[0] and drops the rest: the host reads that count and
-//    runs the batch again with a pool that large, so a list is never truncated.
-// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the tile's list,
-//    taking every other triangle; each lane owns one row and steps across it. Per pixel an
+// 1. bin_main, a workgroup per job: a job is up to JOB consecutive triangles of one view's culled
+//    list (the host cuts each view's list into jobs, so a view's binning spreads over as many
+//    workgroups as its triangles need, not one). Each lane transforms and snaps its triangles as
+//    the raster path's hardware would and appends each to the list of every 32×32 raster tile
+//    its bounding box touches (a singly linked list per raster tile, nodes from one pool taken
+//    with one atomicAdd). A triangle whose box touches more raster tiles than large_tiles (a
+//    quarter of the view's, at least LARGE_TILES) goes once into its view's list of large
+//    triangles instead (two nodes: the triangle, and its box in raster tiles), so a triangle
+//    takes at most large_tiles nodes and the pool a batch needs is bounded by that × its
+//    triangles (large triangles, the usual case on a view fitted to a window, no longer take a
+//    node per tile). Every raster tile walks the large list, so only triangles over a quarter of
+//    the view go there: a tile then rejects at most ~3 boxes for each it draws. A pool too small for the batch still counts
+//    what it needed in heads[0] and drops the rest: the host reads that count and runs the batch
+//    again with a pool that large, so a list is never truncated.
+// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the tile's list and
+//    then the view's large list (skipping large triangles whose box misses the tile), taking
+//    every other triangle; each lane owns one row and steps across it. Per pixel an
 //    atomicMin in workgroup memory on a word packing quantized depth (high 29 bits) and class
 //    (low 3 bits: member k of the view, or CASTER), so the nearest triangle wins and, at equal
 //    quantized depth, a member beats a caster. Members also set their bit of the pixel's
 //    coverage (no depth test, as the raster path's mask pass). Then the tile's visible, covered
 //    and shadow-edge pixels are counted per member, with one global atomicAdd a count a tile.
+//    Which order the lists hold their triangles in changes no pixel (atomicMin and atomicOr).
 //
 // Raster rules as the hardware's (Vulkan, as lavapipe and D3D/Metal do it): the viewport
 // transform into atlas pixels, vertices snapped to 1/256 pixel (8 subpixel bits, round to
@@ -31,6 +42,17 @@ const CASTER: u32 = 7u;
 const MAX_MEMBERS: u32 = 4u;
 // Snapped coordinates are clamped to ±2^29 subpixels (±2^21 pixels), so differences fit an i32.
 const CLAMP: f32 = 536870912.0;
+// Triangles a binning job takes (4 a lane); the library's compute::JOB_TRIANGLES.
+const JOB: u32 = 256u;
+// The fewest raster tiles a triangle's box may touch and go to its view's large list; the
+// library's compute::LARGE_TILES (see large_tiles).
+const LARGE_TILES: u32 = 8u;
+
+// Raster tiles a triangle's box may touch and be binned into each, in a view of `per_row`²
+// raster tiles: a quarter of them, at least LARGE_TILES (the library's compute::node_bound).
+fn large_tiles(per_row: u32) -> u32 {
+    return max(LARGE_TILES, per_row * per_row / 4u);
+}
 
 struct View {
     view_proj: mat4x4<f32>,
@@ -41,12 +63,14 @@ struct View {
     leaves: f32,
     first_member: u32,
     member_count: u32,
-    // The view's culled triangles: ranges[first_range ..][.. range_count], (start, count) each.
+    // The view's culled triangles: ranges[first_range ..][.. range_count], each (first triangle,
+    // the view's triangles in the ranges before it), `triangles` in all.
     first_range: u32,
     range_count: u32,
-    // Where the view's raster tiles' list heads start in heads (after heads[0], the pool count).
+    // Where the view's list heads start in heads (after heads[0], the pool count): one per
+    // raster tile, row by row, then its large list's.
     first_head: u32,
-    _pad0: u32,
+    triangles: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -59,7 +83,12 @@ struct Params {
     // Non-zero (tests only): where in heads each pixel's class and coverage are also written,
     // view after view, row by row: the class (member k, CASTER, or 6 for nothing) | cover << 3.
     dump: u32,
+    // The batch's jobs: ranges[first_job ..][.. jobs], (view, the first of its triangles) each.
+    first_job: u32,
+    jobs: u32,
     _pad1: u32,
+    _pad2: u32,
+    _pad3: u32,
 }
 
 // Triangle t's corners at positions[9t ..][.. 9], scene coordinates relative to the origin.
@@ -68,13 +97,16 @@ struct Params {
 // a leaf), transmittance bits, dither seed).
 @group(0) @binding(1) var<storage, read> attributes: array<vec4<u32>>;
 @group(0) @binding(2) var<storage, read> views: array<View>;
+// The views' ranges of triangles, then the jobs (one array: WebGPU guarantees 8 storage buffers).
 @group(0) @binding(3) var<storage, read> ranges: array<vec2<u32>>;
 @group(0) @binding(4) var<storage, read> members: array<u32>;
 // counts[3m], counts[3m + 1], counts[3m + 2]: visible, covered, edge pairs of member entry m.
 @group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
-// heads[0]: pool nodes asked for; heads[1 + first_head + raster tile]: 1 + its first node, 0 if none.
+// heads[0]: pool nodes asked for; heads[1 + first_head + raster tile] (the large list after the
+// view's raster tiles): 1 + its first node, 0 if none.
 @group(0) @binding(6) var<storage, read_write> heads: array<atomic<u32>>;
-// Node n: (triangle, 1 + next node or 0).
+// Node n: (triangle, 1 + next node or 0); a large triangle's node n + 1: its box in raster tiles,
+// (x0 | y0 << 16, x1 | y1 << 16).
 @group(0) @binding(7) var<storage, read_write> nodes: array<vec2<u32>>;
 @group(0) @binding(8) var<uniform> params: Params;
 
@@ -184,39 +216,78 @@ fn setup(t: u32, view: View) -> Setup {
 
 // ---- pass 1: binning ----
 
+// Triangle k of a view's culled list: the last range starting at or before k (binary search).
+fn triangle_at(view: View, k: u32) -> u32 {
+    var lo = view.first_range;
+    var hi = view.first_range + view.range_count;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if ranges[mid].y <= k {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let range = ranges[lo];
+    return range.x + k - range.y;
+}
+
 @compute @workgroup_size(64)
-fn bin_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let view = views[group.y];
+fn bin_main(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let index = group.x + group.y * groups.x;
+    if index >= params.jobs {
+        return;
+    }
+    let job = ranges[params.first_job + index];
+    let view = views[job.x];
+    let end = min(job.y + JOB, view.triangles);
+    for (var k = job.y + lane; k < end; k += 64u) {
+        bin(triangle_at(view, k), view);
+    }
+}
+
+// Appends triangle t to the lists of the raster tiles its box touches, or to its view's large list.
+fn bin(t: u32, view: View) {
+    let s = setup(t, view);
+    if !s.live {
+        return;
+    }
     let per_row = (view.side + TILE - 1u) / TILE;
     let span = i32(TILE * 256u);
-    for (var r = 0u; r < view.range_count; r++) {
-        let range = ranges[view.first_range + r];
-        for (var i = lane; i < range.y; i += 64u) {
-            let t = range.x + i;
-            let s = setup(t, view);
-            if !s.live {
+    // Raster tiles the bounding box touches (pixel centres lie at 128 + 256·k).
+    let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
+    let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
+    let last = i32(per_row) - 1;
+    if hi.x < 0 || hi.y < 0 || lo.x / span > last || lo.y / span > last {
+        return;
+    }
+    let t0 = clamp(lo / span, vec2<i32>(0), vec2<i32>(last));
+    let t1 = clamp(hi / span, vec2<i32>(0), vec2<i32>(last));
+    let box = t1 - t0 + vec2<i32>(1);
+    if u32(box.x * box.y) > large_tiles(per_row) {
+        let n = atomicAdd(&heads[0], 2u);
+        if n + 1u >= params.capacity {
+            return;
+        }
+        let head = 1u + view.first_head + per_row * per_row;
+        let next = atomicExchange(&heads[head], n + 1u);
+        nodes[n] = vec2<u32>(t, next);
+        nodes[n + 1u] = vec2<u32>(u32(t0.x) | (u32(t0.y) << 16u), u32(t1.x) | (u32(t1.y) << 16u));
+        return;
+    }
+    for (var ty = t0.y; ty <= t1.y; ty++) {
+        for (var tx = t0.x; tx <= t1.x; tx++) {
+            let n = atomicAdd(&heads[0], 1u);
+            if n >= params.capacity {
                 continue;
             }
-            // Raster tiles the bounding box touches (pixel centres lie at 128 + 256·k).
-            let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
-            let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
-            let last = i32(per_row) - 1;
-            let t0 = clamp(lo / span, vec2<i32>(0), vec2<i32>(last));
-            let t1 = clamp(hi / span, vec2<i32>(0), vec2<i32>(last));
-            if hi.x < 0 || hi.y < 0 || lo.x / span > last || lo.y / span > last {
-                continue;
-            }
-            for (var ty = t0.y; ty <= t1.y; ty++) {
-                for (var tx = t0.x; tx <= t1.x; tx++) {
-                    let n = atomicAdd(&heads[0], 1u);
-                    if n >= params.capacity {
-                        continue;
-                    }
-                    let head = 1u + view.first_head + u32(ty) * per_row + u32(tx);
-                    let next = atomicExchange(&heads[head], n + 1u);
-                    nodes[n] = vec2<u32>(t, next);
-                }
-            }
+            let head = 1u + view.first_head + u32(ty) * per_row + u32(tx);
+            let next = atomicExchange(&heads[head], n + 1u);
+            nodes[n] = vec2<u32>(t, next);
         }
     }
 }
@@ -336,6 +407,24 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
         let s = setup(t, view);
         if s.live {
             draw_row(t, view, s, tile0, row);
+        }
+        node = next_node(next_node(node));
+    }
+    // The view's large triangles whose box holds this tile (the box is node `node`: the node
+    // after the triangle's, node - 1).
+    let at = vec2<u32>(group.x % per_row, group.x / per_row);
+    node = atomicLoad(&heads[1u + view.first_head + per_row * per_row]);
+    if lane >= TILE {
+        node = next_node(node);
+    }
+    while node != 0u {
+        let box = nodes[node];
+        if at.x >= (box.x & 0xffffu) && at.y >= (box.x >> 16u) && at.x <= (box.y & 0xffffu) && at.y <= (box.y >> 16u) {
+            let t = nodes[node - 1u].x;
+            let s = setup(t, view);
+            if s.live {
+                draw_row(t, view, s, tile0, row);
+            }
         }
         node = next_node(next_node(node));
     }

@@ -95,7 +95,7 @@ pub fn js_option(param: &str) -> String {
 pub struct Engine {
     counter: Option<Rc<Counter>>,
     options: CounterOptions,
-    /// Which engine answers views (`auto`, `gpu`, `exact`; see [`choice`]).
+    /// Which engine answers views (`auto`, `gpu`, `exact`, `compute`; see [`choice`]).
     kind: EngineKind,
 }
 
@@ -104,8 +104,9 @@ impl Engine {
     /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512);
     /// `accuracy`: a target |error| per view, counting each at 64² first and finer, up to
     /// `resolution`, only where its shadow edges need it (default: every view at `resolution`);
-    /// `engine`: `auto` (default), `gpu` or `exact` ([`choice`]); `gpu: false` (no WebGPU in
-    /// this browser) makes no device: views are clipped, and `engine: 'gpu'` is refused.
+    /// `engine`: `auto` (default), `gpu`, `exact` or `compute` ([`choice`]); `gpu: false` (no
+    /// WebGPU in this browser) makes no device: views are clipped, and `gpu` and `compute` are
+    /// refused.
     pub async fn create(
         resolution: Option<u32>,
         accuracy: Option<f64>,
@@ -157,7 +158,7 @@ impl Engine {
         choice::store_key(&model.inner.scene, views, self.counter.as_ref().map(|c| c.adapter_info()), &self.options, workers.max(1))
     }
 
-    /// Which engine answers views: `auto`, `gpu` or `exact`.
+    /// Which engine answers views: `auto`, `gpu`, `exact` or `compute`.
     #[wasm_bindgen(getter)]
     pub fn engine(&self) -> String {
         self.kind.name().into()

@@ -207,12 +207,18 @@ fn spread_requests(scene: &Scene, location: &sunlit::sun::location::Location, at
     sunlit::bench::spread(&all, at_most)
 }
 
-#[test]
-fn an_overflowing_node_pool_is_grown_and_the_batch_counted_again() {
+/// 60 views of blaas-louvres at 128², counted by a compute counter with the default pool.
+fn louvres_counted_once() -> (Scene, Vec<ViewRequest>, Counter, Vec<Counted>) {
     let (scene, location) = bench_scene("blaas-louvres");
     let requests = spread_requests(&scene, &location, 60);
-    let roomy = compute_counter(128);
-    let want = common::gpu_fractions(&roomy, &scene, &requests);
+    let counter = compute_counter(128);
+    let counted = common::gpu_fractions(&counter, &scene, &requests);
+    (scene, requests, counter, counted)
+}
+
+#[test]
+fn an_overflowing_node_pool_is_grown_and_the_batch_counted_again() {
+    let (scene, requests, roomy, want) = louvres_counted_once();
     assert_eq!(roomy.bin_pool().1, 0, "the default pool holds these views");
     let tight = compute_counter(128);
     tight.set_bin_capacity(64);
@@ -221,6 +227,35 @@ fn an_overflowing_node_pool_is_grown_and_the_batch_counted_again() {
     assert!(reruns >= 1 && capacity > 64, "grown to {capacity} after {reruns} reruns");
     assert!(want.iter().any(|c| c.visible > 0 && c.visible < c.covered), "some views partly shaded");
     assert_eq!(got, want, "counted again in full, never truncated");
+}
+
+#[test]
+fn many_small_batches_count_what_one_batch_counts_and_size_their_pool_ahead() {
+    // The same views in one batch and in batches of 7 views: no count may depend on which batch
+    // a view lands in (the atlas origin, the pool, the jobs), and after the first batch each
+    // batch's pool is sized from the one before, so none is counted twice.
+    let (scene, requests, one, want) = louvres_counted_once();
+    let (batches, views) = one.compute_batches();
+    assert_eq!(batches, 1, "{views} views in one batch");
+    let many = compute_counter(128);
+    many.set_batch_views(7);
+    let got = common::gpu_fractions(&many, &scene, &requests);
+    let (batches, counted) = many.compute_batches();
+    assert_eq!(counted, views);
+    assert!(batches >= 3 && batches == views.div_ceil(7), "{batches} batches of {views} views");
+    assert_eq!(many.bin_pool().1, 0, "no batch counted twice");
+    assert!(want.iter().any(|c| c.visible > 0 && c.visible < c.covered), "some views partly shaded");
+    assert_eq!(got, want);
+    // A pool far too small and nothing planned for it: the first batch is counted again, and
+    // the pool of every batch after it is planned from the nodes a triangle took before.
+    let tight = compute_counter(128);
+    tight.set_batch_views(7);
+    tight.set_bin_capacity(64);
+    let got = common::gpu_fractions(&tight, &scene, &requests);
+    let (capacity, reruns) = tight.bin_pool();
+    println!("{} batches, pool {capacity} nodes after {reruns} reruns", tight.compute_batches().0);
+    assert_eq!(reruns, 1, "only the first batch counted twice");
+    assert_eq!(got, want);
 }
 
 /// Raster and compute counts of the same requests, and per rendered view the pixels where the two

@@ -58,7 +58,7 @@ export function hasWebGPU(): boolean;
 export function sunDirection(azimuth: number, altitude: number): [number, number, number];
 
 /** Opens the GPU device and starts the pool of clipping workers. Without WebGPU the engine
- * still clips (`hasGpu` false), and only `engine: 'gpu'` rejects, with code 'no-webgpu'. `resolution`: pixels along a view's side (default 512). `accuracy`: a
+ * still clips (`hasGpu` false), and only `engine: 'gpu'` or `'compute'` rejects, with code 'no-webgpu'. `resolution`: pixels along a view's side (default 512). `accuracy`: a
  * target |error| per view (e.g. 0.002): each view is counted at 64² first and again, finer up to
  * `resolution`, only where its shadow edges make the estimated error larger; without it every
  * view is counted at `resolution`. */
@@ -74,8 +74,10 @@ export function createEngine(options?: {
    * this device and model (a probe of both engines on the model's own views, kept in IndexedDB
    * keyed like the native CLI's cache); routing is a pure function of the views' loads, the
    * profile and the run's size, so the same profile gives the same CSV byte for byte.
-   * Another value rejects with code 'bad-option', option 'engine'. */
-  engine?: 'auto' | 'gpu' | 'exact';
+   * 'compute': pixels on WebGPU too, counted by the compute rasterizer (compute shaders alone,
+   * no render pipeline; the same pixel rules, for GPUs whose raster hardware is small), which
+   * needs WebGPU as 'gpu' does. Another value rejects with code 'bad-option', option 'engine'. */
+  engine?: 'auto' | 'gpu' | 'exact' | 'compute';
   /** Clipping workers (default navigator.hardwareConcurrency; 0: clip in this thread). Each has
    * its own wasm instance and copy of the model's exact engine; answers do not depend on it. */
   workers?: number;
@@ -195,7 +197,7 @@ export interface SunlitEngine {
   /** Pixels along a view's side. */
   readonly resolution: number;
   /** Which engine answers views (createEngine's `engine`). */
-  readonly engine: 'auto' | 'gpu' | 'exact';
+  readonly engine: 'auto' | 'gpu' | 'exact' | 'compute';
   /** Whether a GPU device is in use (false without WebGPU: views are clipped). */
   readonly hasGpu: boolean;
   /** Clipping workers in the pool (0: clipping runs in the engine's thread). */

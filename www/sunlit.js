@@ -41,20 +41,22 @@ function coded(message, code, names = {}) {
 }
 
 /** Opens the GPU device (or uses `device`, a GPUDevice the caller holds and keeps) and starts
- * the pool of clipping workers. `engine`: 'auto' (default), 'gpu' or 'exact'; `workers`: the
+ * the pool of clipping workers. `engine`: 'auto' (default), 'gpu', 'exact' or 'compute' (pixels
+ * on WebGPU by the compute rasterizer); `workers`: the
  * pool's size (default navigator.hardwareConcurrency; 0 clips in this thread); `profile`: an
  * `auto` profile (JSON text or object, as `year.profile` gives it) to route the sun views by
  * instead of the cached or measured one (sunlit.d.ts); `skyProfile`: the same for the sky views
  * (as `year.skyProfile` gives it), which are routed by their own profile as natively. Without
  * WebGPU the engine still clips (`hasGpu` false);
- * only `engine: 'gpu'` is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
+ * only `engine: 'gpu'` or 'compute' is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
  * for another engine name or pool size. */
 export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile } = {}) {
   const size = workers === undefined ? defaultWorkers() : Number(workers);
   if (!Number.isInteger(size) || size < 0) {
     throw coded(`workers: ${workers} is not a whole number of at least 0`, 'bad-option', { option: 'workers' });
   }
-  const wantsGpu = engine !== undefined && String(engine).trim().toLowerCase() === 'gpu';
+  // The engines that count on WebGPU alone.
+  const wantsGpu = engine !== undefined && ['gpu', 'compute'].includes(String(engine).trim().toLowerCase());
   const noGpu = () =>
     coded(
       "This browser offers no WebGPU, so the GPU engine is missing (try a current Chrome or Edge, or enable WebGPU); engine 'auto' or 'exact' clips without it.",
@@ -254,7 +256,7 @@ class SunlitEngine {
     return this.#engine.resolution;
   }
 
-  /** Which engine answers views: 'auto', 'gpu' or 'exact'. */
+  /** Which engine answers views: 'auto', 'gpu', 'exact' or 'compute'. */
   get engine() {
     return this.#engine.engine;
   }

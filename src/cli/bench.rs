@@ -222,6 +222,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             // count again by overflowing.
             "bin_pool_nodes": counters.iter().map(|c| c.bin_pool().0).max(),
             "bin_pool_reruns": counters.iter().map(|c| c.bin_pool().1).sum::<u64>(),
+            // The compute kernel's views a submission (its batches are not the atlas's).
+            "compute_views_per_submission": compute_views_per_submission(&counters),
             "seconds_per_rendered_view": t.seconds / t.rendered.max(1) as f64,
             "mean_triangles_drawn": t.mean_triangles_drawn.round(),
             "tiles_rendered": t.tiles_rendered,
@@ -377,4 +379,11 @@ fn peak_memory_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let kib: f64 = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?.trim().trim_end_matches("kB").trim().parse().ok()?;
     Some(kib / 1024.0)
+}
+
+/// The compute kernel's views counted per batch (one submission each, reruns aside), over
+/// `counters`; `None` where no batch was counted by it.
+fn compute_views_per_submission(counters: &[&Counter]) -> Option<f64> {
+    let (batches, views) = counters.iter().map(|c| c.compute_batches()).fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    (batches > 0).then(|| views as f64 / batches as f64)
 }

@@ -284,17 +284,25 @@ test('without WebGPU the engine clips (auto and exact agree), and only the GPU e
         } catch (e) {
           refused = { code: e.code, message: e.message };
         }
+        // The compute rasterizer counts on WebGPU too: refused alike.
+        let refusedCompute = null;
+        try {
+          await createEngine({ engine: 'compute' });
+        } catch (e) {
+          refusedCompute = { code: e.code, message: e.message };
+        }
         const auto = await createEngine({ resolution: 128, workers: 2 });
         const exact = await createEngine({ resolution: 128, engine: 'exact', workers: 0 });
         const a = await auto.annual(auto.fromArrays(louvredBlock()), year);
         const e = await exact.annual(exact.fromArrays(louvredBlock()), year);
-        return { refused, hasGpu: auto.hasGpu, adapter: auto.adapter, same: a.csv() === e.csv(), key: auto.routing.key };
+        return { refused, refusedCompute, hasGpu: auto.hasGpu, adapter: auto.adapter, same: a.csv() === e.csv(), key: auto.routing.key };
       },
       { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR },
     );
     assert.deepEqual(errors, []);
     assert.equal(r.refused.code, 'no-webgpu');
     assert.match(r.refused.message, /GPU engine is missing/);
+    assert.equal(r.refusedCompute?.code, 'no-webgpu');
     assert.equal(r.hasGpu, false);
     assert.match(r.adapter, /no WebGPU/);
     assert.ok(r.same, 'auto without a GPU clips every view, as exact does');

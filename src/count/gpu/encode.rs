@@ -76,23 +76,17 @@ impl BatchBuffers {
         let readback = buffer(
             device,
             "readback",
-            POOL_BYTES + entries * COUNTS_PER_MEMBER * 4 * BATCHES_PER_READBACK as u64,
+            entries * COUNTS_PER_MEMBER * 4 * BATCHES_PER_READBACK as u64,
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
         Self { atlas, views, tile_views, tile_bind, tile_stride, members, counts, readback }
     }
 }
 
-/// The readback's first bytes: per batch of a readback, the nodes the compute kernel's pool was
-/// asked for (zero with the raster kernel); the members' counts follow.
-pub(super) const POOL_BYTES: u64 = 4 * BATCHES_PER_READBACK as u64;
-
 /// The compute passes a batch runs after its render.
 pub(super) struct Passes<'a> {
     /// The count pass.
     pub(super) count: bool,
-    /// The batch's place in its readback (where its pool count lands).
-    pub(super) slot: usize,
     /// The mask pass for these map points and views; its words land in the points' readback
     /// from this word on.
     pub(super) masks: Option<(&'a GpuPoints, &'a MaskBatch, u64)>,
@@ -111,7 +105,7 @@ impl Counter {
         first_entry: usize,
         passes: Passes<'_>,
     ) -> Result<usize> {
-        let Passes { count, slot: batch_slot, masks } = passes;
+        let Passes { count, masks } = passes;
         let encoding = Stopwatch::start();
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
@@ -135,13 +129,8 @@ impl Counter {
         self.queue.write_buffer(&self.batch.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.batch.members, 0, bytemuck::cast_slice(&members));
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
-        let by_compute = count && self.counts_by_compute(scene, masks.is_some());
-        if by_compute {
-            self.encode_compute(&mut encoder, scene, requests, batch, side, (&self.batch.readback, 4 * batch_slot as u64))?;
-        } else {
-            self.render_tiles(&mut encoder, scene, requests, batch, side);
-        }
-        if count && !by_compute {
+        self.render_tiles(&mut encoder, scene, requests, batch, side);
+        if count {
             encoder.clear_buffer(&self.batch.counts, 0, None);
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("count"), timestamp_writes: None });
             pass.set_pipeline(&self.pipelines.count);
@@ -152,7 +141,7 @@ impl Counter {
         if count {
             let entry_bytes = COUNTS_PER_MEMBER * 4;
             let bytes = members.len() as u64 * entry_bytes;
-            let at = POOL_BYTES + first_entry as u64 * entry_bytes;
+            let at = first_entry as u64 * entry_bytes;
             encoder.copy_buffer_to_buffer(&self.batch.counts, 0, &self.batch.readback, at, bytes);
         }
         if let Some((points, mask_batch, first_word)) = masks {

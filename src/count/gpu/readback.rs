@@ -5,7 +5,7 @@
 use std::sync::atomic::Ordering;
 
 use super::compute::count_bytes;
-use super::encode::{POOL_BYTES, Passes};
+use super::encode::Passes;
 use super::masks::{GpuPoints, MaskBatch, PointMask};
 use super::pipelines::COUNTS_PER_MEMBER;
 use super::plan::{Tile, tiles_at};
@@ -70,72 +70,67 @@ impl Counter {
         out: &mut [Counted],
         mut masks: Option<MaskOut<'_>>,
     ) -> Result<()> {
+        if masks.is_none() && self.counts_by_compute(scene, false) {
+            return self.count_tiles_compute(scene, requests, tiles, side, out).await;
+        }
         let per_batch = tiles_at(self.atlas_side, side);
         for chunk in tiles.chunks(per_batch * BATCHES_PER_READBACK) {
-            // A compute batch whose node pool overflows is counted again (never truncated).
-            loop {
-                // Each batch's counts land in the readback right after the previous batch's, and so
-                // do its masks.
-                let (mut entries, mut words) = (0, 0u64);
-                let mut mask_batches = Vec::new();
-                let count = masks.as_ref().is_none_or(|m| m.count);
-                for (slot, batch) in chunk.chunks(per_batch).enumerate() {
-                    let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
-                    let passes = Passes { count, slot, masks: mask.as_ref().map(|(p, m)| (*p, m, words)) };
-                    entries += self.submit_batch(scene, requests, batch, side, entries, passes)?;
-                    if let Some((_, m)) = mask {
-                        words += m.words;
-                        mask_batches.push(m);
-                    }
+            // Each batch's counts land in the readback right after the previous batch's, and so
+            // do its masks.
+            let (mut entries, mut words) = (0, 0u64);
+            let mut mask_batches = Vec::new();
+            let count = masks.as_ref().is_none_or(|m| m.count);
+            for batch in chunk.chunks(per_batch) {
+                let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
+                let passes = Passes { count, masks: mask.as_ref().map(|(p, m)| (*p, m, words)) };
+                entries += self.submit_batch(scene, requests, batch, side, entries, passes)?;
+                if let Some((_, m)) = mask {
+                    words += m.words;
+                    mask_batches.push(m);
                 }
-                if let Some(m) = masks.as_mut() {
-                    read_masks(self, m.points, &mask_batches, words, m.answers, m.words).await?;
-                }
-                if !count {
-                    self.note_rendered(scene, chunk);
-                    break;
-                }
-                let waiting = Stopwatch::start();
-                let counts = platform::read_buffer(&self.device, &self.batch.readback, POOL_BYTES + count_bytes(entries)).await;
-                self.stages.waiting.fetch_add(waiting.nanos(), Ordering::Relaxed);
-                let unpacking = Stopwatch::start();
-                // A failed read on a lost device is the loss, not a read error.
-                self.check_errors("counting pixels")?;
-                let counts = counts?;
-                let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
-                let (pools, counts) = counts.split_at(BATCHES_PER_READBACK);
-                // A compute batch whose node pool overflowed dropped triangles from its lists: grow
-                // the pool to what the largest asked for and count the whole chunk again.
-                let capacity = self.bin_pool().0;
-                if let Some(needed) = pools.iter().copied().filter(|&n| n > capacity).max() {
-                    self.grow_pool(needed as u64)?;
-                    log::info!("compute kernel: {needed} bin nodes needed, {capacity} held; counting these batches again");
-                    self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
-                    continue;
-                }
-                self.note_rendered(scene, chunk);
-                let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
-                for ((i, pixel_area), c) in members.zip(counts.chunks_exact(COUNTS_PER_MEMBER as usize)) {
-                    let (visible, covered, edges) = (c[0], c[1], c[2]);
-                    let o = &mut out[i];
-                    o.visible = visible;
-                    o.covered = covered;
-                    o.edges = edges;
-                    o.side = side;
-                    o.pixel_area = pixel_area;
-                    o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
-                }
-                self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
-                break;
             }
+            if let Some(m) = masks.as_mut() {
+                read_masks(self, m.points, &mask_batches, words, m.answers, m.words).await?;
+            }
+            if !count {
+                self.note_rendered(scene, chunk);
+                continue;
+            }
+            let waiting = Stopwatch::start();
+            let counts = platform::read_buffer(&self.device, &self.batch.readback, count_bytes(entries)).await;
+            self.stages.waiting.fetch_add(waiting.nanos(), Ordering::Relaxed);
+            let unpacking = Stopwatch::start();
+            // A failed read on a lost device is the loss, not a read error.
+            self.check_errors("counting pixels")?;
+            let counts = counts?;
+            let counts: &[u32] = bytemuck::try_cast_slice(&counts).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
+            self.note_rendered(scene, chunk);
+            unpack(chunk, counts, side, out);
+            self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
         }
         Ok(())
     }
 
     /// Adds a counted chunk's tiles and triangles to the benchmark totals.
-    fn note_rendered(&self, scene: &GpuScene, chunk: &[Tile]) {
+    pub(super) fn note_rendered(&self, scene: &GpuScene, chunk: &[Tile]) {
         let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
         self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
         self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
+    }
+}
+
+/// Writes the members' counts of `chunk` (three words an entry, in tile and member order),
+/// counted at side `side`, into their requests' places in `out`.
+pub(super) fn unpack(chunk: &[Tile], counts: &[u32], side: u32, out: &mut [Counted]) {
+    let members = chunk.iter().flat_map(|t| t.requests.iter().map(move |&i| (i, t.view.pixel_area)));
+    for ((i, pixel_area), c) in members.zip(counts.chunks_exact(COUNTS_PER_MEMBER as usize)) {
+        let (visible, covered, edges) = (c[0], c[1], c[2]);
+        let o = &mut out[i];
+        o.visible = visible;
+        o.covered = covered;
+        o.edges = edges;
+        o.side = side;
+        o.pixel_area = pixel_area;
+        o.fraction = if covered == 0 { 0.0 } else { (visible as f64 / covered as f64).clamp(0.0, 1.0) };
     }
 }
