@@ -429,3 +429,28 @@ fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
     pollster::block_on(sunlit::sky::energyplus::ratios(&engine, &scene, &mut quiet)).unwrap();
     assert_eq!(said, engine.asked.get(), "{closing}");
 }
+
+/// A ribbon window in a north wall under a row of ten overhangs 0.76 m deep with gaps between
+/// them (the north facade of NREL's 100-zone test file, issue 36). Around the equinoxes the wall
+/// sees the sun only for minutes after sunrise and before sunset, pieces of the day that exist on
+/// one sample day and not on its neighbour, whose samples the fit then borrows from the nearest
+/// day that has them: the spline there is an extrapolation, and was off by up to 0.51 in
+/// Chicago on the days the piece first appears. Such cells are counted directly
+/// (`year::annual`'s borrowed-day rule).
+#[test]
+fn short_pieces_near_the_equinoxes_are_counted_not_borrowed() {
+    let mut s = TestScene::new();
+    let mut window = south_rect(0.0254, 30.4546, 0.76, 1.9812, 0.0);
+    window.reverse();
+    s.polygon("N_WIN", &window, true);
+    for i in 0..10 {
+        let x = 0.3048 + 3.048 * f64::from(i);
+        s.polygon(&format!("OVERHANG_{i}"), &flat_rect(x, x + 2.4384, 0.0, 0.762, 2.286), false);
+    }
+    let scene = s.build();
+    let (dense, _) = exact_year(&scene, Method::Dense);
+    let (spline, _) = exact_year(&scene, Method::Spline(SamplingPlan::default()));
+    let (mean, _, max) = compare(&spline, &dense).unwrap();
+    println!("north window under overhangs: mean |Δ| {mean:.4}, max {max:.4}");
+    assert!(max <= 0.2, "largest |Δ| {max}");
+}

@@ -10,7 +10,8 @@
 //! a north wall in summer) are found exactly from the sun model, the plan's S normalised times
 //! are placed within each piece (τ = 0 where the piece begins, 1 where it ends), and each piece
 //! gets its own spline surface over (day of year, τ). Days on which a piece does not exist borrow
-//! the samples of the nearest day that has it, so the periodic fit stays defined. At evaluation
+//! the samples of the nearest day that has it, so the periodic fit stays defined; with refinement
+//! on, the timesteps between such a day and its neighbour are counted, not extrapolated. At evaluation
 //! the sun-up and facing tests are applied exactly per timestep; values are clamped to [0, 1].
 //!
 //! Foliage (a scene with leaves, [`crate::year::season`]): the fraction then changes with the leaf
@@ -643,7 +644,8 @@ fn fit_regime(regime: &Regime, samples: &[Option<f64>], per_day: usize) -> Resul
         .map(|piece| {
             let Some(v) = fill_dark(piece, regime.days.len(), per_day) else { return Ok(None) };
             let v: Vec<f64> = regime.grid_days.iter().flat_map(|&d| v[d * per_day..(d + 1) * per_day].iter().copied()).collect();
-            Ok(Some(PieceFit { spline: regime.grid.fit(&v)?, samples: v }))
+            let borrowed = regime.grid_days.iter().map(|&d| piece[d * per_day..(d + 1) * per_day].iter().all(Option::is_none)).collect();
+            Ok(Some(PieceFit { spline: regime.grid.fit(&v)?, samples: v, borrowed }))
         })
         .collect()
 }
@@ -659,6 +661,9 @@ struct FittedRegime<'a> {
 struct PieceFit {
     spline: AnnualSpline,
     samples: Vec<f64>,
+    /// Per grid day: the piece does not exist that day, so its samples are another day's
+    /// ([`fill_dark`]).
+    borrowed: Vec<bool>,
 }
 
 /// The sample grid's geometry, to find the cell of samples around any (day, τ).
@@ -682,11 +687,13 @@ struct Cell {
     at: (usize, usize),
     /// Their bilinear interpolation at (day, τ) (τ outside the outermost nodes is held at the node).
     bilinear: f64,
+    /// Whether either of its sample days lacks the piece, its samples borrowed from another day.
+    borrowed: bool,
 }
 
 impl SampleCells {
     /// The cell of samples around (day, τ) that the spline interpolates in.
-    fn cell(&self, samples: &[f64], day: f64, tau: f64) -> Cell {
+    fn cell(&self, samples: &[f64], borrowed: &[bool], day: f64, tau: f64) -> Cell {
         let x = (day - self.first_day) / self.spacing;
         let u = x - x.floor();
         let k0 = x.floor().rem_euclid(self.days as f64) as usize % self.days;
@@ -698,7 +705,7 @@ impl SampleCells {
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
         let v = if j1 > j0 { ((tau - self.taus[j0]) / (self.taus[j1] - self.taus[j0])).clamp(0.0, 1.0) } else { 0.0 };
         let bilinear = (1.0 - u) * ((1.0 - v) * corners[0] + v * corners[1]) + u * ((1.0 - v) * corners[2] + v * corners[3]);
-        Cell { spread: hi - lo, lowest: lo, highest: hi, bilinear, at: (k0, j0) }
+        Cell { spread: hi - lo, lowest: lo, highest: hi, bilinear, at: (k0, j0), borrowed: borrowed[k0] || borrowed[k1] }
     }
 }
 
@@ -736,7 +743,7 @@ fn evaluate(
                 if let Some(piece) = &regime.fits[fit] {
                     let value = piece.spline.eval(grid_day, tau);
                     schedule.set(row, column, as_energyplus(value));
-                    let cell = regime.cells.cell(&piece.samples, grid_day, tau);
+                    let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
                     if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
                         let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
                         rough.push(Rough { row, column, sun, day, cell, corners });
@@ -749,10 +756,15 @@ fn evaluate(
 }
 
 /// With refinement on, whether a fitted `value` in `cell` is counted directly beyond the spread
-/// rule: near dark ([`NEAR_DARK`]) or where the spline leaves the cell's bilinear interpolation
-/// ([`KINK`]).
+/// rule: near dark ([`NEAR_DARK`]), where the spline leaves the cell's bilinear interpolation
+/// ([`KINK`]), or where a sample day of the cell lacks the lit piece. That last is a piece of day
+/// that comes and goes with the season (a north wall's minutes after sunrise near the equinoxes):
+/// its samples on such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the
+/// fit there extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36,
+/// Chicago, Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
+/// appears, 0.14 with those cells counted, for 1.8 % more views.
 fn needs_count(cell: &Cell, value: f64) -> bool {
-    cell.lowest < NEAR_DARK || value < NEAR_DARK || (value - cell.bilinear).abs() > KINK
+    cell.borrowed || cell.lowest < NEAR_DARK || value < NEAR_DARK || (value - cell.bilinear).abs() > KINK
 }
 
 /// Which of a regime's fits (by receiver and piece) serves receiver `column` at time `t`, given
