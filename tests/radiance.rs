@@ -333,10 +333,11 @@ fn sample_grid_points(model: &Path, dir: &Path, step: usize, out: &Path) -> usiz
 
 /// `sunlit map --points` with the EPW: per point (named p0, p1, … in the file's order) the
 /// columns as the summary's keys.
-fn sunlit_points(model: &Path, epw: &Path, points: &Path, dir: &Path) -> HashMap<String, Value> {
+fn sunlit_points(model: &Path, epw: &Path, points: &Path, dir: &Path, extra: &[&str]) -> HashMap<String, Value> {
     let out_csv = dir.join("points-out.csv");
     let start = Instant::now();
-    let out = sunlit(&[
+    let albedo = ALBEDO.to_string();
+    let mut args = vec![
         "map",
         model.to_str().unwrap(),
         "--points",
@@ -344,10 +345,12 @@ fn sunlit_points(model: &Path, epw: &Path, points: &Path, dir: &Path) -> HashMap
         "--epw",
         epw.to_str().unwrap(),
         "--albedo",
-        &ALBEDO.to_string(),
+        &albedo,
         "-o",
         out_csv.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = sunlit(&args);
     assert!(out.status.success(), "sunlit map --points: {}", String::from_utf8_lossy(&out.stderr));
     eprintln!("sunlit map: {:.1} s", start.elapsed().as_secs_f64());
     let text = std::fs::read_to_string(&out_csv).unwrap();
@@ -399,8 +402,29 @@ fn blaas_louvres_point_irradiance_matches_radiance() {
     assert!(count > 200, "{count} points sampled");
     let truth =
         radiance_with(&scene, &epw, &["--sensors", points.to_str().unwrap(), "--ambient-divisions", "8192"], &dir.join("radiance.json"));
-    let ours = sunlit_points(&model, &epw, &points, &dir);
+    let ours = sunlit_points(&model, &epw, &points, &dir, &[]);
     let failures = compare_parts("blaas-louvres points", &ours, &truth, false, Sky::EnergyPlus);
+    assert!(failures.is_empty(), "{} of {count} points miss:\n{}", failures.len(), failures.join("\n"));
+}
+
+/// `sunlit map --sky-model perez-all-weather` per point against Radiance on the same points: a
+/// sample of the office's 0.5 m grid (every 7th point: walls, windows under the overhangs, the
+/// roof), each point within 3 % / 5 % of Radiance's total, beam and sky + ground, with no
+/// allowance for a gap between sky models.
+#[test]
+fn office_point_all_weather_sky_matches_radiance() {
+    let dir = scratch("office-points-all-weather");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
+    let epw = golden_epw();
+    let scene = dir.join("scene.json");
+    scene_json(&model, &scene);
+    let points = dir.join("points.csv");
+    let count = sample_grid_points(&model, &dir, 7, &points);
+    assert!(count > 50, "{count} points sampled");
+    let truth =
+        radiance_with(&scene, &epw, &["--sensors", points.to_str().unwrap(), "--ambient-divisions", "4096"], &dir.join("radiance.json"));
+    let ours = sunlit_points(&model, &epw, &points, &dir, &["--sky-model", "perez-all-weather"]);
+    let failures = compare_parts("office points", &ours, &truth, true, Sky::AllWeather);
     assert!(failures.is_empty(), "{} of {count} points miss:\n{}", failures.len(), failures.join("\n"));
 }
 

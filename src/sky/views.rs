@@ -94,6 +94,17 @@ impl SkyViews {
         }
     }
 
+    /// Item `r`'s Σ over leaf states and patches of `per_state[state][patch]` × its visible
+    /// ∫cos dΩ of the patch at that state: a period's sky diffuse from its radiance × hours summed
+    /// per patch and weighted by leaf state. 0 for views kept without patches.
+    pub fn distribution_sum(&self, r: usize, per_state: &[Vec<f64>]) -> f64 {
+        self.patch_seen
+            .iter()
+            .zip(per_state)
+            .map(|(state, totals)| state[r].iter().zip(totals).map(|(&w, t)| f64::from(w) * t).sum::<f64>())
+            .sum()
+    }
+
     /// Item `r`'s sky diffuse (W/m²) under patch `radiances` with nothing in the way.
     pub fn distribution_open(&self, r: usize, radiances: &[f64]) -> f64 {
         self.patch_open.get(r).map_or(0.0, |open| open.iter().zip(radiances).map(|(&w, l)| f64::from(w) * l).sum())
