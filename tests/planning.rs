@@ -1,6 +1,7 @@
 //! Window studies against independent truths: BRE 209's VSC against the closed form of a
 //! vertical point facing an infinitely long obstruction and against Radiance's `rtrace -I`
-//! (tests/planning/vsc_radiance.py); APSH/WPSH against a numpy ray caster
+//! (tests/planning/vsc_radiance.py), and the `cie-overcast` and `uniform` sky models against the
+//! same Radiance; APSH/WPSH against a numpy ray caster
 //! over the same EPW hours (tests/planning/apsh_truth.py, its own sun); GB 50180's sunlight
 //! hours against the analytic canyon (a sill facing a long slab); true solar time against a
 //! published equation-of-time table; the CLI's output contract, before/after and refusals.
@@ -19,8 +20,10 @@ use glam::DVec3;
 use serde_json::Value;
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
 use sunlit::map::planning::{Windows, apsh, vsc};
-use sunlit::map::{Points, Site, from_csv};
+use sunlit::map::{Mapper, Points, Site, from_csv, point_sky_for};
 use sunlit::scene::Scene;
+use sunlit::sky::model::SkyModel;
+use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::location::Location;
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -77,34 +80,70 @@ fn vsc_matches_the_closed_form_of_a_long_obstruction() {
     }
 }
 
-/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
-/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
-/// off to one side: each point's VSC within 0.5 points.
-#[test]
-fn vsc_matches_radiance_rtrace_on_boxes() {
-    let boxes = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
-    let rows = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+/// The boxes and façade points both Radiance tests below use: a long low slab and a tower off to
+/// one side, south of a south façade.
+const BOXES: [([f64; 3], [f64; 3]); 2] = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
+const ROWS: [[f64; 6]; 3] = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+
+fn boxes_scene() -> Scene {
     let mut s = TestScene::new();
     s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
-    for (k, (lo, hi)) in boxes.iter().enumerate() {
+    for (k, (lo, hi)) in BOXES.iter().enumerate() {
         s.cuboid(&format!("BOX{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
     }
-    let scene = s.build();
-    let got = vsc::vsc(&Windows::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
-    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{}", std::process::id()));
+    s.build()
+}
+
+/// Radiance's irradiance at [`ROWS`] over the unobstructed horizontal's, in %, under `sky`
+/// (cie-overcast or uniform: tests/planning/vsc_radiance.py), and that horizontal.
+fn radiance_ratios(sky: &str) -> (Vec<f64>, f64) {
+    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{sky}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let case = dir.join("case.json");
-    let boxes_json: Vec<Value> = boxes.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
-    std::fs::write(&case, serde_json::json!({"points": rows, "boxes": boxes_json}).to_string()).unwrap();
+    let boxes_json: Vec<Value> = BOXES.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
+    std::fs::write(&case, serde_json::json!({"points": ROWS, "boxes": boxes_json, "sky": sky}).to_string()).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planning/vsc_radiance.py");
     let run = Command::new(radiance_python()).arg(script).arg(&case).output().unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     assert!(run.status.success(), "vsc_radiance.py: {}", String::from_utf8_lossy(&run.stderr));
     let truth: Value = serde_json::from_slice(&run.stdout).unwrap();
-    assert!((truth["horizontal"].as_f64().unwrap() - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {truth}");
-    for (i, t) in truth["vsc"].as_array().unwrap().iter().enumerate() {
-        let t = t.as_f64().unwrap();
+    (truth["vsc"].as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect(), truth["horizontal"].as_f64().unwrap())
+}
+
+/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
+/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
+/// off to one side: each point's VSC within 0.5 points.
+#[test]
+fn vsc_matches_radiance_rtrace_on_boxes() {
+    let scene = boxes_scene();
+    let got = vsc::vsc(&Windows::new(&scene, &points(&scene, &ROWS)).unwrap(), &mut |_, _| {});
+    let (truth, horizontal) = radiance_ratios("cie-overcast");
+    assert!((horizontal - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {horizontal}");
+    for (i, t) in truth.iter().enumerate() {
         assert!((got.vsc[i] - t).abs() <= 0.5, "point {i}: VSC {:.3} vs Radiance {t:.3}", got.vsc[i]);
+    }
+}
+
+/// The `cie-overcast` and `uniform` sky models as a map applies them (each point's visible
+/// ∫cos dΩ per Tregenza patch, [`point_sky_for`], times the model's patch radiances for 1 W/m² of
+/// diffuse horizontal) against Radiance's `rtrace -I` under the same luminance on the boxes: the
+/// points' sky diffuse per unit DHI, in %, within 0.5 points, and an open roof's exactly 100 %.
+#[test]
+fn cie_overcast_and_uniform_sky_models_match_radiance_on_boxes() {
+    let scene = boxes_scene();
+    let pts = points(&scene, &ROWS);
+    let mapper = Mapper::new(&scene, &pts).unwrap();
+    let patches = SkyPatches::tregenza();
+    for (model, sky) in [(SkyModel::CieOvercast, "cie-overcast"), (SkyModel::Uniform, "uniform")] {
+        let views = point_sky_for(&mapper, &patches, model, &mut |_, _| {});
+        let radiances = model.on(&patches).unwrap().radiances(0.0, 1.0, DVec3::Z, 1).unwrap();
+        let open_roof: f64 = patches.patches.iter().zip(&radiances).map(|(p, r)| r * p.weight(DVec3::Z).weight).sum();
+        assert!((open_roof - 1.0).abs() < 1e-9, "{sky}: an open roof gets {open_roof} of DHI");
+        let (truth, _) = radiance_ratios(sky);
+        for (i, t) in truth.iter().enumerate() {
+            let got = 100.0 * views.distribution_diffuse(i, 1.0, &radiances);
+            assert!((got - t).abs() <= 0.5, "{sky}, point {i}: {got:.3} % of DHI vs Radiance's {t:.3} %");
+        }
     }
 }
 
