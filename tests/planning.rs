@@ -19,7 +19,7 @@ use std::process::Command;
 use glam::DVec3;
 use serde_json::Value;
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{Windows, apsh, vsc};
+use sunlit::map::planning::{Windows, apsh, bre_lines, compare, vsc};
 use sunlit::map::{Mapper, Points, Site, from_csv, point_sky_for};
 use sunlit::scene::Scene;
 use sunlit::sky::model::SkyModel;
@@ -143,6 +143,55 @@ fn cie_overcast_and_uniform_sky_models_match_radiance_on_boxes() {
         for (i, t) in truth.iter().enumerate() {
             let got = 100.0 * views.distribution_diffuse(i, 1.0, &radiances);
             assert!((got - t).abs() <= 0.5, "{sky}, point {i}: {got:.3} % of DHI vs Radiance's {t:.3} %");
+        }
+    }
+}
+
+/// BRE 209's 25° line against the canyon's closed form: a long slab `distance` m out rising
+/// `height` m subtends atan((height − z)/distance) in the section from a point at z (within 1e-4°:
+/// the mesh holds f32 positions); the
+/// pre-check passes at 25° and below. Geometry behind the wall or beside the section never counts.
+#[test]
+fn bre_25deg_line_is_the_canyons_elevation() {
+    let south = DVec3::new(0.0, -1.0, 0.0);
+    let open = canyon(10.0, None);
+    let v = bre_lines::evaluate(&open, &[DVec3::new(0.0, 0.0, 1.5)], &[south]);
+    assert_eq!(v.angle_deg, [0.0], "nothing in front");
+    for (theta_deg, passes) in [(10.0f64, true), (24.9, true), (25.1, false), (40.0, false)] {
+        let (distance, z) = (12.0, 1.5);
+        let scene = canyon(distance, Some(z + distance * theta_deg.to_radians().tan()));
+        let origins = [DVec3::new(-3.0, 0.0, z), DVec3::new(0.0, 0.0, z), DVec3::new(4.0, 0.0, z)];
+        let v = bre_lines::evaluate(&scene, &origins, &[south; 3]);
+        for (i, &got) in v.angle_deg.iter().enumerate() {
+            assert!((got - theta_deg).abs() < 1e-4, "θ = {theta_deg}°, point {i}: {got}°");
+            assert_eq!(compare::line_25(got).passes, passes, "θ = {theta_deg}°");
+        }
+        // The same slab behind a north-facing wall is not in front of it.
+        let v = bre_lines::evaluate(&scene, &[DVec3::new(0.0, 0.0, z)], &[-south]);
+        assert_eq!(v.angle_deg, [0.0], "behind the wall");
+    }
+}
+
+/// BRE 209's 45° lines against their plan and elevation construction: a block standing on the
+/// wall beside the window, `offset` m from the window's centre to its near side, `depth` m out
+/// and `top` m above the centre, is within both lines exactly when offset ≤ depth (plan) and
+/// offset ≤ top (elevation).
+#[test]
+fn bre_45deg_lines_follow_plan_and_elevation() {
+    let south = DVec3::new(0.0, -1.0, 0.0);
+    let z = 1.5;
+    for (offset, depth, top, within) in
+        [(2.0, 3.0, 3.0, true), (2.0, 1.9, 3.0, false), (2.0, 3.0, 1.9, false), (4.0, 6.0, 4.5, true), (4.0, 3.5, 4.5, false)]
+    {
+        for side in [1.0, -1.0] {
+            let mut s = TestScene::new();
+            s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+            let (x0, x1) = if side > 0.0 { (offset, offset + 3.0) } else { (-offset - 3.0, -offset) };
+            s.cuboid("EXTENSION", DVec3::new(x0, -depth, 0.0), DVec3::new(x1, 0.0, z + top));
+            let scene = s.build();
+            let v = bre_lines::evaluate(&scene, &[DVec3::new(0.0, 0.0, z)], &[south]);
+            assert_eq!(v.within_45, [within], "offset {offset}, depth {depth}, top {top}, side {side}");
+            assert_eq!(compare::line_45(within).passes, !within);
         }
     }
 }
@@ -446,6 +495,46 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     assert!(dir.join("w.mask-4.svg").exists() && !dir.join("w.mask-2.svg").exists());
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.contains("<table") && html.contains("bre-apsh") && html.contains("<svg") && html.contains("GB 50180"));
+
+    // BRE's pre-checks, before and after: the block raises no angle it does not stand in (the
+    // north window's is as it was) and lowers none; the south windows' own overhangs stand in
+    // their sections already (a section drawing shows them too), so they fail before and after.
+    let out = run_map(
+        &dir,
+        &[office, "block.gltf", "--receivers", "WIN_*", "--points", "windows.csv", "--study", "bre-25deg", "--study", "bre-45deg"],
+    );
+    assert!(!out.status.success(), "-o is required");
+    let out = run_map(
+        &dir,
+        &[
+            office,
+            "block.gltf",
+            "--receivers",
+            "WIN_*",
+            "--points",
+            "windows.csv",
+            "--study",
+            "bre-25deg",
+            "--study",
+            "bre-45deg",
+            "--before",
+            office,
+            "-o",
+            "lines.csv",
+        ],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line25 = read("lines.study-bre-25deg.json");
+    let line45 = read("lines.study-bre-45deg.json");
+    for p in line25["points"].as_array().unwrap() {
+        let (now, before) = (p["angle_deg"].as_f64().unwrap(), p["angle_deg_before"].as_f64().unwrap());
+        assert!(now >= before && p["passes"] == (now <= 25.0), "{p}");
+    }
+    assert_eq!(line25["points"][0]["passes"], false);
+    let n = &line25["points"][3];
+    assert_eq!(n["angle_deg"], n["angle_deg_before"], "{n}");
+    assert!(line45["points"].as_array().unwrap().iter().all(|p| p["within_45deg"].is_number() && p["passes"].is_boolean()));
+    assert_eq!(line25["rule"]["line_deg"], 25.0);
 
     std::fs::write(dir.join("dull.epw"), epw_without_dni()).unwrap();
     // A window far away: a receiver of the same name pattern, but none of the points on it.
