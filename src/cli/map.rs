@@ -71,7 +71,7 @@ pub(super) struct MapArgs {
     #[arg(long, value_name = "MAP.glb")]
     glb_out: Option<PathBuf>,
     /// Study: bre-ground or en17037 (sun hours on areas), or the window studies bre-vsc,
-    /// bre-apsh, gb50180 (per reference point; docs/planning.md); repeatable. Reports go beside the output as
+    /// bre-apsh, gb50180, bre-25deg, bre-45deg (per reference point; docs/planning.md); repeatable. Reports go beside the output as
     /// POINTS.study-NAME.json and .csv.
     #[arg(long, value_name = "NAME")]
     study: Vec<String>,
