@@ -499,30 +499,9 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     // BRE's pre-checks, before and after: the block raises no angle it does not stand in (the
     // north window's is as it was) and lowers none; the south windows' own overhangs stand in
     // their sections already (a section drawing shows them too), so they fail before and after.
-    let out = run_map(
-        &dir,
-        &[office, "block.gltf", "--receivers", "WIN_*", "--points", "windows.csv", "--study", "bre-25deg", "--study", "bre-45deg"],
-    );
-    assert!(!out.status.success(), "-o is required");
-    let out = run_map(
-        &dir,
-        &[
-            office,
-            "block.gltf",
-            "--receivers",
-            "WIN_*",
-            "--points",
-            "windows.csv",
-            "--study",
-            "bre-25deg",
-            "--study",
-            "bre-45deg",
-            "--before",
-            office,
-            "-o",
-            "lines.csv",
-        ],
-    );
+    let windows_of_both = [office, "block.gltf", "--receivers", "WIN_*", "--points", "windows.csv"];
+    let lines = ["--study", "bre-25deg", "--study", "bre-45deg", "--before", office, "-o", "lines.csv"];
+    let out = run_map(&dir, &[&windows_of_both[..], &lines[..]].concat());
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let line25 = read("lines.study-bre-25deg.json");
     let line45 = read("lines.study-bre-45deg.json");
