@@ -539,3 +539,38 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--sky-model` on `annual` and `map`: an unknown name, or a model without the weather its light
+/// comes from, is refused naming the option, and nothing is written.
+#[test]
+fn sky_model_refusals_name_the_option() {
+    let dir = std::env::temp_dir().join(format!("sunlit-sky-model-refusals-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let office = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
+    let office = office.to_str().unwrap();
+    let epw = golden_epw();
+    let epw = epw.to_str().unwrap();
+    let annual = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_sunlit")).arg("annual").args(args).current_dir(&dir).output().unwrap();
+    let cases: Vec<(std::process::Output, &str)> = vec![
+        (annual(&[office, "--epw", epw, "--summary", "s.json", "--sky-model", "perez", "-o", "a.csv"]), "'perez' is not a sky model"),
+        (
+            annual(&[office, "--location", "39.74,-105.18,-7", "--summary", "s.json", "--sky-model", "uniform", "-o", "a.csv"]),
+            "needs a weather file",
+        ),
+        (
+            run_map(&dir, &[office, "--grid", "1", "--epw", epw, "--sky-model", "gendaymtx", "-o", "m.csv"]),
+            "'gendaymtx' is not a sky model",
+        ),
+        (
+            run_map(&dir, &[office, "--grid", "1", "--location", "39.74,-105.18,-7", "--sky-model", "cie-overcast", "-o", "m.csv"]),
+            "needs a weather file",
+        ),
+    ];
+    for (out, why) in cases {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("--sky-model") && stderr.contains(why), "{stderr}");
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
