@@ -162,6 +162,11 @@ struct AnnualArgs {
     /// 144·N² + 1 patches).
     #[arg(long, value_name = "SCHEME")]
     sky_patches: Option<String>,
+    /// The sky that weighs the patches, with --epw: energyplus (EnergyPlus's Perez 1990
+    /// irradiance model, the default), perez-all-weather (Radiance's gendaymtx sky, as Ladybug
+    /// uses), cie-overcast or uniform (docs/sky-truth.md).
+    #[arg(long, value_name = "NAME")]
+    sky_model: Option<String>,
     /// Also write a copy of the EnergyPlus model given (IDF or epJSON, as given) that reads the
     /// CSV (by its absolute path); needs an .idf or .epJSON among the models.
     #[arg(long, value_name = "FILE")]
@@ -443,6 +448,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("sam", "--sam"),
     ("albedo", "--albedo"),
     ("sky_patches", "--sky-patches"),
+    ("sky_model", "--sky-model"),
     ("day", "--day"),
     ("required_hours", "--required-hours"),
     ("min_period", "--min-period"),

@@ -1,6 +1,7 @@
 //! Window studies against independent truths: BRE 209's VSC against the closed form of a
 //! vertical point facing an infinitely long obstruction and against Radiance's `rtrace -I`
-//! (tests/planning/vsc_radiance.py); APSH/WPSH against a numpy ray caster
+//! (tests/planning/vsc_radiance.py), and the `cie-overcast` and `uniform` sky models against the
+//! same Radiance; APSH/WPSH against a numpy ray caster
 //! over the same EPW hours (tests/planning/apsh_truth.py, its own sun); GB 50180's sunlight
 //! hours against the analytic canyon (a sill facing a long slab); true solar time against a
 //! published equation-of-time table; the CLI's output contract, before/after and refusals.
@@ -18,9 +19,11 @@ use std::process::Command;
 use glam::DVec3;
 use serde_json::Value;
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{Windows, apsh, vsc};
-use sunlit::map::{Points, Site, from_csv};
+use sunlit::map::planning::{Windows, apsh, bre_lines, compare, vsc};
+use sunlit::map::{Mapper, Points, Site, from_csv, point_sky_for};
 use sunlit::scene::Scene;
+use sunlit::sky::model::SkyModel;
+use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::location::Location;
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -77,34 +80,119 @@ fn vsc_matches_the_closed_form_of_a_long_obstruction() {
     }
 }
 
-/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
-/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
-/// off to one side: each point's VSC within 0.5 points.
-#[test]
-fn vsc_matches_radiance_rtrace_on_boxes() {
-    let boxes = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
-    let rows = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+/// The boxes and façade points both Radiance tests below use: a long low slab and a tower off to
+/// one side, south of a south façade.
+const BOXES: [([f64; 3], [f64; 3]); 2] = [([-1000.0, -12.0, 0.0], [1000.0, -10.0, 6.0]), ([4.0, -30.0, 0.0], [14.0, -20.0, 25.0])];
+const ROWS: [[f64; 6]; 3] = [[0.0, 0.0, 1.5, 0.0, -1.0, 0.0], [3.0, 0.0, 1.5, 0.0, -1.0, 0.0], [0.0, 0.0, 4.0, 0.0, -1.0, 0.0]];
+
+fn boxes_scene() -> Scene {
     let mut s = TestScene::new();
     s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
-    for (k, (lo, hi)) in boxes.iter().enumerate() {
+    for (k, (lo, hi)) in BOXES.iter().enumerate() {
         s.cuboid(&format!("BOX{k}"), DVec3::from_array(*lo), DVec3::from_array(*hi));
     }
-    let scene = s.build();
-    let got = vsc::vsc(&Windows::new(&scene, &points(&scene, &rows)).unwrap(), &mut |_, _| {});
-    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{}", std::process::id()));
+    s.build()
+}
+
+/// Radiance's irradiance at [`ROWS`] over the unobstructed horizontal's, in %, under `sky`
+/// (cie-overcast or uniform: tests/planning/vsc_radiance.py), and that horizontal.
+fn radiance_ratios(sky: &str) -> (Vec<f64>, f64) {
+    let dir = std::env::temp_dir().join(format!("sunlit-vsc-radiance-{sky}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let case = dir.join("case.json");
-    let boxes_json: Vec<Value> = boxes.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
-    std::fs::write(&case, serde_json::json!({"points": rows, "boxes": boxes_json}).to_string()).unwrap();
+    let boxes_json: Vec<Value> = BOXES.iter().map(|(lo, hi)| serde_json::json!([lo, hi])).collect();
+    std::fs::write(&case, serde_json::json!({"points": ROWS, "boxes": boxes_json, "sky": sky}).to_string()).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/planning/vsc_radiance.py");
     let run = Command::new(radiance_python()).arg(script).arg(&case).output().unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     assert!(run.status.success(), "vsc_radiance.py: {}", String::from_utf8_lossy(&run.stderr));
     let truth: Value = serde_json::from_slice(&run.stdout).unwrap();
-    assert!((truth["horizontal"].as_f64().unwrap() - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {truth}");
-    for (i, t) in truth["vsc"].as_array().unwrap().iter().enumerate() {
-        let t = t.as_f64().unwrap();
+    (truth["vsc"].as_array().unwrap().iter().map(|t| t.as_f64().unwrap()).collect(), truth["horizontal"].as_f64().unwrap())
+}
+
+/// Radiance's `rtrace -I` (tests/planning/vsc_radiance.py: black boxes, a glow of the CIE
+/// overcast luminance above the horizon, 2^17 ambient divisions) on a long low slab and a tower
+/// off to one side: each point's VSC within 0.5 points.
+#[test]
+fn vsc_matches_radiance_rtrace_on_boxes() {
+    let scene = boxes_scene();
+    let got = vsc::vsc(&Windows::new(&scene, &points(&scene, &ROWS)).unwrap(), &mut |_, _| {});
+    let (truth, horizontal) = radiance_ratios("cie-overcast");
+    assert!((horizontal - 7.0 * PI / 9.0).abs() < 0.01, "Radiance's horizontal is 7π/9: {horizontal}");
+    for (i, t) in truth.iter().enumerate() {
         assert!((got.vsc[i] - t).abs() <= 0.5, "point {i}: VSC {:.3} vs Radiance {t:.3}", got.vsc[i]);
+    }
+}
+
+/// The `cie-overcast` and `uniform` sky models as a map applies them (each point's visible
+/// ∫cos dΩ per Tregenza patch, [`point_sky_for`], times the model's patch radiances for 1 W/m² of
+/// diffuse horizontal) against Radiance's `rtrace -I` under the same luminance on the boxes: the
+/// points' sky diffuse per unit DHI, in %, within 0.5 points, and an open roof's exactly 100 %.
+#[test]
+fn cie_overcast_and_uniform_sky_models_match_radiance_on_boxes() {
+    let scene = boxes_scene();
+    let pts = points(&scene, &ROWS);
+    let mapper = Mapper::new(&scene, &pts).unwrap();
+    let patches = SkyPatches::tregenza();
+    for (model, sky) in [(SkyModel::CieOvercast, "cie-overcast"), (SkyModel::Uniform, "uniform")] {
+        let views = point_sky_for(&mapper, &patches, model, &mut |_, _| {});
+        let radiances = model.on(&patches).unwrap().radiances(0.0, 1.0, DVec3::Z, 1).unwrap();
+        let open_roof: f64 = patches.patches.iter().zip(&radiances).map(|(p, r)| r * p.weight(DVec3::Z).weight).sum();
+        assert!((open_roof - 1.0).abs() < 1e-9, "{sky}: an open roof gets {open_roof} of DHI");
+        let (truth, _) = radiance_ratios(sky);
+        for (i, t) in truth.iter().enumerate() {
+            let got = 100.0 * views.distribution_diffuse(i, 1.0, &radiances);
+            assert!((got - t).abs() <= 0.5, "{sky}, point {i}: {got:.3} % of DHI vs Radiance's {t:.3} %");
+        }
+    }
+}
+
+/// BRE 209's 25° line against the canyon's closed form: a long slab `distance` m out rising
+/// `height` m subtends atan((height − z)/distance) in the section from a point at z (within 1e-4°:
+/// the mesh holds f32 positions); the
+/// pre-check passes at 25° and below. Geometry behind the wall or beside the section never counts.
+#[test]
+fn bre_25deg_line_is_the_canyons_elevation() {
+    let south = DVec3::new(0.0, -1.0, 0.0);
+    let open = canyon(10.0, None);
+    let v = bre_lines::evaluate(&open, &[DVec3::new(0.0, 0.0, 1.5)], &[south]);
+    assert_eq!(v.angle_deg, [0.0], "nothing in front");
+    for (theta_deg, passes) in [(10.0f64, true), (24.9, true), (25.1, false), (40.0, false)] {
+        let (distance, z) = (12.0, 1.5);
+        let scene = canyon(distance, Some(z + distance * theta_deg.to_radians().tan()));
+        let origins = [DVec3::new(-3.0, 0.0, z), DVec3::new(0.0, 0.0, z), DVec3::new(4.0, 0.0, z)];
+        let v = bre_lines::evaluate(&scene, &origins, &[south; 3]);
+        for (i, &got) in v.angle_deg.iter().enumerate() {
+            assert!((got - theta_deg).abs() < 1e-4, "θ = {theta_deg}°, point {i}: {got}°");
+            assert_eq!(compare::line_25(got).passes, passes, "θ = {theta_deg}°");
+        }
+        // The same slab behind a north-facing wall is not in front of it.
+        let v = bre_lines::evaluate(&scene, &[DVec3::new(0.0, 0.0, z)], &[-south]);
+        assert_eq!(v.angle_deg, [0.0], "behind the wall");
+    }
+}
+
+/// BRE 209's 45° lines against their plan and elevation construction: a block standing on the
+/// wall beside the window, `offset` m from the window's centre to its near side, `depth` m out
+/// and `top` m above the centre, is within both lines exactly when offset ≤ depth (plan) and
+/// offset ≤ top (elevation).
+#[test]
+fn bre_45deg_lines_follow_plan_and_elevation() {
+    let south = DVec3::new(0.0, -1.0, 0.0);
+    let z = 1.5;
+    for (offset, depth, top, within) in
+        [(2.0, 3.0, 3.0, true), (2.0, 1.9, 3.0, false), (2.0, 3.0, 1.9, false), (4.0, 6.0, 4.5, true), (4.0, 3.5, 4.5, false)]
+    {
+        for side in [1.0, -1.0] {
+            let mut s = TestScene::new();
+            s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+            let (x0, x1) = if side > 0.0 { (offset, offset + 3.0) } else { (-offset - 3.0, -offset) };
+            s.cuboid("EXTENSION", DVec3::new(x0, -depth, 0.0), DVec3::new(x1, 0.0, z + top));
+            let scene = s.build();
+            let v = bre_lines::evaluate(&scene, &[DVec3::new(0.0, 0.0, z)], &[south]);
+            assert_eq!(v.within_45, [within], "offset {offset}, depth {depth}, top {top}, side {side}");
+            assert_eq!(compare::line_45(within).passes, !within);
+        }
     }
 }
 
@@ -408,6 +496,25 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.contains("<table") && html.contains("bre-apsh") && html.contains("<svg") && html.contains("GB 50180"));
 
+    // BRE's pre-checks, before and after: the block raises no angle it does not stand in (the
+    // north window's is as it was) and lowers none; the south windows' own overhangs stand in
+    // their sections already (a section drawing shows them too), so they fail before and after.
+    let windows_of_both = [office, "block.gltf", "--receivers", "WIN_*", "--points", "windows.csv"];
+    let lines = ["--study", "bre-25deg", "--study", "bre-45deg", "--before", office, "-o", "lines.csv"];
+    let out = run_map(&dir, &[&windows_of_both[..], &lines[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line25 = read("lines.study-bre-25deg.json");
+    let line45 = read("lines.study-bre-45deg.json");
+    for p in line25["points"].as_array().unwrap() {
+        let (now, before) = (p["angle_deg"].as_f64().unwrap(), p["angle_deg_before"].as_f64().unwrap());
+        assert!(now >= before && p["passes"] == (now <= 25.0), "{p}");
+    }
+    assert_eq!(line25["points"][0]["passes"], false);
+    let n = &line25["points"][3];
+    assert_eq!(n["angle_deg"], n["angle_deg_before"], "{n}");
+    assert!(line45["points"].as_array().unwrap().iter().all(|p| p["within_45deg"].is_number() && p["passes"].is_boolean()));
+    assert_eq!(line25["rule"]["line_deg"], 25.0);
+
     std::fs::write(dir.join("dull.epw"), epw_without_dni()).unwrap();
     // A window far away: a receiver of the same name pattern, but none of the points on it.
     std::fs::write(dir.join("elsewhere.gltf"), box_gltf("WIN_FAR", DVec3::new(500.0, 500.0, 0.0), DVec3::new(501.0, 501.0, 1.0))).unwrap();
@@ -430,5 +537,40 @@ fn cli_window_studies_before_and_after_and_bad_input() {
         assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
         assert!(!dir.join("bad.csv").exists() && !dir.join("bad.html").exists(), "{args:?} wrote its output");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--sky-model` on `annual` and `map`: an unknown name, or a model without the weather its light
+/// comes from, is refused naming the option, and nothing is written.
+#[test]
+fn sky_model_refusals_name_the_option() {
+    let dir = std::env::temp_dir().join(format!("sunlit-sky-model-refusals-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let office = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
+    let office = office.to_str().unwrap();
+    let epw = golden_epw();
+    let epw = epw.to_str().unwrap();
+    let annual = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_sunlit")).arg("annual").args(args).current_dir(&dir).output().unwrap();
+    let cases: Vec<(std::process::Output, &str)> = vec![
+        (annual(&[office, "--epw", epw, "--summary", "s.json", "--sky-model", "perez", "-o", "a.csv"]), "'perez' is not a sky model"),
+        (
+            annual(&[office, "--location", "39.74,-105.18,-7", "--summary", "s.json", "--sky-model", "uniform", "-o", "a.csv"]),
+            "needs a weather file",
+        ),
+        (
+            run_map(&dir, &[office, "--grid", "1", "--epw", epw, "--sky-model", "gendaymtx", "-o", "m.csv"]),
+            "'gendaymtx' is not a sky model",
+        ),
+        (
+            run_map(&dir, &[office, "--grid", "1", "--location", "39.74,-105.18,-7", "--sky-model", "cie-overcast", "-o", "m.csv"]),
+            "needs a weather file",
+        ),
+    ];
+    for (out, why) in cases {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains("--sky-model") && stderr.contains(why), "{stderr}");
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,7 +8,8 @@ use sunlit::export::map_table::{Column, points_csv, study_csv, study_json, value
 use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
 use sunlit::map::study::{self, SunRule};
-use sunlit::map::{MapGpu, MapValues, Mapper, Period, Points, Site, point_sky};
+use sunlit::map::{MapGpu, MapValues, Mapper, Period, Points, Site, point_sky_for};
+use sunlit::sky::model::SkyModel;
 use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::weather::{Weather, check_albedo};
 use sunlit::year::season::LeafCalendar;
@@ -70,7 +71,7 @@ pub(super) struct MapArgs {
     #[arg(long, value_name = "MAP.glb")]
     glb_out: Option<PathBuf>,
     /// Study: bre-ground or en17037 (sun hours on areas), or the window studies bre-vsc,
-    /// bre-apsh, gb50180 (per reference point; docs/planning.md); repeatable. Reports go beside the output as
+    /// bre-apsh, gb50180, bre-25deg, bre-45deg (per reference point; docs/planning.md); repeatable. Reports go beside the output as
     /// POINTS.study-NAME.json and .csv.
     #[arg(long, value_name = "NAME")]
     study: Vec<String>,
@@ -118,7 +119,9 @@ pub(super) struct MapArgs {
     /// gb50180: also the 满窗 (whole window) hours, the sun over the whole sill of this width (m).
     #[arg(long, value_name = "METRES")]
     window_width: Option<f64>,
-    /// The sky a study weighs: bre-vsc takes only cie-overcast (its definition).
+    /// The sky that weighs the patches, with --epw: energyplus (the default), perez-all-weather
+    /// (Radiance's gendaymtx sky), cie-overcast or uniform; bre-vsc takes only cie-overcast (its
+    /// definition).
     #[arg(long, value_name = "NAME")]
     sky_model: Option<String>,
     /// Window studies: sky-mask diagrams (stereographic, with sun paths) for these 1-based point
@@ -253,7 +256,6 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         ("--min-period", args.min_period.is_some()),
         ("--max-periods", args.max_periods.is_some()),
         ("--window-width", args.window_width.is_some()),
-        ("--sky-model", args.sky_model.is_some()),
         ("--mask", args.mask.is_some()),
         ("--html", args.html.is_some()),
     ];
@@ -261,6 +263,9 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         return Err(Error::argument(*flag, format!("is taken by the window studies only ({})", planning::STUDIES.join(", "))));
     }
     if args.inside || args.study.iter().any(|s| inside::STUDIES.contains(&s.as_str())) {
+        if args.sky_model.is_some() {
+            return Err(Error::argument("--sky-model", "the inside map counts the beam through the windows and takes no sky model"));
+        }
         return inside::map_inside(args);
     }
     let plan = args.plan()?;
@@ -280,6 +285,10 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     if args.sky_patches.is_some() && args.epw.is_none() {
         return Err(Error::argument("sky_patches", "needs a weather file (--epw): the sky's light comes from it"));
     }
+    let model = args.sky_model.as_deref().map_or(Ok(SkyModel::EnergyPlus), SkyModel::parse)?;
+    if args.sky_model.is_some() && args.epw.is_none() {
+        return Err(Error::argument("sky_model", "needs a weather file (--epw): the sky's light comes from it"));
+    }
     let (location, weather) = args.site()?;
     let scene = args.model.load()?;
     let points = args.points(&scene)?;
@@ -296,7 +305,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     // Each point's own sky views, once (geometry only), when irradiation is summed.
     let sky_start = Instant::now();
     let mut meter = Meter::new(&format!("{} points: sky views ({} patches)", points.len(), patches.len()), "patch views")?;
-    let sky = (weather.is_some() && !plan.instant).then(|| point_sky(&mapper, &patches, &mut meter.counts()));
+    let sky = (weather.is_some() && !plan.instant).then(|| point_sky_for(&mapper, &patches, model, &mut meter.counts()));
     meter.stage(&format!("{} points", points.len()), "instants");
     let sky_seconds = sky_start.elapsed().as_secs_f64();
     let site = Site { location: &location, calendar: &calendar, weather: weather.as_ref(), sky: sky.as_ref() };
@@ -371,7 +380,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         None => json!({"exact_rays": point_instants, "gpu_masks": 0}),
     };
     if let Some(sky) = &sky {
-        summary["sky"] = json!({"patches": sky.patches.name(), "count": sky.patches.len(), "leaf_states": sky.leaf_states.len(), "seconds": round(sky_seconds, 3)});
+        summary["sky"] = json!({"patches": sky.patches.name(), "model": sky.model().name(), "count": sky.patches.len(), "leaf_states": sky.leaf_states.len(), "seconds": round(sky_seconds, 3)});
     }
     summary["written"] = json!(files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>());
     if args.json {

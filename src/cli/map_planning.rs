@@ -8,7 +8,7 @@ use serde_json::{Value, json};
 use sunlit::export::planning_report::{StudyTable, SunPath, mask_svg, report_html, study_csv, study_json};
 use sunlit::map::planning::compare::{self, Verdict};
 use sunlit::map::planning::gb50180::{self, Gb50180Rule, StandardDay};
-use sunlit::map::planning::{SceneRays, Windows, apsh, mask, vsc};
+use sunlit::map::planning::{SceneRays, Windows, apsh, bre_lines, mask, vsc};
 use sunlit::map::{Points, Site};
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -16,7 +16,7 @@ use sunlit::year::season::LeafCalendar;
 use super::*;
 
 /// The window studies' names.
-pub(super) const STUDIES: [&str; 3] = ["bre-vsc", "bre-apsh", "gb50180"];
+pub(super) const STUDIES: [&str; 5] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg"];
 
 /// Whether `args` ask for a window study (then [`run`] answers them).
 pub(super) fn wanted(args: &MapArgs) -> bool {
@@ -146,6 +146,9 @@ struct Values {
     vsc: Option<vsc::VscValues>,
     apsh: Option<apsh::ApshValues>,
     gb: Option<gb50180::Gb50180Values>,
+    lines: Option<bre_lines::LineValues>,
+    /// The studies asked for, in order.
+    asked: Vec<String>,
     seconds: Vec<(String, f64)>,
 }
 
@@ -154,12 +157,20 @@ fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_
     // One tree for the scene; gb50180 places its own points (with its sill samples) on it, and
     // the BRE studies share these.
     let tree = SceneRays::new(scene);
-    let windows = args.study.iter().any(|s| s != "gb50180").then(|| Windows::on(scene, &tree, points)).transpose()?;
-    let mut values = Values { seconds: vec![("index".into(), start.elapsed().as_secs_f64())], ..Values::default() };
+    let windows = args.study.iter().any(|s| s == "bre-vsc" || s == "bre-apsh").then(|| Windows::on(scene, &tree, points)).transpose()?;
+    let mut values =
+        Values { seconds: vec![("index".into(), start.elapsed().as_secs_f64())], asked: args.study.clone(), ..Values::default() };
     for study in &args.study {
         let start = Instant::now();
         match (study.as_str(), &windows) {
             ("bre-vsc", Some(windows)) => values.vsc = Some(vsc::vsc(windows, &mut |_, _| {})),
+            ("bre-25deg" | "bre-45deg", _) => {
+                if values.lines.is_none() {
+                    let positions: Vec<_> = (0..points.len()).map(|i| points.position(i)).collect();
+                    let normals: Vec<_> = (0..points.len()).map(|i| points.normal(i)).collect();
+                    values.lines = Some(bre_lines::evaluate(scene, &positions, &normals));
+                }
+            }
             ("bre-apsh", Some(windows)) => {
                 let site = site.ok_or_else(|| Error::argument("--epw", "bre-apsh needs a weather file"))?;
                 values.apsh = Some(apsh::apsh(windows, site, &mut |_, _| {})?);
@@ -172,6 +183,11 @@ fn evaluate(args: &MapArgs, scene: &Scene, points: &Points, site: Option<Site<'_
         values.seconds.push((study.clone(), start.elapsed().as_secs_f64()));
     }
     Ok(values)
+}
+
+/// 1.0 for true, 0.0 for false (the report's values are numbers).
+fn zero_one(flags: &[bool]) -> Vec<f64> {
+    flags.iter().map(|&f| if f { 1.0 } else { 0.0 }).collect()
 }
 
 /// Spreads the existing scene's values (at `index` of the proposed points) over all `n` points.
@@ -234,6 +250,48 @@ fn tables(
             verdicts: vec![("passes".into(), verdicts)],
             assessed: Some(v.assessed.clone()),
         });
+    }
+    if let Some(v) = &now.lines {
+        let former = before
+            .and_then(|(b, index)| b.lines.as_ref().map(|b| (spread(&b.angle_deg, index, n), spread(&zero_one(&b.within_45), index, n))));
+        let line = |study: &str,
+                    source: &str,
+                    rule: Value,
+                    key: &str,
+                    values: Vec<f64>,
+                    before: Option<Vec<Option<f64>>>,
+                    verdicts: Vec<Verdict>| StudyTable {
+            study: study.into(),
+            source: source.into(),
+            rule,
+            values: vec![(key.into(), values)],
+            before: before.map(|b| vec![b]),
+            verdicts: vec![("passes".into(), verdicts)],
+            assessed: None,
+        };
+        for study in [&"bre-25deg", &"bre-45deg"].into_iter().filter(|s| now.asked.iter().any(|a| a == *s)) {
+            out.push(if *study == "bre-25deg" {
+                line(
+                    study,
+                    "BRE 209, 3rd ed. (2022), 2.2.5: in the section perpendicular to the window wall, from the centre of the lowest window, a new development subtending more than 25° to the horizontal may affect the diffuse daylight (check the VSC)",
+                    json!({"line_deg": bre_lines::LINE_25_DEG, "section": "vertical, through the point, along its normal's horizontal part", "reference_point": "the points given (BRE: the centre of the lowest window)"}),
+                    "angle_deg",
+                    v.angle_deg.clone(),
+                    former.as_ref().map(|(a, _)| a.clone()),
+                    v.angle_deg.iter().map(|&a| compare::line_25(a)).collect(),
+                )
+            } else {
+                line(
+                    study,
+                    "BRE 209, 3rd ed. (2022), 2.2.16: for an extension beside the window, a window whose centre lies within 45° lines drawn on plan (from the extension's far end) and in elevation (down from its top) is likely to be affected",
+                    json!({"line_deg": 45.0, "plan": "obstruction within 45° of the window's normal", "elevation": "obstruction above 45° lines up from the window's centre", "value": "1 within both lines, 0 not"}),
+                    "within_45deg",
+                    zero_one(&v.within_45),
+                    former.as_ref().map(|(_, w)| w.clone()),
+                    v.within_45.iter().map(|&w| compare::line_45(w)).collect(),
+                )
+            });
+        }
     }
     if let (Some(v), Some(rule)) = (&now.gb, gb) {
         let former = before.and_then(|(b, index)| b.gb.as_ref().map(|b| spread(&b.hours, index, n)));
@@ -383,7 +441,13 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         files.push((html.clone(), report_html(&scene, &points, &tables, &svgs, &inputs).into_bytes()));
     }
     if let (Some(glb), Some((name, values))) = (&args.glb_out, columns.first()) {
-        let unit = if name.starts_with("hours") { "h" } else { "%" };
+        let unit = if name.starts_with("hours") {
+            "h"
+        } else if name.starts_with("angle") {
+            "deg"
+        } else {
+            "%"
+        };
         files.push((glb.clone(), map_glb(&scene, &points, values, name, unit)));
     }
     for (path, bytes) in &files {

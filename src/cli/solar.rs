@@ -1,6 +1,6 @@
 //! `sunlit annual`'s solar outputs: the per-surface summary (`--summary`), the per-timestep
 //! irradiance (`--irradiance`) and what PV tools read (`--pvlib`, `--sam`), with their flags
-//! `--albedo` and `--sky-patches`.
+//! `--albedo`, `--sky-patches` and `--sky-model`.
 //!
 //! A thin edge like the rest of the CLI: it reads the flags and the weather before any counting
 //! (so a bad value is refused with nothing written), then asks the library for the sky views
@@ -16,8 +16,9 @@ use sunlit::export::pv;
 use sunlit::model;
 use sunlit::scene::Scene;
 use sunlit::sky::directions::direction_fractions;
+use sunlit::sky::model::SkyModel;
 use sunlit::sky::patches::SkyPatches;
-use sunlit::sky::views::sky_views;
+use sunlit::sky::views::sky_views_for;
 use sunlit::sun::weather::{Weather, check_albedo};
 use sunlit::year::annual::Progress;
 use sunlit::year::settings::Resolved;
@@ -32,6 +33,7 @@ type SummaryFormat = fn(&[irradiation::SurfaceSummary]) -> String;
 /// What the solar outputs need, read and checked before the counting.
 pub struct SolarPlan {
     patches: SkyPatches,
+    model: SkyModel,
     weather: Option<Weather>,
     summary: Option<(PathBuf, SummaryFormat)>,
     irradiance: Option<PathBuf>,
@@ -46,6 +48,10 @@ pub struct SolarPlan {
 /// neither output is asked for.
 pub fn solar_plan(args: &AnnualArgs) -> Result<Option<SolarPlan>> {
     let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;
+    let model = args.sky_model.as_deref().map_or(Ok(SkyModel::EnergyPlus), SkyModel::parse)?;
+    if args.sky_model.is_some() && args.epw.is_none() {
+        return Err(Error::argument("sky_model", "needs a weather file (--epw): the sky's light comes from it"));
+    }
     if let Some(albedo) = args.albedo {
         check_albedo(albedo)?;
     }
@@ -92,6 +98,7 @@ pub fn solar_plan(args: &AnnualArgs) -> Result<Option<SolarPlan>> {
     };
     Ok(Some(SolarPlan {
         patches,
+        model,
         weather,
         summary,
         irradiance: args.irradiance.clone(),
@@ -122,15 +129,16 @@ pub fn solar_outputs(
     }
     let start = std::time::Instant::now();
     meter.stage("sky views", "views");
-    let views = pollster::block_on(sky_views(engine, scene, &plan.patches, &mut |p| {
+    let views = pollster::block_on(sky_views_for(engine, scene, &plan.patches, plan.model, &mut |p| {
         meter.report(p);
         Ok(())
     }))?;
     eprintln!(
-        "sky views: {} receivers × {} patches ({}) in {:.2} s",
+        "sky views: {} receivers × {} patches ({}, {} sky) in {:.2} s",
         scene.receivers.len(),
         plan.patches.len(),
         plan.patches.name(),
+        plan.model.name(),
         start.elapsed().as_secs_f64()
     );
     if let (Some(path), Some(weather)) = (&plan.irradiance, &plan.weather) {

@@ -6,7 +6,9 @@
 //! views ([`crate::sky::views`]):
 //! - beam: DNI·cos θ·fraction;
 //! - sky diffuse: the Perez 1990 sky ([`crate::sky::perez`]): isotropic part weighted by the
-//!   visible patches, circumsolar part shaded like the beam, horizon band by its visibility;
+//!   visible patches, circumsolar part shaded like the beam, horizon band by its visibility; or,
+//!   with views kept for a luminance distribution ([`crate::sky::model`]), each patch's radiance
+//!   that hour times the receiver's visible ∫cos dΩ of it;
 //! - ground-reflected: GHI·albedo·(1 − cos tilt)/2, unobstructed, as EnergyPlus does it.
 //!
 //! **Instants.** Every part uses the sun the fractions were counted for: [`shading_sun_day`]'s
@@ -81,6 +83,7 @@ fn for_each_incident(
     if solar.sky.receivers() != scene.receivers.len() {
         return Err(Error::argument("sky", format!("sky views of {} receivers for {}", solar.sky.receivers(), scene.receivers.len())));
     }
+    let distribution = solar.sky.model().on(&solar.sky.patches);
     for (row, instant) in schedule.timesteps.instants().enumerate() {
         let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
         if sun.z < MIN_COS_INCIDENCE {
@@ -88,18 +91,21 @@ fn for_each_incident(
         }
         let hour = solar.weather.at(schedule.timesteps, row);
         let perez = PerezSky::new(hour.dni, hour.dhi, sun.z, location.elevation);
+        let radiances = distribution.as_ref().and_then(|d| d.radiances(hour.dni, hour.dhi, sun, instant.day));
         let leaves = solar.calendar.fraction(f64::from(instant.day));
         for (c, receiver) in scene.receivers.iter().enumerate() {
             let fraction = f64::from(schedule.get(row, c));
             let cos = receiver.normal.dot(sun).max(0.0);
             let sin_tilt = receiver.normal.truncate().length();
             let ground = hour.ghi * hour.albedo * (1.0 - receiver.normal.z) / 2.0;
-            let (sky, unshaded_sky) = match perez {
-                Some(p) => (
+            let (sky, unshaded_sky) = match (&radiances, perez) {
+                (Some(r), _) => (solar.sky.distribution_diffuse(c, leaves, r), solar.sky.distribution_open(c, r)),
+                (None, _) if distribution.is_some() => (0.0, 0.0),
+                (None, Some(p)) => (
                     p.diffuse(hour.dhi, cos, solar.sky.isotropic(c, leaves), fraction, sin_tilt, solar.sky.horizon(c, leaves)),
                     p.diffuse(hour.dhi, cos, solar.sky.unobstructed(c), if cos > 0.0 { 1.0 } else { 0.0 }, sin_tilt, 1.0),
                 ),
-                None => (0.0, 0.0),
+                (None, None) => (0.0, 0.0),
             };
             let unshaded_direct = hour.dni * cos;
             let incident = Incident {

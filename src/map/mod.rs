@@ -49,7 +49,7 @@ use glam::DVec3;
 pub use gpu::MapGpu;
 pub use period::{Period, Sample};
 pub use points::{from_csv, grid};
-pub use sky::point_sky;
+pub use sky::{point_sky, point_sky_for};
 
 use crate::count::MIN_COS_INCIDENCE;
 use crate::count::exact::engine::ExactEngine;
@@ -381,7 +381,8 @@ impl<'a> Sums<'a> {
             (Some(_), sky) => sky,
             (None, _) => None,
         };
-        let plan = sky.map(|sky| sky::SkyPlan::new(mapper, sky));
+        // A luminance distribution is summed per patch over the period in `finish`, not per step.
+        let plan = sky.filter(|sky| !sky.model().is_distribution()).map(|sky| sky::SkyPlan::new(mapper, sky));
         Ok(Self { mapper, site, weather, sky, plan })
     }
 
@@ -429,7 +430,10 @@ impl<'a> Sums<'a> {
             }
             sky_parts.extend(part.sky);
         }
-        let sky_diffuse = self.plan.map(|p| p.finish(mapper, sky_parts));
+        let sky_diffuse = match self.plan {
+            Some(p) => Some(p.finish(mapper, sky_parts)),
+            None => sky::distribution_diffuse(mapper, site, samples),
+        };
         let sun_up: Vec<&Sample> = samples.iter().filter(|s| mapper.sun(site, s).z >= MIN_COS_INCIDENCE).collect();
         let mut values = MapValues { sun_hours: total.hours, instants: samples.len(), sun_up: sun_up.len(), ..MapValues::default() };
         values.direct_kwh_m2 = total.direct;

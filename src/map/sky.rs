@@ -19,6 +19,10 @@
 //! - with foliage, once at bare and once at full leaf ([`SkyViews`] interpolates between them as
 //!   the leaf calendar ramps, as for surfaces).
 //!
+//! For a sky model that is a luminance distribution ([`crate::sky::model`]) each point also keeps
+//! its visible ∫cos dΩ per patch (the sub-patches summed into their patch), and its sky diffuse is
+//! the period's radiance per patch and leaf state summed over them ([`distribution_diffuse`]).
+//!
 //! Per timestep, [`SkyPlan`] adds each point's Perez sky diffuse ([`PerezSky`]) with its own
 //! view factors and its circumsolar part shaded by its own sun visibility, as a receiver's
 //! ([`crate::export::irradiation`]); where the max(0, …) of the Perez sum cannot bind for any
@@ -34,6 +38,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::DVec3;
 
 use super::Mapper;
+use crate::count::MIN_COS_INCIDENCE;
+use crate::sky::model::SkyModel;
 use crate::sky::patches::{Patch, PatchWeight, SkyPatches};
 use crate::sky::perez::PerezSky;
 use crate::sky::views::{Seen, SkyViews};
@@ -50,9 +56,17 @@ struct NormalClasses {
     class: Vec<u32>,
 }
 
-/// Every point's sky views on `patches`, through `mapper`'s shadow rays. Spread over every core
-/// (natively; on the web the calling thread alone); `progress(done, total)` counts patch views.
+/// Every point's sky views on `patches`, through `mapper`'s shadow rays, for the `energyplus`
+/// sky. Spread over every core (natively; on the web the calling thread alone);
+/// `progress(done, total)` counts patch views.
 pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut(usize, usize)) -> SkyViews {
+    point_sky_for(mapper, patches, SkyModel::EnergyPlus, progress)
+}
+
+/// [`point_sky`] kept for sky `model` (per patch for a distribution).
+pub fn point_sky_for(mapper: &Mapper, patches: &SkyPatches, model: SkyModel, progress: &mut dyn FnMut(usize, usize)) -> SkyViews {
+    let keep = if model.is_distribution() { patches.len() } else { 0 };
+    let per_patch = SUBDIVISION * SUBDIVISION;
     let leaf_states: Vec<f32> = if mapper.foliage { vec![0.0, 1.0] } else { vec![1.0] };
     let fine: Vec<Patch> = patches.patches.iter().flat_map(|p| p.split(SUBDIVISION)).collect();
     let weights_of = |normal: DVec3| -> Vec<PatchWeight> { fine.iter().map(|p| p.weight(normal)).collect() };
@@ -72,11 +86,12 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
     let done = AtomicUsize::new(0);
     let work = || {
         let mut seen = vec![vec![Seen::default(); n]; leaf_states.len()];
+        let mut kept = vec![vec![0.0f32; n * keep]; leaf_states.len()];
         let mut scratch = mapper.engine.point_scratch();
         let mut vis: Vec<f32> = Vec::new();
         loop {
             let k = next.fetch_add(1, Ordering::Relaxed);
-            let Some(&(s, g, p)) = jobs.get(k) else { break seen };
+            let Some(&(s, g, p)) = jobs.get(k) else { break (seen, kept) };
             let group = &mapper.groups[g];
             vis.resize(group.members.len(), 0.0);
             let direction = receiver_weights[g][p].direction;
@@ -87,6 +102,9 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
                 let weight = c.weights[class as usize][p].weight;
                 if weight > 0.0 {
                     seen[s][i as usize].add(weight, f64::from(v), horizon);
+                    if keep > 0 {
+                        kept[s][i as usize * keep + p / per_patch] += (weight * f64::from(v)) as f32;
+                    }
                 }
             }
             done.fetch_add(1, Ordering::Relaxed);
@@ -94,10 +112,16 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
     };
     let parts = super::run_on_every_core(jobs.len(), &done, progress, work);
     let mut seen = vec![vec![Seen::default(); n]; leaf_states.len()];
-    for part in parts {
+    let mut kept = vec![vec![0.0f32; n * keep]; leaf_states.len()];
+    for (part, part_kept) in parts {
         for (into, from) in seen.iter_mut().zip(part) {
             for (a, b) in into.iter_mut().zip(&from) {
                 a.merge(b);
+            }
+        }
+        for (into, from) in kept.iter_mut().zip(&part_kept) {
+            for (a, b) in into.iter_mut().zip(from) {
+                *a += b;
             }
         }
     }
@@ -107,7 +131,49 @@ pub fn point_sky(mapper: &Mapper, patches: &SkyPatches, progress: &mut dyn FnMut
             unobstructed[i as usize] = c.weights[class as usize].iter().map(|w| w.weight).sum::<f64>() / std::f64::consts::PI;
         }
     }
-    SkyViews::from_seen(patches, leaf_states, &seen, unobstructed)
+    let views = SkyViews::from_seen(patches, leaf_states, &seen, unobstructed);
+    if keep == 0 {
+        return views;
+    }
+    // Each point's open weight per patch: its class's sub-patch weights summed into their patch.
+    let mut open = vec![Vec::new(); n];
+    for (g, c) in mapper.groups.iter().zip(&classes) {
+        let sums: Vec<Vec<f32>> =
+            c.weights.iter().map(|w| w.chunks(per_patch).map(|sub| sub.iter().map(|pw| pw.weight).sum::<f64>() as f32).collect()).collect();
+        for (&i, &class) in g.members.iter().zip(&c.class) {
+            open[i as usize].clone_from(&sums[class as usize]);
+        }
+    }
+    let seen_per_point = kept.into_iter().map(|state| state.chunks(keep).map(<[f32]>::to_vec).collect()).collect();
+    views.with_patches(model, seen_per_point, open)
+}
+
+/// Each point's sky diffuse (kWh/m²) over `samples` under the distribution its views were kept
+/// for: the period's Σ radiance × hours per patch and leaf state, once for every point, then per
+/// point Σ over patches of that times the point's visible ∫cos dΩ. `None` for views kept for the
+/// `energyplus` sky.
+pub(super) fn distribution_diffuse(mapper: &Mapper, site: super::Site<'_>, samples: &[super::Sample]) -> Option<Vec<f64>> {
+    let (sky, weather) = (site.sky?, site.weather?);
+    let distribution = sky.model().on(&sky.patches)?;
+    let hourly = crate::year::samples::Timesteps::new(1).ok()?;
+    let states = sky.leaf_states.len();
+    let mut totals = vec![vec![0.0f64; sky.patches.len()]; states];
+    for s in samples {
+        let sun = mapper.sun(site, s);
+        if sun.z < MIN_COS_INCIDENCE {
+            continue;
+        }
+        let hour = weather.at(hourly, s.epw_hour);
+        let Some(radiances) = distribution.radiances(hour.dni, hour.dhi, sun, s.day) else { continue };
+        let t = site.calendar.fraction(f64::from(s.day)).clamp(0.0, 1.0);
+        let weights = if states == 1 { [1.0, 0.0] } else { [1.0 - t, t] };
+        for (total, w) in totals.iter_mut().zip(weights) {
+            for (a, r) in total.iter_mut().zip(&radiances) {
+                *a += r * w * s.hours / 1000.0;
+            }
+        }
+    }
+    Some((0..mapper.points).map(|i| sky.distribution_sum(i, &totals)).collect())
 }
 
 /// The distinct normals of a group's members and their weights.

@@ -11,13 +11,17 @@
 //! - [`energyplus`]: EnergyPlus's own 144-direction diffuse shading ratios;
 //! - [`directions`]: fractions for given sun directions (SAM's azimuth × altitude table);
 //! - [`luminance`]: weather-free luminance distributions (the CIE standard overcast sky, which
-//!   BRE 209's vertical sky component is defined under, and the uniform sky).
+//!   BRE 209's vertical sky component is defined under, and the uniform sky);
+//! - [`all_weather`]: the Perez all-weather luminance distribution, as Radiance's gendaymtx;
+//! - [`model`]: the `sky_model` choice among them, and each hour's patch radiances.
 //!
 //! Combining them with the beam per timestep is [`crate::export::irradiation`]'s.
 
+pub mod all_weather;
 pub mod directions;
 pub mod energyplus;
 pub mod luminance;
+pub mod model;
 pub mod patches;
 pub mod perez;
 pub mod views;

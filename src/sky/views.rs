@@ -11,6 +11,10 @@
 //!   horizon-band visibility (the weight-averaged visibility of the band nearest the horizon,
 //!   1 where the receiver sees none of that band), the three things the Perez sky needs.
 //!
+//! For a sky model that is a luminance distribution ([`SkyModel::is_distribution`]) the views
+//! also keep, per item and patch, the visible ∫cos dΩ (weight × visibility) and the open one, so
+//! that each hour's patch radiances can be summed over what the item sees of them.
+//!
 //! [`Seen`] is that combination patch by patch, and [`SkyViews`] holds its results for any list
 //! of items: the receivers here, a map's points in [`crate::map::sky`] (each point's own patch
 //! visibility, from shadow rays instead of fractions).
@@ -18,6 +22,7 @@
 use crate::count::{Engine, ViewKind, ViewRequest};
 use crate::error::Result;
 use crate::scene::Scene;
+use crate::sky::model::SkyModel;
 use crate::sky::patches::SkyPatches;
 use crate::year::annual::Progress;
 
@@ -37,6 +42,12 @@ pub struct SkyViews {
     horizon: Vec<Vec<f64>>,
     /// Per receiver: Σ weight / π.
     unobstructed: Vec<f64>,
+    /// The sky model the views are kept for.
+    model: SkyModel,
+    /// For a distribution, per leaf state, per item, per patch: weight × visibility (sr).
+    patch_seen: Vec<Vec<Vec<f32>>>,
+    /// For a distribution, per item, per patch: the weight (sr).
+    patch_open: Vec<Vec<f32>>,
 }
 
 impl SkyViews {
@@ -49,7 +60,54 @@ impl SkyViews {
             isotropic: seen.iter().map(|state| state.iter().map(Seen::isotropic).collect()).collect(),
             horizon: seen.iter().map(|state| state.iter().map(Seen::horizon).collect()).collect(),
             unobstructed,
+            model: SkyModel::EnergyPlus,
+            patch_seen: Vec::new(),
+            patch_open: Vec::new(),
         }
+    }
+
+    /// The views kept for a luminance distribution `model`: `seen[state][item][patch]` is the
+    /// item's weight × visibility of the patch and `open[item][patch]` its weight.
+    pub(crate) fn with_patches(mut self, model: SkyModel, seen: Vec<Vec<Vec<f32>>>, open: Vec<Vec<f32>>) -> Self {
+        self.model = model;
+        self.patch_seen = seen;
+        self.patch_open = open;
+        self
+    }
+
+    /// The sky model the views are kept for ([`SkyModel::EnergyPlus`] unless counted for another).
+    pub fn model(&self) -> SkyModel {
+        self.model
+    }
+
+    /// Item `r`'s sky diffuse (W/m²) under patch `radiances` (W/m²/sr) at leaf fraction
+    /// `leaves`: Σ radiance × visible ∫cos dΩ. 0 for views kept without patches.
+    pub fn distribution_diffuse(&self, r: usize, leaves: f64, radiances: &[f64]) -> f64 {
+        let dot = |patches: &[f32]| -> f64 { patches.iter().zip(radiances).map(|(&w, l)| f64::from(w) * l).sum() };
+        match self.patch_seen.as_slice() {
+            [only] => dot(&only[r]),
+            [bare, full, ..] => {
+                let t = leaves.clamp(0.0, 1.0);
+                dot(&bare[r]) * (1.0 - t) + dot(&full[r]) * t
+            }
+            [] => 0.0,
+        }
+    }
+
+    /// Item `r`'s Σ over leaf states and patches of `per_state[state][patch]` × its visible
+    /// ∫cos dΩ of the patch at that state: a period's sky diffuse from its radiance × hours summed
+    /// per patch and weighted by leaf state. 0 for views kept without patches.
+    pub fn distribution_sum(&self, r: usize, per_state: &[Vec<f64>]) -> f64 {
+        self.patch_seen
+            .iter()
+            .zip(per_state)
+            .map(|(state, totals)| state[r].iter().zip(totals).map(|(&w, t)| f64::from(w) * t).sum::<f64>())
+            .sum()
+    }
+
+    /// Item `r`'s sky diffuse (W/m²) under patch `radiances` with nothing in the way.
+    pub fn distribution_open(&self, r: usize, radiances: &[f64]) -> f64 {
+        self.patch_open.get(r).map_or(0.0, |open| open.iter().zip(radiances).map(|(&w, l)| f64::from(w) * l).sum())
     }
 
     /// Receivers covered (points, for a map's views).
@@ -85,11 +143,23 @@ impl SkyViews {
     }
 }
 
-/// Counts the sky views of every receiver of `scene` with `engine`.
+/// Counts the sky views of every receiver of `scene` with `engine`, for the `energyplus` sky.
 pub async fn sky_views(
     engine: &impl Engine,
     scene: &Scene,
     patches: &SkyPatches,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<SkyViews> {
+    sky_views_for(engine, scene, patches, SkyModel::EnergyPlus, progress).await
+}
+
+/// Counts the sky views of every receiver of `scene` with `engine`, kept for sky `model` (per
+/// patch for a distribution).
+pub async fn sky_views_for(
+    engine: &impl Engine,
+    scene: &Scene,
+    patches: &SkyPatches,
+    model: SkyModel,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<SkyViews> {
     let leaf_states: Vec<f32> = if scene.has_foliage() { vec![0.0, 1.0] } else { vec![1.0] };
@@ -108,12 +178,22 @@ pub async fn sky_views(
     let receivers = scene.receivers.len();
     let unobstructed: Vec<f64> = weights.iter().map(|w| w.iter().map(|pw| pw.weight).sum::<f64>() / std::f64::consts::PI).collect();
     let mut seen = vec![vec![Seen::default(); receivers]; leaf_states.len()];
-    for (state, fractions) in seen.iter_mut().zip(fractions.chunks(lit.len().max(1))) {
+    let keep = model.is_distribution();
+    let mut patch_seen = vec![vec![vec![0.0f32; if keep { patches.len() } else { 0 }]; receivers]; leaf_states.len()];
+    for ((state, kept), fractions) in seen.iter_mut().zip(patch_seen.iter_mut()).zip(fractions.chunks(lit.len().max(1))) {
         for (&(r, p), &f) in lit.iter().zip(fractions) {
             state[r].add(weights[r][p].weight, f, patches.patches[p].band == 0);
+            if keep {
+                kept[r][p] = (weights[r][p].weight * f) as f32;
+            }
         }
     }
-    Ok(SkyViews::from_seen(patches, leaf_states, &seen, unobstructed))
+    let views = SkyViews::from_seen(patches, leaf_states, &seen, unobstructed);
+    if !keep {
+        return Ok(views);
+    }
+    let open = weights.iter().map(|w| w.iter().map(|pw| pw.weight as f32).collect()).collect();
+    Ok(views.with_patches(model, patch_seen, open))
 }
 
 /// What one item (a receiver, a map's point) sees of the sky, gathered patch by patch: Σ

@@ -9,6 +9,9 @@ blend towards the ground near the horizon, which VSC leaves out). `rtrace -I -ab
 ambient divisions, no caching, gives each point's irradiance from the visible sky (offset 1 mm
 along its normal), and one horizontal point with no geometry the unobstructed horizontal; VSC is
 their ratio in %. Prints JSON {"vsc": [...], "horizontal": E}.
+
+With "sky": "uniform" in the input, the glow is uniform above the horizon instead (the same
+ratio is then the view factor to the visible sky over the horizontal's, in %).
 """
 
 import json
@@ -24,8 +27,9 @@ env = dict(os.environ, RAYPATH=os.path.join(root, "lib") + os.pathsep + ".")
 binary = lambda name: os.path.join(root, "bin", name)
 case = json.load(open(sys.argv[1]))
 
-SKY = """void brightfunc overcast
-2 max(0,(1+2*Dz)/3)*if(Dz,1,0) .
+LUMINANCE = {"cie-overcast": "max(0,(1+2*Dz)/3)*if(Dz,1,0)", "uniform": "if(Dz,1,0)"}[case.get("sky", "cie-overcast")]
+SKY = f"""void brightfunc overcast
+2 {LUMINANCE} .
 0
 0
 overcast glow skyglow

@@ -60,6 +60,17 @@ pub fn apsh(apsh: f64, wpsh: f64, before: Option<(f64, f64)>) -> Verdict {
     Verdict { passes: absolute || relative == Some(true), absolute, relative }
 }
 
+/// BRE 209's 25° pre-check: nothing in the perpendicular section above [`super::bre_lines::LINE_25_DEG`].
+pub fn line_25(angle_deg: f64) -> Verdict {
+    let absolute = angle_deg <= super::bre_lines::LINE_25_DEG + TOLERANCE;
+    Verdict { passes: absolute, absolute, relative: None }
+}
+
+/// BRE 209's 45° pre-check: nothing within both 45° lines.
+pub fn line_45(within: bool) -> Verdict {
+    Verdict { passes: !within, absolute: !within, relative: None }
+}
+
 /// GB 50180's test: `hours` reach `required`.
 pub fn hours(hours: f64, required: f64) -> Verdict {
     let absolute = at_least(hours, required);

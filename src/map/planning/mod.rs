@@ -4,6 +4,7 @@
 //! - [`apsh`]: BRE 209's annual and winter probable sunlight hours, approximated from an EPW's
 //!   direct normal irradiance;
 //! - [`gb50180`]: GB 50180-2018's sunlight hours on 大寒日 or 冬至日 in true solar time;
+//! - [`bre_lines`]: BRE 209's 25° and 45° pre-checks, exact on the scene's triangles;
 //! - [`compare`]: each rule's pass/fail, alone and against the existing scene's values
 //!   (BRE's 0.8 × former value and 4-point APSH loss);
 //! - [`mask`]: what a point sees of the sky and the sun's paths, for its stereographic diagram.
@@ -13,6 +14,7 @@
 //! exact engine's shadows, as for every map, where casters are see-through.
 
 pub mod apsh;
+pub mod bre_lines;
 pub mod compare;
 pub mod gb50180;
 pub mod mask;
