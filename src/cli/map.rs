@@ -21,6 +21,8 @@ use super::*;
 mod inside;
 #[path = "map_planning.rs"]
 mod planning;
+#[path = "map_pv.rs"]
+mod pv;
 
 #[derive(Args)]
 #[command(group = clap::ArgGroup::new("site").args(["epw", "location"]))]
@@ -100,6 +102,14 @@ pub(super) struct MapArgs {
     /// Print a JSON summary.
     #[arg(long)]
     json: bool,
+    /// Also write each point's beam shaded fraction per timestep on pvlib's time index, one column
+    /// point_I per row I of the points CSV (annual; docs/district.md shows the pvlib code).
+    #[arg(long, value_name = "FILE.csv")]
+    pvlib: Option<PathBuf>,
+    /// Also write SAM pvsamv1's shading inputs for the points taken as one array (annual; needs
+    /// --epw).
+    #[arg(long, value_name = "FILE.json")]
+    sam: Option<PathBuf>,
     /// Window studies (bre-vsc, bre-apsh, gb50180): the existing scene's models; each point's
     /// former values go beside the proposed ones, with BRE's relative tests. Needs --points.
     #[arg(long, value_name = "MODEL", num_args = 1..)]
@@ -270,6 +280,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
     }
     let plan = args.plan()?;
     let on_gpu = args.on_gpu()?;
+    pv::check(&args, &plan, on_gpu)?;
     if let Some(g) = args.grid
         && !(g.is_finite() && g > 0.0)
     {
@@ -332,6 +343,9 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         };
         let csv = points_csv(&scene, &points, &value_columns(&values));
         summary["sun_up_instants"] = json!(values.sun_up);
+        if pv::wanted(&args) {
+            files.extend(pv::outputs(&args, &mapper, &points, &samples, site, &values, &mut meter)?);
+        }
         let mut studies = Vec::new();
         for rule in &plan.rules {
             meter.stage(&format!("{} points: {}", points.len(), rule.name), "instants");

@@ -121,7 +121,7 @@ pub fn solar_outputs(
     let year = plan.year.unwrap_or(pv::DEFAULT_YEAR);
     let mut out = Vec::new();
     if let Some(path) = &plan.pvlib {
-        out.push((path.clone(), pv::pvlib_csv(scene, schedule, &settings.location, year)?));
+        out.push((path.clone(), pv::pvlib_csv(&pv::PvSet::surfaces(scene, schedule)?, &settings.location, year)?));
     }
     // The pvlib CSV needs the fractions alone, not the sky.
     if plan.summary.is_none() && plan.irradiance.is_none() && plan.sam.is_none() {
@@ -154,8 +154,8 @@ pub fn solar_outputs(
         }))?;
         let summaries =
             irradiation::summarize(scene, schedule, &settings.location, Some((&views, &settings.calendar)), Some(weather), &[])?;
-        let inputs = pv::SamInputs { year, azal_fractions: &azal_fractions, summaries: &summaries };
-        out.push((path.clone(), pv::sam_json(scene, schedule, &settings.location, &inputs)?));
+        let inputs = pv::SamInputs { year, azal_fractions: &azal_fractions, diffuse_loss: pv::surfaces_diffuse_loss(&summaries)? };
+        out.push((path.clone(), pv::sam_json(&pv::PvSet::surfaces(scene, schedule)?, &settings.location, &inputs)?));
     }
     if let Some((path, format)) = &plan.summary {
         let start = std::time::Instant::now();

@@ -1,14 +1,16 @@
-//! What PV tools read: the beam shaded fraction of a selected set of receivers, per timestep, for
-//! pvlib (a CSV on pvlib's time index) and for SAM's detailed PV model `pvsamv1` (its
-//! `subarray1_shading_*` inputs as JSON).
+//! What PV tools read: the beam shaded fraction of a selected set of receivers (`annual`) or of
+//! a map's points (`map`), per timestep, for pvlib (a CSV on pvlib's time index) and for SAM's
+//! detailed PV model `pvsamv1` (its `subarray1_shading_*` inputs as JSON).
 //!
-//! Owns the definitions (docs/district.md shows the pvlib and PySAM code that reads them):
-//! - **beam shaded fraction** of a receiver at a timestep: 1 − its sunlit fraction while the sun
-//!   is up and in front of it (cos zenith and cos incidence ≥ [`MIN_COS_INCIDENCE`], the
-//!   fractions' own rule); 0 otherwise, as there is no beam to lose;
+//! Owns the definitions (docs/district.md shows the pvlib and PySAM code that reads them), over
+//! a [`PvSet`] of members (receivers, or points with their own normals and visibilities):
+//! - **beam shaded fraction** of a member at a timestep: 1 − its sunlit fraction (a point's
+//!   visibility) while the sun is up and in front of it (cos zenith and cos incidence ≥
+//!   [`MIN_COS_INCIDENCE`], the fractions' own rule); 0 otherwise, as there is no beam to lose;
 //! - **a set's beam loss** (SAM's one array): 1 − Σ area·fraction·cos θ / Σ area·cos θ over its
-//!   receivers facing the sun, i.e. the share of the set's unshaded beam that is shaded (for one
-//!   receiver, its shaded fraction); 0 when no receiver faces the sun;
+//!   members facing the sun, i.e. the share of the set's unshaded beam that is shaded (for one
+//!   member, its shaded fraction); 0 when none faces the sun. A grid's points each stand for
+//!   spacing² of surface; points from a CSV weigh alike;
 //! - **pvlib's time index**: each row labelled with the start of its timestep in local standard
 //!   time with the UTC offset (`2023-01-01T00:00:00+01:00`), as `pvlib.iotools.read_epw` labels
 //!   the EPW's hours (hour − 1). The value holds for the whole timestep; it was counted at its
@@ -31,12 +33,13 @@ use super::Schedule;
 use super::irradiation::SurfaceSummary;
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
+use crate::map::Points;
 use crate::model::run_year::is_leap;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 use crate::year::annual::shading_sun_day;
-use crate::year::samples::month_day_of;
+use crate::year::samples::{Timesteps, month_day_of};
 
 /// SAM's azimuth × altitude table: azimuths every this many degrees from 0 to 360.
 pub const AZAL_AZIMUTH_STEP: u32 = 10;
@@ -70,27 +73,82 @@ fn timestamp(year: i32, leap: bool, row: usize, per_hour: u32, time_zone: f64) -
     )
 }
 
+/// One array's members as the PV outputs see them (surfaces of a schedule, or a map's points),
+/// each with a name, a normal, an area and a sunlit fraction at each row of a year.
+pub struct PvSet<'a> {
+    /// What the members are ("surfaces" or "points"), for SAM's notes.
+    pub kind: &'static str,
+    /// Column names, one a member.
+    pub names: Vec<String>,
+    /// Each member's unit normal (x east, y north, z up).
+    pub normals: Vec<DVec3>,
+    /// Each member's area (m²): its weight in the array.
+    pub areas: Vec<f64>,
+    /// The rows' timesteps (a whole year).
+    pub timesteps: Timesteps,
+    /// `fraction(row, member)`: the member's sunlit fraction (a point's visibility) at a row.
+    pub fraction: Box<dyn Fn(usize, usize) -> f32 + 'a>,
+}
+
+impl<'a> PvSet<'a> {
+    /// The scene's receivers, their fractions the schedule's columns.
+    pub fn surfaces(scene: &Scene, schedule: &'a Schedule) -> Result<Self> {
+        if scene.receivers.len() != schedule.names.len() {
+            return Err(Error::argument("schedule", format!("{} columns for {} receivers", schedule.names.len(), scene.receivers.len())));
+        }
+        Ok(Self {
+            kind: "surfaces",
+            names: schedule.names.clone(),
+            normals: scene.receivers.iter().map(|r| r.normal).collect(),
+            areas: scene.receivers.iter().map(|r| r.area).collect(),
+            timesteps: schedule.timesteps,
+            fraction: Box::new(|row, c| schedule.get(row, c)),
+        })
+    }
+
+    /// A map's points named `point_I` (I the 0-based row of the map's points CSV), each standing
+    /// for `spacing²` of surface (a grid) or 1 m² (points from a CSV: equal weights), their
+    /// visibilities `series` (row-major: a row of every point per timestep of a 365-day year at
+    /// `per_hour`, as [`crate::map::Mapper::visibility_series`] gives).
+    pub fn points(points: &Points, series: &'a [f32], per_hour: u32) -> Result<Self> {
+        let timesteps = Timesteps::new(per_hour)?;
+        let n = points.len();
+        if series.len() != timesteps.rows() * n {
+            return Err(Error::argument("series", format!("{} values for {n} points × {} timesteps", series.len(), timesteps.rows())));
+        }
+        let area = points.spacing.map_or(1.0, |s| s * s);
+        Ok(Self {
+            kind: "points",
+            names: (0..n).map(|i| format!("point_{i}")).collect(),
+            normals: (0..n).map(|i| points.normal(i)).collect(),
+            areas: vec![area; n],
+            timesteps,
+            fraction: Box::new(move |row, i| series[row * n + i]),
+        })
+    }
+
+    fn len(&self) -> usize {
+        self.names.len()
+    }
+}
+
 /// The sun (unit vector) at each row, or `None` while it is down.
-fn suns(schedule: &Schedule, location: &Location) -> Vec<Option<DVec3>> {
-    schedule
-        .timesteps
+fn suns(set: &PvSet, location: &Location) -> Vec<Option<DVec3>> {
+    set.timesteps
         .instants()
         .map(|i| Some(sun_direction(location, shading_sun_day(i.day), i.hour)).filter(|s| s.z >= MIN_COS_INCIDENCE))
         .collect()
 }
 
-fn check(scene: &Scene, schedule: &Schedule, year: i32) -> Result<()> {
-    if scene.receivers.len() != schedule.names.len() {
-        return Err(Error::argument("schedule", format!("{} columns for {} receivers", schedule.names.len(), scene.receivers.len())));
-    }
-    if is_leap(year) != schedule.timesteps.is_leap() {
-        let days = schedule.timesteps.days();
-        return Err(Error::argument("year", format!("{year} does not have the schedule's {days} days")));
+fn check_year(set: &PvSet, year: i32) -> Result<()> {
+    if is_leap(year) != set.timesteps.is_leap() {
+        let days = set.timesteps.days();
+        return Err(Error::argument("year", format!("{year} does not have the {}' {days} days", set.kind)));
     }
     Ok(())
 }
 
-/// A receiver's beam shaded fraction at a row (see the module doc).
+/// A member's beam shaded fraction at a row (see the module doc).
 fn shaded(normal: DVec3, sun: Option<DVec3>, fraction: f32) -> f64 {
     match sun {
         Some(s) if normal.dot(s) >= MIN_COS_INCIDENCE => 1.0 - f64::from(fraction).clamp(0.0, 1.0),
@@ -103,24 +161,24 @@ fn field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() }
 }
 
-/// The pvlib CSV: `time`, then one column per receiver (its name) of beam shaded fractions, one
+/// The pvlib CSV: `time`, then one column per member (its name) of beam shaded fractions, one
 /// row per timestep of `year` (see the module doc).
-pub fn pvlib_csv(scene: &Scene, schedule: &Schedule, location: &Location, year: i32) -> Result<Vec<u8>> {
-    check(scene, schedule, year)?;
-    let suns = suns(schedule, location);
-    let columns = schedule.names.len();
+pub fn pvlib_csv(set: &PvSet, location: &Location, year: i32) -> Result<Vec<u8>> {
+    check_year(set, year)?;
+    let suns = suns(set, location);
+    let columns = set.len();
     let mut text = String::with_capacity(suns.len() * (32 + 8 * columns));
     text.push_str("time");
-    for name in &schedule.names {
+    for name in &set.names {
         text.push(',');
         text.push_str(&field(name));
     }
     text.push('\n');
-    let (leap, per_hour) = (schedule.timesteps.is_leap(), schedule.timesteps.per_hour());
+    let (leap, per_hour) = (set.timesteps.is_leap(), set.timesteps.per_hour());
     for (row, sun) in suns.iter().enumerate() {
         text.push_str(&timestamp(year, leap, row, per_hour, location.time_zone));
-        for (c, receiver) in scene.receivers.iter().enumerate() {
-            let v = shaded(receiver.normal, *sun, schedule.get(row, c));
+        for (c, normal) in set.normals.iter().enumerate() {
+            let v = shaded(*normal, *sun, (set.fraction)(row, c));
             // Six decimals; never "-0".
             let _ = write!(text, ",{}", if v == 0.0 { "0".to_string() } else { format!("{v:.6}") });
         }
@@ -129,15 +187,15 @@ pub fn pvlib_csv(scene: &Scene, schedule: &Schedule, location: &Location, year: 
     Ok(text.into_bytes())
 }
 
-/// The set's beam loss (0..1) for a sun, from each receiver's fraction (see the module doc);
-/// `None` when no receiver faces it.
-fn set_loss(scene: &Scene, sun: DVec3, fraction: impl Fn(usize) -> f64) -> Option<f64> {
+/// The set's beam loss (0..1) for a sun, from each member's fraction (see the module doc);
+/// `None` when no member faces it.
+fn set_loss(set: &PvSet, sun: DVec3, fraction: impl Fn(usize) -> f64) -> Option<f64> {
     let (mut lit, mut all) = (0.0, 0.0);
-    for (c, r) in scene.receivers.iter().enumerate() {
-        let cos = r.normal.dot(sun);
+    for (c, (normal, area)) in set.normals.iter().zip(&set.areas).enumerate() {
+        let cos = normal.dot(sun);
         if cos >= MIN_COS_INCIDENCE && sun.z >= MIN_COS_INCIDENCE {
-            lit += r.area * cos * fraction(c).clamp(0.0, 1.0);
-            all += r.area * cos;
+            lit += area * cos * fraction(c).clamp(0.0, 1.0);
+            all += area * cos;
         }
     }
     (all > 0.0).then(|| (1.0 - lit / all).clamp(0.0, 1.0))
@@ -163,34 +221,34 @@ fn percent(loss: f64) -> f64 {
     if p == 0.0 { 0.0 } else { p }
 }
 
-/// What [`sam_json`] is made from besides the schedule.
+/// What [`sam_json`] is made from besides the set's fractions.
 pub struct SamInputs<'a> {
-    /// The run's year (its length must be the schedule's).
+    /// The run's year (its length must be the set's).
     pub year: i32,
-    /// The engine's fraction for each receiver (inner) and each of [`azal_directions`] (outer).
+    /// The engine's fraction for each member (inner) and each of [`azal_directions`] (outer).
     pub azal_fractions: &'a [Vec<f64>],
-    /// Each receiver's summary, with weather (the diffuse loss).
-    pub summaries: &'a [SurfaceSummary],
+    /// The set's sky-diffuse loss over the year (0..1): [`diffuse_loss`] of its members.
+    pub diffuse_loss: f64,
 }
 
-/// SAM's `pvsamv1` shading inputs for the scene's receivers taken as one array, as JSON:
+/// SAM's `pvsamv1` shading inputs for the set's members taken as one array, as JSON:
 /// `{"sunlit": {…what and how…}, "Shading": {"subarray1_shading_…": …}}`; `Shading` is what
 /// PySAM's `Pvsamv1.Shading.assign` takes.
-pub fn sam_json(scene: &Scene, schedule: &Schedule, location: &Location, inputs: &SamInputs) -> Result<Vec<u8>> {
-    check(scene, schedule, inputs.year)?;
+pub fn sam_json(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<Vec<u8>> {
+    check_year(set, inputs.year)?;
     let directions = azal_directions();
     if inputs.azal_fractions.len() != directions.len() {
         return Err(Error::argument("azal_fractions", format!("{} directions, not {}", inputs.azal_fractions.len(), directions.len())));
     }
-    let suns = suns(schedule, location);
-    let per_hour = schedule.timesteps.per_hour() as usize;
-    let leap = schedule.timesteps.is_leap();
+    let suns = suns(set, location);
+    let per_hour = set.timesteps.per_hour() as usize;
+    let leap = set.timesteps.is_leap();
     let mut timestep = Vec::with_capacity(8760 * per_hour);
     let mut mxh = [[(0.0f64, 0usize); 24]; 12];
     for (row, sun) in suns.iter().enumerate() {
         let day = (row / (24 * per_hour)) as u32 + 1;
         let (month, dom) = month_day_of(day, leap);
-        let loss = sun.and_then(|s| set_loss(scene, s, |c| f64::from(schedule.get(row, c))));
+        let loss = sun.and_then(|s| set_loss(set, s, |c| f64::from((set.fraction)(row, c))));
         if let Some(l) = loss {
             let cell = &mut mxh[month as usize - 1][(row / per_hour) % 24];
             cell.0 += l;
@@ -202,14 +260,12 @@ pub fn sam_json(scene: &Scene, schedule: &Schedule, location: &Location, inputs:
     }
     let mxh: Vec<Vec<f64>> =
         mxh.iter().map(|m| m.iter().map(|&(s, n)| if n == 0 { 0.0 } else { percent(s / n as f64) }).collect()).collect();
-    let azal = azal_table(scene, &directions, inputs.azal_fractions);
-    let diffuse = diffuse_loss(inputs.summaries)?;
-    let names: Vec<&str> = schedule.names.iter().map(String::as_str).collect();
-    let area: f64 = scene.receivers.iter().map(|r| r.area).sum();
+    let azal = azal_table(set, &directions, inputs.azal_fractions);
+    let area: f64 = set.areas.iter().sum();
     let doc = json!({
         "sunlit": {
-            "what": "pvsamv1 shading inputs for the surfaces below taken as one array (subarray 1): beam loss % = 100·(1 − shaded beam / unshaded beam)",
-            "surfaces": names,
+            "what": format!("pvsamv1 shading inputs for the {} below taken as one array (subarray 1): beam loss % = 100·(1 − shaded beam / unshaded beam)", set.kind),
+            set.kind: set.names,
             "area_m2": area,
             "year": inputs.year,
             "timesteps_per_hour": per_hour,
@@ -224,7 +280,7 @@ pub fn sam_json(scene: &Scene, schedule: &Schedule, location: &Location, inputs:
             "subarray1_shading_en_azal": 0,
             "subarray1_shading_azal": azal,
             "subarray1_shading_en_diff": 1,
-            "subarray1_shading_diff": percent(diffuse),
+            "subarray1_shading_diff": percent(inputs.diffuse_loss),
         },
     });
     let mut text = serde_json::to_vec(&doc).map_err(|e| Error::model("SAM shading", e.to_string()))?;
@@ -233,32 +289,40 @@ pub fn sam_json(scene: &Scene, schedule: &Schedule, location: &Location, inputs:
 }
 
 /// SAM's azimuth × altitude table: `[[0, az…], [alt, loss%…], …]`.
-fn azal_table(scene: &Scene, directions: &[(f64, f64, DVec3)], fractions: &[Vec<f64>]) -> Vec<Vec<f64>> {
+fn azal_table(set: &PvSet, directions: &[(f64, f64, DVec3)], fractions: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let columns = (360 / AZAL_AZIMUTH_STEP + 1) as usize;
     let mut table = vec![std::iter::once(0.0).chain(directions.iter().take(columns).map(|d| d.0)).collect::<Vec<f64>>()];
     for (row, chunk) in directions.chunks(columns).enumerate() {
         let mut line = vec![chunk[0].1];
         for (k, &(_, _, sun)) in chunk.iter().enumerate() {
             let f = &fractions[row * columns + k];
-            line.push(percent(set_loss(scene, sun, |c| f.get(c).copied().unwrap_or(0.0)).unwrap_or(0.0)));
+            line.push(percent(set_loss(set, sun, |c| f.get(c).copied().unwrap_or(0.0)).unwrap_or(0.0)));
         }
         table.push(line);
     }
     table
 }
 
-/// The set's sky-diffuse loss (0..1) over the year: 1 − Σ area·shaded / Σ area·unshaded.
-fn diffuse_loss(summaries: &[SurfaceSummary]) -> Result<f64> {
-    let (mut shaded, mut unshaded) = (0.0, 0.0);
-    for s in summaries {
-        let need = |v: Option<f64>| v.ok_or_else(|| Error::argument("epw", "SAM's diffuse loss needs weather (irradiation)"));
-        let sky = need(s.sky_diffuse)?;
-        // The unshaded total less the unshaded beam and the (never shaded) ground-reflected part.
-        let open = need(s.unshaded_total)? - need(s.unshaded_irradiation)? - need(s.ground_reflected)?;
-        shaded += s.area * sky;
-        unshaded += s.area * open;
-    }
-    Ok(if unshaded > 0.0 { (1.0 - shaded / unshaded).clamp(0.0, 1.0) } else { 0.0 })
+/// A set's sky-diffuse loss (0..1) over the year from each member's `(area, shaded, unshaded)`
+/// sky diffuse: 1 − Σ area·shaded / Σ area·unshaded (0 with no sky at all).
+pub fn diffuse_loss(members: impl IntoIterator<Item = (f64, f64, f64)>) -> f64 {
+    let (shaded, unshaded) =
+        members.into_iter().fold((0.0, 0.0), |(s, u), (area, shaded, unshaded)| (s + area * shaded, u + area * unshaded));
+    if unshaded > 0.0 { (1.0 - shaded / unshaded).clamp(0.0, 1.0) } else { 0.0 }
+}
+
+/// The surfaces' sky-diffuse loss (0..1) over the year from their summaries ([`diffuse_loss`]).
+pub fn surfaces_diffuse_loss(summaries: &[SurfaceSummary]) -> Result<f64> {
+    let need = |v: Option<f64>| v.ok_or_else(|| Error::argument("epw", "SAM's diffuse loss needs weather (irradiation)"));
+    let members = summaries
+        .iter()
+        .map(|s| {
+            // The unshaded total less the unshaded beam and the (never shaded) ground-reflected part.
+            let open = need(s.unshaded_total)? - need(s.unshaded_irradiation)? - need(s.ground_reflected)?;
+            Ok((s.area, need(s.sky_diffuse)?, open))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(diffuse_loss(members))
 }
 
 #[cfg(test)]

@@ -15,6 +15,8 @@
 //!   with the sun `sunlit annual` uses;
 //! - [`planning`]: window studies (BRE 209's VSC and APSH/WPSH, GB 50180's sunlight hours),
 //!   their pass/fail alone and against an existing scene, and each point's sky mask;
+//! - [`series`]: each point's visibility at every instant and its unshaded sky (what PV tools
+//!   read, [`crate::export::pv`]);
 //! - [`MapGpu`]: the same sweeps with each point answered by its texel in the GPU counter's tile
 //!   of its receiver (`gpu`, [`crate::count::gpu::masks`]): `*_gpu` methods of [`Mapper`].
 //!
@@ -39,6 +41,7 @@ pub mod inside;
 pub mod period;
 pub mod planning;
 pub mod points;
+pub mod series;
 pub mod sky;
 pub mod study;
 

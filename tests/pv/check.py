@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 import pvlib
 import PySAM
-import PySAM.Pvsamv1 as Pvsamv1
+
+import pysam_run
 
 setup = json.load(open(sys.argv[1]))
 out = {"pvlib_version": pvlib.__version__, "pysam_version": PySAM.__version__}
@@ -40,25 +41,10 @@ sam = json.load(open(setup["sam"]))["Shading"]
 
 
 def run(**change):
-    model = Pvsamv1.default("FlatPlatePVNone")
-    model.SolarResource.solar_resource_file = setup["epw"]
-    model.SystemDesign.subarray1_tilt = 0
-    model.Losses.subarray1_soiling = [0] * 12  # the beam factor is shading × soiling
-    model.Shading.assign(dict(sam, **change))
-    model.execute(0)
-    return model  # outputs live while the model does
+    return pysam_run.run(setup["epw"], sam, **change)
 
 
-timestep = run()
-factor = np.array(timestep.Outputs.subarray1_beam_shading_factor)
-loss = np.array([row[0] for row in sam["subarray1_shading_timestep"]]) / 100
-out["sam_timestep_max_error"] = float(np.abs(factor - (1 - loss)).max())
-no_diffuse = run(subarray1_shading_en_diff=0)
-diffuse = np.array(timestep.Outputs.subarray1_poa_eff_diff)
-open_diffuse = np.array(no_diffuse.Outputs.subarray1_poa_eff_diff)
-lit = open_diffuse > 1
-out["sam_diffuse_factor"] = float((diffuse[lit] / open_diffuse[lit]).mean())
-out["sam_diffuse_loss_percent"] = sam["subarray1_shading_diff"]
+timestep, factor, loss = pysam_run.applied(setup["epw"], sam, out)
 beam = np.array(timestep.Outputs.subarray1_poa_eff_beam) > 1
 
 
