@@ -42,6 +42,9 @@ pub struct Glazing {
     pub plane: Plane,
     /// Its outline in `plane`'s coordinates.
     pub outline: Vec<DVec2>,
+    /// Its outline moved onto its base surface's plane: the hole cut in the wall (the same as
+    /// `vertices` unless the window is set back).
+    pub hole: Vec<DVec3>,
     /// Solar transmittance at normal incidence (beam irradiation).
     pub solar: f64,
     /// Visible transmittance at normal incidence (illuminance).
@@ -118,11 +121,12 @@ pub fn inside_scene(input: &EnergyPlusInput) -> Result<Scene> {
     builder.build()
 }
 
-/// As [`inside_scene`] with only the glazing named `window` open (see
-/// [`super::building::Building::add_inside_through`]).
-pub fn inside_scene_through(input: &EnergyPlusInput, window: &str) -> Result<Scene> {
+/// As [`inside_scene`] with every opening glazed (see
+/// [`super::building::Building::add_inside_glazed`]): each window's glass is a receiver under
+/// the window's name, for views that see through it alone.
+pub fn inside_scene_glazed(input: &EnergyPlusInput) -> Result<Scene> {
     let mut builder = SceneBuilder::new();
-    input.building.add_inside_through(&mut builder, window)?;
+    input.building.add_inside_glazed(&mut builder)?;
     builder.build()
 }
 
@@ -197,10 +201,16 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
             (t, t, None)
         }
     };
-    let interzone = input
-        .building
-        .surface(s.base.as_deref().unwrap_or_default())
-        .is_some_and(|b| b.outside_boundary.eq_ignore_ascii_case("Surface") || b.outside_boundary.eq_ignore_ascii_case("Zone"));
+    let base = input.building.surface(s.base.as_deref().unwrap_or_default());
+    let interzone =
+        base.is_some_and(|b| b.outside_boundary.eq_ignore_ascii_case("Surface") || b.outside_boundary.eq_ignore_ascii_case("Zone"));
+    let hole = match base {
+        Some(b) => {
+            let wall = Plane::of_polygon(&b.vertices);
+            s.vertices.iter().map(|&p| wall.flatten(p)).collect()
+        }
+        None => s.vertices.clone(),
+    };
     let plane = Plane::through(s.vertices[0], newell(&s.vertices));
     let outline = s.vertices.iter().map(|&p| plane.project(p)).collect();
     Ok(Glazing {
@@ -209,6 +219,7 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
         vertices: s.vertices.clone(),
         plane,
         outline,
+        hole,
         solar,
         visible,
         solar_reflectance,
