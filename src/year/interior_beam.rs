@@ -16,9 +16,9 @@
 //! views a year asks are such (4ZoneWithShading_Simple_1: 223,533 before this test). The lit share `f` of face `s`
 //! through window `w` gives `DNI · τ_w · cos θ_s · f` on the face (θ_s between the sun and the
 //! face's inside normal): the beam's cross-section is the same on the window and on the patch.
-//! `τ_w` is the glass's solar transmittance at the window's incidence ([`Glazing::solar_at`]: one
-//! uncoated pane's angular dependence, else the normal-incidence value; EnergyPlus's curves for
-//! simple glazing are not applied).
+//! `τ_w` is the glass's solar transmittance at the window's incidence ([`Glazing::solar_at`]:
+//! EnergyPlus's curves for simple glazing, one uncoated pane's Fresnel physics, else the
+//! normal-incidence value).
 //!
 //! Interzone windows are no source of interior beam: their beam is what another zone's exterior
 //! window let in, which EnergyPlus passes on as diffuse. They are skipped by name.
