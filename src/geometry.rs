@@ -111,6 +111,25 @@ pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     p.distance(a + ab * t)
 }
 
+/// Whether an edge of either of two convex polygons (either orientation, possibly flat)
+/// separates them by at least `gap`: they are then at least that far apart. With no gap,
+/// touching polygons are apart; the test errs towards overlap (a flattened polygon across the
+/// other is not apart), which only costs its callers time.
+pub fn convex_apart(a: &[DVec2], b: &[DVec2], gap: f64) -> bool {
+    let separates = |edges: &[DVec2]| {
+        (0..edges.len()).any(|i| {
+            let axis = (edges[(i + 1) % edges.len()] - edges[i]).perp();
+            let span =
+                |p: &[DVec2]| p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(axis.dot(*q)), hi.max(axis.dot(*q))));
+            let ((a0, a1), (b0, b1)) = (span(a), span(b));
+            // The gap in the axis's own units (it is not normalised).
+            let slack = gap * axis.length();
+            axis != DVec2::ZERO && (a1 + slack <= b0 || b1 + slack <= a0)
+        })
+    };
+    separates(a) || separates(b)
+}
+
 /// Whether every turn of the polygon goes the same way as its normal.
 pub fn is_convex(v: &[DVec3]) -> bool {
     let n = newell(v);

@@ -9,9 +9,10 @@
 //! simple glazing correlation (Engineering Reference, "Simple Window Model", step 4: one formula
 //! for U > 4.5 W/m²K, one for U < 3.4, linear in U between). Any other construction takes the
 //! caller's `glass` value for both, except one `WindowMaterial:Glazing` pane given by spectral
-//! averages, whose normal-incidence fields are read as they are. EnergyPlus's angular dependence of the simple glazing model
-//! (its curves A–J chosen by U and SHGC) is not applied: the glass lets its normal-incidence
-//! value through at every angle.
+//! averages, whose normal-incidence fields are read as they are. The solar transmittance's
+//! angular dependence ([`Glazing::solar_at`], used by the interior beam) is EnergyPlus's: its
+//! curves A–J chosen by U and SHGC for simple glazing ([`super::simple_glazing`]), Fresnel's
+//! physics for one pane; the maps still weight a beam by the normal-incidence values.
 //!
 //! The scene ([`inside_scene`]) is the building's surfaces with the glazing left out, so an
 //! opening is a hole in its wall: the engines see the beam pass and the map weights it by the
@@ -21,6 +22,7 @@ use glam::{DVec2, DVec3};
 
 use super::EnergyPlusInput;
 use super::building::{EpSurface, inside_name};
+use super::simple_glazing::angular_factor;
 use crate::error::{Error, Result};
 use crate::geometry::{Plane, inside_or_on, newell, triangulate};
 use crate::scene::{Scene, SceneBuilder};
@@ -42,26 +44,48 @@ pub struct Glazing {
     pub plane: Plane,
     /// Its outline in `plane`'s coordinates.
     pub outline: Vec<DVec2>,
+    /// Its outline moved onto its base surface's plane: the hole cut in the wall (the same as
+    /// `vertices` unless the window is set back).
+    pub hole: Vec<DVec3>,
     /// Solar transmittance at normal incidence (beam irradiation).
     pub solar: f64,
     /// Visible transmittance at normal incidence (illuminance).
     pub visible: f64,
-    /// Front solar reflectance at normal incidence of one uncoated pane, which gives the solar
-    /// transmittance's angular dependence ([`Glazing::solar_at`]); None: the normal value holds
-    /// at every angle.
-    pub solar_reflectance: Option<f64>,
+    /// How the solar transmittance falls off with the angle of incidence ([`Glazing::solar_at`]).
+    pub angular: Angular,
     /// Its base surface's other side is another zone (Outside Boundary Condition Surface or Zone).
     pub interzone: bool,
 }
 
+/// The angular dependence of a glass's solar transmittance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Angular {
+    /// The normal-incidence value at every angle (a construction sunlit cannot read).
+    Normal,
+    /// One uncoated pane given by spectral averages, with its front solar reflectance at normal
+    /// incidence: Fresnel's physics ([`pane_transmittance`]).
+    Pane {
+        /// Front solar reflectance at normal incidence.
+        reflectance: f64,
+    },
+    /// A `WindowMaterial:SimpleGlazingSystem`: EnergyPlus's curves chosen by U and SHGC
+    /// ([`angular_factor`]).
+    Simple {
+        /// U-factor (W/m²K).
+        u: f64,
+        /// Solar heat gain coefficient.
+        shgc: f64,
+    },
+}
+
 impl Glazing {
-    /// Solar transmittance for a beam at `cos_incidence` to the glass's normal: one uncoated
-    /// pane's (see [`pane_transmittance`]) where the pane's reflectance is known, else the normal
-    /// value.
+    /// Solar transmittance for a beam at `cos_incidence` to the glass's normal, by its
+    /// [`Angular`] dependence.
     pub fn solar_at(&self, cos_incidence: f64) -> f64 {
-        match self.solar_reflectance {
-            Some(r) => pane_transmittance(self.solar, r, cos_incidence),
-            None => self.solar,
+        match self.angular {
+            Angular::Pane { reflectance } => pane_transmittance(self.solar, reflectance, cos_incidence),
+            Angular::Simple { u, shgc } => (self.solar * angular_factor(u, shgc, cos_incidence)).clamp(0.0, 1.0),
+            Angular::Normal => self.solar,
         }
     }
 
@@ -118,11 +142,12 @@ pub fn inside_scene(input: &EnergyPlusInput) -> Result<Scene> {
     builder.build()
 }
 
-/// As [`inside_scene`] with only the glazing named `window` open (see
-/// [`super::building::Building::add_inside_through`]).
-pub fn inside_scene_through(input: &EnergyPlusInput, window: &str) -> Result<Scene> {
+/// As [`inside_scene`] with every opening glazed (see
+/// [`super::building::Building::add_inside_glazed`]): each window's glass is a receiver under
+/// the window's name, for views that see through it alone.
+pub fn inside_scene_glazed(input: &EnergyPlusInput) -> Result<Scene> {
     let mut builder = SceneBuilder::new();
-    input.building.add_inside_through(&mut builder, window)?;
+    input.building.add_inside_glazed(&mut builder)?;
     builder.build()
 }
 
@@ -184,7 +209,7 @@ fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3]) -> bool {
 }
 
 fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Result<Glazing> {
-    let (solar, visible, solar_reflectance) = match simple_glazing(input, s)? {
+    let (solar, visible, angular) = match simple_glazing(input, s)? {
         Some(t) => t,
         None => {
             let Some(t) = glass else {
@@ -194,13 +219,19 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
                     "has no WindowMaterial:SimpleGlazingSystem construction to take a transmittance from: give a glass transmittance",
                 ));
             };
-            (t, t, None)
+            (t, t, Angular::Normal)
         }
     };
-    let interzone = input
-        .building
-        .surface(s.base.as_deref().unwrap_or_default())
-        .is_some_and(|b| b.outside_boundary.eq_ignore_ascii_case("Surface") || b.outside_boundary.eq_ignore_ascii_case("Zone"));
+    let base = input.building.surface(s.base.as_deref().unwrap_or_default());
+    let interzone =
+        base.is_some_and(|b| b.outside_boundary.eq_ignore_ascii_case("Surface") || b.outside_boundary.eq_ignore_ascii_case("Zone"));
+    let hole = match base {
+        Some(b) => {
+            let wall = Plane::of_polygon(&b.vertices);
+            s.vertices.iter().map(|&p| wall.flatten(p)).collect()
+        }
+        None => s.vertices.clone(),
+    };
     let plane = Plane::through(s.vertices[0], newell(&s.vertices));
     let outline = s.vertices.iter().map(|&p| plane.project(p)).collect();
     Ok(Glazing {
@@ -209,17 +240,18 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
         vertices: s.vertices.clone(),
         plane,
         outline,
+        hole,
         solar,
         visible,
-        solar_reflectance,
+        angular,
         interzone,
     })
 }
 
-/// (solar, visible) normal-incidence transmittance from a window's construction, when it is one
-/// `WindowMaterial:SimpleGlazingSystem` layer or one spectral-average pane (then with the pane's
-/// front solar reflectance); refuses values outside 0..=1, naming the material.
-fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64, f64, Option<f64>)>> {
+/// (solar, visible) normal-incidence transmittance and the solar one's angular dependence from a
+/// window's construction, when it is one `WindowMaterial:SimpleGlazingSystem` layer or one
+/// spectral-average pane; refuses values outside 0..=1, naming the material.
+fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64, f64, Angular)>> {
     let Some(name) = construction_of(input, s) else { return Ok(None) };
     let named = |class: &str, name: &str| {
         input.objects.iter().find(|o| o.is(class) && o.name().is_some_and(|n| n.eq_ignore_ascii_case(name.trim())))
@@ -252,7 +284,7 @@ fn simple_glazing(input: &EnergyPlusInput, s: &EpSurface) -> Result<Option<(f64,
         Some(v) => in_unit(v, "Visible Transmittance")?,
         None => solar,
     };
-    Ok(Some((solar, visible, None)))
+    Ok(Some((solar, visible, Angular::Simple { u, shgc })))
 }
 
 /// The construction a surface names, as written (None for a surface read from no object with
@@ -268,7 +300,7 @@ pub fn construction_of(input: &EnergyPlusInput, s: &EpSurface) -> Option<String>
 /// (solar, visible) normal-incidence transmittance and front solar reflectance of one
 /// `WindowMaterial:Glazing` pane given by its spectral averages; None for spectral data, which
 /// sunlit does not integrate.
-fn one_pane(input: &EnergyPlusInput, glass: &crate::model::idf::IdfObject) -> Result<Option<(f64, f64, Option<f64>)>> {
+fn one_pane(input: &EnergyPlusInput, glass: &crate::model::idf::IdfObject) -> Result<Option<(f64, f64, Angular)>> {
     if !glass.field(1).trim().eq_ignore_ascii_case("SpectralAverage") {
         return Ok(None);
     }
@@ -282,7 +314,7 @@ fn one_pane(input: &EnergyPlusInput, glass: &crate::model::idf::IdfObject) -> Re
     Ok(Some((
         value(4, "Solar Transmittance at Normal Incidence")?,
         value(7, "Visible Transmittance at Normal Incidence")?,
-        Some(value(5, "Front Side Solar Reflectance at Normal Incidence")?),
+        Angular::Pane { reflectance: value(5, "Front Side Solar Reflectance at Normal Incidence")? },
     )))
 }
 

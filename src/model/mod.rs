@@ -41,6 +41,7 @@ pub mod run_year;
 pub mod schedule;
 pub mod shades;
 pub mod shading_update;
+pub mod simple_glazing;
 pub mod site;
 
 use std::collections::HashMap;

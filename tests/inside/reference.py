@@ -14,7 +14,8 @@ stdout: JSON {lit: [[0|1 per point] per sun]} without lux; with lux (one per sun
 Second mode, any closed room of planar polygons (an L-shaped zone): stdin JSON {faces: [{name,
 vertices: [[x, y, z]...], holes: [window outlines in it]}...] (the room's boundary; a wall's
 outline includes its windows, its samples leave them out),
-windows: [{vertices, tau}...], beams: [[sx, sy, sz, dni]...], spacing: float}. Each face is
+windows: [{vertices, tau}...] (tau one number, or one per beam: the glass's transmittance at
+that beam's incidence), beams: [[sx, sy, sz, dni]...], spacing: float}. Each face is
 sampled on a square grid of that spacing in its own plane (cell centres inside the polygon); a
 sample sees the sun through a window when its ray meets the window's polygon before any face
 (a hit on a face inside a window's outline is the window). stdout: JSON {incident: {name: sum
@@ -103,7 +104,7 @@ def room(q):
             grid = grid[~inside_2d(grid, np.stack([h @ u, h @ w], axis=1))]
         pts = o + grid[:, :1] * u + grid[:, 1:] * w + n * 1e-7
         total = 0.0
-        for sx, sy, sz, dni in q["beams"]:
+        for k, (sx, sy, sz, dni) in enumerate(q["beams"]):
             sun = np.array([sx, sy, sz])
             cos = sun @ n
             if cos <= 0:
@@ -115,7 +116,8 @@ def room(q):
                 # building shades its own windows), but the wall that holds the window, there.
                 blocked = np.any([np.isfinite(t) & (np.abs(t - tw) > 1e-9) for t in walls], axis=0)
                 lit = np.isfinite(tw) & ~blocked
-                total += dni * win["tau"] * cos * lit.mean()
+                tau = win["tau"][k] if isinstance(win["tau"], list) else win["tau"]
+                total += dni * tau * cos * lit.mean()
         out[f["name"]] = total
     return {"incident": out}
 

@@ -96,6 +96,9 @@ pub struct Scratch {
     boundary: Boundary,
     /// Set for a point query ([`super::rays`]): shadows are kept as polygons, not integrated.
     keep: bool,
+    /// The receiver whose triangles cast nothing in this view besides the view's own (an
+    /// opening's glass, for [`ExactEngine::fractions_through`]).
+    open: Option<u32>,
     /// Transmittance of the caster whose shadow is being cast (0: opaque).
     casting: f32,
     /// Kept shadows' corners (receiver frame), and per shadow its range of them and transmittance.
@@ -179,6 +182,7 @@ impl ExactEngine {
             shadows: 0,
             boundary: Boundary::default(),
             keep: false,
+            open: None,
             casting: 0.0,
             kept_points: Vec::new(),
             kept: Vec::new(),
@@ -207,28 +211,39 @@ impl ExactEngine {
         self.fractions_walking(requests, |i| loads.get(i).is_none_or(|l| l.triangles > 0))
     }
 
+    /// As [`Self::fractions`], each view seeing through one opening: the triangles of receiver
+    /// `open[i]` (an opening's glass) cast nothing in view `i`, as if that opening were left out
+    /// of the scene (None: every caster casts). One scene then answers the views through each of
+    /// its windows, instead of one scene per window.
+    pub fn fractions_through(&self, requests: &[ViewRequest], open: &[Option<u32>]) -> Vec<f64> {
+        self.each_view(requests.len(), |i, scratch| {
+            scratch.open = open.get(i).copied().flatten();
+            let f = self.fraction(requests[i], requests[i].leaves, true, scratch);
+            scratch.open = None;
+            f
+        })
+    }
+
     /// The views' fractions, walking the BVH for those `walk` says.
     fn fractions_walking(&self, requests: &[ViewRequest], walk: impl Fn(usize) -> bool + Sync) -> Vec<f64> {
-        let one = |i: usize, scratch: &mut Scratch| self.fraction(requests[i], requests[i].leaves, walk(i), scratch);
-        let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
-        if threads == 1 {
-            let mut scratch = self.scratch();
-            return (0..requests.len()).map(|i| one(i, &mut scratch)).collect();
-        }
-        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), one)
+        self.each_view(requests.len(), |i, scratch| self.fraction(requests[i], requests[i].leaves, walk(i), scratch))
     }
 
     /// Every view's [`Self::load`] and, unless `defer` claims that load, its fraction: one BVH
     /// walk a view, for routing that clips most views and leaves the rest to be decided by
     /// load. Natively over every core.
     pub fn fractions_unless(&self, requests: &[ViewRequest], defer: impl Fn(ViewLoad) -> bool + Sync) -> Vec<(ViewLoad, Option<f64>)> {
-        let one = |i: usize, scratch: &mut Scratch| self.clip(requests[i], requests[i].leaves, true, &defer, scratch);
-        let threads = worker_threads().min(requests.len().div_ceil(CHUNK)).max(1);
+        self.each_view(requests.len(), |i, scratch| self.clip(requests[i], requests[i].leaves, true, &defer, scratch))
+    }
+
+    /// `one(i, scratch)` for views `0..n`, in order; natively over every core.
+    fn each_view<T: Send + Default + Clone>(&self, n: usize, one: impl Fn(usize, &mut Scratch) -> T + Sync) -> Vec<T> {
+        let threads = worker_threads().min(n.div_ceil(CHUNK)).max(1);
         if threads == 1 {
             let mut scratch = self.scratch();
-            return (0..requests.len()).map(|i| one(i, &mut scratch)).collect();
+            return (0..n).map(|i| one(i, &mut scratch)).collect();
         }
-        parallel_chunks(requests.len(), threads, CHUNK, || self.scratch(), one)
+        parallel_chunks(n, threads, CHUNK, || self.scratch(), one)
     }
 
     /// [`Self::load`] of every request, natively over every core.
@@ -317,7 +332,7 @@ impl ExactEngine {
         // Taken out for the walk over it, which needs the rest of the scratch mutably.
         let reached = std::mem::take(&mut scratch.reached);
         for p in reached.iter().flat_map(|r| r.clone()) {
-            if self.owner[p] == outline.gpu_id || !self.veils[p].present(0.0, leaves) {
+            if self.owner[p] == outline.gpu_id || scratch.open == Some(self.owner[p]) || !self.veils[p].present(0.0, leaves) {
                 continue;
             }
             scratch.casting = self.veils[p].transmittance;
@@ -566,20 +581,10 @@ fn push_projected(
     true
 }
 
-/// Whether two convex polygons (either orientation, possibly flat) share interior points: no
-/// edge of either separates them. Touching polygons do not overlap; the test errs towards
-/// overlap (a flattened polygon across the other is reported), which only costs time.
+/// Whether two convex polygons (either orientation, possibly flat) share interior points:
+/// [`crate::geometry::convex_apart`] with no gap (touching polygons do not overlap).
 fn convex_overlap(a: &[DVec2], b: &[DVec2]) -> bool {
-    let separates = |edges: &[DVec2]| {
-        (0..edges.len()).any(|i| {
-            let axis = (edges[(i + 1) % edges.len()] - edges[i]).perp();
-            let span =
-                |p: &[DVec2]| p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| (lo.min(axis.dot(*q)), hi.max(axis.dot(*q))));
-            let ((a0, a1), (b0, b1)) = (span(a), span(b));
-            axis != DVec2::ZERO && (a1 <= b0 || b1 <= a0)
-        })
-    };
-    !(separates(a) || separates(b))
+    !crate::geometry::convex_apart(a, b, 0.0)
 }
 
 /// A convex polygon clipped to the window box, into `a` (`b` is scratch).

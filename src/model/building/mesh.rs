@@ -84,11 +84,13 @@ impl Building {
         self.add_inside_open(builder, EpSurface::is_glazing)
     }
 
-    /// As [`Building::add_inside_to`], with only the glazing named `window` open: every other
-    /// window and glass door casts as if opaque, so the beam reaching an inside face came through
-    /// that one window (EnergyPlus's interior beam is counted per exterior window).
-    pub fn add_inside_through(&self, builder: &mut SceneBuilder, window: &str) -> Result<()> {
-        self.add_inside_open(builder, |s| s.is_glazing() && s.name.eq_ignore_ascii_case(window))
+    /// As [`Building::add_inside_to`], with every opening glazed: each window and glass door
+    /// casts (and receives, under its own name), set-back ones with their reveals. A view that
+    /// leaves one window's glass out ([`crate::count::exact::engine::ExactEngine::fractions_through`])
+    /// sees the beam that came through that window alone (EnergyPlus's interior beam is counted
+    /// per exterior window), so one scene answers every window.
+    pub fn add_inside_glazed(&self, builder: &mut SceneBuilder) -> Result<()> {
+        self.add_inside_open(builder, |_| false)
     }
 
     /// The inside scene with the openings `open` picks left out (holes in their walls).
