@@ -132,7 +132,8 @@ fn literals_after(marker: &str) -> BTreeSet<String> {
 
 #[test]
 fn the_engine_names_are_the_same_on_both_sides() {
-    let rust: BTreeSet<String> = [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact]
+    // Every engine the page's wasm accepts (web.rs's `choice`), the compute rasterizer included.
+    let rust: BTreeSet<String> = [EngineKind::Auto, EngineKind::Gpu, EngineKind::Exact, EngineKind::Compute]
         .iter()
         .map(|k| EngineKind::parse(k.name()).unwrap().name().to_string())
         .collect();
