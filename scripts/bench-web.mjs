@@ -82,6 +82,31 @@ function treeRss(root) {
   return out;
 }
 
+/** CPU seconds (user + system) spent so far by every process below `root` (from /proc): the
+ * cost of a run that a loaded machine's wall clock hides. Processes that have exited are not
+ * counted, so it is read before the browser closes. */
+function treeCpu(root) {
+  const stats = new Map();
+  for (const name of readdirSync('/proc')) {
+    if (!/^\d+$/.test(name)) continue;
+    try {
+      const fields = readFileSync(`/proc/${name}/stat`, 'utf8');
+      const rest = fields.slice(fields.lastIndexOf(')') + 2).split(' ');
+      // After the name: state, ppid, … utime and stime are the 14th and 15th fields of the line.
+      stats.set(Number(name), { parent: Number(rest[1]), ticks: Number(rest[11]) + Number(rest[12]) });
+    } catch {
+      // Gone between the listing and the read.
+    }
+  }
+  let ticks = 0;
+  for (const [pid, { ticks: t }] of stats) {
+    let p = pid;
+    while (p > 1 && p !== root) p = stats.get(p)?.parent ?? 0;
+    if (p === root && pid !== root) ticks += t;
+  }
+  return ticks / 100;
+}
+
 /** The larger of each field. */
 function peakOf(a, b) {
   return Object.fromEntries(Object.keys(b).map((k) => [k, Math.max(a[k] ?? 0, b[k])]));
@@ -111,6 +136,7 @@ async function browserRun(side) {
       }
     });
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
+    const cpuBefore = treeCpu(process.pid);
     const result = await page.evaluate(
       async ({ name, file, days, perDay, resolution, place, options, loadOnly, timesteps }) => {
         // A first visit starts here: the module's import, the wasm's compile, the device, the pool.
@@ -183,8 +209,11 @@ async function browserRun(side) {
       },
       { name: basename(model), file: process.pid, days, perDay, resolution: Number(resolution), place, options: ENGINES[side], loadOnly, timesteps },
     );
+    // Chromium's CPU seconds over the run (all its processes: the page, its workers, the GPU
+    // process), from the API's import to the year's end.
+    const cpu = treeCpu(process.pid) - cpuBefore;
     peak = peakOf(peak, treeRss(process.pid));
-    return { side: `page-${side}`, ...result, peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
+    return { side: `page-${side}`, ...result, cpu_s: Number(cpu.toFixed(2)), peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
   } finally {
     clearInterval(sampler);
     await browser.close();
@@ -233,12 +262,16 @@ function nativeRun(fresh) {
   statSync(bin);
   const cache = fresh ? mkdtempSync(join(tmpdir(), 'sunlit-bench-cache-')) : undefined;
   const env = cache ? { ...process.env, XDG_CACHE_HOME: cache } : process.env;
+  const times = join(tmpdir(), `sunlit-bench-web-time-${process.pid}`);
   const t0 = performance.now();
-  execFileSync(bin, ['annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
+  // /usr/bin/time for the CLI's CPU seconds (user + system), as Chromium's are read from /proc.
+  execFileSync('/usr/bin/time', ['-f', '%U %S', '-o', times, bin, 'annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
     '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
   const total = (performance.now() - t0) / 1000;
+  const cpu = readFileSync(times, 'utf8').trim().split(/\s+/).map(Number).reduce((a, b) => a + b, 0);
+  rmSync(times, { force: true });
   if (cache) rmSync(cache, { recursive: true, force: true });
-  return { side: fresh ? 'native-first' : 'native', total_s: total };
+  return { side: fresh ? 'native-first' : 'native', total_s: total, cpu_s: Number(cpu.toFixed(2)) };
 }
 
 const median = (xs) => {

@@ -1,5 +1,6 @@
 // One worker of the clipping pool (pool.js): its own wasm instance, holding one model's exact
-// engine (a Clipper), answering chunks of packed views. Messages in: load { source }, clip
+// engine (a Clipper), answering chunks of packed views. Messages in: init { module } (the page's
+// compiled WebAssembly.Module, or null to fetch the wasm here), load { source }, clip
 // { job, data }. Out: ready, loaded { wasmBytes }, loadError { message, code }, clipped { job,
 // fractions }, clipError { job, message, code }. `wasmBytes`: this instance's wasm memory once the
 // model is built (it never shrinks, so it is the load's peak).
@@ -21,7 +22,8 @@ function failure(error) {
 }
 
 onmessage = ({ data }) => {
-  if (data.type === 'load') {
+  if (data.type === 'init') start(data.module);
+  else if (data.type === 'load') {
     try {
       clipper?.free();
       clipper = null;
@@ -44,10 +46,12 @@ onmessage = ({ data }) => {
 // No top-level await: bundlers build workers as classic scripts by default (Vite's 'iife'), where
 // it is a syntax error. A wasm that cannot start is thrown from a task of its own, so the pool
 // sees it as the worker's error event, as it would a module that cannot load.
-init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) }).then(
-  (exports) => {
-    memory = exports.memory;
-    postMessage({ type: 'ready' });
-  },
-  (error) => setTimeout(() => { throw error; }),
-);
+function start(module) {
+  init({ module_or_path: module ?? new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) }).then(
+    (exports) => {
+      memory = exports.memory;
+      postMessage({ type: 'ready' });
+    },
+    (error) => setTimeout(() => { throw error; }),
+  );
+}

@@ -18,6 +18,24 @@ const CHUNK = 32;
 /** Numbers per packed request (receiver, sun x, y, z, leaf fraction); see src/web/choice.rs. */
 const PACKED = 5;
 
+/** The wasm, compiled once per page: this thread's instance and every worker's are made from
+ * the same `WebAssembly.Module` (it is posted to them), so a first visit compiles and tiers up
+ * the code once, not once per instance (docs/page-speed.md, "The first visit"). */
+let compiled;
+
+/** The wasm's `WebAssembly.Module`, compiled once (streaming where the server sends
+ * `application/wasm`, from the bytes otherwise); later calls share it. */
+export function wasmModule() {
+  compiled ??= (async () => {
+    const url = new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url);
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText}`);
+    const streams = typeof WebAssembly.compileStreaming === 'function' && response.headers.get('Content-Type') === 'application/wasm';
+    return streams ? WebAssembly.compileStreaming(response) : WebAssembly.compile(await response.arrayBuffer());
+  })();
+  return compiled;
+}
+
 function coded(message, code, names = {}) {
   return Object.assign(new Error(message), { code }, names);
 }
@@ -96,6 +114,12 @@ export class ClipPool {
         if (!slot.ready) reject(error);
         else this.#fail(slot, error);
       };
+      // The worker starts its instance from this page's compiled module; where it has none (the
+      // compile failed here), it fetches and compiles the wasm itself.
+      wasmModule().then(
+        (module) => worker.postMessage({ type: 'init', module }),
+        () => worker.postMessage({ type: 'init', module: null }),
+      );
       worker.onmessage = ({ data }) => {
         if (data.type === 'ready') {
           slot.ready = true;

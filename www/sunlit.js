@@ -5,14 +5,15 @@
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
-import { ClipPool, defaultWorkers } from './pool.js';
+import { ClipPool, defaultWorkers, wasmModule } from './pool.js';
 import { cachedProfile, storeProfile } from './profiles.js';
 
 let wasmReady;
 
-/** Loads the wasm module once (later calls share it). */
+/** Starts this thread's wasm instance once (later calls share it), from the module the pool's
+ * workers are given too (pool.js, `wasmModule`). */
 function ready() {
-  wasmReady ??= init({ module_or_path: new URL('./pkg/sunlit_wasm_bg.wasm', import.meta.url) });
+  wasmReady ??= wasmModule().then((module) => init({ module_or_path: module }));
   return wasmReady;
 }
 
