@@ -50,25 +50,34 @@ const [days, perDay] = samples.split('x').map(Number);
 const place = { latitude: 39.74, longitude: -105.18, timeZone: -7 };
 const ENGINES = { default: {}, 'default-cached': {}, exact: { engine: 'exact' }, gpu: { engine: 'gpu' }, 'exact-1': { engine: 'exact', workers: 1 } };
 
-/** Resident bytes of every process below `root` (from /proc), in all and by Chromium's process
- * type (`renderer`: the page and its workers, whose wasm instances are the model's copies;
- * `gpu-process`: WebGPU's buffers, on SwiftShader here; `other`: the browser and its utilities). */
-function treeRss(root) {
-  const parent = new Map();
+/** Every process below `root` (not `root` itself), each with the fields of its /proc stat line
+ * after its name (state, ppid, …; utime and stime are [11] and [12], in clock ticks). */
+function descendants(root) {
+  const stats = new Map();
   for (const name of readdirSync('/proc')) {
     if (!/^\d+$/.test(name)) continue;
     try {
-      const stat = readFileSync(`/proc/${name}/stat`, 'utf8');
-      parent.set(Number(name), Number(stat.slice(stat.lastIndexOf(')') + 2).split(' ')[1]));
+      const line = readFileSync(`/proc/${name}/stat`, 'utf8');
+      stats.set(Number(name), line.slice(line.lastIndexOf(')') + 2).split(' '));
     } catch {
       // Gone between the listing and the read.
     }
   }
-  const out = { total: 0, renderer: 0, 'gpu-process': 0, other: 0 };
-  for (const [pid] of parent) {
+  const below = new Map();
+  for (const [pid, fields] of stats) {
     let p = pid;
-    while (p > 1 && p !== root) p = parent.get(p) ?? 0;
-    if (p !== root || pid === root) continue;
+    while (p > 1 && p !== root) p = Number(stats.get(p)?.[1] ?? 0);
+    if (p === root && pid !== root) below.set(pid, fields);
+  }
+  return below;
+}
+
+/** Resident bytes of every process below `root` (from /proc), in all and by Chromium's process
+ * type (`renderer`: the page and its workers, whose wasm instances are the model's copies;
+ * `gpu-process`: WebGPU's buffers, on SwiftShader here; `other`: the browser and its utilities). */
+function treeRss(root) {
+  const out = { total: 0, renderer: 0, 'gpu-process': 0, other: 0 };
+  for (const pid of descendants(root).keys()) {
     try {
       const rss = /VmRSS:\s+(\d+) kB/.exec(readFileSync(`/proc/${pid}/status`, 'utf8'));
       const bytes = rss ? Number(rss[1]) * 1024 : 0;
@@ -86,24 +95,8 @@ function treeRss(root) {
  * cost of a run that a loaded machine's wall clock hides. Processes that have exited are not
  * counted, so it is read before the browser closes. */
 function treeCpu(root) {
-  const stats = new Map();
-  for (const name of readdirSync('/proc')) {
-    if (!/^\d+$/.test(name)) continue;
-    try {
-      const fields = readFileSync(`/proc/${name}/stat`, 'utf8');
-      const rest = fields.slice(fields.lastIndexOf(')') + 2).split(' ');
-      // After the name: state, ppid, … utime and stime are the 14th and 15th fields of the line.
-      stats.set(Number(name), { parent: Number(rest[1]), ticks: Number(rest[11]) + Number(rest[12]) });
-    } catch {
-      // Gone between the listing and the read.
-    }
-  }
   let ticks = 0;
-  for (const [pid, { ticks: t }] of stats) {
-    let p = pid;
-    while (p > 1 && p !== root) p = stats.get(p)?.parent ?? 0;
-    if (p === root && pid !== root) ticks += t;
-  }
+  for (const fields of descendants(root).values()) ticks += Number(fields[11]) + Number(fields[12]);
   return ticks / 100;
 }
 
