@@ -11,7 +11,9 @@
 // line per side with the median seconds; the browser's lines also carry the peak resident memory
 // of Chromium's processes (sampled from /proc every 200 ms; in all and by process type), the wasm
 // memory of the engine's instance (the page's thread here) after the load and at the end, and
-// of each clipping worker once it built the model. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
+// of each clipping worker once it built the model; the API's and the CLI's sides their CPU seconds (`cpu_s`:
+// Chromium's processes from the API's import to the year's end; the CLI's user + system), which
+// a loaded machine's wall clock hides. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
 import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
