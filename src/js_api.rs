@@ -8,6 +8,7 @@ use std::collections::BTreeSet;
 
 use crate::count::hybrid::EngineKind;
 use crate::error::{Error, GpuError, NoReceivers};
+use crate::sky::model::SkyModel;
 use crate::year::settings::AnnualSettings;
 
 const DTS: &str = include_str!("../www/sunlit.d.ts");
@@ -143,6 +144,22 @@ fn the_engine_names_are_the_same_on_both_sides() {
     assert_eq!((error.code(), error.parameter()), ("bad-option", Some("engine")));
 }
 
+#[test]
+fn the_sky_model_names_are_the_same_on_both_sides() {
+    // `skyModel` takes the names `--sky-model` takes: both are read by `SkyModel::parse`.
+    let rust: BTreeSet<String> = SkyModel::ALL.iter().map(|m| SkyModel::parse(m.name()).unwrap().name().to_string()).collect();
+    assert_eq!(rust.len(), 4);
+    assert_eq!(union(interface("AnnualSettings"), "skyModel"), rust, "AnnualSettings.skyModel");
+    assert_eq!(union(interface("MapOptions"), "skyModel"), rust, "MapOptions.skyModel");
+    let with_epw =
+        |name: &str| AnnualSettings { epw_file: Some("a.epw".into()), sky_model: Some(name.into()), ..AnnualSettings::default() };
+    for model in SkyModel::ALL {
+        assert_eq!(with_epw(model.name()).sky_model().unwrap(), model);
+    }
+    let error = with_epw("gendaymtx").sky_model().unwrap_err();
+    assert_eq!((error.code(), error.parameter()), ("bad-option", Some("sky_model")));
+}
+
 /// The web's map options reader, compiled natively so that it is tested without a browser.
 #[path = "web/map_options.rs"]
 mod map_options;
@@ -214,6 +231,8 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"value": "shade"})), bad("value"));
     assert_eq!(named(json!({"grid": 1, "points": [0, 0, 0, 0, 0, 1]})), bad("points"));
     assert_eq!(named(json!({"grid": "fine"})), bad("grid"));
+    assert_eq!(named(json!({"skyModel": "uniform"})), bad("sky_model"), "a sky model needs an EPW");
+    assert_eq!(named(json!({"skyModel": "perez"})), bad("sky_model"));
     assert_eq!(named(json!({"timestepsPerHour": 4})), bad("options"));
     assert_eq!(MapRequest::from_value(json!({"grid": 1})).err().map(|e| e.code()), Some("bad-option"), "no location");
 }

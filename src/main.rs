@@ -216,6 +216,7 @@ impl AnnualArgs {
             evergreen: Some(self.evergreen),
             leaf_out: self.leaf_out.clone(),
             leaf_fall: self.leaf_fall.clone(),
+            sky_model: self.sky_model.clone(),
             ..Default::default()
         })
     }
@@ -454,6 +455,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("min_period", "--min-period"),
     ("max_periods", "--max-periods"),
     ("window_width", "--window-width"),
+    ("window_points", "--window-points"),
     ("tile", "--tile"),
     ("context", "--context"),
     ("min_kwh_m2", "--min-kwh-m2"),

@@ -37,7 +37,7 @@ use crate::model::shading_update::periodic_update;
 use crate::model::{EnergyPlusInput, LoadOptions, load_bytes_all, parse_transmittance};
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
-use crate::sky::views::sky_views;
+use crate::sky::views::sky_views_for;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 use crate::sun::weather::Weather;
@@ -323,10 +323,10 @@ impl Engine {
             let routed = |views| Routed { profile: chosen.profile(views), refused: chosen.refused(views) };
             let means = daylight_means(&schedule, &location);
             let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
-            // The sky views (the same engine, Tregenza's patches) only when there is weather to weigh them.
+            // The sky views (the same engine, Tregenza's patches, the sky model asked) only when there is weather to weigh them.
             let sky = match &weather {
                 Some(Ok(_)) => Some(
-                    sky_views(&chosen, &model.scene, &SkyPatches::tregenza(), &mut report)
+                    sky_views_for(&chosen, &model.scene, &SkyPatches::tregenza(), settings.sky_model, &mut report)
                         .await
                         .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?,
                 ),

@@ -329,6 +329,41 @@ fn gb50180_matches_the_analytic_canyon_within_a_minute() {
     assert!(StandardDay::parse("06-21").unwrap_err().to_string().contains("day"));
 }
 
+/// GB 50180 counts at the ground-floor window sill: given a window (not a point), the study finds
+/// its sill, the middle of its lowest edge. A south window 0.9..2.4 m up in a wall faces a long
+/// garden wall 20 m away, 12.3 m high, whose shadow on 大寒日 at Beijing covers the sill for all
+/// but 1.29 h of the analytic canyon (k = 11.4/20) and the window's centre for less (k =
+/// 10.65/20, 3.35 h): the window fails at its sill and would pass at its centre.
+#[test]
+fn gb50180_finds_the_sill_of_a_window_and_fails_there() {
+    use sunlit::map::planning::window_points::{OFFSET, WindowPoint, window_points};
+    let (distance, height, sill_z, centre_z) = (20.0, 12.3, 0.9, 1.65);
+    let mut s = TestScene::new();
+    s.polygon("WALL", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), false);
+    s.polygon("WIN", &south_rect(-0.75, 0.75, sill_z, 2.4, 0.0), true);
+    s.cuboid("GARDEN_WALL", DVec3::new(-1000.0, -distance - 2.0, 0.0), DVec3::new(1000.0, -distance, height));
+    let scene = s.build();
+    let win = common::receiver_id(&scene, "WIN");
+    let sill = window_points(&scene, &[win], WindowPoint::Sill).unwrap();
+    let centre = window_points(&scene, &[win], WindowPoint::Centre).unwrap();
+    assert!((sill.position(0) - DVec3::new(0.0, -OFFSET, sill_z)).length() < 1e-5, "the sill: {}", sill.position(0));
+    assert!((centre.position(0) - DVec3::new(0.0, -OFFSET, centre_z)).length() < 1e-5, "the centre: {}", centre.position(0));
+    let beijing = Location::new(39.9, 116.4, 8.0).unwrap();
+    let day = StandardDay::Dahan;
+    let rule = Gb50180Rule::new(day);
+    let half = (day.window().1 - day.window().0) / 2.0;
+    let at = |points: &Points, z: f64| {
+        let got = gb50180::evaluate(&scene, points, &beijing, &rule, &mut |_, _| {}).unwrap().hours[0];
+        let truth = canyon_hours(beijing.latitude, day.declination_deg(), (height - z) / distance, half);
+        assert!((got - truth).abs() <= 1.0 / 60.0, "at z = {z}: {got:.4} h vs the canyon's {truth:.4} h");
+        (got, compare::hours(got, rule.required_hours).passes)
+    };
+    let (sill_hours, sill_passes) = at(&sill, sill_z);
+    let (centre_hours, centre_passes) = at(&centre, centre_z);
+    assert!(sill_hours < 1.5 && !sill_passes, "the sill is shaded: {sill_hours:.3} h");
+    assert!(centre_hours > 3.0 && centre_passes, "the centre is not: {centre_hours:.3} h");
+}
+
 /// True solar time = standard time + EoT + (longitude − 15° · zone)/15, with EoT from the
 /// equation-of-time table of K. Krisciunas (Texas A&M, "Equation of time", values by day of a
 /// non-leap year from Meeus's approximate formula, stated within 30 s):
@@ -540,15 +575,66 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An empty scratch directory `sunlit-NAME-PID` and the office example's path.
+fn fresh_dir_and_office(name: &str) -> (PathBuf, String) {
+    let dir = std::env::temp_dir().join(format!("sunlit-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let office = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
+    (dir, office.to_str().unwrap().to_string())
+}
+
+/// `--window-points`: one point per window, found from its geometry (BRE's centre, GB 50180's
+/// sill), before and after, with the reports saying which; its refusals name it.
+#[test]
+fn cli_window_points_are_found_on_each_window() {
+    let (dir, office) = fresh_dir_and_office("planning-window-points");
+    let office = office.as_str();
+    std::fs::write(dir.join("block.gltf"), box_gltf("BLOCK", DVec3::new(-10.0, -14.0, 0.0), DVec3::new(40.0, -8.0, 12.0))).unwrap();
+    let rows = |at: &str| -> (Value, Vec<Vec<String>>) {
+        let file = format!("{at}.csv");
+        let windows = [office, "block.gltf", "--receivers", "WIN_*", "--window-points", at, "--location", "39.9,116.4,8"];
+        let out = run_map(&dir, &[&windows[..], &["--study", "gb50180", "--before", office, "-o", &file, "--json"]].concat());
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let csv = std::fs::read_to_string(dir.join(format!("{at}.csv"))).unwrap();
+        (summary, csv.lines().skip(1).map(|l| l.split(',').map(String::from).collect()).collect())
+    };
+    let (summary, sills) = rows("sill");
+    let (_, centres) = rows("centre");
+    assert_eq!((summary["points"].as_u64(), summary["points_before"].as_u64()), (Some(5), Some(5)), "{summary}");
+    assert_eq!(sills.iter().map(|r| r[0].as_str()).collect::<Vec<_>>(), ["WIN_S1", "WIN_S2", "WIN_E", "WIN_N", "WIN_W"]);
+    let number = |r: &[String], k: usize| r[k].parse::<f64>().unwrap();
+    for (s, c) in sills.iter().zip(&centres) {
+        assert_eq!(s[0], c[0]);
+        assert!(number(s, 3) < number(c, 3) - 0.3, "the sill lies below the centre: {s:?} {c:?}");
+        assert!((4..7).all(|k| number(s, k) == number(c, k)), "one window, one normal: {s:?} {c:?}");
+    }
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("sill.study-gb50180.json")).unwrap()).unwrap();
+    assert_eq!(report["inputs"]["points"]["window_points"], "sill", "{}", report["inputs"]);
+    assert!(report["points"].as_array().unwrap().iter().all(|p| p["hours_before"].is_number()), "the existing scene has the same sills");
+    for (args, says) in [
+        (vec!["--window-points", "middle", "--study", "gb50180", "--location", "39.9,116.4,8"], "--window-points"),
+        (vec!["--window-points", "sill", "--grid", "1", "--study", "gb50180", "--location", "39.9,116.4,8"], "--window-points"),
+        (vec!["--window-points", "sill", "--location", "39.9,116.4,8", "--period", "03-21"], "--window-points"),
+    ] {
+        let mut all = vec![office, "--receivers", "WIN_*"];
+        all.extend(args.iter().copied());
+        all.extend(["-o", "bad.csv"]);
+        let out = run_map(&dir, &all);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says), "{args:?}: {err}");
+        assert!(!dir.join("bad.csv").exists(), "{args:?} wrote its output");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `--sky-model` on `annual` and `map`: an unknown name, or a model without the weather its light
 /// comes from, is refused naming the option, and nothing is written.
 #[test]
 fn sky_model_refusals_name_the_option() {
-    let dir = std::env::temp_dir().join(format!("sunlit-sky-model-refusals-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let office = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/office.glb");
-    let office = office.to_str().unwrap();
+    let (dir, office) = fresh_dir_and_office("sky-model-refusals");
+    let office = office.as_str();
     let epw = golden_epw();
     let epw = epw.to_str().unwrap();
     let annual = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_sunlit")).arg("annual").args(args).current_dir(&dir).output().unwrap();

@@ -179,6 +179,10 @@ export interface AnnualSettings {
   /** The calendar year: a leap year gives 366 days (8784 × timestepsPerHour rows). Default: the
    * EnergyPlus model's RunPeriod year, else the EPW's Feb 29 record, else a non-leap year. */
   year?: number;
+  /** The sky that weighs the sky patches (needs `epw`), as `sunlit annual --sky-model`:
+   * 'energyplus' (EnergyPlus's Perez 1990 irradiance model, the default), 'perez-all-weather'
+   * (Radiance's gendaymtx sky, as Ladybug uses), 'cie-overcast' or 'uniform'. */
+  skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
 }
 
 export interface AnnualRunOptions {
@@ -275,6 +279,9 @@ export interface MapOptions {
   leafOut?: string;
   /** Leaf-fall period "MM-DD,MM-DD" (as AnnualSettings). */
   leafFall?: string;
+  /** The sky for 'skyDiffuse' and 'total' (needs `epw`), as `sunlit map --sky-model`:
+   * 'energyplus' (the default), 'perez-all-weather', 'cie-overcast' or 'uniform'. */
+  skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
 }
 
 export interface MapRunOptions extends AnnualRunOptions {

@@ -7,6 +7,7 @@ use sunlit::export::map_glb::map_glb;
 use sunlit::export::map_table::{Column, points_csv, study_csv, study_json, value_columns};
 use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
+use sunlit::map::planning::window_points::{WindowPoint, window_points};
 use sunlit::map::study::{self, SunRule};
 use sunlit::map::{MapGpu, MapValues, Mapper, Period, Points, Site, point_sky_for};
 use sunlit::sky::model::SkyModel;
@@ -35,6 +36,10 @@ pub(super) struct MapArgs {
     /// Points from a CSV with the header x,y,z,nx,ny,nz (world axes, metres), each on a receiver.
     #[arg(long, value_name = "FILE.csv")]
     points: Option<PathBuf>,
+    /// Window studies: one point per receiver (each a window), found from its geometry: centre
+    /// (BRE's reference point, the window's centre) or sill (GB 50180's, its lowest edge's middle).
+    #[arg(long, value_name = "centre|sill", conflicts_with_all = ["points", "grid"])]
+    window_points: Option<String>,
     /// Weather file: the site and its solar data (adds direct_kwh_m2, sky_diffuse_kwh_m2,
     /// ground_reflected_kwh_m2 and total_kwh_m2).
     #[arg(long, value_name = "FILE.epw")]
@@ -111,7 +116,7 @@ pub(super) struct MapArgs {
     #[arg(long, value_name = "FILE.json")]
     sam: Option<PathBuf>,
     /// Window studies (bre-vsc, bre-apsh, gb50180): the existing scene's models; each point's
-    /// former values go beside the proposed ones, with BRE's relative tests. Needs --points.
+    /// former values go beside the proposed ones, with BRE's relative tests. Needs --points or --window-points.
     #[arg(long, value_name = "MODEL", num_args = 1..)]
     before: Vec<PathBuf>,
     /// gb50180's standard day: dahan (大寒日, the default) or dongzhi (冬至日).
@@ -207,6 +212,9 @@ impl MapArgs {
 
     fn points(&self, scene: &Scene) -> Result<Points> {
         let all: Vec<u32> = (0..scene.receivers.len() as u32).collect();
+        if let Some(at) = &self.window_points {
+            return window_points(scene, &all, WindowPoint::parse(at)?);
+        }
         match &self.points {
             Some(path) => {
                 let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
@@ -266,6 +274,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         ("--min-period", args.min_period.is_some()),
         ("--max-periods", args.max_periods.is_some()),
         ("--window-width", args.window_width.is_some()),
+        ("--window-points", args.window_points.is_some()),
         ("--mask", args.mask.is_some()),
         ("--html", args.html.is_some()),
     ];

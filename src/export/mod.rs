@@ -22,6 +22,7 @@ pub mod irradiation;
 pub mod map_glb;
 pub mod map_table;
 pub mod planning_report;
+pub mod planning_tables;
 pub mod pv;
 pub mod wgs84;
 

@@ -161,6 +161,22 @@ pub(crate) fn csv_rows(file_label: &str, text: &str) -> Result<Vec<(usize, DVec3
     Ok(rows)
 }
 
+/// The points of `points` that lie on one of `receivers` of `scene` (placed as [`from_csv`]
+/// places a row), and where each sits in `points`: the same reference points on another scene,
+/// as the existing scene beside the proposed one. A point on none of them is left out.
+pub fn place_on(scene: &Scene, points: &Points, receivers: &[u32]) -> (Points, Vec<usize>) {
+    let mut kept = Points::default();
+    let mut index = Vec::new();
+    for i in 0..points.len() {
+        let (p, n) = (points.position(i), points.normal(i));
+        if let Some(id) = receiver_under(scene, receivers, p, n) {
+            kept.push(p, n, id);
+            index.push(i);
+        }
+    }
+    (kept, index)
+}
+
 /// The receiver `p` lies on (see [`from_csv`]), if any.
 pub(crate) fn receiver_under(scene: &Scene, receivers: &[u32], p: DVec3, n: DVec3) -> Option<u32> {
     let mut best: Option<(f64, u32)> = None;

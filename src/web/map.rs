@@ -19,7 +19,8 @@ use super::{Engine, Model, ModelInner, js_error};
 use crate::error::{Error, Result};
 use crate::export::map_glb::map_glb;
 use crate::export::map_table::{Column, points_csv, value_columns};
-use crate::map::{MapValues, Mapper, Points, Sample, Site, from_csv, grid, point_sky};
+use crate::map::{MapValues, Mapper, Points, Sample, Site, from_csv, grid, point_sky_for};
+use crate::sky::model::SkyModel;
 use crate::sky::patches::SkyPatches;
 use crate::sky::views::SkyViews;
 use crate::sun::position::sun_direction;
@@ -54,13 +55,14 @@ fn points_for(model: &ModelInner, place: &Where) -> Result<(Rc<Points>, Rc<Mappe
     Ok((points, mapper))
 }
 
-/// The points' sky views for `place` (whose mapper is `mapper`), counted once per place.
-fn sky_for(model: &ModelInner, place: &Where, mapper: &Mapper) -> Rc<SkyViews> {
+/// The points' sky views for `place` (whose mapper is `mapper`) under `sky_model`, counted once
+/// per place and model.
+fn sky_for(model: &ModelInner, place: &Where, mapper: &Mapper, sky_model: SkyModel) -> Rc<SkyViews> {
     let mut cache = model.maps.borrow_mut();
-    if let Some(sky) = cache.as_ref().filter(|c| c.place == *place).and_then(|c| c.sky.clone()) {
+    if let Some(sky) = cache.as_ref().filter(|c| c.place == *place).and_then(|c| c.sky.clone()).filter(|s| s.model() == sky_model) {
         return sky;
     }
-    let sky = Rc::new(point_sky(mapper, &SkyPatches::tregenza(), &mut |_, _| {}));
+    let sky = Rc::new(point_sky_for(mapper, &SkyPatches::tregenza(), sky_model, &mut |_, _| {}));
     if let Some(c) = cache.as_mut().filter(|c| c.place == *place) {
         c.sky = Some(sky.clone());
     }
@@ -230,7 +232,7 @@ impl Engine {
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
             let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
-            let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper));
+            let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper, request.site.sky_model));
             let site = Site {
                 location: &request.site.location,
                 calendar: &request.site.calendar,

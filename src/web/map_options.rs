@@ -23,9 +23,9 @@ pub const DEFAULT_DAY_STEP: u32 = 10;
 /// The keys of the options object that say where, when and what.
 pub const MAP_KEYS: [&str; 8] = ["grid", "points", "period", "step", "from", "to", "at", "value"];
 
-/// The annual settings' keys a map also takes: the site and the foliage's calendar
+/// The annual settings' keys a map also takes: the site, the foliage's calendar and the sky model
 /// ([`AnnualSettings`], resolved as an annual run resolves them).
-pub const SITE_KEYS: [&str; 8] = ["latitude", "longitude", "timeZone", "epw", "epwName", "evergreen", "leafOut", "leafFall"];
+pub const SITE_KEYS: [&str; 9] = ["latitude", "longitude", "timeZone", "epw", "epwName", "evergreen", "leafOut", "leafFall", "skyModel"];
 
 /// What a map holds per point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

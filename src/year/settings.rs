@@ -7,7 +7,8 @@
 //! - the refinement threshold, default [`DEFAULT_REFINE`], in 0..=1;
 //! - the leaf calendar: evergreen, both leaf periods, or neither (then the hemisphere's default);
 //! - timesteps per hour: as asked, else the EnergyPlus model's Timestep, else
-//!   [`DEFAULT_TIMESTEPS_PER_HOUR`] ([`Resolved::timesteps`], once the model is read).
+//!   [`DEFAULT_TIMESTEPS_PER_HOUR`] ([`Resolved::timesteps`], once the model is read);
+//! - the sky model ([`SkyModel`], by its name), with an EPW only.
 
 use std::path::PathBuf;
 
@@ -17,6 +18,7 @@ use super::annual::{AnnualOptions, DEFAULT_REFINE, Method};
 use super::samples::{SamplingPlan, Timesteps};
 use super::season::{LeafCalendar, parse_period};
 use crate::error::{Error, Result};
+use crate::sky::model::SkyModel;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
 
@@ -62,6 +64,9 @@ pub struct AnnualSettings {
     /// the EnergyPlus model's RunPeriod year, else the EPW's Feb 29, else a non-leap year
     /// ([`crate::model::run_year::choose`]).
     pub year: Option<i32>,
+    /// The sky that weighs the sky patches with an EPW ([`SkyModel`]'s names, `--sky-model`'s):
+    /// energyplus (the default), perez-all-weather, cie-overcast or uniform.
+    pub sky_model: Option<String>,
 }
 
 /// Settings with their defaults applied and every value checked.
@@ -77,6 +82,8 @@ pub struct Resolved {
     pub calendar: LeafCalendar,
     /// Timesteps per hour as asked (checked); `None`: the model's, else the default.
     pub timesteps_per_hour: Option<Timesteps>,
+    /// The sky model (the default without one asked).
+    pub sky_model: SkyModel,
 }
 
 impl AnnualSettings {
@@ -96,7 +103,8 @@ impl AnnualSettings {
         let location = self.location()?;
         let calendar = self.calendar(&location)?;
         let timesteps_per_hour = self.timesteps_per_hour.map(Timesteps::new).transpose()?;
-        Ok(Resolved { location, method, refine, calendar, timesteps_per_hour })
+        let sky_model = self.sky_model()?;
+        Ok(Resolved { location, method, refine, calendar, timesteps_per_hour, sky_model })
     }
 
     fn location(&self) -> Result<Location> {
@@ -106,6 +114,16 @@ impl AnnualSettings {
             (None, None, Some(lat), Some(lon), Some(tz)) => Location::new(lat, lon, tz),
             _ => Err(Error::argument("location", "give an EPW or latitude, longitude and time zone")),
         }
+    }
+
+    /// The sky model asked for; refused without an EPW, whose hours give the sky its light.
+    pub(crate) fn sky_model(&self) -> Result<SkyModel> {
+        let Some(name) = &self.sky_model else { return Ok(SkyModel::default()) };
+        let model = SkyModel::parse(name)?;
+        if self.epw.is_none() && self.epw_file.is_none() {
+            return Err(Error::argument("sky_model", "needs a weather file (an EPW): the sky's light comes from it"));
+        }
+        Ok(model)
     }
 
     /// The foliage calendar: evergreen, the given periods, or the defaults for the latitude.
@@ -180,6 +198,8 @@ mod tests {
         assert_eq!(refused(AnnualSettings { timesteps_per_hour: Some(7), ..golden() }), Some(Some("timesteps_per_hour".into())));
         assert_eq!(refused(AnnualSettings { leaf_out: Some("04-15,05-31".into()), ..golden() }), Some(Some("leaf_out/leaf_fall".into())));
         assert_eq!(refused(AnnualSettings { time_zone: None, ..golden() }), Some(Some("location".into())));
+        assert_eq!(refused(AnnualSettings { sky_model: Some("perez".into()), ..golden() }), Some(Some("sky_model".into())));
+        assert_eq!(refused(AnnualSettings { sky_model: Some("uniform".into()), ..golden() }), Some(Some("sky_model".into())), "no EPW");
     }
 
     #[test]

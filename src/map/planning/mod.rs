@@ -7,7 +7,9 @@
 //! - [`bre_lines`]: BRE 209's 25° and 45° pre-checks, exact on the scene's triangles;
 //! - [`compare`]: each rule's pass/fail, alone and against the existing scene's values
 //!   (BRE's 0.8 × former value and 4-point APSH loss);
-//! - [`mask`]: what a point sees of the sky and the sun's paths, for its stereographic diagram.
+//! - [`mask`]: what a point sees of the sky and the sun's paths, for its stereographic diagram;
+//! - [`run`]: every study asked, on one scene, sharing its shadow-ray tree;
+//! - [`window_points`]: each window's reference point or sill, found from its geometry.
 //!
 //! The points are [`Windows`]: any list of directions is asked of them (not a period's suns),
 //! answered by shadow rays through a BVH of the scene ([`crate::count::rays`]), or by the
@@ -18,7 +20,9 @@ pub mod bre_lines;
 pub mod compare;
 pub mod gb50180;
 pub mod mask;
+pub mod run;
 pub mod vsc;
+pub mod window_points;
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -1,0 +1,73 @@
+//! Every window study asked, run on one scene at one set of points, sharing the scene's one
+//! shadow-ray tree: what `sunlit map --study` runs on the proposed scene and again on the
+//! existing one, so that the edges only read their options and write the reports
+//! ([`crate::export::planning_tables`] makes the tables).
+
+use super::gb50180::{self, Gb50180Rule};
+use super::{SceneRays, Windows, apsh, bre_lines, vsc};
+use crate::error::{Error, Result};
+use crate::map::{Points, Site};
+use crate::scene::Scene;
+
+/// The window studies' names.
+pub const STUDIES: [&str; 5] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg"];
+
+/// One scene's values per study asked ([`STUDIES`]' names).
+#[derive(Default)]
+pub struct StudyValues {
+    /// `bre-vsc`'s.
+    pub vsc: Option<vsc::VscValues>,
+    /// `bre-apsh`'s.
+    pub apsh: Option<apsh::ApshValues>,
+    /// `gb50180`'s.
+    pub gb: Option<gb50180::Gb50180Values>,
+    /// `bre-25deg`'s and `bre-45deg`'s (one pass gives both).
+    pub lines: Option<bre_lines::LineValues>,
+    /// The studies asked for, in order.
+    pub asked: Vec<String>,
+}
+
+/// Every study of `studies` ([`STUDIES`]' names, in order) at `points` of `scene`: `site` for
+/// bre-apsh (with its weather) and gb50180, `gb` gb50180's rule. `done(part)` is called once the
+/// scene is indexed (`index`) and after each study (its name), so a caller can time the parts.
+/// Refuses a study it does not know, and bre-apsh or gb50180 without what they need, by name.
+pub fn evaluate(
+    studies: &[String],
+    scene: &Scene,
+    points: &Points,
+    site: Option<Site<'_>>,
+    gb: Option<&Gb50180Rule>,
+    done: &mut dyn FnMut(&str),
+) -> Result<StudyValues> {
+    if let Some(other) = studies.iter().find(|s| !STUDIES.contains(&s.as_str())) {
+        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", STUDIES.join(", "))));
+    }
+    // One tree for the scene; gb50180 places its own points (with its sill samples) on it, and
+    // the BRE studies share these.
+    let tree = SceneRays::new(scene);
+    let windows = studies.iter().any(|s| s == "bre-vsc" || s == "bre-apsh").then(|| Windows::on(scene, &tree, points)).transpose()?;
+    let mut values = StudyValues { asked: studies.to_vec(), ..StudyValues::default() };
+    done("index");
+    for study in studies {
+        match (study.as_str(), &windows) {
+            ("bre-vsc", Some(windows)) => values.vsc = Some(vsc::vsc(windows, &mut |_, _| {})),
+            ("bre-25deg" | "bre-45deg", _) => {
+                if values.lines.is_none() {
+                    let positions: Vec<_> = (0..points.len()).map(|i| points.position(i)).collect();
+                    let normals: Vec<_> = (0..points.len()).map(|i| points.normal(i)).collect();
+                    values.lines = Some(bre_lines::evaluate(scene, &positions, &normals));
+                }
+            }
+            ("bre-apsh", Some(windows)) => {
+                let site = site.ok_or_else(|| Error::argument("epw", "bre-apsh needs a weather file"))?;
+                values.apsh = Some(apsh::apsh(windows, site, &mut |_, _| {})?);
+            }
+            _ => {
+                let (site, rule) = site.zip(gb).ok_or_else(|| Error::argument("location", "gb50180 needs the site"))?;
+                values.gb = Some(gb50180::evaluate_on(scene, &tree, points, site.location, rule, &mut |_, _| {})?);
+            }
+        }
+        done(study);
+    }
+    Ok(values)
+}

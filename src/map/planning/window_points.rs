@@ -1,0 +1,170 @@
+//! A window study's points found from the windows themselves, one per window (each receiver is
+//! one window, as `--receivers 'WIN_*'` chooses them), instead of points given in a CSV:
+//! - [`WindowPoint::Centre`]: BRE 209's reference point, the centre of the window on its outside
+//!   face (the area centroid of its triangles);
+//! - [`WindowPoint::Sill`]: GB 50180's 底层窗台面, the middle of the window's lowest edge: the
+//!   lowest vertices (within [`EDGE_TOLERANCE`] of the lowest height), from the one furthest
+//!   left to the one furthest right along the wall. A window whose bottom is one corner (a
+//!   diamond) has that corner as its sill.
+//!
+//! Each point sits [`OFFSET`] out of the window's plane along its outward normal: on the outside
+//! face, and within the map's on-surface tolerance ([`crate::map::points::ON_SURFACE_TOLERANCE`]) so that
+//! `--before` finds the same window in the existing scene. The studies answer a point from its
+//! projection onto its receiver's plane (as every map's points), so the offset changes no
+//! answer; it says where the point is meant to be.
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+use crate::map::Points;
+use crate::scene::{Receiver, Scene};
+
+/// How far (m) a window's point sits out of its plane, on the outside.
+pub const OFFSET: f64 = 0.005;
+
+/// Vertices within this height (m) of a window's lowest vertex are on its lowest edge (its
+/// triangulation may put the edge's ends a rounding apart).
+pub const EDGE_TOLERANCE: f64 = 0.001;
+
+/// A window whose normal is within this of vertical (|n_z| above it) lies flat and has no sill.
+const FLAT: f64 = 0.999;
+
+/// Which point of each window a study is asked at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WindowPoint {
+    /// BRE 209's reference point: the window's centre on its outside face.
+    Centre,
+    /// GB 50180's ground-floor sill: the middle of the window's lowest edge.
+    Sill,
+}
+
+impl WindowPoint {
+    /// The names [`Self::parse`] reads.
+    pub const NAMES: [&'static str; 2] = ["centre", "sill"];
+
+    /// Reads `centre` (or `center`) or `sill`; refuses another, naming `window_points`.
+    pub fn parse(text: &str) -> Result<Self> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "centre" | "center" => Ok(Self::Centre),
+            "sill" => Ok(Self::Sill),
+            other => Err(Error::argument("window_points", format!("'{other}' is not one of {}", Self::NAMES.join(", ")))),
+        }
+    }
+
+    /// The name, as [`Self::parse`] reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Centre => "centre",
+            Self::Sill => "sill",
+        }
+    }
+
+    /// What the point is, for a report.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Centre => "each window's centre on its outside face (BRE 209's reference point)",
+            Self::Sill => "the middle of each window's lowest edge on its outside face (GB 50180's 底层窗台面)",
+        }
+    }
+}
+
+/// One point per receiver of `receivers` (ids into `scene.receivers`, in that order) at `at`,
+/// [`OFFSET`] out of its plane, with its normal. Refuses a receiver without area, and for
+/// [`WindowPoint::Sill`] one lying flat (a roof light has no lowest edge), naming it.
+pub fn window_points(scene: &Scene, receivers: &[u32], at: WindowPoint) -> Result<Points> {
+    let mut points = Points::default();
+    for &id in receivers {
+        let r = scene.receivers.get(id as usize).ok_or_else(|| Error::argument("receiver", format!("id {id} out of range")))?;
+        if r.triangles.is_empty() || r.area.is_nan() || r.area <= 0.0 {
+            return Err(Error::argument("window_points", format!("receiver '{}' ({}) has no area to put a point on", r.name, r.origin)));
+        }
+        let on = match at {
+            WindowPoint::Centre => centroid(r),
+            WindowPoint::Sill => sill(r)?,
+        };
+        points.push(on + r.normal * OFFSET, r.normal, id);
+    }
+    Ok(points)
+}
+
+/// The area centroid of a receiver's triangles.
+fn centroid(r: &Receiver) -> DVec3 {
+    let (mut sum, mut area) = (DVec3::ZERO, 0.0);
+    for t in &r.triangles {
+        let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        sum += (t[0] + t[1] + t[2]) / 3.0 * a;
+        area += a;
+    }
+    sum / area
+}
+
+/// The middle of a receiver's lowest edge (see the module's docs).
+fn sill(r: &Receiver) -> Result<DVec3> {
+    if r.normal.z.abs() > FLAT {
+        return Err(Error::argument(
+            "window_points",
+            format!("receiver '{}' ({}) lies flat: it has no lowest edge to be a sill", r.name, r.origin),
+        ));
+    }
+    // Along the wall, horizontal: which way is left and right on the sill.
+    let along = DVec3::Z.cross(r.normal).normalize();
+    let vertices = || r.triangles.iter().flatten();
+    let lowest = vertices().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    let bottom = || vertices().filter(|p| p.z <= lowest + EDGE_TOLERANCE);
+    let left = bottom().min_by(|a, b| a.dot(along).total_cmp(&b.dot(along)));
+    let right = bottom().max_by(|a, b| a.dot(along).total_cmp(&b.dot(along)));
+    match left.zip(right) {
+        Some((a, b)) => Ok((*a + *b) / 2.0),
+        None => Err(Error::argument("window_points", format!("receiver '{}' ({}) has no finite vertices", r.name, r.origin))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::scene::{SceneBuilder, SourceMesh};
+
+    /// A scene of one receiver, the polygon `corners` (counter-clockwise seen from outside) fanned
+    /// from its first corner.
+    fn window(corners: &[DVec3]) -> Scene {
+        let positions: Vec<[f32; 3]> = corners.iter().map(|c| c.as_vec3().to_array()).collect();
+        let indices: Vec<u32> = (1..corners.len() as u32 - 1).flat_map(|i| [0, i, i + 1]).collect();
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "WIN", SourceMesh { positions, indices }, true);
+        b.build().unwrap()
+    }
+
+    #[test]
+    fn a_rectangles_sill_is_its_lowest_edges_middle_and_its_centre_the_middle() {
+        // A south window 1.5 m wide, 0.9..2.4 m up, drawn from a top corner so the fan's triangles
+        // do not start on the sill.
+        let south = [DVec3::new(2.5, 0.0, 2.4), DVec3::new(1.0, 0.0, 2.4), DVec3::new(1.0, 0.0, 0.9), DVec3::new(2.5, 0.0, 0.9)];
+        let scene = window(&south);
+        let n = scene.receivers[0].normal;
+        assert!((n - DVec3::new(0.0, -1.0, 0.0)).length() < 1e-5, "{n}");
+        let sill = window_points(&scene, &[0], WindowPoint::Sill).unwrap();
+        assert!((sill.position(0) - DVec3::new(1.75, -OFFSET, 0.9)).length() < 1e-5, "{}", sill.position(0));
+        assert!((sill.normal(0) - n).length() < 1e-5);
+        let centre = window_points(&scene, &[0], WindowPoint::Centre).unwrap();
+        assert!((centre.position(0) - DVec3::new(1.75, -OFFSET, 1.65)).length() < 1e-5, "{}", centre.position(0));
+    }
+
+    #[test]
+    fn a_diamonds_sill_is_its_lowest_corner_and_a_flat_window_has_none() {
+        // A window facing east turned 45°: its lowest point is one corner.
+        let east = [DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.0, 0.5, 1.5), DVec3::new(0.0, 0.0, 2.0), DVec3::new(0.0, -0.5, 1.5)];
+        let scene = window(&east);
+        let sill = window_points(&scene, &[0], WindowPoint::Sill).unwrap();
+        assert!((sill.position(0) - DVec3::new(OFFSET, 0.0, 1.0)).length() < 1e-5, "{}", sill.position(0));
+        let flat = window(&[DVec3::new(0.0, 0.0, 3.0), DVec3::new(1.0, 0.0, 3.0), DVec3::new(1.0, 1.0, 3.0), DVec3::new(0.0, 1.0, 3.0)]);
+        let error = window_points(&flat, &[0], WindowPoint::Sill).unwrap_err();
+        assert_eq!(error.parameter(), Some("window_points"));
+        assert!(error.to_string().contains("WIN") && error.to_string().contains("flat"), "{error}");
+        assert!(window_points(&flat, &[0], WindowPoint::Centre).is_ok(), "a roof light still has a centre");
+        assert_eq!(WindowPoint::parse("middle").unwrap_err().parameter(), Some("window_points"));
+        for at in [WindowPoint::Centre, WindowPoint::Sill] {
+            assert_eq!(WindowPoint::parse(at.name()).unwrap(), at);
+        }
+    }
+}
