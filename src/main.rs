@@ -302,6 +302,12 @@ impl ModelArgs {
         model::load_all(&self.models, &LoadOptions { all_energyplus_surfaces, ..self.options() })
     }
 
+    /// The scene with mesh nodes picked as rooms (`interior`) and glass (`glazing`).
+    fn load_rooms(&self, interior: &[String], glazing: &[String]) -> Result<model::Loaded> {
+        self.check()?;
+        model::load_all(&self.models, &LoadOptions { interior: interior.to_vec(), glazing: glazing.to_vec(), ..self.options() })
+    }
+
     /// The scene with EnergyPlus shades at the given transmittances.
     fn load_with_shades(&self, shade_transmittance: Vec<(String, f64)>) -> Result<Scene> {
         model::load(&self.models, &LoadOptions { shade_transmittance, ..self.options() })

@@ -214,6 +214,21 @@ impl Scene {
     pub fn receiver(&self, name: &str) -> Option<(u32, &Receiver)> {
         self.receivers.iter().enumerate().find(|(_, r)| r.name == name).map(|(i, r)| (i as u32, r))
     }
+
+    /// Appends the back face of receiver `of` as a receiver named `name` (see
+    /// [`SceneBuilder::add_mirror`]), for callers that learn which faces they need once the
+    /// scene is built (a glTF room's inside faces); returns its id. The caller keeps names unique.
+    pub fn push_mirror(&mut self, of: u32, name: &str) -> u32 {
+        let original = self.receivers[of as usize].clone();
+        let id = self.receivers.len() as u32;
+        self.receivers.push(Receiver {
+            name: name.to_string(),
+            origin: format!("{} (mirrored)", original.origin),
+            normal: -original.normal,
+            ..original
+        });
+        id
+    }
 }
 
 fn to_dvec(p: [f32; 3]) -> DVec3 {
@@ -360,15 +375,10 @@ impl SceneBuilder {
             }
         }
         for (of, name) in &self.mirrors {
-            let Some(original) = scene.receivers.iter().find(|r| r.name == *of).cloned() else {
+            let Some((id, _)) = scene.receiver(of) else {
                 return Err(Error::NoReceivers(NoReceivers::Other(format!("'{name}' mirrors '{of}', which is not a receiver"))));
             };
-            scene.receivers.push(Receiver {
-                name: name.clone(),
-                origin: format!("{} (mirrored)", original.origin),
-                normal: -original.normal,
-                ..original
-            });
+            scene.push_mirror(id, name);
         }
         for r in &scene.receivers {
             if let Some(first) = names.insert(r.name.clone(), r.origin.clone()) {

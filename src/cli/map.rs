@@ -96,8 +96,16 @@ pub(super) struct MapArgs {
     /// surfaces or free in them, the beam through the windows (see docs/maps.md, "The sun inside").
     #[arg(long)]
     inside: bool,
+    /// With --inside and a glTF (or OBJ) model: mesh nodes that are rooms, each a closed shell
+    /// named after its node (glob over node names, case-insensitive; repeatable).
+    #[arg(long, value_name = "GLOB", requires = "inside")]
+    interior: Vec<String>,
+    /// With --interior: mesh nodes that are glass, left out as openings and letting
+    /// --glass-transmittance through (glob over node names; repeatable).
+    #[arg(long, value_name = "GLOB", requires = "interior")]
+    glazing: Vec<String>,
     /// With --inside: transmittance (0..1) of glazing whose construction is not a
-    /// WindowMaterial:SimpleGlazingSystem.
+    /// WindowMaterial:SimpleGlazingSystem, and of every --glazing node.
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     glass_transmittance: Option<f64>,
     /// With --inside and a grid: put it this many metres above each floor (default 0: on the

@@ -5,7 +5,8 @@
 use sunlit::map::inside::{
     self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, InsideMap, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
 };
-use sunlit::model::inside::{inside_scene, rooms};
+use sunlit::model::inside::gltf::rooms as gltf_rooms;
+use sunlit::model::inside::{Rooms, inside_scene, rooms};
 
 use super::*;
 
@@ -67,12 +68,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
     let (location, weather) = args.site()?;
-    let loaded = args.model.load_all(false)?;
-    let Some(ep) = loaded.energyplus.as_ref().filter(|_| args.model.models.len() == 1) else {
-        return Err(Error::argument("inside", "maps the zones of one EnergyPlus model (IDF or epJSON), given alone"));
-    };
-    let mut scene = inside_scene(ep)?;
-    let rooms = rooms(ep, args.glass_transmittance)?;
+    let (mut scene, rooms) = read_rooms(&args)?;
     let (default_spacing, default_height) = match ask {
         Ask::Ase => (ASE_SPACING, WORK_PLANE_HEIGHT),
         Ask::Nsl => (0.5, NSL_WORK_PLANE),
@@ -158,6 +154,27 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         eprintln!("{} points in {} rooms → {}", at.points.len(), rooms.rooms.len(), args.output.display());
     }
     Ok(())
+}
+
+/// The scene and rooms of one EnergyPlus model given alone, or of mesh models whose rooms and
+/// glass `--interior` and `--glazing` pick.
+fn read_rooms(args: &MapArgs) -> Result<(Scene, Rooms)> {
+    if !args.interior.is_empty() {
+        let mut loaded = args.model.load_rooms(&args.interior, &args.glazing)?;
+        if let Some(ep) = &loaded.energyplus {
+            return Err(Error::model(&ep.file, "--interior picks the rooms of mesh models: an EnergyPlus model's zones are its rooms"));
+        }
+        let rooms = gltf_rooms(&mut loaded.scene, &loaded.interior, &loaded.glazing, args.glass_transmittance)?;
+        return Ok((loaded.scene, rooms));
+    }
+    let loaded = args.model.load_all(false)?;
+    let Some(ep) = loaded.energyplus.as_ref().filter(|_| args.model.models.len() == 1) else {
+        return Err(Error::argument(
+            "inside",
+            "maps the zones of one EnergyPlus model (IDF or epJSON), given alone, or the rooms --interior picks in mesh models",
+        ));
+    };
+    Ok((inside_scene(ep)?, rooms(ep, args.glass_transmittance)?))
 }
 
 /// One instant: the points' `lit` and glass weights, and each inside face's sun patch.

@@ -58,17 +58,28 @@ pub fn points_csv(scene: &Scene, points: &Points, columns: &[Column<'_>]) -> Str
         let name = scene.receivers.get(points.receivers[i] as usize).map_or("", |r| r.name.as_str());
         out.push_str(&csv_field(name));
         for v in &points.positions[3 * i..3 * i + 3] {
-            let _ = write!(out, ",{v:.4}");
+            push_fixed(&mut out, f64::from(*v), 4);
         }
         for v in &points.normals[3 * i..3 * i + 3] {
-            let _ = write!(out, ",{v:.5}");
+            push_fixed(&mut out, f64::from(*v), 5);
         }
         for c in columns {
-            let _ = write!(out, ",{:.*}", c.decimals, c.values.get(i).copied().unwrap_or(f64::NAN));
+            push_fixed(&mut out, c.values.get(i).copied().unwrap_or(f64::NAN), c.decimals);
         }
         out.push('\n');
     }
     out
+}
+
+/// `,v` at `decimals` places, never `-0.000` (a mirrored normal's −0, or a tiny negative that
+/// rounds to zero, prints as 0).
+fn push_fixed(out: &mut String, v: f64, decimals: usize) {
+    let text = format!("{v:.decimals$}");
+    out.push(',');
+    match text.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => out.push_str(rest),
+        _ => out.push_str(&text),
+    }
 }
 
 /// A CSV field, quoted when it holds a comma, quote or line break.

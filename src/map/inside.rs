@@ -8,7 +8,9 @@
 //! frames, doors, overhangs stay opaque. The glass then weights the beam: a lit point's ray
 //! leaves its room through one of the room's openings, and the beam is multiplied by the
 //! transmittance of each opening of the room the ray crosses ([`crate::model::inside::Glazing`]).
-//! `lit` stays geometry (lit through glass is lit); the weights are separate values.
+//! Each transmittance is the glass's at the beam's angle of incidence on it (EnergyPlus's
+//! angular dependence, as for the interior beam). `lit` stays geometry (lit through glass is
+//! lit); the weights are separate values.
 //!
 //! Free points (not on an inside face) get a plane of their own: a receiver that is no geometry
 //! (no triangle carries its id, so it casts nothing and the GPU cannot draw it), through the
@@ -178,14 +180,15 @@ pub struct InsideMap<'a> {
 }
 
 /// Per point, the glass between it and the sun: the product of the transmittances (solar,
-/// visible) of its room's openings its ray to the sun crosses.
+/// visible) of its room's openings its ray to the sun crosses, each at the ray's incidence on
+/// it ([`crate::model::inside::Glazing::solar_at`], the same curves as the interior beam).
 pub fn through_glass(rooms: &Rooms, room: u32, p: DVec3, sun: DVec3) -> (f64, f64) {
     let Some(room) = rooms.rooms.get(room as usize) else { return (1.0, 1.0) };
-    room.glazing
-        .iter()
-        .map(|&g| &rooms.glazing[g])
-        .filter(|g| g.crossed_by(p, sun))
-        .fold((1.0, 1.0), |(s, v), g| (s * g.solar, v * g.visible))
+    room.glazing.iter().map(|&g| &rooms.glazing[g]).filter(|g| g.crossed_by(p, sun)).fold((1.0, 1.0), |(s, v), g| {
+        // Either side's normal: the beam crosses the glass one way or the other.
+        let cos = g.plane.normal.dot(sun).abs();
+        (s * g.solar_at(cos), v * g.visible_at(cos))
+    })
 }
 
 /// One instant inside: per point its geometric visibility (`lit`: 1 lit, also through glass; 0

@@ -10,9 +10,9 @@
 //! for U > 4.5 W/m²K, one for U < 3.4, linear in U between). Any other construction takes the
 //! caller's `glass` value for both, except one `WindowMaterial:Glazing` pane given by spectral
 //! averages, whose normal-incidence fields are read as they are. The solar transmittance's
-//! angular dependence ([`Glazing::solar_at`], used by the interior beam) is EnergyPlus's: its
-//! curves A–J chosen by U and SHGC for simple glazing ([`super::simple_glazing`]), Fresnel's
-//! physics for one pane; the maps still weight a beam by the normal-incidence values.
+//! angular dependence ([`Glazing::solar_at`], [`Glazing::visible_at`]: the interior beam and the
+//! maps alike) is EnergyPlus's: its curves A–J chosen by U and SHGC for simple glazing
+//! ([`super::simple_glazing`]), Fresnel's physics for one pane.
 //!
 //! The scene ([`inside_scene`]) is the building's surfaces with the glazing left out, so an
 //! opening is a hole in its wall: the engines see the beam pass and the map weights it by the
@@ -27,9 +27,16 @@ use crate::error::{Error, Result};
 use crate::geometry::{Plane, inside_or_on, newell, triangulate};
 use crate::scene::{Scene, SceneBuilder};
 
+pub mod gltf;
+
 /// A ray within this distance (m) of an opening's outline crosses it: the engine counts a point
 /// whose ray grazes an edge as lit, and map points are f32 (about 1e-5 m at 100 m).
 const CROSSING_TOLERANCE: f64 = 1e-4;
+/// Barycentric slack of a crossing of a mesh pane's triangle (a ray through its edge crosses it).
+const EDGE_SLACK: f64 = 1e-7;
+/// The direction [`Room::contains`] counts an EnergyPlus zone's crossings along: an
+/// irrational-looking one, so the ray does not graze edges of axis-aligned rooms.
+const ZONE_PROBE: DVec3 = DVec3::new(0.577_3, 0.587_9, 0.566_4);
 
 /// An opening with glass, in world coordinates.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,6 +62,9 @@ pub struct Glazing {
     pub angular: Angular,
     /// Its base surface's other side is another zone (Outside Boundary Condition Surface or Zone).
     pub interzone: bool,
+    /// A mesh's glazing node ([`gltf`]): its triangles, crossed once wherever the ray meets one;
+    /// empty for an EnergyPlus window, whose `outline` is crossed.
+    pub pane: Vec<[DVec3; 3]>,
 }
 
 /// The angular dependence of a glass's solar transmittance.
@@ -89,8 +99,25 @@ impl Glazing {
         }
     }
 
+    /// Visible transmittance for a beam at `cos_incidence`: the normal value scaled by the same
+    /// angular dependence as the solar one. EnergyPlus runs simple glazing's curves (and an
+    /// uncoated pane's physics) over each of its optical passes alike, solar and visible; for a
+    /// pane sunlit has only the solar reflectance, so the solar curve's share stands in for the
+    /// visible one.
+    pub fn visible_at(&self, cos_incidence: f64) -> f64 {
+        match self.angular {
+            Angular::Pane { .. } if self.solar > 0.0 => (self.visible * self.solar_at(cos_incidence) / self.solar).clamp(0.0, 1.0),
+            Angular::Pane { .. } => 0.0,
+            Angular::Simple { u, shgc } => (self.visible * angular_factor(u, shgc, cos_incidence)).clamp(0.0, 1.0),
+            Angular::Normal => self.visible,
+        }
+    }
+
     /// Whether the ray from `p` along `dir` crosses this opening (ahead of `p`).
     pub fn crossed_by(&self, p: DVec3, dir: DVec3) -> bool {
+        if !self.pane.is_empty() {
+            return self.pane.iter().any(|t| ray_hits_triangle(p, dir, t, EDGE_SLACK));
+        }
         let across = self.plane.normal.dot(dir);
         if across.abs() < 1e-12 {
             return false;
@@ -111,17 +138,18 @@ pub struct Room {
     pub floors: Vec<String>,
     /// Indices into [`Rooms::glazing`] of its openings with glass.
     pub glazing: Vec<usize>,
-    /// Its boundary as triangles, openings filled: which points lie in it.
+    /// Its boundary as triangles (an EnergyPlus zone's openings filled): which points lie in it.
     shell: Vec<[DVec3; 3]>,
+    /// The direction along which [`Room::contains`] counts the shell's crossings.
+    probe: DVec3,
 }
 
 impl Room {
     /// Whether `p` lies inside the zone's boundary (a ray's crossings counted; a point on the
     /// boundary may go either way).
     pub fn contains(&self, p: DVec3) -> bool {
-        // An irrational-looking direction, so the ray does not graze edges of axis-aligned rooms.
-        let dir = DVec3::new(0.5773, 0.5879, 0.5664).normalize();
-        self.shell.iter().filter(|t| ray_hits_triangle(p, dir, t)).count() % 2 == 1
+        let dir = self.probe.normalize();
+        self.shell.iter().filter(|t| ray_hits_triangle(p, dir, t, 0.0)).count() % 2 == 1
     }
 }
 
@@ -164,7 +192,8 @@ pub fn rooms(input: &EnergyPlusInput, glass: Option<f64>) -> Result<Rooms> {
     let mut rooms: Vec<Room> = Vec::new();
     for zone in surfaces.iter().filter(|s| !s.is_fenestration()).filter_map(|s| s.zone.as_ref()) {
         if !rooms.iter().any(|r| r.name == *zone) {
-            rooms.push(Room { name: zone.clone(), inside: Vec::new(), floors: Vec::new(), glazing: Vec::new(), shell: Vec::new() });
+            let name = zone.clone();
+            rooms.push(Room { name, inside: Vec::new(), floors: Vec::new(), glazing: Vec::new(), shell: Vec::new(), probe: ZONE_PROBE });
         }
     }
     let mut glazing = Vec::new();
@@ -193,8 +222,9 @@ fn fan(vertices: &[DVec3]) -> Vec<[DVec3; 3]> {
     triangulate(&plane, vertices, &[]).into_iter().map(|t| t.map(|i| vertices[i])).collect()
 }
 
-/// Möller–Trumbore: whether the ray from `p` along `dir` crosses triangle `t` ahead of `p`.
-fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3]) -> bool {
+/// Möller–Trumbore: whether the ray from `p` along `dir` crosses triangle `t` ahead of `p`, its
+/// edges widened by `slack` (barycentric).
+fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3], slack: f64) -> bool {
     let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
     let h = dir.cross(e2);
     let a = e1.dot(h);
@@ -205,7 +235,7 @@ fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3]) -> bool {
     let u = s.dot(h) / a;
     let q = s.cross(e1);
     let v = dir.dot(q) / a;
-    u >= 0.0 && v >= 0.0 && u + v <= 1.0 && e2.dot(q) / a > 0.0
+    u >= -slack && v >= -slack && u + v <= 1.0 + slack && e2.dot(q) / a > 0.0
 }
 
 fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Result<Glazing> {
@@ -245,6 +275,7 @@ fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Res
         visible,
         angular,
         interzone,
+        pane: Vec::new(),
     })
 }
 

@@ -84,6 +84,12 @@ pub struct LoadOptions {
     /// The scene's f32 origin (world), when scenes cut from one model must round alike; `None`:
     /// the input's centre ([`crate::scene::SceneBuilder::set_origin`]).
     pub origin: Option<glam::DVec3>,
+    /// Glob patterns over mesh node names: glazing, left out of the scene (an opening) and kept in
+    /// [`Loaded::glazing`] ([`inside::gltf`]).
+    pub glazing: Vec<String>,
+    /// Glob patterns over mesh node names: rooms, each a receiver and kept in [`Loaded::interior`]
+    /// ([`inside::gltf`]); they are the only receivers when `receivers` is empty.
+    pub interior: Vec<String>,
 }
 
 /// The EnergyPlus model among the inputs, kept for hooking the schedule into a copy of it.
@@ -120,6 +126,10 @@ pub struct Loaded {
     /// What the caller should hear about the choices made (also logged as warnings), e.g. that
     /// the default receiver rule chose more than [`MANY_RECEIVERS`] receivers.
     pub notes: Vec<String>,
+    /// The mesh nodes the `glazing` option picked (not in the scene).
+    pub glazing: Vec<inside::gltf::MarkedNode>,
+    /// The mesh nodes the `interior` option picked (receivers of the scene).
+    pub interior: Vec<inside::gltf::MarkedNode>,
 }
 
 /// More receivers than this, chosen by the default rule (every named node), are reported: a CAD
@@ -223,16 +233,25 @@ fn read_inputs(files: &[(String, Vec<u8>)], dirs: &[Option<PathBuf>], options: &
             }),
         }
     }
+    let glazing = inside::gltf::marked_nodes(&mut models, "glazing", &options.glazing, true)?;
+    let interior = inside::gltf::marked_nodes(&mut models, "interior", &options.interior, false)?;
+    let rooms_only;
+    let options = if options.receivers.is_empty() && !options.interior.is_empty() {
+        rooms_only = LoadOptions { receivers: options.interior.clone(), ..options.clone() };
+        &rooms_only
+    } else {
+        options
+    };
     let (scene, mut notes) = build(models, energyplus.as_ref(), options)?;
     notes.extend(city_notes);
-    Ok(Loaded { scene, energyplus, notes })
+    Ok(Loaded { scene, energyplus, notes, glazing, interior })
 }
 
 /// A city model already read (a district's tile) into a scene, as [`load_bytes_all`] would.
 pub fn load_city(city: &cityjson::City, options: &LoadOptions) -> Result<Loaded> {
     check_options(options)?;
     let (scene, notes) = build(vec![cityjson::city_model(city, options.north)?], None, options)?;
-    Ok(Loaded { scene, energyplus: None, notes })
+    Ok(Loaded { scene, energyplus: None, notes, glazing: Vec::new(), interior: Vec::new() })
 }
 
 /// What a run over a city model says of north: its grid north is true north unless turned.

@@ -7,9 +7,12 @@ outside its rectangle. Nothing here comes from sunlit: only the geometry's numbe
 
 stdin: JSON {room: [W, D, H], window: [x0, x1, z0, z1], overhang: [x0, x1, depth, z] | null,
 points: [[x, y, z]...], normal: [nx, ny, nz], suns: [[sx, sy, sz]...], lux: [...] | null,
-vt: float}
-stdout: JSON {lit: [[0|1 per point] per sun]} without lux; with lux (one per sun)
-{hours_over: [per point hours with lux * vt * cos * lit > 1000]}.
+vt: float, angular: "E" | null}
+stdout: JSON {lit: [[0|1 per point] per sun], visible: [[vt at the sun's incidence on the window
+per lit point, 0 unlit] per sun]} without lux; with lux (one per sun) {hours_over: [per point hours
+with lux * vt * cos * lit > 1000]}. With angular "E" the window's transmittance at incidence theta
+is vt times EnergyPlus's simple glazing curve E of cos theta (Engineering Reference, "Simple
+Window Model": the curve of a glazing with U under 3.4 W/m2K and SHGC over 0.55); null: vt.
 
 Second mode, any closed room of planar polygons (an L-shaped zone): stdin JSON {faces: [{name,
 vertices: [[x, y, z]...], holes: [window outlines in it]}...] (the room's boundary; a wall's
@@ -43,6 +46,22 @@ def lit(points, sun, window, overhang):
         under = (to > t) & (at[:, 1] <= 0) & (at[:, 1] >= -depth) & (at[:, 0] >= ox0) & (at[:, 0] <= ox1)
         through &= ~under
     return through
+
+
+# EnergyPlus Engineering Reference, "Simple Window Model", curve E: T(c) = 1.51c + 2.49c^2 -
+# 5.87c^3 + 2.88c^4, set to 1 at normal incidence.
+CURVE_E = (1.51, 2.49, -5.87, 2.88)
+
+
+def window_vt(vt, sun, angular):
+    """The window's transmittance for the beam along `sun` (the window faces -y)."""
+    if angular is None:
+        return vt
+    c = min(max(-float(sun[1]), 0.0), 1.0)
+    if c >= 1.0:
+        return vt
+    a, b, d, e = CURVE_E
+    return vt * max(a * c + b * c**2 + d * c**3 + e * c**4, 0.0)
 
 
 def frame(vertices):
@@ -131,12 +150,15 @@ def main():
     suns = np.array(q["suns"], dtype=float)
     normal = np.array(q["normal"], dtype=float)
     if q.get("lux") is None:
-        out = {"lit": [lit(points, s, q["window"], q.get("overhang")).astype(int).tolist() for s in suns]}
+        lits = [lit(points, s, q["window"], q.get("overhang")) for s in suns]
+        out = {"lit": [l.astype(int).tolist() for l in lits]}
+        if q.get("vt") is not None:
+            out["visible"] = [(l * window_vt(q["vt"], s, q.get("angular"))).tolist() for l, s in zip(lits, suns)]
     else:
         hours = np.zeros(len(points))
         for s, lux in zip(suns, q["lux"]):
             cos = max(float(normal @ s), 0.0)
-            if lux * q["vt"] * cos > 1000.0:
+            if lux * window_vt(q["vt"], s, q.get("angular")) * cos > 1000.0:
                 hours += lit(points, s, q["window"], q.get("overhang"))
         out = {"hours_over": hours.tolist()}
     json.dump(out, sys.stdout)
