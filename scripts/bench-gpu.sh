@@ -14,6 +14,11 @@
 # compute_views_per_submission (the batches are no longer the atlas's 16 views).
 # BEFORE=path/to/an/older/sunlit adds that binary's compute run on the same spread right after,
 # for a before/after on the same lease.
+# ONLY=REGEX runs only the runs whose label matches (e.g. ONLY=cull for the GPU culling pass).
+# The GPU culling pass (--gpu-cull: clusters of <= 128 triangles against 1,024 views a dispatch,
+# src/count/gpu/cluster_cull.rs) is timed first, beside the CPU culling's share of the host
+# stages (host_stages_seconds.culling) on the same views: the one figure of the new path that a
+# GPU can give before the draw per batch exists.
 # Used for docs/benchmarks-gpu.md (an H100 and an H200 lent for one session: see there).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +30,7 @@ gpu_flags=(); [ -n "${ATLAS:-}" ] && gpu_flags+=(--atlas "$ATLAS"); [ -n "${LANE
 views=(); [ -n "${VIEWS:-}" ] && views=(--views "$VIEWS")
 run() { # label timeout args...
   local label=$1 t=$2; shift 2
+  if [ -n "${ONLY:-}" ] && ! [[ $label =~ $ONLY ]]; then return; fi
   if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-480}" ]; then echo "skip $label" >> "$OUT/stderr.txt"; return; fi
   # SKIP_EXACT=1: a second lease on the same machine need not time the CPU again.
   if [ -n "${SKIP_EXACT:-}" ] && [[ $label == *exact* || $label == *noop* ]]; then return; fi
@@ -44,6 +50,11 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # The targets: nyt-blocks 27×19 (353,780 views) best GPU kernel ≤ 8 s and ≥ 4× exact on 16
 # cores; blaas-trees-summer (16,492 views) ≤ 0.5 s. A short lease first gets the three engines
 # on the same even spread of 20,040 nyt-blocks views (extrapolated), then every view.
+# The new path first: the GPU culling pass over 20,040 nyt-blocks views (its JSON's gpu_cull), its
+# host cost alone on noop, and blaas-trees-summer's every view.
+run nyt-blocks-gpu-cull 90 bench nyt-blocks --engine gpu --views "${VIEWS:-20040}" --gpu-cull "${gpu_flags[@]}"
+run nyt-blocks-noop-cull 90 bench nyt-blocks --engine gpu --backend noop --lanes 1 --views "${VIEWS:-20040}" --gpu-cull
+run blaas-trees-summer-gpu-cull 40 bench blaas-trees-summer --engine gpu --gpu-cull "${views[@]}" "${gpu_flags[@]}"
 if [ -z "${VIEWS:-}" ]; then
   run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views 20040 --check 30 "${gpu_flags[@]}"
   [ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views 20040 "${gpu_flags[@]}"

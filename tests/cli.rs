@@ -348,6 +348,17 @@ fn bench_on_the_noop_backend_times_the_same_views_on_the_host() {
         assert!(stages[stage].as_f64().is_some_and(|s| s >= 0.0), "{stage} in {noop}");
     }
     assert!(stages["planning"].as_f64().unwrap() > 0.0, "{noop}");
+    // The culling is a part of the planning, the recording of the encoding.
+    for (part, whole) in [("culling", "planning"), ("recording", "encoding")] {
+        let (part, whole) = (stages[part].as_f64().unwrap(), stages[whole].as_f64().unwrap());
+        assert!(part > 0.0 && part <= whole, "{noop}");
+    }
+    // The GPU's culling pass over the same views: it keeps some clusters of every lit view.
+    let culled = line(&["--gpu-cull"]);
+    let cull = &culled["gpu_cull"];
+    assert!(cull["views"].as_u64().unwrap() >= real["views_rendered"].as_u64().unwrap(), "{cull}");
+    assert!(cull["pairs_per_view"].as_f64().unwrap() >= 1.0 && cull["triangles_per_view"].as_f64().unwrap() > 0.0, "{cull}");
+    fails_with(&sunlit(&["bench", "blaas-buildings", "--gpu-cull"]), &["--gpu-cull", "--engine gpu"]);
     // WebGPU's core limits on lavapipe: a smaller atlas at most, the same views.
     assert_eq!(line(&["--limits", "webgpu"])["views_rendered"], real["views_rendered"]);
     fails_with(&sunlit(&[&quick[..], &["--backend", "noop", "--check", "5"]].concat()), &["--check", "noop"]);

@@ -1,7 +1,9 @@
 //! The compute rasterizer (`Kernel::Compute`, shaders/compute_raster.wgsl) against its CPU truth
 //! pixel for pixel (the hardware's rules written here again in plain i64), the fill rule on
 //! shared edges through pixel centres, depth ties, a node pool forced to overflow, and real views
-//! against the exact reference and the raster kernel (per-view histogram of differing pixels).
+//! against the exact reference and the raster kernel (per-view histogram of differing pixels);
+//! and the GPU culling pass (shaders/cull_clusters.wgsl) against its CPU truth, with a pair list
+//! forced to overflow.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
@@ -331,4 +333,88 @@ fn bench_views_compute_raster_and_exact_agree() {
     assert!(truth.iter().filter(|e| **e > 0.02 && **e < 0.98).count() >= 4, "partly shaded views: {truth:?}");
     assert!(worst[0] <= 0.001 && worst[1] <= 0.001, "max |error| raster {}, compute {}", worst[0], worst[1]);
     assert!(differing.iter().all(|&n| n <= DIFFERING_PIXELS_BOUND), "{differing:?}");
+}
+
+/// A city of 3,000 random boxes (36,000 triangles, ~400 clusters) and 40 views fitted to random
+/// squares at random suns, as the counter fits them; the clusters and their clip transforms.
+fn culling_case() -> (Vec<sunlit::count::cull::Cluster>, Vec<glam::DMat4>) {
+    use glam::DVec3;
+    let mut rng = SmallRng::seed_from_u64(32);
+    let mut s = common::TestScene::new();
+    for k in 0..3000 {
+        let lo = DVec3::new(rng.random_range(0.0..200.0), rng.random_range(0.0..200.0), 0.0);
+        let size = DVec3::new(rng.random_range(1.0..8.0), rng.random_range(1.0..8.0), rng.random_range(2.0..30.0));
+        s.cuboid(&format!("B{k}"), lo, lo + size);
+    }
+    let scene = s.build();
+    let culling = sunlit::count::cull::Culling::new(&scene, sunlit::count::cull::LEAF_TRIANGLES);
+    let views = (0..40)
+        .map(|_| {
+            let at = DVec3::new(rng.random_range(0.0..200.0), rng.random_range(0.0..200.0), rng.random_range(0.0..20.0));
+            let points = [at, at + DVec3::X * 3.0, at + DVec3::new(3.0, 0.0, 3.0), at + DVec3::Z * 3.0];
+            let (azimuth, altitude) = (rng.random_range(0.0..360.0f64).to_radians(), rng.random_range(5.0..85.0f64).to_radians());
+            let sun = DVec3::new(azimuth.sin() * altitude.cos(), -azimuth.cos() * altitude.cos(), altitude.sin());
+            sunlit::count::view::fit(&points, sun, scene.bounds, scene.origin, 64).view_proj
+        })
+        .collect();
+    (culling.clusters(), views)
+}
+
+/// The CPU truth of the cull pass, written apart from both culls: a cluster is kept where the
+/// clip coordinates of its box's eight corners span a range that meets x, y in [−1 − s, 1 + s]
+/// and depth in [−s, 1 + s].
+fn culled_truth(clusters: &[sunlit::count::cull::Cluster], views: &[glam::DMat4], s: f64) -> std::collections::BTreeSet<[u32; 2]> {
+    let mut kept = std::collections::BTreeSet::new();
+    for (v, m) in views.iter().enumerate() {
+        for (c, cluster) in clusters.iter().enumerate() {
+            let (lo, hi) = (cluster.lo.as_dvec3(), cluster.hi.as_dvec3());
+            let corners = (0..8).map(|i| {
+                m.project_point3(glam::DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                ))
+            });
+            let (a, b) = corners.fold((glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)));
+            if a.x <= 1.0 + s && b.x >= -1.0 - s && a.y <= 1.0 + s && b.y >= -1.0 - s && a.z <= 1.0 + s && b.z >= -s {
+                kept.insert([v as u32, c as u32]);
+            }
+        }
+    }
+    kept
+}
+
+#[test]
+fn the_gpu_cull_keeps_the_pairs_its_cpu_truth_keeps_and_writes_their_draw() {
+    use sunlit::count::cull::{CLIP_SLACK, CLUSTER_TRIANGLES};
+    use sunlit::count::gpu::cluster_cull::GpuClusters;
+    let (clusters, views) = culling_case();
+    assert!(clusters.len() > 5 * 64, "several workgroups of clusters: {}", clusters.len());
+    let counter = common::counter(64);
+    let gpu = GpuClusters::new(&counter, &clusters);
+    let culled = pollster::block_on(counter.cull_clusters(&gpu, &views, 1 << 16)).unwrap();
+    assert_eq!(culled.reruns, 0);
+    let got: std::collections::BTreeSet<[u32; 2]> = culled.pairs.iter().copied().collect();
+    assert_eq!(got.len(), culled.pairs.len(), "each pair once");
+    // f32 on the GPU against f64 here: pairs within 1e-5 of the slack's edge may go either way.
+    let (must, may) = (culled_truth(&clusters, &views, CLIP_SLACK - 1e-5), culled_truth(&clusters, &views, CLIP_SLACK + 1e-5));
+    assert!(must.len() > views.len() && may.len() < views.len() * clusters.len() / 4, "a cull that keeps some: {}", must.len());
+    assert!(must.is_subset(&got), "missed: {:?}", must.difference(&got).take(5).collect::<Vec<_>>());
+    assert!(got.is_subset(&may), "kept beyond the volume: {:?}", got.difference(&may).take(5).collect::<Vec<_>>());
+    assert_eq!(culled.draw, [3 * CLUSTER_TRIANGLES, culled.pairs.len() as u32, 0, 0], "one instance a pair");
+}
+
+#[test]
+fn an_overflowing_pair_list_is_run_again_never_truncated() {
+    use sunlit::count::gpu::cluster_cull::GpuClusters;
+    let (clusters, views) = culling_case();
+    let counter = common::counter(64);
+    let gpu = GpuClusters::new(&counter, &clusters);
+    let roomy = pollster::block_on(counter.cull_clusters(&gpu, &views, 1 << 16)).unwrap();
+    let tight = pollster::block_on(counter.cull_clusters(&gpu, &views, 16)).unwrap();
+    assert!(roomy.pairs.len() > 16);
+    assert_eq!(tight.reruns, 1, "run again once, with as many pairs as it needed");
+    let sorted = |p: &[[u32; 2]]| p.iter().copied().collect::<std::collections::BTreeSet<_>>();
+    assert_eq!(sorted(&tight.pairs), sorted(&roomy.pairs));
+    assert_eq!(tight.draw, roomy.draw);
 }

@@ -11,7 +11,8 @@ use std::collections::BTreeMap;
 use glam::DVec3;
 
 use crate::count::ViewRequest;
-use crate::count::gpu::plan::planned_triangles;
+use crate::count::gpu::cluster_cull::GpuClusters;
+use crate::count::gpu::plan::{clusters, planned_triangles, planned_views};
 use crate::count::gpu::{Counted, Counter, GpuScene, HostStages};
 use crate::count::lanes::{Lane, fractions_side_by_side};
 use crate::error::Result;
@@ -197,15 +198,69 @@ pub struct ViewTiming {
     pub counted: Vec<Counted>,
 }
 
+/// The GPU's culling pass ([`crate::count::gpu::cluster_cull`]) timed over a model's views.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct GpuCullTiming {
+    /// Views culled (those facing the sun).
+    pub views: usize,
+    /// The scene's clusters.
+    pub clusters: usize,
+    /// Fitting the views on the CPU (what the pass reads).
+    pub fitting_seconds: f64,
+    /// The pass itself: its batches recorded, submitted and read back.
+    pub seconds: f64,
+    /// (view, cluster) pairs kept a view.
+    pub pairs_per_view: f64,
+    /// Triangles the kept clusters hold, a view.
+    pub triangles_per_view: f64,
+    /// Batches run again because their pair list overflowed.
+    pub reruns: u32,
+}
+
+/// Views a batch of [`time_gpu_cull`] culls: the raster kernel's largest batches at 64².
+pub const CULL_BATCH_VIEWS: usize = 1024;
+
+/// Times the GPU's culling pass over the views of `requests` (at side `side`), in batches of
+/// [`CULL_BATCH_VIEWS`], on `counter` with `gpu` uploaded to it.
+pub async fn time_gpu_cull(
+    counter: &Counter,
+    gpu: &GpuScene,
+    requests: &[ViewRequest],
+    side: u32,
+    now: impl Fn() -> f64,
+) -> Result<GpuCullTiming> {
+    let clusters = clusters(gpu);
+    let on_gpu = GpuClusters::new(counter, &clusters);
+    let start = now();
+    let views = planned_views(gpu, requests, side);
+    let fitting_seconds = now() - start;
+    let start = now();
+    let (mut pairs, mut triangles, mut reruns) = (0usize, 0u64, 0);
+    // Room for the pairs of the batch before, so in steady state no batch runs twice.
+    let mut capacity = 1 << 16;
+    for batch in views.chunks(CULL_BATCH_VIEWS) {
+        let culled = counter.cull_clusters(&on_gpu, batch, capacity).await?;
+        pairs += culled.pairs.len();
+        triangles += culled.pairs.iter().map(|&[_, c]| clusters[c as usize].count as u64).sum::<u64>();
+        reruns += culled.reruns;
+        capacity = capacity.max(culled.pairs.len() as u32);
+    }
+    let seconds = now() - start;
+    let per_view = |n: f64| n / views.len().max(1) as f64;
+    Ok(GpuCullTiming {
+        views: views.len(),
+        clusters: clusters.len(),
+        fitting_seconds,
+        seconds,
+        pairs_per_view: per_view(pairs as f64),
+        triangles_per_view: per_view(triangles as f64),
+        reruns,
+    })
+}
+
 /// The lanes' host stages added up.
 fn lanes_host_stages(lanes: &[Lane<'_>]) -> HostStages {
-    lanes.iter().map(|l| l.counter.host_stages()).fold(HostStages::default(), |a, b| HostStages {
-        planning: a.planning + b.planning,
-        encoding: a.encoding + b.encoding,
-        submitting: a.submitting + b.submitting,
-        waiting: a.waiting + b.waiting,
-        unpacking: a.unpacking + b.unpacking,
-    })
+    lanes.iter().map(|l| l.counter.host_stages()).fold(HostStages::default(), |a, b| a + b)
 }
 
 /// Times counting `requests` over the lanes (side by side); one warm-up batch a lane first.
@@ -222,13 +277,7 @@ pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: im
     let seconds = now() - start;
     let after = rendered_so_far();
     let stages_after = lanes_host_stages(lanes);
-    let host_stages = HostStages {
-        planning: stages_after.planning - stages_before.planning,
-        encoding: stages_after.encoding - stages_before.encoding,
-        submitting: stages_after.submitting - stages_before.submitting,
-        waiting: stages_after.waiting - stages_before.waiting,
-        unpacking: stages_after.unpacking - stages_before.unpacking,
-    };
+    let host_stages = stages_after - stages_before;
     let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);
     let rendered = counted.iter().filter(|c| c.side > 0).count();
     let start = now();

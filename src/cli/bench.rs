@@ -58,6 +58,12 @@ pub(super) struct BenchArgs {
     /// grants), so the fallbacks those devices take are timed on any adapter.
     #[arg(long, value_name = "adapter|lavapipe|webgpu", default_value = "adapter")]
     limits: String,
+    /// Also time the GPU's culling pass (clusters of at most 128 triangles tested against every
+    /// view of a batch of 1,024, on the GPU) over the same views, after the timed count: its
+    /// figures go in a `gpu_cull` object. Only with --engine gpu or compute and models; no count
+    /// depends on it yet.
+    #[arg(long)]
+    gpu_cull: bool,
     /// Time each model's sky pass instead: every receiver's sky views over the given patch
     /// scheme (`tregenza` or `reinhart:N`), once, on the chosen engine.
     #[arg(long, value_name = "SCHEME")]
@@ -86,6 +92,9 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
     if args.suns == 0 {
         return Err(Error::argument("--suns", "must be at least 1"));
     }
+    if args.gpu_cull && (args.models.is_empty() || args.sky.is_some()) {
+        return Err(Error::argument("--gpu-cull", "times the culling over a model's sun views: name a model, without --sky"));
+    }
     if let Some(scheme) = &args.sky {
         return bench_sky(&args, scheme);
     }
@@ -93,6 +102,9 @@ pub(super) fn run_bench(args: BenchArgs) -> Result<()> {
     if !args.models.is_empty() && !args.engine.kind()?.gpu_only() {
         if options.backend == Backend::Noop {
             return Err(Error::argument("--backend", "noop times the GPU counter alone: use it with --engine gpu or compute"));
+        }
+        if args.gpu_cull {
+            return Err(Error::argument("--gpu-cull", "times the GPU's culling pass: use it with --engine gpu or compute"));
         }
         let start = Instant::now();
         return bench_hybrid(&args, move || start.elapsed().as_secs_f64());
@@ -231,6 +243,10 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             "load_seconds": load_seconds,
             "peak_memory_mib": peak_memory_mib(),
         });
+        if args.gpu_cull {
+            let cull = pollster::block_on(bench::time_gpu_cull(counter, &gpus[0], requests, counter.resolution(), now))?;
+            line["gpu_cull"] = json!(cull);
+        }
         if args.check > 0 {
             let check = bench::check_exact(&scene, requests, &t.counted, args.check);
             line["exact_views_checked"] = json!(check.views);

@@ -39,7 +39,26 @@ pub const LEAF_TRIANGLES: u32 = 64;
 pub const CPU_LEAF_TRIANGLES: u32 = 16;
 
 /// Slack in clip units for the box test, so rounding never culls what the GPU would draw.
-const CLIP_SLACK: f64 = 1e-4;
+pub const CLIP_SLACK: f64 = 1e-4;
+
+/// The most triangles a cluster ([`Culling::clusters`]) holds: a BVH node is a cluster when it
+/// holds at most this many and its parent more, so a cluster of the static mesh holds 64–128
+/// (median splits halve a node).
+pub const CLUSTER_TRIANGLES: u32 = 128;
+
+/// A run of triangles of [`Culling::triangles`], spatially compact, with its box (scene
+/// coordinates relative to the origin): what the GPU's culling pass tests against each view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cluster {
+    /// Its first triangle in [`Culling::triangles`]' order.
+    pub first: u32,
+    /// Its triangles (at most [`CLUSTER_TRIANGLES`]).
+    pub count: u32,
+    /// Its box's lowest corner.
+    pub lo: Vec3,
+    /// Its box's highest corner.
+    pub hi: Vec3,
+}
 
 /// A bounding volume hierarchy over items stored contiguously in BVH order.
 #[derive(Debug, Default)]
@@ -104,6 +123,20 @@ impl Bvh {
         let r = self.split(right, first + mid as u32, per_leaf);
         self.nodes[at as usize].right = Some(r);
         at
+    }
+
+    /// Calls `f`, in item order, with the item range of every highest node holding at most `most`
+    /// triangles (`per_item` an item), or of a leaf holding more: the ranges cover every item
+    /// once.
+    fn cut(&self, most: usize, per_item: usize, mut f: impl FnMut(Range<u32>)) {
+        let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0u32] };
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            match node.right {
+                Some(r) if node.items.len() * per_item > most => stack.extend([r, n + 1]),
+                _ => f(node.items.clone()),
+            }
+        }
     }
 
     /// Calls `f` with the item range of every leaf whose box reaches into `clip`, in item order.
@@ -387,6 +420,31 @@ impl Culling {
         out
     }
 
+    /// The triangles cut into clusters of at most [`CLUSTER_TRIANGLES`], in triangle order: BVH
+    /// nodes of the static mesh and of each shared mesh's instances; a leaf of one instance with
+    /// more triangles than that is cut into even runs of it.
+    pub fn clusters(&self) -> Vec<Cluster> {
+        let most = CLUSTER_TRIANGLES as usize;
+        let mut out = Vec::new();
+        self.static_bvh.cut(most, 1, |r| self.push_clusters(&mut out, r.start as usize..r.end as usize));
+        for g in &self.groups {
+            let n = g.triangles_per_instance;
+            let at = |i: u32| g.first_triangle + i as usize * n;
+            g.bvh.cut(most, n, |r| self.push_clusters(&mut out, at(r.start)..at(r.end)));
+        }
+        out
+    }
+
+    fn push_clusters(&self, out: &mut Vec<Cluster>, range: Range<usize>) {
+        let pieces = range.len().div_ceil(CLUSTER_TRIANGLES as usize);
+        for k in 0..pieces {
+            let (a, b) = (range.start + range.len() * k / pieces, range.start + range.len() * (k + 1) / pieces);
+            let (lo, hi) =
+                self.triangles[a..b].iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+            out.push(Cluster { first: a as u32, count: (b - a) as u32, lo, hi });
+        }
+    }
+
     fn any_shades(&self, prism: &Prism, own: u32, range: Range<usize>) -> bool {
         self.triangles[range.clone()].iter().zip(&self.ids[range]).any(|(t, id)| (*id != own || own == NO_RECEIVER) && prism.may_shade(t))
     }
@@ -521,5 +579,51 @@ mod tests {
         assert!(slots > 0 && slots < 3000, "{slots} instances drawn");
         let statics: usize = low.static_triangles.iter().map(|r| r.len()).sum();
         assert!(statics <= 2 * LEAF_TRIANGLES as usize, "{statics} static triangles drawn");
+    }
+
+    #[test]
+    fn clusters_cover_every_triangle_once_within_their_boxes() {
+        // 10,000 static triangles, 3,000 instances of 2 and two of a 300-triangle mesh (a mesh
+        // placed once is merged into the static mesh).
+        let mut b = SceneBuilder::new();
+        let mut row = SourceMesh::default();
+        for k in 0..5000u32 {
+            let s = square(0.01 * k as f32, (k % 7) as f32, 1.0, 0.005);
+            row.indices.extend(s.indices.iter().map(|i| i + row.positions.len() as u32));
+            row.positions.extend(s.positions);
+        }
+        b.add_object("test", "ROW", row, false);
+        let shared = b.add_mesh("tile", square(0.0, 0.0, 0.0, 0.005));
+        let mut big = SourceMesh::default();
+        for k in 0..150u32 {
+            let s = square(0.0, k as f32, 0.0, 0.5);
+            big.indices.extend(s.indices.iter().map(|i| i + big.positions.len() as u32));
+            big.positions.extend(s.positions);
+        }
+        let big = b.add_mesh("big", big);
+        for (k, mesh) in (0..3002).map(|k| (k, if k >= 3000 { big } else { shared })) {
+            let transform = DMat4::from_translation(DVec3::new(60.0 + 0.01 * k as f64, 0.0, 1.0));
+            let name = format!("T{k}");
+            b.add_node(crate::scene::SourceNode { origin: name.clone(), name, mesh, transform, receiver: false });
+        }
+        let culling = Culling::new(&b.build().unwrap(), LEAF_TRIANGLES);
+        let clusters = culling.clusters();
+        let (triangles, _) = culling.triangles();
+        assert_eq!(triangles.len(), 10_000 + 6_000 + 600);
+        let mut next = 0;
+        for c in &clusters {
+            assert_eq!(c.first, next, "in order, no gap or overlap");
+            assert!(c.count >= 1 && c.count <= CLUSTER_TRIANGLES, "{c:?}");
+            for p in triangles[c.first as usize..(c.first + c.count) as usize].iter().flatten() {
+                assert!(p.cmpge(c.lo).all() && p.cmple(c.hi).all(), "{p} outside {c:?}");
+            }
+            next += c.count;
+        }
+        assert_eq!(next as usize, triangles.len());
+        // The static mesh's clusters are BVH nodes of 64-128 triangles.
+        let statics: Vec<u32> = clusters.iter().filter(|c| c.first < 10_000).map(|c| c.count).collect();
+        assert!(statics.iter().all(|&n| (64..=128).contains(&n)), "{statics:?}");
+        // Each large instance is cut into even runs: 100 + 100 + 100.
+        assert_eq!(clusters.iter().rev().take(6).map(|c| c.count).collect::<Vec<_>>(), [100; 6]);
     }
 }

@@ -506,6 +506,7 @@ impl Counter {
                 entry(8, bins.params.as_entire_binding()),
             ],
         });
+        let recording = Stopwatch::start();
         let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("compute batch") });
         encoder.clear_buffer(&bins.counts, 0, Some(entry_bytes.max(4)));
         encoder.clear_buffer(&bins.heads, 0, Some(head_bytes));
@@ -523,6 +524,7 @@ impl Counter {
             encoder.copy_buffer_to_buffer(&bins.counts, 0, &bins.readback, 4, entry_bytes);
         }
         let commands = encoder.finish();
+        self.stages.recording.fetch_add(recording.nanos(), Ordering::Relaxed);
         self.stages.encoding.fetch_add(encoding.nanos(), Ordering::Relaxed);
         let submitting = Stopwatch::start();
         self.queue.submit([commands]);

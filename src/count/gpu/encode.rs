@@ -128,6 +128,7 @@ impl Counter {
         self.queue.write_buffer(&self.batch.views, 0, bytemuck::cast_slice(&views));
         self.queue.write_buffer(&self.batch.tile_views, 0, &tile_views);
         self.queue.write_buffer(&self.batch.members, 0, bytemuck::cast_slice(&members));
+        let recording = Stopwatch::start();
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
         self.render_tiles(&mut encoder, scene, requests, batch, side);
         if count {
@@ -148,6 +149,7 @@ impl Counter {
             self.encode_masks(&mut encoder, points, mask_batch, first_word);
         }
         let commands = encoder.finish();
+        self.stages.recording.fetch_add(recording.nanos(), Ordering::Relaxed);
         self.stages.encoding.fetch_add(encoding.nanos(), Ordering::Relaxed);
         let submitting = Stopwatch::start();
         self.queue.submit([commands]);

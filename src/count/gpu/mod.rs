@@ -34,10 +34,13 @@
 //! - [`masks`]: map points uploaded per receiver and the mask pass that reads, after the count
 //!   pass and from the same atlas, whether each point sees the sun;
 //! - `readback`: mapping the counts (and masks) and turning them into fractions.
+//! - [`cluster_cull`]: culling on the GPU, clusters against a batch's views into one list of
+//!   (view, cluster) pairs and an indirect draw (built and tested; not yet drawn from).
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
 
+pub mod cluster_cull;
 pub mod compute;
 mod device;
 mod encode;
@@ -182,13 +185,20 @@ pub fn error_estimate(covered: u32, edges: u32) -> f64 {
 
 /// The host's time a [`Counter`] has spent counting, by stage, in seconds (natively; the web
 /// build has no clock here and reports zeros). What is left of a count's wall time beyond their
-/// sum is the GPU's own work that the host did not wait for.
+/// sum is the GPU's own work that the host did not wait for. `culling` is part of `planning` and
+/// `recording` part of `encoding` (their rest: fitting and packing tiles; writing buffers).
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct HostStages {
     /// Fitting views, culling what each draws and packing tiles (CPU only).
     pub planning: f64,
+    /// Of `planning`: culling, the BVH walk choosing what each tile draws and the test whether
+    /// anything in it can shade the receiver.
+    pub culling: f64,
     /// Writing each batch's buffers and recording its passes.
     pub encoding: f64,
+    /// Of `encoding`: recording the passes (the raster kernel's render pass, a draw per member
+    /// and per merged range, and its count pass; the compute kernel's dispatches).
+    pub recording: f64,
     /// `Queue::submit`.
     pub submitting: f64,
     /// Waiting for a readback to map (the GPU finishing, and the round trip).
@@ -197,11 +207,42 @@ pub struct HostStages {
     pub unpacking: f64,
 }
 
+impl HostStages {
+    /// Stage by stage, `f` of the two.
+    fn zip(self, other: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        Self {
+            planning: f(self.planning, other.planning),
+            culling: f(self.culling, other.culling),
+            encoding: f(self.encoding, other.encoding),
+            recording: f(self.recording, other.recording),
+            submitting: f(self.submitting, other.submitting),
+            waiting: f(self.waiting, other.waiting),
+            unpacking: f(self.unpacking, other.unpacking),
+        }
+    }
+}
+
+impl std::ops::Add for HostStages {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        self.zip(other, |a, b| a + b)
+    }
+}
+
+impl std::ops::Sub for HostStages {
+    type Output = Self;
+    fn sub(self, other: Self) -> Self {
+        self.zip(other, |a, b| a - b)
+    }
+}
+
 /// [`HostStages`] as a counter accumulates them, in nanoseconds, from any lane's thread.
 #[derive(Default)]
 struct StageClock {
     planning: AtomicU64,
+    culling: AtomicU64,
     encoding: AtomicU64,
+    recording: AtomicU64,
     submitting: AtomicU64,
     waiting: AtomicU64,
     unpacking: AtomicU64,
@@ -212,7 +253,9 @@ impl StageClock {
         let s = |a: &AtomicU64| a.load(Ordering::Relaxed) as f64 * 1e-9;
         HostStages {
             planning: s(&self.planning),
+            culling: s(&self.culling),
             encoding: s(&self.encoding),
+            recording: s(&self.recording),
             submitting: s(&self.submitting),
             waiting: s(&self.waiting),
             unpacking: s(&self.unpacking),
@@ -378,8 +421,10 @@ impl Counter {
         let ladder = sides(&self.options);
         let first = ladder.first().copied().unwrap_or(self.options.resolution);
         let planning = Stopwatch::start();
-        let tiles = plan_tiles(&scene.layout, requests, first, &mut out)?;
+        let mut culling = 0;
+        let tiles = plan_tiles(&scene.layout, requests, first, &mut out, &mut culling)?;
         self.stages.planning.fetch_add(planning.nanos(), Ordering::Relaxed);
+        self.stages.culling.fetch_add(culling, Ordering::Relaxed);
         // Tiles waiting to be counted, by side; each round counts the smallest side waiting.
         let mut waiting: BTreeMap<u32, Vec<Tile>> = BTreeMap::from([(first, tiles)]);
         while let Some((side, tiles)) = waiting.pop_first() {

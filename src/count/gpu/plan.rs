@@ -18,6 +18,7 @@ use crate::count::group::{MAX_MEMBERS, ViewGroups};
 use crate::count::view::{self, SunView};
 use crate::count::{ViewRequest, check_receivers, cos_incidence, is_dark};
 use crate::error::Result;
+use crate::platform::Stopwatch;
 use crate::scene::Scene;
 
 /// The CPU side of an uploaded scene: what planning reads.
@@ -144,7 +145,14 @@ pub(super) fn fit_tile(scene: &SceneLayout, requests: &[ViewRequest], members: &
 /// of their view group, sun and leaf fraction (bitwise: the sampler asks for a wall and its
 /// windows at the very same sun vectors). Each tile's view is fitted to its requested
 /// members; a tile with nothing in front of any member gets fraction 1 without a render.
-pub(super) fn plan_tiles(scene: &SceneLayout, requests: &[ViewRequest], side: u32, out: &mut [Counted]) -> Result<Vec<Tile>> {
+/// `culling_nanos` gains the time spent in the culling (a part of the planning, timed apart).
+pub(super) fn plan_tiles(
+    scene: &SceneLayout,
+    requests: &[ViewRequest],
+    side: u32,
+    out: &mut [Counted],
+    culling_nanos: &mut u64,
+) -> Result<Vec<Tile>> {
     let mut open: HashMap<(u32, [u64; 3], u32), usize> = HashMap::new();
     let mut pending: Vec<Vec<usize>> = Vec::new();
     check_receivers(scene.receivers.len(), requests)?;
@@ -176,7 +184,10 @@ pub(super) fn plan_tiles(scene: &SceneLayout, requests: &[ViewRequest], side: u3
         let view = view::fit(&points, sun, scene.bounds, scene.origin, side);
         // The union of the members: the draw list covers every member's prism.
         let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
-        match scene.culling.select(&view.view_proj, &target, sun) {
+        let culling = Stopwatch::start();
+        let selected = scene.culling.select(&view.view_proj, &target, sun);
+        *culling_nanos += culling.nanos();
+        match selected {
             Some(draws) => tiles.push(Tile { requests: members, view, draws }),
             // Nothing in the prism in front of any member: all fully sunlit, no render needed.
             None => members.iter().for_each(|&i| out[i].fraction = 1.0),
@@ -219,6 +230,24 @@ pub fn planned_triangles(scene: &super::GpuScene, requests: &[ViewRequest], side
         }
     }
     (sum, n)
+}
+
+/// The clip transform of each view of `requests` that faces the sun, each view alone at side
+/// `side` (as [`planned_triangles`] fits them): what the GPU's culling pass
+/// ([`super::cluster_cull`]) is timed on by `sunlit bench`.
+pub fn planned_views(scene: &super::GpuScene, requests: &[ViewRequest], side: u32) -> Vec<glam::DMat4> {
+    let layout = &scene.layout;
+    let lit = |req: &&ViewRequest| layout.receivers.get(req.receiver as usize).is_some_and(|r| !is_dark(r.normal, req.sun));
+    requests
+        .iter()
+        .filter(lit)
+        .map(|req| view::fit(&layout.receivers[req.receiver as usize].points, req.sun, layout.bounds, layout.origin, side).view_proj)
+        .collect()
+}
+
+/// The scene's clusters ([`crate::count::cull::Culling::clusters`]) in the uploaded order.
+pub fn clusters(scene: &super::GpuScene) -> Vec<crate::count::cull::Cluster> {
+    scene.layout.culling.clusters()
 }
 
 #[cfg(test)]
@@ -282,7 +311,7 @@ mod tests {
 
     fn plan(layout: &SceneLayout, requests: &[ViewRequest]) -> (Vec<Tile>, Vec<Counted>) {
         let mut out = vec![Counted::default(); requests.len()];
-        let tiles = plan_tiles(layout, requests, 64, &mut out).unwrap();
+        let tiles = plan_tiles(layout, requests, 64, &mut out, &mut 0).unwrap();
         (tiles, out)
     }
 
@@ -328,7 +357,7 @@ mod tests {
         let scene = scene();
         let layout = SceneLayout::new(&scene, LEAF_TRIANGLES);
         let mut out = vec![Counted::default(); 1];
-        let e = plan_tiles(&layout, &[ViewRequest::new(9, south(40.0))], 64, &mut out).err().unwrap();
+        let e = plan_tiles(&layout, &[ViewRequest::new(9, south(40.0))], 64, &mut out, &mut 0).err().unwrap();
         assert_eq!(e.to_string(), "invalid receiver: id 9 out of range (3 receivers)");
     }
 
