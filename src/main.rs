@@ -65,6 +65,8 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run and matched at once, so the variants' sizes cost nothing worth boxing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Sunlit fraction (sunlit area / area) of every receiver for one sun position.
