@@ -16,7 +16,7 @@ use common::{TestScene, flat_rect};
 use glam::DVec3;
 use sunlit::count::exact::Exact;
 use sunlit::count::{Engine, ViewRequest};
-use sweep_fixture::{scratch, stderr, sunlit, tile_rows, varying_epw};
+use sweep_fixture::{boxes_city, scratch, stderr, sunlit, tile_rows, varying_epw};
 
 const BLOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/city/block.city.json");
 
@@ -245,40 +245,6 @@ fn a_tile_size_or_context_that_is_not_positive_is_refused() {
         assert!(stderr(&run).contains(flag) && stderr(&run).contains(why), "{}", stderr(&run));
         assert!(!out.exists(), "nothing written for {more:?}");
     }
-}
-
-/// A CityJSON 2.0 city of boxes `(id, [x0, y0, z0], [x1, y1, z1])`, each a `Building` with an
-/// LoD2 `Solid`: roof, ground and four walls, millimetre vertices.
-fn boxes_city(boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
-    let mut vertices: Vec<[i64; 3]> = Vec::new();
-    let mut objects = serde_json::Map::new();
-    for (id, lo, hi) in boxes {
-        let base = vertices.len();
-        for k in 0..8 {
-            let pick = |axis: usize| if k >> axis & 1 == 1 { hi[axis] } else { lo[axis] };
-            vertices.push([0, 1, 2].map(|a| (pick(a) * 1000.0).round() as i64));
-        }
-        // Corners by bits (x, y, z); each face counter-clockwise seen from outside.
-        let faces: [([usize; 4], &str); 6] = [
-            ([4, 5, 7, 6], "RoofSurface"),
-            ([0, 2, 3, 1], "GroundSurface"),
-            ([0, 1, 5, 4], "WallSurface"),
-            ([2, 6, 7, 3], "WallSurface"),
-            ([0, 4, 6, 2], "WallSurface"),
-            ([1, 3, 7, 5], "WallSurface"),
-        ];
-        let boundaries: Vec<Vec<Vec<usize>>> = faces.iter().map(|(f, _)| vec![f.iter().map(|i| base + i).collect()]).collect();
-        let values: Vec<usize> =
-            faces.iter().map(|(_, t)| ["RoofSurface", "GroundSurface", "WallSurface"].iter().position(|k| k == t).unwrap()).collect();
-        objects.insert(
-            id.to_string(),
-            serde_json::json!({"type": "Building", "geometry": [{"type": "Solid", "lod": "2.2", "boundaries": [boundaries],
-                "semantics": {"surfaces": [{"type": "RoofSurface"}, {"type": "GroundSurface"}, {"type": "WallSurface"}], "values": [values]}}]}),
-        );
-    }
-    serde_json::json!({"type": "CityJSON", "version": "2.0", "transform": {"scale": [0.001, 0.001, 0.001], "translate": [85000.0, 446000.0, 0.0]},
-        "metadata": {"referenceSystem": "https://www.opengis.net/def/crs/EPSG/0/7415"}, "CityObjects": objects, "vertices": vertices})
-    .to_string()
 }
 
 /// The points of a district run's `cadastre-points.csv`: (y in the model, total kWh/m²).

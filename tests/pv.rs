@@ -14,7 +14,8 @@
 //! The same for a map's points (`map --grid --pvlib --sam`), tests/pv/check_points.py: read by
 //! both tools, and every point's shading at every hour, the set's loss and each cell of SAM's
 //! azimuth × altitude table recounted by an independent numpy ray cast against the one box that
-//! shades them.
+//! shades them; and the same for a district's roof points (`district --grid --pv`), merged from
+//! two tiles.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
@@ -22,7 +23,7 @@ mod sweep_fixture;
 
 use std::path::PathBuf;
 
-use sweep_fixture::{scratch, stderr, sunlit, varying_epw};
+use sweep_fixture::{boxes_city, scratch, stderr, sunlit, varying_epw};
 
 const BLOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/city/block.city.json");
 
@@ -150,6 +151,76 @@ fn map_points_pvlib_and_sam_match_a_numpy_ray_cast() {
 
     assert!(f("sam_timestep_max_error") < 1e-6, "SAM applies the timestep table as written: {got}");
     assert!(f("sam_set_loss_mean") > 0.05, "{got}");
+    assert!(f("sam_set_loss_error") < 0.005 && f("sam_set_loss_error") < f("sam_set_loss_hour_later_error") / 4.0, "{got}");
+    let diffuse_loss = f("sam_diffuse_loss_percent");
+    assert!(diffuse_loss > 0.1, "the tower hides some sky: {got}");
+    assert!((f("sam_diffuse_factor") - (1.0 - diffuse_loss / 100.0)).abs() < 1e-5, "{got}");
+    assert!(f("azal_shaded_cells") > 10.0, "{got}");
+    assert!(f("azal_max_error_percent") < 1e-6, "each table cell is the ray cast's loss along its direction: {got}");
+}
+
+/// Two 10 m × 10 m flat roofs 3 m up, side by side 4 m apart, each in its own 12 m tile, with a
+/// 15 m tower south of them in a third (model coordinates, before the translate).
+const DISTRICT: [(&str, [f64; 3], [f64; 3]); 3] =
+    [("A", [0.0, 10.0, 0.0], [10.0, 20.0, 3.0]), ("B", [14.0, 10.0, 0.0], [24.0, 20.0, 3.0]), ("T", [6.3, -2.0, 0.0], [17.3, 4.0, 15.0])];
+
+/// `district --grid --pv`: each tile's files and the merged ones, the latter read by pvlib and
+/// PySAM and recounted by the numpy ray cast against the tower (the roofs cannot shade each
+/// other's tops), as the map's points are above.
+#[test]
+fn district_roof_points_pvlib_and_sam_per_tile_and_merged_match_a_numpy_ray_cast() {
+    let Some(python) = pv_python() else {
+        eprintln!("SKIPPED: pvlib and NREL-PySAM not found: run `SUNLIT_PV=1 . scripts/setup.sh` (npm test does) or set SUNLIT_PV_PYTHON");
+        return;
+    };
+    let dir = scratch("pv-district");
+    let (epw, city, out) = (dir.join("bolzano.epw"), dir.join("d.city.json"), dir.join("out"));
+    std::fs::write(&epw, varying_epw()).unwrap();
+    std::fs::write(&city, boxes_city(&DISTRICT)).unwrap();
+    let (e, c, o) = (epw.display().to_string(), city.display().to_string(), out.display().to_string());
+    #[rustfmt::skip]
+    let run = sunlit(&[
+        "district", &c, "--epw", &e, "-o", &o, "--tile", "12", "--context", "100", "--buildings", "A,B", "--receivers", "RoofSurface",
+        "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5", "--grid", "2", "--pv",
+    ]);
+    assert!(run.status.success(), "{}", stderr(&run));
+
+    // Tiles 1 (A) and 2 (B) have 25 points each and their own files; tile 0 (the tower) none.
+    let header = |path: std::path::PathBuf| std::fs::read_to_string(path).unwrap().lines().next().unwrap().to_string();
+    for (k, building) in [(1, "A"), (2, "B")] {
+        let names: Vec<String> = (0..25).map(|j| format!("{building}/RoofSurface/0/p{j}")).collect();
+        assert_eq!(header(out.join(format!("pv/tile-{k}-pvlib.csv"))), format!("time,{}", names.join(",")));
+        let sam: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join(format!("pv/tile-{k}-sam.json"))).unwrap()).unwrap();
+        assert_eq!(sam["sunlit"]["points"], serde_json::json!(names));
+        assert_eq!(sam["Shading"]["subarray1_shading_timestep"].as_array().unwrap().len(), 8760);
+    }
+    assert!(!out.join("pv/tile-0-pvlib.csv").exists(), "the tower's tile has no points");
+
+    // The points CSV as check_points.py reads it: in the model's coordinates, the roofs' normal.
+    let points_csv = std::fs::read_to_string(out.join("cadastre-points.csv")).unwrap();
+    let mut points = String::from("x,y,z,nx,ny,nz\n");
+    for line in points_csv.lines().skip(1) {
+        let v: Vec<&str> = line.split(',').collect();
+        points.push_str(&format!("{},{},{},0,0,1\n", v[2], v[3], v[4]));
+    }
+    let points_path = dir.join("points.csv");
+    std::fs::write(&points_path, points).unwrap();
+    let (_, [x0, y0, z0], [x1, y1, z1]) = DISTRICT[2];
+    let tower = [[x0 + 85_000.0, y0 + 446_000.0, z0], [x1 + 85_000.0, y1 + 446_000.0, z1]];
+    let path = |name: &str| out.join(name).display().to_string();
+    #[rustfmt::skip]
+    let setup = serde_json::json!({"epw": e, "pvlib": path("cadastre-points-pvlib.csv"), "sam": path("cadastre-points-sam.json"),
+        "points": points_path.display().to_string(), "box": tower});
+    let got = check(&python, &dir, "check_points.py", &setup);
+    let f = |key: &str| got[key].as_f64().unwrap_or_else(|| panic!("{key}: {got}"));
+
+    assert_eq!(got["index_equal"], true, "the CSV's index is read_epw's");
+    assert_eq!(got["columns"], serde_json::json!(["A/RoofSurface/0/p0", "A/RoofSurface/0/p1", 50]), "the points CSV's order");
+    assert_eq!(got["sam_points"], 50, "the two tiles' points as one array");
+    assert!(f("shaded_cells") > 0.02 * f("cells"), "the tower shades the roofs: {got}");
+    assert!(f("cell_agreement") > 0.995, "{got}");
+    assert!(f("cell_agreement_hour_later") < f("cell_agreement") - 0.005, "{got}");
+    assert!(f("sam_timestep_max_error") < 1e-6, "SAM applies the timestep table as written: {got}");
     assert!(f("sam_set_loss_error") < 0.005 && f("sam_set_loss_error") < f("sam_set_loss_hour_later_error") / 4.0, "{got}");
     let diffuse_loss = f("sam_diffuse_loss_percent");
     assert!(diffuse_loss > 0.1, "the tower hides some sky: {got}");

@@ -73,6 +73,10 @@ pub(super) struct DistrictArgs {
     /// many kWh/m² (usable_area_m2 in the CSV, GeoJSON and CityJSON).
     #[arg(long, value_name = "KWH", requires = "grid", allow_negative_numbers = true)]
     min_kwh_m2: Option<f64>,
+    /// With --grid: what PV tools read for the roofs' points, each tile's in pv/ and every
+    /// point's in cadastre-points-pvlib.csv (pvlib) and cadastre-points-sam.json (SAM pvsamv1).
+    #[arg(long, requires = "grid")]
+    pv: bool,
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
@@ -131,6 +135,9 @@ impl DistrictArgs {
             if let Some(v) = value {
                 words.extend([flag.to_string(), v]);
             }
+        }
+        if self.pv {
+            words.push("--pv".into());
         }
         words
     }
@@ -194,6 +201,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
             counter: CounterOptions { resolution: args.resolution, ..Default::default() },
             lanes: None,
             grid,
+            pv: args.pv,
         };
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }
@@ -240,17 +248,20 @@ fn count_one(
 ) -> Result<()> {
     let start = Instant::now();
     let log = record::log_path(dir, &district::tile_id(k));
-    match district::count_tile(city, tiling, k, tile, &mut |_| Ok(())) {
-        Ok(TileCount { rows, points, casters }) => {
-            let seconds = start.elapsed().as_secs_f64();
-            eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
-            district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points })
+    let counted = district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, casters }| {
+        let seconds = start.elapsed().as_secs_f64();
+        eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
+        // The PV files before the record: a finished tile has them.
+        if let Some(pv) = &pv {
+            sunlit::sweep::district_pv::write_tile_pv(dir, k, pv)?;
         }
-        Err(e) => {
-            let _ = district::write_tile_failure(dir, k, Some(1), &e.render(&flag), &log);
-            Err(e)
-        }
+        let pv = pv.map(|p| p.sums);
+        district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv })
+    });
+    if let Err(e) = &counted {
+        let _ = district::write_tile_failure(dir, k, Some(1), &e.render(&flag), &log);
     }
+    counted
 }
 
 /// Runs each pending tile as a child process, `jobs` at a time; a failed tile is recorded and

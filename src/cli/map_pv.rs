@@ -64,8 +64,8 @@ pub(super) fn outputs(
         let azal_fractions = mapper.direction_visibility(&directions);
         let shaded = values.sky_diffuse_kwh_m2.as_ref().ok_or_else(|| Error::argument("sam", "needs the points' sky (--epw)"))?;
         let unshaded = mapper.unshaded_sky_diffuse(samples, site)?;
-        let diffuse_loss = pv::diffuse_loss(set.areas.iter().zip(shaded).zip(&unshaded).map(|((&a, &s), &u)| (a, s, u)));
-        out.push((path.clone(), pv::sam_json(&set, site.location, &SamInputs { year, azal_fractions: &azal_fractions, diffuse_loss })?));
+        let diffuse = pv::diffuse_sums(set.areas.iter().zip(shaded).zip(&unshaded).map(|((&a, &s), &u)| (a, s, u)));
+        out.push((path.clone(), pv::sam_json(&set, site.location, &SamInputs { year, azal_fractions: &azal_fractions, diffuse })?));
     }
     Ok(out)
 }

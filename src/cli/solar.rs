@@ -154,7 +154,7 @@ pub fn solar_outputs(
         }))?;
         let summaries =
             irradiation::summarize(scene, schedule, &settings.location, Some((&views, &settings.calendar)), Some(weather), &[])?;
-        let inputs = pv::SamInputs { year, azal_fractions: &azal_fractions, diffuse_loss: pv::surfaces_diffuse_loss(&summaries)? };
+        let inputs = pv::SamInputs { year, azal_fractions: &azal_fractions, diffuse: pv::surfaces_diffuse_sums(&summaries)? };
         out.push((path.clone(), pv::sam_json(&pv::PvSet::surfaces(scene, schedule)?, &settings.location, &inputs)?));
     }
     if let Some((path, format)) = &plan.summary {

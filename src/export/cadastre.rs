@@ -215,7 +215,8 @@ fn shift_indices(v: &mut Value, base: u64) {
         Value::Array(items) => items.iter_mut().for_each(|i| shift_indices(i, base)),
         Value::Number(n) => {
             if let Some(k) = n.as_u64() {
-                *v = json!(k + base);
+                // An index past every vertex (in a geometry the reader skipped) stays past them.
+                *v = json!(k.saturating_add(base));
             }
         }
         _ => {}

@@ -27,6 +27,7 @@
 use std::fmt::Write as _;
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use serde_json::json;
 
 use super::Schedule;
@@ -187,9 +188,9 @@ pub fn pvlib_csv(set: &PvSet, location: &Location, year: i32) -> Result<Vec<u8>>
     Ok(text.into_bytes())
 }
 
-/// The set's beam loss (0..1) for a sun, from each member's fraction (see the module doc);
-/// `None` when no member faces it.
-fn set_loss(set: &PvSet, sun: DVec3, fraction: impl Fn(usize) -> f64) -> Option<f64> {
+/// The set's beam sums for a sun, `[Σ area·cos θ·fraction, Σ area·cos θ]` over the members
+/// facing it (see [`SamSums`]), from each member's fraction.
+fn beam_sums(set: &PvSet, sun: DVec3, fraction: impl Fn(usize) -> f64) -> [f64; 2] {
     let (mut lit, mut all) = (0.0, 0.0);
     for (c, (normal, area)) in set.normals.iter().zip(&set.areas).enumerate() {
         let cos = normal.dot(sun);
@@ -198,7 +199,7 @@ fn set_loss(set: &PvSet, sun: DVec3, fraction: impl Fn(usize) -> f64) -> Option<
             all += area * cos;
         }
     }
-    (all > 0.0).then(|| (1.0 - lit / all).clamp(0.0, 1.0))
+    [lit, all]
 }
 
 /// The sun directions of SAM's azimuth × altitude table, row by row (altitude) then azimuth:
@@ -227,8 +228,88 @@ pub struct SamInputs<'a> {
     pub year: i32,
     /// The engine's fraction for each member (inner) and each of [`azal_directions`] (outer).
     pub azal_fractions: &'a [Vec<f64>],
-    /// The set's sky-diffuse loss over the year (0..1): [`diffuse_loss`] of its members.
-    pub diffuse_loss: f64,
+    /// The set's sky diffuse over the year, shaded and unshaded: [`diffuse_sums`] of its members.
+    pub diffuse: [f64; 2],
+}
+
+/// A set's beam and sky sums, from which SAM's inputs are made. They add over sets: the sums of
+/// disjoint sets (a district's tiles) are the sums of their union, so a merge needs no member's
+/// year. Each beam pair is `[Σ area·cos θ·fraction, Σ area·cos θ]` over the members facing the
+/// sun (`[0, 0]` when none does or the sun is down); the loss is 1 − their ratio.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SamSums {
+    /// What the members are ("surfaces" or "points").
+    pub kind: String,
+    /// The members' names, in order.
+    pub names: Vec<String>,
+    /// Their area, m².
+    pub area: f64,
+    /// Timesteps per hour of the rows.
+    pub per_hour: u32,
+    /// Whether the rows cover a leap year.
+    pub leap: bool,
+    /// One pair per row of the year.
+    pub rows: Vec<[f64; 2]>,
+    /// One pair per direction of [`azal_directions`].
+    pub azal: Vec<[f64; 2]>,
+    /// `[Σ area·shaded, Σ area·unshaded]` sky diffuse over the year.
+    pub diffuse: [f64; 2],
+}
+
+impl SamSums {
+    /// The set's sums at each row of its year and each of SAM's table directions.
+    pub fn of(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<Self> {
+        let directions = azal_directions();
+        if inputs.azal_fractions.len() != directions.len() {
+            return Err(Error::argument("azal_fractions", format!("{} directions, not {}", inputs.azal_fractions.len(), directions.len())));
+        }
+        let rows = suns(set, location)
+            .iter()
+            .enumerate()
+            .map(|(row, sun)| sun.map_or([0.0; 2], |s| beam_sums(set, s, |c| f64::from((set.fraction)(row, c)))))
+            .collect();
+        let azal = directions
+            .iter()
+            .zip(inputs.azal_fractions)
+            .map(|(&(_, _, sun), f)| beam_sums(set, sun, |c| f.get(c).copied().unwrap_or(0.0)))
+            .collect();
+        Ok(Self {
+            kind: set.kind.to_string(),
+            names: set.names.clone(),
+            area: set.areas.iter().sum(),
+            per_hour: set.timesteps.per_hour(),
+            leap: set.timesteps.is_leap(),
+            rows,
+            azal,
+            diffuse: inputs.diffuse,
+        })
+    }
+
+    /// Adds another set's sums (same year and timesteps) to these: the sums of the two sets' union.
+    pub fn add(&mut self, other: &SamSums) -> Result<()> {
+        if (self.per_hour, self.leap) != (other.per_hour, other.leap)
+            || self.rows.len() != other.rows.len()
+            || self.azal.len() != other.azal.len()
+        {
+            return Err(Error::argument("sam", format!("sums of {} rows cannot join sums of {}", other.rows.len(), self.rows.len())));
+        }
+        let add = |a: &mut [f64; 2], b: &[f64; 2]| {
+            a[0] += b[0];
+            a[1] += b[1];
+        };
+        self.rows.iter_mut().zip(&other.rows).for_each(|(a, b)| add(a, b));
+        self.azal.iter_mut().zip(&other.azal).for_each(|(a, b)| add(a, b));
+        add(&mut self.diffuse, &other.diffuse);
+        self.names.extend(other.names.iter().cloned());
+        self.area += other.area;
+        Ok(())
+    }
+}
+
+/// The beam loss (0..1) of a pair of [`SamSums`]; `None` when no member faces the sun.
+fn loss_of(sums: [f64; 2]) -> Option<f64> {
+    let [lit, all] = sums;
+    (all > 0.0).then(|| (1.0 - lit / all).clamp(0.0, 1.0))
 }
 
 /// SAM's `pvsamv1` shading inputs for the set's members taken as one array, as JSON:
@@ -236,19 +317,22 @@ pub struct SamInputs<'a> {
 /// PySAM's `Pvsamv1.Shading.assign` takes.
 pub fn sam_json(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<Vec<u8>> {
     check_year(set, inputs.year)?;
-    let directions = azal_directions();
-    if inputs.azal_fractions.len() != directions.len() {
-        return Err(Error::argument("azal_fractions", format!("{} directions, not {}", inputs.azal_fractions.len(), directions.len())));
+    sam_json_of(&SamSums::of(set, location, inputs)?, inputs.year)
+}
+
+/// [`sam_json`] from a set's sums (a merge's, or one set's).
+pub fn sam_json_of(sums: &SamSums, year: i32) -> Result<Vec<u8>> {
+    let leap = sums.leap;
+    if is_leap(year) != leap || sums.rows.len() != Timesteps::new(sums.per_hour)?.leap_year(leap).rows() {
+        return Err(Error::argument("year", format!("{year} is not the year of the {}' {} rows", sums.kind, sums.rows.len())));
     }
-    let suns = suns(set, location);
-    let per_hour = set.timesteps.per_hour() as usize;
-    let leap = set.timesteps.is_leap();
+    let per_hour = sums.per_hour as usize;
     let mut timestep = Vec::with_capacity(8760 * per_hour);
     let mut mxh = [[(0.0f64, 0usize); 24]; 12];
-    for (row, sun) in suns.iter().enumerate() {
+    for (row, &pair) in sums.rows.iter().enumerate() {
         let day = (row / (24 * per_hour)) as u32 + 1;
         let (month, dom) = month_day_of(day, leap);
-        let loss = sun.and_then(|s| set_loss(set, s, |c| f64::from((set.fraction)(row, c))));
+        let loss = loss_of(pair);
         if let Some(l) = loss {
             let cell = &mut mxh[month as usize - 1][(row / per_hour) % 24];
             cell.0 += l;
@@ -260,14 +344,14 @@ pub fn sam_json(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<
     }
     let mxh: Vec<Vec<f64>> =
         mxh.iter().map(|m| m.iter().map(|&(s, n)| if n == 0 { 0.0 } else { percent(s / n as f64) }).collect()).collect();
-    let azal = azal_table(set, &directions, inputs.azal_fractions);
-    let area: f64 = set.areas.iter().sum();
+    let azal = azal_table(&azal_directions(), &sums.azal);
+    let [shaded, unshaded] = sums.diffuse;
     let doc = json!({
         "sunlit": {
-            "what": format!("pvsamv1 shading inputs for the {} below taken as one array (subarray 1): beam loss % = 100·(1 − shaded beam / unshaded beam)", set.kind),
-            set.kind: set.names,
-            "area_m2": area,
-            "year": inputs.year,
+            "what": format!("pvsamv1 shading inputs for the {} below taken as one array (subarray 1): beam loss % = 100·(1 − shaded beam / unshaded beam)", sums.kind),
+            sums.kind.as_str(): sums.names,
+            "area_m2": sums.area,
+            "year": year,
             "timesteps_per_hour": per_hour,
             "enabled": "subarray1_shading_timestep and _diff; _mxh and _azal are alternatives to the timestep table (SAM multiplies every enabled beam table)",
             "checked_against": CHECKED_AGAINST,
@@ -280,7 +364,7 @@ pub fn sam_json(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<
             "subarray1_shading_en_azal": 0,
             "subarray1_shading_azal": azal,
             "subarray1_shading_en_diff": 1,
-            "subarray1_shading_diff": percent(inputs.diffuse_loss),
+            "subarray1_shading_diff": percent(diffuse_loss_of(shaded, unshaded)),
         },
     });
     let mut text = serde_json::to_vec(&doc).map_err(|e| Error::model("SAM shading", e.to_string()))?;
@@ -288,31 +372,29 @@ pub fn sam_json(set: &PvSet, location: &Location, inputs: &SamInputs) -> Result<
     Ok(text)
 }
 
-/// SAM's azimuth × altitude table: `[[0, az…], [alt, loss%…], …]`.
-fn azal_table(set: &PvSet, directions: &[(f64, f64, DVec3)], fractions: &[Vec<f64>]) -> Vec<Vec<f64>> {
+/// SAM's azimuth × altitude table: `[[0, az…], [alt, loss%…], …]`, from each direction's sums.
+fn azal_table(directions: &[(f64, f64, DVec3)], sums: &[[f64; 2]]) -> Vec<Vec<f64>> {
     let columns = (360 / AZAL_AZIMUTH_STEP + 1) as usize;
     let mut table = vec![std::iter::once(0.0).chain(directions.iter().take(columns).map(|d| d.0)).collect::<Vec<f64>>()];
-    for (row, chunk) in directions.chunks(columns).enumerate() {
-        let mut line = vec![chunk[0].1];
-        for (k, &(_, _, sun)) in chunk.iter().enumerate() {
-            let f = &fractions[row * columns + k];
-            line.push(percent(set_loss(set, sun, |c| f.get(c).copied().unwrap_or(0.0)).unwrap_or(0.0)));
-        }
-        table.push(line);
+    for (chunk, pairs) in directions.chunks(columns).zip(sums.chunks(columns)) {
+        table.push(std::iter::once(chunk[0].1).chain(pairs.iter().map(|&p| percent(loss_of(p).unwrap_or(0.0)))).collect());
     }
     table
 }
 
-/// A set's sky-diffuse loss (0..1) over the year from each member's `(area, shaded, unshaded)`
-/// sky diffuse: 1 − Σ area·shaded / Σ area·unshaded (0 with no sky at all).
-pub fn diffuse_loss(members: impl IntoIterator<Item = (f64, f64, f64)>) -> f64 {
-    let (shaded, unshaded) =
-        members.into_iter().fold((0.0, 0.0), |(s, u), (area, shaded, unshaded)| (s + area * shaded, u + area * unshaded));
+/// A set's sky diffuse over the year from each member's `(area, shaded, unshaded)`:
+/// `[Σ area·shaded, Σ area·unshaded]`.
+pub fn diffuse_sums(members: impl IntoIterator<Item = (f64, f64, f64)>) -> [f64; 2] {
+    members.into_iter().fold([0.0; 2], |[s, u], (area, shaded, unshaded)| [s + area * shaded, u + area * unshaded])
+}
+
+/// The sky-diffuse loss (0..1): 1 − shaded / unshaded (0 with no sky at all).
+fn diffuse_loss_of(shaded: f64, unshaded: f64) -> f64 {
     if unshaded > 0.0 { (1.0 - shaded / unshaded).clamp(0.0, 1.0) } else { 0.0 }
 }
 
-/// The surfaces' sky-diffuse loss (0..1) over the year from their summaries ([`diffuse_loss`]).
-pub fn surfaces_diffuse_loss(summaries: &[SurfaceSummary]) -> Result<f64> {
+/// The surfaces' sky diffuse over the year from their summaries ([`diffuse_sums`]).
+pub fn surfaces_diffuse_sums(summaries: &[SurfaceSummary]) -> Result<[f64; 2]> {
     let need = |v: Option<f64>| v.ok_or_else(|| Error::argument("epw", "SAM's diffuse loss needs weather (irradiation)"));
     let members = summaries
         .iter()
@@ -322,7 +404,7 @@ pub fn surfaces_diffuse_loss(summaries: &[SurfaceSummary]) -> Result<f64> {
             Ok((s.area, need(s.sky_diffuse)?, open))
         })
         .collect::<Result<Vec<_>>>()?;
-    Ok(diffuse_loss(members))
+    Ok(diffuse_sums(members))
 }
 
 #[cfg(test)]

@@ -361,6 +361,9 @@ fn flatten(g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, S
                 }
             };
             let rings = surface.as_array().ok_or_else(|| format!("surface {s} is not a list of rings"))?;
+            if rings.is_empty() {
+                return Err(format!("surface {s} has no rings (it needs an exterior ring)"));
+            }
             let rings =
                 rings.iter().enumerate().map(|(r, ring)| read_ring(ring, vertices).map_err(|e| format!("surface {s}, ring {r}: {e}")));
             Ok((semantic, rings.collect::<std::result::Result<Vec<_>, String>>()?))
@@ -441,7 +444,7 @@ fn surface_mesh(s: &CitySurface) -> std::result::Result<SourceMesh, String> {
         }
         at += ring.len();
     }
-    let exterior = &s.rings[0];
+    let exterior = s.rings.first().ok_or_else(|| format!("surface {} ({}) has no rings", s.index, s.name))?;
     let normal = newell(exterior);
     if normal.length() == 0.0 {
         return Err(format!("surface {} ({}) has no area", s.index, s.name));

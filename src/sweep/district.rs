@@ -20,7 +20,8 @@
 //!   `cadastre.city.json`, `cadastre.csv` and `cadastre-roofs.geojson` (with a grid, also the
 //!   roofs' points) when every tile is done, and `failed.csv` listing the rest;
 //! - per-point maps on roofs ([`RoofGrid`]): a tile's roofs gridded and each point's year counted
-//!   with the map's exact rays ([`crate::map`]), each roof's usable area from its points.
+//!   with the map's exact rays ([`crate::map`]), each roof's usable area from its points; with
+//!   `pv`, their PV tools' files ([`super::district_pv`]).
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -28,6 +29,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
+use super::district_pv::{self, TilePv};
 use super::record::{self, Failed, Fingerprint};
 use crate::count::gpu::CounterOptions;
 use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
@@ -35,6 +37,7 @@ use crate::error::{Error, Result};
 use crate::export::cadastre::{self, CadastreRow};
 use crate::export::cadastre_points::{self, PointRow};
 use crate::export::irradiation::summarize;
+use crate::export::pv::SamSums;
 use crate::export::write_atomic;
 use crate::map::{Mapper, Period, Site, point_sky};
 use crate::model::LoadOptions;
@@ -228,6 +231,8 @@ pub struct TileSettings<'a> {
     pub lanes: Option<usize>,
     /// Per-point maps on the roofs.
     pub grid: Option<RoofGrid>,
+    /// With a grid: the points' PV tools' files too.
+    pub pv: bool,
 }
 
 /// What a tile counted.
@@ -236,6 +241,8 @@ pub struct TileCount {
     pub rows: Vec<CadastreRow>,
     /// With a grid: its roofs' points.
     pub points: Vec<PointRow>,
+    /// With a grid and `pv` (and points): their PV files' contents.
+    pub pv: Option<TilePv>,
     /// Surfaces it was counted with.
     pub casters: usize,
 }
@@ -260,7 +267,7 @@ pub fn count_tile(
         [] => tile.buildings.clone(),
         asked => tile.buildings.iter().filter(|b| asked.contains(b)).cloned().collect(),
     };
-    let empty = TileCount { rows: Vec::new(), points: Vec::new(), casters: part.surfaces.len() };
+    let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, casters: part.surfaces.len() };
     if buildings.is_empty() {
         return Ok(empty);
     }
@@ -279,16 +286,22 @@ pub fn count_tile(
     let summaries = summarize(&scene, &schedule, location, Some((&views, &s.settings.calendar)), Some(s.weather), &[])?;
     let hours = cadastre::sun_hours(&schedule, location);
     let mut rows = cadastre::rows(&part, &scene, &summaries, &hours)?;
-    let points = match s.grid {
+    let (points, pv) = match s.grid {
         Some(grid) => roof_points(&part, &scene, grid, s, &mut rows)?,
-        None => Vec::new(),
+        None => (Vec::new(), None),
     };
-    Ok(TileCount { rows, points, casters: part.surfaces.len() })
+    Ok(TileCount { rows, points, pv, casters: part.surfaces.len() })
 }
 
 /// The grid on the scene's roofs, each point's year counted directly (never interpolated: the
-/// map's exact rays, [`crate::map`]), and each row's usable area.
-fn roof_points(city: &City, scene: &Scene, grid: RoofGrid, s: &TileSettings, rows: &mut [CadastreRow]) -> Result<Vec<PointRow>> {
+/// map's exact rays, [`crate::map`]), each row's usable area, and with `pv` the points' PV files.
+fn roof_points(
+    city: &City,
+    scene: &Scene,
+    grid: RoofGrid,
+    s: &TileSettings,
+    rows: &mut [CadastreRow],
+) -> Result<(Vec<PointRow>, Option<TilePv>)> {
     let roofs: std::collections::HashSet<&str> =
         city.surfaces.iter().filter(|c| c.kind.as_deref() == Some("RoofSurface")).map(|c| c.name.as_str()).collect();
     let on_roofs: Vec<u32> = scene
@@ -300,7 +313,7 @@ fn roof_points(city: &City, scene: &Scene, grid: RoofGrid, s: &TileSettings, row
         .collect();
     let points = crate::map::grid(scene, grid.spacing, &on_roofs)?;
     if points.is_empty() {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     }
     let mapper = Mapper::new(scene, &points)?;
     let sky = point_sky(&mapper, s.patches, &mut |_, _| {});
@@ -310,7 +323,9 @@ fn roof_points(city: &City, scene: &Scene, grid: RoofGrid, s: &TileSettings, row
     // Scene positions are the model's turned by north; the model's own add the offset back.
     let back = glam::DMat3::from_rotation_z(s.load.north.to_radians());
     let to_model = |p: DVec3| back * p + city.offset;
-    cadastre_points::point_rows(city, scene, &points, &values, grid.min_kwh_m2, rows, to_model)
+    let point_rows = cadastre_points::point_rows(city, scene, &points, &values, grid.min_kwh_m2, rows, to_model)?;
+    let pv = if s.pv { Some(district_pv::tile_pv(&mapper, &points, &point_rows, &samples, site, &values)?) } else { None };
+    Ok((point_rows, pv))
 }
 
 /// A finished tile's record.
@@ -329,6 +344,9 @@ pub struct TileDone {
     /// With a grid: its roofs' points.
     #[serde(default)]
     pub points: Vec<PointRow>,
+    /// With a grid and PV files: its points' SAM sums (its pvlib CSV is in `pv/`).
+    #[serde(default)]
+    pub pv: Option<SamSums>,
 }
 
 /// The record id of tile `k`.
@@ -391,12 +409,14 @@ pub fn merge(
 ) -> Result<DistrictMerged> {
     let mut rows: Vec<CadastreRow> = Vec::new();
     let mut points: Vec<PointRow> = Vec::new();
+    let mut pv: Vec<(usize, SamSums)> = Vec::new();
     let mut unfinished = Vec::new();
     for t in &tiling.tiles {
         match finished(dir, t.index, fingerprint) {
             Some(done) => {
                 rows.extend(done.rows);
                 points.extend(done.points);
+                pv.extend(done.pv.map(|sums| (t.index, sums)));
             }
             None => {
                 let id = tile_id(t.index);
@@ -431,6 +451,7 @@ pub fn merge(
         files.push((dir.join(POINTS_CSV), cadastre_points::points_csv(&points).into_bytes()));
         files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &placer, north_note)?.into_bytes()));
     }
+    files.extend(district_pv::merged(dir, &pv, &position)?);
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
     }

@@ -6,11 +6,13 @@
 //! - [`run`]: counting variants in child processes;
 //! - [`summary`]: the per-surface means and `summary.csv`;
 //! - [`slurm`]: the job array, its scripts and the merge job;
-//! - [`district`]: a city model's tiles with their context, their records and the merged cadastre.
+//! - [`district`]: a city model's tiles with their context, their records and the merged cadastre;
+//! - [`district_pv`]: with `--grid --pv`, what PV tools read for the roofs' points, per tile and merged.
 //!
 //! Native only: it runs processes and writes files.
 
 pub mod district;
+pub mod district_pv;
 pub mod manifest;
 pub mod record;
 pub mod run;
