@@ -290,19 +290,26 @@ fn noon_crossing_with_the_models_own_periodic_update_matches_energyplus() {
 /// window `WIN_E` was off on the weekend days of every period.
 #[test]
 fn transmitting_shades_with_the_models_own_periodic_update_match_energyplus() {
-    let dir = scratch("tau-periodic");
-    let idf = dir.join("shades.idf");
     let text = model(4).replace("PolygonClipping, Timestep, 1,", "PolygonClipping, Periodic, 7,");
     assert!(text.contains("Periodic, 7"));
+    let log = shades_against_clipping("tau-periodic", &text);
+    assert!(log.contains("every 7 days (Periodic)"), "{log}");
+}
+
+/// Writes `text` as a model, runs EnergyPlus's clipping and sunlit on it, and asserts every
+/// surface within mean |Δ| 0.005 with no dark/lit disagreement; returns sunlit's log.
+fn shades_against_clipping(name: &str, text: &str) -> String {
+    let dir = scratch(name);
+    let idf = dir.join("shades.idf");
     std::fs::write(&idf, text).unwrap();
     run_energyplus(&idf, &dir.join("clipping"));
     let csv = dir.join("shading.csv");
     let log = sunlit(&idf, &csv, &[]);
-    assert!(log.contains("every 7 days (Periodic)"), "{log}");
     let (ours, clipped) = (columns(&csv), reported(&dir.join("clipping")));
     assert_eq!(ours.len(), 8, "5 exterior walls and roof, 3 windows");
     let failures = compare(&ours, &clipped, None);
     assert!(failures.is_empty(), "beyond the bounds: {failures:?}");
+    log
 }
 
 /// The transmitting shades in a model with daylight saving (`RunPeriodControl:DaylightSavingTime`,
@@ -313,17 +320,8 @@ fn transmitting_shades_with_the_models_own_periodic_update_match_energyplus() {
 /// more than that.
 #[test]
 fn transmitting_shades_under_daylight_saving_match_energyplus() {
-    let dir = scratch("tau-dst");
-    let idf = dir.join("shades.idf");
     let text = format!("{}RunPeriodControl:DaylightSavingTime, 2nd Sunday in March, 1st Sunday in November;\n", model(4));
-    std::fs::write(&idf, text).unwrap();
-    run_energyplus(&idf, &dir.join("clipping"));
-    let csv = dir.join("shading.csv");
-    sunlit(&idf, &csv, &[]);
-    let (ours, clipped) = (columns(&csv), reported(&dir.join("clipping")));
-    assert_eq!(ours.len(), 8, "5 exterior walls and roof, 3 windows");
-    let failures = compare(&ours, &clipped, None);
-    assert!(failures.is_empty(), "beyond the bounds: {failures:?}");
+    shades_against_clipping("tau-dst", &text);
 }
 
 /// Chicago's weather with no diffuse (DHI 0), so that the irradiance sunlit writes with albedo 0
