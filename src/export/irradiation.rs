@@ -11,11 +11,16 @@
 //!   that hour times the receiver's visible ∫cos dΩ of it;
 //! - ground-reflected: GHI·albedo·(1 − cos tilt)/2, unobstructed, as EnergyPlus does it.
 //!
-//! **Instants.** Every part uses the sun the fractions were counted for: [`shading_sun_day`]'s
-//! day and the timestep's instant (mid-hour with one timestep an hour, else each timestep's end),
-//! and a timestep counts only with that sun up (cos zenith ≥ [`MIN_COS_INCIDENCE`], EnergyPlus's
-//! rule); at other times nothing is incident. The weather's hour is held over its timesteps
-//! ([`Weather::at`]): each hour's energy is kept whatever the timestep count.
+//! **Instants.** The sun is [`shading_sun_day`]'s day at the timestep's instant (mid-hour with
+//! one timestep an hour, else each timestep's end), and a timestep counts only with that sun up
+//! (cos zenith ≥ [`MIN_COS_INCIDENCE`], EnergyPlus's rule); at other times nothing is incident.
+//! The beam's incidence is that of the sun the fractions were counted for
+//! ([`Schedule::fraction_sun`]): the same sun, except under EnergyPlus's `Periodic` update, where
+//! EnergyPlus's incident beam is `BeamSolarRad · SunlitFrac · CosIncAng`, both factors from the
+//! period's sun (`CalcPerSolarBeam`; HeatBalanceSurfaceManager.cc's `InitSolarHeatGains`), while
+//! whether the sun is up is the weather's calendar day (`SunIsUp`). The sky and ground keep the
+//! calendar day's sun. The weather's hour is held over its timesteps ([`Weather::at`]): each
+//! hour's energy is kept whatever the timestep count.
 //!
 //! The per-surface summary (mean fraction; direct, sky diffuse, ground-reflected, total and
 //! unshaded total irradiation; sky view factor; EnergyPlus's two diffuse shading ratios) is
@@ -85,10 +90,14 @@ fn for_each_incident(
     }
     let distribution = solar.sky.model().on(&solar.sky.patches);
     for (row, instant) in schedule.timesteps.instants().enumerate() {
+        // The calendar day's sun says whether it is up (EnergyPlus's SunIsUp) and places the
+        // sky; the beam's incidence is that of the sun the fractions were counted for (its
+        // CosIncAng), which differs under a Periodic update.
         let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
         if sun.z < MIN_COS_INCIDENCE {
             continue;
         }
+        let beam_sun = schedule.fraction_sun(location, row);
         let hour = solar.weather.at(schedule.timesteps, row);
         let perez = PerezSky::new(hour.dni, hour.dhi, sun.z, location.elevation);
         let radiances = distribution.as_ref().and_then(|d| d.radiances(hour.dni, hour.dhi, sun, instant.day));
@@ -107,7 +116,7 @@ fn for_each_incident(
                 ),
                 (None, None) => (0.0, 0.0),
             };
-            let unshaded_direct = hour.dni * cos;
+            let unshaded_direct = hour.dni * receiver.normal.dot(beam_sun).max(0.0);
             let incident = Incident {
                 direct: unshaded_direct * fraction,
                 unshaded_direct,

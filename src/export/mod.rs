@@ -11,7 +11,13 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use glam::DVec3;
+
 use crate::error::{Error, Result};
+use crate::sun::location::Location;
+use crate::sun::periods::ShadingPeriods;
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
 use crate::year::samples::Timesteps;
 
 pub mod cadastre;
@@ -35,13 +41,30 @@ pub struct Schedule {
     pub timesteps: Timesteps,
     /// Row-major values: `values[row * names.len() + column]`.
     pub values: Vec<f32>,
+    /// The EnergyPlus `Periodic` update the fractions were counted for (every day of a period
+    /// one sun, [`ShadingPeriods`]); `None`: each calendar day's own sun. Passes that weigh the
+    /// fractions by the sun's incidence take it from [`Self::fraction_sun`].
+    pub periods: Option<ShadingPeriods>,
 }
 
 impl Schedule {
     /// A schedule of zeros.
     pub fn zeros(names: Vec<String>, timesteps: Timesteps) -> Self {
         let values = vec![0.0; timesteps.rows() * names.len()];
-        Self { names, timesteps, values }
+        Self { names, timesteps, values, periods: None }
+    }
+
+    /// The sun the fractions of `row` were counted for: the period's mean sun under a `Periodic`
+    /// update, else the calendar day's ([`shading_sun_day`]). EnergyPlus weighs its beam by the
+    /// incidence of the sun it shaded for (`CosIncAng` beside `SunlitFrac`, both from
+    /// `CalcPerSolarBeam`), while the weather's own sun (`SOLCOS`) decides whether the sun is up
+    /// and places the circumsolar sky.
+    pub fn fraction_sun(&self, location: &Location, row: usize) -> DVec3 {
+        let at = self.timesteps.instant(row);
+        match self.periods {
+            Some(p) => p.sun(location, at.day, self.timesteps.days(), at.hour),
+            None => sun_direction(location, shading_sun_day(at.day), at.hour),
+        }
     }
 
     /// Value of `column` at `row`.
@@ -152,7 +175,7 @@ impl Schedule {
                 return Err(fail(line, format!("{found} values for {} surfaces", names.len())));
             }
         }
-        let schedule = Schedule { names, timesteps, values };
+        let schedule = Schedule { names, timesteps, values, periods: None };
         schedule.validate().map_err(|e| Error::model(file, e.to_string()))?;
         Ok(schedule)
     }

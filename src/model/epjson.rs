@@ -349,6 +349,8 @@ const CLASSES: &[ClassSpec] = &[
         ],
         false,
     ),
+    // Daylight saving shifts schedules by an hour (`super::schedule`).
+    spec("RunPeriodControl:DaylightSavingTime", false, &[("start_date", Text), ("end_date", Text)], false),
     spec(
         "RunPeriod",
         true,

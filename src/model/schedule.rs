@@ -129,6 +129,8 @@ pub struct Schedule {
     source: Source,
     /// Weekday of 1 January (0 = Sunday).
     first_weekday: usize,
+    /// The model's `RunPeriodControl:DaylightSavingTime` (its start and end dates).
+    daylight_saving: Option<(DateRule, DateRule)>,
 }
 
 /// What a run needs to know about its calendar to read schedules.
@@ -149,8 +151,28 @@ impl Schedule {
         }
     }
 
-    /// The value of every timestep of the run, in row order (day → hour → timestep).
+    /// The value of every timestep of the run, in row order (day → hour → timestep). On the days
+    /// of a daylight-saving period each timestep takes the value one hour later (the first hour
+    /// of the next day for the last), as EnergyPlus's `LookUpScheduleValue` adds its
+    /// `DSTIndicator` to the hour.
     pub fn values(&self, calendar: RunCalendar) -> Vec<f64> {
+        let standard = self.standard_values(calendar);
+        let Some((start, end)) = self.daylight_saving else { return standard };
+        let (start, end) = (start.day(calendar.leap, self.first_weekday), end.day(calendar.leap, self.first_weekday));
+        let per_hour = calendar.per_hour as usize;
+        let per_day = 24 * per_hour;
+        let last = standard.len().saturating_sub(1);
+        (0..standard.len())
+            .map(|row| {
+                let day = (row / per_day) as u32 + 1;
+                let saving = if start <= end { (start..=end).contains(&day) } else { day >= start || day <= end };
+                if saving { standard[(row + per_hour).min(last)] } else { standard[row] }
+            })
+            .collect()
+    }
+
+    /// [`Self::values`] in standard time.
+    fn standard_values(&self, calendar: RunCalendar) -> Vec<f64> {
         let n = calendar.per_hour as usize;
         let days = 365 + usize::from(calendar.leap);
         match &self.source {
@@ -203,6 +225,7 @@ pub struct Schedules<'a> {
     /// The folder relative `Schedule:File` names are found in (None: no folder, the web).
     dir: Option<PathBuf>,
     first_weekday: usize,
+    daylight_saving: Option<(DateRule, DateRule)>,
 }
 
 /// Classes a shade's `Transmittance Schedule Name` may name.
@@ -210,6 +233,9 @@ const YEAR_CLASSES: [&str; 4] = ["Schedule:Constant", "Schedule:Compact", "Sched
 /// Classes a week's day type may name.
 const DAY_CLASSES: [&str; 2] = ["Schedule:Day:Hourly", "Schedule:Day:Interval"];
 const LIMITS: &str = "ScheduleTypeLimits";
+const DAYLIGHT_SAVING: &str = "RunPeriodControl:DaylightSavingTime";
+/// The daylight-saving object kept among the schedule objects under this key (it has no name).
+const DAYLIGHT_SAVING_KEY: &str = " daylight saving";
 const WEEK: &str = "Schedule:Week:Daily";
 
 impl<'a> Schedules<'a> {
@@ -222,7 +248,17 @@ impl<'a> Schedules<'a> {
                 by_name.entry(n.to_ascii_lowercase()).or_default().push(o);
             }
         }
-        Self { file, objects: by_name, dir: dir.map(Path::to_path_buf), first_weekday: first_weekday(objects) }
+        if let Some(o) = objects.iter().find(|o| o.is(DAYLIGHT_SAVING)) {
+            by_name.entry(DAYLIGHT_SAVING_KEY.into()).or_default().push(o);
+        }
+        let daylight_saving = objects.iter().find(|o| o.is(DAYLIGHT_SAVING)).map(|o| (o.field(0).to_string(), o.field(1).to_string()));
+        Self {
+            file,
+            objects: by_name,
+            dir: dir.map(Path::to_path_buf),
+            first_weekday: first_weekday(objects),
+            daylight_saving: daylight_saving.and_then(|(a, b)| Some((DateRule::parse(&a)?, DateRule::parse(&b)?))),
+        }
     }
 
     fn find(&self, classes: &[&str], name: &str) -> Option<&'a IdfObject> {
@@ -236,9 +272,31 @@ impl<'a> Schedules<'a> {
             return Err(Error::object(self.file, user, format!("field '{field}': '{name}' names no schedule in the model")));
         };
         let source = self.source(object)?;
-        let schedule = Schedule { name: object.field(0).to_string(), label: object.label(), source, first_weekday: self.first_weekday };
+        self.check_daylight_saving()?;
+        let schedule = Schedule {
+            name: object.field(0).to_string(),
+            label: object.label(),
+            source,
+            first_weekday: self.first_weekday,
+            daylight_saving: self.daylight_saving,
+        };
         self.check_limits(object, &schedule)?;
         Ok(schedule)
+    }
+
+    /// A `RunPeriodControl:DaylightSavingTime` whose dates sunlit cannot read is refused (it
+    /// would shift every schedule by an hour for months).
+    fn check_daylight_saving(&self) -> Result<()> {
+        let Some(object) = self.objects.get(DAYLIGHT_SAVING_KEY).and_then(|o| o.first()) else { return Ok(()) };
+        for (i, field) in [(0, "Start Date"), (1, "End Date")] {
+            if DateRule::parse(object.field(i)).is_none() {
+                return Err(self.bad(
+                    object,
+                    format!("field '{field}': '{}' is not a date (M/D, Month D, or Nth Weekday in Month)", object.field(i).trim()),
+                ));
+            }
+        }
+        Ok(())
     }
 
     fn bad(&self, object: &IdfObject, reason: impl Into<String>) -> Error {
@@ -543,6 +601,75 @@ fn check_untils(untils: &[(usize, f64)]) -> std::result::Result<(), String> {
     match untils.last() {
         Some((DAY_MINUTES, _)) => Ok(()),
         _ => Err("its last Until time is not 24:00".into()),
+    }
+}
+
+/// A date as `RunPeriodControl:DaylightSavingTime` gives it: a month and day, or the nth (1–5,
+/// or last) weekday of a month.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum DateRule {
+    /// Month (1–12) and day.
+    Fixed(usize, u32),
+    /// Which (1–5; 0 for the last), weekday (0 = Sunday), month (1–12).
+    Nth(u32, usize, usize),
+}
+
+const MONTH_NAMES: [&str; 12] =
+    ["january", "february", "march", "april", "may", "june", "july", "august", "september", "october", "november", "december"];
+
+impl DateRule {
+    /// `4/1`, `April 1`, `1 April`, `2nd Sunday in March`, `Last Sunday in October` (EnergyPlus's
+    /// date forms; month names may be cut to three letters).
+    fn parse(text: &str) -> Option<Self> {
+        let text = text.trim().to_ascii_lowercase();
+        let month = |w: &str| MONTH_NAMES.iter().position(|m| w.len() >= 3 && m.starts_with(w)).map(|m| m + 1);
+        let words: Vec<&str> = text.split_whitespace().collect();
+        let fixed = |m: usize, d: &str| {
+            let d: u32 = d.parse().ok()?;
+            (d >= 1 && d <= MONTH_DAYS[m - 1]).then_some(DateRule::Fixed(m, d))
+        };
+        match words.as_slice() {
+            [one] => {
+                let (m, d) = one.split_once('/')?;
+                let m: usize = m.parse().ok().filter(|m| (1..=12).contains(m))?;
+                fixed(m, d)
+            }
+            [a, b] => match (month(a), month(b)) {
+                (Some(m), None) => fixed(m, b),
+                (None, Some(m)) => fixed(m, a),
+                _ => None,
+            },
+            [which, weekday, "in" | "of", m] => {
+                let which = match *which {
+                    "last" => 0,
+                    w => w.trim_end_matches(|c: char| c.is_ascii_alphabetic()).parse().ok().filter(|n| (1..=5).contains(n))?,
+                };
+                let weekday = DAY_TYPE_NAMES[..7].iter().position(|n| n.eq_ignore_ascii_case(weekday))?;
+                Some(DateRule::Nth(which, weekday, month(m)?))
+            }
+            _ => None,
+        }
+    }
+
+    /// The day of the run's year (1-based; Feb 29 counted only in a leap run) given the weekday
+    /// of 1 January.
+    fn day(self, leap: bool, first_weekday: usize) -> u32 {
+        let lengths = |m: usize| if m == 2 && !leap { 28 } else { MONTH_DAYS[m - 1] };
+        let before = |m: usize| (1..m).map(lengths).sum::<u32>();
+        match self {
+            DateRule::Fixed(m, d) => before(m) + d.min(lengths(m)),
+            DateRule::Nth(which, weekday, m) => {
+                let weekday_of = |day: u32| (first_weekday + day as usize - 1) % 7;
+                if which == 0 {
+                    let last = before(m) + lengths(m);
+                    last - ((weekday_of(last) + 7 - weekday) % 7) as u32
+                } else {
+                    let first = before(m) + 1;
+                    let day = first + ((weekday + 7 - weekday_of(first)) % 7) as u32 + 7 * (which - 1);
+                    day.min(before(m) + lengths(m))
+                }
+            }
+        }
     }
 }
 

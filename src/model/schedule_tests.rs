@@ -104,3 +104,36 @@ fn schedule_file_reads_its_column_and_refuses_a_short_file() {
     assert!(e.contains("too short: 2 values") && e.contains("8760 needed"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `RunPeriodControl:DaylightSavingTime`'s date forms, on 2017 (1 January a Sunday).
+#[test]
+fn daylight_saving_dates_in_every_form() {
+    let day = |text: &str| DateRule::parse(text).unwrap().day(false, 0);
+    assert_eq!(day("2nd Sunday in March"), 71, "12 March 2017");
+    assert_eq!(day("1st Sunday in November"), 309, "5 November 2017");
+    assert_eq!(day("Last Sunday in October"), 302, "29 October 2017");
+    assert_eq!(day("4/1"), 91);
+    assert_eq!(day("April 1"), 91);
+    assert_eq!(day("1 Apr"), 91);
+    assert_eq!(DateRule::parse("3/1").unwrap().day(true, 0), 61, "a leap run counts Feb 29");
+    for bad in ["", "13/1", "2/30", "6th Sunday in March", "Sunday in March", "Funday 1"] {
+        assert_eq!(DateRule::parse(bad), None, "{bad}");
+    }
+}
+
+/// On daylight-saving days every timestep takes the value one hour later, as EnergyPlus looks
+/// schedules up at the hour plus its DST indicator; a date it cannot read is refused by field.
+#[test]
+fn daylight_saving_shifts_values_by_an_hour() {
+    let text = "Schedule:Compact, S, , Through: 12/31, For: AllDays, Until: 12:00, 0.1, Until: 24:00, 0.3;\n\
+                RunPeriod, R, 1, 1, 2017, 12, 31, 2017;\nRunPeriodControl:DaylightSavingTime, 4/1, Last Sunday in October;";
+    let v = schedule(text, "S").unwrap().values(N4);
+    assert_eq!(v[row(90, 11, 15)], 0.1, "31 March: standard time");
+    assert_eq!(v[row(91, 11, 0)], 0.1, "1 April, 11:00 is noon's step in daylight time");
+    assert_eq!(v[row(91, 11, 15)], 0.3);
+    assert_eq!(v[row(302, 11, 15)], 0.3, "29 October, the last day");
+    assert_eq!(v[row(303, 11, 15)], 0.1);
+    let bad = text.replace("4/1", "Easter");
+    let err = schedule(&bad, "S").unwrap_err().to_string();
+    assert!(err.contains("RunPeriodControl:DaylightSavingTime") && err.contains("field 'Start Date': 'Easter' is not a date"), "{err}");
+}

@@ -57,6 +57,8 @@ pub(super) async fn periodic_year(
             cells.push((row, column, index));
         }
     }
+    // Later passes weigh these fractions by this sun's incidence, as EnergyPlus does.
+    schedule.periods = Some(periods);
     let values = views.count(&requests, progress).await?;
     for (row, column, index) in cells {
         schedule.set(row, column, as_energyplus(values[index]));

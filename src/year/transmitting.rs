@@ -12,13 +12,16 @@
 //! engine's boundary step counts a see-through caster as opaque and the GPU's per-pixel threshold
 //! is a dithered estimate, while a mix of two years of opaque or absent casters is exact on
 //! either engine. Shades always at τ = 0 are plain casters and those always at 1 are left out
-//! ([`crate::model::shades::ShadeGroup::constant`]).
+//! ([`crate::model::shades::ShadeGroup::constant`]). Under EnergyPlus's `Periodic` update a
+//! period takes the τ of its first day ([`transmittance_row`]), as EnergyPlus's shading does.
 
 use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::model::schedule::RunCalendar;
 use crate::model::shades::ShadeGroup;
+use crate::sun::periods::ShadingPeriods;
 use crate::year::annual::energyplus_fraction;
+use crate::year::samples::Timesteps;
 
 /// At most this many shade groups may be mixed: each doubles the years counted.
 pub const MAX_VARYING: usize = 4;
@@ -81,9 +84,11 @@ impl VaryingShades {
             return Err(Error::argument("years", "the variants' years differ in columns or rows"));
         }
         let columns = first.names.len();
-        let mut out = Schedule { names: first.names.clone(), timesteps: first.timesteps, values: vec![0.0; first.values.len()] };
+        let values = vec![0.0; first.values.len()];
+        let mut out = Schedule { names: first.names.clone(), timesteps: first.timesteps, values, periods: first.periods };
         for (row, values) in out.values.chunks_mut(columns.max(1)).enumerate() {
-            let weights: Vec<f64> = (0..years.len()).map(|v| self.weight(v, row)).collect();
+            let at = transmittance_row(first.periods, first.timesteps, row);
+            let weights: Vec<f64> = (0..years.len()).map(|v| self.weight(v, at)).collect();
             for (c, value) in values.iter_mut().enumerate() {
                 let f: f64 = years.iter().zip(&weights).map(|(y, w)| w * f64::from(y.values[row * columns + c])).sum();
                 *value = energyplus_fraction(f) as f32;
@@ -104,13 +109,25 @@ impl VaryingShades {
     }
 }
 
+/// The row whose τ EnergyPlus's shading uses at `row`: the row itself, or under a `Periodic`
+/// update the same timestep of the period's first day. EnergyPlus computes a period's shading on
+/// that day, reading each shade's schedule at the hour and timestep of that day
+/// (`LookUpScheduleValue` in SHADOW), and every day of the period reuses those fractions, so a
+/// weekend screen value, say, never reaches a period that starts on a weekday.
+fn transmittance_row(periods: Option<ShadingPeriods>, timesteps: Timesteps, row: usize) -> usize {
+    let Some(periods) = periods else { return row };
+    let per_day = timesteps.rows() / timesteps.days().max(1) as usize;
+    let day = (row / per_day) as u32 + 1;
+    let (start, _) = periods.period_of(day, timesteps.days());
+    (start as usize - 1) * per_day + row % per_day
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
     use crate::model::idf::parse_idf;
     use crate::model::shades::read_shade_schedules;
-    use crate::year::samples::Timesteps;
 
     /// Two shades, one at a constant 0.25 and one at 0 until noon and 1 after (hourly, N = 1),
     /// and a third at 0 all year (an ordinary caster, not mixed).
@@ -123,6 +140,19 @@ mod tests {
         let objects = parse_idf("m.idf", text).unwrap();
         let groups = read_shade_schedules("m.idf", &objects, None).unwrap();
         VaryingShades::new("m.idf", &groups, RunCalendar { per_hour: 1, leap: false }).unwrap().unwrap()
+    }
+
+    /// Under a Periodic update every day of a period takes its first day's τ, at the same time of
+    /// day; without one each row its own.
+    #[test]
+    fn a_period_takes_its_first_days_transmittance() {
+        let t = Timesteps::new(4).unwrap();
+        let periods = ShadingPeriods { days: 7, first_day: 1, run_days: 365 };
+        let row = |day: usize, step: usize| (day - 1) * 96 + step;
+        assert_eq!(transmittance_row(None, t, row(10, 37)), row(10, 37));
+        assert_eq!(transmittance_row(Some(periods), t, row(10, 37)), row(8, 37), "days 8–14");
+        assert_eq!(transmittance_row(Some(periods), t, row(7, 95)), row(1, 95), "days 1–7");
+        assert_eq!(transmittance_row(Some(periods), t, row(365, 3)), row(365, 3), "the last period, one day");
     }
 
     #[test]
@@ -143,7 +173,7 @@ mod tests {
         // One column: 0.1 with both opaque, 0.3 with A removed, 0.6 with B removed, 1 with both.
         let years: Vec<Schedule> = [0.1f32, 0.3, 0.6, 1.0]
             .iter()
-            .map(|&f| Schedule { names: vec!["W".into()], timesteps, values: vec![f; timesteps.rows()] })
+            .map(|&f| Schedule { values: vec![f; timesteps.rows()], ..Schedule::zeros(vec!["W".into()], timesteps) })
             .collect();
         let mixed = v.mix(&years).unwrap();
         // Morning (B opaque): 0.75·0.1 + 0.25·0.3; afternoon (B removed): 0.75·0.6 + 0.25·1.
