@@ -15,6 +15,7 @@ use std::rc::Rc;
 mod choice;
 mod clipper;
 mod embed;
+mod lazy;
 mod map;
 mod map_options;
 
@@ -23,9 +24,8 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::future_to_promise;
 
 use crate::count::exact::engine::ExactEngine;
-use crate::count::gpu::{Counter, CounterOptions, GpuScene, Kernel};
+use crate::count::gpu::{CounterOptions, GpuScene, Kernel};
 use crate::count::hybrid::EngineKind;
-use crate::count::lanes::Lane;
 use crate::count::{Engine as _, ViewKind, ViewRequest};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
@@ -89,11 +89,11 @@ pub fn js_option(param: &str) -> String {
     out
 }
 
-/// The GPU counter on this page's WebGPU device (none where the browser has no WebGPU: then
-/// views are clipped only).
+/// The page's WebGPU adapter, its device opened when a view is first routed to it ([`lazy`];
+/// none where the browser has no WebGPU: then views are clipped only).
 #[wasm_bindgen]
 pub struct Engine {
-    counter: Option<Rc<Counter>>,
+    gpu: Option<Rc<lazy::Gpu>>,
     options: CounterOptions,
     /// Which engine answers views (`auto`, `gpu`, `exact`, `compute`; see [`choice`]).
     kind: EngineKind,
@@ -101,7 +101,8 @@ pub struct Engine {
 
 #[wasm_bindgen]
 impl Engine {
-    /// Opens the WebGPU device. `resolution`: pixels along a view's side (default 512);
+    /// Finds the WebGPU adapter; its device is opened when a view is first routed to the GPU
+    /// ([`lazy`]), not here. `resolution`: pixels along a view's side (default 512);
     /// `accuracy`: a target |error| per view, counting each at 64² first and finer, up to
     /// `resolution`, only where its shadow edges need it (default: every view at `resolution`);
     /// `engine`: `auto` (default), `gpu`, `exact` or `compute` ([`choice`]); `gpu: false` (no
@@ -134,10 +135,24 @@ impl Engine {
             {
                 return Err(js_error(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)"))));
             }
-            return Ok(Engine { counter: None, options, kind });
+            return Ok(Engine { gpu: None, options, kind });
         }
-        let counter = Counter::new(options).await.map_err(js_error)?;
-        Ok(Engine { counter: Some(Rc::new(counter)), options, kind })
+        let gpu = lazy::Gpu::request(options).await.map_err(js_error)?;
+        Ok(Engine { gpu: Some(Rc::new(gpu)), options, kind })
+    }
+
+    /// Opens the GPU device now rather than when a view is first routed to it (nothing without
+    /// WebGPU): `createEngine({ device })` does, so the caller's device is taken, and its error
+    /// handler chained, while the caller's adapter stands in for the browser's.
+    #[wasm_bindgen(js_name = openDevice)]
+    pub fn open_device(&self) -> Promise {
+        let gpu = self.gpu.clone();
+        future_to_promise(async move {
+            if let Some(gpu) = gpu {
+                gpu.counter().await.map_err(js_error)?;
+            }
+            Ok(JsValue::UNDEFINED)
+        })
     }
 
     /// The key under which this model's `auto` profile for sun views is kept (IndexedDB in the
@@ -155,7 +170,7 @@ impl Engine {
     }
 
     fn key_of(&self, model: &Model, views: ViewKind, workers: usize) -> String {
-        choice::store_key(&model.inner.scene, views, self.counter.as_ref().map(|c| c.adapter_info()), &self.options, workers.max(1))
+        choice::store_key(&model.inner.scene, views, self.gpu.as_ref().map(|g| g.info()), &self.options, workers.max(1))
     }
 
     /// Which engine answers views: `auto`, `gpu`, `exact` or `compute`.
@@ -167,9 +182,9 @@ impl Engine {
     /// The adapter's name and backend, for the page's status line.
     #[wasm_bindgen(getter)]
     pub fn adapter(&self) -> String {
-        let Some(counter) = &self.counter else { return "none (no WebGPU: views are clipped only)".into() };
+        let Some(gpu) = &self.gpu else { return "none (no WebGPU: views are clipped only)".into() };
         // Browsers hide the adapter's name unless asked; say what is known.
-        let info = counter.adapter_info();
+        let info = gpu.info();
         if info.name.is_empty() { "the browser's WebGPU".into() } else { format!("{} ({:?})", info.name, info.backend) }
     }
 
@@ -179,13 +194,15 @@ impl Engine {
         self.options.resolution
     }
 
-    /// Whether a GPU device was made (false where the browser has no WebGPU).
+    /// Whether the browser offers a WebGPU adapter (false where it has no WebGPU); its device is
+    /// opened when a view is first routed to it.
     #[wasm_bindgen(getter, js_name = hasGpu)]
     pub fn has_gpu(&self) -> bool {
-        self.counter.is_some()
+        self.gpu.is_some()
     }
 
-    /// Reads model files (glb/gltf with embedded buffers, IDF, epJSON) and uploads the scene.
+    /// Reads model files (glb/gltf with embedded buffers, IDF, epJSON); the scene is uploaded when
+    /// a view is first routed to the GPU.
     /// `names[i]` labels `contents[i]` in messages and picks its reader by extension.
     #[wasm_bindgen(js_name = loadFiles)]
     /// `receivers` and `foliage` are comma-separated globs over node names; `transmittance` a
@@ -202,16 +219,14 @@ impl Engine {
     ) -> Result<Model, JsValue> {
         let (loaded, variants) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
         let model = self.model(loaded.scene, loaded.energyplus, loaded.notes)?;
-        let counter = self.counter.as_ref().filter(|_| self.kind != EngineKind::Exact);
         let mut inner = Rc::try_unwrap(model.inner).map_err(|_| js_error(Error::argument("model", "shared while loading")))?;
         for scene in variants {
-            let gpu = counter.map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
-            inner.variants.push(Variant { scene, gpu, exact: Default::default() });
+            inner.variants.push(Variant { scene, gpu: Default::default(), exact: Default::default() });
         }
         Ok(Model { inner: Rc::new(inner) })
     }
 
-    /// Builds a scene from typed arrays (see `model::arrays`) and uploads it.
+    /// Builds a scene from typed arrays (see `model::arrays`).
     #[wasm_bindgen(js_name = fromArrays)]
     pub fn from_arrays(
         &self,
@@ -226,10 +241,7 @@ impl Engine {
     }
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
-        // `exact` never draws: no upload, which for a large model is as much wasm memory again as
-        // its scene (nyt-blocks: 1,103 MB with the upload, 620 MB without; docs/page-speed.md).
-        let counter = self.counter.as_ref().filter(|_| self.kind != EngineKind::Exact);
-        let gpu = counter.map(|c| c.upload(&scene)).transpose().map_err(js_error)?;
+        let gpu = Default::default();
         let inner = ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default(), variants: Vec::new() };
         Ok(Model { inner: Rc::new(inner) })
     }
@@ -238,7 +250,7 @@ impl Engine {
     /// direction: a unit vector towards the sun, x east, y north, z up. `routing`: the pool and
     /// profile ([`choice::Routing`]).
     pub fn fractions(&self, model: &Model, sun_x: f64, sun_y: f64, sun_z: f64, routing: JsValue) -> Promise {
-        let (counter, model, kind, options) = (self.counter.clone(), model.inner.clone(), self.kind, self.options);
+        let (gpu, model, kind, options) = (self.gpu.clone(), model.inner.clone(), self.kind, self.options);
         future_to_promise(async move {
             let routing = choice::Routing::from_js(&routing).map_err(js_error)?;
             let sun = glam::DVec3::new(sun_x, sun_y, sun_z);
@@ -248,7 +260,7 @@ impl Engine {
             let sun = sun.normalize();
             let requests: Vec<ViewRequest> =
                 (0..model.scene.receivers.len() as u32).map(|receiver| ViewRequest::new(receiver, sun)).collect();
-            let chosen = model.chosen(kind, counter.as_deref(), &options, &routing);
+            let chosen = model.chosen(kind, gpu.as_deref(), &options, &routing);
             let answers = chosen.answer(&requests).await.map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?;
             let fractions: Vec<f64> = answers.iter().map(|a| a.fraction).collect();
             Ok(Float64Array::from(fractions.as_slice()).into())
@@ -269,7 +281,7 @@ impl Engine {
         signal: Option<web_sys::AbortSignal>,
         routing: JsValue,
     ) -> Promise {
-        let (counter, model, kind, counter_options) = (self.counter.clone(), model.inner.clone(), self.kind, self.options);
+        let (gpu, model, kind, counter_options) = (self.gpu.clone(), model.inner.clone(), self.kind, self.options);
         future_to_promise(async move {
             let routing = choice::Routing::from_js(&routing).map_err(js_error)?;
             let given = settings_from_js(&settings).map_err(js_error)?;
@@ -293,7 +305,7 @@ impl Engine {
                 }
                 Ok(())
             };
-            let chosen = model.chosen(kind, counter.as_deref(), &counter_options, &routing);
+            let chosen = model.chosen(kind, gpu.as_deref(), &counter_options, &routing);
             let (schedule, fitted) = match (&model.energyplus, model.variants.is_empty()) {
                 (Some(ep), false) => {
                     // Shades whose τ changes in time: a year per variant (each such shade opaque
@@ -304,8 +316,8 @@ impl Engine {
                     let local = choice::Routing::from_js(&JsValue::UNDEFINED).map_err(js_error)?;
                     let mut years = Vec::new();
                     for v in &model.variants {
-                        let lane = counter.as_deref().zip(v.gpu.as_ref()).map(|(counter, gpu)| Lane { counter, gpu });
-                        let engine = choice::Chosen::new(kind, &v.scene, &v.exact, lane, &counter_options, &local);
+                        let upload = upload(kind, gpu.as_deref(), &v.scene, &v.gpu);
+                        let engine = choice::Chosen::new(kind, &v.scene, &v.exact, upload, &counter_options, &local);
                         years.push(
                             annual_fitted_with(&engine, &v.scene, &location, &options, &calendar, &mut report).await.map_err(js_error)?.0,
                         );
@@ -386,8 +398,8 @@ pub struct Model {
 
 struct ModelInner {
     scene: Scene,
-    /// The scene on the GPU (none without WebGPU).
-    gpu: Option<GpuScene>,
+    /// The scene on the GPU, uploaded when a view is first routed to it (never without WebGPU).
+    gpu: std::cell::OnceCell<GpuScene>,
     energyplus: Option<EnergyPlusInput>,
     /// What loading chose that the user should hear (e.g. many default receivers).
     notes: Vec<String>,
@@ -403,22 +415,33 @@ struct ModelInner {
 /// One of [`ModelInner::variants`]: a scene, its upload and its exact engine.
 struct Variant {
     scene: Scene,
-    gpu: Option<GpuScene>,
+    gpu: std::cell::OnceCell<GpuScene>,
     exact: std::cell::OnceCell<ExactEngine>,
 }
 
 impl ModelInner {
-    /// The engine `kind` over this model, on `counter`'s device (if any), routed by `routing`.
+    /// The engine `kind` over this model, on the page's GPU (if any), routed by `routing`.
     fn chosen<'a>(
         &'a self,
         kind: EngineKind,
-        counter: Option<&'a Counter>,
+        gpu: Option<&'a lazy::Gpu>,
         options: &CounterOptions,
         routing: &'a choice::Routing,
     ) -> choice::Chosen<'a> {
-        let lane = counter.zip(self.gpu.as_ref()).map(|(counter, gpu)| Lane { counter, gpu });
-        choice::Chosen::new(kind, &self.scene, &self.exact, lane, options, routing)
+        choice::Chosen::new(kind, &self.scene, &self.exact, upload(kind, gpu, &self.scene, &self.gpu), options, routing)
     }
+}
+
+/// `scene`'s way onto the page's GPU, if any. `exact` never draws: no upload, which for a large
+/// model is as much wasm memory again as its scene (nyt-blocks: 1,103 MB with the upload, 620 MB
+/// without; docs/page-speed.md).
+fn upload<'a>(
+    kind: EngineKind,
+    gpu: Option<&'a lazy::Gpu>,
+    scene: &'a Scene,
+    uploaded: &'a std::cell::OnceCell<GpuScene>,
+) -> Option<lazy::Upload<'a>> {
+    gpu.filter(|_| kind != EngineKind::Exact).map(|gpu| lazy::Upload { gpu, scene, uploaded })
 }
 
 #[wasm_bindgen]

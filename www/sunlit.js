@@ -86,7 +86,9 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
 async function openEngine({ resolution, accuracy, device, engine, wantsGpu, noGpu }) {
   await ready();
   const open = (gpu) => () => Engine.create(resolution, accuracy, engine === undefined ? undefined : String(engine), gpu);
-  if (device !== undefined) return onDevice(device, open(true));
+  // The caller's device is taken at once (the engine otherwise opens its device on the first
+  // view routed to the GPU), while onDevice's adapter stands in and its error handler is chained.
+  if (device !== undefined) return onDevice(device, () => open(true)().then(async (made) => (await made.openDevice(), made)));
   if (!hasWebGPU()) return open(false)();
   try {
     return await open(true)();

@@ -33,6 +33,8 @@ use crate::count::{Engine, ViewAnswer, ViewKind, ViewRequest, check_receivers};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 
+use super::lazy::Upload;
+
 /// Numbers per packed request handed to the pool: receiver, sun x, y, z, leaf fraction.
 pub(super) const PACKED: usize = 5;
 
@@ -92,13 +94,16 @@ struct Routed {
     refused: RefCell<Option<String>>,
 }
 
-/// The chosen engine over one model for one call: its exact engine (made on first use), its GPU
-/// lane (none without WebGPU), the caller's routing, and what routing learnt per kind of views.
+/// The chosen engine over one model for one call: its exact engine and its GPU lane (each made on
+/// first use; no lane without WebGPU), the caller's routing, and what routing learnt per kind of
+/// views.
 pub(super) struct Chosen<'a> {
     kind: EngineKind,
     scene: &'a Scene,
     exact: &'a OnceCell<ExactEngine>,
-    lane: Option<Lane<'a>>,
+    /// The way onto the GPU (none without WebGPU), and the lane once a view needed it.
+    gpu: Option<Upload<'a>>,
+    lane: OnceCell<Lane<'a>>,
     routing: &'a Routing,
     /// Per kind of views ([`kind_index`]).
     routed: [Routed; 2],
@@ -110,16 +115,16 @@ pub(super) struct Chosen<'a> {
 }
 
 impl<'a> Chosen<'a> {
-    /// The engine `kind` over `scene`; `adapter` names the GPU (None without WebGPU).
+    /// The engine `kind` over `scene`; `gpu` its way onto the GPU (None without WebGPU).
     pub(super) fn new(
         kind: EngineKind,
         scene: &'a Scene,
         exact: &'a OnceCell<ExactEngine>,
-        lane: Option<Lane<'a>>,
+        gpu: Option<Upload<'a>>,
         options: &CounterOptions,
         routing: &'a Routing,
     ) -> Self {
-        let adapter = lane.as_ref().map(|l| l.counter.adapter_info());
+        let adapter = gpu.as_ref().map(|g| g.gpu.info());
         let routed = |views| Routed {
             keys: profile_keys(scene, views, adapter, options, routing.threads),
             profile: OnceCell::new(),
@@ -129,7 +134,8 @@ impl<'a> Chosen<'a> {
             kind,
             scene,
             exact,
-            lane,
+            gpu,
+            lane: OnceCell::new(),
             routing,
             routed: [routed(ViewKind::Sun), routed(ViewKind::Sky)],
             views: Cell::new(ViewKind::Sun),
@@ -147,17 +153,26 @@ impl<'a> Chosen<'a> {
         self.exact.get_or_init(|| ExactEngine::new(self.scene))
     }
 
-    fn lane(&self) -> Result<&Lane<'a>> {
-        self.lane.as_ref().ok_or_else(|| {
-            Error::argument("engine", "the GPU engine is missing: this browser offers no WebGPU ('exact' and 'auto' clip without it)")
-        })
+    /// The GPU lane, its device opened and the scene uploaded on first use.
+    async fn lane(&self) -> Result<&Lane<'a>> {
+        let Some(upload) = &self.gpu else {
+            return Err(Error::argument(
+                "engine",
+                "the GPU engine is missing: this browser offers no WebGPU ('exact' and 'auto' clip without it)",
+            ));
+        };
+        if self.lane.get().is_none() {
+            let lane = upload.lane().await?;
+            let _ = self.lane.set(lane);
+        }
+        self.lane.get().ok_or_else(|| Error::argument("engine", "the GPU lane went missing"))
     }
 
     /// Whether `auto` clips every view whatever its load, so the loads need not be walked here
     /// (the pool walks them as it clips): a profile without a GPU cost, or no GPU, and nothing
     /// see-through in the scene. [`Profile::route`] would send every view to the exact engine.
     fn clips_everything(&self) -> bool {
-        let exact_only = self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.lane.is_none());
+        let exact_only = self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_none() || self.gpu.is_none());
         exact_only && self.scene.see_through_triangles == 0
     }
 
@@ -202,13 +217,14 @@ impl<'a> Chosen<'a> {
 
     /// The native calibration on this page: the exact engine timed on one thread (a pool
     /// worker's speed) and spread over the pool's workers; the GPU only where it could pay.
-    /// The device exists already, so its start-up is spent (0 s).
+    /// The device is opened before the GPU is timed, so its start-up is not in the profile (0 s).
     async fn measure(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Profile> {
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact, mean_us) = probe_exact(self.exact(), requests, loads, &probe, self.routing.threads);
-        let gpu = match &self.lane {
-            Some(lane) if gpu_worth_probing(mean_us, loads) => Some(probe_gpu(std::slice::from_ref(lane), requests, loads).await?),
-            _ => None,
+        let gpu = if self.gpu.is_some() && gpu_worth_probing(mean_us, loads) {
+            Some(probe_gpu(std::slice::from_ref(self.lane().await?), requests, loads).await?)
+        } else {
+            None
         };
         let keys = &self.now().keys;
         let device = match (&gpu, &keys.1) {
@@ -293,8 +309,8 @@ impl Engine for Chosen<'_> {
             EngineKind::Auto => self.now().profile.get().is_some_and(|(p, _)| p.gpu.is_some()),
             EngineKind::Exact => false,
         };
-        match &self.lane {
-            Some(l) if gpu_routed => l.batch(),
+        match &self.gpu {
+            Some(g) if gpu_routed => g.gpu.tiles_per_batch(),
             _ => 256,
         }
     }
@@ -310,14 +326,14 @@ impl Engine for Chosen<'_> {
     async fn answer(&self, requests: &[ViewRequest]) -> Result<Vec<ViewAnswer>> {
         check_receivers(self.scene.receivers.len(), requests)?;
         let (routes, loads) = match self.kind {
-            EngineKind::Gpu | EngineKind::Compute => return self.lane()?.answer(requests).await,
+            EngineKind::Gpu | EngineKind::Compute => return self.lane().await?.answer(requests).await,
             EngineKind::Exact => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto if self.clips_everything() => (vec![Route::Exact; requests.len()], None),
             EngineKind::Auto => {
                 let loads = self.exact().loads(requests);
                 let profile = self.routing_profile(requests, &loads).await?;
                 let mut routes = profile.route(&loads, self.run_views.get());
-                if self.lane.is_none() {
+                if self.gpu.is_none() {
                     // No WebGPU: see-through views are clipped as opaque, as `exact` does.
                     routes.iter_mut().for_each(|r| *r = Route::Exact);
                 }
@@ -329,7 +345,7 @@ impl Engine for Chosen<'_> {
             Some(pool) if !split.exact_reqs.is_empty() => Some(self.start_pool(pool, &split.exact_reqs)?),
             _ => None,
         };
-        let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane()?.answer(&split.gpu_reqs).await? };
+        let gpu = if split.gpu_reqs.is_empty() { Vec::new() } else { self.lane().await?.answer(&split.gpu_reqs).await? };
         let exact = match pooled {
             Some(pending) => self.finish_pool(pending, split.exact_reqs.len()).await?,
             None if split.exact_reqs.is_empty() => Vec::new(),

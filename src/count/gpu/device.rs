@@ -23,41 +23,70 @@ pub(super) struct Opened {
     pub tiles_per_side: u32,
 }
 
-/// Opens the platform's default adapter and a device with all its limits, refusing options the
-/// device cannot meet (a resolution above its texture size) before allocating anything.
-pub(super) async fn open(options: &CounterOptions) -> Result<Opened> {
-    let profile = options.limits.limits();
-    let instance = match options.backend {
-        Backend::Platform => platform::instance(),
-        Backend::Noop => platform::noop_instance(profile.clone())?,
-    };
-    let adapter = instance
-        .request_adapter(&wgpu::RequestAdapterOptions::default())
-        .await
-        .map_err(|e| GpuError::NoAdapter { hint: platform::no_adapter_hint().into(), reason: e.to_string() })?;
-    // A profile asks for no more than the named class offers, and never more than the adapter.
-    let limits = match &profile {
-        Some(profile) => adapter.limits().or_worse_values_from(profile),
-        None => adapter.limits(),
-    };
-    let resolution = options.resolution;
-    if !(16..=limits.max_texture_dimension_2d).contains(&resolution) {
-        return Err(Error::argument(
-            "resolution",
-            format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
-        ));
+/// The platform's default adapter, its limits checked against a counter's options, before any
+/// device is opened (the page learns its adapter at once and opens the device only when a view
+/// is routed to it).
+#[derive(Clone)]
+pub struct Adapter {
+    adapter: wgpu::Adapter,
+    limits: wgpu::Limits,
+    tiles_per_side: u32,
+}
+
+impl Adapter {
+    /// Asks for the platform's default adapter, refusing options it cannot meet (a resolution
+    /// above its texture size) before allocating anything.
+    pub async fn request(options: &CounterOptions) -> Result<Self> {
+        let profile = options.limits.limits();
+        let instance = match options.backend {
+            Backend::Platform => platform::instance(),
+            Backend::Noop => platform::noop_instance(profile.clone())?,
+        };
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions::default())
+            .await
+            .map_err(|e| GpuError::NoAdapter { hint: platform::no_adapter_hint().into(), reason: e.to_string() })?;
+        // A profile asks for no more than the named class offers, and never more than the adapter.
+        let limits = match &profile {
+            Some(profile) => adapter.limits().or_worse_values_from(profile),
+            None => adapter.limits(),
+        };
+        let resolution = options.resolution;
+        if !(16..=limits.max_texture_dimension_2d).contains(&resolution) {
+            return Err(Error::argument(
+                "resolution",
+                format!("{resolution} is outside 16..={} (this device's texture size limit)", limits.max_texture_dimension_2d),
+            ));
+        }
+        if let Some(a) = options.accuracy
+            && !(a > 0.0 && a < 1.0)
+        {
+            return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
+        }
+        let tiles_per_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d) / resolution;
+        Ok(Self { adapter, limits, tiles_per_side })
     }
-    if let Some(a) = options.accuracy
-        && !(a > 0.0 && a < 1.0)
-    {
-        return Err(Error::argument("accuracy", format!("{a} is not a fraction error in (0, 1)")));
+
+    /// The adapter's name, backend and device type.
+    pub fn info(&self) -> wgpu::AdapterInfo {
+        self.adapter.get_info()
     }
-    let tiles_per_side = options.max_atlas.clamp(resolution, limits.max_texture_dimension_2d) / resolution;
+
+    /// Views per batch a counter opened on this adapter at `options` takes
+    /// ([`super::Counter::tiles_per_batch`]), known before its device is opened.
+    pub fn tiles_per_batch(&self, options: &CounterOptions) -> usize {
+        super::plan::tiles_at(self.tiles_per_side * options.resolution, options.resolution)
+    }
+}
+
+/// Opens a device on `adapter` with all its (checked) limits.
+pub(super) async fn open_on(adapter: &Adapter) -> Result<Opened> {
     let (device, queue) = adapter
-        .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: limits, ..Default::default() })
+        .adapter
+        .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: adapter.limits.clone(), ..Default::default() })
         .await
         .map_err(|e| GpuError::Device(e.to_string()))?;
-    Ok(Opened { device, queue, info: adapter.get_info(), tiles_per_side })
+    Ok(Opened { device, queue, info: adapter.info(), tiles_per_side: adapter.tiles_per_side })
 }
 
 /// What the uncaptured-error handler records: out-of-memory apart, so it gets its own error.

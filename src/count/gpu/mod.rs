@@ -57,6 +57,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
+pub use self::device::Adapter;
 use self::device::Faults;
 use self::encode::BatchBuffers;
 #[cfg(feature = "test-hooks")]
@@ -341,7 +342,13 @@ pub struct GpuScene {
 impl Counter {
     /// Opens a device and builds the pipelines and atlas.
     pub async fn new(options: CounterOptions) -> Result<Self> {
-        let device::Opened { device, queue, info, tiles_per_side } = device::open(&options).await?;
+        Self::on(&Adapter::request(&options).await?, options).await
+    }
+
+    /// Opens a device on `adapter` (requested for these `options`) and builds the pipelines and
+    /// atlas.
+    pub async fn on(adapter: &Adapter, options: CounterOptions) -> Result<Self> {
+        let device::Opened { device, queue, info, tiles_per_side } = device::open_on(adapter).await?;
         let faults = Faults::watch(&device);
         let pipelines = Pipelines::new(&device);
         let atlas_side = tiles_per_side * options.resolution;
