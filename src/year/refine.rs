@@ -1,0 +1,263 @@
+//! Refined timesteps counted sparsely: where the refinement rules of [`super::annual`] ask for a
+//! timestep to be counted directly (and no certificate settled it, [`super::certified`]), the
+//! steps of one receiver at one time of day on consecutive days are counted by bisection in days
+//! and the rest interpolated linearly between counted days, only where that is as good as
+//! counting.
+//!
+//! Why days: at a fixed clock time the sun moves at most about 0.4° a day, so a receiver's
+//! fraction at that time changes slowly and smoothly from day to day, except where a shadow edge
+//! enters or leaves it (a kink) or where it goes dark. The refined cells of the spline are those
+//! where the fraction changes too fast *within a day* (the spread rule) or has a kink between
+//! sample days 13.5 days apart (`KINK`); along the days of one time of day most of them are
+//! still nearly straight, and a handful of counted days carries them.
+//!
+//! The rules, so that no step becomes less exact than counting it would make it where that matters:
+//! - the first and last day of every run are counted;
+//! - a span between counted days whose ends are not both lit (≥ [`NEAR_DARK`]) and of the same
+//!   kind (both partly lit, or both wholly lit) is counted step by step, as before: a dark/lit
+//!   edge, a sliver of sun in a dark canyon or a shadow entering a wholly lit surface is never
+//!   interpolated;
+//! - otherwise its middle day is counted, and the span is interpolated (piecewise linearly
+//!   through the middle) only if the middle lies within [`TOLERANCE`] of the straight line
+//!   between its ends, is of the same kind, and no counted day is more than [`MAX_GAP`] days
+//!   from the next; else each half is taken the same way.
+//!
+//! So the views only go down: every refined step is counted at most once. Measured against
+//! counting every timestep in docs/energyplus-fidelity.md ("Refined steps counted sparsely").
+
+use crate::count::{Engine, ViewRequest};
+use crate::error::Result;
+use crate::year::annual::{NEAR_DARK, Progress, Views};
+use crate::year::certified::Rough;
+
+/// How far, at most, a counted value may lie from the straight line between the counted days
+/// around it for the days between to be interpolated.
+pub const TOLERANCE: f64 = 0.01;
+
+/// The most days between two counted days that are interpolated across.
+pub const MAX_GAP: usize = 4;
+
+/// A counted fraction this close to 1 is wholly lit.
+const WHOLLY_LIT: f64 = 1.0 - 1e-9;
+
+/// What a counted fraction says about the steps around it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    /// Dark or nearly: a span touching it is counted step by step.
+    Dark,
+    Partly,
+    Wholly,
+}
+
+fn kind(v: f64) -> Kind {
+    if v < NEAR_DARK {
+        Kind::Dark
+    } else if v >= WHOLLY_LIT {
+        Kind::Wholly
+    } else {
+        Kind::Partly
+    }
+}
+
+/// The refined steps of one year, their values as they are counted or interpolated, and the
+/// spans still open.
+pub(super) struct Sparse {
+    /// Per step (index into the refined steps): its value once counted or interpolated.
+    values: Vec<Option<f64>>,
+    /// Runs: steps of one fitted piece at one time of day on consecutive days, in day order.
+    runs: Vec<Vec<usize>>,
+    /// Spans (run, first, last position) whose ends are counted and whose inside is not known.
+    spans: Vec<(usize, usize, usize)>,
+    /// Of `spans`, those whose middle is asked this round (the rest are counted whole).
+    asked_middles: Vec<(usize, usize, usize)>,
+    /// Steps counted so far.
+    counted: usize,
+    /// Per step: whether it was counted (not interpolated).
+    was_counted: Vec<bool>,
+    /// Whether the first round (every run's ends) was asked.
+    started: bool,
+}
+
+impl Sparse {
+    /// Groups `rough` (the steps to count, `rows_per_day` rows a day) into runs.
+    pub(super) fn new(rough: &[Rough], rows_per_day: usize) -> Self {
+        let key = |i: usize| {
+            let r = &rough[i];
+            (r.cell.0, r.cell.1, r.row % rows_per_day, r.row / rows_per_day)
+        };
+        let mut order: Vec<usize> = (0..rough.len()).collect();
+        order.sort_by_key(|&i| key(i));
+        let runs = order
+            .chunk_by(|&a, &b| {
+                let (ka, kb) = (key(a), key(b));
+                (ka.0, ka.1, ka.2) == (kb.0, kb.1, kb.2) && kb.3 == ka.3 + 1
+            })
+            .map(<[usize]>::to_vec)
+            .collect();
+        Sparse {
+            values: vec![None; rough.len()],
+            runs,
+            spans: Vec::new(),
+            asked_middles: Vec::new(),
+            counted: 0,
+            was_counted: vec![false; rough.len()],
+            started: false,
+        }
+    }
+
+    /// Steps neither counted nor interpolated yet: the most that may still be counted.
+    pub(super) fn unsettled(&self) -> usize {
+        self.values.iter().filter(|v| v.is_none()).count()
+    }
+
+    /// Steps counted so far.
+    pub(super) fn counted(&self) -> usize {
+        self.counted
+    }
+
+    /// The steps to count next (indices into the refined steps); empty once every step has a value.
+    pub(super) fn next_round(&mut self) -> Vec<usize> {
+        if !self.started {
+            self.started = true;
+            return self.first_round();
+        }
+        let mut asked = Vec::new();
+        for (run, a, b) in std::mem::take(&mut self.spans) {
+            let steps = &self.runs[run];
+            let (va, vb) = (self.value(steps[a]), self.value(steps[b]));
+            if interpolable(va, vb) {
+                asked.push(steps[(a + b) / 2]);
+                self.asked_middles.push((run, a, b));
+            } else {
+                asked.extend(steps[a + 1..b].iter().copied());
+            }
+        }
+        asked
+    }
+
+    /// Every run's first and last day, and the whole of runs of one or two days.
+    fn first_round(&mut self) -> Vec<usize> {
+        let mut asked = Vec::new();
+        for (run, steps) in self.runs.iter().enumerate() {
+            let last = steps.len() - 1;
+            asked.push(steps[0]);
+            if last > 0 {
+                asked.push(steps[last]);
+            }
+            if last > 1 {
+                self.spans.push((run, 0, last));
+            }
+        }
+        asked
+    }
+
+    /// Takes the counts of `asked` (as returned by [`Self::next_round`]) and decides the spans
+    /// whose middles they were: interpolated, or halved for the next round.
+    pub(super) fn answer(&mut self, asked: &[usize], values: &[f64]) {
+        for (&i, &v) in asked.iter().zip(values) {
+            self.values[i] = Some(v);
+            self.was_counted[i] = true;
+        }
+        self.counted += asked.len();
+        for (run, a, b) in std::mem::take(&mut self.asked_middles) {
+            let m = (a + b) / 2;
+            let steps = &self.runs[run];
+            let (va, vm, vb) = (self.value(steps[a]), self.value(steps[m]), self.value(steps[b]));
+            let straight = va + (vb - va) * (m - a) as f64 / (b - a) as f64;
+            let agrees = kind(vm) == kind(va) && (vm - straight).abs() <= TOLERANCE;
+            if agrees && b - a <= 2 * MAX_GAP {
+                self.interpolate(run, a, m);
+                self.interpolate(run, m, b);
+            } else {
+                for (x, y) in [(a, m), (m, b)] {
+                    if y > x + 1 {
+                        self.spans.push((run, x, y));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Fills the steps strictly between positions `a` and `b` of `run` on the straight line
+    /// between their counted values.
+    fn interpolate(&mut self, run: usize, a: usize, b: usize) {
+        let (va, vb) = (self.value(self.runs[run][a]), self.value(self.runs[run][b]));
+        for p in a + 1..b {
+            let step = self.runs[run][p];
+            self.values[step] = Some(va + (vb - va) * (p - a) as f64 / (b - a) as f64);
+        }
+    }
+
+    fn value(&self, step: usize) -> f64 {
+        self.values[step].unwrap_or(0.0)
+    }
+
+    /// Every step's value, once [`Self::next_round`] returns nothing.
+    pub(super) fn values(self) -> Vec<f64> {
+        self.values.into_iter().map(|v| v.unwrap_or(0.0)).collect()
+    }
+}
+
+/// Whether a span whose ends count `a` and `b` may be interpolated at all: both lit, of one kind.
+fn interpolable(a: f64, b: f64) -> bool {
+    kind(a) != Kind::Dark && kind(a) == kind(b)
+}
+
+/// Counts the refined steps `rough` sparsely ([`Sparse`]) and returns every step's fraction, in
+/// order. `leaves` gives a step's leaf fraction; `report` gets, with each progress report, the
+/// most refined steps that may in all be counted (those counted so far and those still open).
+pub(super) async fn count_sparsely(
+    views: &Views<'_, impl Engine>,
+    rough: &[Rough],
+    rows_per_day: usize,
+    refine: f64,
+    leaves: &dyn Fn(&Rough) -> f32,
+    report: &mut dyn FnMut(usize, Progress) -> Result<()>,
+) -> Result<Vec<f64>> {
+    let mut sparse = Sparse::new(rough, rows_per_day);
+    loop {
+        let to_count = sparse.counted() + sparse.unsettled();
+        let asked = sparse.next_round();
+        if asked.is_empty() {
+            break;
+        }
+        let requests: Vec<ViewRequest> =
+            asked.iter().map(|&i| ViewRequest::new(rough[i].column as u32, rough[i].sun).with_leaves(leaves(&rough[i]))).collect();
+        let before = sparse.counted();
+        let values = views.count(&requests, &mut |p| report(to_count, Progress::counting(before + p.done, to_count))).await?;
+        sparse.answer(&asked, &values);
+    }
+    // The last round's interpolated steps are settled too: the year ends at its total.
+    let counted = sparse.counted();
+    report(counted, Progress::counting(counted, counted))?;
+    log::info!("refinement: {} of {} steps counted, the rest interpolated between counted days", sparse.counted(), rough.len());
+    log::info!("refinement by rule (steps / counted): {}", by_rule(rough, refine, &sparse.was_counted));
+    Ok(sparse.values())
+}
+
+/// The refined steps and those of them counted, by the first refinement rule that asked for
+/// them (as far as a step's cell tells): the spread rule, a near-dark corner, and the rest (a
+/// near-dark fit, `KINK`, a borrowed day).
+fn by_rule(rough: &[Rough], refine: f64, counted: &[bool]) -> String {
+    let mut tally = [(0usize, 0usize); 3];
+    for (r, &c) in rough.iter().zip(counted) {
+        let (lowest, highest) = r.corners;
+        let rule = if highest - lowest > refine {
+            0
+        } else if lowest < NEAR_DARK {
+            1
+        } else {
+            2
+        };
+        tally[rule].0 += 1;
+        tally[rule].1 += usize::from(c);
+    }
+    let [spread, dark, other] = tally;
+    format!(
+        "spread {} / {}, near-dark corner {} / {}, KINK or near-dark fit or borrowed day {} / {}",
+        spread.0, spread.1, dark.0, dark.1, other.0, other.1
+    )
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,127 @@
+//! Sparse counting of refined steps against counting every one of them, on fractions given as
+//! functions of the day (one receiver, one time of day).
+
+use glam::DVec3;
+
+use super::*;
+
+/// Rows a day in these tests (Timestep 4).
+const ROWS: usize = 96;
+
+/// A refined step of fitted piece `fit` at time of day `slot` on day `day` (0-based).
+fn step(fit: usize, slot: usize, day: usize) -> Rough {
+    Rough { row: day * ROWS + slot, column: fit, sun: DVec3::Z, day: day as f64 + 1.0, cell: (0, fit, 0, 0), corners: (0.0, 1.0) }
+}
+
+/// Runs the rounds of [`Sparse`] with `truth` answering every asked step: each step's value and
+/// how many were counted.
+fn sparse(rough: &[Rough], truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
+    let mut s = Sparse::new(rough, ROWS);
+    let mut asked_ever = vec![false; rough.len()];
+    loop {
+        let asked = s.next_round();
+        if asked.is_empty() {
+            break;
+        }
+        for &i in &asked {
+            assert!(!asked_ever[i], "step {i} asked twice");
+            asked_ever[i] = true;
+        }
+        let values: Vec<f64> = asked.iter().map(|&i| truth(&rough[i])).collect();
+        s.answer(&asked, &values);
+    }
+    assert_eq!(s.unsettled(), 0, "every step has a value");
+    let counted = s.counted();
+    (s.values(), counted)
+}
+
+/// One run of `days` consecutive days at one time of day, with `f(day)` its fraction.
+fn run(days: usize, f: impl Fn(usize) -> f64) -> (Vec<f64>, Vec<f64>, usize) {
+    let rough: Vec<Rough> = (0..days).map(|d| step(0, 40, d)).collect();
+    let (values, counted) = sparse(&rough, |r| f(r.row / ROWS));
+    ((0..days).map(f).collect(), values, counted)
+}
+
+fn largest_error(truth: &[f64], values: &[f64]) -> f64 {
+    truth.iter().zip(values).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+}
+
+/// A sliver of sun on one day in a run dark at both ends (a slot's minutes of sun at this time of
+/// day): every step is counted, so the sliver is kept. Bisection alone would miss it: day 16 lies
+/// between the counted days 14 and 17, which are dark.
+#[test]
+fn a_short_lit_piece_between_dark_days_is_counted_whole() {
+    let (truth, values, counted) = run(30, |d| if d == 16 { 0.4 } else { 0.0 });
+    assert_eq!(values, truth);
+    assert_eq!(counted, 30);
+}
+
+/// Partly lit at both ends and dark for eight days in between: the middle day that falls dark
+/// makes the halves touching it counted step by step, so no dark step is interpolated as lit and
+/// the days around the spell are counted; the lit days well away from it are interpolated.
+#[test]
+fn a_dark_spell_between_lit_days_is_not_interpolated_across() {
+    let f = |d: usize| if (26..34).contains(&d) { 0.0 } else { 0.5 + 0.001 * d as f64 };
+    let (truth, values, counted) = run(40, f);
+    for (d, (t, v)) in truth.iter().zip(&values).enumerate() {
+        assert_eq!(*t == 0.0, *v == 0.0, "day {d}: {t} against {v}");
+        if (25..=34).contains(&d) {
+            assert_eq!(t, v, "day {d} at the edges is counted");
+        }
+    }
+    assert!(counted < 40, "the lit days away from the spell are interpolated: {counted} counted");
+}
+
+/// A shadow entering a wholly lit surface: 1 up to day 9, then falling. The span between a
+/// wholly lit day and a partly lit one is counted, so the kink where the shadow enters is exact.
+#[test]
+fn a_shadow_entering_a_wholly_lit_surface_is_counted() {
+    let f = |d: usize| if d < 10 { 1.0 } else { 1.0 - 0.02 * (d - 9) as f64 };
+    let (truth, values, _) = run(30, f);
+    for d in 5..15 {
+        assert_eq!(truth[d], values[d], "day {d}");
+    }
+    assert!(largest_error(&truth, &values) <= TOLERANCE);
+}
+
+/// A smooth fraction is carried by few counted days, within the tolerance everywhere.
+#[test]
+fn a_smooth_fraction_is_interpolated_within_the_tolerance() {
+    let f = |d: usize| 0.5 + 0.2 * (d as f64 / 20.0).sin();
+    let (truth, values, counted) = run(41, f);
+    let error = largest_error(&truth, &values);
+    println!("smooth: {counted} of 41 counted, largest error {error:.4}");
+    assert!(counted * 2 < 41, "{counted} of 41 counted");
+    assert!(error <= TOLERANCE, "largest error {error}");
+}
+
+/// A kink inside a partly lit run (a plateau, then a fall) is found by the middle days, and the
+/// days around it are counted until the straight lines fit.
+#[test]
+fn a_kink_between_counted_days_is_followed() {
+    let f = |d: usize| if d < 17 { 0.8 } else { 0.8 - 0.015 * (d - 17) as f64 };
+    let (truth, values, counted) = run(40, f);
+    let error = largest_error(&truth, &values);
+    println!("kink: {counted} of 40 counted, largest error {error:.4}");
+    assert!(error <= TOLERANCE, "largest error {error}");
+    assert!(counted < 40);
+}
+
+/// Steps of different times of day, of different pieces, or with a day missing between them
+/// are separate runs: a span never reaches across them.
+#[test]
+fn runs_break_at_gaps_times_of_day_and_pieces() {
+    let mut rough = Vec::new();
+    for d in (0..10).chain(12..20) {
+        rough.push(step(0, 40, d));
+        rough.push(step(0, 41, d));
+        rough.push(step(1, 40, d));
+    }
+    let s = Sparse::new(&rough, ROWS);
+    let mut lengths: Vec<usize> = s.runs.iter().map(Vec::len).collect();
+    lengths.sort_unstable();
+    assert_eq!(lengths, vec![8, 8, 8, 10, 10, 10]);
+    for run in &s.runs {
+        assert!(run.windows(2).all(|w| rough[w[1]].row == rough[w[0]].row + ROWS), "consecutive days");
+    }
+}
