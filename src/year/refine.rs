@@ -231,7 +231,10 @@ pub(super) async fn count_sparsely(
     let counted = sparse.counted();
     report(counted, Progress::counting(counted, counted))?;
     log::info!("refinement: {} of {} steps counted, the rest interpolated between counted days", sparse.counted(), rough.len());
-    log::info!("refinement by rule (steps / counted): {}", by_rule(rough, refine, &sparse.was_counted));
+    // The tally walks every refined step again: only when someone reads it.
+    if log::log_enabled!(log::Level::Info) {
+        log::info!("refinement by rule (steps / counted): {}", by_rule(rough, refine, &sparse.was_counted));
+    }
     Ok(sparse.values())
 }
 
