@@ -16,6 +16,7 @@
 use glam::DVec3;
 
 use crate::error::{Error, Result};
+use crate::geometry::triangle_area;
 use crate::map::Points;
 use crate::scene::{Receiver, Scene};
 
@@ -91,7 +92,7 @@ pub fn window_points(scene: &Scene, receivers: &[u32], at: WindowPoint) -> Resul
 fn centroid(r: &Receiver) -> DVec3 {
     let (mut sum, mut area) = (DVec3::ZERO, 0.0);
     for t in &r.triangles {
-        let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let a = triangle_area(t);
         sum += (t[0] + t[1] + t[2]) / 3.0 * a;
         area += a;
     }
