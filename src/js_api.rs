@@ -236,3 +236,70 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"timestepsPerHour": 4})), bad("options"));
     assert_eq!(MapRequest::from_value(json!({"grid": 1})).err().map(|e| e.code()), Some("bad-option"), "no location");
 }
+
+/// The web's study options reader, compiled natively so that it is tested without a browser.
+#[path = "web/study_options.rs"]
+mod study_options;
+
+use study_options::{STUDY_KEYS, StudyPlace, StudyRequest};
+
+use crate::map::planning::run::STUDIES;
+use crate::map::planning::window_points::WindowPoint;
+
+#[test]
+fn the_study_options_are_the_same_on_both_sides() {
+    let rust: BTreeSet<String> = STUDY_KEYS.iter().map(|k| k.to_string()).collect();
+    assert_eq!(fields(interface("StudyOptions")), rust);
+    let studies: BTreeSet<String> = STUDIES.iter().map(|s| s.to_string()).collect();
+    assert_eq!(literals_after("export type StudyName "), studies, "StudyName: the window studies run.rs runs");
+    let at: BTreeSet<String> = WindowPoint::NAMES.iter().map(|s| s.to_string()).collect();
+    assert_eq!(union(interface("StudyOptions"), "windowPoints"), at, "StudyOptions.windowPoints");
+    let sky: BTreeSet<String> = SkyModel::ALL.iter().map(|m| m.name().to_string()).collect();
+    assert_eq!(union(interface("StudyOptions"), "skyModel"), sky, "StudyOptions.skyModel");
+}
+
+fn study(options: serde_json::Value) -> crate::error::Result<StudyRequest> {
+    StudyRequest::from_value(options)
+}
+
+#[test]
+fn study_options_read_as_sunlit_map_reads_its_flags() {
+    let vsc = study(json!({"study": "bre-vsc", "windows": [0, 3]})).unwrap();
+    assert_eq!((vsc.studies, vsc.place), (vec!["bre-vsc".to_string()], StudyPlace::Windows(vec![0, 3], WindowPoint::Centre)));
+    assert!(vsc.location.is_none() && vsc.weather.is_none() && vsc.gb.is_none(), "bre-vsc needs no site");
+    let gb = study(json!({"study": ["gb50180", "bre-vsc"], "windows": [1], "windowPoints": "sill", "latitude": 39.9, "longitude": 116.4,
+        "timeZone": 8, "day": "dongzhi", "minPeriod": 5, "maxPeriods": 2, "skyModel": "cie-overcast"}))
+    .unwrap();
+    assert_eq!(gb.place, StudyPlace::Windows(vec![1], WindowPoint::Sill));
+    let rule = gb.gb.unwrap();
+    assert_eq!((rule.day.name(), rule.required_hours, rule.min_period_minutes, rule.max_periods), ("dongzhi", 1.0, 5.0, Some(2)));
+    assert_eq!(gb.location.map(|l| (l.latitude, l.time_zone)), Some((39.9, 8.0)));
+    let given = study(json!({"study": "bre-25deg", "points": [1, 2, 3, 0, -1, 0]})).unwrap();
+    assert_eq!(given.place, StudyPlace::Given(vec![1.0, 2.0, 3.0, 0.0, -1.0, 0.0]));
+}
+
+#[test]
+fn bad_study_options_are_refused_naming_the_option() {
+    let named = |o: serde_json::Value| study(o).err().map(|e| (e.code(), e.parameter().map(String::from)));
+    let bad = |option: &str| Some(("bad-option", Some(option.to_string())));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": []})), bad("windows"), "no window selected");
+    assert_eq!(named(json!({"study": "bre-vsc"})), bad("windows"), "neither windows nor points");
+    assert_eq!(named(json!({"windows": [0]})), bad("study"));
+    assert_eq!(named(json!({"study": [], "windows": [0]})), bad("study"));
+    assert_eq!(named(json!({"study": "bre-ground", "windows": [0]})), bad("study"), "a map study is not a window study");
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "skyModel": "perez-all-weather"})), bad("sky_model"));
+    assert_eq!(
+        named(json!({"study": "gb50180", "windows": [0], "latitude": 40, "longitude": 116, "timeZone": 8, "skyModel": "cie-overcast"})),
+        bad("sky_model")
+    );
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "day": "dahan"})), bad("day"), "only gb50180 takes a day");
+    assert_eq!(
+        named(json!({"study": "gb50180", "windows": [0], "latitude": 40, "longitude": 116, "timeZone": 8, "day": "06-21"})),
+        bad("day")
+    );
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "windowPoints": "middle"})), bad("window_points"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "points": [0, 0, 0, 0, 0, 1]})), bad("points"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [-1]})), bad("windows"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "grid": 1})), bad("options"));
+    assert_eq!(named(json!({"study": "gb50180", "windows": [0], "latitude": 40})), bad("longitude"));
+}

@@ -18,6 +18,8 @@ mod embed;
 mod lazy;
 mod map;
 mod map_options;
+mod study;
+mod study_options;
 
 use js_sys::{Array, Float32Array, Float64Array, Function, Int32Array, Promise, Uint8Array};
 use wasm_bindgen::prelude::*;

@@ -4,6 +4,7 @@ import { colourOf, UNCOMPUTED } from './colour.js';
 import { checkModelSize } from './sunlit.js';
 import { drawHeatmap } from './heatmap.js';
 import { mapMode } from './mapmode.js';
+import { studyMode } from './studymode.js';
 import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
@@ -23,6 +24,7 @@ const maps = mapMode({
     const { latitude, longitude, timeZone, epw, epwName } = await settings();
     return epw ? { epw, epwName } : { latitude, longitude, timeZone };
   },
+  skyModel: () => $('skymodel').value,
   engineOptions: () => engineOptions(),
   viewer: () => state.viewer,
   showLegend: (scale) => showLegend(scale ?? colourScale()),
@@ -30,6 +32,28 @@ const maps = mapMode({
   busy: () => state.busy,
   download: (...args) => download(...args),
   modelName: () => state.modelName,
+});
+
+const studies = studyMode({
+  $,
+  worker,
+  status: (text) => status(text),
+  location: async () => {
+    const { latitude, longitude, timeZone, epw, epwName } = await settings();
+    return epw ? { epw, epwName } : { latitude, longitude, timeZone };
+  },
+  skyModel: () => $('skymodel').value,
+  engineOptions: () => engineOptions(),
+  viewer: () => {
+    const { viewer, model } = state;
+    if (viewer && model && viewer.positions !== model.positions) viewer.setModel(model.positions, model.receivers);
+    return viewer;
+  },
+  showLegend: (scale) => showLegend(scale),
+  setBusy: (busy) => setBusy(busy),
+  download: (...args) => download(...args),
+  modelName: () => state.modelName,
+  names: () => state.model?.names ?? [],
 });
 
 function setBusy(busy) {
@@ -97,6 +121,7 @@ function showModel(msg) {
   $('heatfigure').hidden = true;
   fillTable(null);
   maps.reset();
+  studies.reset(msg.names);
   showInViewer();
   const n = msg.names.length;
   // An EnergyPlus model's own Site:Location is its location (an EPW, if chosen, still wins).
@@ -113,10 +138,17 @@ function showModel(msg) {
 /** The model in the 3D view, coloured by the result when there is one. The viewer may start
  * after the model arrives, so it is also called once the viewer exists. */
 function showInViewer() {
+  // The Study mode colours the windows by their verdicts, with its own legend.
+  if (studies.active()) return studies.recolour();
+  showLegend(colourScale());
+  paintReceivers();
+}
+
+/** The receivers coloured by the year's result (uncomputed without one). */
+function paintReceivers() {
   const { viewer, model, result } = state;
-  const scale = colourScale();
-  showLegend(scale);
   if (!viewer || !model) return;
+  const scale = colourScale();
   if (viewer.positions !== model.positions) viewer.setModel(model.positions, model.receivers);
   viewer.setColours(result ? (r) => colourOf(scale.values[r] / scale.max) : () => UNCOMPUTED);
 }
@@ -208,6 +240,7 @@ function showError(msg) {
   // A download of the map's files failing leaves the map (and any map in flight) as it is.
   if (msg.request === 'mapFile') return status(`Could not download the map: ${msg.message}.`, { error: true });
   maps.failed();
+  if (msg.request === 'study') studies.failed();
   if (msg.request === 'load') {
     // The files were not read: the last good model (if any) stays, and Compute with it.
     state.reading = null;
@@ -216,7 +249,7 @@ function showError(msg) {
   $('progress').value = 0;
   if (msg.cancelled) return status('Cancelled.');
   $('retry').hidden = !msg.gpu;
-  const what = { load: 'Could not read the model', map: 'Could not map' }[msg.request] ?? 'Could not compute';
+  const what = { load: 'Could not read the model', map: 'Could not map', study: 'Could not run the study' }[msg.request] ?? 'Could not compute';
   const hint = msg.gpu ? ' The GPU device was lost or failed; press Retry to start a new one.' : '';
   status(`${what}: ${String(msg.message).replace(/\.$/, '')}.${hint}`, { error: true });
 }
@@ -246,6 +279,8 @@ worker.onmessage = ({ data: msg }) => {
     maps.shown(msg);
   } else if (msg.type === 'mapFile') {
     maps.fileArrived(msg);
+  } else if (msg.type === 'studyResult') {
+    studies.shown(msg);
   } else if (msg.type === 'epwLocation') {
     showEpwLocation(msg);
   } else if (msg.type === 'error') {
@@ -319,6 +354,7 @@ async function settings() {
     s.leafOut = $('leafout').value.trim();
     s.leafFall = $('leaffall').value.trim();
   }
+  if ($('skymodel').value) s.skyModel = $('skymodel').value;
   const epw = $('epw').files[0];
   if (epw) {
     s.epw = await epw.text();
@@ -372,6 +408,10 @@ function wire() {
       status('Mapping the points…');
       return maps.compute();
     }
+    if (studies.active()) {
+      status('Running the study…');
+      return studies.compute();
+    }
     status('Sampling the sun…');
     worker.postMessage({ type: 'compute', settings: await settings(), engine: engineOptions(), csvName: state.csvName });
   });
@@ -383,6 +423,9 @@ function wire() {
   });
   $('retry').addEventListener('click', () => $('settings').requestSubmit());
   maps.wire();
+  studies.wire();
+  // Leaving the Study mode gives the receivers back the year's colours (the legend is the mode's).
+  $('mode').addEventListener('change', () => studies.active() || paintReceivers());
   $('download').addEventListener('click', () => state.result && download(state.csvName, state.result.csv, 'text/csv'));
   $('downloadidf').addEventListener('click', () => {
     if (!state.result?.hooked) return;
@@ -405,6 +448,7 @@ async function start() {
     state.viewer = await Viewer.create($('view'));
     showInViewer();
     maps.reset();
+    studies.recolour();
   } catch (error) {
     status(`The 3D view is unavailable (${error.message}); results still work.`, { error: true });
   }

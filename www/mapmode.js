@@ -25,7 +25,7 @@ export function clock(hours) {
 
 /**
  * Wires the Map mode's controls. `page`: { $, worker, status, location() (the form's location as
- * MapOptions keys), engineOptions(), viewer() (the 3D view or null), showLegend({ max, title, tick }),
+ * MapOptions keys), skyModel() (the sky control's value, '' for the default), engineOptions(), viewer() (the 3D view or null), showLegend({ max, title, tick }),
  * setBusy(busy), download(name, text, type), modelName() }.
  */
 export function mapMode(page) {
@@ -37,7 +37,7 @@ export function mapMode(page) {
 
   function showFields() {
     const map = mode() === 'map';
-    for (const el of document.querySelectorAll('.yearonly')) el.hidden = map;
+    for (const el of document.querySelectorAll('.yearonly')) el.hidden = mode() !== 'year';
     $('mapfields').hidden = !map;
     const period = instant() ? 'instant' : $('mapperiod').value;
     for (const el of document.querySelectorAll('[data-period]')) el.hidden = !el.dataset.period.split(' ').includes(period);
@@ -49,6 +49,7 @@ export function mapMode(page) {
 
   async function options() {
     const o = { ...(await page.location()), grid: Number($('mapgrid').value) };
+    if (page.skyModel()) o.skyModel = page.skyModel();
     if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit' };
     o.value = $('mapvalue').value;
     const period = $('mapperiod').value;

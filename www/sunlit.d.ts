@@ -239,6 +239,82 @@ export interface SunlitEngine {
    * or total irradiation over a period, or lit (1) or not (0) at an instant, each point by its own
    * shadow rays (to the sun, and to each sky patch for the sky). */
   map(model: Model, options: MapOptions, run?: MapRunOptions): Promise<SunlitMap>;
+  /** The window studies of planning rules (BRE 209's VSC, APSH/WPSH and 25°/45° pre-checks,
+   * GB 50180's sunlight hours; docs/planning.md) at one point per window, or at given points,
+   * by the exact shadow rays on the CPU, as `sunlit map --study` runs them. Bad options throw a
+   * SunlitError naming the option (`windows` when none is selected). */
+  study(model: Model, options: StudyOptions): Promise<SunlitStudy>;
+}
+
+/** A window study, as `sunlit map --study` names it. */
+export type StudyName = 'bre-vsc' | 'bre-apsh' | 'gb50180' | 'bre-25deg' | 'bre-45deg';
+
+/** engine.study's options, as `sunlit map --study` takes them (docs/planning.md). */
+export interface StudyOptions {
+  /** One study or several. */
+  study: StudyName | StudyName[];
+  /** The windows: receiver indices (into receiverNames), one point on each (`windowPoints`),
+   * as `sunlit map --window-points`. Give these or `points`. */
+  windows?: ArrayLike<number>;
+  /** Where on each window: 'centre' (BRE's reference point, the default) or 'sill' (GB 50180's
+   * ground-floor sill, the middle of the lowest edge). */
+  windowPoints?: 'centre' | 'sill';
+  /** Or given points: 6 numbers per point, x y z nx ny nz, each on a receiver (as `--points`). */
+  points?: ArrayLike<number>;
+  /** Degrees north; with longitude and timeZone (gb50180 needs a site; bre-vsc none). */
+  latitude?: number;
+  /** Degrees east. */
+  longitude?: number;
+  /** Hours from UTC of local standard time. */
+  timeZone?: number;
+  /** An EPW's text: its location, and for bre-apsh its direct normal irradiance (needed). */
+  epw?: string;
+  /** The EPW's file name, for messages. */
+  epwName?: string;
+  /** bre-vsc's sky: only 'cie-overcast' (VSC is defined under it); refused for the other studies. */
+  skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
+  /** gb50180: 'dahan' (大寒日, the default) or 'dongzhi' (冬至日). */
+  day?: string;
+  /** gb50180: hours required (default 2 on 大寒日, 1 on 冬至日). */
+  requiredHours?: number;
+  /** gb50180: only continuous periods of at least this many minutes count. */
+  minPeriod?: number;
+  /** gb50180: only the longest N periods count. */
+  maxPeriods?: number;
+  /** gb50180: the 满窗 (whole window) variant over a sill this wide, in metres. */
+  windowWidth?: number;
+}
+
+/** One study's results per point, as `POINTS.study-NAME.json` holds them. */
+export interface StudyTable {
+  study: StudyName;
+  /** The rule and its source, in words. */
+  source: string;
+  /** Every parameter of the rule, as the report states them. */
+  rule: Record<string, unknown>;
+  /** Per value key ('vsc'; 'apsh', 'wpsh'; 'hours', 'hours_whole_window'; 'angle_deg';
+   * 'within_45deg'), the value per point. */
+  values: Record<string, number[]>;
+  /** Per point: passes (true), fails (false), or not assessed (null: APSH of a window facing
+   * more than 90° from due south). */
+  passes: (boolean | null)[];
+  /** Per verdict key ('passes', 'passes_whole_window'), per point. */
+  verdicts: Record<string, boolean[]>;
+}
+
+/** engine.study's answer, one entry per point (in the order of `windows` or `points`). */
+export interface SunlitStudy {
+  /** x y z per point. */
+  points: Float32Array;
+  /** The outward unit normal per point. */
+  normals: Float32Array;
+  /** The receiver each point lies on: an index into receiverNames. */
+  receivers: Uint32Array;
+  /** One table per study asked. */
+  tables: StudyTable[];
+  /** Per study, its table as `sunlit map --study NAME -o POINTS.csv` writes
+   * `POINTS.study-NAME.csv`, byte for byte. */
+  csv: Record<string, string>;
 }
 
 /** engine.map's options: where (a grid or given points), when (a period or an instant) and what

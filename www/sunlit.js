@@ -372,6 +372,25 @@ class SunlitEngine {
     if (!files) map.free();
     return answer;
   }
+
+  /** The window studies (sunlit.d.ts, StudyOptions) on `model`: a plain object of typed arrays
+   * (points, normals, receivers), the tables (values and pass/fail per point) and per study the
+   * CSV `sunlit map --study` writes. The studies are the library's; nothing is decided here. */
+  async study(model, options) {
+    const study = this.#engine.study(model, options);
+    try {
+      const tables = JSON.parse(study.tablesJson());
+      return {
+        points: study.points,
+        normals: study.normals,
+        receivers: study.receivers,
+        tables,
+        csv: Object.fromEntries(tables.map((t) => [t.study, study.csv(t.study)])),
+      };
+    } finally {
+      study.free();
+    }
+  }
 }
 
 /** A map's files on demand: the wasm map is kept (its values in full precision, as the CLI writes

@@ -1,6 +1,7 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
 // page stays responsive. Messages in: warm (make the engine now), load, compute, map, mapFile,
-// cancel, epw. Messages out: loaded, progress, notice, result, mapResult, mapFile, epwLocation,
+// study, cancel, epw. Messages out: loaded, progress, notice, result, mapResult, mapFile,
+// studyResult, epwLocation,
 // error (with the error's `code`, and `gpu: true` when the device failed twice and a retry may
 // help). Errors are told apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
@@ -206,6 +207,17 @@ async function map({ options, engine: made, tag }) {
   postMessage({ type: 'mapResult', tag, id: mapFiles.id, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
 }
 
+/** The window studies (engine.study) of the loaded model: its tables and CSVs, all at once (a
+ * study is small: one point a window). */
+async function study({ options, engine: made }) {
+  if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
+  const e = await engineFor(made);
+  const m = modelOn(e);
+  const started = performance.now();
+  const result = await e.study(m, options);
+  postMessage({ type: 'studyResult', study: result, seconds: (performance.now() - started) / 1000 });
+}
+
 /** The points CSV ('csv') or the map glb ('glb') of map `id`, as `sunlit map` writes them. */
 function mapFile({ id, kind }) {
   if (!mapFiles || mapFiles.id !== id) {
@@ -263,6 +275,7 @@ onmessage = async ({ data }) => {
     else if (data.type === 'compute') await compute(data);
     else if (data.type === 'map') await map(data);
     else if (data.type === 'mapFile') mapFile(data);
+    else if (data.type === 'study') await study(data);
     else if (data.type === 'epw') await epw(data);
     else if (data.type === 'warm') warm(data);
   } catch (error) {

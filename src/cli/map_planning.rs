@@ -8,7 +8,7 @@
 use serde_json::{Value, json};
 use sunlit::export::planning_report::{mask_svg, report_html, study_csv, study_json};
 use sunlit::export::planning_tables::{sun_paths, tables};
-use sunlit::map::planning::gb50180::{Gb50180Rule, StandardDay};
+use sunlit::map::planning::gb50180::Gb50180Rule;
 use sunlit::map::planning::window_points::WindowPoint;
 use sunlit::map::planning::{mask, run};
 use sunlit::map::{Points, Site};
@@ -62,18 +62,7 @@ fn check_options(args: &MapArgs) -> Result<()> {
     if !gb && let Some((flag, _)) = gb_only.iter().find(|(_, given)| *given) {
         return Err(Error::argument(*flag, format!("{names} does not take it: only gb50180 does")));
     }
-    if let Some(model) = &args.sky_model {
-        let vsc = args.study.iter().any(|s| s == "bre-vsc");
-        if !vsc {
-            return Err(Error::argument("--sky-model", format!("{names} counts the sun alone and takes no sky model")));
-        }
-        if model != "cie-overcast" {
-            return Err(Error::argument(
-                "--sky-model",
-                format!("'{model}': bre-vsc is defined under the CIE standard overcast sky and takes only cie-overcast"),
-            ));
-        }
-    }
+    run::check_sky_model(&args.study, args.sky_model.as_deref())?;
     if args.study.iter().any(|s| s == "bre-apsh") && args.epw.is_none() {
         return Err(Error::argument(
             "--epw",
@@ -93,18 +82,7 @@ fn check_options(args: &MapArgs) -> Result<()> {
 }
 
 fn gb_rule(args: &MapArgs) -> Result<Gb50180Rule> {
-    let day = StandardDay::parse(args.day.as_deref().unwrap_or("dahan"))?;
-    let mut rule = Gb50180Rule::new(day);
-    if let Some(h) = args.required_hours {
-        rule.required_hours = h;
-    }
-    if let Some(m) = args.min_period {
-        rule.min_period_minutes = m;
-    }
-    rule.max_periods = args.max_periods;
-    rule.whole_window = args.window_width;
-    rule.check()?;
-    Ok(rule)
+    Gb50180Rule::from_options(args.day.as_deref(), args.required_hours, args.min_period, args.max_periods, args.window_width)
 }
 
 /// The 1-based rows `--mask` asks diagrams for (`all`, or a comma list), as 0-based indices.

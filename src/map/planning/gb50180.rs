@@ -130,6 +130,28 @@ impl Gb50180Rule {
         Self { day, required_hours: day.default_hours(), min_period_minutes: 0.0, max_periods: None, whole_window: None }
     }
 
+    /// The rule as asked: `day` (default 大寒日, by [`StandardDay::parse`]), then each local
+    /// addition given, checked ([`Self::check`]); what the edges (`--day`…, `day`…) hand in.
+    pub fn from_options(
+        day: Option<&str>,
+        required_hours: Option<f64>,
+        min_period_minutes: Option<f64>,
+        max_periods: Option<usize>,
+        whole_window: Option<f64>,
+    ) -> Result<Self> {
+        let mut rule = Self::new(StandardDay::parse(day.unwrap_or("dahan"))?);
+        if let Some(h) = required_hours {
+            rule.required_hours = h;
+        }
+        if let Some(m) = min_period_minutes {
+            rule.min_period_minutes = m;
+        }
+        rule.max_periods = max_periods;
+        rule.whole_window = whole_window;
+        rule.check()?;
+        Ok(rule)
+    }
+
     /// Refuses parameters outside their sense, naming them.
     pub fn check(&self) -> Result<()> {
         if !(self.required_hours.is_finite() && self.required_hours > 0.0 && self.required_hours <= 8.0) {

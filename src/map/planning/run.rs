@@ -12,6 +12,22 @@ use crate::scene::Scene;
 /// The window studies' names.
 pub const STUDIES: [&str; 5] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg"];
 
+/// Refuses a sky model the studies do not take, naming `sky_model`: only bre-vsc looks at the
+/// sky, and it is defined under the CIE standard overcast sky; the others count the sun alone.
+pub fn check_sky_model(studies: &[String], sky_model: Option<&str>) -> Result<()> {
+    let Some(model) = sky_model else { return Ok(()) };
+    if !studies.iter().any(|s| s == "bre-vsc") {
+        return Err(Error::argument("sky_model", format!("{} counts the sun alone and takes no sky model", studies.join(", "))));
+    }
+    if model != "cie-overcast" {
+        return Err(Error::argument(
+            "sky_model",
+            format!("'{model}': bre-vsc is defined under the CIE standard overcast sky and takes only cie-overcast"),
+        ));
+    }
+    Ok(())
+}
+
 /// One scene's values per study asked ([`STUDIES`]' names).
 #[derive(Default)]
 pub struct StudyValues {

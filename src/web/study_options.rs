@@ -1,0 +1,170 @@
+//! `engine.study`'s options object (`StudyOptions` in `www/sunlit.d.ts`) read into the library's
+//! terms: which window studies ([`run::STUDIES`]), where (the windows' own points, found by
+//! [`WindowPoint`], or given points), the site (a location or an EPW), GB 50180's rule
+//! ([`Gb50180Rule::from_options`]) and the sky model ([`run::check_sky_model`]). The studies
+//! themselves are the library's ([`crate::map::planning::run`]); this only reads names. Plain
+//! JSON in, so it is tested natively too (`js_api`).
+
+use serde_json::{Map, Value};
+
+use crate::error::{Error, Result};
+use crate::map::planning::gb50180::Gb50180Rule;
+use crate::map::planning::run;
+use crate::map::planning::window_points::WindowPoint;
+use crate::sun::location::Location;
+use crate::sun::weather::Weather;
+
+/// The keys of the options object.
+pub const STUDY_KEYS: [&str; 15] = [
+    "study",
+    "windows",
+    "windowPoints",
+    "points",
+    "latitude",
+    "longitude",
+    "timeZone",
+    "epw",
+    "epwName",
+    "skyModel",
+    "day",
+    "requiredHours",
+    "minPeriod",
+    "maxPeriods",
+    "windowWidth",
+];
+
+/// GB 50180's own keys: refused beside the other studies, as `sunlit map` refuses `--day`….
+const GB_KEYS: [&str; 5] = ["day", "requiredHours", "minPeriod", "maxPeriods", "windowWidth"];
+
+/// Where the studies' points are.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StudyPlace {
+    /// One point on each of these receivers (indices into the model's receivers), as
+    /// `sunlit map --window-points` puts it.
+    Windows(Vec<u32>, WindowPoint),
+    /// Given points, 6 numbers each (x y z nx ny nz).
+    Given(Vec<f64>),
+}
+
+/// A study request read from the JS options.
+pub struct StudyRequest {
+    /// The window studies asked, in order.
+    pub studies: Vec<String>,
+    /// Where the points are.
+    pub place: StudyPlace,
+    /// The site (none given: only the studies that need none can run).
+    pub location: Option<Location>,
+    /// The EPW's hours, for bre-apsh.
+    pub weather: Option<Weather>,
+    /// GB 50180's rule, when gb50180 is asked.
+    pub gb: Option<Gb50180Rule>,
+}
+
+impl StudyRequest {
+    /// The options object (as JSON), checked: the studies' names, where, the site, the rule.
+    pub fn from_value(options: Value) -> Result<Self> {
+        let Value::Object(all) = options else {
+            return Err(Error::argument("options", "give an object with at least a study and the windows (or points)"));
+        };
+        if let Some(key) = all.keys().find(|k| !STUDY_KEYS.contains(&k.as_str())) {
+            return Err(Error::argument("options", format!("'{key}' is not a study option ({})", STUDY_KEYS.join(", "))));
+        }
+        let studies = studies(all.get("study"))?;
+        let gb = studies.iter().any(|s| s == "gb50180");
+        if !gb && let Some(key) = GB_KEYS.iter().find(|k| all.contains_key(**k)) {
+            return Err(Error::argument(*key, format!("{} does not take it: only gb50180 does", studies.join(", "))));
+        }
+        run::check_sky_model(&studies, text_of(&all, "skyModel")?.as_deref())?;
+        let place = place(&all)?;
+        let weather = match text_of(&all, "epw")? {
+            Some(text) => Some(Weather::from_epw_text(text_of(&all, "epwName")?.as_deref().unwrap_or("EPW"), &text)?),
+            None => None,
+        };
+        let location = match (&weather, number(&all, "latitude")?) {
+            (Some(w), _) => Some(w.location.clone()),
+            (None, Some(latitude)) => {
+                let coordinate =
+                    |key: &str| number(&all, key)?.ok_or_else(|| Error::argument(key, "give latitude, longitude and timeZone"));
+                Some(Location::new(latitude, coordinate("longitude")?, coordinate("timeZone")?)?)
+            }
+            (None, None) => None,
+        };
+        let gb = gb
+            .then(|| {
+                let max_periods = match number(&all, "maxPeriods")? {
+                    Some(n) if n >= 0.0 && n.fract() == 0.0 => Some(n as usize),
+                    Some(n) => return Err(Error::argument("max_periods", format!("{n} is not a whole number"))),
+                    None => None,
+                };
+                Gb50180Rule::from_options(
+                    text_of(&all, "day")?.as_deref(),
+                    number(&all, "requiredHours")?,
+                    number(&all, "minPeriod")?,
+                    max_periods,
+                    number(&all, "windowWidth")?,
+                )
+            })
+            .transpose()?;
+        Ok(Self { studies, place, location, weather, gb })
+    }
+}
+
+/// `study`: one name or an array of names, each a window study.
+fn studies(value: Option<&Value>) -> Result<Vec<String>> {
+    let names: Vec<String> = match value {
+        None => return Err(Error::argument("study", format!("give one of {}", run::STUDIES.join(", ")))),
+        Some(Value::String(name)) => vec![name.clone()],
+        Some(Value::Array(names)) => names
+            .iter()
+            .map(|n| n.as_str().map(String::from).ok_or_else(|| Error::argument("study", format!("{n} is not a study's name"))))
+            .collect::<Result<_>>()?,
+        Some(other) => return Err(Error::argument("study", format!("{other} is not a study's name or an array of them"))),
+    };
+    if names.is_empty() {
+        return Err(Error::argument("study", format!("no study asked: give one of {}", run::STUDIES.join(", "))));
+    }
+    if let Some(other) = names.iter().find(|s| !run::STUDIES.contains(&s.as_str())) {
+        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", run::STUDIES.join(", "))));
+    }
+    Ok(names)
+}
+
+/// `windows` (with `windowPoints`) or `points`: one of them, not empty.
+fn place(all: &Map<String, Value>) -> Result<StudyPlace> {
+    let at = text_of(all, "windowPoints")?;
+    match (all.get("windows"), all.get("points")) {
+        (Some(_), Some(_)) => Err(Error::argument("points", "give windows or points, not both")),
+        (None, Some(points)) => {
+            if at.is_some() {
+                return Err(Error::argument("window_points", "puts a point on each of `windows`: give windows, not points"));
+            }
+            let numbers: Vec<f64> =
+                serde_json::from_value(points.clone()).map_err(|_| Error::argument("points", "must be an array of numbers"))?;
+            if numbers.is_empty() {
+                return Err(Error::argument("points", "no point given: give 6 numbers a point (x, y, z, nx, ny, nz)"));
+            }
+            Ok(StudyPlace::Given(numbers))
+        }
+        (windows, None) => {
+            let ids: Vec<u32> = match windows {
+                Some(w) => serde_json::from_value(w.clone())
+                    .map_err(|_| Error::argument("windows", "must be an array of receiver indices (whole numbers from 0)"))?,
+                None => Vec::new(),
+            };
+            if ids.is_empty() {
+                return Err(Error::argument("windows", "no window selected: select at least one window (a receiver) or give points"));
+            }
+            Ok(StudyPlace::Windows(ids, WindowPoint::parse(at.as_deref().unwrap_or("centre"))?))
+        }
+    }
+}
+
+/// A number option, if given.
+fn number(all: &Map<String, Value>, key: &str) -> Result<Option<f64>> {
+    all.get(key).map(|v| v.as_f64().ok_or_else(|| Error::argument(key, format!("{v} is not a number")))).transpose()
+}
+
+/// A text option, if given.
+fn text_of(all: &Map<String, Value>, key: &str) -> Result<Option<String>> {
+    all.get(key).map(|v| v.as_str().map(String::from).ok_or_else(|| Error::argument(key, format!("{v} is not text")))).transpose()
+}

@@ -1,0 +1,190 @@
+// The page's Study mode: planning rules per window (engine.study, run by the worker): a rule, a
+// point on each ticked window (a receiver), GB 50180's parameters; the results as a table per
+// window and the windows coloured pass/fail in the 3D view; the study's CSV to download, as
+// `sunlit map --study NAME` writes POINTS.study-NAME.csv (the library's own writer). Nothing here
+// decides a rule: the options are handed on as the user set them, and the library refuses what
+// is wrong (no window ticked, a sky the rule does not take) naming the option.
+import { UNCOMPUTED } from './colour.js';
+
+/** A window that passes, fails, or is not assessed by the rule. */
+export const PASS = [0.2, 0.66, 0.32];
+export const FAIL = [0.84, 0.2, 0.17];
+export const NOT_ASSESSED = [0.55, 0.55, 0.58];
+
+/**
+ * Wires the Study mode's controls. `page`: { $, worker, status, location() (the form's location
+ * as StudyOptions keys), skyModel() (the sky control's value, '' for the default), engineOptions(),
+ * viewer() (the 3D view, its model set, or null), showLegend({ max, title, tick }), setBusy(busy), download(name, text, type),
+ * modelName(), names() (the model's receiver names) }.
+ */
+export function studyMode(page) {
+  const { $ } = page;
+  const state = { study: null, asked: null };
+
+  const mode = () => $('mode').value;
+
+  function showFields() {
+    const study = mode() === 'study';
+    $('studyfields').hidden = !study;
+    for (const el of document.querySelectorAll('[data-study]')) el.hidden = !el.dataset.study.split(' ').includes($('study').value);
+    if (study) $('compute').textContent = 'Run study';
+    $('studywrap').hidden = !study || !state.study;
+    recolour();
+  }
+
+  /** The 3D view's receivers: each studied window by its verdict, the others uncomputed. */
+  function recolour() {
+    if (mode() !== 'study') return;
+    page.showLegend({ max: 1, title: 'Study per window (green: passes, red: fails, grey: not assessed)', tick: () => '' });
+    const verdicts = state.study ? verdictsByReceiver(state.study) : new Map();
+    // What the view paints, for a reader (and the tests): each studied window's verdict.
+    $('view').dataset.verdicts = [...verdicts].map(([r, v]) => `${page.names()[r]}:${v}`).join(',');
+    const viewer = page.viewer();
+    if (!viewer) return;
+    viewer.setColours((r) => {
+      const v = verdicts.get(r);
+      return v === undefined ? UNCOMPUTED : v === true ? PASS : v === false ? FAIL : NOT_ASSESSED;
+    });
+  }
+
+  /** Each studied receiver's verdict: true if all its points pass, false if one fails, null if
+   * none is assessed (as the report's `areas`). */
+  function verdictsByReceiver({ receivers, tables }) {
+    const passes = tables[0].passes;
+    const out = new Map();
+    receivers.forEach((r, i) => {
+      const p = passes[i];
+      const was = out.get(r);
+      if (p === null) out.set(r, was ?? null);
+      else out.set(r, was === false ? false : p);
+    });
+    return out;
+  }
+
+  /** The ticked windows' receiver indices, in the model's order. */
+  function windows() {
+    return [...$('studywindows').querySelectorAll('input:checked')].map((el) => Number(el.value));
+  }
+
+  async function options() {
+    const o = { ...(await page.location()), study: $('study').value, windows: windows(), windowPoints: $('windowpoints').value };
+    const sky = page.skyModel();
+    if (sky) o.skyModel = sky;
+    if (o.study === 'gb50180') {
+      o.day = $('gbday').value;
+      for (const [id, key] of [['gbhours', 'requiredHours'], ['gbminperiod', 'minPeriod'], ['gbmaxperiods', 'maxPeriods'], ['gbwidth', 'windowWidth']]) {
+        if ($(id).value.trim() !== '') o[key] = Number($(id).value);
+      }
+    }
+    return o;
+  }
+
+  /** Forgets the last study: its table, colours and download (a new study, a failed one, a new
+   * model), so no download is ever of another study than the one shown. */
+  function clear() {
+    state.study = null;
+    state.asked = null;
+    $('downloadstudy').disabled = true;
+    $('studytable').tHead.replaceChildren();
+    $('studytable').tBodies[0].replaceChildren();
+    $('studytable').removeAttribute('data-verdicts');
+    showFields();
+  }
+
+  async function compute() {
+    clear();
+    page.worker.postMessage({ type: 'study', options: await options(), engine: page.engineOptions() });
+  }
+
+  function shown({ study, seconds }) {
+    page.setBusy(false);
+    state.study = study;
+    fillTable(study);
+    $('downloadstudy').disabled = false;
+    showFields();
+    const t = study.tables[0];
+    const count = (v) => t.passes.filter((p) => p === v).length;
+    const na = count(null) ? `, ${count(null)} not assessed` : '';
+    page.status(`Study ${t.study} in ${seconds.toFixed(1)} s: ${t.passes.length} windows, ${count(true)} pass, ${count(false)} fail${na}.`);
+  }
+
+  function fillTable({ receivers, tables }) {
+    const table = tables[0];
+    const names = page.names();
+    const keys = Object.keys(table.values);
+    const head = $('studytable').tHead.insertRow();
+    for (const title of ['Window', ...keys, 'Result']) {
+      const th = document.createElement('th');
+      th.scope = 'col';
+      th.textContent = title;
+      head.append(th);
+    }
+    const body = $('studytable').tBodies[0];
+    const verdicts = [];
+    receivers.forEach((r, i) => {
+      const row = body.insertRow();
+      const pass = table.passes[i];
+      row.className = pass === null ? 'na' : pass ? 'pass' : 'fail';
+      // textContent, never innerHTML: names come from the user's file.
+      row.insertCell().textContent = names[r];
+      for (const key of keys) {
+        const cell = row.insertCell();
+        cell.textContent = table.values[key][i].toFixed(2);
+        cell.className = 'num';
+      }
+      const verdict = row.insertCell();
+      verdict.className = 'verdict';
+      verdict.textContent = pass === null ? 'not assessed' : pass ? 'passes' : 'fails';
+      verdicts.push(verdict.textContent);
+    });
+    $('studycaption').textContent = `${table.study}: ${table.source}`;
+    $('studytable').dataset.verdicts = verdicts.join(',');
+  }
+
+  /** The model's receivers as windows to tick (none ticked: the user picks them). */
+  function listWindows(names) {
+    const boxes = names.map((name, i) => {
+      const label = document.createElement('label');
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.value = String(i);
+      label.append(box, ` ${name}`);
+      return label;
+    });
+    $('studywindows').replaceChildren(...boxes);
+  }
+
+  function wire() {
+    for (const id of ['mode', 'study']) $(id).addEventListener('change', showFields);
+    // GB 50180 counts at the sill, BRE at the window's centre: the picker follows the rule.
+    $('study').addEventListener('change', () => {
+      $('windowpoints').value = $('study').value === 'gb50180' ? 'sill' : 'centre';
+    });
+    const tickAll = (on) => {
+      for (const box of $('studywindows').querySelectorAll('input')) box.checked = on;
+    };
+    $('studyall').addEventListener('click', () => tickAll(true));
+    $('studynone').addEventListener('click', () => tickAll(false));
+    $('downloadstudy').addEventListener('click', () => {
+      if (!state.study) return;
+      const name = state.study.tables[0].study;
+      const base = page.modelName().replace(/\.[^.]*$/, '') || 'model';
+      page.download(`${base}.study-${name}.csv`, state.study.csv[name], 'text/csv');
+    });
+    showFields();
+  }
+
+  return {
+    wire,
+    active: () => mode() === 'study',
+    compute,
+    shown,
+    failed: clear,
+    recolour,
+    /** A new model: its windows to tick, and no study. */
+    reset(names) {
+      listWindows(names ?? []);
+      clear();
+    },
+  };
+}
