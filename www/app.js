@@ -16,43 +16,41 @@ function status(text, { error = false } = {}) {
   $('status').classList.toggle('error', error);
 }
 
-const maps = mapMode({
+/** The form's site as map and study options take it: the EPW, or the three numbers. */
+async function site() {
+  const { latitude, longitude, timeZone, epw, epwName } = await settings();
+  return epw ? { epw, epwName } : { latitude, longitude, timeZone };
+}
+
+/** What the Map and Study modes share of the page. */
+const modeHooks = {
   $,
   worker,
   status: (text) => status(text),
-  location: async () => {
-    const { latitude, longitude, timeZone, epw, epwName } = await settings();
-    return epw ? { epw, epwName } : { latitude, longitude, timeZone };
-  },
+  location: () => site(),
   skyModel: () => $('skymodel').value,
   engineOptions: () => engineOptions(),
-  viewer: () => state.viewer,
-  showLegend: (scale) => showLegend(scale ?? colourScale()),
   setBusy: (busy) => setBusy(busy),
-  busy: () => state.busy,
   download: (...args) => download(...args),
   modelName: () => state.modelName,
+};
+
+const maps = mapMode({
+  ...modeHooks,
+  viewer: () => state.viewer,
+  showLegend: (scale) => showLegend(scale ?? colourScale()),
+  busy: () => state.busy,
 });
 
 const studies = studyMode({
-  $,
-  worker,
-  status: (text) => status(text),
-  location: async () => {
-    const { latitude, longitude, timeZone, epw, epwName } = await settings();
-    return epw ? { epw, epwName } : { latitude, longitude, timeZone };
-  },
-  skyModel: () => $('skymodel').value,
-  engineOptions: () => engineOptions(),
+  ...modeHooks,
+  // The view paints receivers: it needs the model even before a year was coloured.
   viewer: () => {
     const { viewer, model } = state;
     if (viewer && model && viewer.positions !== model.positions) viewer.setModel(model.positions, model.receivers);
     return viewer;
   },
   showLegend: (scale) => showLegend(scale),
-  setBusy: (busy) => setBusy(busy),
-  download: (...args) => download(...args),
-  modelName: () => state.modelName,
   names: () => state.model?.names ?? [],
 });
 

@@ -379,11 +379,11 @@ class SunlitEngine {
   async study(model, options) {
     const study = this.#engine.study(model, options);
     try {
-      const tables = JSON.parse(study.tablesJson());
+      const { points, normals, receivers, tables } = JSON.parse(study.json());
       return {
-        points: study.points,
-        normals: study.normals,
-        receivers: study.receivers,
+        points: Float32Array.from(points),
+        normals: Float32Array.from(normals),
+        receivers: Uint32Array.from(receivers),
         tables,
         csv: Object.fromEntries(tables.map((t) => [t.study, study.csv(t.study)])),
       };

@@ -5,7 +5,6 @@
 //! library's writers', so a study's CSV is `sunlit map`'s `POINTS.study-NAME.csv` byte for byte.
 //! No study logic lives here or in JS.
 
-use js_sys::{Float32Array, Uint32Array};
 use serde_json::json;
 use wasm_bindgen::prelude::*;
 
@@ -32,45 +31,30 @@ pub struct Study {
 
 #[wasm_bindgen]
 impl Study {
-    /// x y z per point (world axes: x east, y north, z up).
-    #[wasm_bindgen(getter)]
-    pub fn points(&self) -> Float32Array {
-        Float32Array::from(self.points.positions.as_slice())
-    }
-
-    /// The outward unit normal per point.
-    #[wasm_bindgen(getter)]
-    pub fn normals(&self) -> Float32Array {
-        Float32Array::from(self.points.normals.as_slice())
-    }
-
-    /// The receiver (index into `receiverNames`) per point.
-    #[wasm_bindgen(getter)]
-    pub fn receivers(&self) -> Uint32Array {
-        Uint32Array::from(self.points.receivers.as_slice())
-    }
-
-    /// The tables as JSON text (sunlit.js parses it): per study asked, `study`, `source`,
-    /// `rule`, `values` (per key, per point), `passes` (per point: true, false, or null where
-    /// the rule does not assess it) and `verdicts` (per verdict key, per point).
-    #[wasm_bindgen(js_name = tablesJson)]
-    pub fn tables_json(&self) -> String {
+    /// The answer as JSON text (sunlit.js parses it into `SunlitStudy`'s typed arrays and
+    /// tables): `points` and `normals` (3 numbers a point, the f32 values exactly), `receivers`,
+    /// and per study asked `study`, `source`, `rule`, `values` (per key, per point), `passes`
+    /// (per point: true, false, or null where the rule does not assess it) and `verdicts` (per
+    /// verdict key, per point).
+    pub fn json(&self) -> String {
         let n = self.points.len();
         let tables: Vec<_> = self
             .tables
             .iter()
             .map(|t| {
+                let verdicts = t.verdicts.iter().map(|(k, v)| (k.clone(), json!(v.iter().map(|x| x.passes).collect::<Vec<_>>())));
                 json!({
                     "study": t.study,
                     "source": t.source,
                     "rule": t.rule,
                     "values": t.values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
                     "passes": (0..n).map(|i| t.passes(i)).collect::<Vec<_>>(),
-                    "verdicts": t.verdicts.iter().map(|(k, v)| (k.clone(), json!(v.iter().map(|x| x.passes).collect::<Vec<_>>()))).collect::<serde_json::Map<_, _>>(),
+                    "verdicts": verdicts.collect::<serde_json::Map<_, _>>(),
                 })
             })
             .collect();
-        json!(tables).to_string()
+        let p = &self.points;
+        json!({"points": p.positions, "normals": p.normals, "receivers": p.receivers, "tables": tables}).to_string()
     }
 
     /// `study`'s table as `sunlit map --study STUDY` writes `POINTS.study-STUDY.csv`.

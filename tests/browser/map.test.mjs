@@ -6,37 +6,26 @@
 // arrays, its direct irradiation under an EPW equals the CLI's, and bad options are refused naming
 // the option. The map is saved to target/artifacts/map.png for a person to look at.
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { fileURLToPath } from 'node:url';
-import { serve } from '../../scripts/serve.mjs';
-import { launch } from './chromium.mjs';
+import { ROOT, closePage, downloadText, servePage, statusAfter as statusAfterOn, sunlit, waitForStatus as statusIs } from './pagetest.mjs';
 import { SYDNEY, syntheticEpw } from './epw.mjs';
 
-const ROOT = fileURLToPath(new URL('../../', import.meta.url));
 const EXAMPLE = join(ROOT, 'www/pkg/office.glb');
 const ARTIFACTS = join(ROOT, 'target/artifacts');
 const WORK = join(tmpdir(), `sunlit-map-${process.pid}`);
 const LOCATION = { latitude: '39.74', longitude: '-105.18', timezone: '-7' };
 const GRID = '1';
 
-let server;
-let origin;
-let browser;
+let served;
 let page;
-const pageErrors = [];
+let pageErrors;
 
 before(async () => {
-  mkdirSync(WORK, { recursive: true });
-  mkdirSync(ARTIFACTS, { recursive: true });
-  server = await serve(0);
-  origin = `http://127.0.0.1:${server.address().port}`;
-  browser = await launch();
-  page = await (await browser.newContext({ acceptDownloads: true })).newPage();
-  page.on('pageerror', (e) => pageErrors.push(e.message));
+  served = await servePage(WORK);
+  ({ page, pageErrors } = served);
   // Records what the page's worker sends back for maps: a map's answer, and a map's file.
   await page.addInitScript(() => {
     const PageWorker = globalThis.Worker;
@@ -51,38 +40,19 @@ before(async () => {
       }
     };
   });
-  await page.goto(`${origin}/`);
+  await page.goto(`${served.origin}/`);
   await waitForStatus(/^Ready/);
 });
 
-after(async () => {
-  await browser?.close();
-  server?.close();
-  rmSync(WORK, { recursive: true, force: true });
-});
+after(() => closePage(served, WORK));
 
-async function waitForStatus(pattern, timeout = 120_000) {
-  await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent), pattern.source, { timeout });
-  return page.textContent('#status');
-}
-
-async function statusAfter(action, pattern, timeout) {
-  await page.evaluate(() => {
-    document.getElementById('status').textContent = '';
-  });
-  await action();
-  return waitForStatus(pattern, timeout);
-}
+const waitForStatus = (pattern, timeout) => statusIs(page, pattern, timeout);
+const statusAfter = (action, pattern, timeout) => statusAfterOn(page, action, pattern, timeout);
 
 /** `sunlit map` on the example office; its points CSV as text. */
 function nativeMap(name, args) {
   const out = join(WORK, `${name}.csv`);
-  // The CLI `cargo test` built (as the npm package test uses it).
-  execFileSync(join(ROOT, 'target/debug/sunlit'), ['map', EXAMPLE, '--grid', GRID, ...args, '-o', out], {
-    cwd: ROOT,
-    stdio: ['ignore', 'ignore', 'inherit'],
-    env: { ...process.env, XDG_RUNTIME_DIR: WORK },
-  });
+  sunlit(['map', EXAMPLE, '--grid', GRID, ...args, '-o', out], WORK);
   return readFileSync(out, 'utf8');
 }
 
@@ -115,11 +85,7 @@ function compare(webText, nativeText, tolerance) {
 }
 
 async function downloadMap(name) {
-  const download = page.waitForEvent('download');
-  await page.click('#downloadmap');
-  const file = join(WORK, name);
-  await (await download).saveAs(file);
-  return readFileSync(file, 'utf8');
+  return (await downloadText(page, '#downloadmap', join(WORK, name))).text;
 }
 
 /** The worker's map replies since the last call. */

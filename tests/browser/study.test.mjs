@@ -6,75 +6,38 @@
 // window ticked, or with a sky the rule does not take, is refused naming the option, and leaves
 // nothing to download. The view is saved to target/artifacts/study.png for a person to look at.
 import assert from 'node:assert/strict';
-import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { fileURLToPath } from 'node:url';
-import { serve } from '../../scripts/serve.mjs';
-import { launch } from './chromium.mjs';
+import { ROOT, closePage, downloadText, servePage, statusAfter, sunlit, waitForStatus } from './pagetest.mjs';
 import { GOLDEN, syntheticEpw } from './epw.mjs';
 
-const ROOT = fileURLToPath(new URL('../../', import.meta.url));
 const EXAMPLE = join(ROOT, 'www/pkg/office.glb');
 const ARTIFACTS = join(ROOT, 'target/artifacts');
 const WORK = join(tmpdir(), `sunlit-study-${process.pid}`);
 const BEIJING = { latitude: '39.9', longitude: '116.4', timezone: '8' };
 
-let server;
-let browser;
+let served;
 let page;
-const pageErrors = [];
+let pageErrors;
 
 before(async () => {
-  mkdirSync(WORK, { recursive: true });
-  mkdirSync(ARTIFACTS, { recursive: true });
-  server = await serve(0);
-  browser = await launch();
-  page = await (await browser.newContext({ acceptDownloads: true })).newPage();
-  page.on('pageerror', (e) => pageErrors.push(e.message));
-  await page.goto(`http://127.0.0.1:${server.address().port}/`);
-  await waitForStatus(/^Ready/);
+  served = await servePage(WORK);
+  ({ page, pageErrors } = served);
+  await page.goto(`${served.origin}/`);
+  await waitForStatus(page, /^Ready/);
 });
 
-after(async () => {
-  await browser?.close();
-  server?.close();
-  rmSync(WORK, { recursive: true, force: true });
-});
+after(() => closePage(served, WORK));
 
-async function waitForStatus(pattern, timeout = 120_000) {
-  await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent), pattern.source, { timeout });
-  return page.textContent('#status');
-}
+const downloaded = (button, name) => downloadText(page, button, join(WORK, name));
 
-async function statusAfter(action, pattern, timeout) {
-  await page.evaluate(() => {
-    document.getElementById('status').textContent = '';
-  });
-  await action();
-  return waitForStatus(pattern, timeout);
-}
-
-/** `sunlit map` on the example office (the CLI `cargo test` built); `read(suffix)` reads one of
- * the files it wrote beside `NAME.csv`. */
+/** `sunlit map` on the example office; `read(suffix)` reads one of the files it wrote beside
+ * `NAME.csv`. */
 function cli(name, args) {
-  const out = join(WORK, `${name}.csv`);
-  execFileSync(join(ROOT, 'target/debug/sunlit'), ['map', EXAMPLE, ...args, '-o', out], {
-    cwd: ROOT,
-    stdio: ['ignore', 'ignore', 'inherit'],
-    env: { ...process.env, XDG_RUNTIME_DIR: WORK },
-  });
+  sunlit(['map', EXAMPLE, ...args, '-o', join(WORK, `${name}.csv`)], WORK);
   return (suffix = '') => readFileSync(join(WORK, `${name}${suffix}.csv`), 'utf8');
-}
-
-async function downloaded(button, name) {
-  const download = page.waitForEvent('download');
-  await page.click(button);
-  const file = join(WORK, name);
-  await (await download).saveAs(file);
-  return { name: (await download).suggestedFilename(), text: readFileSync(file, 'utf8') };
 }
 
 /** Ticks exactly the windows named. */
@@ -94,7 +57,7 @@ function verdictsOf(csv) {
 
 test('the Study mode: gb50180 at the sills and bre-vsc at the centres of ticked windows; the CSV is `sunlit map --study`\'s, byte for byte', { timeout: 300_000 }, async () => {
   await page.fill('#receivers', 'WIN_*');
-  assert.match(await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb \(5 receivers\)/);
+  assert.match(await statusAfter(page, () => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb \(5 receivers\)/);
   await page.fill('#latitude', BEIJING.latitude);
   await page.fill('#longitude', BEIJING.longitude);
   await page.fill('#timezone', BEIJING.timezone);
@@ -105,7 +68,7 @@ test('the Study mode: gb50180 at the sills and bre-vsc at the centres of ticked 
   assert.equal(await page.inputValue('#windowpoints'), 'sill', 'GB 50180 counts at the sill');
   assert.equal(await page.isVisible('#gbday'), true);
   await page.click('#studyall');
-  const status = await statusAfter(() => page.click('#compute'), /^Study|^Could not/, 120_000);
+  const status = await statusAfter(page, () => page.click('#compute'), /^Study|^Could not/, 120_000);
   assert.match(status, /^Study gb50180 in [\d.]+ s: 5 windows, \d+ pass, \d+ fail\.$/);
   const gb = await downloaded('#downloadstudy', 'gb.csv');
   assert.equal(gb.name, 'office.study-gb50180.csv');
@@ -131,7 +94,7 @@ test('the Study mode: gb50180 at the sills and bre-vsc at the centres of ticked 
   assert.equal(await page.inputValue('#windowpoints'), 'centre');
   await page.selectOption('#skymodel', 'cie-overcast');
   await tick(['WIN_S1', 'WIN_S2']);
-  assert.match(await statusAfter(() => page.click('#compute'), /^Study|^Could not/, 120_000), /^Study bre-vsc in [\d.]+ s: 2 windows/);
+  assert.match(await statusAfter(page, () => page.click('#compute'), /^Study|^Could not/, 120_000), /^Study bre-vsc in [\d.]+ s: 2 windows/);
   const vsc = await downloaded('#downloadstudy', 'vsc.csv');
   const nativeVsc = cli('vsc', ['--receivers', 'WIN_S*', '--window-points', 'centre', '--study', 'bre-vsc', '--sky-model', 'cie-overcast']);
   assert.equal(vsc.text, nativeVsc('.study-bre-vsc'));
@@ -144,17 +107,17 @@ test('bad input: no window ticked, or a sky bre-vsc does not take, is refused na
   await page.selectOption('#mode', 'study');
   await page.selectOption('#study', 'bre-vsc');
   await page.click('#studyall');
-  assert.match(await statusAfter(() => page.click('#compute'), /^Study|^Could not/, 120_000), /^Study bre-vsc/);
+  assert.match(await statusAfter(page, () => page.click('#compute'), /^Study|^Could not/, 120_000), /^Study bre-vsc/);
   assert.equal(await page.isDisabled('#downloadstudy'), false);
   let downloads = 0;
   page.on('download', () => downloads++);
 
   await page.click('#studynone');
-  const none = await statusAfter(() => page.click('#compute'), /^Study|^Could not/, 120_000);
+  const none = await statusAfter(page, () => page.click('#compute'), /^Study|^Could not/, 120_000);
   assert.match(none, /^Could not run the study: invalid windows: no window selected/);
   await page.selectOption('#skymodel', 'perez-all-weather');
   await page.click('#studyall');
-  const sky = await statusAfter(() => page.click('#compute'), /^Study|^Could not/, 120_000);
+  const sky = await statusAfter(page, () => page.click('#compute'), /^Study|^Could not/, 120_000);
   assert.match(sky, /^Could not run the study: invalid skyModel: 'perez-all-weather': bre-vsc is defined under the CIE standard overcast sky/);
   await page.selectOption('#skymodel', '');
   const left = await page.evaluate(() => ({
@@ -204,7 +167,7 @@ test('the sky model control: a day\'s total irradiation map under perez-all-weat
   const maps = {};
   for (const sky of ['perez-all-weather', '']) {
     await page.selectOption('#skymodel', sky);
-    assert.match(await statusAfter(() => page.click('#compute'), /^Map in|^Could not/, 300_000), /^Map in [\d.]+ s/);
+    assert.match(await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 300_000), /^Map in [\d.]+ s/);
     const { text } = await downloaded('#downloadmap', `sky-${sky || 'default'}.csv`);
     const native = cli(`sky-${sky || 'default'}`, [...day, ...(sky ? ['--sky-model', sky] : [])])();
     maps[sky || 'default'] = sameMap(text, native);

@@ -1,0 +1,64 @@
+// What the page's browser tests share: the page's status line awaited, a download saved and
+// read, and the native CLI (the one `cargo test` built) run on the same model, its output read.
+import { execFileSync } from 'node:child_process';
+import { mkdirSync, readFileSync, rmSync } from 'node:fs';
+import { join } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { serve } from '../../scripts/serve.mjs';
+import { launch } from './chromium.mjs';
+
+export const ROOT = fileURLToPath(new URL('../../', import.meta.url));
+
+/** The page served on a free port in headless Chromium, downloads accepted, `work` and
+ * target/artifacts made: { server, origin, browser, page, pageErrors } (the page not yet
+ * opened: add init scripts, then `page.goto(origin + '/')`). */
+export async function servePage(work) {
+  mkdirSync(work, { recursive: true });
+  mkdirSync(join(ROOT, 'target/artifacts'), { recursive: true });
+  const server = await serve(0);
+  const origin = `http://127.0.0.1:${server.address().port}`;
+  const browser = await launch();
+  const page = await (await browser.newContext({ acceptDownloads: true })).newPage();
+  const pageErrors = [];
+  page.on('pageerror', (e) => pageErrors.push(e.message));
+  return { server, origin, browser, page, pageErrors };
+}
+
+/** Closes what [`servePage`] opened and removes `work`. */
+export async function closePage(served, work) {
+  await served?.browser?.close();
+  served?.server?.close();
+  rmSync(work, { recursive: true, force: true });
+}
+
+/** Waits until `page`'s status line matches `pattern`; its text. */
+export async function waitForStatus(page, pattern, timeout = 120_000) {
+  await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent), pattern.source, { timeout });
+  return page.textContent('#status');
+}
+
+/** Clears the status line, does `action`, and waits for a status matching `pattern`. */
+export async function statusAfter(page, action, pattern, timeout) {
+  await page.evaluate(() => {
+    document.getElementById('status').textContent = '';
+  });
+  await action();
+  return waitForStatus(page, pattern, timeout);
+}
+
+/** Clicks `button` and saves the download as `file`: its suggested name and its text. */
+export async function downloadText(page, button, file) {
+  const download = page.waitForEvent('download');
+  await page.click(button);
+  await (await download).saveAs(file);
+  return { name: (await download).suggestedFilename(), text: readFileSync(file, 'utf8') };
+}
+
+/** `sunlit ARGS…` with its scratch in `work` (stderr shown, stdout dropped). */
+export function sunlit(args, work) {
+  execFileSync(join(ROOT, 'target/debug/sunlit'), args, {
+    cwd: ROOT,
+    stdio: ['ignore', 'ignore', 'inherit'],
+    env: { ...process.env, XDG_RUNTIME_DIR: work },
+  });
+}
