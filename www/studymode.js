@@ -26,6 +26,8 @@ export function studyMode(page) {
   function showFields() {
     const study = mode() === 'study';
     $('studyfields').hidden = !study;
+    // The colour bar is a value scale; the windows' colours are verdicts, named in the title.
+    document.querySelector('#legend .bar').hidden = study;
     for (const el of document.querySelectorAll('[data-study]')) el.hidden = !el.dataset.study.split(' ').includes($('study').value);
     if (study) $('compute').textContent = 'Run study';
     $('studywrap').hidden = !study || !state.study;
