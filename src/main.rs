@@ -655,7 +655,11 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     options.timesteps = options.timesteps.leap_year(chosen_year.is_some_and(sunlit::model::run_year::is_leap));
     let timesteps = options.timesteps;
-    let weather_days = weather_days(&args)?;
+    // Read only for shades with schedules: a holidays record nothing uses is no reason to refuse.
+    let weather_days = match &energyplus {
+        Some(ep) if !ep.shades.is_empty() => weather_days(&args)?,
+        _ => None,
+    };
     let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap(), weather: weather_days.as_ref() };
     let varying = match &energyplus {
         Some(ep) => VaryingShades::new(&ep.file, &ep.shades, calendar)?,

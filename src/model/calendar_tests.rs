@@ -83,3 +83,20 @@ fn unreadable_special_days_are_refused() {
     let e = WeatherDays::from_epw_text("w.epw", "L\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,1,Fest,Easter\n").unwrap_err().to_string();
     assert!(e.contains("w.epw") && e.contains("HOLIDAYS/DAYLIGHT SAVINGS") && e.contains("holiday 1 ('Fest')"), "{e}");
 }
+
+/// The same calendar from epJSON: special days and the RunPeriod's switches by their keys.
+#[test]
+fn special_days_from_epjson() {
+    let text = r#"{"RunPeriod": {"R": {"begin_month": 1, "begin_day_of_month": 1, "begin_year": 2017, "end_month": 12,
+        "end_day_of_month": 31, "end_year": 2017, "use_weather_file_holidays_and_special_days": "No",
+        "use_weather_file_daylight_saving_period": "Yes", "apply_weekend_holiday_rule": "Yes"}},
+        "RunPeriodControl:SpecialDays": {"S": {"start_date": "1/21", "duration": 1, "special_day_type": "SummerDesignDay"},
+        "C": {"start_date": "3rd Wednesday in January", "duration": 2, "special_day_type": "CustomDay1"}}}"#;
+    let objects = crate::model::epjson::parse_epjson("m.epJSON", text).unwrap();
+    let calendar = ModelCalendar::read("m.epJSON", &objects).unwrap();
+    let weather = WeatherDays::from_epw_text("w.epw", "L\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,1/17,1/19,1,H,1/20\n").unwrap();
+    let types = calendar.day_types(false, Some(&weather));
+    assert_eq!((types[17], types[18], types[19]), (t("CustomDay1"), t("CustomDay1"), t("Friday")), "no weather holidays");
+    assert_eq!((types[20], types[22]), (t("Saturday"), t("SummerDesignDay")), "the weekend rule");
+    assert!(calendar.saving_days(false, Some(&weather))[16], "the weather file's daylight saving");
+}
