@@ -21,6 +21,7 @@ use sunlit::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use sunlit::count::lanes::{Lane, default_lanes};
 use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
+use sunlit::model::calendar::WeatherDays;
 use sunlit::model::obj::{ObjUnit, ObjUp};
 use sunlit::model::schedule::RunCalendar;
 use sunlit::model::{self, LoadOptions};
@@ -654,7 +655,12 @@ fn annual(args: AnnualArgs) -> Result<()> {
     }
     options.timesteps = options.timesteps.leap_year(chosen_year.is_some_and(sunlit::model::run_year::is_leap));
     let timesteps = options.timesteps;
-    let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap() };
+    // Read only for shades with schedules: a holidays record nothing uses is no reason to refuse.
+    let weather_days = match &energyplus {
+        Some(ep) if !ep.shades.is_empty() => weather_days(&args)?,
+        _ => None,
+    };
+    let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap(), weather: weather_days.as_ref() };
     let varying = match &energyplus {
         Some(ep) => VaryingShades::new(&ep.file, &ep.shades, calendar)?,
         None => None,
@@ -704,7 +710,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let beam_files = match (&beam, energyplus.as_ref(), patched.as_mut()) {
         (Some(plan), Some(ep), Some((_, _, text))) => {
             meter.stage("interior beam", "views");
-            let (csv, objects, notes) = beam_outputs(plan, ep, &settings.location, timesteps)?;
+            let (csv, objects, notes) = beam_outputs(plan, ep, &settings.location, timesteps, periods)?;
             text.push_str(&objects);
             Some((plan.csv.clone(), csv, notes))
         }
@@ -761,6 +767,13 @@ fn site_location(settings: &mut AnnualSettings, energyplus: Option<&model::Energ
     );
     (settings.latitude, settings.longitude, settings.time_zone) = (Some(site.latitude), Some(site.longitude), Some(site.time_zone));
     Ok(())
+}
+
+/// The EPW's holidays and daylight saving period (`--epw`), for the shades' schedules.
+fn weather_days(args: &AnnualArgs) -> Result<Option<WeatherDays>> {
+    let Some(path) = &args.epw else { return Ok(None) };
+    let bytes = std::fs::read(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+    Ok(Some(WeatherDays::from_epw_text(&path.display().to_string(), &String::from_utf8_lossy(&bytes))?))
 }
 
 /// The run's year (`--year`, else the model's RunPeriod, else the EPW's Feb 29), saying which year

@@ -33,6 +33,7 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
+use crate::model::calendar::WeatherDays;
 use crate::model::run_year::{choose, is_leap};
 use crate::model::schedule::RunCalendar;
 use crate::model::shading_update::periodic_update;
@@ -313,7 +314,11 @@ impl Engine {
                     // Shades whose τ changes in time: a year per variant (each such shade opaque
                     // or removed), mixed per timestep; the variants' scenes are not the pool's, so
                     // their exact share is clipped here.
-                    let run = RunCalendar { per_hour: options.timesteps.per_hour(), leap: options.timesteps.is_leap() };
+                    // The weather file's holidays and daylight saving period, as the CLI reads them.
+                    let epw_name = given.epw_name.as_deref().unwrap_or("EPW");
+                    let days = given.epw.as_deref().map(|text| WeatherDays::from_epw_text(epw_name, text)).transpose().map_err(js_error)?;
+                    let run =
+                        RunCalendar { per_hour: options.timesteps.per_hour(), leap: options.timesteps.is_leap(), weather: days.as_ref() };
                     let varying = VaryingShades::new(&ep.file, &ep.shades, run).map_err(js_error)?;
                     let local = choice::Routing::from_js(&JsValue::UNDEFINED).map_err(js_error)?;
                     let mut years = Vec::new();
@@ -379,7 +384,7 @@ fn load_files(
     let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new())) };
     // Which shades vary does not depend on the run's timesteps; their mean τ for the one-scene
     // passes (the sky views) is taken over hourly values.
-    let hourly = RunCalendar { per_hour: 1, leap: false };
+    let hourly = RunCalendar { per_hour: 1, leap: false, weather: None };
     let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new())) };
     let with = |shade_transmittance: Vec<(String, f64)>| load_bytes_all(&files, &LoadOptions { shade_transmittance, ..options.clone() });
     loaded.scene = with(varying.mean_transmittance())?.scene;

@@ -861,4 +861,18 @@ fn shade_transmittance_schedules() {
             &format!("through.idf: Schedule:Compact 'TAU' (line {next}): field 'Through': its dates end on 06/30, not on 12/31"),
         ),
     );
+    // A special day sunlit cannot place would change a schedule's day type for days.
+    let special = |day: &str| with("TAU", &format!("Schedule:Constant, TAU, , 0.5;\nRunPeriodControl:SpecialDays, FEST, {day};\n"));
+    let fest = format!("RunPeriodControl:SpecialDays 'FEST' (line {})", next + 1);
+    for (file, day, why) in [
+        (
+            "special-type.idf",
+            "7/4, 1, Festival",
+            "field 'Special Day Type': 'Festival' is not Holiday, SummerDesignDay, WinterDesignDay, CustomDay1 or CustomDay2",
+        ),
+        ("special-duration.idf", "7/4, 400, Holiday", "field 'Duration': '400' is not a whole number of days from 1 to 366"),
+        ("special-date.idf", "Easter, 1, Holiday", "field 'Start Date': 'Easter' is not a date (M/D, Month D, or Nth Weekday in Month)"),
+    ] {
+        check(file, Case::model(file, special(day), &format!("{file}: {fest}: {why}")));
+    }
 }

@@ -141,7 +141,7 @@ fn l_shaped_zone_beam_per_face_agrees_with_numpy_rays() {
     let rooms = rooms(&ep, None).unwrap();
     let weather = Weather::from_epw_text("two-days.epw", &two_day_epw()).unwrap();
     let timesteps = Timesteps::new(4).unwrap();
-    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, timesteps).unwrap();
+    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, timesteps, None).unwrap();
     assert_eq!(beam.faces.len(), 8, "six walls, floor and roof");
     assert!(beam.skipped.is_empty());
 
@@ -282,7 +282,7 @@ fn interzone_windows_are_skipped_by_name() {
     let ep = load(&idf);
     let rooms = rooms(&ep, None).unwrap();
     let weather = Weather::from_epw_text("two-days.epw", &two_day_epw()).unwrap();
-    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, Timesteps::new(1).unwrap()).unwrap();
+    let beam = interior_beam(&ep, &rooms, &weather, &weather.location, Timesteps::new(1).unwrap(), None).unwrap();
     assert_eq!(beam.skipped, vec!["Through".to_string()]);
     assert!(
         beam.faces.iter().all(|f| f.zone.eq_ignore_ascii_case("Office")),

@@ -10,6 +10,7 @@ use sunlit::export::interior_beam::{interior_beam_csv, interior_beam_objects};
 use sunlit::model::EnergyPlusInput;
 use sunlit::model::inside::{Rooms, rooms};
 use sunlit::sun::location::Location;
+use sunlit::sun::periods::ShadingPeriods;
 use sunlit::sun::weather::Weather;
 use sunlit::year::interior_beam::interior_beam;
 use sunlit::year::samples::Timesteps;
@@ -64,8 +65,9 @@ pub fn beam_outputs(
     ep: &EnergyPlusInput,
     location: &Location,
     timesteps: Timesteps,
+    periods: Option<ShadingPeriods>,
 ) -> Result<(Vec<u8>, String, Vec<String>)> {
-    let beam = interior_beam(ep, &plan.rooms, &plan.weather, location, timesteps)?;
+    let beam = interior_beam(ep, &plan.rooms, &plan.weather, location, timesteps, periods)?;
     let folder = std::fs::canonicalize(plan.csv.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")))
         .map_err(|source| Error::Io { path: plan.csv.clone(), source })?;
     let name = folder.join(plan.csv.file_name().unwrap_or_default()).display().to_string();

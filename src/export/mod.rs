@@ -16,8 +16,7 @@ use glam::DVec3;
 use crate::error::{Error, Result};
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
-use crate::sun::position::sun_direction;
-use crate::year::annual::shading_sun_day;
+use crate::year::annual::shaded_sun;
 use crate::year::samples::Timesteps;
 
 pub mod cadastre;
@@ -60,11 +59,7 @@ impl Schedule {
     /// `CalcPerSolarBeam`), while the weather's own sun (`SOLCOS`) decides whether the sun is up
     /// and places the circumsolar sky.
     pub fn fraction_sun(&self, location: &Location, row: usize) -> DVec3 {
-        let at = self.timesteps.instant(row);
-        match self.periods {
-            Some(p) => p.sun(location, at.day, self.timesteps.days(), at.hour),
-            None => sun_direction(location, shading_sun_day(at.day), at.hour),
-        }
+        shaded_sun(location, self.timesteps, self.periods, row)
     }
 
     /// Value of `column` at `row`.

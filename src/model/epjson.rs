@@ -349,8 +349,10 @@ const CLASSES: &[ClassSpec] = &[
         ],
         false,
     ),
-    // Daylight saving shifts schedules by an hour (`super::schedule`).
+    // Daylight saving shifts schedules by an hour, and special days set a day's type
+    // (`super::calendar`).
     spec("RunPeriodControl:DaylightSavingTime", false, &[("start_date", Text), ("end_date", Text)], false),
+    spec("RunPeriodControl:SpecialDays", true, &[("start_date", Text), ("duration", Number), ("special_day_type", Text)], false),
     spec(
         "RunPeriod",
         true,
@@ -362,6 +364,9 @@ const CLASSES: &[ClassSpec] = &[
             ("end_day_of_month", Number),
             ("end_year", Number),
             ("day_of_week_for_start_day", Text),
+            ("use_weather_file_holidays_and_special_days", Text),
+            ("use_weather_file_daylight_saving_period", Text),
+            ("apply_weekend_holiday_rule", Text),
         ],
         false,
     ),

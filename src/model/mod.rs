@@ -17,6 +17,7 @@
 //! default its roofs and walls are marked as receivers. Only buildings' surfaces ever receive.
 pub mod arrays;
 pub mod building;
+pub mod calendar;
 #[cfg(feature = "fixtures")]
 pub mod city_write;
 pub mod cityjson;

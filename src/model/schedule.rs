@@ -9,11 +9,10 @@
 //!   takes, with `Interpolate` No, the value of its last minute (the one holding at its end, the
 //!   instant EnergyPlus stamps it with); with Average the mean of its minutes; with Linear the
 //!   mean of minutes ramped linearly from the previous `Until` value to this one;
-//! - a day's type is its weekday: a weather-file run has no design days, and holidays come only
-//!   from special days, which are not read (so `Holiday`, `CustomDay1/2` and the design days
-//!   never apply; `AllOtherDays` fills every day type a `For` of its `Through` left open);
-//! - the weekday of 1 January is the RunPeriod's (its Begin Year's, else its `Day of Week for
-//!   Start Day`, else Sunday, EnergyPlus's default).
+//! - a day's type (its weekday, or a holiday, design day or custom day) and whether it is in
+//!   daylight saving are the run's calendar's ([`super::calendar`]: the model's special days and
+//!   daylight saving, and the weather file's when the RunPeriod uses them); `AllOtherDays` fills
+//!   every day type a `For` of its `Through` left open.
 //!
 //! Only schedules that are asked for are read ([`Schedules::resolve`]), so a broken schedule no
 //! shade uses is EnergyPlus's business, not sunlit's.
@@ -21,29 +20,12 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use super::calendar::{DAY_TYPE_NAMES, DAY_TYPES, MONTH_DAYS, ModelCalendar, WeatherDays, month_day};
 use super::idf::IdfObject;
 use crate::error::{Error, Result};
 
 /// Minutes in a day.
 const DAY_MINUTES: usize = 24 * 60;
-/// Day types in EnergyPlus's order: Sunday … Saturday, Holiday, SummerDesignDay,
-/// WinterDesignDay, CustomDay1, CustomDay2.
-const DAY_TYPES: usize = 12;
-const DAY_TYPE_NAMES: [&str; DAY_TYPES] = [
-    "Sunday",
-    "Monday",
-    "Tuesday",
-    "Wednesday",
-    "Thursday",
-    "Friday",
-    "Saturday",
-    "Holiday",
-    "SummerDesignDay",
-    "WinterDesignDay",
-    "CustomDay1",
-    "CustomDay2",
-];
-const MONTH_DAYS: [u32; 12] = [31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
 
 /// How a day's minute values become timestep values.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -127,19 +109,19 @@ pub struct Schedule {
     /// `Class 'Name' (line N)`, for messages.
     pub label: String,
     source: Source,
-    /// Weekday of 1 January (0 = Sunday).
-    first_weekday: usize,
-    /// The model's `RunPeriodControl:DaylightSavingTime` (its start and end dates).
-    daylight_saving: Option<(DateRule, DateRule)>,
+    /// The model's side of the run's calendar: weekdays, special days, daylight saving.
+    calendar: ModelCalendar,
 }
 
 /// What a run needs to know about its calendar to read schedules.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RunCalendar {
+pub struct RunCalendar<'a> {
     /// Timesteps per hour.
     pub per_hour: u32,
     /// Whether the run has a Feb 29.
     pub leap: bool,
+    /// The weather file's holidays and daylight saving period, when a weather file is given.
+    pub weather: Option<&'a WeatherDays>,
 }
 
 impl Schedule {
@@ -155,24 +137,17 @@ impl Schedule {
     /// of a daylight-saving period each timestep takes the value one hour later (the first hour
     /// of the next day for the last), as EnergyPlus's `LookUpScheduleValue` adds its
     /// `DSTIndicator` to the hour.
-    pub fn values(&self, calendar: RunCalendar) -> Vec<f64> {
+    pub fn values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
         let standard = self.standard_values(calendar);
-        let Some((start, end)) = self.daylight_saving else { return standard };
-        let (start, end) = (start.day(calendar.leap, self.first_weekday), end.day(calendar.leap, self.first_weekday));
+        let saving = self.calendar.saving_days(calendar.leap, calendar.weather);
         let per_hour = calendar.per_hour as usize;
         let per_day = 24 * per_hour;
         let last = standard.len().saturating_sub(1);
-        (0..standard.len())
-            .map(|row| {
-                let day = (row / per_day) as u32 + 1;
-                let saving = if start <= end { (start..=end).contains(&day) } else { day >= start || day <= end };
-                if saving { standard[(row + per_hour).min(last)] } else { standard[row] }
-            })
-            .collect()
+        (0..standard.len()).map(|row| if saving[row / per_day] { standard[(row + per_hour).min(last)] } else { standard[row] }).collect()
     }
 
     /// [`Self::values`] in standard time.
-    fn standard_values(&self, calendar: RunCalendar) -> Vec<f64> {
+    fn standard_values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
         let n = calendar.per_hour as usize;
         let days = 365 + usize::from(calendar.leap);
         match &self.source {
@@ -180,11 +155,11 @@ impl Schedule {
             Source::Calendar { days: profiles, periods } => {
                 let per_day: Vec<Vec<f64>> = profiles.iter().map(|d| d.timestep_values(n)).collect();
                 let mut out = Vec::with_capacity(days * 24 * n);
-                for day in 1..=days as u32 {
+                let day_types = self.calendar.day_types(calendar.leap, calendar.weather);
+                for (day, &day_type) in (1..=days as u32).zip(&day_types) {
                     let leap_day = if calendar.leap || day < 60 { day } else { day + 1 };
-                    let weekday = (self.first_weekday + day as usize - 1) % 7;
                     let types = periods.iter().find(|(last, _)| leap_day <= *last).map(|p| p.1);
-                    match types.and_then(|t| t[weekday]) {
+                    match types.and_then(|t| t[day_type]) {
                         Some(d) => out.extend_from_slice(&per_day[d]),
                         None => out.extend(std::iter::repeat_n(0.0, 24 * n)),
                     }
@@ -224,8 +199,8 @@ pub struct Schedules<'a> {
     objects: HashMap<String, Vec<&'a IdfObject>>,
     /// The folder relative `Schedule:File` names are found in (None: no folder, the web).
     dir: Option<PathBuf>,
-    first_weekday: usize,
-    daylight_saving: Option<(DateRule, DateRule)>,
+    /// Every object of the model (its calendar is read from them when a schedule is).
+    all: &'a [IdfObject],
 }
 
 /// Classes a shade's `Transmittance Schedule Name` may name.
@@ -233,9 +208,6 @@ const YEAR_CLASSES: [&str; 4] = ["Schedule:Constant", "Schedule:Compact", "Sched
 /// Classes a week's day type may name.
 const DAY_CLASSES: [&str; 2] = ["Schedule:Day:Hourly", "Schedule:Day:Interval"];
 const LIMITS: &str = "ScheduleTypeLimits";
-const DAYLIGHT_SAVING: &str = "RunPeriodControl:DaylightSavingTime";
-/// The daylight-saving object kept among the schedule objects under this key (it has no name).
-const DAYLIGHT_SAVING_KEY: &str = " daylight saving";
 const WEEK: &str = "Schedule:Week:Daily";
 
 impl<'a> Schedules<'a> {
@@ -248,17 +220,7 @@ impl<'a> Schedules<'a> {
                 by_name.entry(n.to_ascii_lowercase()).or_default().push(o);
             }
         }
-        if let Some(o) = objects.iter().find(|o| o.is(DAYLIGHT_SAVING)) {
-            by_name.entry(DAYLIGHT_SAVING_KEY.into()).or_default().push(o);
-        }
-        let daylight_saving = objects.iter().find(|o| o.is(DAYLIGHT_SAVING)).map(|o| (o.field(0).to_string(), o.field(1).to_string()));
-        Self {
-            file,
-            objects: by_name,
-            dir: dir.map(Path::to_path_buf),
-            first_weekday: first_weekday(objects),
-            daylight_saving: daylight_saving.and_then(|(a, b)| Some((DateRule::parse(&a)?, DateRule::parse(&b)?))),
-        }
+        Self { file, objects: by_name, dir: dir.map(Path::to_path_buf), all: objects }
     }
 
     fn find(&self, classes: &[&str], name: &str) -> Option<&'a IdfObject> {
@@ -272,31 +234,12 @@ impl<'a> Schedules<'a> {
             return Err(Error::object(self.file, user, format!("field '{field}': '{name}' names no schedule in the model")));
         };
         let source = self.source(object)?;
-        self.check_daylight_saving()?;
-        let schedule = Schedule {
-            name: object.field(0).to_string(),
-            label: object.label(),
-            source,
-            first_weekday: self.first_weekday,
-            daylight_saving: self.daylight_saving,
-        };
+        // A special day or daylight saving date sunlit cannot read is refused: it would change
+        // the schedule's values for days or months.
+        let calendar = ModelCalendar::read(self.file, self.all)?;
+        let schedule = Schedule { name: object.field(0).to_string(), label: object.label(), source, calendar };
         self.check_limits(object, &schedule)?;
         Ok(schedule)
-    }
-
-    /// A `RunPeriodControl:DaylightSavingTime` whose dates sunlit cannot read is refused (it
-    /// would shift every schedule by an hour for months).
-    fn check_daylight_saving(&self) -> Result<()> {
-        let Some(object) = self.objects.get(DAYLIGHT_SAVING_KEY).and_then(|o| o.first()) else { return Ok(()) };
-        for (i, field) in [(0, "Start Date"), (1, "End Date")] {
-            if DateRule::parse(object.field(i)).is_none() {
-                return Err(self.bad(
-                    object,
-                    format!("field '{field}': '{}' is not a date (M/D, Month D, or Nth Weekday in Month)", object.field(i).trim()),
-                ));
-            }
-        }
-        Ok(())
     }
 
     fn bad(&self, object: &IdfObject, reason: impl Into<String>) -> Error {
@@ -604,83 +547,6 @@ fn check_untils(untils: &[(usize, f64)]) -> std::result::Result<(), String> {
     }
 }
 
-/// A date as `RunPeriodControl:DaylightSavingTime` gives it: a month and day, or the nth (1–5,
-/// or last) weekday of a month.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum DateRule {
-    /// Month (1–12) and day.
-    Fixed(usize, u32),
-    /// Which (1–5; 0 for the last), weekday (0 = Sunday), month (1–12).
-    Nth(u32, usize, usize),
-}
-
-const MONTH_NAMES: [&str; 12] =
-    ["january", "february", "march", "april", "may", "june", "july", "august", "september", "october", "november", "december"];
-
-impl DateRule {
-    /// `4/1`, `April 1`, `1 April`, `2nd Sunday in March`, `Last Sunday in October` (EnergyPlus's
-    /// date forms; month names may be cut to three letters).
-    fn parse(text: &str) -> Option<Self> {
-        let text = text.trim().to_ascii_lowercase();
-        let month = |w: &str| MONTH_NAMES.iter().position(|m| w.len() >= 3 && m.starts_with(w)).map(|m| m + 1);
-        let words: Vec<&str> = text.split_whitespace().collect();
-        let fixed = |m: usize, d: &str| {
-            let d: u32 = d.parse().ok()?;
-            (d >= 1 && d <= MONTH_DAYS[m - 1]).then_some(DateRule::Fixed(m, d))
-        };
-        match words.as_slice() {
-            [one] => {
-                let (m, d) = one.split_once('/')?;
-                let m: usize = m.parse().ok().filter(|m| (1..=12).contains(m))?;
-                fixed(m, d)
-            }
-            [a, b] => match (month(a), month(b)) {
-                (Some(m), None) => fixed(m, b),
-                (None, Some(m)) => fixed(m, a),
-                _ => None,
-            },
-            [which, weekday, "in" | "of", m] => {
-                let which = match *which {
-                    "last" => 0,
-                    w => w.trim_end_matches(|c: char| c.is_ascii_alphabetic()).parse().ok().filter(|n| (1..=5).contains(n))?,
-                };
-                let weekday = DAY_TYPE_NAMES[..7].iter().position(|n| n.eq_ignore_ascii_case(weekday))?;
-                Some(DateRule::Nth(which, weekday, month(m)?))
-            }
-            _ => None,
-        }
-    }
-
-    /// The day of the run's year (1-based; Feb 29 counted only in a leap run) given the weekday
-    /// of 1 January.
-    fn day(self, leap: bool, first_weekday: usize) -> u32 {
-        let lengths = |m: usize| if m == 2 && !leap { 28 } else { MONTH_DAYS[m - 1] };
-        let before = |m: usize| (1..m).map(lengths).sum::<u32>();
-        match self {
-            DateRule::Fixed(m, d) => before(m) + d.min(lengths(m)),
-            DateRule::Nth(which, weekday, m) => {
-                let weekday_of = |day: u32| (first_weekday + day as usize - 1) % 7;
-                if which == 0 {
-                    let last = before(m) + lengths(m);
-                    last - ((weekday_of(last) + 7 - weekday) % 7) as u32
-                } else {
-                    let first = before(m) + 1;
-                    let day = first + ((weekday + 7 - weekday_of(first)) % 7) as u32 + 7 * (which - 1);
-                    day.min(before(m) + lengths(m))
-                }
-            }
-        }
-    }
-}
-
-/// `MM/DD` (or `M/D`) as a day of a leap year (1–366: schedules number Feb 29 as day 60).
-fn month_day(text: &str) -> Option<u32> {
-    let (m, d) = text.trim().split_once('/')?;
-    let (m, d): (usize, u32) = (m.trim().parse().ok()?, d.trim().parse().ok()?);
-    let length = *MONTH_DAYS.get(m.checked_sub(1)?)?;
-    (d >= 1 && d <= length).then(|| MONTH_DAYS[..m - 1].iter().sum::<u32>() + d)
-}
-
 /// A day of the leap-numbered year as `MM/DD`.
 fn date_text(day: u32) -> String {
     let mut d = day.max(1);
@@ -699,24 +565,6 @@ fn clock(text: &str) -> Option<usize> {
     let (h, m): (usize, usize) = (h.trim().parse().ok()?, m.trim().parse().ok()?);
     let minutes = h * 60 + m;
     (m < 60 && (1..=DAY_MINUTES).contains(&minutes)).then_some(minutes)
-}
-
-/// The weekday (0 = Sunday) of 1 January in the model's run: from the first RunPeriod's Begin
-/// Year (what weekday 1 January of that year is), else its `Day of Week for Start Day` counted back to
-/// 1 January from its begin date, else Sunday.
-fn first_weekday(objects: &[IdfObject]) -> usize {
-    let Some(run) = objects.iter().find(|o| o.is("RunPeriod")) else { return 0 };
-    let begin = month_day(&format!("{}/{}", run.field(1), run.field(2))).unwrap_or(1);
-    if let Ok(year) = run.field(3).trim().parse::<i64>() {
-        // Zeller-style count: days from a known Sunday (1 January 2017) to 1 January of `year`.
-        let days_before = |y: i64| 365 * y + y.div_euclid(4) - y.div_euclid(100) + y.div_euclid(400);
-        return (days_before(year - 1) - days_before(2016)).rem_euclid(7) as usize;
-    }
-    match DAY_TYPE_NAMES[..7].iter().position(|n| n.eq_ignore_ascii_case(run.field(7).trim())) {
-        // Non-leap numbering of the begin day; 1 January is that many days earlier.
-        Some(start) => (start as i64 - (begin as i64 - 1 - i64::from(begin > 60))).rem_euclid(7) as usize,
-        None => 0,
-    }
 }
 
 #[cfg(test)]

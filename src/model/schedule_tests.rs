@@ -1,8 +1,9 @@
 #![allow(clippy::unwrap_used)]
 use super::*;
+use crate::model::calendar::DateRule;
 use crate::model::idf::parse_idf;
 
-const N4: RunCalendar = RunCalendar { per_hour: 4, leap: false };
+const N4: RunCalendar = RunCalendar { per_hour: 4, leap: false, weather: None };
 
 fn schedule(text: &str, name: &str) -> Result<Schedule> {
     let objects = parse_idf("m.idf", text)?;
@@ -56,7 +57,7 @@ fn year_week_and_day_schedules() {
     let v = s.values(N4);
     assert_eq!((v[row(1, 11, 45)], v[row(1, 12, 0)], v[row(1, 11, 0)]), (0.5, 0.5, 0.0), "hour 12 is 11:00–12:00");
     assert_eq!((v[row(182, 6, 0)], v[row(182, 6, 15)]), (1.0, 0.25), "1 July");
-    let leap = s.values(RunCalendar { per_hour: 1, leap: true });
+    let leap = s.values(RunCalendar { per_hour: 1, leap: true, weather: None });
     assert_eq!(leap.len(), 366 * 24);
     let hours = vec!["0"; 24].join(",");
     let half = format!(
@@ -98,7 +99,7 @@ fn schedule_file_reads_its_column_and_refuses_a_short_file() {
     let schedules = Schedules::new("m.idf", &objects, Some(&dir));
     let v = schedules.resolve("F", "x", "y").unwrap().values(N4);
     assert_eq!((v[row(2, 12, 0)], v[row(2, 12, 15)]), (0.25, 0.75));
-    let hourly = schedules.resolve("F", "x", "y").unwrap().values(RunCalendar { per_hour: 1, leap: false });
+    let hourly = schedules.resolve("F", "x", "y").unwrap().values(RunCalendar { per_hour: 1, leap: false, weather: None });
     assert_eq!(hourly[12], 0.75, "one timestep an hour: the value at the hour's end");
     let e = schedules.resolve("G", "x", "y").unwrap_err().to_string();
     assert!(e.contains("too short: 2 values") && e.contains("8760 needed"), "{e}");

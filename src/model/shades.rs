@@ -28,7 +28,7 @@ pub struct ShadeGroup {
 
 impl ShadeGroup {
     /// The transmittance at every timestep of the run (row order).
-    pub fn values(&self, calendar: RunCalendar) -> Vec<f64> {
+    pub fn values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
         self.schedule.values(calendar)
     }
 

@@ -33,6 +33,7 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
+use crate::sun::periods::ShadingPeriods;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
 use crate::year::certified::{self, Rough};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
@@ -296,6 +297,19 @@ pub(super) const MAX_PIECES: usize = 2;
 /// by one day (docs/energyplus-fidelity.md).
 pub fn shading_sun_day(day: u32) -> f64 {
     f64::from(day)
+}
+
+/// The sun EnergyPlus shades for at `row` of `timesteps`: under a `Periodic` update the
+/// period's mean sun ([`ShadingPeriods::sun`]), else the calendar day's ([`shading_sun_day`]).
+/// Its beam on a surface, outside (`CosIncAng` beside `SunlitFrac`) and inside (the back-surface
+/// overlaps), is of this sun, all from `CalcPerSolarBeam`; whether the sun is up is the calendar
+/// day's (`SunIsUp`).
+pub fn shaded_sun(location: &Location, timesteps: Timesteps, periods: Option<ShadingPeriods>, row: usize) -> DVec3 {
+    let at = timesteps.instant(row);
+    match periods {
+        Some(p) => p.sun(location, at.day, timesteps.days(), at.hour),
+        None => sun_direction(location, shading_sun_day(at.day), at.hour),
+    }
 }
 
 /// A fraction as EnergyPlus stores its own: clamped to [0, 1], and 0 below 1e-5 (SolarShading.cc

@@ -24,8 +24,10 @@
 //! window let in, which EnergyPlus passes on as diffuse. They are skipped by name.
 //!
 //! The hour's DNI holds over its timesteps (EnergyPlus interpolates weather between hours for
-//! sub-hourly timesteps); the sun is EnergyPlus's at each timestep (`shading_sun_day`,
-//! [`Timesteps::instant`]). Foliage counts in full leaf (EnergyPlus has none).
+//! sub-hourly timesteps); the sun is EnergyPlus's at each timestep ([`shaded_sun`]: under a
+//! `Periodic` update the period's, whose back-surface overlaps EnergyPlus's own interior
+//! distribution uses, while whether the sun is up is the calendar day's). Foliage counts in full
+//! leaf (EnergyPlus has none).
 
 use glam::{DVec2, DVec3};
 
@@ -38,9 +40,10 @@ use crate::model::building::inside_name;
 use crate::model::inside::{Glazing, Rooms, construction_of, inside_scene_glazed};
 use crate::scene::{Receiver, Scene};
 use crate::sun::location::Location;
+use crate::sun::periods::ShadingPeriods;
 use crate::sun::position::sun_direction;
 use crate::sun::weather::Weather;
-use crate::year::annual::shading_sun_day;
+use crate::year::annual::{shaded_sun, shading_sun_day};
 use crate::year::samples::Timesteps;
 
 /// One inside face that receives interior beam.
@@ -84,24 +87,28 @@ pub struct InteriorBeam {
     pub views: usize,
 }
 
-/// The interior beam of every zone with exterior windows, at every timestep of `timesteps`.
+/// The interior beam of every zone with exterior windows, at every timestep of `timesteps`, for
+/// the sun of the model's shading update (`periods`).
 pub fn interior_beam(
     input: &EnergyPlusInput,
     rooms: &Rooms,
     weather: &Weather,
     location: &Location,
     timesteps: Timesteps,
+    periods: Option<ShadingPeriods>,
 ) -> Result<InteriorBeam> {
     let mut out =
         InteriorBeam { skipped: rooms.glazing.iter().filter(|g| g.interzone).map(|g| g.name.clone()).collect(), ..Default::default() };
     let rows = timesteps.rows();
-    // Per row: the sun when it is up and the hour has beam.
+    // Per row: the shading's sun when the calendar day's is up, the shading's too, and the hour
+    // has beam.
     let suns: Vec<Option<(DVec3, f64)>> = (0..rows)
         .map(|r| {
             let at = timesteps.instant(r);
-            let sun = sun_direction(location, shading_sun_day(at.day), at.hour);
+            let up = sun_direction(location, shading_sun_day(at.day), at.hour).z >= MIN_COS_INCIDENCE;
+            let sun = shaded_sun(location, timesteps, periods, r);
             let dni = weather.at(timesteps, r).dni;
-            (sun.z >= MIN_COS_INCIDENCE && dni > 0.0).then_some((sun, dni))
+            (up && sun.z >= MIN_COS_INCIDENCE && dni > 0.0).then_some((sun, dni))
         })
         .collect();
     // One scene for every window: a view through a window leaves that window's glass out.

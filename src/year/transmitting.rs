@@ -37,7 +37,7 @@ impl VaryingShades {
     /// The groups of `shades` that let part of the sun through at some time; refused past
     /// [`MAX_VARYING`] groups. None when every shade is opaque or absent all year (the scene as
     /// loaded is then already right).
-    pub fn new(file: &str, shades: &[ShadeGroup], calendar: RunCalendar) -> Result<Option<Self>> {
+    pub fn new(file: &str, shades: &[ShadeGroup], calendar: RunCalendar<'_>) -> Result<Option<Self>> {
         let mixed: Vec<&ShadeGroup> = shades.iter().filter(|g| !matches!(g.constant(), Some(t) if t == 0.0 || t >= 1.0)).collect();
         let groups: Vec<(Vec<String>, Vec<f64>)> = mixed.iter().map(|g| (g.shades.clone(), g.values(calendar))).collect();
         if groups.len() > MAX_VARYING {
@@ -139,7 +139,7 @@ mod tests {
             Schedule:Compact, NOON, , Through: 12/31, For: AllDays, Until: 12:00, 0, Until: 24:00, 1;";
         let objects = parse_idf("m.idf", text).unwrap();
         let groups = read_shade_schedules("m.idf", &objects, None).unwrap();
-        VaryingShades::new("m.idf", &groups, RunCalendar { per_hour: 1, leap: false }).unwrap().unwrap()
+        VaryingShades::new("m.idf", &groups, RunCalendar { per_hour: 1, leap: false, weather: None }).unwrap().unwrap()
     }
 
     /// Under a Periodic update every day of a period takes its first day's τ, at the same time of
