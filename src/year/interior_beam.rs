@@ -25,8 +25,9 @@
 //!
 //! The DNI is the one EnergyPlus's heat balance sees at the timestep
 //! ([`Weather::dni_as_energyplus`]: interpolated between hour middles), not the hour's: held
-//! over the hour, it put the low sun's beam on the wrong side of the hour, so walls lit in the
-//! morning took too much and walls lit in the evening too little (2–11 % a year on
+//! over the hour, it missed the morning's first beam (the hour ending 08:00 at 0 where
+//! EnergyPlus already has half the next hour's) and kept the evening's too long, so walls lit in
+//! the morning took too little and walls lit in the evening too much (2–11 % a year on
 //! 4ZoneWithShading_Simple_1's walls against EnergyPlus's own distribution). The sun is
 //! EnergyPlus's at each timestep (`shading_sun_day`, [`Timesteps::instant`]). Foliage counts in
 //! full leaf (EnergyPlus has none).
