@@ -12,7 +12,10 @@
 //!   outside 0..=1 is an error;
 //! - which record holds at a schedule's row ([`Weather::at`]): its hour's, held over the hour's
 //!   timesteps. A leap-year file's 29 February is kept for a leap-year schedule and skipped for a
-//!   365-day one; a 365-day file under a leap-year schedule repeats 28 February's hours.
+//!   365-day one; a 365-day file under a leap-year schedule repeats 28 February's hours;
+//! - the direct normal irradiance EnergyPlus's heat balance sees at a row
+//!   ([`Weather::dni_as_energyplus`]): interpolated between hours, for what sunlit hands
+//!   EnergyPlus in W/m².
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
@@ -189,6 +192,23 @@ impl Weather {
             hour
         };
         self.hours.get(index).copied().unwrap_or(Hour { dni: 0.0, dhi: 0.0, ghi: 0.0, albedo: DEFAULT_ALBEDO })
+    }
+
+    /// Direct normal irradiance (W/m²) at the end of `row`'s timestep as EnergyPlus 25.2 gives it
+    /// to its heat balance (WeatherManager's `SolarInterpolation` weights). An EPW record is the
+    /// mean over its hour, so EnergyPlus pins it to the hour's middle and interpolates linearly
+    /// between middles: a timestep ending at fraction `e` of its hour takes `1 − |e − ½|` of its
+    /// own hour and the rest from the hour before (`e < ½`) or after. At one timestep an hour
+    /// that is half this hour and half the next. The year's first and last hours stand in for
+    /// their missing neighbours. (EnergyPlus also sets it to 0 while its sun is down; callers
+    /// ask only with the sun up.)
+    pub fn dni_as_energyplus(&self, timesteps: Timesteps, row: usize) -> f64 {
+        let n = timesteps.per_hour() as usize;
+        let end = (row % n + 1) as f64 / n as f64;
+        let own = 1.0 - (end - 0.5).abs();
+        let neighbour = if end < 0.5 { row.checked_sub(n) } else { Some(row + n).filter(|&r| r < timesteps.rows()) };
+        let here = self.at(timesteps, row).dni;
+        own * here + (1.0 - own) * neighbour.map_or(here, |r| self.at(timesteps, r).dni)
     }
 }
 

@@ -117,6 +117,27 @@ fn each_row_takes_its_hour_and_leap_years_line_up() {
     assert_eq!(weather.at(leap, feb29 + 24 * 4).dni, weather.at(n4, feb29).dni);
 }
 
+/// EnergyPlus 25.2's direct normal irradiance at Timestep 4 (`Site Direct Solar Radiation Rate
+/// per Area`, Chicago TMY3, 9 February 16:15–17:00, hours of 747, 490 and 41 W/m²): 554.25,
+/// 490, 377.75, 265.5. Timestep 1 averages an hour with the next; the last hour has none after.
+#[test]
+fn dni_is_interpolated_between_hour_middles_as_energyplus_does() {
+    let mut text = epw(8760, "0", "0", "0", "0.2");
+    let hour = (31 + 8) * 24 + 16; // 9 February, the record ending 17:00
+    for (h, dni) in [(hour - 1, "747"), (hour, "490"), (hour + 1, "41"), (8759, "100")] {
+        let line = text.lines().nth(8 + h).unwrap().to_string();
+        let mut f: Vec<&str> = line.split(',').collect();
+        f[14] = dni;
+        text = text.replacen(&line, &f.join(","), 1);
+    }
+    let weather = Weather::from_epw_text("w.epw", &text).unwrap();
+    let n4 = Timesteps::new(4).unwrap();
+    let got: Vec<f64> = (0..4).map(|ts| weather.dni_as_energyplus(n4, hour * 4 + ts)).collect();
+    assert_eq!(got, [554.25, 490.0, 377.75, 265.5]);
+    assert_eq!(weather.dni_as_energyplus(Timesteps::new(1).unwrap(), hour), 265.5);
+    assert_eq!(weather.dni_as_energyplus(n4, 8759 * 4 + 3), 100.0);
+}
+
 fn short_first_record() -> String {
     let text = epw(8760, "5", "5", "5", "0.2");
     let mut lines: Vec<&str> = text.lines().collect();
