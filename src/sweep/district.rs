@@ -451,11 +451,13 @@ pub fn merge(
         files.push((dir.join(POINTS_CSV), cadastre_points::points_csv(&points).into_bytes()));
         files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &placer, north_note)?.into_bytes()));
     }
-    files.extend(district_pv::merged(dir, &pv, &position)?);
+    // The PV files first: their CSV, streamed from the tiles' files, is what a bad tile file fails.
+    let pv_files = district_pv::write_merged(dir, &pv, &position)?;
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
     }
-    Ok(DistrictMerged { written: files.into_iter().map(|(p, _)| p).collect(), surfaces: rows.len(), unfinished })
+    let written = files.into_iter().map(|(p, _)| p).chain(pv_files).collect();
+    Ok(DistrictMerged { written, surfaces: rows.len(), unfinished })
 }
 
 #[cfg(test)]
