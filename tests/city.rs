@@ -312,3 +312,34 @@ fn roof_grids_and_usable_area_against_an_open_and_a_half_covered_roof() {
     let surfaces = doc["CityObjects"]["A"]["geometry"][0]["semantics"]["surfaces"].as_array().unwrap().clone();
     assert!(surfaces.iter().any(|s| s["usable_area_m2"] == 50.0), "{surfaces:?}");
 }
+
+/// Terrain casts shadows: a TINRelief ridge (tests/city/terrain.city.json, valid by `cjval`)
+/// 8 m south of a flat-roofed house shades its roof as a numpy ray cast written independently
+/// (tests/city/terrain_truth.py: the file read by itself, a 300 × 300 grid of rays against every
+/// triangle) says, for low suns from the south, south-east and south-west; a sun high or from the
+/// east leaves it lit.
+#[test]
+fn tin_relief_terrain_shades_a_roof_as_a_numpy_ray_cast_does() {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/city/terrain.city.json");
+    assert_valid_cityjson(&fixture);
+    let suns = [(180.0, 12.0), (150.0, 15.0), (210.0, 10.0), (180.0, 40.0), (90.0, 10.0)];
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/city/terrain_truth.py");
+    let mut truth = std::process::Command::new(common::radiance_python());
+    truth.arg(script).arg(&fixture).args(suns.iter().map(|(az, alt)| format!("{az},{alt}")));
+    let out = truth.output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let truth: HashMap<String, Vec<f64>> = serde_json::from_slice(&out.stdout).unwrap();
+    let options = sunlit::model::LoadOptions { receivers: vec!["RoofSurface".into()], ..Default::default() };
+    let bytes = std::fs::read(&fixture).unwrap();
+    let scene = sunlit::model::load_bytes(&[("terrain.city.json".into(), bytes)], &options).unwrap();
+    assert_eq!(scene.receivers.len(), 1, "the house's one roof");
+    let roof = &scene.receivers[0];
+    let expected = &truth[&roof.name];
+    for ((az, alt), want) in suns.iter().zip(expected) {
+        let requests = [ViewRequest::new(0, common::sun(*az, *alt))];
+        let got = pollster::block_on(Exact { scene: &scene }.answer(&requests)).unwrap()[0].fraction;
+        // The ray cast's grid puts a shadow edge within 1/300 of the roof's side.
+        assert!((got - want).abs() < 0.005, "{} at ({az}, {alt}): sunlit {got}, the numpy ray cast {want}", roof.name);
+    }
+    assert!(expected.iter().any(|&f| f < 0.5), "the terrain shades the roof for some sun: {expected:?}");
+}

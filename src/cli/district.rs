@@ -177,8 +177,20 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     };
     let bytes = std::fs::read(&city_path).map_err(|e| io(e, &city_path))?;
     let name = args.city.display().to_string();
-    let city = sunlit::model::cityjson::read_city(&name, &bytes, args.lod.as_deref())?;
-    let tiling = district::tiles(&city, args.tile, args.context, args.north)?;
+    let lod = args.lod.as_deref();
+    let (city, tiling) = match args.index {
+        // One tile reads only its part of the city (after a pass that holds no surfaces).
+        Some(k) => {
+            let plan = district::CityPlan::read(&name, &bytes, lod, args.north)?;
+            let tiling = district::tiles_of(&plan, args.tile, args.context)?;
+            (district::read_tile_city(&name, &bytes, lod, &plan, &tiling, k)?, tiling)
+        }
+        None => {
+            let city = sunlit::model::cityjson::read_city(&name, &bytes, lod)?;
+            let tiling = district::tiles(&city, args.tile, args.context, args.north)?;
+            (city, tiling)
+        }
+    };
     let defining = args.defining(&city_path, &epw_path);
     let fingerprint = district::fingerprint(&defining, &city_path);
     let north = model::city_north_note(args.north);

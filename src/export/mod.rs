@@ -205,12 +205,21 @@ fn partials() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 
 /// Writes `bytes` to `path` atomically: a temporary file beside it, flushed, then renamed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |w| w.write_all(bytes).map_err(|source| Error::Io { path: path.to_path_buf(), source }))
+}
+
+/// Writes `path` atomically from what `write` streams into it (buffered): a temporary file
+/// beside it, flushed, then renamed; on any error the temporary file is removed and `path` is
+/// left as it was. For outputs too large to build in memory first.
+pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
     let io = |source: std::io::Error, p: &Path| Error::Io { path: p.to_path_buf(), source };
     let tmp = temporary_sibling(path);
     partials().push(tmp.clone());
     let written = (|| {
-        let mut file = std::fs::File::create(&tmp).map_err(|e| io(e, path))?;
-        file.write_all(bytes).map_err(|e| io(e, path))?;
+        let file = std::fs::File::create(&tmp).map_err(|e| io(e, path))?;
+        let mut buffered = std::io::BufWriter::with_capacity(1 << 16, file);
+        write(&mut buffered)?;
+        let file = buffered.into_inner().map_err(|e| io(e.into_error(), path))?;
         file.sync_all().map_err(|e| io(e, path))
     })();
     let mut list = partials();

@@ -90,34 +90,68 @@ pub fn is_cityjson(name: &str, bytes: &[u8]) -> bool {
 /// Reads a CityJSON file or CityJSONSeq (by its lines: a header then features). `lod` picks the
 /// level of detail (exactly, or `2` for any `2.x`); `None`: each object's highest.
 pub fn read_city(file: &str, bytes: &[u8], lod: Option<&str>) -> Result<City> {
+    let mut surfaces = Vec::new();
+    let mut city = read_city_with(file, bytes, lod, None, &mut |s| surfaces.push(s))?;
+    city.surfaces = surfaces;
+    Ok(city)
+}
+
+/// Reads a city as [`read_city`] does, but builds the surfaces of only the CityObjects `keep`
+/// takes (by id; `None`: all) and hands each to `out` in file order instead of holding them; the returned
+/// [`City`] has no surfaces. A CityJSONSeq is read a line at a time (never held whole), and a
+/// feature line none of whose objects `keep` takes is skipped after reading only its objects'
+/// ids, without building its geometry (when the header has a `transform`: without one, the first
+/// feature's vertices set the offset, so every line is read). A skipped line is not checked: a
+/// reader of part of a city has read it whole before (the tiling does).
+pub fn read_city_with(
+    file: &str,
+    bytes: &[u8],
+    lod: Option<&str>,
+    keep: Option<&dyn Fn(&str) -> bool>,
+    out: &mut dyn FnMut(CitySurface),
+) -> Result<City> {
     let text = std::str::from_utf8(bytes).map_err(|e| Error::model(file, format!("not UTF-8 text ({e})")))?;
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let whole: std::result::Result<Value, _> = serde_json::from_str(text);
-    let (header, features): (Value, Vec<Value>) = match whole {
-        Ok(doc) => (doc, Vec::new()),
+    let (header, seq) = match whole {
+        Ok(doc) => (doc, None),
         Err(e) => {
             // CityJSONSeq: every line a JSON object.
-            let first = lines.next().ok_or_else(|| Error::model(file, "the file is empty"))?;
+            let mut lines = text.lines().filter(|l| !l.trim().is_empty()).enumerate();
+            let (_, first) = lines.next().ok_or_else(|| Error::model(file, "the file is empty"))?;
             let header: Value = serde_json::from_str(first).map_err(|_| Error::model(file, format!("not JSON: {e}")))?;
-            let features = lines
-                .enumerate()
-                .map(|(i, l)| serde_json::from_str(l).map_err(|e| Error::model(file, format!("line {}: not JSON: {e}", i + 2))))
-                .collect::<Result<Vec<Value>>>()?;
-            (header, features)
+            (header, Some(lines))
         }
     };
     if header.get("type").and_then(Value::as_str) != Some("CityJSON") {
         return Err(Error::model(file, "not CityJSON: its \"type\" is not \"CityJSON\""));
     }
     let mut reader = Reader::new(file, &header, lod)?;
-    reader.document(&header)?;
-    for (i, feature) in features.iter().enumerate() {
-        if feature.get("type").and_then(Value::as_str) != Some("CityJSONFeature") {
-            return Err(Error::model(file, format!("line {}: not a CityJSONFeature", i + 2)));
+    reader.document(&header, keep, out)?;
+    let skip = keep.filter(|_| reader.scale.is_some());
+    // Lines are numbered among the non-blank ones, the header line 1.
+    for (i, line) in seq.into_iter().flatten() {
+        if skip.is_some_and(|keep| !feature_kept(line, keep)) {
+            continue;
         }
-        reader.document(feature)?;
+        let feature: Value = serde_json::from_str(line).map_err(|e| Error::model(file, format!("line {}: not JSON: {e}", i + 1)))?;
+        if feature.get("type").and_then(Value::as_str) != Some("CityJSONFeature") {
+            return Err(Error::model(file, format!("line {}: not a CityJSONFeature", i + 1)));
+        }
+        reader.document(&feature, keep, out)?;
     }
     Ok(reader.city)
+}
+
+/// Whether `keep` takes an object of a CityJSONSeq line, from its objects' ids alone (the rest of
+/// the line is scanned, not built). A line that does not read so is kept, for the full read to
+/// name its fault.
+fn feature_kept(line: &str, keep: &dyn Fn(&str) -> bool) -> bool {
+    #[derive(serde::Deserialize)]
+    struct Ids {
+        #[serde(rename = "CityObjects")]
+        objects: std::collections::BTreeMap<String, serde::de::IgnoredAny>,
+    }
+    serde_json::from_str::<Ids>(line).map_or(true, |ids| ids.objects.keys().any(|id| keep(id)))
 }
 
 /// Parsing state: the header's transform and templates, the surfaces so far.
@@ -179,8 +213,9 @@ impl<'a> Reader<'a> {
         Ok(Self { city, scale, lod, templates, template_vertices, offset_set: offset.is_some() })
     }
 
-    /// One CityJSON document or CityJSONFeature: its vertices and CityObjects.
-    fn document(&mut self, doc: &Value) -> Result<()> {
+    /// One CityJSON document or CityJSONFeature: its vertices and CityObjects, the surfaces of
+    /// those `keep` takes handed to `out`.
+    fn document(&mut self, doc: &Value, keep: Option<&dyn Fn(&str) -> bool>, out: &mut dyn FnMut(CitySurface)) -> Result<()> {
         let file = self.city.file.clone();
         let raw = doc.get("vertices").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
         let vertices = self.vertices(&file, raw)?;
@@ -189,7 +224,7 @@ impl<'a> Reader<'a> {
         };
         let parents: HashMap<&str, &str> =
             objects.iter().filter_map(|(id, o)| Some((id.as_str(), o.pointer("/parents/0").and_then(Value::as_str)?))).collect();
-        for (id, object) in objects {
+        for (id, object) in objects.iter().filter(|(id, _)| keep.is_none_or(|keep| keep(id))) {
             let kind = object.get("type").and_then(Value::as_str).unwrap_or("");
             let building = BUILDING_TYPES.contains(&kind).then(|| root_of(id, &parents).to_string());
             let geometries = object.get("geometry").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
@@ -198,7 +233,7 @@ impl<'a> Reader<'a> {
             let mut found = self.surfaces(&geometries[g], &vertices).map_err(err)?;
             for (index, (kind, rings)) in found.drain(..).enumerate() {
                 let type_name = kind.clone().unwrap_or_else(|| "Surface".into());
-                self.city.surfaces.push(CitySurface {
+                out(CitySurface {
                     name: format!("{id}/{type_name}/{index}"),
                     object: id.clone(),
                     building: building.clone(),

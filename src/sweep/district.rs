@@ -111,8 +111,18 @@ pub struct Tiling {
 /// A building's footprint centroid: its ground surfaces' area-weighted centroid seen from above,
 /// else the centre of its outline's box.
 pub fn footprint_centroid(surfaces: &[&CitySurface]) -> DVec2 {
+    let grounds: Vec<&CitySurface> = surfaces.iter().copied().filter(|s| is_ground(s)).collect();
+    centroid_or_box(&grounds, box_of(surfaces.iter().copied()))
+}
+
+fn is_ground(s: &CitySurface) -> bool {
+    s.kind.as_deref() == Some("GroundSurface")
+}
+
+/// The area-weighted centroid of `grounds` seen from above, else the centre of `outline`.
+fn centroid_or_box(grounds: &[&CitySurface], outline: (DVec2, DVec2)) -> DVec2 {
     let (mut area, mut moment) = (0.0, DVec2::ZERO);
-    for s in surfaces.iter().filter(|s| s.kind.as_deref() == Some("GroundSurface")) {
+    for s in grounds {
         for (r, ring) in s.rings.iter().enumerate() {
             let (a, c) = shoelace(ring);
             // Holes take their area away, whatever their winding.
@@ -124,7 +134,7 @@ pub fn footprint_centroid(surfaces: &[&CitySurface]) -> DVec2 {
     if area > 1e-9 {
         return moment / area;
     }
-    let (lo, hi) = box_of(surfaces.iter().copied());
+    let (lo, hi) = outline;
     (lo + hi) * 0.5
 }
 
@@ -150,28 +160,115 @@ fn box_of<'a>(surfaces: impl Iterator<Item = &'a CitySurface>) -> (DVec2, DVec2)
     (lo, hi)
 }
 
+/// What cutting a city into tiles, and choosing a tile's part, needs of it, gathered from its
+/// surfaces one at a time ([`CityPlan::read`] never holds them all): each building's ground
+/// surfaces and outline box, each object's box seen from above, and the city's boxes.
+pub struct CityPlan {
+    /// The city without its surfaces (file, version, reference system, offset).
+    pub head: City,
+    /// The model's north turn, degrees.
+    north: f64,
+    /// Per building (by id): its ground surfaces in file order, and the box of all its surfaces.
+    buildings: BTreeMap<String, (Vec<CitySurface>, (DVec2, DVec2))>,
+    /// Per CityObject: its building, and the box of its surfaces seen from above.
+    objects: HashMap<String, (Option<String>, (DVec2, DVec2))>,
+    /// The box of every surface seen from above.
+    outline: (DVec2, DVec2),
+    /// The box of every surface turned by north, in 3D (the scene's frame).
+    turned: (DVec3, DVec3),
+}
+
+impl CityPlan {
+    fn empty(head: City, north: f64) -> Self {
+        let (inf, neg) = (f64::INFINITY, f64::NEG_INFINITY);
+        Self {
+            head,
+            north,
+            buildings: BTreeMap::new(),
+            objects: HashMap::new(),
+            outline: (DVec2::splat(inf), DVec2::splat(neg)),
+            turned: (DVec3::splat(inf), DVec3::splat(neg)),
+        }
+    }
+
+    /// Reads a CityJSON file's plan, a surface at a time (a CityJSONSeq a line at a time);
+    /// `north` (degrees) turns the model as the scene will.
+    pub fn read(file: &str, bytes: &[u8], lod: Option<&str>, north: f64) -> Result<Self> {
+        let mut plan = Self::empty(
+            City { file: file.to_string(), version: String::new(), reference_system: None, offset: DVec3::ZERO, surfaces: Vec::new() },
+            north,
+        );
+        let head = crate::model::cityjson::read_city_with(file, bytes, lod, None, &mut |s| plan.add(s))?;
+        plan.head = head;
+        Ok(plan)
+    }
+
+    /// The plan of a city read whole.
+    pub fn of(city: &City, north: f64) -> Self {
+        let mut plan = Self::empty(City { surfaces: Vec::new(), ..city.clone() }, north);
+        city.surfaces.iter().cloned().for_each(|s| plan.add(s));
+        plan
+    }
+
+    fn add(&mut self, s: CitySurface) {
+        let turn = glam::DMat3::from_rotation_z(-self.north.to_radians());
+        let grow = |b: &mut (DVec2, DVec2), p: DVec2| *b = (b.0.min(p), b.1.max(p));
+        let blank = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        let object = self.objects.entry(s.object.clone()).or_insert_with(|| (s.building.clone(), blank));
+        let mut building = s.building.as_ref().map(|b| self.buildings.entry(b.clone()).or_insert_with(|| (Vec::new(), blank)));
+        for p in s.rings.iter().flatten() {
+            grow(&mut self.outline, p.truncate());
+            grow(&mut object.1, p.truncate());
+            if let Some((_, b)) = building.as_mut() {
+                grow(b, p.truncate());
+            }
+            let w = turn * *p;
+            self.turned = (self.turned.0.min(w), self.turned.1.max(w));
+        }
+        if let Some((grounds, _)) = building.filter(|_| is_ground(&s)) {
+            grounds.push(s);
+        }
+    }
+
+    /// Whether tile `tile` of `tiling` is counted with CityObject `id`: one of its own buildings',
+    /// or one whose box comes within the context ([`tile_city`]'s surfaces all lie in such
+    /// objects).
+    pub fn keeps(&self, tiling: &Tiling, tile: &Tile, id: &str) -> bool {
+        self.objects.get(id).is_some_and(|(building, outline)| {
+            building.as_ref().is_some_and(|b| tile.buildings.binary_search(b).is_ok()) || within(tiling, tile, *outline)
+        })
+    }
+}
+
+/// Whether a box seen from above comes within the context radius of the tile's square.
+fn within(tiling: &Tiling, tile: &Tile, (lo, hi): (DVec2, DVec2)) -> bool {
+    let (sw, ne) = tile.square;
+    let gap = (sw - hi).max(lo - ne).max(DVec2::ZERO);
+    gap.length() <= tiling.context
+}
+
 /// Cuts `city` into tiles of `tile` metres with a `context` radius; `north` (degrees) turns the
 /// model as the scene will, so the shared origin is the scene's.
 pub fn tiles(city: &City, tile: f64, context: f64, north: f64) -> Result<Tiling> {
+    tiles_of(&CityPlan::of(city, north), tile, context)
+}
+
+/// Cuts a city, from its plan, into tiles of `tile` metres with a `context` radius.
+pub fn tiles_of(plan: &CityPlan, tile: f64, context: f64) -> Result<Tiling> {
     if !(tile.is_finite() && tile > 0.0) {
         return Err(Error::argument("tile", format!("{tile} is not a positive size in metres")));
     }
     if !(context.is_finite() && context > 0.0) {
         return Err(Error::argument("context", format!("{context} is not a positive radius in metres")));
     }
-    let mut by_building: BTreeMap<&str, Vec<&CitySurface>> = BTreeMap::new();
-    for s in &city.surfaces {
-        if let Some(b) = &s.building {
-            by_building.entry(b.as_str()).or_default().push(s);
-        }
+    if plan.buildings.is_empty() {
+        return Err(Error::model(&plan.head.file, "no Building with geometry: nothing to tile"));
     }
-    if by_building.is_empty() {
-        return Err(Error::model(&city.file, "no Building with geometry: nothing to tile"));
-    }
-    let (lo, _) = box_of(city.surfaces.iter());
+    let lo = plan.outline.0;
     let mut cells: BTreeMap<(i64, i64), Vec<String>> = BTreeMap::new();
-    for (id, surfaces) in &by_building {
-        let c = (footprint_centroid(surfaces) - lo) / tile;
+    for (id, (grounds, outline)) in &plan.buildings {
+        let grounds: Vec<&CitySurface> = grounds.iter().collect();
+        let c = (centroid_or_box(&grounds, *outline) - lo) / tile;
         cells.entry((c.y.floor() as i64, c.x.floor() as i64)).or_default().push(id.to_string());
     }
     let tiles = cells
@@ -182,34 +279,42 @@ pub fn tiles(city: &City, tile: f64, context: f64, north: f64) -> Result<Tiling>
             Tile { index, cell: (column, row), square: (sw, sw + DVec2::splat(tile)), buildings }
         })
         .collect();
-    Ok(Tiling { tile, context, tiles, origin: city_origin(city, north) })
-}
-
-/// The centre of the city's box after the north turn: where the scene builder would centre the
-/// whole city.
-fn city_origin(city: &City, north: f64) -> DVec3 {
-    let turn = glam::DMat3::from_rotation_z(-north.to_radians());
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for p in city.surfaces.iter().flat_map(|s| s.rings.iter().flatten()) {
-        let w = turn * *p;
-        lo = lo.min(w);
-        hi = hi.max(w);
-    }
-    if lo.x > hi.x { DVec3::ZERO } else { (lo + hi) * 0.5 }
+    // The centre of the city's box after the north turn: where the scene builder would centre
+    // the whole city.
+    let (tlo, thi) = plan.turned;
+    let origin = if tlo.x > thi.x { DVec3::ZERO } else { (tlo + thi) * 0.5 };
+    Ok(Tiling { tile, context, tiles, origin })
 }
 
 /// The part of `city` a tile is counted with: every surface whose box comes within the context
 /// radius of the tile's square (its own buildings always do).
 pub fn tile_city(city: &City, tiling: &Tiling, tile: &Tile) -> City {
-    let (sw, ne) = tile.square;
-    let near = |s: &CitySurface| {
-        let (lo, hi) = box_of(std::iter::once(s));
-        let gap = (sw - hi).max(lo - ne).max(DVec2::ZERO);
-        gap.length() <= tiling.context
-    };
+    let near = |s: &CitySurface| within(tiling, tile, box_of(std::iter::once(s)));
     let own: std::collections::HashSet<&str> = tile.buildings.iter().map(String::as_str).collect();
     let surfaces = city.surfaces.iter().filter(|s| s.building.as_deref().is_some_and(|b| own.contains(b)) || near(s)).cloned().collect();
     City { surfaces, ..city.clone() }
+}
+
+/// Reads only what tile `k` is counted with from the city file: the surfaces of the CityObjects
+/// [`CityPlan::keeps`] takes (a CityJSONSeq's other lines skipped unbuilt), so a tile's memory
+/// follows its tile and context. [`tile_city`] of it is [`tile_city`] of the whole city.
+pub fn read_tile_city(file: &str, bytes: &[u8], lod: Option<&str>, plan: &CityPlan, tiling: &Tiling, k: usize) -> Result<City> {
+    let tile = tile_of(tiling, k)?;
+    let mut surfaces = Vec::new();
+    let keep = |id: &str| plan.keeps(tiling, tile, id);
+    let mut city = crate::model::cityjson::read_city_with(file, bytes, lod, Some(&keep), &mut |s| surfaces.push(s))?;
+    city.surfaces = surfaces;
+    Ok(city)
+}
+
+/// Tile `k`, or an error naming the tiles there are.
+fn tile_of(tiling: &Tiling, k: usize) -> Result<&Tile> {
+    tiling.tiles.get(k).ok_or_else(|| {
+        Error::argument(
+            "index",
+            format!("{k} is past the last tile ({} tiles: 0..={})", tiling.tiles.len(), tiling.tiles.len().saturating_sub(1)),
+        )
+    })
 }
 
 /// What counting a tile needs beside the city: the readers' options (receivers, buildings, lod,
@@ -256,12 +361,7 @@ pub fn count_tile(
     s: &TileSettings,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<TileCount> {
-    let tile = tiling.tiles.get(k).ok_or_else(|| {
-        Error::argument(
-            "index",
-            format!("{k} is past the last tile ({} tiles: 0..={})", tiling.tiles.len(), tiling.tiles.len().saturating_sub(1)),
-        )
-    })?;
+    let tile = tile_of(tiling, k)?;
     let part = tile_city(city, tiling, tile);
     let buildings: Vec<String> = match s.load.buildings.as_slice() {
         [] => tile.buildings.clone(),
@@ -451,11 +551,13 @@ pub fn merge(
         files.push((dir.join(POINTS_CSV), cadastre_points::points_csv(&points).into_bytes()));
         files.push((dir.join(POINTS_GEOJSON), cadastre_points::points_geojson(&points, &placer, north_note)?.into_bytes()));
     }
-    files.extend(district_pv::merged(dir, &pv, &position)?);
+    // The PV files first: their CSV, streamed from the tiles' files, is what a bad tile file fails.
+    let pv_files = district_pv::write_merged(dir, &pv, &position)?;
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
     }
-    Ok(DistrictMerged { written: files.into_iter().map(|(p, _)| p).collect(), surfaces: rows.len(), unfinished })
+    let written = files.into_iter().map(|(p, _)| p).chain(pv_files).collect();
+    Ok(DistrictMerged { written, surfaces: rows.len(), unfinished })
 }
 
 #[cfg(test)]
@@ -492,5 +594,83 @@ mod tests {
         assert_eq!(tile_city(&city, &wide, &wide.tiles[0]).surfaces.len(), 2);
         assert!(tiles(&city, 0.0, 5.0, 0.0).unwrap_err().to_string().contains("tile"));
         assert!(tiles(&city, 10.0, -1.0, 0.0).unwrap_err().to_string().contains("context"));
+    }
+
+    /// The city as CityJSONSeq: its header, then one feature a CityObject with its own vertices.
+    fn as_seq(doc: &str) -> String {
+        fn renumber(
+            v: &serde_json::Value,
+            map: &mut Vec<u64>,
+            old: &[serde_json::Value],
+            vertices: &mut Vec<serde_json::Value>,
+        ) -> serde_json::Value {
+            match v {
+                serde_json::Value::Array(items) => {
+                    serde_json::Value::Array(items.iter().map(|i| renumber(i, map, old, vertices)).collect())
+                }
+                serde_json::Value::Number(n) => {
+                    let k = n.as_u64().unwrap() as usize;
+                    if map[k] == u64::MAX {
+                        map[k] = vertices.len() as u64;
+                        vertices.push(old[k].clone());
+                    }
+                    serde_json::json!(map[k])
+                }
+                other => other.clone(),
+            }
+        }
+        let mut doc: serde_json::Value = serde_json::from_str(doc).unwrap();
+        let objects = doc["CityObjects"].as_object().unwrap().clone();
+        let old = doc["vertices"].as_array().unwrap().clone();
+        doc["CityObjects"] = serde_json::json!({});
+        doc["vertices"] = serde_json::json!([]);
+        let mut lines = vec![doc.to_string()];
+        for (id, mut object) in objects {
+            let (mut map, mut vertices) = (vec![u64::MAX; old.len()], Vec::new());
+            for g in object["geometry"].as_array_mut().unwrap() {
+                g["boundaries"] = renumber(&g["boundaries"], &mut map, &old, &mut vertices);
+            }
+            let feature =
+                serde_json::json!({"type": "CityJSONFeature", "id": id, "CityObjects": {id.clone(): object}, "vertices": vertices});
+            lines.push(feature.to_string());
+        }
+        lines.join("\n") + "\n"
+    }
+
+    fn same(a: &City, b: &City) -> bool {
+        let key =
+            |s: &CitySurface| (s.name.clone(), s.object.clone(), s.building.clone(), s.kind.clone(), s.geometry, s.index, s.rings.clone());
+        a.offset == b.offset && a.surfaces.iter().map(key).eq(b.surfaces.iter().map(key))
+    }
+
+    /// A tile that reads only its part of the city file (CityJSON and CityJSONSeq) is counted with
+    /// exactly the surfaces it was counted with from the whole city, bit for bit, on the same
+    /// tiling and origin; and it reads fewer.
+    #[test]
+    fn a_tile_read_alone_has_the_surfaces_it_has_in_the_whole_city() {
+        let doc = crate::model::city_write::district_cityjson(5, 4, 3);
+        let seq = as_seq(&doc);
+        for (file, text) in [("d.city.json", &doc), ("d.city.jsonl", &seq)] {
+            let whole = crate::model::cityjson::read_city(file, text.as_bytes(), None).unwrap();
+            assert!(whole.surfaces.len() > 100, "{file}: {} surfaces", whole.surfaces.len());
+            let tiling = tiles(&whole, 30.0, 12.0, 20.0).unwrap();
+            let plan = CityPlan::read(file, text.as_bytes(), None, 20.0).unwrap();
+            let planned = tiles_of(&plan, 30.0, 12.0).unwrap();
+            assert_eq!(planned.tiles, tiling.tiles, "{file}");
+            assert!(planned.origin == tiling.origin, "{file}");
+            assert!(tiling.tiles.len() >= 4, "{file}: {} tiles", tiling.tiles.len());
+            for tile in &tiling.tiles {
+                let read = read_tile_city(file, text.as_bytes(), None, &plan, &tiling, tile.index).unwrap();
+                assert!(read.surfaces.len() < whole.surfaces.len(), "{file}: tile {} read the whole city", tile.index);
+                let (alone, from_whole) = (tile_city(&read, &tiling, tile), tile_city(&whole, &tiling, tile));
+                assert!(
+                    same(&alone, &from_whole),
+                    "{file}: tile {}: {} surfaces against {}",
+                    tile.index,
+                    alone.surfaces.len(),
+                    from_whole.surfaces.len()
+                );
+            }
+        }
     }
 }
