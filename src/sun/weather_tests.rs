@@ -134,7 +134,7 @@ fn dni_is_interpolated_between_hour_middles_as_energyplus_does() {
     let n4 = Timesteps::new(4).unwrap();
     let got: Vec<f64> = (0..4).map(|ts| weather.dni_as_energyplus(n4, hour * 4 + ts)).collect();
     assert_eq!(got, [554.25, 490.0, 377.75, 265.5]);
-    assert_eq!(weather.dni_as_energyplus(Timesteps::new(1).unwrap(), hour), 265.5);
+    assert_eq!(weather.dni_as_energyplus(Timesteps::new(1).unwrap(), hour), 490.0, "one timestep an hour: the hour held");
     assert_eq!(weather.dni_as_energyplus(n4, 8759 * 4 + 3), 100.0);
 }
 
