@@ -82,6 +82,17 @@ const MAX_SWEPT: usize = 20_000;
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
 
+/// A partly-lit proof's patch is one of the receiver's triangles scaled by this about a point
+/// of it (so it lies inside the triangle).
+const PATCH_SCALE: f64 = 0.1;
+
+/// Least share of the receiver's area a patch holds: well above EnergyPlus's 1e-5 (a fraction
+/// under it is written as 0), so a patch that is lit makes the step lit in the schedule too.
+const MIN_PATCH_SHARE: f64 = 1e-4;
+
+/// Most patches tried per receiver: the centre and the corners of its largest triangles.
+const MAX_PATCHES: usize = 8;
+
 /// A receiver as the certificates need it.
 #[derive(Debug, Default)]
 struct Shape {
@@ -92,6 +103,44 @@ struct Shape {
     p0: DVec3,
     lowest: f64,
     gpu_id: u32,
+    /// Small pieces of it for the partly-lit proof ([`Certifier::not_dark`]), each a shape of
+    /// its own (without patches).
+    patches: Vec<Shape>,
+}
+
+impl Shape {
+    /// A receiver of `triangles`, with its patches.
+    fn receiver(triangles: &[[DVec3; 3]], normal: DVec3, gpu_id: u32) -> Self {
+        let mut shape = Self::flat(triangles.iter().flatten().copied().collect(), normal, gpu_id);
+        shape.patches = patches(triangles).into_iter().map(|t| Self::flat(t.to_vec(), normal, gpu_id)).collect();
+        shape
+    }
+
+    fn flat(points: Vec<DVec3>, normal: DVec3, gpu_id: u32) -> Self {
+        let lowest = points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+        Shape { p0: points.first().copied().unwrap_or_default(), points, normal, lowest, gpu_id, patches: Vec::new() }
+    }
+}
+
+/// The patches a partly-lit proof tries, largest triangles first: each triangle scaled by
+/// [`PATCH_SCALE`] about its centroid, then about points near its corners (a shadow covering
+/// most of a window leaves a corner lit). Triangles too small for a patch of
+/// [`MIN_PATCH_SHARE`] of the whole are skipped.
+fn patches(triangles: &[[DVec3; 3]]) -> Vec<[DVec3; 3]> {
+    let area = |t: &[DVec3; 3]| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+    let total: f64 = triangles.iter().map(area).sum();
+    let mut order: Vec<&[DVec3; 3]> =
+        triangles.iter().filter(|t| area(t) * PATCH_SCALE * PATCH_SCALE >= MIN_PATCH_SHARE * total && total > 0.0).collect();
+    order.sort_by(|a, b| area(b).total_cmp(&area(a)));
+    let scaled = |t: &[DVec3; 3], q: DVec3| t.map(|v| q + (v - q) * PATCH_SCALE);
+    let mut out: Vec<[DVec3; 3]> = order.iter().map(|t| scaled(t, (t[0] + t[1] + t[2]) / 3.0)).take(2).collect();
+    for t in &order {
+        let centre = (t[0] + t[1] + t[2]) / 3.0;
+        // Near a corner, the patch's far side a little short of it: inside the triangle.
+        out.extend(t.iter().map(|v| scaled(t, *v + (centre - *v) * PATCH_SCALE)));
+    }
+    out.truncate(MAX_PATCHES);
+    out
 }
 
 /// The certificates of one scene. Build once, then ask [`Self::certify`].
@@ -106,15 +155,7 @@ impl Certifier {
     pub fn new(scene: &Scene) -> Self {
         let extent = (scene.bounds.1 - scene.bounds.0).length();
         let extent = if extent.is_finite() { extent } else { 0.0 };
-        let shapes = scene
-            .receivers
-            .iter()
-            .map(|r| {
-                let points: Vec<DVec3> = r.triangles.iter().flatten().copied().collect();
-                let lowest = points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-                Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id }
-            })
-            .collect();
+        let shapes = scene.receivers.iter().map(|r| Shape::receiver(&r.triangles, r.normal, r.gpu_id)).collect();
         Self { index: ExactEngine::new(scene), shapes, extent }
     }
 
@@ -125,11 +166,11 @@ impl Certifier {
         parallel_chunks(sets.len(), threads, CHUNK, || (), |i, _| self.certify(sets[i].0, sets[i].1, sets[i].2))
     }
 
-    /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
-    /// can be proved (count those views). Every sun must be up and in front of the receiver.
-    pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+    /// The receiver's shape and a cone holding `suns`, where a proof may be looked for: every
+    /// sun up and in front of the receiver, and so the whole cone.
+    fn cone_of(&self, receiver: usize, suns: &[DVec3]) -> Option<(&Shape, DirectionCone)> {
         let shape = self.shapes.get(receiver).filter(|s| !s.points.is_empty())?;
-        if !(wanted.dark || wanted.lit) || suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
+        if suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
             return None;
         }
         let cone = DirectionCone::enclosing(suns)?;
@@ -137,6 +178,16 @@ impl Certifier {
         if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
             return None;
         }
+        Some((shape, cone))
+    }
+
+    /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
+    /// can be proved (count those views). Every sun must be up and in front of the receiver.
+    pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+        if !(wanted.dark || wanted.lit) {
+            return None;
+        }
+        let (shape, cone) = self.cone_of(receiver, suns)?;
         if wanted.lit && self.swept_is_empty(shape, &cone) {
             return Some(Certificate::Lit);
         }
@@ -155,6 +206,50 @@ impl Certifier {
             }
         });
         candidates.into_iter().any(|o| self.covers(shape, &cone, o)).then_some(Certificate::Dark)
+    }
+
+    /// For many sets (receiver, its suns), in order, the suns of each at which the receiver is
+    /// not proved partly lit ([`Self::not_dark`]): the set is tried whole, then in halves, down
+    /// to single suns. Natively over every core.
+    pub fn unproved_lit(&self, sets: &[(usize, &[DVec3])]) -> Vec<Vec<usize>> {
+        let threads = worker_threads().min(sets.len().div_ceil(CHUNK)).max(1);
+        parallel_chunks(
+            sets.len(),
+            threads,
+            CHUNK,
+            || (),
+            |i, _| {
+                let mut out = Vec::new();
+                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut out);
+                out
+            },
+        )
+    }
+
+    /// Pushes onto `out` the indices (from `first`) of `suns` not proved by [`Self::not_dark`],
+    /// halving the set where the whole is not proved: a shorter stretch of the sun's path sweeps
+    /// a thinner volume, which misses what the whole one reaches.
+    fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, out: &mut Vec<usize>) {
+        if suns.is_empty() || self.not_dark(receiver, suns) {
+            return;
+        }
+        if suns.len() == 1 {
+            out.push(first);
+            return;
+        }
+        let half = suns.len() / 2;
+        self.bisect_not_dark(receiver, &suns[..half], first, out);
+        self.bisect_not_dark(receiver, &suns[half..], first + half, out);
+    }
+
+    /// Whether some patch of the receiver (at least [`MIN_PATCH_SHARE`] of it) sweeps an empty
+    /// volume along every one of `suns`: that patch is then lit at each, so the receiver's
+    /// fraction is above EnergyPlus's 1e-5 there, never dark. What lets a step be interpolated:
+    /// a sliver of shadow between the samples may lower its fraction, but not to 0. Every
+    /// triangle counts, see-through or not.
+    pub fn not_dark(&self, receiver: usize, suns: &[DVec3]) -> bool {
+        let Some((shape, cone)) = self.cone_of(receiver, suns) else { return false };
+        shape.patches.iter().any(|p| self.swept_is_empty(p, &cone))
     }
 
     /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;

@@ -151,3 +151,56 @@ fn a_panelled_block_without_a_floor_proves_a_window_above_the_ground_dark() {
     let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
     assert!(ExactEngine::new(&scene).fractions(&requests).iter().all(|f| *f == 0.0));
 }
+
+/// Brute force for the partly-lit proof: random blocks round random windows, random cells of
+/// suns; every sun [`Certifier::unproved_lit`] leaves out (proved) must find the window's
+/// fraction, counted by the exact engine, above EnergyPlus's 1e-5; and the bisection proves
+/// most suns while leaving some to count, so the test means something.
+#[test]
+fn suns_proved_not_dark_are_lit_by_the_exact_engine() {
+    let mut seed = 11u64;
+    let mut next = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut proved, mut unproved, mut dark_found) = (0, 0, 0);
+    for _ in 0..6 {
+        let mut b = SceneBuilder::new();
+        for k in 0..4 {
+            let x = (next() * 20.0 - 10.0) as f32;
+            let z = (next() * 10.0) as f32;
+            b.add_object("test", &format!("W{k}"), window(x, x + 1.0 + next() as f32, z, z + 1.0, (next() * 4.0) as f32), true);
+        }
+        for k in 0..12 {
+            let (x, y) = ((next() * 40.0 - 25.0) as f32, (next() * 25.0 - 30.0) as f32);
+            let (w, d, h) = ((next() * 3.0 + 0.3) as f32, (next() * 3.0 + 0.3) as f32, (next() * 30.0 + 1.0) as f32);
+            b.add_object("test", &format!("P{k}"), block([x, y, 0.0], [x + w, y + d, h]), false);
+        }
+        let scene = b.build().unwrap();
+        let certifier = Certifier::new(&scene);
+        let exact = ExactEngine::new(&scene);
+        let cells: Vec<(usize, Vec<DVec3>)> = (0..40)
+            .map(|_| {
+                let first = 1 + (next() * 350.0) as u32;
+                let start = 6.0 + (next() * 10.0).floor() * 0.5;
+                let receiver = (next() * 4.0) as usize;
+                (receiver, suns(first..first + 14, (start, start + 1.0), scene.receivers[receiver].normal))
+            })
+            .collect();
+        let sets: Vec<(usize, &[DVec3])> = cells.iter().map(|(r, s)| (*r, s.as_slice())).collect();
+        for ((receiver, cell), left) in cells.iter().zip(certifier.unproved_lit(&sets)) {
+            let requests: Vec<ViewRequest> = cell.iter().map(|s| ViewRequest::new(*receiver as u32, *s)).collect();
+            for (k, f) in exact.fractions(&requests).into_iter().enumerate() {
+                if left.contains(&k) {
+                    unproved += 1;
+                    dark_found += usize::from(f < 1e-5);
+                } else {
+                    assert!(f >= 1e-5, "receiver {receiver} proved partly lit at {}: the exact engine says {f}", cell[k]);
+                    proved += 1;
+                }
+            }
+        }
+    }
+    println!("{proved} suns proved partly lit, {unproved} left to count ({dark_found} of them dark)");
+    assert!(proved > 3 * unproved && dark_found >= 10, "{proved} proved, {unproved} left, {dark_found} dark");
+}
