@@ -21,6 +21,9 @@
 //!   of either cone in the chart). Every such triangle counts, see-through or leaf or not: the
 //!   fraction is then exactly 1.
 //! - Otherwise: no certificate, and the steps are counted.
+//! - **Never dark** ([`Certifier::unproved_lit`]), for steps the year would interpolate: the lit
+//!   proof on a small patch of the receiver (at least 1e-4 of its area), so some of it is lit
+//!   and the fraction is above EnergyPlus's 1e-5 at every sun of the set.
 //!
 //! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
 //! objects: a closed convex polyhedron or a flat convex polygon; up to 64 triangles any such,
@@ -78,6 +81,20 @@ const MIN_CHART_COS: f64 = 1e-3;
 /// A lit proof is not looked for where the swept volume reaches more triangles than this (a
 /// city's street seen along a low sun): its cost would exceed the views it saves.
 const MAX_SWEPT: usize = 20_000;
+
+/// A swept volume is first searched this far (in scene extents, plus one unit) along the cone.
+const NEAR_REACH: f64 = 0.02;
+
+/// What a swept volume holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sweep {
+    /// Nothing but the receiver.
+    Empty,
+    /// A triangle that may shade it.
+    Blocked,
+    /// More than [`MAX_SWEPT`] triangles: not searched.
+    TooMany,
+}
 
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
@@ -249,32 +266,62 @@ impl Certifier {
     /// triangle counts, see-through or not.
     pub fn not_dark(&self, receiver: usize, suns: &[DVec3]) -> bool {
         let Some((shape, cone)) = self.cone_of(receiver, suns) else { return false };
-        shape.patches.iter().any(|p| self.swept_is_empty(p, &cone))
+        for patch in &shape.patches {
+            match self.sweep(patch, &cone) {
+                Sweep::Empty => return true,
+                // The patches' volumes are nearly the same: the next would reach as many.
+                Sweep::TooMany => return false,
+                Sweep::Blocked => {}
+            }
+        }
+        false
     }
 
     /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;
     /// false (no proof) as well where that volume reaches more than [`MAX_SWEPT`] triangles.
     fn swept_is_empty(&self, shape: &Shape, cone: &DirectionCone) -> bool {
-        let view = view::fit(&self.swept_corners(shape, cone), cone.axis(), self.index.bounds, self.index.origin, 64);
+        self.sweep(shape, cone) == Sweep::Empty
+    }
+
+    /// What the volume the receiver sweeps along the cone holds. The first [`NEAR_REACH`] of it
+    /// is looked at first: a caster close in front (a scrim's rod, a reveal) is found there with
+    /// a small search, and whatever lies in that part lies in the whole.
+    fn sweep(&self, shape: &Shape, cone: &DirectionCone) -> Sweep {
+        let near = NEAR_REACH * (1.0 + self.extent);
+        if near < self.reach(cone) && self.sweep_within(shape, cone, near) == Sweep::Blocked {
+            return Sweep::Blocked;
+        }
+        self.sweep_within(shape, cone, self.reach(cone))
+    }
+
+    /// [`Self::sweep`] over the part of the volume within `reach` of the receiver along each
+    /// generator (a convex volume holding every triangle point that far along the cone).
+    fn sweep_within(&self, shape: &Shape, cone: &DirectionCone, reach: f64) -> Sweep {
+        let view = view::fit(&self.swept_corners(shape, cone, reach), cone.axis(), self.index.bounds, self.index.origin, 64);
         let mut reached = Vec::new();
         self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
         if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
-            return false;
+            return Sweep::TooMany;
         }
         let mut w = Vec::new();
-        reached.into_iter().flatten().all(|p| {
+        let empty = reached.into_iter().flatten().all(|p| {
             (self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER)
                 || self.misses(shape, cone, &self.index.triangles[p], &mut w)
-        })
+        });
+        if empty { Sweep::Empty } else { Sweep::Blocked }
     }
 
-    /// Corners of a convex volume holding the part of `R + K` inside the scene's bounds: the
-    /// receiver's vertices and each moved along each generator far enough to leave the bounds.
-    fn swept_corners(&self, shape: &Shape, cone: &DirectionCone) -> Vec<DVec3> {
+    /// How far along a generator the swept volume must reach to leave the scene's bounds.
+    fn reach(&self, cone: &DirectionCone) -> f64 {
         // A direction d of the cone is Σ λ_k g_k with Σ λ_k ≤ |d| / min_k (g_k · axis); a point
         // of R + K in the bounds is at most the extent from its receiver point.
         let min_cos = cone.generators().iter().map(|g| g.dot(cone.axis())).fold(1.0, f64::min);
-        let reach = (self.extent + 1.0) / min_cos * 1.01;
+        (self.extent + 1.0) / min_cos * 1.01
+    }
+
+    /// Corners of a convex volume holding the part of `R + K` within `reach` along each
+    /// generator: the receiver's vertices and each moved along each generator by `reach`.
+    fn swept_corners(&self, shape: &Shape, cone: &DirectionCone, reach: f64) -> Vec<DVec3> {
         let mut out = shape.points.clone();
         for g in cone.generators() {
             out.extend(shape.points.iter().map(|p| *p + *g * reach));
