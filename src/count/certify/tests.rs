@@ -65,30 +65,40 @@ fn a_block_proves_a_window_dark_and_an_empty_street_proves_it_lit() {
     assert_eq!(Certifier::new(&scene).certify(0, &winter, both), Some(Certificate::Lit));
 }
 
+/// A reproducible uniform draw in [0, 1).
+fn random(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Four random south-facing windows and twelve random blocks south of them, each block
+/// `width.0 · u + width.1` long and `depth.0 · u + depth.1` deep, up to 31 m high.
+fn random_street(next: &mut impl FnMut() -> f64, width: (f64, f64), depth: (f64, f64)) -> Scene {
+    let mut b = SceneBuilder::new();
+    for k in 0..4 {
+        let x = (next() * 20.0 - 10.0) as f32;
+        let z = (next() * 10.0) as f32;
+        b.add_object("test", &format!("W{k}"), window(x, x + 1.0 + next() as f32, z, z + 1.0, (next() * 4.0) as f32), true);
+    }
+    for k in 0..12 {
+        let (x, y) = ((next() * 40.0 - 25.0) as f32, (next() * 25.0 - 30.0) as f32);
+        let (w, d, h) = ((next() * width.0 + width.1) as f32, (next() * depth.0 + depth.1) as f32, (next() * 30.0 + 1.0) as f32);
+        b.add_object("test", &format!("B{k}"), block([x, y, 0.0], [x + w, y + d, h]), false);
+    }
+    b.build().unwrap()
+}
+
 /// Brute force against the exact engine: random blocks round random windows, random cells of
 /// suns; wherever a certificate is given, every sun of its cell is counted and must agree
 /// (0 for dark, 1 for lit); and enough are given that the test means something.
 #[test]
 fn certificates_agree_with_the_exact_engine_at_every_sun_of_their_cell() {
-    let mut seed = 7u64;
-    let mut next = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = random(7);
     let (mut dark, mut lit, mut checked) = (0, 0, 0);
     for _ in 0..8 {
-        let mut b = SceneBuilder::new();
-        for k in 0..4 {
-            let x = (next() * 20.0 - 10.0) as f32;
-            let z = (next() * 10.0) as f32;
-            b.add_object("test", &format!("W{k}"), window(x, x + 1.0 + next() as f32, z, z + 1.0, (next() * 4.0) as f32), true);
-        }
-        for k in 0..12 {
-            let (x, y) = ((next() * 40.0 - 25.0) as f32, (next() * 25.0 - 30.0) as f32);
-            let (w, d, h) = ((next() * 20.0 + 0.5) as f32, (next() * 6.0 + 0.5) as f32, (next() * 30.0 + 1.0) as f32);
-            b.add_object("test", &format!("B{k}"), block([x, y, 0.0], [x + w, y + d, h]), false);
-        }
-        let scene = b.build().unwrap();
+        let scene = random_street(&mut next, (20.0, 0.5), (6.0, 0.5));
         let certifier = Certifier::new(&scene);
         let exact = ExactEngine::new(&scene);
         for _ in 0..60 {
@@ -158,25 +168,10 @@ fn a_panelled_block_without_a_floor_proves_a_window_above_the_ground_dark() {
 /// most suns while leaving some to count, so the test means something.
 #[test]
 fn suns_proved_not_dark_are_lit_by_the_exact_engine() {
-    let mut seed = 11u64;
-    let mut next = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = random(11);
     let (mut proved, mut unproved, mut dark_found) = (0, 0, 0);
     for _ in 0..6 {
-        let mut b = SceneBuilder::new();
-        for k in 0..4 {
-            let x = (next() * 20.0 - 10.0) as f32;
-            let z = (next() * 10.0) as f32;
-            b.add_object("test", &format!("W{k}"), window(x, x + 1.0 + next() as f32, z, z + 1.0, (next() * 4.0) as f32), true);
-        }
-        for k in 0..12 {
-            let (x, y) = ((next() * 40.0 - 25.0) as f32, (next() * 25.0 - 30.0) as f32);
-            let (w, d, h) = ((next() * 3.0 + 0.3) as f32, (next() * 3.0 + 0.3) as f32, (next() * 30.0 + 1.0) as f32);
-            b.add_object("test", &format!("P{k}"), block([x, y, 0.0], [x + w, y + d, h]), false);
-        }
-        let scene = b.build().unwrap();
+        let scene = random_street(&mut next, (3.0, 0.3), (3.0, 0.3));
         let certifier = Certifier::new(&scene);
         let exact = ExactEngine::new(&scene);
         let cells: Vec<(usize, Vec<DVec3>)> = (0..40)
