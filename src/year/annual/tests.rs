@@ -1,0 +1,53 @@
+use super::*;
+use crate::scene::{SceneBuilder, SourceMesh};
+
+/// Five receivers facing south, east, north-west, up and a tilted north-east.
+fn facets() -> Scene {
+    let mut b = SceneBuilder::new();
+    let quads: [[[f32; 3]; 4]; 5] = [
+        [[0., 0., 0.], [1., 0., 0.], [1., 0., 1.], [0., 0., 1.]],
+        [[1., 0., 0.], [1., 1., 0.], [1., 1., 1.], [1., 0., 1.]],
+        [[1., 1., 0.], [0., 2., 0.], [0., 2., 1.], [1., 1., 1.]],
+        [[0., 0., 1.], [1., 0., 1.], [1., 1., 1.], [0., 1., 1.]],
+        [[2., 2., 0.], [3., 1., 0.], [2.5, 0.5, 1.], [1.5, 1.5, 1.]],
+    ];
+    for (k, q) in quads.iter().enumerate() {
+        b.add_object("test", &format!("R{k}"), SourceMesh { positions: q.to_vec(), indices: vec![0, 1, 2, 0, 2, 3] }, true);
+    }
+    b.build().unwrap()
+}
+
+/// Every sample cell gets a view whose sun is the one its own day and time would give, and
+/// twin days share views except where their pieces differ (polar day, New Year).
+#[test]
+fn twin_days_share_views_with_the_same_sun() {
+    let scene = facets();
+    let plan = SamplingPlan::new(27, 7).unwrap();
+    let taus = plan.taus();
+    for (latitude, at_least) in [(40.0, 0.45), (-33.9, 0.45), (75.0, 0.2)] {
+        let location = Location::new(latitude, 10.0, 1.0).unwrap();
+        let regimes = vec![Regime::year(plan, &taus, 1.0).unwrap()];
+        let views = sample_views(&scene, &location, &regimes, &taus);
+        let per_piece = plan.days * taus.len();
+        for &(request, _, cell) in &views.cells {
+            let (id, rest) = (cell / (MAX_PIECES * per_piece), cell % (MAX_PIECES * per_piece));
+            let (p, d, j) = (rest / per_piece, (rest % per_piece) / taus.len(), rest % taus.len());
+            let day = sun_day(regimes[0].days[d]);
+            let (start, end) = lit_intervals(&location, scene.receivers[id].normal, day, MIN_COS_INCIDENCE)[p];
+            let own = sun_direction(&location, day, start + taus[j] * (end - start));
+            let used = views.requests[request];
+            assert_eq!(used.receiver as usize, id);
+            assert!(own.distance(used.sun) < 1e-7, "{latitude}: receiver {id} day {day} τ {}: {own} vs {}", taus[j], used.sun);
+        }
+        let saved = 1.0 - views.requests.len() as f64 / views.cells.len() as f64;
+        assert!(saved >= at_least && saved < 0.5, "{latitude}: shared {saved:.3} of the views");
+    }
+}
+
+#[test]
+fn dark_samples_take_the_nearest_lit_value() {
+    let s = [None, Some(0.2), None, Some(0.8), None, None, None, None];
+    let filled = fill_dark(&s, 2, 4).unwrap();
+    assert_eq!(filled, vec![0.2, 0.2, 0.2, 0.8, 0.2, 0.2, 0.2, 0.8]);
+    assert_eq!(fill_dark(&[None, None, None], 1, 3), None);
+}
