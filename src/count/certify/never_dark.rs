@@ -41,6 +41,10 @@ pub const MIN_LIT_SHARE: f64 = 1e-4;
 /// centroid each way).
 const LINES: usize = 5;
 
+/// A footprint is taken along the cone's axis alone, dilated by how far the generators would
+/// move it, where that is at most this share of the disc's radius.
+const SLACK_SHARE: f64 = 0.25;
+
 /// Most times a candidate disc is checked against its whole swept volume and, blocked there,
 /// the search run again with what blocked it.
 const ROUNDS: usize = 4;
@@ -61,13 +65,14 @@ pub(super) struct Outline {
     radius: f64,
 }
 
-/// A caster's footprint on the receiver's plane over a cone: a convex polygon (counter-
-/// clockwise; one or two points where it has no area) and its bounds.
+/// A caster's footprint on the receiver's plane over a cone: within `slack` of a convex
+/// polygon (counter-clockwise; one or two points where it has no area), with its bounds.
 #[derive(Debug)]
 struct Footprint {
     hull: Vec<DVec2>,
     lo: DVec2,
     hi: DVec2,
+    slack: f64,
 }
 
 /// A bit-exact key of a point, for matching edges.
@@ -146,15 +151,24 @@ impl Outline {
                 front.push((p + (q - p) * (hp / (hp - hq)), 0.0));
             }
         }
-        let moved: Vec<DVec2> = cone
-            .generators()
+        // Along the axis alone, each corner moves at most `slack` from where a generator would
+        // take it; where that is small (a short run of suns) the footprint is the corners moved
+        // along the axis and dilated by it, else the hull over every generator.
+        let onto = |g: DVec3| g / g.dot(self.normal);
+        let axis = onto(cone.axis());
+        let highest = front.iter().map(|(_, hp)| *hp).fold(0.0, f64::max);
+        let slack = highest * cone.generators().iter().map(|g| (onto(*g) - axis).length()).fold(0.0, f64::max);
+        let narrow = slack <= SLACK_SHARE * self.radius;
+        let directions = if narrow { std::slice::from_ref(&axis) } else { cone.generators() };
+        let moved: Vec<DVec2> = directions
             .iter()
-            .flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - *g * (hp / g.dot(self.normal)))))
+            .map(|g| if narrow { *g } else { onto(*g) })
+            .flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - g * *hp)))
             .collect();
         let hull = convex_hull(&moved);
         let lo = hull.iter().fold(DVec2::INFINITY, |m, q| m.min(*q));
         let hi = hull.iter().fold(DVec2::NEG_INFINITY, |m, q| m.max(*q));
-        (lo.is_finite() && hi.is_finite()).then_some(Footprint { hull, lo, hi })
+        (lo.is_finite() && hi.is_finite()).then_some(Footprint { hull, lo, hi, slack: if narrow { slack } else { 0.0 } })
     }
 
     /// Whether `q` lies inside the polygon (even-odd rule over the boundary edges).
@@ -171,18 +185,19 @@ impl Outline {
     }
 
     /// A point where a disc of radius `r` is inside the polygon and clear of every footprint,
-    /// looked for at the centroid, then at the middle of the widest clear stretch of the lines
-    /// searched; None where none is found.
+    /// looked for at the centroid, then at the middle of the widest clear stretch of each line
+    /// searched in turn; None where none is found.
     fn find(&self, footprints: &[Footprint], r: f64) -> Option<DVec2> {
         if self.clear(self.centroid, r, footprints) {
             return Some(self.centroid);
         }
-        let mut stretches: Vec<(f64, DVec2)> = Vec::new();
-        for (o, d) in self.lines() {
-            stretches.extend(self.clear_stretches(o, d, r, footprints).into_iter().map(|(t0, t1)| (t1 - t0, o + d * (0.5 * (t0 + t1)))));
-        }
-        stretches.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)).then(a.1.y.total_cmp(&b.1.y)));
-        stretches.into_iter().map(|(_, q)| q).find(|q| self.clear(*q, r, footprints))
+        // Line by line (the centroid's first), the widest clear stretch first.
+        self.lines().into_iter().find_map(|(o, d)| {
+            let mut stretches: Vec<(f64, DVec2)> =
+                self.clear_stretches(o, d, r, footprints).into_iter().map(|(t0, t1)| (t1 - t0, o + d * (0.5 * (t0 + t1)))).collect();
+            stretches.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)).then(a.1.y.total_cmp(&b.1.y)));
+            stretches.into_iter().map(|(_, q)| q).find(|q| self.clear(*q, r, footprints))
+        })
     }
 
     /// The lines searched (a point and a unit direction): [`LINES`] evenly across the bounds in
@@ -231,6 +246,7 @@ impl Outline {
 impl Footprint {
     /// Whether `q` is at least `r` from the footprint.
     fn distance_at_least(&self, q: DVec2, r: f64) -> bool {
+        let r = r + self.slack;
         if q.x < self.lo.x - r || q.x > self.hi.x + r || q.y < self.lo.y - r || q.y > self.hi.y + r {
             return true;
         }
@@ -243,6 +259,7 @@ impl Footprint {
     /// the footprint dilated by a disc being convex, spanned by the edges' capsules (the line
     /// meets the footprint only between two points of its boundary).
     fn interval(&self, o: DVec2, d: DVec2, r: f64) -> Option<(f64, f64)> {
+        let r = r + self.slack;
         let across = DVec2::new(-d.y, d.x);
         let (lo, hi) = ((self.lo - o).dot(across), (self.hi - o).dot(across));
         if lo.min(hi) > r || lo.max(hi) < -r {
@@ -309,7 +326,7 @@ impl Certifier {
             || (),
             |i, _| {
                 let mut out = Vec::new();
-                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut out);
+                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut None, &mut out);
                 out
             },
         )
@@ -317,9 +334,10 @@ impl Certifier {
 
     /// Pushes onto `out` the indices (from `first`) of `suns` not proved by [`Self::not_dark`],
     /// halving the set where the whole is not proved: a shorter stretch of the sun's path sweeps
-    /// thinner footprints, between which a disc may pass.
-    fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, out: &mut Vec<usize>) {
-        if suns.is_empty() || self.not_dark(receiver, suns) {
+    /// thinner footprints, between which a disc may pass. `near`: the casters near the receiver
+    /// found for the first set tried, searched first in its halves too.
+    fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, near: &mut Option<Vec<usize>>, out: &mut Vec<usize>) {
+        if suns.is_empty() || self.not_dark_near(receiver, suns, near) {
             return;
         }
         if suns.len() == 1 {
@@ -327,14 +345,21 @@ impl Certifier {
             return;
         }
         let half = suns.len() / 2;
-        self.bisect_not_dark(receiver, &suns[..half], first, out);
-        self.bisect_not_dark(receiver, &suns[half..], first + half, out);
+        self.bisect_not_dark(receiver, &suns[..half], first, near, out);
+        self.bisect_not_dark(receiver, &suns[half..], first + half, near, out);
     }
 
     /// Whether some disc of the receiver holding [`MIN_LIT_SHARE`] of its area is lit at every
     /// one of `suns` (see the module's doc): its fraction is then above EnergyPlus's 1e-5 at
     /// each, never dark.
     pub fn not_dark(&self, receiver: usize, suns: &[DVec3]) -> bool {
+        self.not_dark_near(receiver, suns, &mut None)
+    }
+
+    /// [`Self::not_dark`], the first candidate disc looked for among the casters `near` the
+    /// receiver (found here along these suns where None). Which casters those are only guides
+    /// the search: every caster in the volume the disc sweeps is checked.
+    fn not_dark_near(&self, receiver: usize, suns: &[DVec3], near: &mut Option<Vec<usize>>) -> bool {
         let Some((shape, cone)) = self.cone_of(receiver, suns) else { return false };
         let Some(outline) = &shape.outline else { return false };
         let tolerance = PLANE_TOLERANCE * (1.0 + self.extent);
@@ -343,23 +368,22 @@ impl Certifier {
         let reach = self.reach(&cone);
         let mut seen = HashSet::new();
         let mut footprints = Vec::new();
-        let mut add = |positions: Vec<usize>, footprints: &mut Vec<Footprint>| {
+        let mut add = |positions: &[usize], footprints: &mut Vec<Footprint>| {
             let own = |p: usize| self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER;
-            let fresh: Vec<usize> = positions.into_iter().filter(|p| !own(*p) && seen.insert(*p)).collect();
+            let fresh: Vec<usize> = positions.iter().copied().filter(|p| !own(*p) && seen.insert(*p)).collect();
             let start = footprints.len();
             footprints.extend(fresh.iter().filter_map(|p| outline.footprint(&self.index.triangles[*p], &cone, tolerance)));
             start
         };
         // The casters near the receiver (a scrim's rods, a reveal) first, for a good candidate;
         // what the candidate's own volume holds decides.
-        let near = NEAR_REACH * (1.0 + self.extent);
-        if let Some(found) = self.reached(&shape.points, &cone, near.min(reach)) {
-            add(found, &mut footprints);
-        }
+        let near = near
+            .get_or_insert_with(|| self.reached(&shape.points, &cone, (NEAR_REACH * (1.0 + self.extent)).min(reach)).unwrap_or_default());
+        add(near, &mut footprints);
         for _ in 0..ROUNDS {
             let Some(q) = outline.find(&footprints, r) else { return false };
             let Some(found) = self.reached(&outline.square(q, r), &cone, reach) else { return false };
-            let start = add(found, &mut footprints);
+            let start = add(&found, &mut footprints);
             if footprints[start..].iter().all(|f| f.distance_at_least(q, r)) {
                 return true;
             }
