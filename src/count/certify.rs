@@ -118,16 +118,45 @@ struct Shape {
     outline: Option<Outline>,
 }
 
+/// The exact engine's index of the scene: the certifier's own, or one an engine built.
+enum Index<'a> {
+    Own(Box<ExactEngine>),
+    Shared(&'a ExactEngine),
+}
+
+impl std::ops::Deref for Index<'_> {
+    type Target = ExactEngine;
+
+    fn deref(&self) -> &ExactEngine {
+        match self {
+            Index::Own(index) => index,
+            Index::Shared(index) => index,
+        }
+    }
+}
+
 /// The certificates of one scene. Build once, then ask [`Self::certify`].
-pub struct Certifier {
-    index: ExactEngine,
+pub struct Certifier<'a> {
+    index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
 }
 
-impl Certifier {
+impl Certifier<'static> {
     /// Indexes `scene` (the exact engine's culling and convex objects).
     pub fn new(scene: &Scene) -> Self {
+        Certifier::with_index(scene, Index::Own(Box::new(ExactEngine::new(scene))))
+    }
+}
+
+impl<'a> Certifier<'a> {
+    /// Certifies over `index`, the exact engine's index of `scene` that an engine already built
+    /// (on a city, building a second one cost as much as the proofs).
+    pub fn sharing(scene: &Scene, index: &'a ExactEngine) -> Self {
+        Certifier::with_index(scene, Index::Shared(index))
+    }
+
+    fn with_index(scene: &Scene, index: Index<'a>) -> Self {
         let extent = (scene.bounds.1 - scene.bounds.0).length();
         let extent = if extent.is_finite() { extent } else { 0.0 };
         let shapes = scene
@@ -140,7 +169,7 @@ impl Certifier {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index: ExactEngine::new(scene), shapes, extent }
+        Self { index, shapes, extent }
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;

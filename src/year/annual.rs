@@ -531,7 +531,7 @@ async fn spline_year(
     let rough = if rough.is_empty() && smooth.is_empty() {
         rough
     } else {
-        certified::certify_steps(scene, location, schedule.timesteps, rough, smooth, schedule)
+        certified::certify_steps(scene, views.engine.index(), location, schedule.timesteps, rough, smooth, schedule)
     };
     // Certified timesteps are settled like interpolated ones: done, not counted.
     let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;

@@ -18,6 +18,7 @@
 use glam::DVec3;
 
 use crate::count::certify::{Certificate, Certifier, Wanted};
+use crate::count::exact::engine::ExactEngine;
 use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
@@ -145,16 +146,21 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Sc
 
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
 /// the rest, to count, with the interpolated ones not proved never dark
-/// ([`never_dark`]).
+/// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one.
+#[allow(clippy::too_many_arguments)] // The year's steps and where they go; grouping them would hide nothing.
 pub(super) fn certify_steps(
     scene: &Scene,
+    index: Option<&ExactEngine>,
     location: &Location,
     timesteps: Timesteps,
     rough: Vec<Rough>,
     smooth: Vec<Smooth>,
     schedule: &mut Schedule,
 ) -> Vec<Rough> {
-    let certifier = Certifier::new(scene);
+    let certifier = match index {
+        Some(index) => Certifier::sharing(scene, index),
+        None => Certifier::new(scene),
+    };
     let asked = rough.len();
     let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
     let interpolated = smooth.len();

@@ -84,6 +84,17 @@ struct Onto {
     spread: f64,
 }
 
+/// The casters a never-dark search has taken (or passed over as never near).
+#[derive(Default)]
+struct Seen {
+    /// Convex casters, by object.
+    casters: HashSet<u32>,
+    /// Convex casters with a corner behind the receiver's plane: taken triangle by triangle.
+    straddling: HashSet<u32>,
+    /// Triangles taken one by one (not convex, or of a straddling caster), by position.
+    triangles: HashSet<usize>,
+}
+
 /// A bit-exact key of a point, for matching edges.
 type Key = [u64; 3];
 
@@ -153,10 +164,8 @@ impl Outline {
 
     /// The footprint of triangle `t` over the cone (`onto`, whose generators all face the
     /// plane); None where `t` lies on or behind the plane (within `tolerance`), as both engines
-    /// ignore it, or where the footprint stays `r` or more outside the polygon's bounds, so that
-    /// no disc of radius `r` on the polygon is near it: its hull is then never built. Most
-    /// casters a swept volume reaches in a city are such (the culling is a box about the volume,
-    /// and a scrim's rods above and below the window pass their shadows past its bounds).
+    /// ignore it, or where the footprint stays `r` or more outside the polygon's bounds
+    /// ([`Self::footprint_of`]).
     fn footprint(&self, t: &[DVec3; 3], onto: &Onto, tolerance: f64, r: f64) -> Option<Footprint> {
         let h = t.map(|p| (p - self.origin).dot(self.normal));
         if h.iter().all(|x| *x <= tolerance) {
@@ -176,7 +185,34 @@ impl Outline {
                 n += 1;
             }
         }
-        let front = &front[..n];
+        self.footprint_of(&front[..n], onto, r)
+    }
+
+    /// The footprint over the cone of a whole convex caster whose `corners` all lie on or in
+    /// front of the plane (none below 0): the convex hull of its corners moved along each
+    /// generator, since every ray of the cone that hits the solid leaves it through the hull of
+    /// those points. It holds the footprint of every triangle of the caster (each lies in the
+    /// hull), so one footprint stands for all of them: a rod's 12 triangles, a panelled block's
+    /// thousands. None where it has no part in front (within `tolerance`), or where some
+    /// corner lies behind the plane (its triangles are then taken one by one), or where it stays
+    /// `r` off the polygon's bounds.
+    fn caster_footprint(&self, corners: &[DVec3], onto: &Onto, tolerance: f64, r: f64) -> Option<Option<Footprint>> {
+        let front: Vec<(DVec3, f64)> = corners.iter().map(|p| (*p, (*p - self.origin).dot(self.normal))).collect();
+        if front.iter().any(|(_, h)| *h < 0.0 || h.is_nan()) {
+            return None;
+        }
+        if front.iter().all(|(_, h)| *h <= tolerance) {
+            return Some(None);
+        }
+        Some(self.footprint_of(&front, onto, r))
+    }
+
+    /// The footprint over the cone of the convex hull of `front` (points on or in front of the
+    /// plane, with their heights); None where it stays `r` or more outside the polygon's bounds,
+    /// so that no disc of radius `r` on the polygon is near it: its hull is then never built.
+    /// Most casters a swept volume reaches in a city are such (the culling is a box about the
+    /// volume, and a scrim's rods above and below the window pass their shadows past its bounds).
+    fn footprint_of(&self, front: &[(DVec3, f64)], onto: &Onto, r: f64) -> Option<Footprint> {
         // Along the axis alone, each corner moves at most `slack` from where a direction of the
         // cone would take it (the scaled directions are convex combinations of the scaled
         // generators). So a footprint whose corners moved along the axis stay `slack + r` off
@@ -351,7 +387,7 @@ fn capsule_interval(o: DVec2, d: DVec2, a: DVec2, b: DVec2, r: f64) -> Option<(f
     [disc(a), disc(b), band()].into_iter().flatten().reduce(|x, y| (x.0.min(y.0), x.1.max(y.1)))
 }
 
-impl Certifier {
+impl Certifier<'_> {
     /// For many sets (receiver, its suns), in order, the suns of each at which the receiver is
     /// not proved partly lit ([`Self::not_dark`]): the set is tried whole, then in halves, down
     /// to single suns. Natively over every core.
@@ -405,18 +441,42 @@ impl Certifier {
         let r = outline.radius + COVER_MARGIN * (1.0 + self.extent);
         let reach = self.reach(&cone);
         let onto = outline.onto(&cone);
-        let mut seen = HashSet::new();
+        let mut seen = Seen::default();
         let mut footprints = Vec::new();
         // Footprints of the fresh casters among `positions` that may come near a disc, and
-        // which casters those were.
+        // which casters those were (one position each).
         let mut add = |positions: &[usize], footprints: &mut Vec<Footprint>, kept: &mut Vec<usize>| {
             let own = |p: usize| self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER;
             let start = footprints.len();
             for &p in positions {
-                if own(p) || !seen.insert(p) {
+                if own(p) {
                     continue;
                 }
-                if let Some(f) = outline.footprint(&self.index.triangles[p], &onto, tolerance, r) {
+                // A convex caster's footprint once for all its triangles, where it lies wholly
+                // in front; else (or where it is not convex) the triangle's own.
+                let footprint = match self.index.objects.of(p) {
+                    Some(o) if !seen.straddling.contains(&o) => {
+                        if !seen.casters.insert(o) {
+                            continue;
+                        }
+                        let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c)).collect();
+                        match outline.caster_footprint(&corners, &onto, tolerance, r) {
+                            Some(footprint) => footprint,
+                            None => {
+                                seen.straddling.insert(o);
+                                seen.triangles.insert(p);
+                                outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                            }
+                        }
+                    }
+                    _ => {
+                        if !seen.triangles.insert(p) {
+                            continue;
+                        }
+                        outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                    }
+                };
+                if let Some(f) = footprint {
                     footprints.push(f);
                     kept.push(p);
                 }
@@ -498,5 +558,68 @@ mod tests {
             if footprint.is_some() { kept += 1 } else { left_out += 1 }
         }
         assert_eq!((kept, left_out), (1, 1));
+    }
+
+    /// One footprint for a whole convex caster holds every point any of its triangles shades
+    /// at any direction of the cone, and is a convex polygon wound counter-clockwise. A box
+    /// (a scrim's rod, 12 triangles) 0.6 m in front of a window, over a wide cone (so the hull
+    /// over the generators is taken, not the axis's dilation) and a narrow one (the dilation):
+    /// brute force over the box's surface points and the cone's scaled directions. A footprint
+    /// from the box's corners moved along the axis alone, without the generators, misses
+    /// shadow points here and fails; one from only the face nearest the window does too.
+    #[test]
+    fn a_casters_one_footprint_holds_every_shadow_of_its_triangles_and_is_convex() {
+        let corner = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        let window = [[corner(0.0, 0.0), corner(2.0, 0.0), corner(2.0, 2.0)], [corner(0.0, 0.0), corner(2.0, 2.0), corner(0.0, 2.0)]];
+        let outline = Outline::new(&window, -DVec3::Y).expect("a square has area");
+        let (lo, hi) = (DVec3::new(-0.5, -0.65, 0.9), DVec3::new(2.5, -0.6, 0.95));
+        let corners: Vec<DVec3> = (0..8).map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2])).collect();
+        let scaled = |tx: f64, tz: f64| DVec3::new(tx, -1.0, tz);
+        for (wide, edges) in [
+            (true, [(-0.4, 0.2), (0.4, 0.2), (-0.4, 0.8), (0.4, 0.8)]),
+            (false, [(0.1, 0.5), (0.1005, 0.5), (0.1, 0.5005), (0.1005, 0.5005)]),
+        ] {
+            let cone = DirectionCone::enclosing(&edges.map(|(tx, tz)| scaled(tx, tz).normalize())).expect("a cone");
+            let onto = outline.onto(&cone);
+            let footprint =
+                outline.caster_footprint(&corners, &onto, 1e-9, outline.radius).expect("wholly in front").expect("near the window");
+            assert_eq!(footprint.slack > 0.0, !wide, "the wide cone takes the generators' hull, the narrow one the axis's dilation");
+            let n = footprint.hull.len();
+            assert!(n >= 3, "a box's footprint has area");
+            for k in 0..n {
+                let (a, b, c) = (footprint.hull[k], footprint.hull[(k + 1) % n], footprint.hull[(k + 2) % n]);
+                assert!((b - a).perp_dot(c - b) > 0.0, "the footprint's hull turns right at {b}: not convex counter-clockwise");
+            }
+            // Every point of the box's surface (its faces sampled), along every sampled direction.
+            let steps = 12;
+            let mut tried = 0;
+            for (a, b) in edges.iter().zip(edges.iter().skip(1).chain(edges.first())) {
+                for s in 0..=steps {
+                    let w = f64::from(s) / f64::from(steps);
+                    let d = scaled(a.0 + (b.0 - a.0) * w, a.1 + (b.1 - a.1) * w);
+                    for i in 0..=steps {
+                        for j in 0..=steps {
+                            let (u, v) = (f64::from(i) / f64::from(steps), f64::from(j) / f64::from(steps));
+                            let faces = [
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y, lo.z + v * (hi.z - lo.z)),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), hi.y, lo.z + v * (hi.z - lo.z)),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y + v * (hi.y - lo.y), lo.z),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y + v * (hi.y - lo.y), hi.z),
+                            ];
+                            for p in faces {
+                                let height = (p - outline.origin).dot(outline.normal);
+                                let shadow = outline.flat(p - d * height);
+                                assert!(
+                                    !footprint.distance_at_least(shadow, 1e-9),
+                                    "wide {wide}: the shadow {shadow} of {p} falls outside the footprint"
+                                );
+                                tried += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(tried > 10_000);
+        }
     }
 }
