@@ -303,6 +303,27 @@ fn certificates_keep_every_minute_of_sun_in_a_canyon_of_blocks() {
     assert!(spline_views * 2 < dense_views, "{spline_views} views against {dense_views} dense");
 }
 
+/// A lit window across a street from a row of tall narrow posts: each post's shadow passes
+/// over the window once a day and covers it wholly for a step or two, mostly between samples
+/// whose cell is lit at all four corners, so neither the spread, the near-dark nor the kink rule
+/// counts the dip, and the spline would carry the window lit through it (as 72 steps on
+/// `sunlit bench canyon-slots` were before). A step is interpolated only where a patch of the
+/// window is proved lit at its sun (`year::certified::never_dark`), so the year tells dark from
+/// lit as counting every timestep does.
+#[test]
+fn a_post_passing_the_sun_between_samples_darkens_the_window() {
+    let mut s = TestScene::new();
+    s.polygon("WIN", &south_rect(0.0, 0.5, 0.0, 1.0, 0.0), true);
+    for (k, x) in [-14.0, -6.0, 3.0, 9.0].into_iter().enumerate() {
+        s.cuboid(&format!("POST_{k}"), DVec3::new(x, -8.0, 0.0), DVec3::new(x + 1.5, -6.5, 25.0));
+    }
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "posts");
+    assert!(lit > 10_000, "the window is lit at {lit} steps");
+    assert_eq!(disagree, 0, "steps dark in one and lit in the other");
+    assert!(mean <= 0.005, "mean |Δ| {mean}");
+    assert!(spline_views < dense_views, "{spline_views} views against {dense_views} dense");
+}
+
 /// The exact reference, tallying the views it is asked to count.
 struct Tally<'a> {
     exact: sunlit::count::exact::Exact<'a>,

@@ -21,6 +21,11 @@
 //!   of either cone in the chart). Every such triangle counts, see-through or leaf or not: the
 //!   fraction is then exactly 1.
 //! - Otherwise: no certificate, and the steps are counted.
+//! - **Never dark** ([`Certifier::unproved_lit`], [`never_dark`]), for steps the year would
+//!   interpolate: a disc of the receiver holding [`MIN_LIT_SHARE`] of its area is clear of every
+//!   caster's footprint over the cone, so the fraction is above EnergyPlus's 1e-5 at every sun
+//!   of the set. The disc is looked for past a union of casters, on the receiver's polygon, not
+//!   its triangles.
 //!
 //! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
 //! objects: a closed convex polyhedron or a flat convex polygon; up to 64 triangles any such,
@@ -32,10 +37,13 @@
 //! dark; it only stops a step being proved lit.
 
 pub mod cone;
+mod never_dark;
 
 use glam::{DVec2, DVec3};
 
 pub use cone::DirectionCone;
+pub use never_dark::MIN_LIT_SHARE;
+use never_dark::Outline;
 
 use crate::count::MIN_COS_INCIDENCE;
 use crate::count::exact::engine::{ExactEngine, parallel_chunks, worker_threads};
@@ -79,6 +87,20 @@ const MIN_CHART_COS: f64 = 1e-3;
 /// city's street seen along a low sun): its cost would exceed the views it saves.
 const MAX_SWEPT: usize = 20_000;
 
+/// A swept volume is first searched this far (in scene extents, plus one unit) along the cone.
+const NEAR_REACH: f64 = 0.02;
+
+/// What a swept volume holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sweep {
+    /// Nothing but the receiver.
+    Empty,
+    /// A triangle that may shade it.
+    Blocked,
+    /// More than [`MAX_SWEPT`] triangles: not searched.
+    TooMany,
+}
+
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
 
@@ -92,18 +114,49 @@ struct Shape {
     p0: DVec3,
     lowest: f64,
     gpu_id: u32,
+    /// Its polygon for the never-dark proof ([`never_dark`]); None where it has no area.
+    outline: Option<Outline>,
+}
+
+/// The exact engine's index of the scene: the certifier's own, or one an engine built.
+enum Index<'a> {
+    Own(Box<ExactEngine>),
+    Shared(&'a ExactEngine),
+}
+
+impl std::ops::Deref for Index<'_> {
+    type Target = ExactEngine;
+
+    fn deref(&self) -> &ExactEngine {
+        match self {
+            Index::Own(index) => index,
+            Index::Shared(index) => index,
+        }
+    }
 }
 
 /// The certificates of one scene. Build once, then ask [`Self::certify`].
-pub struct Certifier {
-    index: ExactEngine,
+pub struct Certifier<'a> {
+    index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
 }
 
-impl Certifier {
+impl Certifier<'static> {
     /// Indexes `scene` (the exact engine's culling and convex objects).
     pub fn new(scene: &Scene) -> Self {
+        Certifier::with_index(scene, Index::Own(Box::new(ExactEngine::new(scene))))
+    }
+}
+
+impl<'a> Certifier<'a> {
+    /// Certifies over `index`, the exact engine's index of `scene` that an engine already built
+    /// (on a city, building a second one cost as much as the proofs).
+    pub fn sharing(scene: &Scene, index: &'a ExactEngine) -> Self {
+        Certifier::with_index(scene, Index::Shared(index))
+    }
+
+    fn with_index(scene: &Scene, index: Index<'a>) -> Self {
         let extent = (scene.bounds.1 - scene.bounds.0).length();
         let extent = if extent.is_finite() { extent } else { 0.0 };
         let shapes = scene
@@ -112,10 +165,11 @@ impl Certifier {
             .map(|r| {
                 let points: Vec<DVec3> = r.triangles.iter().flatten().copied().collect();
                 let lowest = points.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
-                Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id }
+                let outline = Outline::new(&r.triangles, r.normal);
+                Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index: ExactEngine::new(scene), shapes, extent }
+        Self { index, shapes, extent }
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
@@ -125,11 +179,11 @@ impl Certifier {
         parallel_chunks(sets.len(), threads, CHUNK, || (), |i, _| self.certify(sets[i].0, sets[i].1, sets[i].2))
     }
 
-    /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
-    /// can be proved (count those views). Every sun must be up and in front of the receiver.
-    pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+    /// The receiver's shape and a cone holding `suns`, where a proof may be looked for: every
+    /// sun up and in front of the receiver, and so the whole cone.
+    fn cone_of(&self, receiver: usize, suns: &[DVec3]) -> Option<(&Shape, DirectionCone)> {
         let shape = self.shapes.get(receiver).filter(|s| !s.points.is_empty())?;
-        if !(wanted.dark || wanted.lit) || suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
+        if suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
             return None;
         }
         let cone = DirectionCone::enclosing(suns)?;
@@ -137,6 +191,16 @@ impl Certifier {
         if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
             return None;
         }
+        Some((shape, cone))
+    }
+
+    /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
+    /// can be proved (count those views). Every sun must be up and in front of the receiver.
+    pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+        if !(wanted.dark || wanted.lit) {
+            return None;
+        }
+        let (shape, cone) = self.cone_of(receiver, suns)?;
         if wanted.lit && self.swept_is_empty(shape, &cone) {
             return Some(Certificate::Lit);
         }
@@ -160,29 +224,52 @@ impl Certifier {
     /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;
     /// false (no proof) as well where that volume reaches more than [`MAX_SWEPT`] triangles.
     fn swept_is_empty(&self, shape: &Shape, cone: &DirectionCone) -> bool {
-        let view = view::fit(&self.swept_corners(shape, cone), cone.axis(), self.index.bounds, self.index.origin, 64);
+        self.sweep(shape, cone) == Sweep::Empty
+    }
+
+    /// What the volume the receiver sweeps along the cone holds. The first [`NEAR_REACH`] of it
+    /// is looked at first: a caster close in front (a scrim's rod, a reveal) is found there with
+    /// a small search, and whatever lies in that part lies in the whole.
+    fn sweep(&self, shape: &Shape, cone: &DirectionCone) -> Sweep {
+        let near = NEAR_REACH * (1.0 + self.extent);
+        if near < self.reach(cone) && self.sweep_within(shape, cone, near) == Sweep::Blocked {
+            return Sweep::Blocked;
+        }
+        self.sweep_within(shape, cone, self.reach(cone))
+    }
+
+    /// [`Self::sweep`] over the part of the volume within `reach` of the receiver along each
+    /// generator (a convex volume holding every triangle point that far along the cone).
+    fn sweep_within(&self, shape: &Shape, cone: &DirectionCone, reach: f64) -> Sweep {
+        let view = view::fit(&self.swept_corners(&shape.points, cone, reach), cone.axis(), self.index.bounds, self.index.origin, 64);
         let mut reached = Vec::new();
         self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
         if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
-            return false;
+            return Sweep::TooMany;
         }
         let mut w = Vec::new();
-        reached.into_iter().flatten().all(|p| {
+        let empty = reached.into_iter().flatten().all(|p| {
             (self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER)
                 || self.misses(shape, cone, &self.index.triangles[p], &mut w)
-        })
+        });
+        if empty { Sweep::Empty } else { Sweep::Blocked }
     }
 
-    /// Corners of a convex volume holding the part of `R + K` inside the scene's bounds: the
-    /// receiver's vertices and each moved along each generator far enough to leave the bounds.
-    fn swept_corners(&self, shape: &Shape, cone: &DirectionCone) -> Vec<DVec3> {
+    /// How far along a generator the swept volume must reach to leave the scene's bounds.
+    fn reach(&self, cone: &DirectionCone) -> f64 {
         // A direction d of the cone is Σ λ_k g_k with Σ λ_k ≤ |d| / min_k (g_k · axis); a point
         // of R + K in the bounds is at most the extent from its receiver point.
         let min_cos = cone.generators().iter().map(|g| g.dot(cone.axis())).fold(1.0, f64::min);
-        let reach = (self.extent + 1.0) / min_cos * 1.01;
-        let mut out = shape.points.clone();
+        (self.extent + 1.0) / min_cos * 1.01
+    }
+
+    /// Corners of a convex volume holding the part of `P + K` within `reach` along each
+    /// generator, for the convex hull `P` of `points` (a receiver's vertices): the points and
+    /// each moved along each generator by `reach`.
+    fn swept_corners(&self, points: &[DVec3], cone: &DirectionCone, reach: f64) -> Vec<DVec3> {
+        let mut out = points.to_vec();
         for g in cone.generators() {
-            out.extend(shape.points.iter().map(|p| *p + *g * reach));
+            out.extend(points.iter().map(|p| *p + *g * reach));
         }
         out
     }

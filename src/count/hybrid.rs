@@ -708,6 +708,10 @@ impl<'a> HybridEngine<'a> {
 }
 
 impl Engine for HybridEngine<'_> {
+    fn index(&self) -> Option<&ExactEngine> {
+        self.exact()
+    }
+
     fn batch(&self) -> usize {
         // Enough views that both engines have work and the GPU whole atlases.
         self.lanes().and_then(|l| l.first()).map_or(1024, |(c, _)| (c.tiles_per_batch() * 16).max(1024))

@@ -102,6 +102,12 @@ pub trait Engine {
     /// Told which kind of views follow, until told otherwise ([`ViewKind::Sun`] at first): an
     /// engine that prices views by a measured profile keeps one per kind.
     fn views_of(&self, _kind: ViewKind) {}
+
+    /// The exact engine's index of the scene, where this engine holds one: the certificates
+    /// ([`certify::Certifier::sharing`]) use it instead of building a second.
+    fn index(&self) -> Option<&exact::engine::ExactEngine> {
+        None
+    }
 }
 
 /// A leaf fraction as a [`ViewRequest`] takes it, refused outside 0 (bare) ..= 1 (full leaf).

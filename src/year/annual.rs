@@ -25,7 +25,6 @@
 
 use glam::DVec3;
 
-use crate::count::certify::Certifier;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
@@ -35,7 +34,7 @@ use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
 use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
-use crate::year::certified::{self, Rough};
+use crate::year::certified::{self, Rough, Smooth};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::refine;
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
@@ -542,8 +541,12 @@ async fn spline_year(
         fits.push(fit_regime(regime, samples, taus.len())?);
     }
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
-    let rough = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
-    let rough = if rough.is_empty() { rough } else { settle_by_certificate(scene, rough, schedule) };
+    let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, schedule);
+    let rough = if rough.is_empty() && smooth.is_empty() {
+        rough
+    } else {
+        certified::certify_steps(scene, views.engine.index(), location, schedule.timesteps, rough, smooth, schedule)
+    };
     // Certified timesteps are settled like interpolated ones: done, not counted.
     let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
@@ -557,15 +560,6 @@ async fn spline_year(
         .map(|(g, f)| FittedSurfaces { map: g.map, splines: f.into_iter().map(|p| p.map(|p| p.spline)).collect() })
         .collect();
     Ok(FittedYear::new(scene, location, *calendar, surfaces, regime_of, schedule.timesteps.days()))
-}
-
-/// Sets the refined timesteps that a certificate proves dark or lit ([`certified`]) and returns
-/// the rest, to count.
-fn settle_by_certificate(scene: &Scene, rough: Vec<Rough>, schedule: &mut Schedule) -> Vec<Rough> {
-    let asked = rough.len();
-    let (rest, dark, lit) = certified::settle(&Certifier::new(scene), rough, schedule);
-    log::info!("refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit, {} counted", rest.len());
-    rest
 }
 
 /// The views the sample grids need, and where each count goes.
@@ -709,14 +703,21 @@ struct Cell {
 }
 
 impl SampleCells {
+    /// The cell's first sample day and time (indices) around (day, τ).
+    fn at(&self, day: f64, tau: f64) -> (usize, usize) {
+        let x = (day - self.first_day) / self.spacing;
+        let k0 = x.floor().rem_euclid(self.days as f64) as usize % self.days;
+        let j0 = self.taus.partition_point(|t| *t <= tau).saturating_sub(1).min(self.taus.len().saturating_sub(2));
+        (k0, j0)
+    }
+
     /// The cell of samples around (day, τ) that the spline interpolates in.
     fn cell(&self, samples: &[f64], borrowed: &[bool], day: f64, tau: f64) -> Cell {
         let x = (day - self.first_day) / self.spacing;
         let u = x - x.floor();
-        let k0 = x.floor().rem_euclid(self.days as f64) as usize % self.days;
+        let (k0, j0) = self.at(day, tau);
         let k1 = (k0 + 1) % self.days;
         let s = self.taus.len();
-        let j0 = self.taus.partition_point(|t| *t <= tau).saturating_sub(1).min(s.saturating_sub(2));
         let j1 = (j0 + 1).min(s - 1);
         let corners = [samples[k0 * s + j0], samples[k0 * s + j1], samples[k1 * s + j0], samples[k1 * s + j1]];
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
@@ -728,8 +729,10 @@ impl SampleCells {
 
 /// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
 /// where dark) and returns the timesteps to count directly: those whose sample cell spreads
-/// more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]) or where the spline
-/// leaves its cell's bilinear interpolation ([`KINK`]).
+/// more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]), where the spline
+/// leaves its cell's bilinear interpolation ([`KINK`]), or dark at every sample of the year;
+/// and (refinement on) the interpolated ones, which are kept only where proved never dark
+/// ([`certified::never_dark`]).
 fn evaluate(
     scene: &Scene,
     location: &Location,
@@ -737,8 +740,8 @@ fn evaluate(
     regime_of: &dyn Fn(f64) -> usize,
     refine: f64,
     schedule: &mut Schedule,
-) -> Vec<Rough> {
-    let mut rough = Vec::new();
+) -> (Vec<Rough>, Vec<Smooth>) {
+    let (mut rough, mut smooth) = (Vec::new(), Vec::new());
     let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
     for day in 1..=schedule.timesteps.days() {
         let pieces: Vec<Vec<(f64, f64)>> =
@@ -757,19 +760,28 @@ fn evaluate(
                     continue;
                 }
                 let Some((fit, tau)) = fit_at(&pieces[column], column, instant.hour) else { continue };
-                if let Some(piece) = &regime.fits[fit] {
-                    let value = piece.spline.eval(grid_day, tau);
-                    schedule.set(row, column, as_energyplus(value));
-                    let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
-                    if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
-                        let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
-                        rough.push(Rough { row, column, sun, day, cell, corners });
+                let Some(piece) = &regime.fits[fit] else {
+                    // Dark at every sample: counted (or proved dark) with refinement on, not
+                    // guessed dark, since a slot of sun may light it between them.
+                    if refine < 1.0 {
+                        let at = regime.cells.at(grid_day, tau);
+                        rough.push(Rough { row, column, sun, day: day as f64, cell: (g, fit, at.0, at.1), corners: (0.0, 0.0) });
                     }
+                    continue;
+                };
+                let value = piece.spline.eval(grid_day, tau);
+                schedule.set(row, column, as_energyplus(value));
+                let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
+                if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
+                    let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
+                    rough.push(Rough { row, column, sun, day, cell, corners });
+                } else if refine < 1.0 {
+                    smooth.push(Smooth::new(row, column, fit, g, cell.at));
                 }
             }
         }
     }
-    rough
+    (rough, smooth)
 }
 
 /// With refinement on, whether a fitted `value` in `cell` is counted directly beyond the spread

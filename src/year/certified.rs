@@ -7,11 +7,24 @@
 //! with the counting stage ([`crate::count::certify`]), where the page and both engines share
 //! them. Exact either way: a certificate holds at every sun of its steps, so the schedule is what
 //! counting them would give, and a step no certificate settles is counted as before.
+//!
+//! The steps the spline interpolates are handed over too ([`Smooth`], [`never_dark`]): a sliver
+//! of shadow between the samples may take a lit cell's receiver wholly dark for a step (a tall
+//! block passing the sun in a street canyon), which no rule on the samples can see. A step is
+//! interpolated only where some patch of its receiver is proved lit at its sun
+//! ([`Certifier::unproved_lit`]); the rest are counted, so no dark step is ever interpolated as
+//! lit.
 
 use glam::DVec3;
 
 use crate::count::certify::{Certificate, Certifier, Wanted};
+use crate::count::exact::engine::ExactEngine;
 use crate::export::Schedule;
+use crate::scene::Scene;
+use crate::sun::location::Location;
+use crate::sun::position::sun_direction;
+use crate::year::annual::shading_sun_day;
+use crate::year::samples::Timesteps;
 
 /// A timestep the refinement counts directly unless a certificate settles it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,6 +37,62 @@ pub(super) struct Rough {
     pub cell: (usize, usize, usize, usize),
     /// The lowest and highest of the cell's four samples.
     pub corners: (f64, f64),
+}
+
+/// A timestep the spline interpolates, kept small (a city's year has millions): its row,
+/// receiver and sample cell (regime, fitted piece, the cell's first day and τ indices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Smooth {
+    pub row: u32,
+    pub column: u32,
+    pub fit: u32,
+    pub regime: u16,
+    pub at: (u16, u16),
+}
+
+impl Smooth {
+    /// The interpolated step at `row` of receiver `column`, in regime `regime`'s fitted piece
+    /// `fit` and its sample cell `(k, j)` (first day and τ indices).
+    pub(super) fn new(row: usize, column: usize, fit: usize, regime: usize, (k, j): (usize, usize)) -> Self {
+        let small = |x: usize| u16::try_from(x).unwrap_or(u16::MAX);
+        Smooth { row: row as u32, column: column as u32, fit: fit as u32, regime: small(regime), at: (small(k), small(j)) }
+    }
+}
+
+/// Interpolated steps proved per batch: bounds the suns held at once.
+const SMOOTH_BATCH: usize = 1 << 18;
+
+/// The interpolated steps of `smooth` whose receiver is not proved partly lit at their sun
+/// (`sun_of` gives a row's sun and calendar day), as steps to count. The steps of one receiver
+/// in one cell are proved together, then in halves where the whole fails.
+pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of: &dyn Fn(usize) -> (DVec3, f64)) -> Vec<Rough> {
+    smooth.sort_by_key(|s| (s.regime, s.fit, s.at, s.row));
+    let cells: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit, a.at) == (b.regime, b.fit, b.at)).collect();
+    let mut out = Vec::new();
+    let mut start = 0;
+    while start < cells.len() {
+        // Whole cells per batch, up to about SMOOTH_BATCH steps.
+        let mut end = start;
+        let mut steps = 0;
+        while end < cells.len() && (end == start || steps + cells[end].len() <= SMOOTH_BATCH) {
+            steps += cells[end].len();
+            end += 1;
+        }
+        let batch = &cells[start..end];
+        let suns: Vec<Vec<(DVec3, f64)>> = batch.iter().map(|c| c.iter().map(|s| sun_of(s.row as usize)).collect()).collect();
+        let directions: Vec<Vec<DVec3>> = suns.iter().map(|c| c.iter().map(|s| s.0).collect()).collect();
+        let sets: Vec<(usize, &[DVec3])> = batch.iter().zip(&directions).map(|(c, d)| (c[0].column as usize, d.as_slice())).collect();
+        for ((cell, suns), unproved) in batch.iter().zip(&suns).zip(certifier.unproved_lit(&sets)) {
+            out.extend(unproved.into_iter().map(|k| {
+                let s = cell[k];
+                let (sun, day) = suns[k];
+                let key = (usize::from(s.regime), s.fit as usize, usize::from(s.at.0), usize::from(s.at.1));
+                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0) }
+            }));
+        }
+        start = end;
+    }
+    out
 }
 
 /// Cells with fewer steps to settle than this are counted: one view costs about what a proof
@@ -73,4 +142,38 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Sc
     }
     let rest = rough.into_iter().zip(settled).filter(|(_, s)| !s).map(|(r, _)| r).collect();
     (rest, dark, lit)
+}
+
+/// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
+/// the rest, to count, with the interpolated ones not proved never dark
+/// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one.
+#[allow(clippy::too_many_arguments)] // The year's steps and where they go; grouping them would hide nothing.
+pub(super) fn certify_steps(
+    scene: &Scene,
+    index: Option<&ExactEngine>,
+    location: &Location,
+    timesteps: Timesteps,
+    rough: Vec<Rough>,
+    smooth: Vec<Smooth>,
+    schedule: &mut Schedule,
+) -> Vec<Rough> {
+    let certifier = match index {
+        Some(index) => Certifier::sharing(scene, index),
+        None => Certifier::new(scene),
+    };
+    let asked = rough.len();
+    let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
+    let interpolated = smooth.len();
+    let sun_of = |row: usize| {
+        let instant = timesteps.instant(row);
+        (sun_direction(location, shading_sun_day(instant.day), instant.hour), f64::from(instant.day))
+    };
+    let unproved = never_dark(&certifier, smooth, &sun_of);
+    log::info!(
+        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit; of {interpolated} interpolated, {} not proved never dark; {} counted",
+        unproved.len(),
+        rest.len() + unproved.len()
+    );
+    rest.extend(unproved);
+    rest
 }

@@ -1,0 +1,626 @@
+//! The never-dark proof: that at every sun of a set some disc of a receiver, holding at least
+//! [`MIN_LIT_SHARE`] of its area, is lit, so its fraction is above EnergyPlus's 1e-5 at each.
+//! What lets the year interpolate a step ([`crate::year`]): a sliver of shadow between the
+//! samples may lower its fraction, but not to 0.
+//!
+//! Owns the receiver's outline and the search for a lit disc. Both are taken from the receiver's
+//! polygon, never from its triangles: the outline is the triangles' boundary edges (an edge
+//! that one triangle uses), sorted, in a frame fixed by the normal, so a polygon listed from
+//! another corner (another triangulation) gives the same outline, the same discs tried and so
+//! the same steps proved.
+//!
+//! The proof is exact geometry. A triangle `T` in front of the receiver's plane shades a point
+//! of it at some direction of the cone `K` exactly where the point lies in `(T − K) ∩ plane`,
+//! its *footprint*: convex, and the convex hull of `T`'s corners (clipped to the front) moved
+//! along each generator onto the plane, since the rays `t − s·g` are the convex set's edges that
+//! cross the plane. A disc at distance at least its radius from every footprint is lit at every
+//! direction of the cone. So the search sees past a union of casters (a scrim's rods, a reveal
+//! and a neighbour) where none alone would leave the receiver lit: it looks, along a few lines
+//! across the receiver, for the widest stretch that no footprint dilated by the radius covers.
+//! A candidate found against the casters near the receiver is then checked against every
+//! triangle of the thin volume its own disc sweeps; a caster found there joins the footprints
+//! and the search is run again, a few rounds at most. Every triangle counts, see-through or leaf
+//! or not.
+
+use std::collections::{HashMap, HashSet};
+use std::f64::consts::PI;
+
+use glam::{DVec2, DVec3};
+
+use super::{CHUNK, COVER_MARGIN, Certifier, DirectionCone, MAX_SWEPT, NEAR_REACH, PLANE_TOLERANCE};
+use crate::count::exact::engine::{parallel_chunks, worker_threads};
+use crate::count::view::{self, convex_hull};
+use crate::scene::NO_RECEIVER;
+
+/// Least share of the receiver's area the lit disc holds: ten times EnergyPlus's 1e-5 (a
+/// fraction under it is written as 0), so a proved step is lit in the schedule with room for an
+/// engine's rounding.
+pub const MIN_LIT_SHARE: f64 = 1e-4;
+
+/// Lines searched across the receiver in each of its two directions (plus one through its
+/// centroid each way).
+const LINES: usize = 5;
+
+/// A footprint is taken along the cone's axis alone, dilated by how far the generators would
+/// move it, where that is at most this share of the disc's radius.
+const SLACK_SHARE: f64 = 0.25;
+
+/// Most times a candidate disc is checked against its whole swept volume and, blocked there,
+/// the search run again with what blocked it.
+const ROUNDS: usize = 4;
+
+/// A receiver's polygon in its own plane, independent of how it was cut into triangles.
+#[derive(Debug)]
+pub(super) struct Outline {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+    normal: DVec3,
+    /// Boundary edges, wound counter-clockwise about the normal, sorted.
+    edges: Vec<(DVec2, DVec2)>,
+    lo: DVec2,
+    hi: DVec2,
+    centroid: DVec2,
+    /// The lit disc's radius: its area is [`MIN_LIT_SHARE`] of the polygon's.
+    radius: f64,
+}
+
+/// A caster's footprint on the receiver's plane over a cone: within `slack` of a convex
+/// polygon (counter-clockwise; one or two points where it has no area), with its bounds.
+#[derive(Debug)]
+struct Footprint {
+    hull: Vec<DVec2>,
+    lo: DVec2,
+    hi: DVec2,
+    slack: f64,
+}
+
+/// A cone's directions scaled to rise one unit off the receiver's plane: a point that high
+/// moves by minus such a vector onto the plane.
+struct Onto {
+    axis: DVec3,
+    generators: Vec<DVec3>,
+    /// How far the farthest generator lies from the axis.
+    spread: f64,
+}
+
+/// The casters a never-dark search has taken (or passed over as never near).
+#[derive(Default)]
+struct Seen {
+    /// Convex casters, by object.
+    casters: HashSet<u32>,
+    /// Convex casters with a corner behind the receiver's plane: taken triangle by triangle.
+    straddling: HashSet<u32>,
+    /// Triangles taken one by one (not convex, or of a straddling caster), by position.
+    triangles: HashSet<usize>,
+}
+
+/// A bit-exact key of a point, for matching edges.
+type Key = [u64; 3];
+
+/// How many triangles use an undirected edge, and its ends as the first one winds it.
+type EdgeUses = HashMap<(Key, Key), (usize, DVec3, DVec3)>;
+
+fn key(p: DVec3) -> Key {
+    p.to_array().map(f64::to_bits)
+}
+
+impl Outline {
+    /// The outline of a flat receiver of `triangles` facing `normal`; None where it has no area.
+    pub(super) fn new(triangles: &[[DVec3; 3]], normal: DVec3) -> Option<Self> {
+        // An undirected edge that one triangle uses is on the boundary; two (a shared diagonal)
+        // is inside. A T-junction leaves both its long and its short edges, which only makes
+        // the distance test stricter and leaves the crossing parity right.
+        let mut uses = EdgeUses::new();
+        for t in triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (ka, kb) = (key(a), key(b));
+                if ka != kb {
+                    uses.entry(if ka < kb { (ka, kb) } else { (kb, ka) }).and_modify(|e| e.0 += 1).or_insert((1, a, b));
+                }
+            }
+        }
+        let mut boundary: Vec<(DVec3, DVec3)> = uses.into_values().filter(|e| e.0 == 1).map(|e| (e.1, e.2)).collect();
+        boundary.sort_by_key(|(a, b)| (key(*a), key(*b)));
+        let origin = boundary.iter().map(|e| e.0).min_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)).then(a.z.total_cmp(&b.z)))?;
+        let across = DVec3::Z.cross(normal);
+        let u = if across.length() > 0.1 { across } else { DVec3::X.cross(normal) }.try_normalize()?;
+        let v = normal.cross(u);
+        let flat = |p: DVec3| DVec2::new((p - origin).dot(u), (p - origin).dot(v));
+        let edges: Vec<(DVec2, DVec2)> = boundary.iter().map(|(a, b)| (flat(*a), flat(*b))).collect();
+        let twice_area: f64 = edges.iter().map(|(a, b)| a.perp_dot(*b)).sum();
+        if twice_area.is_nan() || twice_area <= 0.0 {
+            return None;
+        }
+        let centroid = edges.iter().map(|(a, b)| (*a + *b) * a.perp_dot(*b)).sum::<DVec2>() / (3.0 * twice_area);
+        let lo = edges.iter().fold(DVec2::INFINITY, |m, (a, _)| m.min(*a));
+        let hi = edges.iter().fold(DVec2::NEG_INFINITY, |m, (a, _)| m.max(*a));
+        let radius = (MIN_LIT_SHARE * 0.5 * twice_area / PI).sqrt();
+        Some(Self { origin, u, v, normal, edges, lo, hi, centroid, radius })
+    }
+
+    fn flat(&self, p: DVec3) -> DVec2 {
+        DVec2::new((p - self.origin).dot(self.u), (p - self.origin).dot(self.v))
+    }
+
+    fn world(&self, q: DVec2) -> DVec3 {
+        self.origin + q.x * self.u + q.y * self.v
+    }
+
+    /// The square of half-side `half` about `q`, in the world: it holds the disc there.
+    fn square(&self, q: DVec2, half: f64) -> [DVec3; 4] {
+        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, y)| self.world(q + DVec2::new(x, y) * half))
+    }
+
+    /// The cone's directions scaled onto the receiver's plane, once per cone.
+    fn onto(&self, cone: &DirectionCone) -> Onto {
+        let onto = |g: DVec3| g / g.dot(self.normal);
+        let axis = onto(cone.axis());
+        let generators: Vec<DVec3> = cone.generators().iter().map(|g| onto(*g)).collect();
+        let spread = generators.iter().map(|g| (*g - axis).length()).fold(0.0, f64::max);
+        Onto { axis, generators, spread }
+    }
+
+    /// The footprint of triangle `t` over the cone (`onto`, whose generators all face the
+    /// plane); None where `t` lies on or behind the plane (within `tolerance`), as both engines
+    /// ignore it, or where the footprint stays `r` or more outside the polygon's bounds
+    /// ([`Self::footprint_of`]).
+    fn footprint(&self, t: &[DVec3; 3], onto: &Onto, tolerance: f64, r: f64) -> Option<Footprint> {
+        let h = t.map(|p| (p - self.origin).dot(self.normal));
+        if h.iter().all(|x| *x <= tolerance) {
+            return None;
+        }
+        // The part in front (height ≥ 0); only it can be hit by rays leaving the plane forward.
+        let mut front = [(DVec3::ZERO, 0.0); 4];
+        let mut n = 0;
+        for k in 0..3 {
+            let (p, hp, q, hq) = (t[k], h[k], t[(k + 1) % 3], h[(k + 1) % 3]);
+            if hp >= 0.0 {
+                front[n] = (p, hp);
+                n += 1;
+            }
+            if (hp >= 0.0) != (hq >= 0.0) {
+                front[n] = (p + (q - p) * (hp / (hp - hq)), 0.0);
+                n += 1;
+            }
+        }
+        self.footprint_of(&front[..n], onto, r)
+    }
+
+    /// The footprint over the cone of a whole convex caster whose `corners` all lie on or in
+    /// front of the plane (none below 0): the convex hull of its corners moved along each
+    /// generator, since every ray of the cone that hits the solid leaves it through the hull of
+    /// those points. It holds the footprint of every triangle of the caster (each lies in the
+    /// hull), so one footprint stands for all of them: a rod's 12 triangles, a panelled block's
+    /// thousands. None where it has no part in front (within `tolerance`), or where some
+    /// corner lies behind the plane (its triangles are then taken one by one), or where it stays
+    /// `r` off the polygon's bounds.
+    fn caster_footprint(&self, corners: &[DVec3], onto: &Onto, tolerance: f64, r: f64) -> Option<Option<Footprint>> {
+        let front: Vec<(DVec3, f64)> = corners.iter().map(|p| (*p, (*p - self.origin).dot(self.normal))).collect();
+        if front.iter().any(|(_, h)| *h < 0.0 || h.is_nan()) {
+            return None;
+        }
+        if front.iter().all(|(_, h)| *h <= tolerance) {
+            return Some(None);
+        }
+        Some(self.footprint_of(&front, onto, r))
+    }
+
+    /// The footprint over the cone of the convex hull of `front` (points on or in front of the
+    /// plane, with their heights); None where it stays `r` or more outside the polygon's bounds,
+    /// so that no disc of radius `r` on the polygon is near it: its hull is then never built.
+    /// Most casters a swept volume reaches in a city are such (the culling is a box about the
+    /// volume, and a scrim's rods above and below the window pass their shadows past its bounds).
+    fn footprint_of(&self, front: &[(DVec3, f64)], onto: &Onto, r: f64) -> Option<Footprint> {
+        // Along the axis alone, each corner moves at most `slack` from where a direction of the
+        // cone would take it (the scaled directions are convex combinations of the scaled
+        // generators). So a footprint whose corners moved along the axis stay `slack + r` off
+        // the polygon's bounds is not near any disc: rejected before the generators are tried.
+        let highest = front.iter().map(|(_, hp)| *hp).fold(0.0, f64::max);
+        let slack = highest * onto.spread;
+        let along_axis: Vec<DVec2> = front.iter().map(|(p, hp)| self.flat(*p - onto.axis * *hp)).collect();
+        let (lo, hi) = bounds(&along_axis);
+        if !(lo.is_finite() && hi.is_finite()) || self.apart(lo, hi, r + slack) {
+            return None;
+        }
+        // Where the slack is small (a short run of suns) the footprint is the corners moved
+        // along the axis, dilated by it; else the hull over every generator.
+        if slack <= SLACK_SHARE * self.radius {
+            return Some(Footprint { hull: convex_hull(&along_axis), lo, hi, slack });
+        }
+        let moved: Vec<DVec2> = onto.generators.iter().flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - *g * *hp))).collect();
+        // The hull's bounds are the moved corners' bounds.
+        let (lo, hi) = bounds(&moved);
+        (!self.apart(lo, hi, r)).then(|| Footprint { hull: convex_hull(&moved), lo, hi, slack: 0.0 })
+    }
+
+    /// Whether the box `lo..hi` lies more than `reach` outside the polygon's bounds.
+    fn apart(&self, lo: DVec2, hi: DVec2, reach: f64) -> bool {
+        lo.x > self.hi.x + reach || lo.y > self.hi.y + reach || hi.x < self.lo.x - reach || hi.y < self.lo.y - reach
+    }
+
+    /// Whether `q` lies inside the polygon (even-odd rule over the boundary edges).
+    fn contains(&self, q: DVec2) -> bool {
+        self.edges.iter().filter(|(a, b)| (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y)).count() % 2
+            == 1
+    }
+
+    /// Whether a disc of radius `r` at `q` lies inside the polygon and clear of every footprint.
+    fn clear(&self, q: DVec2, r: f64, footprints: &[Footprint]) -> bool {
+        self.contains(q)
+            && self.edges.iter().all(|(a, b)| segment_distance(q, *a, *b) >= r)
+            && footprints.iter().all(|f| f.distance_at_least(q, r))
+    }
+
+    /// A point where a disc of radius `r` is inside the polygon and clear of every footprint,
+    /// looked for at the centroid, then at the middle of the widest clear stretch of each line
+    /// searched in turn; None where none is found.
+    fn find(&self, footprints: &[Footprint], r: f64) -> Option<DVec2> {
+        if self.clear(self.centroid, r, footprints) {
+            return Some(self.centroid);
+        }
+        // Line by line (the centroid's first), the widest clear stretch first.
+        self.lines().into_iter().find_map(|(o, d)| {
+            let mut stretches: Vec<(f64, DVec2)> =
+                self.clear_stretches(o, d, r, footprints).into_iter().map(|(t0, t1)| (t1 - t0, o + d * (0.5 * (t0 + t1)))).collect();
+            stretches.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)).then(a.1.y.total_cmp(&b.1.y)));
+            stretches.into_iter().map(|(_, q)| q).find(|q| self.clear(*q, r, footprints))
+        })
+    }
+
+    /// The lines searched (a point and a unit direction): [`LINES`] evenly across the bounds in
+    /// each direction, and one through the centroid each way.
+    fn lines(&self) -> Vec<(DVec2, DVec2)> {
+        let mut out = vec![(self.centroid, DVec2::Y), (self.centroid, DVec2::X)];
+        for k in 0..LINES {
+            let s = (k as f64 + 0.5) / LINES as f64;
+            out.push((DVec2::new(self.lo.x + s * (self.hi.x - self.lo.x), self.lo.y), DVec2::Y));
+            out.push((DVec2::new(self.lo.x, self.lo.y + s * (self.hi.y - self.lo.y)), DVec2::X));
+        }
+        out
+    }
+
+    /// Stretches (parameters along `o + t·d`) of the line inside the polygon, at least `r` from
+    /// its boundary and from every footprint.
+    fn clear_stretches(&self, o: DVec2, d: DVec2, r: f64, footprints: &[Footprint]) -> Vec<(f64, f64)> {
+        let side = |p: DVec2| d.perp_dot(p - o);
+        let mut crossings: Vec<f64> = self
+            .edges
+            .iter()
+            .filter(|(a, b)| (side(*a) > 0.0) != (side(*b) > 0.0))
+            .map(|(a, b)| (*a + (*b - *a) * (side(*a) / (side(*a) - side(*b))) - o).dot(d))
+            .collect();
+        crossings.sort_by(f64::total_cmp);
+        let mut blocked: Vec<(f64, f64)> = self.edges.iter().filter_map(|(a, b)| capsule_interval(o, d, *a, *b, r)).collect();
+        blocked.extend(footprints.iter().filter_map(|f| f.interval(o, d, r)));
+        blocked.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut out = Vec::new();
+        for inside in crossings.chunks_exact(2) {
+            let mut start = inside[0];
+            for (b0, b1) in blocked.iter().filter(|(b0, b1)| *b1 > inside[0] && *b0 < inside[1]) {
+                if *b0 > start {
+                    out.push((start, *b0));
+                }
+                start = start.max(*b1);
+            }
+            if inside[1] > start {
+                out.push((start, inside[1]));
+            }
+        }
+        out
+    }
+}
+
+impl Footprint {
+    /// Whether `q` is at least `r` from the footprint.
+    fn distance_at_least(&self, q: DVec2, r: f64) -> bool {
+        let r = r + self.slack;
+        if q.x < self.lo.x - r || q.x > self.hi.x + r || q.y < self.lo.y - r || q.y > self.hi.y + r {
+            return true;
+        }
+        let n = self.hull.len();
+        let inside = n >= 3 && (0..n).all(|k| (self.hull[(k + 1) % n] - self.hull[k]).perp_dot(q - self.hull[k]) >= 0.0);
+        !inside && (0..n).all(|k| segment_distance(q, self.hull[k], self.hull[(k + 1) % n]) >= r)
+    }
+
+    /// The parameters along `o + t·d` (d a unit axis) within `r` of the footprint: one interval,
+    /// the footprint dilated by a disc being convex, spanned by the edges' capsules (the line
+    /// meets the footprint only between two points of its boundary).
+    fn interval(&self, o: DVec2, d: DVec2, r: f64) -> Option<(f64, f64)> {
+        let r = r + self.slack;
+        let across = DVec2::new(-d.y, d.x);
+        let (lo, hi) = ((self.lo - o).dot(across), (self.hi - o).dot(across));
+        if lo.min(hi) > r || lo.max(hi) < -r {
+            return None;
+        }
+        let n = self.hull.len();
+        (0..n).filter_map(|k| capsule_interval(o, d, self.hull[k], self.hull[(k + 1) % n], r)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+    }
+}
+
+/// The bounds of `points`.
+fn bounds(points: &[DVec2]) -> (DVec2, DVec2) {
+    points.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), q| (lo.min(*q), hi.max(*q)))
+}
+
+/// Distance from `q` to the segment `ab`.
+fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let e = b - a;
+    let s = if e.length_squared() > 0.0 { ((q - a).dot(e) / e.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    q.distance(a + e * s)
+}
+
+/// The parameters along `o + t·d` (d unit) within `r` of the segment `ab`: the hull of the line's
+/// intervals in the two end discs and the band between them.
+fn capsule_interval(o: DVec2, d: DVec2, a: DVec2, b: DVec2, r: f64) -> Option<(f64, f64)> {
+    let disc = |c: DVec2| {
+        let along = (c - o).dot(d);
+        let off = (c - o).perp_dot(d);
+        (off.abs() <= r).then(|| {
+            let half = (r * r - off * off).max(0.0).sqrt();
+            (along - half, along + half)
+        })
+    };
+    let band = || {
+        let e = b - a;
+        let length = e.length();
+        if length == 0.0 {
+            return None;
+        }
+        let (along, across) = (e / length, DVec2::new(-e.y, e.x) / length);
+        // 0 ≤ (x − a)·along ≤ length and |(x − a)·across| ≤ r, with x = o + t·d.
+        let mut range = (f64::NEG_INFINITY, f64::INFINITY);
+        for (axis, low, high) in [(along, 0.0, length), (across, -r, r)] {
+            let (base, rate) = ((o - a).dot(axis), d.dot(axis));
+            if rate == 0.0 {
+                if base < low || base > high {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((low - base) / rate, (high - base) / rate);
+            range = (range.0.max(t0.min(t1)), range.1.min(t0.max(t1)));
+        }
+        (range.0 <= range.1).then_some(range)
+    };
+    [disc(a), disc(b), band()].into_iter().flatten().reduce(|x, y| (x.0.min(y.0), x.1.max(y.1)))
+}
+
+impl Certifier<'_> {
+    /// For many sets (receiver, its suns), in order, the suns of each at which the receiver is
+    /// not proved partly lit ([`Self::not_dark`]): the set is tried whole, then in halves, down
+    /// to single suns. Natively over every core.
+    pub fn unproved_lit(&self, sets: &[(usize, &[DVec3])]) -> Vec<Vec<usize>> {
+        let threads = worker_threads().min(sets.len().div_ceil(CHUNK)).max(1);
+        parallel_chunks(
+            sets.len(),
+            threads,
+            CHUNK,
+            || (),
+            |i, _| {
+                let mut out = Vec::new();
+                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut None, &mut out);
+                out
+            },
+        )
+    }
+
+    /// Pushes onto `out` the indices (from `first`) of `suns` not proved by [`Self::not_dark`],
+    /// halving the set where the whole is not proved: a shorter stretch of the sun's path sweeps
+    /// thinner footprints, between which a disc may pass. `near`: the casters near the receiver
+    /// found for the first set tried, searched first in its halves too.
+    fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, near: &mut Option<Vec<usize>>, out: &mut Vec<usize>) {
+        if suns.is_empty() || self.not_dark_near(receiver, suns, near) {
+            return;
+        }
+        if suns.len() == 1 {
+            out.push(first);
+            return;
+        }
+        let half = suns.len() / 2;
+        self.bisect_not_dark(receiver, &suns[..half], first, near, out);
+        self.bisect_not_dark(receiver, &suns[half..], first + half, near, out);
+    }
+
+    /// Whether some disc of the receiver holding [`MIN_LIT_SHARE`] of its area is lit at every
+    /// one of `suns` (see the module's doc): its fraction is then above EnergyPlus's 1e-5 at
+    /// each, never dark.
+    pub fn not_dark(&self, receiver: usize, suns: &[DVec3]) -> bool {
+        self.not_dark_near(receiver, suns, &mut None)
+    }
+
+    /// [`Self::not_dark`], the first candidate disc looked for among the casters `near` the
+    /// receiver (found here along these suns where None). Which casters those are only guides
+    /// the search: every caster in the volume the disc sweeps is checked.
+    fn not_dark_near(&self, receiver: usize, suns: &[DVec3], near: &mut Option<Vec<usize>>) -> bool {
+        let Some((shape, cone)) = self.cone_of(receiver, suns) else { return false };
+        let Some(outline) = &shape.outline else { return false };
+        let tolerance = PLANE_TOLERANCE * (1.0 + self.extent);
+        // The GPU rounds in f32 about the scene's origin: the disc keeps this much clear too.
+        let r = outline.radius + COVER_MARGIN * (1.0 + self.extent);
+        let reach = self.reach(&cone);
+        let onto = outline.onto(&cone);
+        let mut seen = Seen::default();
+        let mut footprints = Vec::new();
+        // Footprints of the fresh casters among `positions` that may come near a disc, and
+        // which casters those were (one position each).
+        let mut add = |positions: &[usize], footprints: &mut Vec<Footprint>, kept: &mut Vec<usize>| {
+            let own = |p: usize| self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER;
+            let start = footprints.len();
+            for &p in positions {
+                if own(p) {
+                    continue;
+                }
+                // A convex caster's footprint once for all its triangles, where it lies wholly
+                // in front; else (or where it is not convex) the triangle's own.
+                let footprint = match self.index.objects.of(p) {
+                    Some(o) if !seen.straddling.contains(&o) => {
+                        if !seen.casters.insert(o) {
+                            continue;
+                        }
+                        let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c)).collect();
+                        match outline.caster_footprint(&corners, &onto, tolerance, r) {
+                            Some(footprint) => footprint,
+                            None => {
+                                seen.straddling.insert(o);
+                                seen.triangles.insert(p);
+                                outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                            }
+                        }
+                    }
+                    _ => {
+                        if !seen.triangles.insert(p) {
+                            continue;
+                        }
+                        outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                    }
+                };
+                if let Some(f) = footprint {
+                    footprints.push(f);
+                    kept.push(p);
+                }
+            }
+            start
+        };
+        // The casters near the receiver (a scrim's rods, a reveal) first, for a good candidate;
+        // what the candidate's own volume holds decides. Found once per set, and only those
+        // whose footprint came near the receiver are handed to its halves.
+        let (listed, first) = match near.take() {
+            Some(listed) => (listed, false),
+            None => (self.reached(&shape.points, &cone, (NEAR_REACH * (1.0 + self.extent)).min(reach)).unwrap_or_default(), true),
+        };
+        let mut kept = Vec::new();
+        add(&listed, &mut footprints, &mut kept);
+        *near = Some(if first { kept } else { listed });
+        for _ in 0..ROUNDS {
+            let Some(q) = outline.find(&footprints, r) else { return false };
+            let Some(found) = self.reached(&outline.square(q, r), &cone, reach) else { return false };
+            let start = add(&found, &mut footprints, &mut Vec::new());
+            if footprints[start..].iter().all(|f| f.distance_at_least(q, r)) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The positions of the triangles the culling finds in the volume `points` sweep along the
+    /// cone within `reach`; None past [`MAX_SWEPT`].
+    fn reached(&self, points: &[DVec3], cone: &DirectionCone, reach: f64) -> Option<Vec<usize>> {
+        let corners = self.swept_corners(points, cone, reach);
+        let view = view::fit(&corners, cone.axis(), self.index.bounds, self.index.origin, 64);
+        let mut reached = Vec::new();
+        self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
+        if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
+            return None;
+        }
+        Some(reached.into_iter().flatten().collect())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A footprint is left out only where no direction of the cone casts its triangle within
+    /// the disc's radius of the polygon's bounds, and one kept holds every shadow point. A
+    /// triangle 10 m in front of a 2 m window, whose shadow along the cone's axis falls 1.3 m
+    /// beside the window but along one edge of the cone reaches it, is kept: a reject on the
+    /// axis alone, without the generators' slack, drops it and fails here. One farther aside is
+    /// left out, and no direction brings it near (brute force over the cone's scaled directions).
+    #[test]
+    fn a_footprint_is_left_out_only_where_no_direction_of_the_cone_brings_it_near() {
+        let corner = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        let window = [[corner(0.0, 0.0), corner(2.0, 0.0), corner(2.0, 2.0)], [corner(0.0, 0.0), corner(2.0, 2.0), corner(0.0, 2.0)]];
+        let outline = Outline::new(&window, -DVec3::Y).expect("a square has area");
+        let scaled = |tx: f64, tz: f64| DVec3::new(tx, -1.0, tz);
+        let edges = [(0.0, 0.3), (0.3, 0.3), (0.0, 0.32), (0.3, 0.32)];
+        let cone = DirectionCone::enclosing(&edges.map(|(tx, tz)| scaled(tx, tz).normalize())).expect("a narrow cone");
+        let onto = outline.onto(&cone);
+        let r = outline.radius;
+        let (mut kept, mut left_out) = (0, 0);
+        for x in [4.8, 10.0] {
+            let t = [DVec3::new(x, -10.0, 4.0), DVec3::new(x + 0.2, -10.0, 4.0), DVec3::new(x, -10.0, 4.5)];
+            let footprint = outline.footprint(&t, &onto, 1e-9, r);
+            for k in 0..=30 {
+                for (tz, p) in [(0.3, 0), (0.32, 1), (0.31, 2)] {
+                    let shadow = outline.flat(t[p] - scaled(0.3 * f64::from(k) / 30.0, tz) * 10.0);
+                    let near = !outline.apart(shadow, shadow, r);
+                    match &footprint {
+                        Some(f) => assert!(!f.distance_at_least(shadow, 1e-9), "the footprint at x = {x} misses the shadow {shadow}"),
+                        None => assert!(!near, "left out at x = {x}, yet the shadow {shadow} comes within the disc of the window"),
+                    }
+                }
+            }
+            // What a reject on the axis alone would have said: both apart.
+            let (lo, hi) = bounds(&t.map(|p| outline.flat(p - onto.axis * 10.0)));
+            assert!(outline.apart(lo, hi, r), "the triangle at x = {x} is near the window along the axis: the case tests nothing");
+            if footprint.is_some() { kept += 1 } else { left_out += 1 }
+        }
+        assert_eq!((kept, left_out), (1, 1));
+    }
+
+    /// One footprint for a whole convex caster holds every point any of its triangles shades
+    /// at any direction of the cone, and is a convex polygon wound counter-clockwise. A box
+    /// (a scrim's rod, 12 triangles) 0.6 m in front of a window, over a wide cone (so the hull
+    /// over the generators is taken, not the axis's dilation) and a narrow one (the dilation):
+    /// brute force over the box's surface points and the cone's scaled directions. A footprint
+    /// from the box's corners moved along the axis alone, without the generators, would miss
+    /// shadow points of the wide cone by about 0.26 m; one from only the face nearest the
+    /// window, those of its far face by about 0.04 m.
+    #[test]
+    fn a_casters_one_footprint_holds_every_shadow_of_its_triangles_and_is_convex() {
+        let corner = |x: f64, z: f64| DVec3::new(x, 0.0, z);
+        let window = [[corner(0.0, 0.0), corner(2.0, 0.0), corner(2.0, 2.0)], [corner(0.0, 0.0), corner(2.0, 2.0), corner(0.0, 2.0)]];
+        let outline = Outline::new(&window, -DVec3::Y).expect("a square has area");
+        let (lo, hi) = (DVec3::new(-0.5, -0.65, 0.9), DVec3::new(2.5, -0.6, 0.95));
+        let corners: Vec<DVec3> = (0..8).map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2])).collect();
+        let scaled = |tx: f64, tz: f64| DVec3::new(tx, -1.0, tz);
+        for (wide, edges) in [
+            (true, [(-0.4, 0.2), (0.4, 0.2), (-0.4, 0.8), (0.4, 0.8)]),
+            (false, [(0.1, 0.5), (0.1005, 0.5), (0.1, 0.5005), (0.1005, 0.5005)]),
+        ] {
+            let cone = DirectionCone::enclosing(&edges.map(|(tx, tz)| scaled(tx, tz).normalize())).expect("a cone");
+            let onto = outline.onto(&cone);
+            let footprint =
+                outline.caster_footprint(&corners, &onto, 1e-9, outline.radius).expect("wholly in front").expect("near the window");
+            assert_eq!(footprint.slack > 0.0, !wide, "the wide cone takes the generators' hull, the narrow one the axis's dilation");
+            let n = footprint.hull.len();
+            assert!(n >= 3, "a box's footprint has area");
+            for k in 0..n {
+                let (a, b, c) = (footprint.hull[k], footprint.hull[(k + 1) % n], footprint.hull[(k + 2) % n]);
+                assert!((b - a).perp_dot(c - b) > 0.0, "the footprint's hull turns right at {b}: not convex counter-clockwise");
+            }
+            // Every point of the box's surface (its faces sampled), along every sampled direction.
+            let steps = 12;
+            let mut tried = 0;
+            for (a, b) in edges.iter().zip(edges.iter().skip(1).chain(edges.first())) {
+                for s in 0..=steps {
+                    let w = f64::from(s) / f64::from(steps);
+                    let d = scaled(a.0 + (b.0 - a.0) * w, a.1 + (b.1 - a.1) * w);
+                    for i in 0..=steps {
+                        for j in 0..=steps {
+                            let (u, v) = (f64::from(i) / f64::from(steps), f64::from(j) / f64::from(steps));
+                            let faces = [
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y, lo.z + v * (hi.z - lo.z)),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), hi.y, lo.z + v * (hi.z - lo.z)),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y + v * (hi.y - lo.y), lo.z),
+                                DVec3::new(lo.x + u * (hi.x - lo.x), lo.y + v * (hi.y - lo.y), hi.z),
+                            ];
+                            for p in faces {
+                                let height = (p - outline.origin).dot(outline.normal);
+                                let shadow = outline.flat(p - d * height);
+                                assert!(
+                                    !footprint.distance_at_least(shadow, 1e-9),
+                                    "wide {wide}: the shadow {shadow} of {p} falls outside the footprint"
+                                );
+                                tried += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(tried > 10_000);
+        }
+    }
+}
