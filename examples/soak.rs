@@ -22,7 +22,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     let resolution: u32 = args.next().map(|a| a.parse()).transpose()?.unwrap_or(64);
     let scene = load_bytes(&[("office.glb".into(), office(2).to_glb())], &LoadOptions::default())?;
     let location = Location::new(39.74, -105.18, -7.0)?;
-    let options = AnnualOptions { timesteps: Timesteps::new(1)?, method: Method::Spline(SamplingPlan::new(6, 7)?), refine: 1.0 };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1)?,
+        method: Method::Spline(SamplingPlan::new(6, 7)?),
+        refine: 1.0,
+        prove_never_dark: false,
+    };
     let counter = pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))?;
     let gpu = counter.upload(&scene)?;
     let mut lanes = vec![(counter, gpu)];

@@ -136,6 +136,10 @@ struct AnnualArgs {
     /// edge sweeping through); 1 interpolates everywhere.
     #[arg(long, value_name = "T", default_value_t = sunlit::year::annual::DEFAULT_REFINE)]
     refine: f64,
+    /// Interpolate a timestep only where part of the surface is proved lit at its sun, and count
+    /// it otherwise: no shadow passing wholly between samples is lost (slower; off by default).
+    #[arg(long)]
+    prove_never_dark: bool,
     /// Output CSV, EnergyPlus's eplusshading.csv layout (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
@@ -215,6 +219,7 @@ impl AnnualArgs {
             days_per_year: Some(self.days_per_year),
             samples_per_day: Some(self.samples_per_day),
             refine: Some(self.refine),
+            prove_never_dark: Some(self.prove_never_dark),
             dense: Some(self.dense),
             evergreen: Some(self.evergreen),
             leaf_out: self.leaf_out.clone(),
@@ -434,6 +439,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("days_per_year", "--days-per-year"),
     ("samples_per_day", "--samples-per-day"),
     ("refine", "--refine"),
+    ("prove_never_dark", "--prove-never-dark"),
     ("resolution", "--resolution"),
     ("accuracy", "--accuracy"),
     ("hook", "--hook"),

@@ -26,7 +26,7 @@ fn golden() -> Location {
 fn year(scene: &Scene, method: Method, refine: f64, resolution: u32) -> Schedule {
     let counter = counter(resolution);
     let gpu = counter.upload(scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine };
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine, prove_never_dark: false };
     pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| Ok(()))).unwrap()
 }
 
@@ -44,6 +44,7 @@ fn two_lanes_count_the_same_year_as_one() {
         timesteps: Timesteps::new(1).unwrap(),
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
+        prove_never_dark: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut reports = 0;
@@ -66,7 +67,7 @@ fn a_failing_progress_callback_cancels_the_year() {
     let scene = load_bytes(&[("office.glb".into(), office(6).to_glb())], &LoadOptions::default()).unwrap();
     let counter = counter(128);
     let gpu = counter.upload(&scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method: Method::Dense, refine: 1.0 };
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method: Method::Dense, refine: 1.0, prove_never_dark: false };
     let mut reports = Vec::new();
     let result = pollster::block_on(annual(&counter, &gpu, &scene, &golden(), &options, &mut |p| {
         reports.push(p);
@@ -223,9 +224,10 @@ fn cli_bad_annual_input() {
     assert!(err.contains("no/such/folder/out.csv"), "{err}");
 }
 
-/// The exact engine's year for `scene` at 4 timesteps an hour, and the views it counted.
-fn exact_year(scene: &Scene, method: Method) -> (Schedule, usize) {
-    let options = AnnualOptions { timesteps: Timesteps::new(4).unwrap(), method, refine: DEFAULT_REFINE };
+/// The exact engine's year for `scene` at 4 timesteps an hour, and the views it counted;
+/// `prove_never_dark` as [`AnnualOptions::prove_never_dark`].
+fn exact_year(scene: &Scene, method: Method, prove_never_dark: bool) -> (Schedule, usize) {
+    let options = AnnualOptions { timesteps: Timesteps::new(4).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut views = 0;
     let schedule = pollster::block_on(sunlit::year::annual::annual_with(
@@ -245,9 +247,9 @@ fn exact_year(scene: &Scene, method: Method) -> (Schedule, usize) {
 
 /// The default year against counting every timestep, exact engine, Timestep 4: (views, dense
 /// views, steps lit in the dense year, steps dark in one and lit in the other, mean |Δ|).
-fn against_dense(scene: &Scene, label: &str) -> (usize, usize, usize, usize, f64) {
-    let (dense, dense_views) = exact_year(scene, Method::Dense);
-    let (spline, spline_views) = exact_year(scene, Method::Spline(SamplingPlan::default()));
+fn against_dense(scene: &Scene, label: &str, prove_never_dark: bool) -> (usize, usize, usize, usize, f64) {
+    let (dense, dense_views) = exact_year(scene, Method::Dense, false);
+    let (spline, spline_views) = exact_year(scene, Method::Spline(SamplingPlan::default()), prove_never_dark);
     let (mut disagree, mut lit) = (0, 0);
     for (a, b) in spline.values.iter().zip(&dense.values) {
         disagree += usize::from((*a > 0.0) != (*b > 0.0));
@@ -273,7 +275,7 @@ fn a_slot_of_sun_in_a_dark_canyon_is_not_lost() {
     s.polygon("WIN", &south_rect(1.8, 2.2, 0.0, 1.0, 0.0), true);
     s.polygon("WALL_W", &south_rect(-30.0, 2.95, 0.0, 12.0, -6.0), false);
     s.polygon("WALL_E", &south_rect(3.05, 30.0, 0.0, 12.0, -6.0), false);
-    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon slot");
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon slot", false);
     assert!(spline_views < dense_views);
     assert!(lit > 500, "the window is lit at {lit} steps");
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
@@ -296,7 +298,7 @@ fn certificates_keep_every_minute_of_sun_in_a_canyon_of_blocks() {
     s.polygon("ASIDE", &south_rect(1.8, 2.2, 0.0, 1.0, 0.0), true);
     s.cuboid("BLOCK_W", DVec3::new(-40.0, -16.0, 0.0), DVec3::new(2.95, -6.0, 12.0));
     s.cuboid("BLOCK_E", DVec3::new(3.05, -16.0, 0.0), DVec3::new(40.0, -6.0, 12.0));
-    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon of blocks");
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "canyon of blocks", false);
     assert!(lit > 10_000, "the windows are lit at {lit} steps");
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
     assert!(mean <= 0.005, "mean |Δ| {mean}");
@@ -307,9 +309,10 @@ fn certificates_keep_every_minute_of_sun_in_a_canyon_of_blocks() {
 /// over the window once a day and covers it wholly for a step or two, mostly between samples
 /// whose cell is lit at all four corners, so neither the spread, the near-dark nor the kink rule
 /// counts the dip, and the spline would carry the window lit through it (as 72 steps on
-/// `sunlit bench canyon-slots` were before). A step is interpolated only where a patch of the
-/// window is proved lit at its sun (`year::certified::never_dark`), so the year tells dark from
-/// lit as counting every timestep does.
+/// `sunlit bench canyon-slots` are at the defaults). With `prove_never_dark` a step is
+/// interpolated only where a patch of the window is proved lit at its sun
+/// (`year::certified::never_dark`), so the year tells dark from lit as counting every timestep
+/// does.
 #[test]
 fn a_post_passing_the_sun_between_samples_darkens_the_window() {
     let mut s = TestScene::new();
@@ -317,11 +320,16 @@ fn a_post_passing_the_sun_between_samples_darkens_the_window() {
     for (k, x) in [-14.0, -6.0, 3.0, 9.0].into_iter().enumerate() {
         s.cuboid(&format!("POST_{k}"), DVec3::new(x, -8.0, 0.0), DVec3::new(x + 1.5, -6.5, 25.0));
     }
-    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "posts");
+    let scene = s.build();
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&scene, "posts", true);
     assert!(lit > 10_000, "the window is lit at {lit} steps");
     assert_eq!(disagree, 0, "steps dark in one and lit in the other");
     assert!(mean <= 0.005, "mean |Δ| {mean}");
     assert!(spline_views < dense_views, "{spline_views} views against {dense_views} dense");
+    // Without the proof (the default) the same posts are interpolated away at some steps: what
+    // the option buys, and that this scene puts it to work.
+    let (.., unproved, _) = against_dense(&scene, "posts, unproved", false);
+    assert!(unproved > 0, "without the proof no step is lost here, so the test proves nothing");
 }
 
 /// The exact reference, tallying the views it is asked to count.
@@ -350,7 +358,7 @@ impl sunlit::count::Engine for Tally<'_> {
 /// Every progress report of the year for `scene` at `method` (hourly, evergreen), and the views
 /// the engine was asked for.
 fn reported_year(scene: &Scene, method: Method) -> (Vec<sunlit::year::annual::Progress>, usize) {
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine: DEFAULT_REFINE };
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark: false };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let engine = Tally::new(scene);
     let mut reports = Vec::new();
@@ -441,6 +449,7 @@ fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
         timesteps: Timesteps::new(1).unwrap(),
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
+        prove_never_dark: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut quiet = |_: sunlit::year::annual::Progress| -> sunlit::Result<()> { Ok(()) };
@@ -469,8 +478,8 @@ fn short_pieces_near_the_equinoxes_are_counted_not_borrowed() {
         s.polygon(&format!("OVERHANG_{i}"), &flat_rect(x, x + 2.4384, 0.0, 0.762, 2.286), false);
     }
     let scene = s.build();
-    let (dense, _) = exact_year(&scene, Method::Dense);
-    let (spline, _) = exact_year(&scene, Method::Spline(SamplingPlan::default()));
+    let (dense, _) = exact_year(&scene, Method::Dense, false);
+    let (spline, _) = exact_year(&scene, Method::Spline(SamplingPlan::default()), false);
     let (mean, _, max) = compare(&spline, &dense).unwrap();
     println!("north window under overhangs: mean |Δ| {mean:.4}, max {max:.4}");
     assert!(max <= 0.2, "largest |Δ| {max}");

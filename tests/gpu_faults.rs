@@ -21,7 +21,12 @@ fn office_scene() -> Scene {
 }
 
 fn options() -> AnnualOptions {
-    AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method: Method::Spline(SamplingPlan::new(6, 7).unwrap()), refine: 1.0 }
+    AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method: Method::Spline(SamplingPlan::new(6, 7).unwrap()),
+        refine: 1.0,
+        prove_never_dark: false,
+    }
 }
 
 /// A small atlas (4 views per submission), so a year takes many submissions and progress reports.

@@ -168,6 +168,8 @@ export interface AnnualSettings {
   samplesPerDay?: number;
   /** Count a timestep directly where neighbouring samples differ by more than this (default 0.3; 1 never). */
   refine?: number;
+  /** Interpolate a timestep only where part of the surface is proved lit at its sun, else count it (slower; default false). */
+  proveNeverDark?: boolean;
   /** Count every sun-up timestep instead of interpolating (slow). */
   dense?: boolean;
   /** Foliage keeps its leaves all year. */

@@ -136,8 +136,12 @@ mod tests {
 
     fn fitted_year(scene: &Scene, refine: f64) -> (Schedule, FittedYear) {
         let location = Location::new(39.74, -105.18, -7.0).unwrap();
-        let options =
-            AnnualOptions { timesteps: Timesteps::new(2).unwrap(), method: Method::Spline(SamplingPlan::new(14, 9).unwrap()), refine };
+        let options = AnnualOptions {
+            timesteps: Timesteps::new(2).unwrap(),
+            method: Method::Spline(SamplingPlan::new(14, 9).unwrap()),
+            refine,
+            prove_never_dark: false,
+        };
         let calendar = LeafCalendar::for_latitude(location.latitude);
         let (schedule, fitted) =
             pollster::block_on(annual_fitted_with(&Exact { scene }, scene, &location, &options, &calendar, &mut |_| Ok(()))).unwrap();

@@ -51,6 +51,8 @@ pub struct AnnualSettings {
     pub samples_per_day: Option<usize>,
     /// See [`AnnualOptions::refine`] (default [`DEFAULT_REFINE`]).
     pub refine: Option<f64>,
+    /// See [`AnnualOptions::prove_never_dark`] (default off).
+    pub prove_never_dark: Option<bool>,
     /// Count every timestep instead of the spline.
     pub dense: Option<bool>,
     /// Foliage keeps its leaves all year.
@@ -78,6 +80,8 @@ pub struct Resolved {
     pub method: Method,
     /// The refinement threshold.
     pub refine: f64,
+    /// Whether interpolated timesteps must be proved never dark ([`AnnualOptions::prove_never_dark`]).
+    pub prove_never_dark: bool,
     /// When foliage is in leaf.
     pub calendar: LeafCalendar,
     /// Timesteps per hour as asked (checked); `None`: the model's, else the default.
@@ -104,7 +108,8 @@ impl AnnualSettings {
         let calendar = self.calendar(&location)?;
         let timesteps_per_hour = self.timesteps_per_hour.map(Timesteps::new).transpose()?;
         let sky_model = self.sky_model()?;
-        Ok(Resolved { location, method, refine, calendar, timesteps_per_hour, sky_model })
+        let prove_never_dark = self.prove_never_dark.unwrap_or(false);
+        Ok(Resolved { location, method, refine, prove_never_dark, calendar, timesteps_per_hour, sky_model })
     }
 
     fn location(&self) -> Result<Location> {
@@ -151,7 +156,12 @@ impl Resolved {
 
     /// The annual run's options, timesteps as [`Self::timesteps`] gives them.
     pub fn options(&self, model_timesteps: Option<u32>) -> Result<AnnualOptions> {
-        Ok(AnnualOptions { timesteps: self.timesteps(model_timesteps)?, method: self.method, refine: self.refine })
+        Ok(AnnualOptions {
+            timesteps: self.timesteps(model_timesteps)?,
+            method: self.method,
+            refine: self.refine,
+            prove_never_dark: self.prove_never_dark,
+        })
     }
 
     /// The options for an EnergyPlus model whose own shading updates periodically (`periods`,
