@@ -15,10 +15,9 @@
 # BEFORE=path/to/an/older/sunlit adds that binary's compute run on the same spread right after,
 # for a before/after on the same lease.
 # ONLY=REGEX runs only the runs whose label matches (e.g. ONLY=cull for the GPU culling pass).
-# The GPU culling pass (--gpu-cull: clusters of <= 128 triangles against 1,024 views a dispatch,
-# src/count/gpu/cluster_cull.rs) is timed first, beside the CPU culling's share of the host
-# stages (host_stages_seconds.culling) on the same views: the one figure of the new path that a
-# GPU can give before the draw per batch exists.
+# Counting with the GPU's culling (--cull gpu) is timed first, beside the CPU-culled count of the
+# same views, then the culling pass alone (--gpu-cull: clusters of <= 128 triangles against 1,024
+# views a dispatch, src/count/gpu/cluster_cull.rs). ONLY=cull runs just those.
 # Used for docs/benchmarks-gpu.md (an H100 and an H200 lent for one session: see there).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -50,8 +49,16 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # The targets: nyt-blocks 27×19 (353,780 views) best GPU kernel ≤ 8 s and ≥ 4× exact on 16
 # cores; blaas-trees-summer (16,492 views) ≤ 0.5 s. A short lease first gets the three engines
 # on the same even spread of 20,040 nyt-blocks views (extrapolated), then every view.
-# The new path first: the GPU culling pass over 20,040 nyt-blocks views (its JSON's gpu_cull), its
-# host cost alone on noop, and blaas-trees-summer's every view.
+# The new path first: counts drawn from the GPU's culling (--cull gpu: one indirect draw a tile,
+# src/count/gpu/pulled.rs) on 20,040 nyt-blocks views with the CPU-culled count of the same views
+# beside it (same binary, --cull cpu), blaas-trees-summer's every view both ways, and the host's
+# cost of each on noop. Each JSON line's `cull` says which path ran.
+run nyt-blocks-cull-gpu 90 bench nyt-blocks --engine gpu --cull gpu --views "${VIEWS:-20040}" --check 10 "${gpu_flags[@]}"
+run nyt-blocks-cull-cpu 90 bench nyt-blocks --engine gpu --cull cpu --views "${VIEWS:-20040}" "${gpu_flags[@]}"
+run blaas-trees-summer-cull-gpu 40 bench blaas-trees-summer --engine gpu --cull gpu --check 20 "${views[@]}" "${gpu_flags[@]}"
+run blaas-trees-summer-cull-cpu 40 bench blaas-trees-summer --engine gpu --cull cpu "${views[@]}" "${gpu_flags[@]}"
+run nyt-blocks-noop-cull-gpu 60 bench nyt-blocks --engine gpu --backend noop --cull gpu --lanes 1 --views "${VIEWS:-20040}"
+# The culling pass alone (its list form, --gpu-cull), as timed before the draw existed.
 run nyt-blocks-gpu-cull 90 bench nyt-blocks --engine gpu --views "${VIEWS:-20040}" --gpu-cull "${gpu_flags[@]}"
 run nyt-blocks-noop-cull 90 bench nyt-blocks --engine gpu --backend noop --lanes 1 --views "${VIEWS:-20040}" --gpu-cull
 run blaas-trees-summer-gpu-cull 40 bench blaas-trees-summer --engine gpu --gpu-cull "${views[@]}" "${gpu_flags[@]}"

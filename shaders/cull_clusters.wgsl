@@ -90,3 +90,88 @@ fn finish_main() {
     args.first_vertex = 0u;
     args.first_instance = 0u;
 }
+
+// The draw path's form of the pass: each view's kept clusters in cluster order (which is the
+// order of the scene's triangles, so a view draws its casters in the order the CPU's culling
+// draws them and depth ties resolve alike), one segment of `pairs` a view, and one indirect draw a
+// view. Three passes: count what each view keeps (a workgroup a view), lay the segments out and
+// write the draws (one invocation), write each view's clusters at its segment (a workgroup a
+// view, compacted in order by a prefix sum over the workgroup). A list too small still counts
+// every pair it needed (`needed`); views past it get no instances, and the host counts the batch
+// again with the CPU's culling.
+
+// wgpu's DrawIndirectArgs.
+struct Draw {
+    vertex_count: u32,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
+}
+
+@group(0) @binding(5) var<storage, read_write> view_kept: array<u32>;
+@group(0) @binding(6) var<storage, read_write> heads: array<u32>;
+@group(0) @binding(7) var<storage, read_write> draws: array<Draw>;
+
+var<workgroup> kept_total: atomic<u32>;
+var<workgroup> scan: array<u32, GROUP>;
+
+@compute @workgroup_size(64)
+fn view_count_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let v = group.x;
+    var n = 0u;
+    for (var c = lane; c < params.clusters; c += GROUP) {
+        if touches(views[v], clusters[c]) {
+            n += 1u;
+        }
+    }
+    atomicAdd(&kept_total, n);
+    workgroupBarrier();
+    if lane == 0u {
+        view_kept[v] = atomicLoad(&kept_total);
+    }
+}
+
+@compute @workgroup_size(1)
+fn view_layout_main() {
+    var at = 0u;
+    for (var v = 0u; v < params.views; v += 1u) {
+        let n = view_kept[v];
+        heads[v] = at;
+        // A view whose segment does not fit draws nothing; the host sees `needed` and recounts.
+        let fits = at + n <= params.capacity;
+        draws[v] = Draw(params.vertices, select(0u, n, fits), 0u, 0u);
+        at += n;
+    }
+    atomicStore(&args.needed, at);
+}
+
+@compute @workgroup_size(64)
+fn view_write_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let v = group.x;
+    var base = heads[v];
+    for (var start = 0u; start < params.clusters; start += GROUP) {
+        let c = start + lane;
+        var keep = 0u;
+        if c < params.clusters && touches(views[v], clusters[c]) {
+            keep = 1u;
+        }
+        // Inclusive prefix sum of `keep` over the workgroup (Hillis-Steele).
+        scan[lane] = keep;
+        workgroupBarrier();
+        for (var d = 1u; d < GROUP; d *= 2u) {
+            var add = 0u;
+            if lane >= d {
+                add = scan[lane - d];
+            }
+            workgroupBarrier();
+            scan[lane] += add;
+            workgroupBarrier();
+        }
+        let at = base + scan[lane] - keep;
+        if keep == 1u && at < params.capacity {
+            pairs[at] = vec2<u32>(v, c);
+        }
+        base += scan[GROUP - 1u];
+        workgroupBarrier();
+    }
+}

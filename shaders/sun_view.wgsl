@@ -34,7 +34,8 @@ struct TileView {
     view_proj: mat4x4<f32>,
     // Leaf fraction of the view's day: leaves with a lower rank cast shadows.
     leaves: f32,
-    _pad0: u32,
+    // The tile's place in its batch (the GPU culling's view index).
+    slot: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -101,6 +102,81 @@ fn shade(clip: vec4<f32>, v: VertexIn, leaf_shift: f32, receiver_base: u32, slot
     out.transmittance = v.veil.y;
     out.seed = v.seed ^ (slot * 0x9e3779b9u);
     return out;
+}
+
+// Drawing the casters the GPU's culling kept (shaders/cull_clusters.wgsl, view_*_main): one
+// indirect draw a tile, an instance a kept cluster, three vertices for each triangle a cluster
+// may hold. Each vertex pulls its triangle's corner from storage: the cluster's triangle at the
+// vertex's position in the culling's order, its run (the static mesh, or a shared mesh's
+// placements) telling which mesh's corners and which placement. The clip position is computed
+// by the same expressions as vs_static and vs_main, from the same f32 corners and transforms,
+// so every pixel is the one the CPU-culled draws give.
+
+struct Cluster {
+    lo: vec3<f32>,
+    first: u32,
+    hi: vec3<f32>,
+    count: u32,
+}
+
+// A vertex as VertexIn reads it, 4-byte fields only (GpuVertex in pipelines.rs, 28 bytes).
+struct PulledVertex {
+    x: f32,
+    y: f32,
+    z: f32,
+    surface: u32,
+    rank: f32,
+    transmittance: f32,
+    seed: u32,
+}
+
+// A run of triangles placed one way (TriangleRun in cull.rs): `per_instance` triangles a
+// placement from position `first` on; corners from `indices[index_base + 3t + k]`, offset by
+// `vertex_base` into `vertices`; `placed` 0 for the static mesh (no instance transform).
+struct Run {
+    first: u32,
+    per_instance: u32,
+    first_slot: u32,
+    index_base: u32,
+    vertex_base: u32,
+    placed: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(2) @binding(0) var<storage, read> kept: array<vec2<u32>>;
+@group(2) @binding(1) var<storage, read> heads: array<u32>;
+@group(2) @binding(2) var<storage, read> clusters: array<Cluster>;
+@group(2) @binding(3) var<storage, read> cluster_runs: array<u32>;
+@group(2) @binding(4) var<storage, read> runs: array<Run>;
+@group(2) @binding(5) var<storage, read> pulled_vertices: array<PulledVertex>;
+@group(2) @binding(6) var<storage, read> pulled_indices: array<u32>;
+
+@vertex
+fn vs_pulled(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance_index: u32) -> VertexOut {
+    let c = kept[heads[view.slot] + instance_index].y;
+    let cluster = clusters[c];
+    let k = corner / 3u;
+    if k >= cluster.count {
+        // Past the cluster's last triangle: a triangle of DROPPED corners, clipped away.
+        var out: VertexOut;
+        out.position = DROPPED;
+        out.id = NO_RECEIVER;
+        return out;
+    }
+    let run = runs[cluster_runs[c]];
+    let local = cluster.first + k - run.first;
+    let placement = local / run.per_instance;
+    let t = local % run.per_instance;
+    let p = pulled_vertices[run.vertex_base + pulled_indices[run.index_base + 3u * t + corner % 3u]];
+    let v = VertexIn(vec3<f32>(p.x, p.y, p.z), p.surface, vec2<f32>(p.rank, p.transmittance), p.seed);
+    if run.placed == 0u {
+        return shade(view.view_proj * vec4<f32>(v.position, 1.0), v, 0.0, 0u, params.static_slot);
+    }
+    let slot = run.first_slot + placement;
+    let instance = instances[slot];
+    let clip = view.view_proj * (instance.transform * vec4<f32>(v.position, 1.0));
+    return shade(clip, v, instance.leaf_shift, instance.receiver_base, slot);
 }
 
 // PCG hash (Jarzynski & Olano 2020): well-mixed 32 bits from 32.

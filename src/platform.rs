@@ -23,7 +23,12 @@ pub(crate) fn instance() -> wgpu::Instance {
 pub(crate) fn noop_instance(limits: Option<wgpu::Limits>) -> Result<wgpu::Instance> {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
     desc.backends = wgpu::Backends::NOOP;
-    desc.backend_options.noop = wgpu::NoopBackendOptions { limits, ..wgpu::NoopBackendOptions::enabled() };
+    // wgpu 30's indirect-draw validation asserts a storage offset alignment of 32 to 256 bytes,
+    // and the noop adapter's own limits give 1 (it panics at the first indirect draw): 32 is the
+    // finest it accepts, and the counter binds no storage at an offset.
+    let mut limits = limits.unwrap_or_else(wgpu::Limits::unlimited);
+    limits.min_storage_buffer_offset_alignment = limits.min_storage_buffer_offset_alignment.max(32);
+    desc.backend_options.noop = wgpu::NoopBackendOptions { limits: Some(limits), ..wgpu::NoopBackendOptions::enabled() };
     Ok(wgpu::Instance::new(desc))
 }
 

@@ -60,6 +60,21 @@ pub struct Cluster {
     pub hi: Vec3,
 }
 
+/// Triangles of [`Culling::triangles`] placed one way ([`Culling::runs`]): `slots.len()`
+/// placements of mesh `mesh`'s `per_instance` triangles, from position `first` on, placement
+/// by placement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleRun {
+    /// The mesh (0: the static mesh, placed once, its triangles in [`Culling::static_order`]).
+    pub mesh: usize,
+    /// Its first triangle's position.
+    pub first: u32,
+    /// Triangles a placement.
+    pub per_instance: u32,
+    /// The placements' slots.
+    pub slots: Range<u32>,
+}
+
 /// A bounding volume hierarchy over items stored contiguously in BVH order.
 #[derive(Debug, Default)]
 struct Bvh {
@@ -141,6 +156,14 @@ impl Bvh {
 
     /// Calls `f` with the item range of every leaf whose box reaches into `clip`, in item order.
     fn visit(&self, clip: &ClipVolume, mut f: impl FnMut(Range<u32>)) {
+        self.visit_while(clip, |r| {
+            f(r);
+            true
+        });
+    }
+
+    /// [`Self::visit`] until `f` returns false.
+    fn visit_while(&self, clip: &ClipVolume, mut f: impl FnMut(Range<u32>) -> bool) {
         if self.nodes.is_empty() {
             return;
         }
@@ -153,7 +176,8 @@ impl Bvh {
             match node.right {
                 // Right pushed first so the left (lower items) comes out first.
                 Some(r) => stack.extend([r, n + 1]),
-                None => f(node.items.clone()),
+                None if f(node.items.clone()) => {}
+                None => return,
             }
         }
     }
@@ -376,6 +400,31 @@ impl Culling {
         shaded.then_some(list)
     }
 
+    /// Whether anything a view of `target` with clip transform `view_proj` draws can shade it:
+    /// [`Self::select`]'s test alone (`select` is `None` exactly where this is false), stopping
+    /// at the first triangle that can.
+    pub fn may_be_shaded(&self, view_proj: &DMat4, target: &Target<'_>, sun: DVec3) -> bool {
+        let clip = ClipVolume::new(view_proj);
+        let prism = Prism::new(target, sun, self.origin, self.eps);
+        let mut shaded = false;
+        self.static_bvh.visit_while(&clip, |r| {
+            shaded = self.any_shades(&prism, target.gpu_id, r.start as usize..r.end as usize);
+            !shaded
+        });
+        for g in &self.groups {
+            if shaded {
+                break;
+            }
+            let n = g.triangles_per_instance;
+            g.bvh.visit_while(&clip, |r| {
+                shaded =
+                    self.any_shades(&prism, target.gpu_id, g.first_triangle + r.start as usize * n..g.first_triangle + r.end as usize * n);
+                !shaded
+            });
+        }
+        shaded
+    }
+
     /// Calls `f` with the triangle positions (see [`Self::triangle_sources`]) of every leaf that
     /// reaches into the clip volume of `view_proj`, in position order: what a view would draw,
     /// for engines that clip polygons instead of drawing them.
@@ -431,6 +480,23 @@ impl Culling {
             let n = g.triangles_per_instance;
             let at = |i: u32| g.first_triangle + i as usize * n;
             g.bvh.cut(most, n, |r| self.push_clusters(&mut out, at(r.start)..at(r.end)));
+        }
+        out
+    }
+
+    /// The runs of [`Self::triangles`] each placed one way: the static mesh (one placement, at
+    /// [`Self::static_slot`]) and then each shared mesh's instances in slot order, in triangle
+    /// order. A cluster never straddles two runs. What a draw that pulls triangles by position
+    /// needs to find a triangle's mesh, corners and placement.
+    pub fn runs(&self) -> Vec<TriangleRun> {
+        let mut out = Vec::with_capacity(self.groups.len() + 1);
+        if !self.static_order.is_empty() {
+            let n = self.static_order.len() as u32;
+            out.push(TriangleRun { mesh: 0, first: 0, per_instance: n, slots: self.static_slot..self.static_slot + 1 });
+        }
+        for g in &self.groups {
+            let per_instance = g.triangles_per_instance as u32;
+            out.push(TriangleRun { mesh: g.mesh, first: g.first_triangle as u32, per_instance, slots: g.slots.clone() });
         }
         out
     }
@@ -527,7 +593,10 @@ mod tests {
         let roof = &scene.receivers[0];
         let points: Vec<DVec3> = roof.triangles.iter().flatten().copied().collect();
         let view = view::fit(&points, sun, scene.bounds, scene.origin, 64);
-        culling.select(&view.view_proj, &Target { points: &points, normal: roof.normal, gpu_id: roof.gpu_id }, sun)
+        let target = Target { points: &points, normal: roof.normal, gpu_id: roof.gpu_id };
+        let list = culling.select(&view.view_proj, &target, sun);
+        assert_eq!(culling.may_be_shaded(&view.view_proj, &target, sun), list.is_some(), "the test alone agrees");
+        list
     }
 
     #[test]
@@ -625,5 +694,13 @@ mod tests {
         assert!(statics.iter().all(|&n| (64..=128).contains(&n)), "{statics:?}");
         // Each large instance is cut into even runs: 100 + 100 + 100.
         assert_eq!(clusters.iter().rev().take(6).map(|c| c.count).collect::<Vec<_>>(), [100; 6]);
+        // The runs: the static mesh, then each shared mesh's placements; every cluster in one.
+        let runs = culling.runs();
+        let spans: Vec<(u32, u32, usize)> = runs.iter().map(|r| (r.first, r.per_instance, r.slots.len())).collect();
+        assert_eq!(spans, [(0, 10_000, 1), (10_000, 2, 3000), (16_000, 300, 2)]);
+        for c in &clusters {
+            let inside = |r: &TriangleRun| c.first >= r.first && c.first + c.count <= r.first + r.per_instance * r.slots.len() as u32;
+            assert_eq!(runs.iter().filter(|r| inside(r)).count(), 1, "{c:?} in one run");
+        }
     }
 }

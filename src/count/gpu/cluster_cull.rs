@@ -5,9 +5,10 @@
 //! per batch written beside it. What the CPU then does per batch is one dispatch and one draw,
 //! not a BVH walk and draws per view.
 //!
-//! Status: the pass, its overflow handling and its CPU truth are built and tested
-//! (tests/cluster_cull.rs); the raster kernel does not draw from its list yet (the vertex-pulling
-//! draw per batch is not built), so no count depends on it.
+//! Two forms: one list of every kept pair of a batch in the order the GPU appended them
+//! ([`Counter::cull_clusters`], what `sunlit bench --gpu-cull` times and tests hold to a CPU
+//! truth), and the form the raster kernel draws from ([`super::pulled`]): each view's pairs in
+//! cluster order, one segment and one indirect draw a view.
 //!
 //! A list too small for a batch is never truncated: the pass counts every pair it needed, the
 //! host reads that count back and runs the batch again with a list that large
@@ -53,13 +54,34 @@ struct CullParams {
     vertices: u32,
 }
 
-/// A scene's clusters on the device, with the pass that culls them.
+/// A scene's clusters on the device, with the pass that culls them: into one list
+/// ([`Counter::cull_clusters`]), or per view for the draw ([`super::pulled`]).
 pub struct GpuClusters {
     clusters: wgpu::Buffer,
     count: u32,
     layout: wgpu::BindGroupLayout,
     cull: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
+    /// The per-view form: its layout and its three passes (count, lay out, write).
+    view_layout: wgpu::BindGroupLayout,
+    view_passes: [wgpu::ComputePipeline; 3],
+}
+
+/// The per-view cull pass's buffers for a batch of up to `views` views and `capacity` pairs.
+pub(super) struct ViewCullBuffers {
+    views: wgpu::Buffer,
+    params: wgpu::Buffer,
+    /// Each view's kept clusters, view by view (`vec2(view, cluster)`), in cluster order.
+    pub(super) pairs: wgpu::Buffer,
+    /// Where each view's clusters start in `pairs`.
+    pub(super) heads: wgpu::Buffer,
+    /// One indirect draw a view.
+    pub(super) draws: wgpu::Buffer,
+    /// DrawIndirectArgs (unused here) and, at byte 16, the pairs the batch needed.
+    pub(super) args: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+    /// Pairs `pairs` holds.
+    pub(super) capacity: u32,
 }
 
 /// What the cull pass kept of a batch.
@@ -90,9 +112,92 @@ impl GpuClusters {
             storage_entry(4, cs, false),
         ];
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cull clusters"), entries: &entries });
-        let make = |e| compute_pipeline(device, &layout, "cull_clusters.wgsl", CULL_CLUSTERS_WGSL, e);
-        Self { clusters: clusters_buffer, count: clusters.len() as u32, cull: make("cull_main"), finish: make("finish_main"), layout }
+        let make = |layout, e| compute_pipeline(device, layout, "cull_clusters.wgsl", CULL_CLUSTERS_WGSL, e);
+        let view_entries: Vec<_> = entries.iter().cloned().chain((5..8).map(|b| storage_entry(b, cs, false))).collect();
+        let view_layout = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("cull clusters per view"), entries: &view_entries });
+        let view_passes = ["view_count_main", "view_layout_main", "view_write_main"].map(|e| make(&view_layout, e));
+        Self {
+            clusters: clusters_buffer,
+            count: clusters.len() as u32,
+            cull: make(&layout, "cull_main"),
+            finish: make(&layout, "finish_main"),
+            layout,
+            view_layout,
+            view_passes,
+        }
     }
+
+    /// The clusters' buffer (`Cluster`s, as the shaders read them).
+    pub(super) fn buffer(&self) -> &wgpu::Buffer {
+        &self.clusters
+    }
+
+    /// Buffers for the per-view pass over batches of up to `views` views, `capacity` pairs.
+    pub(super) fn view_buffers(&self, counter: &Counter, views: u32, capacity: u32) -> ViewCullBuffers {
+        let d = &counter.device;
+        let (storage, copy_dst) = (wgpu::BufferUsages::STORAGE, wgpu::BufferUsages::COPY_DST);
+        let rows = buffer(d, "cull views", views as u64 * size_of::<GpuClipRows>() as u64, storage | copy_dst);
+        let params = buffer(d, "cull params", size_of::<CullParams>() as u64, wgpu::BufferUsages::UNIFORM | copy_dst);
+        let pairs = buffer(d, "culled pairs per view", capacity as u64 * 8, storage);
+        let args = buffer(d, "cull needed", ARGS_BYTES, storage | wgpu::BufferUsages::COPY_SRC);
+        let kept = buffer(d, "kept per view", views as u64 * 4, storage);
+        let heads = buffer(d, "view heads", views as u64 * 4, storage);
+        let draws = buffer(d, "view draws", views as u64 * 16, storage | wgpu::BufferUsages::INDIRECT);
+        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cull clusters per view"),
+            layout: &self.view_layout,
+            entries: &[
+                entry(0, self.clusters.as_entire_binding()),
+                entry(1, rows.as_entire_binding()),
+                entry(2, params.as_entire_binding()),
+                entry(3, pairs.as_entire_binding()),
+                entry(4, args.as_entire_binding()),
+                entry(5, kept.as_entire_binding()),
+                entry(6, heads.as_entire_binding()),
+                entry(7, draws.as_entire_binding()),
+            ],
+        });
+        ViewCullBuffers { views: rows, params, pairs, heads, draws, args, bind, capacity }
+    }
+
+    /// Records the per-view pass over `views` (at most the buffers' views) into `encoder`, each
+    /// view's draw `vertices` vertices an instance.
+    pub(super) fn encode_view_cull(
+        &self,
+        counter: &Counter,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &ViewCullBuffers,
+        views: &[DMat4],
+        vertices: u32,
+    ) {
+        let rows = clip_rows(views);
+        let params = CullParams { views: rows.len() as u32, clusters: self.count, capacity: buffers.capacity, vertices };
+        counter.queue.write_buffer(&buffers.views, 0, bytemuck::cast_slice(&rows));
+        counter.queue.write_buffer(&buffers.params, 0, bytemuck::bytes_of(&params));
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cull clusters per view"), timestamp_writes: None });
+        pass.set_bind_group(0, &buffers.bind, &[]);
+        let [count, layout, write] = &self.view_passes;
+        let n = rows.len().max(1) as u32;
+        pass.set_pipeline(count);
+        pass.dispatch_workgroups(n, 1, 1);
+        pass.set_pipeline(layout);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(write);
+        pass.dispatch_workgroups(n, 1, 1);
+    }
+}
+
+/// The first three rows of each view's clip transform, in f32.
+fn clip_rows(views: &[DMat4]) -> Vec<GpuClipRows> {
+    views
+        .iter()
+        .map(|m| {
+            let t = m.as_mat4().transpose();
+            GpuClipRows { rows: [t.x_axis.to_array(), t.y_axis.to_array(), t.z_axis.to_array()] }
+        })
+        .collect()
 }
 
 impl Counter {
@@ -105,13 +210,7 @@ impl Counter {
             let need = views.len() as u64;
             return Err(GpuError::OverLimit { limit_name: "max_compute_workgroups_per_dimension", need, limit: limit as u64 }.into());
         }
-        let rows: Vec<GpuClipRows> = views
-            .iter()
-            .map(|m| {
-                let t = m.as_mat4().transpose();
-                GpuClipRows { rows: [t.x_axis.to_array(), t.y_axis.to_array(), t.z_axis.to_array()] }
-            })
-            .collect();
+        let rows = clip_rows(views);
         let mut capacity = capacity.max(1);
         let mut reruns = 0;
         loop {
@@ -178,7 +277,7 @@ impl Counter {
     }
 }
 
-fn init(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+pub(super) fn init(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
     use wgpu::util::DeviceExt;
     // A binding may not be empty.
     let contents = if contents.is_empty() { &[0u8; 16][..] } else { contents };

@@ -358,7 +358,9 @@ impl Counter {
     ) -> Result<()> {
         let Some(triangles) = scene.compute.as_ref() else { return Ok(()) };
         let per_atlas = tiles_at(self.atlas_side, side).max(1);
-        let lists: Vec<Vec<Range<u32>>> = tiles.iter().map(|t| scene.layout.culling.list_ranges(&t.draws)).collect();
+        let culling = &scene.layout.culling;
+        let lists: Vec<Vec<Range<u32>>> =
+            tiles.iter().map(|t| t.draws.as_ref().map_or_else(Vec::new, |d| culling.list_ranges(d))).collect();
         let sizes: Vec<u64> = lists.iter().map(|l| l.iter().map(|r| r.len() as u64).sum()).collect();
         let (mut at, mut most) = (0, usize::MAX);
         while at < tiles.len() {

@@ -21,6 +21,8 @@ pub(super) struct Opened {
     pub info: wgpu::AdapterInfo,
     /// Tiles along the atlas's side at `resolution`, within the device's texture limit.
     pub tiles_per_side: u32,
+    /// What the adapter can do beyond WebGPU's core (indirect draws, storage in vertex shaders).
+    pub downlevel: wgpu::DownlevelFlags,
 }
 
 /// The platform's default adapter, its limits checked against a counter's options, before any
@@ -86,7 +88,8 @@ pub(super) async fn open_on(adapter: &Adapter) -> Result<Opened> {
         .request_device(&wgpu::DeviceDescriptor { label: Some("sunlit"), required_limits: adapter.limits.clone(), ..Default::default() })
         .await
         .map_err(|e| GpuError::Device(e.to_string()))?;
-    Ok(Opened { device, queue, info: adapter.info(), tiles_per_side: adapter.tiles_per_side })
+    let downlevel = adapter.adapter.get_downlevel_capabilities().flags;
+    Ok(Opened { device, queue, info: adapter.info(), tiles_per_side: adapter.tiles_per_side, downlevel })
 }
 
 /// What the uncaptured-error handler records: out-of-memory apart, so it gets its own error.

@@ -90,6 +90,9 @@ pub(super) struct Passes<'a> {
     /// The mask pass for these map points and views; its words land in the points' readback
     /// from this word on.
     pub(super) masks: Option<(&'a GpuPoints, &'a MaskBatch, u64)>,
+    /// The batch's place in its readback chunk (where the GPU's culling reports its pairs
+    /// needed).
+    pub(super) batch_in_chunk: usize,
 }
 
 impl Counter {
@@ -105,7 +108,7 @@ impl Counter {
         first_entry: usize,
         passes: Passes<'_>,
     ) -> Result<usize> {
-        let Passes { count, masks } = passes;
+        let Passes { count, masks, batch_in_chunk } = passes;
         let encoding = Stopwatch::start();
         // Each tile twice, for its two readers: where and whom to count (the count pass), and the
         // view to draw it with (the render, a uniform per tile at `tile_stride`).
@@ -121,7 +124,8 @@ impl Counter {
             let view = GpuTileView {
                 view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
                 leaves: requests[tile.requests[0]].leaves,
-                _pad: [0; 3],
+                slot: slot as u32,
+                _pad: [0; 2],
             };
             at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&view));
         }
@@ -130,6 +134,9 @@ impl Counter {
         self.queue.write_buffer(&self.batch.members, 0, bytemuck::cast_slice(&members));
         let recording = Stopwatch::start();
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
+        if let Some(pulled) = scene.pulled.as_ref().filter(|_| batch.iter().any(|t| t.draws.is_none())) {
+            self.encode_gpu_cull(&mut encoder, pulled, batch, batch_in_chunk);
+        }
         self.render_tiles(&mut encoder, scene, requests, batch, side);
         if count {
             encoder.clear_buffer(&self.batch.counts, 0, None);
@@ -200,7 +207,12 @@ impl Counter {
             }
             // What lies in the prisms in front of them, depth-tested: where a member's id
             // survives, it is sunlit.
-            let draws = &tile.draws;
+            let Some(draws) = &tile.draws else {
+                if let Some(pulled) = &scene.pulled {
+                    self.draw_gpu_culled(&mut pass, pulled, slot);
+                }
+                continue;
+            };
             pass.set_pipeline(&self.pipelines.view.static_scene);
             draw_static(&mut pass, &scene.static_chunks, &draws.static_triangles, scene.layout.culling.static_slot());
             pass.set_pipeline(&self.pipelines.view.scene);

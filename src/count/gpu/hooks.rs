@@ -27,6 +27,12 @@ impl Counter {
         self.upload_chunked(scene, max_triangles)
     }
 
+    /// Uploads `scene` with room for only `pairs` (view, cluster) pairs a batch in the GPU's
+    /// culling, so that tests can force its overflow.
+    pub fn upload_with_pairs(&self, scene: &Scene, pairs: u32) -> Result<GpuScene> {
+        self.upload_with(scene, self.static_chunk_triangles(), Some(pairs))
+    }
+
     /// Reads back the red channel of the id atlas: the visible surface ids (for tests comparing
     /// the compute count with a CPU count).
     pub async fn read_ids(&self) -> Result<(u32, Vec<u32>)> {

@@ -206,7 +206,7 @@ impl Counter {
     pub async fn masks(&self, scene: &GpuScene, points: &GpuPoints, requests: &[ViewRequest], count: bool) -> Result<Masks> {
         let side = self.options.resolution;
         let mut counted = vec![super::Counted::default(); requests.len()];
-        let tiles = super::plan::plan_tiles(&scene.layout, requests, side, &mut counted, &mut 0)?;
+        let tiles = super::plan::plan_tiles(&scene.layout, requests, side, &mut counted, &mut 0, false)?;
         let mut masks: Vec<Option<PointMask>> = vec![None; requests.len()];
         let mut words = Vec::new();
         let out = MaskOut { points, answers: &mut masks, words: &mut words, count };

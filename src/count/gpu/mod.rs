@@ -34,8 +34,10 @@
 //! - [`masks`]: map points uploaded per receiver and the mask pass that reads, after the count
 //!   pass and from the same atlas, whether each point sees the sun;
 //! - `readback`: mapping the counts (and masks) and turning them into fractions.
-//! - [`cluster_cull`]: culling on the GPU, clusters against a batch's views into one list of
-//!   (view, cluster) pairs and an indirect draw (built and tested; not yet drawn from).
+//! - [`cluster_cull`]: culling on the GPU, clusters against a batch's views into (view, cluster)
+//!   pairs and indirect draws;
+//! - `pulled`: counting from that culling ([`CounterOptions::gpu_cull`]): one indirect draw a
+//!   tile whose vertices pull the kept clusters' corners from storage.
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
@@ -49,6 +51,7 @@ mod hooks;
 pub mod masks;
 mod pipelines;
 pub mod plan;
+mod pulled;
 mod readback;
 mod upload;
 
@@ -155,6 +158,11 @@ pub struct CounterOptions {
     pub limits: LimitsProfile,
     /// Which kernel counts.
     pub kernel: Kernel,
+    /// Cull on the GPU (the raster kernel): the views' casters come from the GPU's culling
+    /// pass, one indirect draw a tile, where the adapter and scene allow ([`pulled`]); the CPU
+    /// only fits views. Off by default: on lavapipe its brute-force pass costs more than the
+    /// CPU's walk, and on real GPUs it is not measured yet.
+    pub gpu_cull: bool,
 }
 
 impl Default for CounterOptions {
@@ -166,6 +174,7 @@ impl Default for CounterOptions {
             backend: Backend::Platform,
             limits: LimitsProfile::Adapter,
             kernel: Kernel::Raster,
+            gpu_cull: false,
         }
     }
 }
@@ -322,6 +331,9 @@ pub struct Counter {
     faults: Faults,
     /// The compute kernel's passes and bins (`None` with the raster kernel).
     compute: Option<compute::ComputeState>,
+    /// The draw from the GPU's culling (`None` without [`CounterOptions::gpu_cull`], or where
+    /// the adapter cannot run it).
+    pulled: Option<pulled::PulledPipelines>,
 }
 
 /// A scene uploaded to a [`Counter`]'s device.
@@ -337,6 +349,8 @@ pub struct GpuScene {
     /// The triangles as the compute kernel reads them (`None` with the raster kernel, or where
     /// they do not fit its bindings).
     compute: Option<compute::ComputeScene>,
+    /// Clusters and corners for the GPU's culling (`None` without it, or where they do not fit).
+    pulled: Option<pulled::PulledScene>,
 }
 
 impl Counter {
@@ -348,7 +362,7 @@ impl Counter {
     /// Opens a device on `adapter` (requested for these `options`) and builds the pipelines and
     /// atlas.
     pub async fn on(adapter: &Adapter, options: CounterOptions) -> Result<Self> {
-        let device::Opened { device, queue, info, tiles_per_side } = device::open_on(adapter).await?;
+        let device::Opened { device, queue, info, tiles_per_side, downlevel } = device::open_on(adapter).await?;
         let faults = Faults::watch(&device);
         let pipelines = Pipelines::new(&device);
         let atlas_side = tiles_per_side * options.resolution;
@@ -356,6 +370,8 @@ impl Counter {
         let smallest = sides(&options).first().copied().unwrap_or(options.resolution);
         let batch = BatchBuffers::new(&device, &pipelines, atlas_side, smallest);
         let compute = compute::ComputeState::new(&device, options.kernel);
+        let culls_on_gpu = options.gpu_cull && options.kernel == Kernel::Raster;
+        let pulled = culls_on_gpu.then(|| pulled::PulledPipelines::new(&device, &pipelines, downlevel)).flatten();
         let counter = Self {
             device,
             queue,
@@ -369,6 +385,7 @@ impl Counter {
             stages: StageClock::default(),
             faults,
             compute,
+            pulled,
         };
         counter.check_errors("setting up the GPU")?;
         Ok(counter)
@@ -397,6 +414,11 @@ impl Counter {
     /// Views rendered per submission at `resolution`.
     pub fn tiles_per_batch(&self) -> usize {
         tiles_at(self.atlas_side, self.options.resolution)
+    }
+
+    /// Tiles a batch holds at the smallest side used (what the per-batch buffers are sized for).
+    fn batch_tiles(&self) -> usize {
+        tiles_at(self.atlas_side, sides(&self.options).first().copied().unwrap_or(self.options.resolution))
     }
 
     /// Tiles rendered since this counter was made (a tile counts one request, or several of one
@@ -429,7 +451,7 @@ impl Counter {
         let first = ladder.first().copied().unwrap_or(self.options.resolution);
         let planning = Stopwatch::start();
         let mut culling = 0;
-        let tiles = plan_tiles(&scene.layout, requests, first, &mut out, &mut culling)?;
+        let tiles = plan_tiles(&scene.layout, requests, first, &mut out, &mut culling, self.culls_on_gpu(scene))?;
         self.stages.planning.fetch_add(planning.nanos(), Ordering::Relaxed);
         self.stages.culling.fetch_add(culling, Ordering::Relaxed);
         // Tiles waiting to be counted, by side; each round counts the smallest side waiting.

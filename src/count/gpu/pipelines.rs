@@ -45,7 +45,9 @@ pub(super) struct GpuView {
 pub(super) struct GpuTileView {
     pub(super) view_proj: [[f32; 4]; 4],
     pub(super) leaves: f32,
-    pub(super) _pad: [u32; 3],
+    /// The tile's place in its batch: which of the GPU culling's per-view lists it draws.
+    pub(super) slot: u32,
+    pub(super) _pad: [u32; 2],
 }
 
 /// One view's map points as the mask pass reads them (`MaskView` in point_masks.wgsl).
@@ -120,48 +122,20 @@ pub(super) struct ViewPipelines {
 }
 
 fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_layout: &wgpu::BindGroupLayout) -> ViewPipelines {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("sun_view.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
-    });
+    let module = sun_view_module(device);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("sun view"),
         bind_group_layouts: &[Some(layout), Some(tile_layout)],
         immediate_size: 0,
     });
     let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2, 3 => Uint32];
+    let vertices = [Some(wgpu::VertexBufferLayout {
+        array_stride: size_of::<GpuVertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &attributes,
+    })];
     let make = |label: &str, vertex: &str, depth_write: bool, compare: wgpu::CompareFunction, channels: wgpu::ColorWrites| {
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(vertex),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: size_of::<GpuVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &attributes,
-                })],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(depth_write),
-                depth_compare: Some(compare),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: channels })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+        view_pipeline(device, &module, &pipeline_layout, (label, vertex, &vertices), depth_write, compare, channels)
     };
     let scene = |label, vertex| make(label, vertex, true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED);
     let mask = |label, vertex| make(label, vertex, false, wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN);
@@ -171,6 +145,65 @@ fn render_pipelines(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tile_
         static_scene: scene("scene, static mesh", "vs_static"),
         static_mask: mask("mask, static mesh", "vs_static"),
     }
+}
+
+fn sun_view_module(device: &wgpu::Device) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("sun_view.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(SUN_VIEW_WGSL.into()),
+    })
+}
+
+/// The scene pipeline that draws what the GPU's culling kept (`vs_pulled`: no vertex buffer,
+/// corners pulled from `pulled_layout`'s storage); otherwise as the scene pipeline.
+pub(super) fn pulled_scene_pipeline(
+    device: &wgpu::Device,
+    pipelines: &Pipelines,
+    pulled_layout: &wgpu::BindGroupLayout,
+) -> wgpu::RenderPipeline {
+    let module = sun_view_module(device);
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("sun view, pulled"),
+        bind_group_layouts: &[Some(&pipelines.render_layout), Some(&pipelines.tile_layout), Some(pulled_layout)],
+        immediate_size: 0,
+    });
+    let entry = ("scene, GPU-culled", "vs_pulled", &[][..]);
+    view_pipeline(device, &module, &pipeline_layout, entry, true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED)
+}
+
+/// A sun-view pipeline: `(label, vertex entry point, vertex buffers)`, its depth state and the
+/// channel it writes.
+fn view_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    pipeline_layout: &wgpu::PipelineLayout,
+    (label, vertex, buffers): (&str, &str, &[Option<wgpu::VertexBufferLayout<'_>>]),
+    depth_write: bool,
+    compare: wgpu::CompareFunction,
+    channels: wgpu::ColorWrites,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(pipeline_layout),
+        vertex: wgpu::VertexState { module, entry_point: Some(vertex), compilation_options: Default::default(), buffers },
+        primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(depth_write),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: channels })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 pub(super) fn compute_pipeline(

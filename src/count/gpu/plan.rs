@@ -82,7 +82,9 @@ pub(super) struct Tile {
     /// Request indices, their receivers distinct, the group's owner first.
     pub(super) requests: Vec<usize>,
     pub(super) view: SunView,
-    pub(super) draws: DrawList,
+    /// What its scene pass draws, as the CPU's culling chose it; `None` where the GPU's culling
+    /// chooses ([`super::pulled`]).
+    pub(super) draws: Option<DrawList>,
 }
 
 /// The sides views are counted at: with an accuracy target, ADAPTIVE_FIRST_SIDE doubling up to
@@ -146,12 +148,15 @@ pub(super) fn fit_tile(scene: &SceneLayout, requests: &[ViewRequest], members: &
 /// windows at the very same sun vectors). Each tile's view is fitted to its requested
 /// members; a tile with nothing in front of any member gets fraction 1 without a render.
 /// `culling_nanos` gains the time spent in the culling (a part of the planning, timed apart).
+/// `gpu_culled`: the GPU's culling picks what each tile draws, so none is culled here and every
+/// tile is rendered (one with nothing that shades its members counts all their pixels lit).
 pub(super) fn plan_tiles(
     scene: &SceneLayout,
     requests: &[ViewRequest],
     side: u32,
     out: &mut [Counted],
     culling_nanos: &mut u64,
+    gpu_culled: bool,
 ) -> Result<Vec<Tile>> {
     let mut open: HashMap<(u32, [u64; 3], u32), usize> = HashMap::new();
     let mut pending: Vec<Vec<usize>> = Vec::new();
@@ -178,22 +183,40 @@ pub(super) fn plan_tiles(
     for mut members in pending {
         // The owner (largest outline) first: its plane and id guide the culling.
         members.sort_by_key(|&i| scene.groups.place(requests[i].receiver).1);
-        let owner = &scene.receivers[requests[members[0]].receiver as usize];
-        let points = tile_points(scene, requests, &members);
-        let sun = requests[members[0]].sun;
-        let view = view::fit(&points, sun, scene.bounds, scene.origin, side);
-        // The union of the members: the draw list covers every member's prism.
-        let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
+        let view = fit_tile(scene, requests, &members, side);
+        if gpu_culled {
+            tiles.push(Tile { requests: members, view, draws: None });
+            continue;
+        }
         let culling = Stopwatch::start();
-        let selected = scene.culling.select(&view.view_proj, &target, sun);
+        let selected = cull_on_cpu(scene, requests, &members, &view);
         *culling_nanos += culling.nanos();
         match selected {
-            Some(draws) => tiles.push(Tile { requests: members, view, draws }),
+            Some(draws) => tiles.push(Tile { requests: members, view, draws: Some(draws) }),
             // Nothing in the prism in front of any member: all fully sunlit, no render needed.
             None => members.iter().for_each(|&i| out[i].fraction = 1.0),
         }
     }
     Ok(tiles)
+}
+
+/// Whether anything in front of the tile of `members` (owner first) seen by `view` can shade
+/// any of them: [`cull_on_cpu`]'s test alone.
+pub(super) fn may_be_shaded(scene: &SceneLayout, requests: &[ViewRequest], members: &[usize], view: &SunView) -> bool {
+    let owner = &scene.receivers[requests[members[0]].receiver as usize];
+    let points = tile_points(scene, requests, members);
+    let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
+    scene.culling.may_be_shaded(&view.view_proj, &target, requests[members[0]].sun)
+}
+
+/// What the CPU's culling has the tile of `members` (owner first) seen by `view` draw, or `None`
+/// when nothing can shade any of them.
+pub(super) fn cull_on_cpu(scene: &SceneLayout, requests: &[ViewRequest], members: &[usize], view: &SunView) -> Option<DrawList> {
+    let owner = &scene.receivers[requests[members[0]].receiver as usize];
+    let points = tile_points(scene, requests, members);
+    // The union of the members: the draw list covers every member's prism.
+    let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
+    scene.culling.select(&view.view_proj, &target, requests[members[0]].sun)
 }
 
 /// A static receiver's triangles (an index range of the static mesh) as ranges of positions in
@@ -311,7 +334,7 @@ mod tests {
 
     fn plan(layout: &SceneLayout, requests: &[ViewRequest]) -> (Vec<Tile>, Vec<Counted>) {
         let mut out = vec![Counted::default(); requests.len()];
-        let tiles = plan_tiles(layout, requests, 64, &mut out, &mut 0).unwrap();
+        let tiles = plan_tiles(layout, requests, 64, &mut out, &mut 0, false).unwrap();
         (tiles, out)
     }
 
@@ -349,7 +372,7 @@ mod tests {
         assert!(out[0].cos_incidence < 0.0 && out[0].fraction == 0.0 && out[0].side == 0);
         assert_eq!((out[1].fraction, out[1].side), (0.0, 0));
         assert_eq!((out[2].fraction, out[2].side), (1.0, 0), "unshaded without a render");
-        assert!(tiles[0].draws.triangles(&layout.culling) > 0, "the overhang is drawn");
+        assert!(tiles[0].draws.as_ref().unwrap().triangles(&layout.culling) > 0, "the overhang is drawn");
     }
 
     #[test]
@@ -357,7 +380,7 @@ mod tests {
         let scene = scene();
         let layout = SceneLayout::new(&scene, LEAF_TRIANGLES);
         let mut out = vec![Counted::default(); 1];
-        let e = plan_tiles(&layout, &[ViewRequest::new(9, south(40.0))], 64, &mut out, &mut 0).err().unwrap();
+        let e = plan_tiles(&layout, &[ViewRequest::new(9, south(40.0))], 64, &mut out, &mut 0, false).err().unwrap();
         assert_eq!(e.to_string(), "invalid receiver: id 9 out of range (3 receivers)");
     }
 

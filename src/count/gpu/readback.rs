@@ -80,9 +80,9 @@ impl Counter {
             let (mut entries, mut words) = (0, 0u64);
             let mut mask_batches = Vec::new();
             let count = masks.as_ref().is_none_or(|m| m.count);
-            for batch in chunk.chunks(per_batch) {
+            for (batch_in_chunk, batch) in chunk.chunks(per_batch).enumerate() {
                 let mask = masks.as_ref().map(|m| (m.points, self.mask_batch(scene, m.points, requests, batch, side)));
-                let passes = Passes { count, masks: mask.as_ref().map(|(p, m)| (*p, m, words)) };
+                let passes = Passes { count, masks: mask.as_ref().map(|(p, m)| (*p, m, words)), batch_in_chunk };
                 entries += self.submit_batch(scene, requests, batch, side, entries, passes)?;
                 if let Some((_, m)) = mask {
                     words += m.words;
@@ -107,16 +107,82 @@ impl Counter {
             self.note_rendered(scene, chunk);
             unpack(chunk, counts, side, out);
             self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
+            self.settle_unshaded(scene, requests, chunk, out);
+            let overflowed = self.overflowed_batches(scene, chunk, per_batch).await?;
+            if !overflowed.is_empty() {
+                let again = self.cull_again_on_cpu(scene, requests, &overflowed, out);
+                Box::pin(self.count_tiles(scene, requests, &again, side, out, None)).await?;
+            }
         }
         Ok(())
     }
 
+    /// The tiles of `chunk`'s batches (`per_batch` tiles each) whose GPU-culled pair list
+    /// overflowed: their scene pass drew nothing, so their counts are wrong and must be redone.
+    async fn overflowed_batches<'t>(&self, scene: &GpuScene, chunk: &'t [Tile], per_batch: usize) -> Result<Vec<&'t Tile>> {
+        let Some(pulled) = scene.pulled.as_ref().filter(|_| chunk.iter().any(|t| t.draws.is_none())) else { return Ok(Vec::new()) };
+        let batches = chunk.len().div_ceil(per_batch);
+        let bytes = platform::read_buffer(&self.device, &pulled.needed, batches as u64 * 4).await;
+        self.check_errors("reading the GPU culling's pairs needed")?;
+        let bytes = bytes?;
+        let needed: &[u32] = bytemuck::try_cast_slice(&bytes).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
+        let capacity = pulled.batch.capacity;
+        let over = needed.iter().zip(chunk.chunks(per_batch)).filter(|(n, _)| **n > capacity);
+        let tiles: Vec<&Tile> = over
+            .flat_map(|(n, batch)| {
+                log::info!("GPU culling: {n} pairs needed, {capacity} held; counting the batch again with the CPU's culling");
+                batch.iter()
+            })
+            .collect();
+        Ok(tiles)
+    }
+
+    /// Gives the GPU-culled tiles of `chunk` that nothing can shade fraction 1 without a
+    /// render, as the CPU's culling does. The GPU's culling renders every tile, and at grazing
+    /// suns a receiver's neighbour can take a pixel of its edge where nothing shades it; so each
+    /// such tile with a member not counted fully lit gets the CPU's shading test (the first
+    /// triangle that can shade ends it), and the counts stay the CPU path's exactly.
+    fn settle_unshaded(&self, scene: &GpuScene, requests: &[ViewRequest], chunk: &[Tile], out: &mut [Counted]) {
+        let started = Stopwatch::start();
+        let not_lit = |t: &&Tile| t.draws.is_none() && t.requests.iter().any(|&i| out[i].visible < out[i].covered || out[i].covered == 0);
+        let unshaded: Vec<&Tile> =
+            chunk.iter().filter(not_lit).filter(|t| !super::plan::may_be_shaded(&scene.layout, requests, &t.requests, &t.view)).collect();
+        for tile in unshaded {
+            tile.requests.iter().for_each(|&i| out[i] = lit_without_render(out[i]));
+        }
+        let nanos = started.nanos();
+        self.stages.planning.fetch_add(nanos, Ordering::Relaxed);
+        self.stages.culling.fetch_add(nanos, Ordering::Relaxed);
+    }
+
+    /// `tiles` culled on the CPU, to be counted again: those with nothing that can shade their
+    /// members get fraction 1 in `out` without a render, as the CPU path gives them.
+    fn cull_again_on_cpu(&self, scene: &GpuScene, requests: &[ViewRequest], tiles: &[&Tile], out: &mut [Counted]) -> Vec<Tile> {
+        let mut again = Vec::new();
+        for tile in tiles {
+            match super::plan::cull_on_cpu(&scene.layout, requests, &tile.requests, &tile.view) {
+                Some(draws) => again.push(Tile { requests: tile.requests.clone(), view: tile.view, draws: Some(draws) }),
+                None => tile
+                    .requests
+                    .iter()
+                    .for_each(|&i| out[i] = Counted { fraction: 1.0, cos_incidence: out[i].cos_incidence, ..Counted::default() }),
+            }
+        }
+        again
+    }
+
     /// Adds a counted chunk's tiles and triangles to the benchmark totals.
     pub(super) fn note_rendered(&self, scene: &GpuScene, chunk: &[Tile]) {
-        let drawn: usize = chunk.iter().map(|t| t.draws.triangles(&scene.layout.culling)).sum();
+        // The GPU's culling's draws are not read back: their triangles are not counted.
+        let drawn: usize = chunk.iter().filter_map(|t| t.draws.as_ref()).map(|d| d.triangles(&scene.layout.culling)).sum();
         self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
         self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
     }
+}
+
+/// A view's answer when nothing can shade it: fully lit, not rendered (as planning gives it).
+fn lit_without_render(counted: Counted) -> Counted {
+    Counted { fraction: 1.0, cos_incidence: counted.cos_incidence, ..Counted::default() }
 }
 
 /// Writes the members' counts of `chunk` (three words an entry, in tile and member order),

@@ -32,13 +32,13 @@ pub(super) struct GpuMesh {
 
 /// Vertex `v` of `mesh` as the shaders read it: position, surface id, and its leaf rank,
 /// transmittance and dither seed (defaults when the mesh has no see-through parts).
-fn gpu_vertex(mesh: &Mesh, v: usize) -> GpuVertex {
+pub(super) fn gpu_vertex(mesh: &Mesh, v: usize) -> GpuVertex {
     let veil = mesh.veils.get(v).copied().unwrap_or_default();
     GpuVertex { position: mesh.positions[v], surface: mesh.surfaces[v], veil: [veil.rank, veil.transmittance], seed: veil.seed }
 }
 
 /// Vertices `range` of `mesh`, in order.
-fn gpu_vertices(mesh: &Mesh, range: Range<usize>) -> Vec<GpuVertex> {
+pub(super) fn gpu_vertices(mesh: &Mesh, range: Range<usize>) -> Vec<GpuVertex> {
     range.map(|v| gpu_vertex(mesh, v)).collect()
 }
 
@@ -46,13 +46,23 @@ impl Counter {
     /// Uploads a scene's geometry once; views of it then cost only draws. The static mesh goes
     /// into as many vertex buffers as the device's buffer size limit needs.
     pub fn upload(&self, scene: &Scene) -> Result<GpuScene> {
+        self.upload_chunked(scene, self.static_chunk_triangles())
+    }
+
+    /// Static triangles a vertex buffer holds within the device's buffer size limit.
+    pub(super) fn static_chunk_triangles(&self) -> u32 {
         let per_triangle = 3 * size_of::<GpuVertex>() as u64;
-        let limit = (self.device.limits().max_buffer_size / per_triangle).clamp(1, u32::MAX as u64) as u32;
-        self.upload_chunked(scene, limit)
+        (self.device.limits().max_buffer_size / per_triangle).clamp(1, u32::MAX as u64) as u32
     }
 
     /// [`Self::upload`] with at most `max_triangles` static triangles a vertex buffer.
     pub(super) fn upload_chunked(&self, scene: &Scene, max_triangles: u32) -> Result<GpuScene> {
+        self.upload_with(scene, max_triangles, None)
+    }
+
+    /// [`Self::upload_chunked`], the GPU's culling with room for `pairs` pairs a batch where
+    /// given (tests force its overflow with few).
+    pub(super) fn upload_with(&self, scene: &Scene, max_triangles: u32, pairs: Option<u32>) -> Result<GpuScene> {
         use wgpu::util::DeviceExt as _;
         // wgpu's create_buffer_init panics on a lost device (its mapped range is invalid).
         self.faults.check_lost()?;
@@ -127,7 +137,9 @@ impl Counter {
         });
         self.check_errors("uploading the scene")?;
         let compute = self.upload_compute(scene, &layout);
-        Ok(GpuScene { meshes, static_chunks, layout, render_bind, count_bind, compute })
+        let pulled = self.upload_pulled(scene, &layout, pairs);
+        self.check_errors("uploading the scene for the GPU's culling")?;
+        Ok(GpuScene { meshes, static_chunks, layout, render_bind, count_bind, compute, pulled })
     }
 
     /// Refuses, before allocating, a scene whose buffers exceed this device's limits: wgpu would
@@ -185,7 +197,7 @@ impl Counter {
 /// cost, and indexed draws let it shade a vertex shared by several triangles once per batch of
 /// indices: `nyt-rods` has about one distinct vertex a triangle instead of three, and counts its
 /// views ~1.5× faster.
-fn distinct_vertices(corners: impl Iterator<Item = GpuVertex>) -> (Vec<GpuVertex>, Vec<u32>) {
+pub(super) fn distinct_vertices(corners: impl Iterator<Item = GpuVertex>) -> (Vec<GpuVertex>, Vec<u32>) {
     let mut index: HashMap<[u32; 7], u32> = HashMap::new();
     let mut vertices = Vec::new();
     let indices = corners

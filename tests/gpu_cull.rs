@@ -1,0 +1,105 @@
+//! Counting with the GPU's culling (`CounterOptions::gpu_cull`: the cull pass's per-view lists,
+//! one indirect draw a tile, corners pulled from storage) against counting with the CPU's culling
+//! (the BVH walk, a draw per merged range), on lavapipe: the same pixels in the atlas and the same
+//! counts, exactly, on bench models; a pair list forced to overflow counted again on the CPU.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
+
+mod common;
+
+use sunlit::count::ViewRequest;
+use sunlit::count::gpu::{Counted, Counter, CounterOptions};
+use sunlit::scene::Scene;
+
+fn culling_counter(resolution: u32, gpu_cull: bool) -> Counter {
+    pollster::block_on(Counter::new(CounterOptions { resolution, gpu_cull, ..Default::default() }))
+        .expect("a GPU adapter (lavapipe: apt-get install mesa-vulkan-drivers) — GPU tests never skip")
+}
+
+fn bench_scene(name: &str) -> (Scene, Vec<ViewRequest>) {
+    let model = sunlit::bench::models::generate(name).unwrap();
+    let scene = sunlit::model::load_bytes(&[(format!("{name}.glb"), model.glb.to_glb())], &Default::default()).unwrap();
+    let plan = sunlit::year::samples::SamplingPlan::new(9, 9).unwrap();
+    let all = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    (scene, all)
+}
+
+/// `requests` counted at `side` by the CPU's culling and by the GPU's, with each counter's atlas
+/// after its last batch.
+fn both(scene: &Scene, requests: &[ViewRequest], side: u32) -> [(Vec<Counted>, Vec<[u32; 2]>); 2] {
+    [false, true].map(|gpu_cull| {
+        let counter = culling_counter(side, gpu_cull);
+        let gpu = counter.upload(scene).unwrap();
+        assert_eq!(counter.culls_on_gpu_for(&gpu), gpu_cull, "the path under test is the one taken");
+        let counted = pollster::block_on(counter.fractions(&gpu, requests)).unwrap();
+        let (_, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
+        (counted, atlas)
+    })
+}
+
+/// The views of `name`'s 9×9 year that the CPU's culling renders (something in front can shade
+/// them), at most `at_most` spread over the year, all in one batch at 128².
+fn rendered_views(scene: &Scene, all: &[ViewRequest], at_most: usize) -> Vec<ViewRequest> {
+    let counter = culling_counter(128, false);
+    let candidates = sunlit::bench::spread(all, 4 * at_most);
+    let counted = common::gpu_fractions(&counter, scene, &candidates);
+    let rendered: Vec<ViewRequest> = candidates.iter().zip(&counted).filter(|(_, c)| c.side > 0).map(|(r, _)| *r).collect();
+    let picked = sunlit::bench::spread(&rendered, at_most);
+    assert!(picked.len() <= counter.tiles_per_batch(), "one batch");
+    picked
+}
+
+fn same_pixels_and_counts(name: &str, at_most: usize) {
+    let (scene, all) = bench_scene(name);
+    let requests = rendered_views(&scene, &all, at_most);
+    let [(by_cpu, cpu_atlas), (by_gpu, gpu_atlas)] = both(&scene, &requests, 128);
+    let shaded = by_cpu.iter().filter(|c| c.visible > 0 && c.visible < c.covered).count();
+    assert!(requests.len() >= 10 && shaded >= 3, "{name}: {} views, {shaded} partly shaded", requests.len());
+    assert_eq!(by_gpu, by_cpu, "{name}: counts with the GPU's culling against the CPU's");
+    let differing = cpu_atlas.iter().zip(&gpu_atlas).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "{name}: atlas texels differing");
+}
+
+#[test]
+fn gpu_culling_draws_the_pixels_cpu_culling_draws_on_static_bench_models() {
+    same_pixels_and_counts("blaas-buildings", 40);
+}
+
+#[test]
+fn gpu_culling_draws_the_pixels_cpu_culling_draws_on_placed_see_through_trees() {
+    // Instanced trees: leaves dropped by rank in the vertex shader, see-through fragments
+    // dithered by instance; the pulled draw must place and seed them as vs_main does.
+    same_pixels_and_counts("blaas-trees-summer", 24);
+}
+
+#[test]
+fn every_view_of_a_year_counts_alike_and_unshaded_ones_exactly_lit() {
+    // All views of a 9×9 year of blaas-louvres, dark, unshaded and shaded alike: the GPU's
+    // culling renders the unshaded ones the CPU skips, and they must still count exactly 1.
+    let (scene, all) = bench_scene("blaas-louvres");
+    let requests = sunlit::bench::spread(&all, 300);
+    let [(by_cpu, _), (by_gpu, _)] = both(&scene, &requests, 64);
+    let skipped = by_cpu.iter().filter(|c| c.side == 0 && c.fraction == 1.0).count();
+    assert!(skipped > 0, "some views the CPU's culling skips as unshaded");
+    let differing: Vec<_> = (0..requests.len())
+        .filter(|&i| by_gpu[i].fraction.to_bits() != by_cpu[i].fraction.to_bits())
+        .map(|i| (i, by_cpu[i], by_gpu[i]))
+        .collect();
+    assert!(differing.is_empty(), "{} of {} views differ: {differing:?}", differing.len(), requests.len());
+    for (g, c) in by_gpu.iter().zip(&by_cpu) {
+        if c.side > 0 {
+            assert_eq!(g, c);
+        }
+    }
+}
+
+#[test]
+fn an_overflowing_pair_list_is_counted_again_with_the_cpus_culling() {
+    let (scene, all) = bench_scene("blaas-buildings");
+    let requests = rendered_views(&scene, &all, 40);
+    let want = common::gpu_fractions(&culling_counter(128, false), &scene, &requests);
+    let tight = culling_counter(128, true);
+    let gpu = tight.upload_with_pairs(&scene, 16).unwrap();
+    assert!(tight.culls_on_gpu_for(&gpu));
+    let got = pollster::block_on(tight.fractions(&gpu, &requests)).unwrap();
+    assert_eq!(got, want, "counted again in full, never truncated");
+}
