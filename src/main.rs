@@ -2,7 +2,7 @@
 //!
 //! Owns the flags: clap parses them, they become the library's settings
 //! ([`sunlit::year::settings::AnnualSettings`], resolved there as the web's are), and a library
-//! error's parameter names become the flags that set them when it is printed ([`FLAGS`]).
+//! error's parameter names become the flags that set them when it is printed ([`flags::FLAGS`]).
 //!
 //! Each subcommand is its argument struct and a short translation into library calls; no logic of
 //! the pipeline lives here. `sweep`, which also checks manifest lines as `annual` would, is in
@@ -53,10 +53,13 @@ mod district_cli;
 #[path = "cli/docs_check.rs"]
 mod docs_check;
 use district_cli::{DistrictArgs, district};
+#[path = "cli/flags.rs"]
+mod flags;
 #[path = "cli/map.rs"]
 mod map_cli;
 #[path = "cli/progress.rs"]
 mod progress;
+use flags::flag;
 use map_cli::{MapArgs, map};
 
 #[derive(Parser)]
@@ -424,66 +427,6 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// The library's parameter names and the flags that set them: errors name the flag.
-const FLAGS: &[(&str, &str)] = &[
-    ("receivers", "--receivers"),
-    ("north", "--north"),
-    ("foliage", "--foliage"),
-    ("transmittance", "--transmittance"),
-    ("location", "--location"),
-    ("sun", "--sun"),
-    ("leaves", "--leaves"),
-    ("timesteps_per_hour", "--timesteps-per-hour"),
-    ("days_per_year", "--days-per-year"),
-    ("samples_per_day", "--samples-per-day"),
-    ("refine", "--refine"),
-    ("prove_never_dark", "--prove-never-dark"),
-    ("resolution", "--resolution"),
-    ("accuracy", "--accuracy"),
-    ("hook", "--hook"),
-    ("leaf_out", "--leaf-out"),
-    ("leaf_fall", "--leaf-fall"),
-    ("lanes", "--lanes"),
-    ("jobs", "--jobs"),
-    ("per_task", "--per-task"),
-    ("index", "--index"),
-    ("summary", "--summary"),
-    ("spacing", "--grid"),
-    ("points", "--points"),
-    ("period", "--period"),
-    ("step", "--step"),
-    ("from", "--from"),
-    ("to", "--to"),
-    ("at", "--at"),
-    ("study", "--study"),
-    ("min_altitude", "--min-altitude"),
-    ("irradiance", "--irradiance"),
-    ("pvlib", "--pvlib"),
-    ("sam", "--sam"),
-    ("albedo", "--albedo"),
-    ("sky_patches", "--sky-patches"),
-    ("sky_model", "--sky-model"),
-    ("day", "--day"),
-    ("required_hours", "--required-hours"),
-    ("min_period", "--min-period"),
-    ("max_periods", "--max-periods"),
-    ("window_width", "--window-width"),
-    ("window_points", "--window-points"),
-    ("tile", "--tile"),
-    ("context", "--context"),
-    ("min_kwh_m2", "--min-kwh-m2"),
-    ("buildings", "--buildings"),
-    ("lod", "--lod"),
-    ("up", "--up"),
-    ("unit", "--unit"),
-    ("epw", "--epw"),
-];
-
-/// The flag for a library parameter; a name without one (e.g. `receiver`, an id) as it is.
-fn flag(param: &str) -> String {
-    FLAGS.iter().find(|(p, _)| *p == param).map_or(param, |(_, f)| f).to_string()
 }
 
 /// `sunlit info MODEL | head` closes the pipe while sunlit still prints: Rust ignores SIGPIPE, so
