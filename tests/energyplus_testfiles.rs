@@ -23,7 +23,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::energyplus::{DarkLit, columns, dark_lit, energyplus, sunlit_annual};
+use common::Scratch;
+use common::energyplus::{DarkLit, columns, dark_lit, energyplus, energyplus_glitch, print_glitches, stamp, sunlit_annual};
 
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
@@ -40,11 +41,10 @@ fn testfile(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-eptf-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test's runs (an annual EnergyPlus run writes tens of MB): removed
+/// when the test passes, kept when it fails.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("eptf", name)
 }
 
 /// The test file as an annual weather-file run with EnergyPlus's own clipping updated every
@@ -150,6 +150,42 @@ fn zn_window(key: &str) -> bool {
 fn lit_mean_difference(a: &[f64], b: &[f64]) -> (f64, usize) {
     let lit: Vec<f64> = a.iter().zip(b).filter(|(x, y)| **x > 0.0 || **y > 0.0).map(|(x, y)| (x - y).abs()).collect();
     (lit.iter().sum::<f64>() / lit.len().max(1) as f64, lit.len())
+}
+
+/// The glitch classifier on synthetic series (sunlit, EnergyPlus): a lone EnergyPlus 1.0 where
+/// sunlit is dark, between 0.03 and 0 (28 March 17:45's shape), a lone lit step between zeros and
+/// a lone dark step between lit ones are EnergyPlus's glitches; an edge one step early or late
+/// (with a 1.0 or not), two steps in a row, a step at either end of the run, and sunlit's own lone
+/// step are disagreements. Also the steps' dates as EnergyPlus stamps them.
+#[test]
+fn energyplus_glitches_are_told_from_disagreements_on_synthetic_series() {
+    let classify = |ours: &[f64], theirs: &[f64]| {
+        let found = dark_lit(ours, theirs);
+        (found.glitches.iter().map(|g| (g.step, g.energyplus, g.sunlit)).collect::<Vec<_>>(), found.disagreements)
+    };
+    let glitch = |ours: &[f64], theirs: &[f64], i: usize| (classify(ours, theirs), energyplus_glitch(ours, theirs, i));
+    let lone_full_sun = glitch(&[0.2, 0.03, 0.0, 0.0, 0.0], &[0.2, 0.03, 1.0, 0.0, 0.0], 2);
+    assert_eq!(lone_full_sun, ((vec![(2, 1.0, 0.0)], 0), true));
+    assert_eq!(glitch(&[0.0, 0.0, 0.0, 0.0], &[0.0, 0.0, 0.4, 0.0], 2), ((vec![(2, 0.4, 0.0)], 0), true));
+    assert_eq!(glitch(&[0.5, 0.5, 0.5], &[0.5, 0.0, 0.5], 1), ((vec![(1, 0.0, 0.5)], 0), true));
+    for (ours, theirs, why) in [
+        (&[0.6, 0.6, 0.0, 0.0][..], &[0.6, 0.6, 0.6, 0.0][..], "EnergyPlus's edge a step later"),
+        (&[1.0, 1.0, 0.0, 0.0], &[1.0, 1.0, 1.0, 0.0], "a step later at full sun"),
+        (&[0.0, 0.0, 0.3, 0.3], &[0.0, 0.0, 0.0, 0.3], "sunlit's edge a step earlier"),
+        (&[0.0, 0.0, 0.0, 0.0], &[0.0, 1.0, 1.0, 0.0], "two steps in a row"),
+        (&[0.0, 0.0, 0.0], &[1.0, 0.0, 0.0], "the first step"),
+        (&[0.0, 0.0, 0.0], &[0.0, 0.0, 1.0], "the last step"),
+        (&[0.0, 0.4, 0.0], &[0.0, 0.0, 0.0], "sunlit alone lit"),
+    ] {
+        let (glitches, disagreements) = classify(ours, theirs);
+        assert!(glitches.is_empty() && disagreements > 0, "{why}: {glitches:?}, {disagreements}");
+    }
+    assert_eq!(dark_lit(&[0.0, 0.0, 0.0], &[0.0, 1.0, 0.0]).summary(), "1 EnergyPlus glitches named, 0 disagreements");
+    assert_eq!(stamp(0, 4, 1, false), "01/01 00:15");
+    assert_eq!(stamp(95, 4, 1, false), "01/01 24:00");
+    assert_eq!(stamp(86 * 96 + 70, 4, 1, false), "03/28 17:45");
+    assert_eq!(stamp(59 * 24, 1, 1, true), "02/29 01:00");
+    assert_eq!(stamp(0, 6, 74, false), "03/15 00:10");
 }
 
 /// sunlit's fractions against EnergyPlus's clipping, per surface of sunlit's CSV: the mean
@@ -523,13 +559,15 @@ struct SunCase {
     /// Timesteps per hour, and the RunPeriod's first day of year (1-based, in the run's year).
     n: usize,
     first_day: usize,
+    /// Whether the run has a Feb 29 (for the steps' dates).
+    leap: bool,
 }
 
 /// Runs one case: EnergyPlus's own clipping (Timestep updates) and sunlit with its hook, then the
 /// hooked model; returns per surface of sunlit's CSV (name, steps dark in one and lit in the other
 /// against the clipping's reported fractions, the same against the hooked run's, mean |Δ| over the
-/// lit steps against the clipping).
-fn sun_case(case: &SunCase) -> Vec<SurfaceStats> {
+/// lit steps against the clipping), and the scratch folder (kept if the caller's checks fail).
+fn sun_case(case: &SunCase) -> (Scratch, Vec<SurfaceStats>) {
     let dir = scratch(&format!("sun-{}", case.label));
     let text = annual(&case.text);
     let idf = dir.join("clipping.idf");
@@ -562,7 +600,7 @@ fn sun_case(case: &SunCase) -> Vec<SurfaceStats> {
         let (mean, _) = lit_mean_difference(a, clip);
         stats.push((name.clone(), dark_lit(a, clip), dark_lit(a, hook), mean));
     }
-    stats
+    (dir, stats)
 }
 
 /// Runs EnergyPlus on `idf` with `weather` into `out`, checking there is no severe error.
@@ -588,13 +626,14 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
     let scratch_dir = scratch("sun-weather");
     let four = testfile(CURRENT);
     let cases = [
-        SunCase { label: "4zone-ts4", text: configured(&four, 4, None), weather: weather(), n: 4, first_day: 1 },
+        SunCase { label: "4zone-ts4", text: configured(&four, 4, None), weather: weather(), n: 4, first_day: 1, leap: false },
         SunCase {
             label: "4zone-ts1-leap",
             text: configured(&four, 1, Some([(1, 1, Some(2020)), (12, 31, Some(2020))])),
             weather: leap_weather(&scratch_dir),
             n: 1,
             first_day: 1,
+            leap: true,
         },
         SunCase {
             label: "4zone-ts6-mar15-oct20",
@@ -602,33 +641,45 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
             weather: weather(),
             n: 6,
             first_day: 74,
+            leap: false,
         },
-        SunCase { label: "5zone-ts4", text: testfile(FIVE_ZONE), weather: weather(), n: 4, first_day: 1 },
+        SunCase { label: "5zone-ts4", text: testfile(FIVE_ZONE), weather: weather(), n: 4, first_day: 1, leap: false },
     ];
-    let results: Vec<(&'static str, Vec<SurfaceStats>)> = std::thread::scope(|s| {
-        let handles: Vec<_> = cases.iter().map(|c| (c.label, s.spawn(move || sun_case(c)))).collect();
-        handles.into_iter().map(|(label, h)| (label, h.join().unwrap())).collect()
+    let results: Vec<(&SunCase, (Scratch, Vec<SurfaceStats>))> = std::thread::scope(|s| {
+        let handles: Vec<_> = cases.iter().map(|c| (c, s.spawn(move || sun_case(c)))).collect();
+        handles.into_iter().map(|(case, h)| (case, h.join().unwrap())).collect()
     });
     let mut worst = 0.0f64;
-    for (label, stats) in &results {
-        assert!(stats.len() >= 15, "{label}: {} surfaces", stats.len());
-        for (name, clip, hook, mean) in stats {
-            println!(
-                "{label} {name}: dark/lit disagreements {} (clipping), {} (hooked); EnergyPlus one-step glitches {} (clipping), {} (hooked); mean |Δ| {mean:.4}",
-                clip.disagreements, hook.disagreements, clip.glitches, hook.glitches
-            );
-            worst = worst.max(*mean);
-        }
+    let mut disagreements = 0;
+    for (case, (_, stats)) in &results {
+        assert!(stats.len() >= 15, "{}: {} surfaces", case.label, stats.len());
+        disagreements += report(case, stats);
+        worst = stats.iter().map(|s| s.3).fold(worst, f64::max);
     }
-    let glitches: usize = results.iter().flat_map(|(_, s)| s.iter()).map(|(_, c, h, _)| c.glitches + h.glitches).sum();
-    println!("EnergyPlus one-step glitches (clipping and hooked runs, all cases): {glitches}");
-    for (label, stats) in &results {
-        for (name, clip, hook, mean) in stats {
-            assert_eq!((clip.disagreements, hook.disagreements), (0, 0), "{label} {name}: steps dark in one and lit in the other");
-            assert!(*mean <= 0.005, "{label} {name}: mean |Δ| {mean}");
+    assert_eq!(disagreements, 0, "steps dark in one and lit in the other beyond EnergyPlus's own glitches");
+    for (case, (_, stats)) in &results {
+        for (name, _, _, mean) in stats {
+            assert!(*mean <= 0.005, "{} {name}: mean |Δ| {mean}", case.label);
         }
     }
     println!("largest per-surface mean |Δ| against EnergyPlus's clipping: {worst:.4}");
+}
+
+/// Prints each surface's comparison and each of EnergyPlus's own glitches (file, surface, the
+/// step's `MM/DD HH:MM`, the two values: a row of docs/energyplus-fidelity.md's table), then the
+/// case's `N EnergyPlus glitches named, M disagreements` over both runs; returns M.
+fn report(case: &SunCase, stats: &[SurfaceStats]) -> usize {
+    let (mut named, mut disagreements) = (0, 0);
+    for (name, clip, hook, mean) in stats {
+        println!("{} {name}: {} (clipping), {} (hooked); mean |Δ| {mean:.4}", case.label, clip.summary(), hook.summary());
+        for (run, found) in [("clipping", clip), ("hooked", hook)] {
+            print_glitches(case.label, name, run, found, (case.n, case.first_day, case.leap));
+            named += found.glitches.len();
+            disagreements += found.disagreements;
+        }
+    }
+    println!("{}: {named} EnergyPlus glitches named, {disagreements} disagreements", case.label);
+    disagreements
 }
 
 /// RefBldgMediumOfficeNew2004_Chicago in the layout [`annual`] takes: its SimulationControl (design
@@ -655,18 +706,12 @@ fn medium_office() -> String {
 /// about 2 min each on 2 cores).
 #[test]
 fn medium_office_sun_and_dark_steps_match_energyplus_reported_fractions() {
-    let case = SunCase { label: "mediumoffice-ts6", text: medium_office(), weather: weather(), n: 6, first_day: 1 };
-    let stats = sun_case(&case);
+    let case = SunCase { label: "mediumoffice-ts6", text: medium_office(), weather: weather(), n: 6, first_day: 1, leap: false };
+    let (_dir, stats) = sun_case(&case);
     assert!(stats.len() >= 30, "{}: {} surfaces", case.label, stats.len());
     let worst = stats.iter().map(|s| s.3).fold(0.0f64, f64::max);
-    for (name, clip, hook, mean) in &stats {
-        println!(
-            "{} {name}: dark/lit disagreements {} (clipping), {} (hooked); EnergyPlus one-step glitches {} (clipping), {} (hooked); mean |Δ| {mean:.4}",
-            case.label, clip.disagreements, hook.disagreements, clip.glitches, hook.glitches
-        );
-    }
-    for (name, clip, hook, mean) in &stats {
-        assert_eq!((clip.disagreements, hook.disagreements), (0, 0), "{} {name}: steps dark in one and lit in the other", case.label);
+    assert_eq!(report(&case, &stats), 0, "{}: steps dark in one and lit in the other beyond EnergyPlus's own glitches", case.label);
+    for (name, _, _, mean) in &stats {
         assert!(*mean <= 0.005, "{} {name}: mean |Δ| {mean}", case.label);
     }
     println!("{}: largest per-surface mean |Δ| against EnergyPlus's clipping: {worst:.4}", case.label);
@@ -715,8 +760,9 @@ fn with_set_back_window_from(text: &str, depth: f64, lower_left: bool) -> String
 /// at its depth with the reveal's sides as casters. sunlit at its default settings: mean |Δ| over
 /// lit steps ≤ 0.005 (measured 0.0030; 0.0002 with `--dense`); the same window drawn flush is off
 /// by more than 0.01, so the reveal is what is checked. The only steps dark in one and lit in the
-/// other are EnergyPlus's: on the wall's last lit step before the sun passes its plane its clipping
-/// gives the window 1.0 (and the wall 0.9) between steps of 0.00 (06/28 16:00, 03/28 17:45).
+/// other are EnergyPlus's, named by `energyplus_glitch`: on the wall's last lit step before the sun
+/// passes its plane its clipping gives the window 1.0 between steps of 0.00 (06/28 16:00, 03/28
+/// 17:45), where sunlit says 0.
 #[test]
 fn set_back_window_under_overhang_and_fins_matches_energyplus() {
     let dir = scratch("reveal");
@@ -745,12 +791,14 @@ fn set_back_window_under_overhang_and_fins_matches_energyplus() {
     );
     assert!(lit > 10_000 && mean <= 0.005, "mean |Δ| {mean} over {lit}");
     assert!(flush_mean > 0.01, "the flush window is as close: {flush_mean}");
-    for (i, (x, y)) in a.iter().zip(b).enumerate() {
-        if (*x > 0.0) != (*y > 0.0) {
-            let glitch = *x == 0.0 && *y == 1.0 && b[i + 1] == 0.0 && wall[i + 1] == 0.0 && (b[i - 1] < 0.05);
-            assert!(glitch, "step {i}: sunlit {x}, EnergyPlus {y}");
-        }
+    let found = dark_lit(a, b);
+    print_glitches("4zone-setback", name, "clipping", &found, (4, 1, false));
+    for g in &found.glitches {
+        // Its wall is as dark at the next step: the sun has left the wall's plane.
+        assert_eq!(wall[g.step + 1], 0.0, "step {}: the wall is lit after the glitch", g.step);
     }
+    println!("{name} set back: {}", found.summary());
+    assert_eq!(found.disagreements, 0, "steps dark in one and lit in the other beyond EnergyPlus's own glitches");
 }
 
 /// The same set-back window listed from its lower-left corner: sunlit's fractions do not depend

@@ -1,4 +1,5 @@
-//! Where the round-trip tests find EnergyPlus 25.2.
+//! Where the round-trip tests find EnergyPlus 25.2, and how they tell EnergyPlus's own one-step
+//! glitches from disagreements ([`energyplus_glitch`]).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -34,17 +35,56 @@ pub fn columns(path: &Path) -> HashMap<String, Vec<f64>> {
     cols
 }
 
+/// One of EnergyPlus's own one-step glitches (see [`energyplus_glitch`]): the step (0-based row of
+/// the compared columns) and the two values there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Glitch {
+    pub step: usize,
+    pub energyplus: f64,
+    pub sunlit: f64,
+}
+
 /// Timesteps where sunlit (`ours`) and EnergyPlus (`theirs`) disagree on dark against lit, split
-/// into EnergyPlus's own one-step glitches and the rest.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// into EnergyPlus's own one-step glitches, named, and the rest.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct DarkLit {
     /// Disagreements that are not glitches: these count against sunlit.
     pub disagreements: usize,
-    /// EnergyPlus alone flips for one step: at step i it is dark where sunlit is lit (or lit where
-    /// sunlit is dark), while on both neighbouring steps the two agree and EnergyPlus is on the
-    /// other side of the flip, as sunlit is throughout (e.g. a lone 1.0 reported between two dark
-    /// steps of a window under an overhang, which its neighbours and the geometry say is dark).
-    pub glitches: usize,
+    /// EnergyPlus's own one-step glitches ([`energyplus_glitch`]), in step order.
+    pub glitches: Vec<Glitch>,
+}
+
+impl DarkLit {
+    /// `N EnergyPlus glitches named, M disagreements`, the line every comparison prints.
+    pub fn summary(&self) -> String {
+        format!("{} EnergyPlus glitches named, {} disagreements", self.glitches.len(), self.disagreements)
+    }
+}
+
+/// Whether step `i`, where sunlit and EnergyPlus disagree on dark against lit, is EnergyPlus's own
+/// glitch rather than a disagreement. It is when the two agree on the steps before and after
+/// (exactly one step is in question) and EnergyPlus's value at `i` is a jump of its own:
+/// - EnergyPlus alone flips: lit between two dark steps (a fraction with 0 before and after) or
+///   dark between two lit ones, while sunlit stays on the neighbours' side; or
+/// - EnergyPlus reports full sun (1.0) where sunlit says dark, between two steps at most half lit
+///   (the lone 1.0 on windows under overhangs as the sun leaves their wall's plane, e.g. 28 March
+///   17:45 with 0.03 before and 0 after).
+///
+/// A one-step lead or lag of a lit/dark edge is never a glitch: on one side of it the two disagree
+/// at two steps, or EnergyPlus's value joins a neighbour's.
+pub fn energyplus_glitch(ours: &[f64], theirs: &[f64], i: usize) -> bool {
+    let lit = |v: f64| v > 0.0;
+    let n = ours.len().min(theirs.len());
+    if i == 0 || i + 1 >= n || lit(ours[i]) == lit(theirs[i]) {
+        return false;
+    }
+    let agree = |j: usize| lit(ours[j]) == lit(theirs[j]);
+    if !(agree(i - 1) && agree(i + 1)) {
+        return false;
+    }
+    let flips_alone = lit(theirs[i]) != lit(theirs[i - 1]) && lit(theirs[i]) != lit(theirs[i + 1]);
+    let lone_full_sun = theirs[i] == 1.0 && ours[i] == 0.0 && theirs[i - 1] <= 0.5 && theirs[i + 1] <= 0.5;
+    flips_alone || lone_full_sun
 }
 
 /// Classifies the dark/lit disagreements of two columns of one run's timesteps (see [`DarkLit`]).
@@ -56,18 +96,42 @@ pub fn dark_lit(ours: &[f64], theirs: &[f64]) -> DarkLit {
         if lit(ours[i]) == lit(theirs[i]) {
             continue;
         }
-        let isolated = i > 0 && i + 1 < ours.len().min(theirs.len()) && {
-            let agree = |j: usize| lit(ours[j]) == lit(theirs[j]);
-            let steady = lit(ours[i - 1]) == lit(ours[i]) && lit(ours[i + 1]) == lit(ours[i]);
-            agree(i - 1) && agree(i + 1) && steady
-        };
-        if isolated {
-            out.glitches += 1;
+        if energyplus_glitch(ours, theirs, i) {
+            out.glitches.push(Glitch { step: i, energyplus: theirs[i], sunlit: ours[i] });
         } else {
             out.disagreements += 1;
         }
     }
     out
+}
+
+/// Prints each of `found`'s glitches as a row of docs/energyplus-fidelity.md's table, `| label |
+/// surface | MM/DD HH:MM | EnergyPlus | sunlit | run |`; `dates` is the run's timesteps per hour,
+/// first day of year and leap year, as [`stamp`] takes them.
+#[allow(dead_code)] // Not every test file that uses `common` compares columns.
+pub fn print_glitches(label: &str, surface: &str, run: &str, found: &DarkLit, dates: (usize, usize, bool)) {
+    for g in &found.glitches {
+        let when = stamp(g.step, dates.0, dates.1, dates.2);
+        println!("  glitch: | {label} | {surface} | {when} | {:.4} | {:.4} | {run} |", g.energyplus, g.sunlit);
+    }
+}
+
+/// A row's end as EnergyPlus stamps it, `MM/DD HH:MM`: row `step` of a run with `per_hour`
+/// timesteps an hour whose first row is on day `first_day` (1-based) of a year (leap or not).
+#[allow(dead_code)] // Not every test file that uses `common` compares columns.
+pub fn stamp(step: usize, per_hour: usize, first_day: usize, leap: bool) -> String {
+    let per_day = 24 * per_hour;
+    let mut day = first_day - 1 + step / per_day;
+    let minutes = (step % per_day + 1) * 60 / per_hour;
+    let mut month = 0;
+    for (m, &len) in [31, if leap { 29 } else { 28 }, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31].iter().enumerate() {
+        month = m;
+        if day < len {
+            break;
+        }
+        day -= len;
+    }
+    format!("{:02}/{:02} {:02}:{:02}", month + 1, day + 1, minutes / 60, minutes % 60)
 }
 
 /// `sunlit annual MODEL --epw WEATHER --engine exact -o CSV EXTRA…`: the command's output (the

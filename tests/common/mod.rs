@@ -4,7 +4,7 @@
 pub mod energyplus;
 pub mod inside;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use sunlit::count::ViewRequest;
@@ -153,4 +153,41 @@ pub fn radiance_python() -> PathBuf {
         "Radiance (pyradiance) not found: run `SUNLIT_RADIANCE=1 . scripts/setup.sh` (npm test does) or set SUNLIT_RADIANCE_PYTHON"
     );
     venv
+}
+
+/// A scratch folder that is removed when the test that made it passes and kept (for a look at the
+/// runs) when it fails: dropped while the thread panics, it stays.
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    /// `sunlit-PREFIX-NAME-PID` in the temporary folder, emptied first.
+    pub fn new(prefix: &str, name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("sunlit-{prefix}-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("kept for a look: {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
