@@ -23,7 +23,6 @@ use sunlit::count::{Engine, ViewAnswer, ViewRequest, leaf_fraction};
 use sunlit::export::hook::{Hook, HookPlan};
 use sunlit::model::calendar::WeatherDays;
 use sunlit::model::obj::{ObjUnit, ObjUp};
-use sunlit::model::schedule::RunCalendar;
 use sunlit::model::{self, LoadOptions};
 use sunlit::scene::Scene;
 use sunlit::sun::SunPosition;
@@ -609,9 +608,11 @@ fn annual(args: AnnualArgs) -> Result<()> {
         Some(ep) if !ep.shades.is_empty() => weather_days(&args)?,
         _ => None,
     };
-    let calendar = RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap(), weather: weather_days.as_ref() };
+    if let Some(ep) = &energyplus {
+        sunlit::model::calendar::check_model(&ep.file, &ep.objects, timesteps.is_leap(), weather_days.as_ref())?;
+    }
     let varying = match &energyplus {
-        Some(ep) => VaryingShades::new(&ep.file, &ep.shades, calendar)?,
+        Some(ep) => VaryingShades::for_run(&ep.file, &ep.shades, timesteps, weather_days.as_ref())?,
         None => None,
     };
     if varying.is_some() && hook == Some(Hook::Imported) {

@@ -33,7 +33,7 @@ use crate::error::{Error, Result};
 use crate::export::Schedule;
 use crate::export::hook::{Hook, HookPlan, hook_for, patch_model};
 use crate::model::arrays::{Arrays, scene_from_arrays};
-use crate::model::calendar::WeatherDays;
+use crate::model::calendar::{WeatherDays, check_model};
 use crate::model::run_year::{choose, is_leap};
 use crate::model::schedule::RunCalendar;
 use crate::model::shading_update::periodic_update;
@@ -220,12 +220,11 @@ impl Engine {
         foliage: Option<String>,
         transmittance: Option<String>,
     ) -> Result<Model, JsValue> {
-        let (loaded, variants) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
+        let (loaded, variants, reload) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
         let model = self.model(loaded.scene, loaded.energyplus, loaded.notes)?;
         let mut inner = Rc::try_unwrap(model.inner).map_err(|_| js_error(Error::argument("model", "shared while loading")))?;
-        for scene in variants {
-            inner.variants.push(Variant { scene, gpu: Default::default(), exact: Default::default() });
-        }
+        inner.variants.extend(variants.into_iter().map(Variant::new));
+        inner.reload = reload;
         Ok(Model { inner: Rc::new(inner) })
     }
 
@@ -245,7 +244,16 @@ impl Engine {
 
     fn model(&self, scene: Scene, energyplus: Option<EnergyPlusInput>, notes: Vec<String>) -> Result<Model, JsValue> {
         let gpu = Default::default();
-        let inner = ModelInner { scene, gpu, energyplus, notes, exact: Default::default(), maps: Default::default(), variants: Vec::new() };
+        let inner = ModelInner {
+            scene,
+            gpu,
+            energyplus,
+            notes,
+            exact: Default::default(),
+            maps: Default::default(),
+            variants: Vec::new(),
+            reload: None,
+        };
         Ok(Model { inner: Rc::new(inner) })
     }
 
@@ -294,6 +302,13 @@ impl Engine {
             let mut options = settings.model_options(energyplus.and_then(EnergyPlusInput::timesteps), periods).map_err(js_error)?;
             options.timesteps = options.timesteps.leap_year(is_leap_run(&given, model.energyplus.as_ref()));
             let (location, calendar) = (settings.location, settings.calendar);
+            // The weather file's holidays and daylight saving period, as the CLI reads them; the
+            // run's calendar checked as EnergyPlus places it at a run's start.
+            let epw_name = given.epw_name.as_deref().unwrap_or("EPW");
+            let days = given.epw.as_deref().map(|text| WeatherDays::from_epw_text(epw_name, text)).transpose().map_err(js_error)?;
+            if let Some(ep) = &model.energyplus {
+                check_model(&ep.file, &ep.objects, options.timesteps.is_leap(), days.as_ref()).map_err(js_error)?;
+            }
             // A model that cannot be hooked (e.g. a Version before 9.3) still has its year
             // counted: the refusal is kept for `hookedModel`, the only call that needs the hook.
             let hook = model.energyplus.as_ref().map(|ep| hook_for(ep, &model.scene, None, options.timesteps).map_err(js_error));
@@ -309,18 +324,17 @@ impl Engine {
                 Ok(())
             };
             let chosen = model.chosen(kind, gpu.as_deref(), &counter_options, &routing);
+            let local = choice::Routing::from_js(&JsValue::UNDEFINED).map_err(js_error)?;
+            // Shades mixed by τ: the one-scene passes (the sky views) see each at its mean τ over
+            // this run, read with the run's calendar as the CLI reads it.
+            let mut sky_transmittance = None;
             let (schedule, fitted) = match (&model.energyplus, model.variants.is_empty()) {
                 (Some(ep), false) => {
                     // Shades whose τ changes in time: a year per variant (each such shade opaque
                     // or removed), mixed per timestep; the variants' scenes are not the pool's, so
                     // their exact share is clipped here.
-                    // The weather file's holidays and daylight saving period, as the CLI reads them.
-                    let epw_name = given.epw_name.as_deref().unwrap_or("EPW");
-                    let days = given.epw.as_deref().map(|text| WeatherDays::from_epw_text(epw_name, text)).transpose().map_err(js_error)?;
-                    let run =
-                        RunCalendar { per_hour: options.timesteps.per_hour(), leap: options.timesteps.is_leap(), weather: days.as_ref() };
-                    let varying = VaryingShades::new(&ep.file, &ep.shades, run).map_err(js_error)?;
-                    let local = choice::Routing::from_js(&JsValue::UNDEFINED).map_err(js_error)?;
+                    let varying = VaryingShades::for_run(&ep.file, &ep.shades, options.timesteps, days.as_ref()).map_err(js_error)?;
+                    sky_transmittance = varying.as_ref().map(VaryingShades::mean_transmittance);
                     let mut years = Vec::new();
                     for v in &model.variants {
                         let upload = upload(kind, gpu.as_deref(), &v.scene, &v.gpu);
@@ -344,11 +358,25 @@ impl Engine {
             let weather = given.epw.as_deref().map(|text| Weather::from_epw_text(given.epw_name.as_deref().unwrap_or("EPW"), text));
             // The sky views (the same engine, Tregenza's patches, the sky model asked) only when there is weather to weigh them.
             let sky = match &weather {
-                Some(Ok(_)) => Some(
-                    sky_views_for(&chosen, &model.scene, &SkyPatches::tregenza(), settings.sky_model, &mut report)
-                        .await
-                        .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?,
-                ),
+                Some(Ok(_)) => {
+                    let run_scene = match (&sky_transmittance, &model.reload) {
+                        (Some(t), Some(reload)) => Some(Variant::new(reload.scene_with(t.clone()).map_err(js_error)?)),
+                        _ => None,
+                    };
+                    let patches = SkyPatches::tregenza();
+                    Some(match &run_scene {
+                        Some(v) => {
+                            let upload = upload(kind, gpu.as_deref(), &v.scene, &v.gpu);
+                            let engine = choice::Chosen::new(kind, &v.scene, &v.exact, upload, &counter_options, &local);
+                            sky_views_for(&engine, &v.scene, &patches, settings.sky_model, &mut report)
+                                .await
+                                .map_err(|e| engine.take_pool_error().unwrap_or_else(|| js_error(e)))?
+                        }
+                        None => sky_views_for(&chosen, &model.scene, &patches, settings.sky_model, &mut report)
+                            .await
+                            .map_err(|e| chosen.take_pool_error().unwrap_or_else(|| js_error(e)))?,
+                    })
+                }
                 _ => None,
             };
             let extra = embed::Extra::new(&model.scene, &schedule, &location, weather, sky.as_ref().map(|s| (s, &calendar)), fitted);
@@ -366,7 +394,7 @@ fn load_files(
     north: Option<f64>,
     foliage: Option<String>,
     transmittance: Option<String>,
-) -> Result<(crate::model::Loaded, Vec<Scene>)> {
+) -> Result<(crate::model::Loaded, Vec<Scene>, Option<Reload>)> {
     if names.len() != contents.length() as usize {
         return Err(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length())));
     }
@@ -381,15 +409,31 @@ fn load_files(
         ..Default::default()
     };
     let mut loaded = load_bytes_all(&files, &options)?;
-    let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new())) };
-    // Which shades vary does not depend on the run's timesteps; their mean τ for the one-scene
-    // passes (the sky views) is taken over hourly values.
+    let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new(), None)) };
+    // Which shades vary does not depend on the run's calendar. The scene shown has each at its
+    // mean τ over hourly values without the weather file's holidays (not known yet); a year's
+    // one-scene passes reload it with the run's ([`Reload`]).
     let hourly = RunCalendar { per_hour: 1, leap: false, weather: None };
-    let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new())) };
-    let with = |shade_transmittance: Vec<(String, f64)>| load_bytes_all(&files, &LoadOptions { shade_transmittance, ..options.clone() });
-    loaded.scene = with(varying.mean_transmittance())?.scene;
-    let variants = (0..varying.variants()).map(|v| Ok(with(varying.shade_transmittance(v))?.scene)).collect::<Result<Vec<_>>>()?;
-    Ok((loaded, variants))
+    let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new(), None)) };
+    let reload = Reload { files, options };
+    loaded.scene = reload.scene_with(varying.mean_transmittance())?;
+    let variants = (0..varying.variants()).map(|v| reload.scene_with(varying.shade_transmittance(v))).collect::<Result<Vec<_>>>()?;
+    Ok((loaded, variants, Some(reload)))
+}
+
+/// A model's files and load options, kept when its shades are mixed by τ: a year's one-scene
+/// passes take the shades' mean τ over that run's calendar (its timesteps, leap day, the weather
+/// file's holidays and daylight saving), known only when the year is asked for.
+struct Reload {
+    files: Vec<(String, Vec<u8>)>,
+    options: LoadOptions,
+}
+
+impl Reload {
+    /// The scene with the shades named at the τ given.
+    fn scene_with(&self, shade_transmittance: Vec<(String, f64)>) -> Result<Scene> {
+        Ok(load_bytes_all(&self.files, &LoadOptions { shade_transmittance, ..self.options.clone() })?.scene)
+    }
 }
 
 /// A comma-separated setting (globs, `GLOB=T` items); empty when not given.
@@ -417,6 +461,8 @@ struct ModelInner {
     /// With EnergyPlus shades whose transmittance changes in time: the scene with each such
     /// shade opaque or removed, in [`VaryingShades`]'s order (empty otherwise).
     variants: Vec<Variant>,
+    /// With such shades: the files to load the scene again at a run's mean τ.
+    reload: Option<Reload>,
 }
 
 /// One of [`ModelInner::variants`]: a scene, its upload and its exact engine.
@@ -424,6 +470,12 @@ struct Variant {
     scene: Scene,
     gpu: std::cell::OnceCell<GpuScene>,
     exact: std::cell::OnceCell<ExactEngine>,
+}
+
+impl Variant {
+    fn new(scene: Scene) -> Self {
+        Self { scene, gpu: Default::default(), exact: Default::default() }
+    }
 }
 
 impl ModelInner {

@@ -809,8 +809,10 @@ fn models_the_hook_cannot_take() {
 }
 
 /// A shade's `Transmittance Schedule Name` that names nothing, a transmittance outside 0..1, a
-/// `Schedule:File` that cannot be read or is too short, and a `Schedule:Compact` whose `Through`
-/// dates stop before 12/31: each refused by object, field and reason, before anything is counted.
+/// `Schedule:File` that cannot be read or is too short, a `Schedule:Compact` whose `Through`
+/// dates stop before 12/31, special days sunlit cannot place, and an nth weekday the month lacks
+/// (a 5th Monday of December): each refused by object, field and reason, before anything is
+/// counted.
 #[test]
 fn shade_transmittance_schedules() {
     let base = idf();
@@ -875,4 +877,14 @@ fn shade_transmittance_schedules() {
     ] {
         check(file, Case::model(file, special(day), &format!("{file}: {fest}: {why}")));
     }
+    // A weekday the month lacks in the run's year (the office's RunPeriod starts on a Sunday in a
+    // year of 365 days: December has four Mondays): EnergyPlus stops on it, and so does sunlit,
+    // once the run's year is known (loading alone does not know it, so only the CLI's year).
+    let nths = "there is no 5th Monday of December in the run's year (EnergyPlus stops on such a date: \"Nth Day of Month, not enough Nths\"); use 'Last' or a date";
+    let fifth = format!("fifth.idf: {fest}: field 'Start Date': {nths}");
+    check("fifth weekday", Case::model("fifth.idf", special("5th Monday in December, 1, Holiday"), &fifth).api(None));
+    let saving =
+        with("TAU", "Schedule:Constant, TAU, , 0.5;\nRunPeriodControl:DaylightSavingTime, 2nd Sunday in March, 5th Monday in December;\n");
+    let dst = format!("dst.idf: RunPeriodControl:DaylightSavingTime (line {}): field 'End Date': {nths}", next + 1);
+    check("fifth weekday ends daylight saving", Case::model("dst.idf", saving, &dst).api(None));
 }

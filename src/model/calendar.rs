@@ -20,6 +20,11 @@
 //!   (whatever the RunPeriod says), else the weather file's period when the RunPeriod's `Use
 //!   Weather File Daylight Saving Period` is Yes (the default) and the file gives one.
 //!
+//! - an nth weekday the month lacks in the run's year (a 5th Monday in a month with four), in a
+//!   special day, a daylight saving date or the weather file's record: EnergyPlus stops with a
+//!   fatal error ("Nth Day of Month, not enough Nths", `SetSpecialDayDates`/`SetDSTDateRanges`),
+//!   and sunlit refuses it naming the object (or weather file) and field.
+//!
 //! Only the first RunPeriod is read: sunlit's year is one run period's.
 
 use super::idf::IdfObject;
@@ -99,31 +104,79 @@ impl DateRule {
     }
 
     /// The day of the run's year (1-based; Feb 29 counted only in a leap run) given the weekday
-    /// of 1 January.
-    pub fn day(self, leap: bool, first_weekday: usize) -> u32 {
+    /// of 1 January; None for an nth weekday the month does not have that year (a 5th Monday
+    /// in a month with four), on which EnergyPlus stops ("not enough Nths" in WeatherManager's
+    /// `SetSpecialDayDates` and `SetDSTDateRanges`, a fatal error).
+    pub fn day(self, leap: bool, first_weekday: usize) -> Option<u32> {
         let lengths = |m: usize| if m == 2 && !leap { 28 } else { MONTH_DAYS[m - 1] };
         let before = |m: usize| (1..m).map(lengths).sum::<u32>();
         match self {
-            DateRule::Fixed(m, d) => before(m) + d.min(lengths(m)),
+            DateRule::Fixed(m, d) => Some(before(m) + d.min(lengths(m))),
             DateRule::Nth(which, weekday, m) => {
                 let weekday_of = |day: u32| (first_weekday + day as usize - 1) % 7;
                 if which == 0 {
                     let last = before(m) + lengths(m);
-                    last - ((weekday_of(last) + 7 - weekday) % 7) as u32
+                    Some(last - ((weekday_of(last) + 7 - weekday) % 7) as u32)
                 } else {
                     let first = before(m) + 1;
                     let day = first + ((weekday + 7 - weekday_of(first)) % 7) as u32 + 7 * (which - 1);
-                    day.min(before(m) + lengths(m))
+                    (day <= before(m) + lengths(m)).then_some(day)
                 }
+            }
+        }
+    }
+
+    /// `5th Monday of December`, for messages (a fixed date as month/day).
+    fn describe(self) -> String {
+        match self {
+            DateRule::Fixed(m, d) => format!("{m}/{d}"),
+            DateRule::Nth(which, weekday, m) => {
+                let ordinal = match which {
+                    0 => "last".to_string(),
+                    1 => "1st".to_string(),
+                    2 => "2nd".to_string(),
+                    3 => "3rd".to_string(),
+                    n => format!("{n}th"),
+                };
+                let month = MONTH_NAMES[m - 1];
+                let month = format!("{}{}", month[..1].to_ascii_uppercase(), &month[1..]);
+                format!("{ordinal} {} of {month}", DAY_TYPE_NAMES[weekday])
             }
         }
     }
 }
 
+/// A date and where it was given (file, object, field), so that one EnergyPlus cannot place in
+/// the run's year is refused naming them.
+#[derive(Debug, Clone, PartialEq)]
+struct Dated {
+    rule: DateRule,
+    file: String,
+    object: String,
+    field: String,
+}
+
+impl Dated {
+    /// [`DateRule::day`], or the refusal EnergyPlus's fatal error stands for.
+    fn day(&self, leap: bool, first_weekday: usize) -> Result<u32> {
+        self.rule.day(leap, first_weekday).ok_or_else(|| {
+            Error::object(
+                &self.file,
+                &self.object,
+                format!(
+                    "field '{}': there is no {} in the run's year (EnergyPlus stops on such a date: \"Nth Day of Month, not enough Nths\"); use 'Last' or a date",
+                    self.field,
+                    self.rule.describe()
+                ),
+            )
+        })
+    }
+}
+
 /// One special day period: its first date, its length in days and its day type.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 struct SpecialDay {
-    start: DateRule,
+    start: Dated,
     duration: u32,
     day_type: usize,
 }
@@ -131,8 +184,8 @@ struct SpecialDay {
 /// What the weather file says of its calendar: its holidays and daylight saving period.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct WeatherDays {
-    holidays: Vec<DateRule>,
-    saving: Option<(DateRule, DateRule)>,
+    holidays: Vec<Dated>,
+    saving: Option<(Dated, Dated)>,
 }
 
 impl WeatherDays {
@@ -149,7 +202,7 @@ impl WeatherDays {
         let date = |i: usize, what: &str| match at(i) {
             "" | "0" => Ok(None),
             text => DateRule::parse(text)
-                .map(Some)
+                .map(|rule| Some(Dated { rule, file: file.to_string(), object: EPW_RECORD.to_string(), field: what.to_string() }))
                 .ok_or_else(|| bad(format!("{what} '{text}' is not a date (M/D, Month D, or Nth Weekday in Month)"))),
         };
         let saving = match (date(2, "the daylight saving start")?, date(3, "the daylight saving end")?) {
@@ -178,7 +231,7 @@ pub struct ModelCalendar {
     first_weekday: usize,
     special: Vec<SpecialDay>,
     /// `RunPeriodControl:DaylightSavingTime`'s start and end.
-    saving: Option<(DateRule, DateRule)>,
+    saving: Option<(Dated, Dated)>,
     use_weather_holidays: bool,
     use_weather_saving: bool,
     weekend_rule: bool,
@@ -190,9 +243,13 @@ impl ModelCalendar {
     /// unknown special day type.
     pub fn read(file: &str, objects: &[IdfObject]) -> Result<Self> {
         let bad = |o: &IdfObject, why: String| Error::object(file, o.label(), why);
+        let dated = |o: &IdfObject, i: usize, field: &str| {
+            let rule = date(o, i, field).map_err(|why| bad(o, why))?;
+            Ok::<_, Error>(Dated { rule, file: file.to_string(), object: o.label(), field: field.to_string() })
+        };
         let mut special = Vec::new();
         for o in objects.iter().filter(|o| o.is(SPECIAL_DAYS)) {
-            let start = date(o, 1, "Start Date").map_err(|why| bad(o, why))?;
+            let start = dated(o, 1, "Start Date")?;
             let duration = match o.field(2).trim() {
                 "" => 1,
                 text => text
@@ -217,7 +274,7 @@ impl ModelCalendar {
             special.push(SpecialDay { start, duration, day_type });
         }
         let saving = match objects.iter().find(|o| o.is(DAYLIGHT_SAVING)) {
-            Some(o) => Some((date(o, 0, "Start Date").map_err(|why| bad(o, why))?, date(o, 1, "End Date").map_err(|why| bad(o, why))?)),
+            Some(o) => Some((dated(o, 0, "Start Date")?, dated(o, 1, "End Date")?)),
             None => None,
         };
         let run = RunPeriodFields::first(objects);
@@ -236,18 +293,20 @@ impl ModelCalendar {
         (self.first_weekday + day as usize - 1) % 7
     }
 
-    /// The day type ([`DAY_TYPE_NAMES`] index) of every day of the run's year, in order.
-    pub fn day_types(&self, leap: bool, weather: Option<&WeatherDays>) -> Vec<usize> {
+    /// The day type ([`DAY_TYPE_NAMES`] index) of every day of the run's year, in order; refused,
+    /// naming the object (or weather file) and field, for an nth weekday the run's year does not
+    /// have, on which EnergyPlus stops.
+    pub fn day_types(&self, leap: bool, weather: Option<&WeatherDays>) -> Result<Vec<usize>> {
         let days = 365 + u32::from(leap);
         let mut types: Vec<usize> = (1..=days).map(|d| self.weekday(d)).collect();
         let from_weather = weather.filter(|_| self.use_weather_holidays).map_or(&[][..], |w| &w.holidays[..]);
         let periods = from_weather
             .iter()
-            .map(|&start| SpecialDay { start, duration: 1, day_type: WEATHER_HOLIDAY })
-            .chain(self.special.iter().copied());
+            .map(|start| SpecialDay { start: start.clone(), duration: 1, day_type: WEATHER_HOLIDAY })
+            .chain(self.special.iter().cloned());
         for special in periods {
-            let mut day = special.start.day(leap, self.first_weekday);
-            if self.weekend_rule && special.duration == 1 && matches!(special.start, DateRule::Fixed(..)) {
+            let mut day = special.start.day(leap, self.first_weekday)?;
+            if self.weekend_rule && special.duration == 1 && matches!(special.start.rule, DateRule::Fixed(..)) {
                 day += match self.weekday(day) {
                     0 => 1,
                     6 => 2,
@@ -260,17 +319,33 @@ impl ModelCalendar {
                 types[d as usize] = special.day_type;
             }
         }
-        types
+        Ok(types)
     }
 
-    /// Whether each day of the run's year is in daylight saving, in order.
-    pub fn saving_days(&self, leap: bool, weather: Option<&WeatherDays>) -> Vec<bool> {
+    /// Whether each day of the run's year is in daylight saving, in order; refused as
+    /// [`Self::day_types`] for a date the run's year does not have.
+    pub fn saving_days(&self, leap: bool, weather: Option<&WeatherDays>) -> Result<Vec<bool>> {
         let days = 365 + u32::from(leap);
-        let from_weather = weather.filter(|_| self.use_weather_saving).and_then(|w| w.saving);
-        let Some((start, end)) = self.saving.or(from_weather) else { return vec![false; days as usize] };
-        let (start, end) = (start.day(leap, self.first_weekday), end.day(leap, self.first_weekday));
-        (1..=days).map(|d| if start <= end { (start..=end).contains(&d) } else { d >= start || d <= end }).collect()
+        let from_weather = weather.filter(|_| self.use_weather_saving).and_then(|w| w.saving.as_ref());
+        let Some((start, end)) = self.saving.as_ref().or(from_weather) else { return Ok(vec![false; days as usize]) };
+        let (start, end) = (start.day(leap, self.first_weekday)?, end.day(leap, self.first_weekday)?);
+        Ok((1..=days).map(|d| if start <= end { (start..=end).contains(&d) } else { d >= start || d <= end }).collect())
     }
+
+    /// Every date of the run's calendar placed in the run's year (the special days, the weather
+    /// file's holidays when used, the daylight saving period in use), as EnergyPlus places them at
+    /// the start of a run whether or not a schedule reads them: refused as [`Self::day_types`].
+    pub fn check(&self, leap: bool, weather: Option<&WeatherDays>) -> Result<()> {
+        self.day_types(leap, weather)?;
+        self.saving_days(leap, weather).map(|_| ())
+    }
+}
+
+/// The run's calendar of the model `objects` (from `file`) checked for the run's year: every special
+/// day and daylight saving date placed, as EnergyPlus does at the start of a weather-file run and
+/// stops on one it cannot place ([`ModelCalendar::check`]).
+pub fn check_model(file: &str, objects: &[IdfObject], leap: bool, weather: Option<&WeatherDays>) -> Result<()> {
+    ModelCalendar::read(file, objects)?.check(leap, weather)
 }
 
 /// A date field of `object`, or why it cannot be read.

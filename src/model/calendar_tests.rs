@@ -22,7 +22,7 @@ fn special_days_set_the_day_type() {
                 RunPeriodControl:SpecialDays, NY, 12/31, 3, CustomDay2;\n\
                 RunPeriodControl:SpecialDays, OVER, 1/19, 1, WinterDesignDay;\n\
                 RunPeriodControl:SpecialDays, BLANK, Last Friday in March;";
-    let types = calendar(text).unwrap().day_types(false, None);
+    let types = calendar(text).unwrap().day_types(false, None).unwrap();
     assert_eq!(types.len(), 365);
     assert_eq!(types[0], t("CustomDay2"), "12/31 for 3 days goes on into January");
     assert_eq!(types[1], t("CustomDay2"));
@@ -31,7 +31,7 @@ fn special_days_set_the_day_type() {
     assert_eq!((types[17], types[18]), (t("CustomDay1"), t("WinterDesignDay")), "the later one wins on 19 January");
     assert_eq!(types[20], t("SummerDesignDay"), "21 January, a Saturday, stays without the weekend rule");
     assert_eq!(types[89], t("Holiday"), "31 March 2017, blank duration 1 and type Holiday");
-    let rule = calendar(&text.replace("Yes, Yes, No;", "Yes, Yes, Yes;")).unwrap().day_types(false, None);
+    let rule = calendar(&text.replace("Yes, Yes, No;", "Yes, Yes, Yes;")).unwrap().day_types(false, None).unwrap();
     assert_eq!((rule[20], rule[22]), (t("Saturday"), t("SummerDesignDay")), "Saturday's moves to Monday 23 January");
     assert_eq!(rule[15], t("Holiday"), "an nth-weekday date does not move");
 }
@@ -44,21 +44,21 @@ fn weather_file_holidays_and_daylight_saving() {
     let weather = WeatherDays::from_epw_text("w.epw", epw).unwrap();
     let run = |switches: &str, extra: &str| calendar(&format!("RunPeriod, R, 1, 1, 2017, 12, 31, 2017, , {switches};\n{extra}")).unwrap();
     let uses = run("Yes, Yes, No", "");
-    let types = uses.day_types(false, Some(&weather));
+    let types = uses.day_types(false, Some(&weather)).unwrap();
     assert_eq!((types[19], types[326]), (t("Sunday"), t("Sunday")), "20 January and 23 November 2017");
-    let saving = uses.saving_days(false, Some(&weather));
+    let saving = uses.saving_days(false, Some(&weather)).unwrap();
     assert_eq!((saving[15], saving[16], saving[18], saving[19]), (false, true, true, false));
     let ignores = run("No, No, No", "");
-    assert_eq!(ignores.day_types(false, Some(&weather))[19], t("Friday"));
-    assert!(!ignores.saving_days(false, Some(&weather)).contains(&true));
+    assert_eq!(ignores.day_types(false, Some(&weather)).unwrap()[19], t("Friday"));
+    assert!(!ignores.saving_days(false, Some(&weather)).unwrap().contains(&true));
     // The model's own daylight saving holds whatever the RunPeriod says of the weather file's.
     let own = run("No, No, No", "RunPeriodControl:DaylightSavingTime, 1/22, 1/22;");
-    let saving = own.saving_days(false, Some(&weather));
+    let saving = own.saving_days(false, Some(&weather)).unwrap();
     assert_eq!((saving[16], saving[21]), (false, true));
-    let both = run("Yes, Yes, No", "RunPeriodControl:DaylightSavingTime, 1/22, 1/22;").saving_days(false, Some(&weather));
+    let both = run("Yes, Yes, No", "RunPeriodControl:DaylightSavingTime, 1/22, 1/22;").saving_days(false, Some(&weather)).unwrap();
     assert!(!both[16] && both[21], "the model's period replaces the weather file's");
     // Defaults: a RunPeriod that leaves the switches blank uses the weather file's days.
-    assert_eq!(calendar("RunPeriod, R, 1, 1, 2017, 12, 31, 2017;").unwrap().day_types(false, Some(&weather))[19], t("Sunday"));
+    assert_eq!(calendar("RunPeriod, R, 1, 1, 2017, 12, 31, 2017;").unwrap().day_types(false, Some(&weather)).unwrap()[19], t("Sunday"));
     assert_eq!(
         WeatherDays::from_epw_text("w.epw", "LOCATION,X\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\n").unwrap(),
         WeatherDays::default()
@@ -95,8 +95,39 @@ fn special_days_from_epjson() {
     let objects = crate::model::epjson::parse_epjson("m.epJSON", text).unwrap();
     let calendar = ModelCalendar::read("m.epJSON", &objects).unwrap();
     let weather = WeatherDays::from_epw_text("w.epw", "L\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,1/17,1/19,1,H,1/20\n").unwrap();
-    let types = calendar.day_types(false, Some(&weather));
+    let types = calendar.day_types(false, Some(&weather)).unwrap();
     assert_eq!((types[17], types[18], types[19]), (t("CustomDay1"), t("CustomDay1"), t("Friday")), "no weather holidays");
     assert_eq!((types[20], types[22]), (t("Saturday"), t("SummerDesignDay")), "the weekend rule");
-    assert!(calendar.saving_days(false, Some(&weather))[16], "the weather file's daylight saving");
+    assert!(calendar.saving_days(false, Some(&weather)).unwrap()[16], "the weather file's daylight saving");
+}
+
+/// An nth weekday the month lacks in the run's year is refused naming the object (or the weather
+/// file's record) and field, as EnergyPlus stops on it (`SetSpecialDayDates` and
+/// `SetDSTDateRanges`: "Nth Day of Month, not enough Nths", fatal); sunlit used to take the
+/// month's last day instead. December 2017 has five Fridays and four Mondays; February 2020 has
+/// a fifth Saturday only when the run has its Feb 29.
+#[test]
+fn a_weekday_the_month_lacks_is_refused() {
+    let run = "RunPeriod, R, 1, 1, 2017, 12, 31, 2017, , Yes, Yes, No;\n";
+    let fifth_friday = calendar(&format!("{run}RunPeriodControl:SpecialDays, F, 5th Friday in December, 1, Holiday;")).unwrap();
+    assert_eq!(fifth_friday.day_types(false, None).unwrap()[362], t("Holiday"), "29 December 2017");
+    let fifth_monday = calendar(&format!("{run}RunPeriodControl:SpecialDays, IMPOSSIBLE, 5th Monday in December, 1, Holiday;")).unwrap();
+    let e = fifth_monday.day_types(false, None).unwrap_err().to_string();
+    assert!(
+        e.contains("RunPeriodControl:SpecialDays 'IMPOSSIBLE'") && e.contains("'Start Date'") && e.contains("5th Monday of December"),
+        "{e}"
+    );
+    assert!(fifth_monday.check(false, None).is_err());
+    let saving = calendar(&format!("{run}RunPeriodControl:DaylightSavingTime, 2nd Sunday in March, 5th Monday in December;")).unwrap();
+    let e = saving.saving_days(false, None).unwrap_err().to_string();
+    assert!(e.contains("RunPeriodControl:DaylightSavingTime") && e.contains("'End Date'"), "{e}");
+    let leap_run = "RunPeriod, R, 1, 1, 2020, 12, 31, 2020, , Yes, Yes, No;\nRunPeriodControl:SpecialDays, L, 5th Saturday in February, 1;";
+    assert_eq!(calendar(leap_run).unwrap().day_types(true, None).unwrap()[59], t("Holiday"), "29 February 2020");
+    assert!(calendar(leap_run).unwrap().check(false, None).is_err(), "no fifth Saturday in a 28-day February");
+    let weather =
+        WeatherDays::from_epw_text("w.epw", "L\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,1,Odd,5th Monday in December\n").unwrap();
+    let e = calendar(run).unwrap().day_types(false, Some(&weather)).unwrap_err().to_string();
+    assert!(e.contains("w.epw") && e.contains("HOLIDAYS/DAYLIGHT SAVINGS") && e.contains("holiday 1"), "{e}");
+    let ignored = "RunPeriod, R, 1, 1, 2017, 12, 31, 2017, , No, Yes, No;\n";
+    assert!(calendar(ignored).unwrap().check(false, Some(&weather)).is_ok(), "the weather file's holidays unused: EnergyPlus skips them");
 }

@@ -48,7 +48,7 @@ impl IdfObject {
 }
 
 /// Common classes whose first field is not a name (their objects are labelled by class alone).
-const UNNAMED_CLASSES: [&str; 14] = [
+const UNNAMED_CLASSES: [&str; 15] = [
     "Version",
     "SimulationControl",
     "Timestep",
@@ -63,6 +63,7 @@ const UNNAMED_CLASSES: [&str; 14] = [
     "Site:GroundTemperature:BuildingSurface",
     "Output:Diagnostics",
     "Output:Table:SummaryReports",
+    "RunPeriodControl:DaylightSavingTime",
 ];
 
 /// `Class 'Name' (line N)`: how messages name an object.

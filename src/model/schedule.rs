@@ -136,26 +136,29 @@ impl Schedule {
     /// The value of every timestep of the run, in row order (day → hour → timestep). On the days
     /// of a daylight-saving period each timestep takes the value one hour later (the first hour
     /// of the next day for the last), as EnergyPlus's `LookUpScheduleValue` adds its
-    /// `DSTIndicator` to the hour.
-    pub fn values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
-        let standard = self.standard_values(calendar);
-        let saving = self.calendar.saving_days(calendar.leap, calendar.weather);
+    /// `DSTIndicator` to the hour. Refused for a calendar date the run's year does not have
+    /// ([`ModelCalendar::day_types`]).
+    pub fn values(&self, calendar: RunCalendar<'_>) -> Result<Vec<f64>> {
+        let standard = self.standard_values(calendar)?;
+        let saving = self.calendar.saving_days(calendar.leap, calendar.weather)?;
         let per_hour = calendar.per_hour as usize;
         let per_day = 24 * per_hour;
         let last = standard.len().saturating_sub(1);
-        (0..standard.len()).map(|row| if saving[row / per_day] { standard[(row + per_hour).min(last)] } else { standard[row] }).collect()
+        Ok((0..standard.len())
+            .map(|row| if saving[row / per_day] { standard[(row + per_hour).min(last)] } else { standard[row] })
+            .collect())
     }
 
     /// [`Self::values`] in standard time.
-    fn standard_values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
+    fn standard_values(&self, calendar: RunCalendar<'_>) -> Result<Vec<f64>> {
         let n = calendar.per_hour as usize;
         let days = 365 + usize::from(calendar.leap);
-        match &self.source {
+        Ok(match &self.source {
             Source::Constant(v) => vec![*v; days * 24 * n],
             Source::Calendar { days: profiles, periods } => {
                 let per_day: Vec<Vec<f64>> = profiles.iter().map(|d| d.timestep_values(n)).collect();
                 let mut out = Vec::with_capacity(days * 24 * n);
-                let day_types = self.calendar.day_types(calendar.leap, calendar.weather);
+                let day_types = self.calendar.day_types(calendar.leap, calendar.weather)?;
                 for (day, &day_type) in (1..=days as u32).zip(&day_types) {
                     let leap_day = if calendar.leap || day < 60 { day } else { day + 1 };
                     let types = periods.iter().find(|(last, _)| leap_day <= *last).map(|p| p.1);
@@ -178,7 +181,7 @@ impl Schedule {
                     })
                     .collect()
             }
-        }
+        })
     }
 
     /// Every value the schedule can take (for range checks before a run).

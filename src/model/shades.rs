@@ -27,8 +27,9 @@ pub struct ShadeGroup {
 }
 
 impl ShadeGroup {
-    /// The transmittance at every timestep of the run (row order).
-    pub fn values(&self, calendar: RunCalendar<'_>) -> Vec<f64> {
+    /// The transmittance at every timestep of the run (row order); refused for a calendar date the
+    /// run's year does not have.
+    pub fn values(&self, calendar: RunCalendar<'_>) -> Result<Vec<f64>> {
         self.schedule.values(calendar)
     }
 

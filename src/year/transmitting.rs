@@ -17,6 +17,7 @@
 
 use crate::error::{Error, Result};
 use crate::export::Schedule;
+use crate::model::calendar::WeatherDays;
 use crate::model::schedule::RunCalendar;
 use crate::model::shades::ShadeGroup;
 use crate::sun::periods::ShadingPeriods;
@@ -39,7 +40,8 @@ impl VaryingShades {
     /// loaded is then already right).
     pub fn new(file: &str, shades: &[ShadeGroup], calendar: RunCalendar<'_>) -> Result<Option<Self>> {
         let mixed: Vec<&ShadeGroup> = shades.iter().filter(|g| !matches!(g.constant(), Some(t) if t == 0.0 || t >= 1.0)).collect();
-        let groups: Vec<(Vec<String>, Vec<f64>)> = mixed.iter().map(|g| (g.shades.clone(), g.values(calendar))).collect();
+        let groups: Vec<(Vec<String>, Vec<f64>)> =
+            mixed.iter().map(|g| Ok((g.shades.clone(), g.values(calendar)?))).collect::<Result<_>>()?;
         if groups.len() > MAX_VARYING {
             let names: Vec<&str> = mixed.iter().map(|g| g.schedule.name.as_str()).collect();
             return Err(Error::model(
@@ -52,6 +54,14 @@ impl VaryingShades {
             ));
         }
         Ok((!groups.is_empty()).then_some(Self { groups }))
+    }
+
+    /// [`Self::new`] over a run's calendar: its timesteps, its leap day and the weather file's
+    /// holidays and daylight saving period (when given), which the model's special days and
+    /// daylight saving join. Both edges read the shades of a year this way, so the page's
+    /// one-scene passes see the same τ as the CLI's.
+    pub fn for_run(file: &str, shades: &[ShadeGroup], timesteps: Timesteps, weather: Option<&WeatherDays>) -> Result<Option<Self>> {
+        Self::new(file, shades, RunCalendar { per_hour: timesteps.per_hour(), leap: timesteps.is_leap(), weather })
     }
 
     /// How many years are counted: 2^k.
@@ -153,6 +163,44 @@ mod tests {
         assert_eq!(transmittance_row(Some(periods), t, row(10, 37)), row(8, 37), "days 8–14");
         assert_eq!(transmittance_row(Some(periods), t, row(7, 95)), row(1, 95), "days 1–7");
         assert_eq!(transmittance_row(Some(periods), t, row(365, 3)), row(365, 3), "the last period, one day");
+    }
+
+    /// Each group's mean τ per day of `v`'s run, to 1e-9 (a day's sum of quarter-hours rounds).
+    fn daily(v: &VaryingShades, per_day: usize) -> Vec<Vec<f64>> {
+        let mean = |d: &[f64]| (d.iter().sum::<f64>() / per_day as f64 * 1e9).round() / 1e9;
+        v.groups.iter().map(|(_, t)| t.chunks(per_day).map(mean).collect()).collect()
+    }
+
+    /// The τ the page's one-scene passes take, read with the run's calendar (`for_run` with the
+    /// weather file's text, as the page has it), is the native year's day by day on a model with
+    /// a holiday of its own (25 December 2017, a Monday) and one from the weather file (4 July, a
+    /// Tuesday): the holidays' τ, 0.8, where a weekday's is 0.2. The calendar the page read before
+    /// (hourly, without the weather file) gave 4 July a weekday's τ, and so another mean.
+    #[test]
+    fn the_one_scene_transmittance_reads_the_runs_calendar() {
+        let text = "RunPeriod, R, 1, 1, 2017, 12, 31, 2017, , Yes, Yes, No;\n\
+            RunPeriodControl:SpecialDays, XMAS, 12/25, 1, Holiday;\n\
+            Shading:Site:Detailed, SCREEN, TAU, 3, 0,0,0, 1,0,0, 1,0,1;\n\
+            Schedule:Compact, TAU, , Through: 12/31, For: Weekdays, Until: 24:00, 0.2, For: AllOtherDays, Until: 24:00, 0.8;";
+        let objects = parse_idf("m.idf", text).unwrap();
+        let groups = read_shade_schedules("m.idf", &objects, None).unwrap();
+        let epw = "LOCATION,X\nA\nB\nC\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,1,Fest,7/4\n";
+        let page_days = WeatherDays::from_epw_text("w.epw", epw).unwrap();
+        let timesteps = Timesteps::new(4).unwrap();
+        let page = VaryingShades::for_run("m.idf", &groups, timesteps, Some(&page_days)).unwrap().unwrap();
+        // The native year: the CLI's calendar, the weather file read from its own copy.
+        let native_days = WeatherDays::from_epw_text("chicago.epw", epw).unwrap();
+        let calendar = RunCalendar { per_hour: 4, leap: false, weather: Some(&native_days) };
+        let native = VaryingShades::new("m.idf", &groups, calendar).unwrap().unwrap();
+        let (page_daily, native_daily) = (daily(&page, 96), daily(&native, 96));
+        assert_eq!(page_daily, native_daily);
+        let tau = &page_daily[0];
+        assert_eq!(tau.len(), 365);
+        assert_eq!((tau[1], tau[184], tau[358], tau[0]), (0.2, 0.8, 0.8, 0.8), "2 Jan, 4 July, 25 Dec, a Sunday");
+        assert_eq!(page.mean_transmittance(), native.mean_transmittance());
+        let before = VaryingShades::new("m.idf", &groups, RunCalendar { per_hour: 1, leap: false, weather: None }).unwrap().unwrap();
+        assert_eq!(daily(&before, 24)[0][184], 0.2, "the page's former calendar: 4 July a weekday");
+        assert!(before.mean_transmittance()[0].1 < page.mean_transmittance()[0].1);
     }
 
     #[test]
