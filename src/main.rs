@@ -232,7 +232,7 @@ impl AnnualArgs {
     }
 }
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 struct ModelArgs {
     /// Model files, all casting shadows: glTF (.glb, .gltf), CityJSON (.city.json, .city.jsonl),
     /// OBJ (.obj) and at most one EnergyPlus model (.idf, .epJSON), whose outdoor surfaces and

@@ -284,6 +284,93 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
     assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
 }
 
+/// The proposed model's obstruction for the No-Sky Line: a wall 400 m long (x), `height` m high,
+/// `distance` m south of the window's wall, so the line is drawn in the room's section alone.
+fn long_wall(distance: f64, height: f64) -> String {
+    let y = -distance;
+    format!("Shading:Site:Detailed,Block,,4,-200,{y},{height},-200,{y},0,204,{y},0,204,{y},{height};\n")
+}
+
+/// By hand, in the room's section: a work-plane point `y` m from the window sees sky over the
+/// long wall when the steepest ray through the window's head (z 2.5) clears the wall's top; the
+/// margin (degrees of elevation in the section) by which it does, negative where it does not.
+fn sky_margin_deg(y: f64, distance: f64, height: f64) -> f64 {
+    let rise = WINDOW[3] - inside::NSL_WORK_PLANE;
+    (rise / y).atan().to_degrees() - ((height - inside::NSL_WORK_PLANE) / (y + distance)).atan().to_degrees()
+}
+
+/// BRE 209's No-Sky Line before and after a long wall rises 6 m in front of the window, 5.8 m
+/// high: by hand the line lies 1.65 × 6 / 3.3 = 3 m into the room (60 % of its 5 m depth), so
+/// the room keeps 0.6 of its former area seeing sky and fails BRE's 0.8 rule. Every point more
+/// than 4° (two Tregenza sub-patches, seen in the section) from the line is on its side of it;
+/// the CLI's report has before, after, the ratio and the verdict.
+#[test]
+fn no_sky_line_before_and_after_matches_the_line_drawn_by_hand() {
+    const DISTANCE: f64 = 6.0;
+    const HEIGHT: f64 = 5.8;
+    let patches = sunlit::sky::patches::SkyPatches::parse("tregenza").unwrap();
+    let (before, after) = (room_idf(WINDOW, false, ""), room_idf(WINDOW, false, &long_wall(DISTANCE, HEIGHT)));
+    let nsl = |idf: &str| {
+        let (mut scene, rooms) = load(idf).unwrap();
+        let at = inside::floor_grid(&mut scene, &rooms, 0.3, inside::NSL_WORK_PLANE).unwrap();
+        let mapper = Mapper::new(&scene, &at.points).unwrap();
+        let (sees, areas) = inside::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &patches, &mut |_, _| {});
+        (sees, areas, positions(&at))
+    };
+    let (_, was, _) = nsl(&before);
+    let (sees, now, at) = nsl(&after);
+    assert_eq!(was[0].sees_sky, 100.0);
+    let (mut near, mut by_hand) = (0, 0);
+    for (p, s) in at.iter().zip(&sees) {
+        let margin = sky_margin_deg(p[1], DISTANCE, HEIGHT);
+        by_hand += usize::from(margin > 0.0);
+        if margin.abs() <= 4.0 {
+            near += 1;
+        } else {
+            assert_eq!(*s, margin > 0.0, "point {p:?}: sees sky {s}, {margin:.2}° from the line by hand");
+        }
+    }
+    let (hand, slack) = (100.0 * by_hand as f64 / at.len() as f64, 100.0 * near as f64 / at.len() as f64);
+    eprintln!("No-Sky Line: {} % of the work plane sees sky, {hand} % by hand ({slack} % within 4° of the line)", now[0].sees_sky);
+    assert!((hand - 60.0).abs() < 4.0, "the grid's share in front of the line at 3 m: {hand} %");
+    assert!((now[0].sees_sky - hand).abs() <= slack, "{} % against {hand} % by hand", now[0].sees_sky);
+    let change = &inside::nsl_before_after(&now, &was)[0];
+    assert_eq!((change.before, change.passes), (Some(100.0), Some(false)));
+    assert!((change.ratio.unwrap() - now[0].sees_sky / 100.0).abs() < 1e-12);
+
+    let (old, new, csv) = (scratch("nsl-before.idf"), scratch("nsl-after.idf"), scratch("nsl.csv"));
+    std::fs::write(&old, &before).unwrap();
+    std::fs::write(&new, &after).unwrap();
+    let args = ["map", new.to_str().unwrap(), "--inside", "--study", "bre-nsl", "--grid", "0.3", "--location", "51.5,-0.1,0"];
+    let out = sunlit(&[&args[..], &["--before", old.to_str().unwrap(), "-o", csv.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(scratch("nsl.study-bre-nsl.json")).unwrap()).unwrap();
+    let room = &report["areas"][0];
+    assert_eq!(
+        (room["zone"].as_str(), room["sees_sky_before"].as_f64(), room["passes"].as_bool()),
+        (Some("OFFICE"), Some(100.0), Some(false))
+    );
+    assert!((room["sees_sky"].as_f64().unwrap() - now[0].sees_sky).abs() < 1e-3, "{room}");
+    assert!((room["ratio"].as_f64().unwrap() - now[0].sees_sky / 100.0).abs() < 1e-4, "{room}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.lines().next().unwrap().ends_with(",sees_sky,sees_sky_before"), "{}", &text[..80]);
+    // `--before` with the other inside study is refused, before anything is written.
+    let bad = scratch("nsl-bad.csv");
+    let out = sunlit(&[
+        "map",
+        new.to_str().unwrap(),
+        "--inside",
+        "--study",
+        "leed-ase",
+        "--before",
+        old.to_str().unwrap(),
+        "-o",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains("--before"));
+    assert!(!bad.exists());
+}
+
 #[test]
 fn free_csv_points_answer_as_the_work_plane_grid_does() {
     let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
@@ -588,4 +675,115 @@ fn map_inside_of_a_gltf_room_writes_its_sun_patch_and_refuses_bad_marks() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("Glass") && err.contains("not a closed room"), "{err}");
     assert!(!bad.exists());
+}
+
+/// `glb` with a material carrying `extras` given to the mesh named `mesh` (the GLB's JSON chunk
+/// rewritten, its BIN chunk kept).
+fn with_material(glb: &[u8], mesh: &str, extras: Value) -> Vec<u8> {
+    let word = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = word(12);
+    let mut doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    doc["materials"] = json!([{"name": "Pane", "extras": extras}]);
+    for m in doc["meshes"].as_array_mut().unwrap().iter_mut().filter(|m| m["name"] == mesh) {
+        m["primitives"].as_array_mut().unwrap().iter_mut().for_each(|p| p["material"] = json!(0));
+    }
+    let mut text = doc.to_string().into_bytes();
+    text.resize(text.len().div_ceil(4) * 4, b' ');
+    let rest = &glb[20 + json_len..];
+    let mut out = Vec::new();
+    out.extend_from_slice(&glb[0..8]);
+    out.extend_from_slice(&((12 + 8 + text.len() + rest.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(rest);
+    out
+}
+
+/// A measured curve of transmittance by angle, on the pane's glTF material.
+const CURVE: [[f64; 2]; 4] = [[0.0, 0.8], [30.0, 0.78], [50.0, 0.72], [70.0, 0.5]];
+
+/// A glTF pane whose material gives a curve of transmittance by angle weights the beam by the
+/// curve at the beam's incidence: at four angles the lit work-plane points' solar weight is the
+/// curve's value worked by hand, the visible one the same share of its own normal value; numpy's
+/// ray caster (its own interpolation of the same pairs) agrees point by point and on LEED ASE.
+#[test]
+fn a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle() {
+    const VISIBLE: f64 = 0.85;
+    // No glass transmittance given: the material gives the glass.
+    let load = |overhang: bool| {
+        let glb = with_material(
+            &room_glb(overhang),
+            "glass",
+            json!({"sunlit": {"transmittance_curve": CURVE, "visible_transmittance": VISIBLE}}),
+        );
+        let options = LoadOptions { interior: vec!["Room".into()], glazing: vec!["Glass".into()], ..Default::default() };
+        let mut loaded = model::load_bytes_all(&[("room.glb".to_string(), glb)], &options).unwrap();
+        let rooms = sunlit::model::inside::gltf::rooms(&mut loaded.scene, &loaded.interior, &loaded.glazing, None).unwrap();
+        let mut scene = loaded.scene;
+        let at = inside::floor_grid(&mut scene, &rooms, 0.1, 0.76).unwrap();
+        (scene, rooms, at)
+    };
+    let (scene, rooms, at) = load(false);
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    // Suns in the plane x = 0 meet the south pane (normal −y) at θ from its normal: the curve by
+    // hand there (linear between pairs, down to 0 at 90° past the last).
+    for (theta, expected) in [
+        (20.0_f64, 0.8 - 0.02 * 20.0 / 30.0),
+        (45.0, 0.78 - 0.06 * 15.0 / 20.0),
+        (60.0, 0.72 - 0.22 * 10.0 / 20.0),
+        (75.0, 0.5 * 15.0 / 20.0),
+    ] {
+        let sun = DVec3::new(0.0, -theta.to_radians().cos(), theta.to_radians().sin());
+        let one = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0);
+        let lit = one.lit.iter().filter(|&&l| l == 1.0).count();
+        assert!(lit > 50, "θ {theta}°: only {lit} points lit");
+        for ((l, s), v) in one.lit.iter().zip(&one.solar_transmittance).zip(&one.visible_transmittance) {
+            assert!((s - l * expected).abs() < 1e-9, "θ {theta}°: solar weight {s}, the curve gives {expected}");
+            assert!((v - l * expected * VISIBLE / 0.8).abs() < 1e-9, "θ {theta}°: visible weight {v}");
+        }
+    }
+    let (mut scene, rooms, at) = load(true);
+    let suns = [[0.2, -0.8, 0.7], [-0.5, -0.5, 0.5], [0.35, -0.7, 0.6]];
+    let (answers, reference) = lit_against_numpy(&scene, &rooms, &at, &suns, json!({"vt": VISIBLE, "angular": CURVE}));
+    for (k, (sun, ours, theirs)) in answers.into_iter().enumerate() {
+        let visible = reference["visible"][k].as_array().unwrap();
+        for (i, (l, v)) in ours.lit.iter().zip(&ours.visible_transmittance).enumerate().filter(|(i, (l, _))| **l == theirs[*i]) {
+            let numpy = visible[i].as_f64().unwrap();
+            assert!((v - numpy).abs() < 1e-9, "sun {sun}: point {i} lit {l}: visible weight {v}, numpy {numpy}");
+        }
+    }
+    let (ours, theirs) = ase_against_numpy(&mut scene, &rooms, json!({"vt": VISIBLE, "angular": CURVE}));
+    assert!((ours.areas[0].ase - theirs).abs() <= 1.0, "ASE {} % against numpy's {theirs} %", ours.areas[0].ase);
+
+    // A curve that rises with the angle, or leaves 0..1, is refused by file, material and field,
+    // and `map` writes nothing.
+    let out = scratch("curve-bad.csv");
+    for (curve, needle) in [(json!([[0, 0.7], [40, 0.75]]), "rises"), (json!([[0, 1.3]]), "outside 0..=1")] {
+        let glb = scratch("curve-bad.glb");
+        std::fs::write(&glb, with_material(&room_glb(false), "glass", json!({"sunlit": {"transmittance_curve": curve}}))).unwrap();
+        let run = sunlit(&[
+            "map",
+            glb.to_str().unwrap(),
+            "--inside",
+            "--interior",
+            "Room",
+            "--glazing",
+            "Glass",
+            "--location",
+            "40,-105,-7",
+            "--grid",
+            "0.5",
+            "--at",
+            "03-21",
+            "12:00",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&run.stderr);
+        for word in ["curve-bad.glb", "material 0 'Pane'", "sunlit.transmittance_curve", needle] {
+            assert!(!run.status.success() && err.contains(word), "{curve}: no '{word}' in: {err}");
+        }
+        assert!(!out.exists(), "{curve}: output written");
+    }
 }

@@ -125,6 +125,8 @@ pub(super) struct MapArgs {
     sam: Option<PathBuf>,
     /// Window studies (bre-vsc, bre-apsh, gb50180): the existing scene's models; each point's
     /// former values go beside the proposed ones, with BRE's relative tests. Needs --points or --window-points.
+    /// With --inside --study bre-nsl: the existing model, its rooms read as the proposed one's;
+    /// each room's former share of working plane seeing sky, the ratio and BRE's 0.8 rule.
     #[arg(long, value_name = "MODEL", num_args = 1..)]
     before: Vec<PathBuf>,
     /// gb50180's standard day: dahan (大寒日, the default) or dongzhi (冬至日).
@@ -276,7 +278,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         return planning::run(args);
     }
     let window_only = [
-        ("--before", !args.before.is_empty()),
+        ("--before", !args.before.is_empty() && !args.study.iter().any(|s| s == "bre-nsl")),
         ("--day", args.day.is_some()),
         ("--required-hours", args.required_hours.is_some()),
         ("--min-period", args.min_period.is_some()),

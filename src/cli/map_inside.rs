@@ -5,6 +5,7 @@
 use sunlit::map::inside::{
     self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, InsideMap, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
 };
+use sunlit::map::planning::compare::FORMER_RATIO;
 use sunlit::model::inside::gltf::rooms as gltf_rooms;
 use sunlit::model::inside::{Rooms, inside_scene, rooms};
 
@@ -68,23 +69,13 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
     let (location, weather) = args.site()?;
-    let (mut scene, rooms) = read_rooms(&args)?;
-    let (default_spacing, default_height) = match ask {
+    let (mut scene, rooms) = read_rooms(&args, &args.model)?;
+    let defaults = match ask {
         Ask::Ase => (ASE_SPACING, WORK_PLANE_HEIGHT),
         Ask::Nsl => (0.5, NSL_WORK_PLANE),
         _ => (0.5, 0.0),
     };
-    let at = match &args.points {
-        Some(path) => {
-            let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
-            rooms_map::room_points_csv(&mut scene, &rooms, &path.display().to_string(), &text)?
-        }
-        None => {
-            let spacing = args.grid.unwrap_or(default_spacing);
-            let height = args.work_plane.unwrap_or(default_height);
-            rooms_map::floor_grid(&mut scene, &rooms, spacing, height)?
-        }
-    };
+    let at = room_points(&args, &mut scene, &rooms, defaults)?;
     let start = Instant::now();
     let mapper = Mapper::new(&scene, &at.points)?;
     let map = InsideMap { mapper: &mapper, rooms: &rooms, at: &at };
@@ -120,20 +111,19 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
         Ask::Nsl => {
             let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;
             let (sees, areas) = rooms_map::no_sky_line(map, &patches, &mut |_, _| {});
-            let areas: Vec<Value> =
-                areas.iter().map(|a| json!({"zone": a.zone, "points": a.points, "sees_sky": round(a.sees_sky, 3)})).collect();
-            let report = json!({
-                "study": "bre-nsl",
-                "source": "BRE 209 (3rd ed., 2022), the No-Sky Line: the share of a room's working plane that can see sky (a point sees sky when one of its sky sub-patch directions is clear)",
-                "work_plane_m": args.work_plane.unwrap_or(NSL_WORK_PLANE),
-                "sky_patches": patches.name(),
-                "inputs": {"models": args.model.models},
-                "areas": areas,
-            });
+            let former = if args.before.is_empty() { None } else { Some(nsl_before(&args, defaults, &patches)?) };
+            let report = nsl_report(&args, &patches, &areas, former.as_ref());
             summary["studies"] = json!([{"study": "bre-nsl", "areas": report["areas"].clone()}]);
             files.push((args.study_path("bre-nsl", "json"), format!("{report:#}\n").into_bytes()));
             let sees: Vec<f64> = sees.iter().map(|&s| f64::from(u8::from(s))).collect();
-            (points_csv(&scene, &at.points, &[Column { name: "sees_sky", values: &sees, decimals: 0 }]), ("sees_sky", "", sees.clone()))
+            // The existing model's points go beside only where they are the same points.
+            let same = former.as_ref().filter(|(_, _, points)| *points == at.points.positions);
+            let before: Option<Vec<f64>> = same.map(|(s, _, _)| s.iter().map(|&s| f64::from(u8::from(s))).collect());
+            let mut columns = vec![Column { name: "sees_sky", values: &sees, decimals: 0 }];
+            if let Some(b) = &before {
+                columns.push(Column { name: "sees_sky_before", values: b, decimals: 0 });
+            }
+            (points_csv(&scene, &at.points, &columns), ("sees_sky", "", sees.clone()))
         }
     };
     files.insert(0, (args.output.clone(), csv.into_bytes()));
@@ -156,19 +146,72 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
     Ok(())
 }
 
+/// The rooms' points: `--points`, else a grid (`--grid`, `--work-plane`, else `defaults`:
+/// spacing and height) on their floors.
+fn room_points(args: &MapArgs, scene: &mut Scene, rooms: &Rooms, defaults: (f64, f64)) -> Result<RoomPoints> {
+    match &args.points {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+            rooms_map::room_points_csv(scene, rooms, &path.display().to_string(), &text)
+        }
+        None => rooms_map::floor_grid(scene, rooms, args.grid.unwrap_or(defaults.0), args.work_plane.unwrap_or(defaults.1)),
+    }
+}
+
+/// The existing model's No-Sky Line: per point whether it sees sky, per room the share, and the
+/// points' positions.
+type Former = (Vec<bool>, Vec<rooms_map::NslArea>, Vec<f32>);
+
+/// The No-Sky Line of the existing model (`--before`): its rooms, read as the proposed model's
+/// are, on the same kind of points. Per point whether it sees sky, per room the share, and the
+/// points' positions (to put them beside the proposed ones when they are the same).
+fn nsl_before(args: &MapArgs, defaults: (f64, f64), patches: &SkyPatches) -> Result<Former> {
+    let mut model = args.model.clone();
+    model.models = args.before.clone();
+    let (mut scene, rooms) = read_rooms(args, &model)?;
+    let at = room_points(args, &mut scene, &rooms, defaults)?;
+    let mapper = Mapper::new(&scene, &at.points)?;
+    let (sees, areas) = rooms_map::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, patches, &mut |_, _| {});
+    Ok((sees, areas, at.points.positions))
+}
+
+/// `POINTS.study-bre-nsl.json`: per room `zone`, `points`, `sees_sky` (%), and with `--before`
+/// the former share, the ratio and BRE 209's 0.8 × former value test.
+fn nsl_report(args: &MapArgs, patches: &SkyPatches, areas: &[rooms_map::NslArea], former: Option<&Former>) -> Value {
+    let rows: Vec<Value> = match former {
+        None => areas.iter().map(|a| json!({"zone": a.zone, "points": a.points, "sees_sky": round(a.sees_sky, 3)})).collect(),
+        Some((_, before, _)) => rooms_map::nsl_before_after(areas, before)
+            .iter()
+            .map(|c| {
+                json!({"zone": c.now.zone, "points": c.now.points, "sees_sky": round(c.now.sees_sky, 3),
+                    "sees_sky_before": c.before.map(|b| round(b, 3)), "ratio": c.ratio.map(|r| round(r, 4)), "passes": c.passes})
+            })
+            .collect(),
+    };
+    json!({
+        "study": "bre-nsl",
+        "source": "BRE 209 (3rd ed., 2022), the No-Sky Line: the share of a room's working plane that can see sky (a point sees sky when one of its sky sub-patch directions is clear)",
+        "rule": former.map(|_| format!("with --before: a room passes when the share of its working plane that sees sky is not below {FORMER_RATIO} × its former value (rooms matched by zone name)")),
+        "work_plane_m": args.work_plane.unwrap_or(NSL_WORK_PLANE),
+        "sky_patches": patches.name(),
+        "inputs": {"models": args.model.models, "before": (!args.before.is_empty()).then_some(&args.before)},
+        "areas": rows,
+    })
+}
+
 /// The scene and rooms of one EnergyPlus model given alone, or of mesh models whose rooms and
-/// glass `--interior` and `--glazing` pick.
-fn read_rooms(args: &MapArgs) -> Result<(Scene, Rooms)> {
+/// glass `--interior` and `--glazing` pick; `model` is the proposed model's or the existing one's.
+fn read_rooms(args: &MapArgs, model: &ModelArgs) -> Result<(Scene, Rooms)> {
     if !args.interior.is_empty() {
-        let mut loaded = args.model.load_rooms(&args.interior, &args.glazing)?;
+        let mut loaded = model.load_rooms(&args.interior, &args.glazing)?;
         if let Some(ep) = &loaded.energyplus {
             return Err(Error::model(&ep.file, "--interior picks the rooms of mesh models: an EnergyPlus model's zones are its rooms"));
         }
         let rooms = gltf_rooms(&mut loaded.scene, &loaded.interior, &loaded.glazing, args.glass_transmittance)?;
         return Ok((loaded.scene, rooms));
     }
-    let loaded = args.model.load_all(false)?;
-    let Some(ep) = loaded.energyplus.as_ref().filter(|_| args.model.models.len() == 1) else {
+    let loaded = model.load_all(false)?;
+    let Some(ep) = loaded.energyplus.as_ref().filter(|_| model.models.len() == 1) else {
         return Err(Error::argument(
             "inside",
             "maps the zones of one EnergyPlus model (IDF or epJSON), given alone, or the rooms --interior picks in mesh models",

@@ -24,6 +24,7 @@
 
 use glam::{DVec2, DVec3};
 
+use super::planning::compare;
 use super::points::{csv_rows, receiver_under};
 use super::{Mapper, Points, Sample, Site, grid};
 use crate::count::ViewRequest;
@@ -456,4 +457,36 @@ pub fn no_sky_line(
         })
         .collect();
     (sees, areas)
+}
+
+/// One room's No-Sky Line before and after a development.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NslChange {
+    /// The room now (the proposed model's).
+    pub now: NslArea,
+    /// Its share that saw sky in the existing model (%), None where that model has no room of
+    /// the name.
+    pub before: Option<f64>,
+    /// `now.sees_sky / before` ([`compare::ratio`]): None without a former share, or where it
+    /// was 0.
+    pub ratio: Option<f64>,
+    /// BRE 209's daylight distribution test ([`compare::no_sky_line`]): the area seeing sky
+    /// is not below 0.8 × its former value. None without a former share.
+    pub passes: Option<bool>,
+}
+
+/// Each room of `now` with its former share from `before` (rooms matched by name), by the window
+/// studies' relative tests ([`super::planning::compare`]).
+pub fn nsl_before_after(now: &[NslArea], before: &[NslArea]) -> Vec<NslChange> {
+    now.iter()
+        .map(|area| {
+            let former = before.iter().find(|b| b.zone == area.zone).map(|b| b.sees_sky);
+            NslChange {
+                now: area.clone(),
+                before: former,
+                ratio: compare::ratio(area.sees_sky, former),
+                passes: former.map(|b| compare::no_sky_line(area.sees_sky, b)),
+            }
+        })
+        .collect()
 }

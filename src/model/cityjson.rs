@@ -465,7 +465,7 @@ pub fn city_model(city: &City, north_deg: f64) -> Result<GltfModel> {
         });
         meshes.push(mesh);
     }
-    Ok(GltfModel { file: city.file.clone(), meshes, nodes })
+    Ok(GltfModel { file: city.file.clone(), meshes, nodes, glass: Vec::new() })
 }
 
 /// One surface's triangles (f32, local coordinates: already small).

@@ -13,6 +13,7 @@ use glam::{DMat4, DVec4};
 
 use super::{gltf_accessor, gltf_draco, gltf_extensions, gltf_instancing};
 use crate::error::{Error, Result};
+use crate::model::inside::curve::{MeshGlass, glass_from_extras};
 use crate::scene::{NodeVeil, SourceMesh, SourceNode};
 
 /// One glTF file, read: its meshes (one per glTF mesh, primitives merged) and mesh nodes.
@@ -24,6 +25,9 @@ pub struct GltfModel {
     pub meshes: Vec<SourceMesh>,
     /// Nodes that place a mesh, with world transforms; `receiver` is the extras mark.
     pub nodes: Vec<GltfNode>,
+    /// Per mesh (glTF mesh order; empty for a model without materials), the glass its
+    /// primitives' material describes in its extras ([`mesh_glass`]).
+    pub glass: Vec<Option<MeshGlass>>,
 }
 
 /// A mesh node of a glTF file.
@@ -119,6 +123,7 @@ fn read_with(
     gltf_draco::decode_draco(file, &mut root, &mut buffers)?;
     let document = ::gltf::Document::from_json(root).map_err(invalid)?;
     let meshes = document.meshes().map(|m| read_mesh(file, &m, &buffers)).collect::<Result<Vec<_>>>()?;
+    let glass = document.meshes().map(|m| mesh_glass(file, &m)).collect::<Result<Vec<_>>>()?;
     warn_skipped_primitives(file, &document);
     let world = DMat4::from_rotation_z(-north_deg.to_radians()) * gltf_to_world();
     let mut nodes = Vec::new();
@@ -126,7 +131,33 @@ fn read_with(
     for root in scene_roots(&document) {
         collect_nodes(file, &root, world, (&document, &buffers), &mut nodes, &mut walked)?;
     }
-    Ok(GltfModel { file: file.to_string(), meshes, nodes })
+    Ok(GltfModel { file: file.to_string(), meshes, nodes, glass })
+}
+
+/// The glass a mesh's primitives' materials describe in their extras
+/// ([`glass_from_extras`]): refused by file, material and field where a value cannot be taken,
+/// and by mesh where its primitives describe different glass.
+fn mesh_glass(file: &str, mesh: &::gltf::Mesh) -> Result<Option<MeshGlass>> {
+    let mut found: Option<MeshGlass> = None;
+    for material in mesh.primitives().map(|p| p.material()) {
+        let (Some(index), Some(extras)) = (material.index(), material.extras()) else { continue };
+        let label = format!("material {index} '{}'", material.name().unwrap_or(""));
+        let glass = glass_from_extras(&label, extras.get())
+            .map_err(|(field, reason)| Error::object(file, label.clone(), format!("extras {field}: {reason}")))?;
+        match (&found, glass) {
+            (Some(a), Some(b)) if (a.solar, a.visible, &a.angular) != (b.solar, b.visible, &b.angular) => {
+                let object = format!("mesh {} '{}'", mesh.index(), mesh.name().unwrap_or(""));
+                return Err(Error::object(
+                    file,
+                    object,
+                    format!("its primitives' materials {} and {} describe different glass", a.material, b.material),
+                ));
+            }
+            (None, Some(b)) => found = Some(b),
+            _ => {}
+        }
+    }
+    Ok(found)
 }
 
 /// Points and lines cast no shadow and have no area: they are left out, and the user told once.

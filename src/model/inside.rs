@@ -12,7 +12,8 @@
 //! averages, whose normal-incidence fields are read as they are. The solar transmittance's
 //! angular dependence ([`Glazing::solar_at`], [`Glazing::visible_at`]: the interior beam and the
 //! maps alike) is EnergyPlus's: its curves A–J chosen by U and SHGC for simple glazing
-//! ([`super::simple_glazing`]), Fresnel's physics for one pane.
+//! ([`super::simple_glazing`]), Fresnel's physics for one pane; a glTF pane's own, from its
+//! material's extras ([`curve`]).
 //!
 //! The scene ([`inside_scene`]) is the building's surfaces with the glazing left out, so an
 //! opening is a hole in its wall: the engines see the beam pass and the map weights it by the
@@ -27,7 +28,10 @@ use crate::error::{Error, Result};
 use crate::geometry::{Plane, inside_or_on, newell, triangulate};
 use crate::scene::{Scene, SceneBuilder};
 
+pub mod curve;
 pub mod gltf;
+
+use curve::TransmittanceCurve;
 
 /// A ray within this distance (m) of an opening's outline crosses it: the engine counts a point
 /// whose ray grazes an edge as lit, and map points are f32 (about 1e-5 m at 100 m).
@@ -68,7 +72,7 @@ pub struct Glazing {
 }
 
 /// The angular dependence of a glass's solar transmittance.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Angular {
     /// The normal-incidence value at every angle (a construction sunlit cannot read).
     Normal,
@@ -86,15 +90,19 @@ pub enum Angular {
         /// Solar heat gain coefficient.
         shgc: f64,
     },
+    /// A glTF pane's measured curve of transmittance by angle ([`curve`]); the glazing's
+    /// `solar` is its value at normal incidence.
+    Curve(TransmittanceCurve),
 }
 
 impl Glazing {
     /// Solar transmittance for a beam at `cos_incidence` to the glass's normal, by its
     /// [`Angular`] dependence.
     pub fn solar_at(&self, cos_incidence: f64) -> f64 {
-        match self.angular {
-            Angular::Pane { reflectance } => pane_transmittance(self.solar, reflectance, cos_incidence),
-            Angular::Simple { u, shgc } => (self.solar * angular_factor(u, shgc, cos_incidence)).clamp(0.0, 1.0),
+        match &self.angular {
+            Angular::Pane { reflectance } => pane_transmittance(self.solar, *reflectance, cos_incidence),
+            Angular::Simple { u, shgc } => (self.solar * angular_factor(*u, *shgc, cos_incidence)).clamp(0.0, 1.0),
+            Angular::Curve(curve) => curve.at(cos_incidence),
             Angular::Normal => self.solar,
         }
     }
@@ -103,12 +111,14 @@ impl Glazing {
     /// angular dependence as the solar one. EnergyPlus runs simple glazing's curves (and an
     /// uncoated pane's physics) over each of its optical passes alike, solar and visible; for a
     /// pane sunlit has only the solar reflectance, so the solar curve's share stands in for the
-    /// visible one.
+    /// visible one; so for a measured curve, which is of the solar transmittance.
     pub fn visible_at(&self, cos_incidence: f64) -> f64 {
-        match self.angular {
-            Angular::Pane { .. } if self.solar > 0.0 => (self.visible * self.solar_at(cos_incidence) / self.solar).clamp(0.0, 1.0),
-            Angular::Pane { .. } => 0.0,
-            Angular::Simple { u, shgc } => (self.visible * angular_factor(u, shgc, cos_incidence)).clamp(0.0, 1.0),
+        match &self.angular {
+            Angular::Pane { .. } | Angular::Curve(_) if self.solar > 0.0 => {
+                (self.visible * self.solar_at(cos_incidence) / self.solar).clamp(0.0, 1.0)
+            }
+            Angular::Pane { .. } | Angular::Curve(_) => 0.0,
+            Angular::Simple { u, shgc } => (self.visible * angular_factor(*u, *shgc, cos_incidence)).clamp(0.0, 1.0),
             Angular::Normal => self.visible,
         }
     }

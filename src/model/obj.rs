@@ -115,7 +115,7 @@ pub fn read_obj(file: &str, bytes: &[u8], up: ObjUp, unit: ObjUnit, north_deg: f
     };
     let transform =
         DMat4::from_rotation_z(-north_deg.to_radians()) * axes * DMat4::from_scale(DVec3::splat(unit.0)) * DMat4::from_translation(offset);
-    let mut model = GltfModel { file: file.to_string(), meshes: Vec::new(), nodes: Vec::new() };
+    let mut model = GltfModel { file: file.to_string(), meshes: Vec::new(), nodes: Vec::new(), glass: Vec::new() };
     for name in names {
         let mesh = polygons_mesh(&vertices, &faces[&name], offset);
         model.nodes.push(GltfNode {

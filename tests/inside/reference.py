@@ -12,7 +12,10 @@ stdout: JSON {lit: [[0|1 per point] per sun], visible: [[vt at the sun's inciden
 per lit point, 0 unlit] per sun]} without lux; with lux (one per sun) {hours_over: [per point hours
 with lux * vt * cos * lit > 1000]}. With angular "E" the window's transmittance at incidence theta
 is vt times EnergyPlus's simple glazing curve E of cos theta (Engineering Reference, "Simple
-Window Model": the curve of a glazing with U under 3.4 W/m2K and SHGC over 0.55); null: vt.
+Window Model": the curve of a glazing with U under 3.4 W/m2K and SHGC over 0.55); a list of
+[degrees, transmittance] pairs (a glTF material's measured curve, first at 0): vt times the
+curve's share of its normal value, linear in the angle, falling linearly to 0 at 90 past the last
+pair; null: vt.
 
 Second mode, any closed room of planar polygons (an L-shaped zone): stdin JSON {faces: [{name,
 vertices: [[x, y, z]...], holes: [window outlines in it]}...] (the room's boundary; a wall's
@@ -58,6 +61,14 @@ def window_vt(vt, sun, angular):
     if angular is None:
         return vt
     c = min(max(-float(sun[1]), 0.0), 1.0)
+    if isinstance(angular, list):
+        degrees = [float(a) for a, _ in angular]
+        values = [float(t) for _, t in angular]
+        if degrees[-1] < 90.0:
+            degrees.append(90.0)
+            values.append(0.0)
+        theta = np.degrees(np.arccos(c))
+        return vt * float(np.interp(theta, degrees, values)) / values[0]
     if c >= 1.0:
         return vt
     a, b, d, e = CURVE_E

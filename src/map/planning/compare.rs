@@ -5,7 +5,9 @@
 //! - APSH/WPSH (3.2.11): affected when it receives below [`APSH_TARGET`] % of annual or below
 //!   [`WPSH_TARGET`] % of winter probable sunlight hours, *and* below 0.8 × its former value in
 //!   either period, *and* loses more than [`APSH_LOSS`] points of annual probable sunlight hours;
-//! - GB 50180: the hours reach the required hours (no relative test: the standard has none).
+//! - GB 50180: the hours reach the required hours (no relative test: the standard has none);
+//! - the No-Sky Line (a room's, not a window's): the share of its working plane that sees sky
+//!   not below [`FORMER_RATIO`] × its former share.
 //!
 //! Values within [`TOLERANCE`] of a threshold count as reaching it (the report prints one decimal).
 
@@ -71,6 +73,14 @@ pub fn line_45(within: bool) -> Verdict {
     Verdict { passes: !within, absolute: !within, relative: None }
 }
 
+/// BRE 209's daylight distribution test (the No-Sky Line) for a room whose working plane sees
+/// sky on `now` % of its area and did on `before` %: noticeably worse when reduced below
+/// [`FORMER_RATIO`] × its former value (a room that saw none loses nothing). Relative only: the
+/// guide sets no share a room must reach.
+pub fn no_sky_line(now: f64, before: f64) -> bool {
+    at_least(now, FORMER_RATIO * before)
+}
+
 /// GB 50180's test: `hours` reach `required`.
 pub fn hours(hours: f64, required: f64) -> Verdict {
     let absolute = at_least(hours, required);
@@ -97,5 +107,6 @@ mod tests {
         assert!(apsh(30.0, 5.0, None).passes && !apsh(30.0, 4.9, None).passes);
         assert_eq!(ratio(10.0, Some(0.0)), None);
         assert!(hours(2.0, 2.0).passes && !hours(1.99, 2.0).passes);
+        assert!(no_sky_line(40.0, 50.0) && !no_sky_line(39.9, 50.0) && no_sky_line(0.0, 0.0));
     }
 }

@@ -3,8 +3,9 @@
 //! as an EnergyPlus zone does.
 //!
 //! - **Glazing** (the loader's `glazing` patterns): each matching node is left out of the scene,
-//!   so its place is an opening the beam passes, and weights the beam by one transmittance
-//!   (a mesh says nothing of its glass). A ray that crosses any of the node's triangles crosses
+//!   so its place is an opening the beam passes, and weights the beam by its material's glass
+//!   where the material's extras describe it (a curve of transmittance by angle, or simple
+//!   glazing's U and SHGC: [`super::curve`]), else by one transmittance at every angle. A ray that crosses any of the node's triangles crosses
 //!   its glass once: a pane modelled as a thin box is one pane, not two.
 //! - **Rooms** (the `interior` patterns): each matching node is one room, named after the node:
 //!   a closed shell (its window openings left as holes where the glazing nodes sit). The scene
@@ -19,6 +20,7 @@
 
 use glam::DVec3;
 
+use super::curve::MeshGlass;
 use super::{Angular, Glazing, Room, Rooms};
 use crate::error::{Error, Result};
 use crate::geometry::{Plane, triangle_area, triangle_normal};
@@ -39,6 +41,8 @@ pub struct MarkedNode {
     pub origin: String,
     /// Its triangles, world axes (sunlit's: x east, y north, z up).
     pub triangles: Vec<[DVec3; 3]>,
+    /// The glass its mesh's material describes ([`super::curve`]), if any.
+    pub glass: Option<MeshGlass>,
 }
 
 /// Case-insensitive globs for the loader option `what`.
@@ -74,7 +78,8 @@ pub fn marked_nodes(models: &mut [GltfModel], what: &str, patterns: &[String], t
                 node.transform.transform_point3(DVec3::new(f64::from(v[0]), f64::from(v[1]), f64::from(v[2])))
             };
             let triangles = mesh.indices.chunks_exact(3).map(|t| [p(t[0]), p(t[1]), p(t[2])]).collect();
-            out.push(MarkedNode { name: node.name.clone(), origin: node.origin(&model.file), triangles });
+            let glass = model.glass.get(node.mesh).cloned().flatten();
+            out.push(MarkedNode { name: node.name.clone(), origin: node.origin(&model.file), triangles, glass });
             if !take {
                 keep.push(node);
             }
@@ -142,11 +147,20 @@ pub fn rooms(scene: &mut Scene, interior: &[MarkedNode], glazing: &[MarkedNode],
 const DOWN: DVec3 = DVec3::new(0.012_345, 0.016_789, -0.999_783);
 
 /// One glazing node as a pane: crossed where any of its triangles is; its plane (for the angle
-/// of incidence) is its largest triangle's.
+/// of incidence) is its largest triangle's. Its glass is its material's ([`super::curve`]),
+/// else `glass` at every angle.
 fn pane(node: &MarkedNode, glass: Option<f64>) -> Result<Glazing> {
     let (file, object) = node.origin.split_once(": ").unwrap_or(("", &node.origin));
-    let Some(t) = glass else {
-        return Err(Error::object(file, object, "is glazing but a mesh gives no transmittance: give a glass transmittance"));
+    let (solar, visible, angular) = match (&node.glass, glass) {
+        (Some(g), _) => (g.solar, g.visible, g.angular.clone()),
+        (None, Some(t)) => (t, t, Angular::Normal),
+        (None, None) => {
+            return Err(Error::object(
+                file,
+                object,
+                "is glazing but neither its material's extras nor the options give a transmittance: give a glass transmittance",
+            ));
+        }
     };
     let largest = node.triangles.iter().max_by(|a, b| triangle_area(a).total_cmp(&triangle_area(b)));
     let Some(largest) = largest.filter(|t| triangle_area(t) > 0.0) else {
@@ -160,9 +174,9 @@ fn pane(node: &MarkedNode, glass: Option<f64>) -> Result<Glazing> {
         outline: Vec::new(),
         hole: Vec::new(),
         plane,
-        solar: t,
-        visible: t,
-        angular: Angular::Normal,
+        solar,
+        visible,
+        angular,
         interzone: false,
         pane: node.triangles.clone(),
     })
