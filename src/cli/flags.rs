@@ -46,6 +46,8 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("max_periods", "--max-periods"),
     ("window_width", "--window-width"),
     ("window_points", "--window-points"),
+    ("before", "--before"),
+    ("masks", "--mask"),
     ("tile", "--tile"),
     ("context", "--context"),
     ("min_kwh_m2", "--min-kwh-m2"),
