@@ -47,6 +47,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("window_width", "--window-width"),
     ("window_points", "--window-points"),
     ("before", "--before"),
+    ("floor_level", "--floor-level"),
     ("masks", "--mask"),
     ("tile", "--tile"),
     ("context", "--context"),

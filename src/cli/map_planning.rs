@@ -29,6 +29,9 @@ fn check_options(args: &MapArgs) -> Result<()> {
     if let Some(at) = &args.window_points {
         WindowPoint::parse(at)?;
     }
+    if args.floor_level.is_some() && args.window_points.as_deref().map(WindowPoint::parse).transpose()? != Some(WindowPoint::Sill) {
+        return Err(Error::argument("--floor-level", "places the sill of --window-points sill: give --window-points sill with it"));
+    }
     if let Some(other) = args.study.iter().find(|s| !STUDIES.contains(&s.as_str())) {
         return Err(Error::argument(
             "study",
@@ -216,7 +219,14 @@ fn points_input(args: &MapArgs) -> Result<Value> {
     let file = args.points.as_ref().map(|p| p.display().to_string());
     Ok(match (window, file) {
         (None, None) => json!({"grid_spacing_m": args.grid.unwrap_or(0.5)}),
-        (window, file) => planning_points_input(window, file.as_deref()),
+        (window, file) => {
+            let mut input = planning_points_input(window, file.as_deref());
+            if let Some(floor) = args.floor_level {
+                input["floor_level_m"] = json!(floor);
+                input["sill_height_m"] = json!(sunlit::map::planning::window_points::SILL_HEIGHT);
+            }
+            input
+        }
     })
 }
 
