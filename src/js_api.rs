@@ -241,7 +241,7 @@ fn bad_map_options_are_refused_naming_the_option() {
 #[path = "web/study_options.rs"]
 mod study_options;
 
-use study_options::{STUDY_KEYS, StudyPlace, StudyRequest};
+use study_options::{Masks, STUDY_KEYS, StudyPlace, StudyRequest};
 
 use crate::map::planning::run::STUDIES;
 use crate::map::planning::window_points::WindowPoint;
@@ -266,7 +266,7 @@ fn study(options: serde_json::Value) -> crate::error::Result<StudyRequest> {
 fn study_options_read_as_sunlit_map_reads_its_flags() {
     let vsc = study(json!({"study": "bre-vsc", "windows": [0, 3]})).unwrap();
     assert_eq!((vsc.studies, vsc.place), (vec!["bre-vsc".to_string()], StudyPlace::Windows(vec![0, 3], WindowPoint::Centre)));
-    assert!(vsc.location.is_none() && vsc.weather.is_none() && vsc.gb.is_none(), "bre-vsc needs no site");
+    assert!(vsc.location.is_none() && vsc.weather.is_none() && vsc.epw_name.is_none() && vsc.gb.is_none(), "bre-vsc needs no site");
     let gb = study(json!({"study": ["gb50180", "bre-vsc"], "windows": [1], "windowPoints": "sill", "latitude": 39.9, "longitude": 116.4,
         "timeZone": 8, "day": "dongzhi", "minPeriod": 5, "maxPeriods": 2, "skyModel": "cie-overcast"}))
     .unwrap();
@@ -276,6 +276,12 @@ fn study_options_read_as_sunlit_map_reads_its_flags() {
     assert_eq!(gb.location.map(|l| (l.latitude, l.time_zone)), Some((39.9, 8.0)));
     let given = study(json!({"study": "bre-25deg", "points": [1, 2, 3, 0, -1, 0]})).unwrap();
     assert_eq!(given.place, StudyPlace::Given(vec![1.0, 2.0, 3.0, 0.0, -1.0, 0.0]));
+    assert_eq!((given.masks.rows(3), given.names), (vec![], (vec![], vec![])), "no masks, no names by default");
+    let report = study(json!({"study": "bre-vsc", "windows": [0, 1, 2], "masks": "all", "modelNames": ["office.glb", "block.gltf"],
+        "beforeNames": ["office.glb"]}))
+    .unwrap();
+    assert_eq!((report.masks.rows(3), report.names.1), (vec![0, 1, 2], vec!["office.glb".to_string()]), "--mask all");
+    assert_eq!(study(json!({"study": "bre-vsc", "windows": [0], "masks": [2, 0]})).unwrap().masks, Masks::Rows(vec![2, 0]));
 }
 
 #[test]
@@ -302,4 +308,7 @@ fn bad_study_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"study": "bre-vsc", "windows": [-1]})), bad("windows"));
     assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "grid": 1})), bad("options"));
     assert_eq!(named(json!({"study": "gb50180", "windows": [0], "latitude": 40})), bad("longitude"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "masks": "some"})), bad("masks"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "masks": [-1]})), bad("masks"));
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "modelNames": "office.glb"})), bad("modelNames"));
 }

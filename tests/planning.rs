@@ -364,6 +364,34 @@ fn gb50180_finds_the_sill_of_a_window_and_fails_there() {
     assert!(centre_hours > 3.0 && centre_passes, "the centre is not: {centre_hours:.3} h");
 }
 
+/// A window reaching the floor (落地窗, 0..2.4 m, the ground floor at 0) is counted by GB 50180
+/// 0.9 m above the floor: with `floor_sills` its point is there, and its hours are the analytic
+/// canyon's at 0.9 m (k = 11.4/20, 1.29 h) within a minute, where its lowest edge (k = 12.3/20)
+/// would see less.
+#[test]
+fn gb50180_counts_a_window_reaching_the_floor_at_0_9_m() {
+    use sunlit::map::planning::window_points::{OFFSET, SILL_HEIGHT, WindowPoint, floor_sills, window_points};
+    let (distance, height) = (20.0, 12.3);
+    let mut s = TestScene::new();
+    s.polygon("WALL", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), false);
+    s.polygon("WIN", &south_rect(-0.75, 0.75, 0.0, 2.4, 0.0), true);
+    s.cuboid("GARDEN_WALL", DVec3::new(-1000.0, -distance - 2.0, 0.0), DVec3::new(1000.0, -distance, height));
+    let scene = s.build();
+    let win = common::receiver_id(&scene, "WIN");
+    let raised = floor_sills(&scene, &[win], 0.0).unwrap();
+    assert!((raised.position(0) - DVec3::new(0.0, -OFFSET, SILL_HEIGHT)).length() < 1e-5, "{}", raised.position(0));
+    let lowest = window_points(&scene, &[win], WindowPoint::Sill).unwrap();
+    let beijing = Location::new(39.9, 116.4, 8.0).unwrap();
+    let day = StandardDay::Dahan;
+    let rule = Gb50180Rule::new(day);
+    let half = (day.window().1 - day.window().0) / 2.0;
+    let hours = |points: &Points| gb50180::evaluate(&scene, points, &beijing, &rule, &mut |_, _| {}).unwrap().hours[0];
+    let canyon = |z: f64| canyon_hours(beijing.latitude, day.declination_deg(), (height - z) / distance, half);
+    let (at_sill, at_floor) = (hours(&raised), hours(&lowest));
+    assert!((at_sill - canyon(SILL_HEIGHT)).abs() <= 1.0 / 60.0, "{at_sill:.4} h vs the canyon's {:.4} h", canyon(SILL_HEIGHT));
+    assert!((at_floor - canyon(0.0)).abs() <= 1.0 / 60.0 && at_floor < at_sill - 0.1, "the floor sees less: {at_floor:.4} h");
+}
+
 /// True solar time = standard time + EoT + (longitude − 15° · zone)/15, with EoT from the
 /// equation-of-time table of K. Krisciunas (Texas A&M, "Equation of time", values by day of a
 /// non-leap year from Meeus's approximate formula, stated within 30 s):
@@ -563,6 +591,7 @@ fn cli_window_studies_before_and_after_and_bad_input() {
         (vec!["--study", "bre-vsc", "--period", "03-21"], "--period"),
         (vec!["--study", "bre-vsc", "--study", "bre-ground", "--location", "0,0,0"], "--study"),
         (vec!["--study", "bre-vsc", "--mask", "9"], "--mask"),
+        (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--floor-level", "0"], "--floor-level"),
     ] {
         let mut all = vec![office, "--receivers", "WIN_*", "--points", "windows.csv"];
         all.extend(args.iter().copied());

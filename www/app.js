@@ -9,6 +9,8 @@ import { Viewer } from './viewer.js';
 
 const $ = (id) => document.getElementById(id);
 const state = { files: null, reading: null, model: null, result: null, viewer: null, selected: -1, busy: false, csvName: 'sunlit-shading.csv', modelName: '', colourBy: 'mean' };
+/** A model's parts that are not models themselves: a .gltf's buffers and textures. */
+const MODEL_PARTS = /\.(bin|png|jpe?g|webp|ktx2)$/i;
 const worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
 
 function status(text, { error = false } = {}) {
@@ -52,6 +54,9 @@ const studies = studyMode({
   },
   showLegend: (scale) => showLegend(scale),
   names: () => state.model?.names ?? [],
+  // The model's own files, as the CLI is given them (a .gltf's .bin and textures are found by it).
+  modelFiles: () => (state.files ?? []).map((f) => f.name).filter((n) => !MODEL_PARTS.test(n)),
+  readFiles: (list) => readChosen(list),
 });
 
 function setBusy(busy) {
@@ -91,7 +96,7 @@ async function loadFiles(files) {
   if (!files?.length) return;
   if (state.busy) return status('Could not read the model while computing: cancel first.', { error: true });
   const modelName = files.map((f) => f.name).join(', ');
-  const main = files.find((f) => !/\.(bin|png|jpe?g|webp|ktx2)$/i.test(f.name)) ?? files[0];
+  const main = files.find((f) => !MODEL_PARTS.test(f.name)) ?? files[0];
   const base = main.name.replace(/\.[^.]*$/, '');
   state.reading = { files, modelName, csvName: `${base}-shading.csv` };
   status(`Reading ${modelName}…`);
@@ -239,6 +244,10 @@ function showError(msg) {
   if (msg.request === 'mapFile') return status(`Could not download the map: ${msg.message}.`, { error: true });
   maps.failed();
   if (msg.request === 'study') studies.failed();
+  if (msg.request === 'loadBefore') {
+    studies.beforeFailed(String(msg.message));
+    return status(`Could not read the existing scene: ${String(msg.message).replace(/\.$/, '')}.`, { error: true });
+  }
   if (msg.request === 'load') {
     // The files were not read: the last good model (if any) stays, and Compute with it.
     state.reading = null;
@@ -279,6 +288,9 @@ worker.onmessage = ({ data: msg }) => {
     maps.fileArrived(msg);
   } else if (msg.type === 'studyResult') {
     studies.shown(msg);
+  } else if (msg.type === 'beforeLoaded') {
+    studies.beforeLoaded(msg);
+    status('Existing scene read: the next study compares each window with it.');
   } else if (msg.type === 'epwLocation') {
     showEpwLocation(msg);
   } else if (msg.type === 'error') {
@@ -444,6 +456,11 @@ async function start() {
   if (!adapter) return noWebGPU();
   try {
     state.viewer = await Viewer.create($('view'));
+    // In the Study mode a click on a window ticks or unticks it in the list.
+    state.viewer.onPick = (receiver) => {
+      if (!studies.active() || receiver < 0) return;
+      if (studies.toggleWindow(receiver)) status(`${state.model.names[receiver]} ${studies.ticked(receiver) ? 'ticked' : 'unticked'}.`);
+    };
     showInViewer();
     maps.reset();
     studies.recolour();

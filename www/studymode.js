@@ -1,7 +1,11 @@
 // The page's Study mode: planning rules per window (engine.study, run by the worker): a rule, a
 // point on each ticked window (a receiver), GB 50180's parameters; the results as a table per
 // window and the windows coloured pass/fail in the 3D view; the study's CSV to download, as
-// `sunlit map --study NAME` writes POINTS.study-NAME.csv (the library's own writer). Nothing here
+// `sunlit map --study NAME` writes POINTS.study-NAME.csv (the library's own writer), and its HTML
+// report as `--html` writes it (with every window's sky mask, `--mask all`). An existing scene
+// (`--before`) may be loaded beside the model: the table then shows each window's former value,
+// the ratio and BRE's relative test (0.8 × former). Windows are ticked in a list or by clicking
+// them in the 3D view. Nothing here
 // decides a rule: the options are handed on as the user set them, and the library refuses what
 // is wrong (no window ticked, a sky the rule does not take) naming the option.
 import { UNCOMPUTED } from './colour.js';
@@ -15,11 +19,13 @@ export const NOT_ASSESSED = [0.55, 0.55, 0.58];
  * Wires the Study mode's controls. `page`: { $, worker, status, location() (the form's location
  * as StudyOptions keys), skyModel() (the sky control's value, '' for the default), engineOptions(),
  * viewer() (the 3D view, its model set, or null), showLegend({ max, title, tick }), setBusy(busy), download(name, text, type),
- * modelName(), names() (the model's receiver names) }.
+ * modelName(), modelFiles() (the model's own file names, as the CLI is given them), names() (the
+ * model's receiver names), readFiles(fileList) (the chosen files' names and bytes, or null after
+ * saying why not) }.
  */
 export function studyMode(page) {
   const { $ } = page;
-  const state = { study: null, asked: null };
+  const state = { study: null, asked: null, before: null, reading: null };
 
   const mode = () => $('mode').value;
 
@@ -70,6 +76,10 @@ export function studyMode(page) {
 
   async function options() {
     const o = { ...(await page.location()), study: $('study').value, windows: windows(), windowPoints: $('windowpoints').value };
+    // What the report states and draws, as the CLI's MODEL..., --before MODEL... and --mask all.
+    o.modelNames = page.modelFiles();
+    if (state.before) o.beforeNames = state.before;
+    if ($('studymasks').checked) o.masks = 'all';
     const sky = page.skyModel();
     if (sky) o.skyModel = sky;
     if (o.study === 'gb50180') {
@@ -87,6 +97,9 @@ export function studyMode(page) {
     state.study = null;
     state.asked = null;
     $('downloadstudy').disabled = true;
+    $('downloadreport').disabled = true;
+    $('studymaskfigure').hidden = true;
+    $('studymask').replaceChildren();
     $('studytable').tHead.replaceChildren();
     $('studytable').tBodies[0].replaceChildren();
     $('studytable').removeAttribute('data-verdicts');
@@ -103,6 +116,8 @@ export function studyMode(page) {
     state.study = study;
     fillTable(study);
     $('downloadstudy').disabled = false;
+    $('downloadreport').disabled = false;
+    showMask(0);
     showFields();
     const t = study.tables[0];
     const count = (v) => t.passes.filter((p) => p === v).length;
@@ -110,12 +125,16 @@ export function studyMode(page) {
     page.status(`Study ${t.study} in ${seconds.toFixed(1)} s: ${t.passes.length} windows, ${count(true)} pass, ${count(false)} fail${na}.`);
   }
 
+  /** Per window: its values, and with an existing scene each value's former one and the ratio,
+   * and the relative test (BRE's 0.8 × former; APSH's also the 4-point loss), then the verdict. */
   function fillTable({ receivers, tables }) {
     const table = tables[0];
     const names = page.names();
     const keys = Object.keys(table.values);
+    const former = table.before;
+    const columns = keys.flatMap((key) => (former ? [key, `${key} before`, `${key} ratio`] : [key]));
     const head = $('studytable').tHead.insertRow();
-    for (const title of ['Window', ...keys, 'Result']) {
+    for (const title of ['Window', ...columns, ...(former ? ['0.8 × former'] : []), 'Result']) {
       const th = document.createElement('th');
       th.scope = 'col';
       th.textContent = title;
@@ -123,24 +142,72 @@ export function studyMode(page) {
     }
     const body = $('studytable').tBodies[0];
     const verdicts = [];
+    const number = (x, digits) => (x === null || x === undefined ? '–' : x.toFixed(digits));
     receivers.forEach((r, i) => {
       const row = body.insertRow();
       const pass = table.passes[i];
       row.className = pass === null ? 'na' : pass ? 'pass' : 'fail';
+      row.dataset.point = String(i);
       // textContent, never innerHTML: names come from the user's file.
       row.insertCell().textContent = names[r];
       for (const key of keys) {
-        const cell = row.insertCell();
-        cell.textContent = table.values[key][i].toFixed(2);
-        cell.className = 'num';
+        const cells = [number(table.values[key][i], 2), ...(former ? [number(former[key][i], 2), number(table.ratio[key][i], 2)] : [])];
+        for (const text of cells) {
+          const cell = row.insertCell();
+          cell.textContent = text;
+          cell.className = 'num';
+        }
+      }
+      if (former) {
+        const relative = table.relative[i];
+        row.insertCell().textContent = relative === null ? '–' : relative ? 'kept' : 'lost';
       }
       const verdict = row.insertCell();
       verdict.className = 'verdict';
       verdict.textContent = pass === null ? 'not assessed' : pass ? 'passes' : 'fails';
       verdicts.push(verdict.textContent);
     });
-    $('studycaption').textContent = `${table.study}: ${table.source}`;
+    $('studycaption').textContent = `${table.study}: ${table.source}${former ? ' (against the existing scene)' : ''}`;
     $('studytable').dataset.verdicts = verdicts.join(',');
+  }
+
+  /** Point `i`'s sky mask under the table, if it was drawn. The SVG is the library's (every
+   * text in it escaped there), the same as the report's. */
+  function showMask(i) {
+    const svg = state.study?.masks?.[i];
+    $('studymaskfigure').hidden = !svg;
+    if (!svg) return;
+    $('studymask').innerHTML = svg;
+    $('studymaskcaption').textContent = `Sky mask of ${page.names()[state.study.receivers[i]]} (point ${i + 1}): stereographic, north up; dark: obstructed sky; orange: sun paths.`;
+    $('studymaskfigure').dataset.point = String(i);
+  }
+
+  /** Ticks or unticks window `r` (a receiver index), as a click on it in the 3D view asks. */
+  function toggleWindow(r) {
+    const box = $('studywindows').querySelector(`input[value="${r}"]`);
+    if (!box) return false;
+    box.checked = !box.checked;
+    return true;
+  }
+
+  /** The existing scene, chosen in the file field: read by the worker with the model's options. */
+  async function chooseBefore() {
+    const files = await page.readFiles($('studybefore').files);
+    if (!files?.length) return;
+    const names = files.map((f) => f.name).filter((n) => !/\.(bin|png|jpe?g|webp|ktx2)$/i.test(n));
+    state.reading = names;
+    $('studybeforeinfo').textContent = `Reading ${names.join(', ')}…`;
+    page.worker.postMessage({ type: 'loadBefore', files, engine: page.engineOptions() });
+  }
+
+  function clearBefore() {
+    state.before = null;
+    state.reading = null;
+    $('studybefore').value = '';
+    $('studybeforeclear').disabled = true;
+    $('studybeforeinfo').textContent = 'None: the model above is studied alone.';
+    page.worker.postMessage({ type: 'clearBefore' });
+    clear();
   }
 
   /** The model's receivers as windows to tick (none ticked: the user picks them). */
@@ -167,12 +234,22 @@ export function studyMode(page) {
     };
     $('studyall').addEventListener('click', () => tickAll(true));
     $('studynone').addEventListener('click', () => tickAll(false));
+    const base = () => page.modelFiles()[0]?.replace(/\.[^.]*$/, '') || 'model';
     $('downloadstudy').addEventListener('click', () => {
       if (!state.study) return;
       const name = state.study.tables[0].study;
-      const base = page.modelName().replace(/\.[^.]*$/, '') || 'model';
-      page.download(`${base}.study-${name}.csv`, state.study.csv[name], 'text/csv');
+      page.download(`${base()}.study-${name}.csv`, state.study.csv[name], 'text/csv');
     });
+    $('downloadreport').addEventListener('click', () => {
+      if (!state.study) return;
+      page.download(`${base()}.study-${state.study.tables[0].study}.html`, state.study.html, 'text/html');
+    });
+    $('studytable').tBodies[0].addEventListener('click', (e) => {
+      const row = e.target.closest('tr');
+      if (row?.dataset.point) showMask(Number(row.dataset.point));
+    });
+    $('studybefore').addEventListener('change', chooseBefore);
+    $('studybeforeclear').addEventListener('click', clearBefore);
     showFields();
   }
 
@@ -183,6 +260,23 @@ export function studyMode(page) {
     shown,
     failed: clear,
     recolour,
+    toggleWindow,
+    /** Whether window `r` is ticked. */
+    ticked: (r) => !!$('studywindows').querySelector(`input[value="${r}"]`)?.checked,
+    /** The existing scene was read: it is compared from the next study on. */
+    beforeLoaded({ receivers }) {
+      state.before = state.reading;
+      state.reading = null;
+      $('studybeforeclear').disabled = false;
+      $('studybeforeinfo').textContent = `${state.before.join(', ')} (${receivers} receivers): each window is compared with it.`;
+      clear();
+    },
+    /** The existing scene could not be read: the last one (if any) stays. */
+    beforeFailed(message) {
+      state.reading = null;
+      $('studybefore').value = '';
+      $('studybeforeinfo').textContent = state.before ? `${state.before.join(', ')} (kept): ${message}` : `None: ${message}`;
+    },
     /** A new model: its windows to tick, and no study. */
     reset(names) {
       listWindows(names ?? []);

@@ -285,6 +285,18 @@ export interface StudyOptions {
   maxPeriods?: number;
   /** gb50180: the 满窗 (whole window) variant over a sill this wide, in metres. */
   windowWidth?: number;
+  /** The existing scene (`sunlit map --before MODEL`), loaded as the proposed one is: the same
+   * points are studied on it too, and each table gains the former values, their ratios and
+   * BRE's relative tests (0.8 × former; APSH's 4-point loss). Points not on its receivers have
+   * no former value; none at all is refused naming `before`. */
+  before?: Model;
+  /** The points whose sky masks (stereographic sun-path diagrams, SVG) are drawn into the
+   * answer and the report: 'all', or 0-based rows of the points (`--mask`, which counts from 1). */
+  masks?: 'all' | ArrayLike<number>;
+  /** The proposed model's file names, as the report's inputs state them (the CLI's MODEL...). */
+  modelNames?: string[];
+  /** The existing model's file names, as the report's inputs state them (`--before MODEL...`). */
+  beforeNames?: string[];
 }
 
 /** One study's results per point, as `POINTS.study-NAME.json` holds them. */
@@ -302,6 +314,18 @@ export interface StudyTable {
   passes: (boolean | null)[];
   /** Per verdict key ('passes', 'passes_whole_window'), per point. */
   verdicts: Record<string, boolean[]>;
+  /** Per point, the study's own absolute test ('passes_absolute' of the report). */
+  absolute: boolean[];
+  /** Per point, the relative test against the former value ('passes_relative': BRE's 0.8 ×
+   * former, and for APSH the 4-point loss); null without an existing scene or where the point
+   * is not in it. */
+  relative: (boolean | null)[];
+  /** With `before`: per value key, the existing scene's value per point (null where the point
+   * is not in it); null otherwise. */
+  before: Record<string, (number | null)[]> | null;
+  /** With `before`: per value key, now / before per point (null without a former value or where
+   * it was 0); null otherwise. */
+  ratio: Record<string, (number | null)[]> | null;
 }
 
 /** engine.study's answer, one entry per point (in the order of `windows` or `points`). */
@@ -317,6 +341,13 @@ export interface SunlitStudy {
   /** Per study, its table as `sunlit map --study NAME -o POINTS.csv` writes
    * `POINTS.study-NAME.csv`, byte for byte. */
   csv: Record<string, string>;
+  /** The self-contained HTML report, as `sunlit map --study … --html REPORT.html` writes it
+   * (with `--mask` for `masks`, `--before` for `before`), byte for byte for the same inputs and
+   * file names. */
+  html: string;
+  /** The sky masks asked for (`masks`): per point row (0-based), its diagram as SVG, as
+   * `--mask` writes POINTS.mask-N.svg. */
+  masks: Record<number, string>;
 }
 
 /** engine.map's options: where (a grid or given points), when (a period or an instant) and what

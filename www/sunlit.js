@@ -375,17 +375,23 @@ class SunlitEngine {
 
   /** The window studies (sunlit.d.ts, StudyOptions) on `model`: a plain object of typed arrays
    * (points, normals, receivers), the tables (values and pass/fail per point) and per study the
-   * CSV `sunlit map --study` writes. The studies are the library's; nothing is decided here. */
+   * CSV `sunlit map --study` writes, the HTML report and the sky masks asked for; with
+   * `options.before` (a Model) on the existing scene too. The studies are the library's;
+   * nothing is decided here. */
   async study(model, options) {
-    const study = this.#engine.study(model, options);
+    // The existing scene is a model, not JSON: it goes to the wasm call beside the options.
+    const { before, ...rest } = options ?? {};
+    const study = before ? this.#engine.studyBeforeAfter(model, before, rest) : this.#engine.study(model, options);
     try {
-      const { points, normals, receivers, tables } = JSON.parse(study.json());
+      const { points, normals, receivers, tables, masks } = JSON.parse(study.json());
       return {
         points: Float32Array.from(points),
         normals: Float32Array.from(normals),
         receivers: Uint32Array.from(receivers),
         tables,
         csv: Object.fromEntries(tables.map((t) => [t.study, study.csv(t.study)])),
+        html: study.html(),
+        masks: Object.fromEntries(masks),
       };
     } finally {
       study.free();

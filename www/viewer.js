@@ -1,6 +1,8 @@
 // The 3D view: the model's triangles on a WebGPU canvas, coloured per receiver, with an orbit
 // camera (drag to turn, wheel to zoom); over them, optionally, a per-point map's cells coloured
-// per vertex (setOverlay). Its shader is shaders/viewer.wgsl (copied to pkg/).
+// per vertex (setOverlay). Its shader is shaders/viewer.wgsl (copied to pkg/). A click (a press
+// and release without a drag) asks `onPick(receiver)` with the receiver of the nearest triangle
+// under the pointer (−1: shading geometry or nothing).
 import { GREY } from './colour.js';
 
 const FLOATS_PER_VERTEX = 9; // position, normal, colour
@@ -42,6 +44,8 @@ export class Viewer {
     this.uniform = device.createBuffer({ size: 80, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST });
     this.bind = device.createBindGroup({ layout: this.pipeline.getBindGroupLayout(0), entries: [{ binding: 0, resource: { buffer: this.uniform } }] });
     this.orbit = { yaw: -0.6, pitch: 0.5, distance: 50, target: [0, 0, 0] };
+    /** Called with the receiver a click lands on (−1 for none). */
+    this.onPick = null;
     this.vertices = null;
     this.count = 0;
     this.listen();
@@ -124,8 +128,18 @@ export class Viewer {
 
   listen() {
     let last = null;
-    this.canvas.addEventListener('pointerdown', (e) => { last = [e.clientX, e.clientY]; this.canvas.setPointerCapture(e.pointerId); });
-    this.canvas.addEventListener('pointerup', () => { last = null; });
+    let down = null;
+    this.canvas.addEventListener('pointerdown', (e) => {
+      last = [e.clientX, e.clientY];
+      down = last;
+      this.canvas.setPointerCapture(e.pointerId);
+    });
+    this.canvas.addEventListener('pointerup', (e) => {
+      last = null;
+      // A click, not the end of a turn: what lies under the pointer.
+      if (down && Math.hypot(e.clientX - down[0], e.clientY - down[1]) < 4) this.onPick?.(this.pick(e.clientX, e.clientY));
+      down = null;
+    });
     this.canvas.addEventListener('pointermove', (e) => {
       if (!last) return;
       this.orbit.yaw -= (e.clientX - last[0]) * 0.008;
@@ -140,6 +154,44 @@ export class Viewer {
     }, { passive: false });
   }
 
+  /** The camera's position, world axes. */
+  eye() {
+    const { yaw, pitch, distance, target } = this.orbit;
+    return [
+      target[0] + distance * Math.cos(pitch) * Math.sin(yaw),
+      target[1] - distance * Math.cos(pitch) * Math.cos(yaw),
+      target[2] + distance * Math.sin(pitch),
+    ];
+  }
+
+  /** The receiver of the nearest triangle along the view ray through client point (x, y), −1
+   * when that triangle is shading geometry or the ray meets none. */
+  pick(x, y) {
+    const { positions, receivers } = this;
+    if (!positions) return -1;
+    const rect = this.canvas.getBoundingClientRect();
+    const eye = this.eye();
+    const view = lookAt(eye, this.orbit.target, [0, 0, 1]);
+    // The view matrix's rows are the camera's axes: right, up, and back (towards the eye).
+    const axis = (r) => [view[r], view[4 + r], view[8 + r]];
+    const [right, up, back] = [axis(0), axis(1), axis(2)];
+    const half = Math.tan(FOV / 2);
+    // The drawing's aspect (its pixels'), whatever size the page shows the canvas at.
+    const sx = (2 * (x - rect.left) / rect.width - 1) * half * (this.canvas.width / this.canvas.height);
+    const sy = (1 - 2 * (y - rect.top) / rect.height) * half;
+    const ray = normalise([0, 1, 2].map((k) => sx * right[k] + sy * up[k] - back[k]));
+    let best = Infinity;
+    let hit = -1;
+    for (let t = 0; t < receivers.length; t++) {
+      const d = rayTriangle(eye, ray, positions, 9 * t);
+      if (d < best) {
+        best = d;
+        hit = receivers[t];
+      }
+    }
+    return hit;
+  }
+
   draw() {
     if (!this.vertices) return;
     const { width, height } = this.canvas;
@@ -147,13 +199,9 @@ export class Viewer {
       this.depth?.destroy();
       this.depth = this.device.createTexture({ size: [width, height], format: 'depth32float', usage: GPUTextureUsage.RENDER_ATTACHMENT });
     }
-    const { yaw, pitch, distance, target } = this.orbit;
-    const eye = [
-      target[0] + distance * Math.cos(pitch) * Math.sin(yaw),
-      target[1] - distance * Math.cos(pitch) * Math.cos(yaw),
-      target[2] + distance * Math.sin(pitch),
-    ];
-    const viewProj = multiply(perspective(0.8, width / height, distance / 100, distance * 10), lookAt(eye, target, [0, 0, 1]));
+    const { distance } = this.orbit;
+    const eye = this.eye();
+    const viewProj = multiply(perspective(FOV, width / height, distance / 100, distance * 10), lookAt(eye, this.orbit.target, [0, 0, 1]));
     const light = normalise([0.4, -0.6, 0.7]);
     this.device.queue.writeBuffer(this.uniform, 0, new Float32Array([...viewProj, ...light, 0]));
     const encoder = this.device.createCommandEncoder();
@@ -168,6 +216,30 @@ export class Viewer {
     pass.end();
     this.device.queue.submit([encoder.finish()]);
   }
+}
+
+/** The view's vertical field of view, radians. */
+const FOV = 0.8;
+
+/** Distance along unit `ray` from `origin` to the triangle at `p[at..at + 9]` (Möller–Trumbore),
+ * Infinity when it misses. */
+function rayTriangle(origin, ray, p, at) {
+  const a = [p[at], p[at + 1], p[at + 2]];
+  const e1 = [p[at + 3] - a[0], p[at + 4] - a[1], p[at + 5] - a[2]];
+  const e2 = [p[at + 6] - a[0], p[at + 7] - a[1], p[at + 8] - a[2]];
+  const cross = (u, v) => [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+  const dot = (u, v) => u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  const h = cross(ray, e2);
+  const det = dot(e1, h);
+  if (Math.abs(det) < 1e-12) return Infinity;
+  const s = [origin[0] - a[0], origin[1] - a[1], origin[2] - a[2]];
+  const u = dot(s, h) / det;
+  if (u < 0 || u > 1) return Infinity;
+  const q = cross(s, e1);
+  const v = dot(ray, q) / det;
+  if (v < 0 || u + v > 1) return Infinity;
+  const t = dot(e2, q) / det;
+  return t > 0 ? t : Infinity;
 }
 
 function normal(p) {

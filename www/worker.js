@@ -1,7 +1,7 @@
 // The page's worker: holds the engine and the model, runs the year off the main thread, so the
-// page stays responsive. Messages in: warm (make the engine now), load, compute, map, mapFile,
-// study, cancel, epw. Messages out: loaded, progress, notice, result, mapResult, mapFile,
-// studyResult, epwLocation,
+// page stays responsive. Messages in: warm (make the engine now), load, loadBefore (the Study
+// mode's existing scene), clearBefore, compute, map, mapFile, study, cancel, epw. Messages out:
+// loaded, beforeLoaded, progress, notice, result, mapResult, mapFile, studyResult, epwLocation,
 // error (with the error's `code`, and `gpu: true` when the device failed twice and a retry may
 // help). Errors are told apart by their `code` (sunlit.d.ts, SunlitError), never by their message.
 import { createEngine, epwLocation } from './sunlit.js';
@@ -11,6 +11,15 @@ let model = null;
 let files = null;
 let loadOptions = null;
 let running = null;
+/** The Study mode's existing scene: its files, and the model read from them with the proposed
+ * model's load options (read again, lazily, when the engine or those options change). */
+let before = null;
+
+/** Forgets the existing scene's model (not its files): it is read again when next needed. */
+function dropBeforeModel() {
+  before?.model?.free();
+  if (before) before.model = null;
+}
 
 /** An engine being made: { options, promise }, so that a load arriving while the page's
  * warm-up still makes the engine waits for that one instead of making a second. */
@@ -26,6 +35,7 @@ async function engineFor(options) {
   engine = null;
   model?.free();
   model = null;
+  dropBeforeModel();
   const promise = createEngine(options).then(
     (made) => {
       // Superseded by other options while it was made: not the engine any more.
@@ -58,6 +68,13 @@ function modelOn(e) {
   return model;
 }
 
+/** The existing scene on engine `e`, or null when none was chosen. */
+function beforeOn(e) {
+  if (!before) return null;
+  if (!before.model) before.model = e.loadFiles(before.files, loadOptions);
+  return before.model;
+}
+
 /** Codes after which the device cannot be trusted, but a new one may work. */
 const GPU_FAILURES = new Set(['gpu', 'device-lost']);
 
@@ -73,6 +90,7 @@ function fail(error, request) {
     engine?.close();
     engine = null;
     model = null;
+    if (before) before.model = null;
   }
   postMessage({ type: 'error', request, message, code: error?.code, gpu, cancelled: error?.name === 'AbortError' });
 }
@@ -88,6 +106,8 @@ async function load({ files: given, options, engine: made }) {
   model = m;
   files = given;
   loadOptions = options;
+  // The existing scene is read with the proposed model's options: again, with these.
+  dropBeforeModel();
   const positions = m.worldPositions();
   const receiversOf = m.worldReceivers();
   postMessage(
@@ -207,14 +227,31 @@ async function map({ options, engine: made, tag }) {
   postMessage({ type: 'mapResult', tag, id: mapFiles.id, map: result, seconds: (performance.now() - started) / 1000 }, buffers);
 }
 
-/** The window studies (engine.study) of the loaded model: its tables and CSVs, all at once (a
- * study is small: one point a window). */
+/** The Study mode's existing scene: read now (a bad file is said at once and leaves the last
+ * one), with the proposed model's load options. */
+async function loadBefore({ files: given, engine: made }) {
+  if (!files) throw Object.assign(new Error('load the proposed model first'), { code: 'no-model' });
+  const e = await engineFor(made);
+  const m = e.loadFiles(given, loadOptions);
+  before?.model?.free();
+  before = { files: given, model: m };
+  postMessage({ type: 'beforeLoaded', receivers: m.receiverNames.length });
+}
+
+function clearBefore() {
+  dropBeforeModel();
+  before = null;
+}
+
+/** The window studies (engine.study) of the loaded model, and of the existing scene when one
+ * was chosen: its tables, CSVs and report, all at once (a study is small: one point a window). */
 async function study({ options, engine: made }) {
   if (!files) throw Object.assign(new Error('load a model first'), { code: 'no-model' });
   const e = await engineFor(made);
   const m = modelOn(e);
+  const existing = beforeOn(e);
   const started = performance.now();
-  const result = await e.study(m, options);
+  const result = await e.study(m, existing ? { ...options, before: existing } : options);
   postMessage({ type: 'studyResult', study: result, seconds: (performance.now() - started) / 1000 });
 }
 
@@ -276,6 +313,8 @@ onmessage = async ({ data }) => {
     else if (data.type === 'map') await map(data);
     else if (data.type === 'mapFile') mapFile(data);
     else if (data.type === 'study') await study(data);
+    else if (data.type === 'loadBefore') await loadBefore(data);
+    else if (data.type === 'clearBefore') clearBefore();
     else if (data.type === 'epw') await epw(data);
     else if (data.type === 'warm') warm(data);
   } catch (error) {

@@ -7,7 +7,7 @@ use sunlit::export::map_glb::map_glb;
 use sunlit::export::map_table::{Column, points_csv, study_csv, study_json, value_columns};
 use sunlit::export::write_atomic;
 use sunlit::map::period::{parse_clock, parse_date};
-use sunlit::map::planning::window_points::{WindowPoint, window_points};
+use sunlit::map::planning::window_points::{WindowPoint, floor_sills, window_points};
 use sunlit::map::study::{self, SunRule};
 use sunlit::map::{MapGpu, MapValues, Mapper, Period, Points, Site, point_sky_for};
 use sunlit::sky::model::SkyModel;
@@ -40,6 +40,11 @@ pub(super) struct MapArgs {
     /// (BRE's reference point, the window's centre) or sill (GB 50180's, its lowest edge's middle).
     #[arg(long, value_name = "centre|sill", conflicts_with_all = ["points", "grid"])]
     window_points: Option<String>,
+    /// With --window-points sill: the ground floor's level (m, the model's height); a window
+    /// reaching lower than 0.9 m above it (one reaching the floor) is counted 0.9 m above it, as
+    /// GB 50180 takes its sill.
+    #[arg(long, value_name = "Z", allow_hyphen_values = true)]
+    floor_level: Option<f64>,
     /// Weather file: the site and its solar data (adds direct_kwh_m2, sky_diffuse_kwh_m2,
     /// ground_reflected_kwh_m2 and total_kwh_m2).
     #[arg(long, value_name = "FILE.epw")]
@@ -223,7 +228,10 @@ impl MapArgs {
     fn points(&self, scene: &Scene) -> Result<Points> {
         let all: Vec<u32> = (0..scene.receivers.len() as u32).collect();
         if let Some(at) = &self.window_points {
-            return window_points(scene, &all, WindowPoint::parse(at)?);
+            return match (WindowPoint::parse(at)?, self.floor_level) {
+                (WindowPoint::Sill, Some(floor)) => floor_sills(scene, &all, floor),
+                (at, _) => window_points(scene, &all, at),
+            };
         }
         match &self.points {
             Some(path) => {
@@ -285,6 +293,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         ("--max-periods", args.max_periods.is_some()),
         ("--window-width", args.window_width.is_some()),
         ("--window-points", args.window_points.is_some()),
+        ("--floor-level", args.floor_level.is_some()),
         ("--mask", args.mask.is_some()),
         ("--html", args.html.is_some()),
     ];

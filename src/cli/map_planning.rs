@@ -6,12 +6,12 @@
 //! (`POINTS.mask-N.svg`) and `--html`'s report, all at the end.
 
 use serde_json::{Value, json};
-use sunlit::export::planning_report::{mask_svg, report_html, study_csv, study_json};
-use sunlit::export::planning_tables::{sun_paths, tables};
+use sunlit::export::planning_report::{report_html, study_csv, study_json};
+use sunlit::export::planning_tables::{compared_tables, mask_svgs, points_input as planning_points_input, report_inputs};
+use sunlit::map::Site;
 use sunlit::map::planning::gb50180::Gb50180Rule;
+use sunlit::map::planning::run;
 use sunlit::map::planning::window_points::WindowPoint;
-use sunlit::map::planning::{mask, run};
-use sunlit::map::{Points, Site};
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
 
@@ -28,6 +28,9 @@ pub(super) fn wanted(args: &MapArgs) -> bool {
 fn check_options(args: &MapArgs) -> Result<()> {
     if let Some(at) = &args.window_points {
         WindowPoint::parse(at)?;
+    }
+    if args.floor_level.is_some() && args.window_points.as_deref().map(WindowPoint::parse).transpose()? != Some(WindowPoint::Sill) {
+        return Err(Error::argument("--floor-level", "places the sill of --window-points sill: give --window-points sill with it"));
     }
     if let Some(other) = args.study.iter().find(|s| !STUDIES.contains(&s.as_str())) {
         return Err(Error::argument(
@@ -99,18 +102,6 @@ fn mask_rows(text: Option<&str>, points: usize) -> Result<Vec<usize>> {
         .collect()
 }
 
-/// The existing scene's points: each of the proposed `points` that lies on one of its receivers,
-/// and where it sits in `points`. Refuses a scene with none in common, naming `from` (the points'
-/// source).
-fn before_points(before: &Scene, points: &Points, from: &str) -> Result<(Points, Vec<usize>)> {
-    let all: Vec<u32> = (0..before.receivers.len() as u32).collect();
-    let (kept, index) = sunlit::map::points::place_on(before, points, &all);
-    if index.is_empty() {
-        return Err(Error::argument("--before", format!("no point of {from} lies on a receiver of the existing scene")));
-    }
-    Ok((kept, index))
-}
-
 pub(super) fn run(args: MapArgs) -> Result<()> {
     check_options(&args)?;
     let gb = args.study.iter().any(|s| s == "gb50180").then(|| gb_rule(&args)).transpose()?;
@@ -129,16 +120,10 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     let load_seconds = start.elapsed().as_secs_f64();
     let points = args.points(&scene)?;
     let masks = mask_rows(args.mask.as_deref(), points.len())?;
-    let before = if args.before.is_empty() {
-        None
-    } else {
-        let scene = model::load(&args.before, &args.model.options())?;
-        let from = match (&args.points, &args.window_points) {
-            (Some(path), _) => path.display().to_string(),
-            (None, at) => format!("--window-points {}", at.as_deref().unwrap_or_default()),
-        };
-        let (kept, index) = before_points(&scene, &points, &from)?;
-        Some((scene, kept, index))
+    let before = (!args.before.is_empty()).then(|| model::load(&args.before, &args.model.options())).transpose()?;
+    let from = match (&args.points, &args.window_points) {
+        (Some(path), _) => path.display().to_string(),
+        (None, at) => format!("--window-points {}", at.as_deref().unwrap_or_default()),
     };
     let calendar = location.as_ref().map(|l| LeafCalendar::for_latitude(l.latitude));
     let site = location.as_ref().zip(calendar.as_ref()).map(|(location, calendar)| Site {
@@ -147,23 +132,34 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         weather: weather.as_ref(),
         sky: None,
     });
-    let (now, now_seconds) = timed(|done| run::evaluate(&args.study, &scene, &points, site, gb.as_ref(), done))?;
-    let former = before.as_ref().map(|(s, p, _)| timed(|done| run::evaluate(&args.study, s, p, site, gb.as_ref(), done))).transpose()?;
-    let tables = tables(
-        &now,
-        former.as_ref().zip(before.as_ref()).map(|((v, _), (_, _, index))| (v, index.as_slice())),
-        points.len(),
+    // The parts' seconds, each since the last part ended (the existing scene's run follows the
+    // proposed one's, so its index is timed from the proposed one's last study).
+    let since = std::cell::Cell::new(Instant::now());
+    let part = |seconds: &mut Vec<(String, f64)>, name: &str| {
+        seconds.push((name.to_string(), since.get().elapsed().as_secs_f64()));
+        since.set(Instant::now());
+    };
+    let (mut now_seconds, mut former_seconds) = (Vec::new(), Vec::new());
+    let (now, former) = run::before_after(
+        &args.study,
+        &scene,
+        &points,
+        before.as_ref().map(|s| (s, from.as_str())),
+        site,
         gb.as_ref(),
-        location.as_ref(),
-    );
+        &mut |name| part(&mut now_seconds, name),
+        &mut |name| part(&mut former_seconds, name),
+    )?;
+    let tables = compared_tables(&now, former.as_ref(), points.len(), gb.as_ref(), location.as_ref());
 
-    let inputs = json!({
-        "models": args.model.models,
-        "before": args.before,
-        "points": points_input(&args)?,
-        "site": location.as_ref().map(|l| json!({"latitude": l.latitude, "longitude": l.longitude, "time_zone": l.time_zone})),
-        "epw": args.epw,
-    });
+    let names = |paths: &[PathBuf]| paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>();
+    let inputs = report_inputs(
+        &names(&args.model.models),
+        &names(&args.before),
+        points_input(&args)?,
+        location.as_ref(),
+        args.epw.as_ref().map(|p| p.display().to_string()).as_deref(),
+    );
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     let columns: Vec<(String, Vec<f64>)> = tables.iter().flat_map(|t| t.values.clone()).collect();
     let csv_columns: Vec<Column<'_>> = columns.iter().map(|(name, values)| Column { name, values, decimals: 4 }).collect();
@@ -172,16 +168,9 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         files.push((args.study_path(&t.study, "json"), format!("{:#}\n", study_json(&scene, &points, t, inputs.clone())).into_bytes()));
         files.push((args.study_path(&t.study, "csv"), study_csv(&scene, &points, t).into_bytes()));
     }
-    let mut svgs = Vec::new();
-    if !masks.is_empty() {
-        let chosen = subset(&points, &masks);
-        let paths = location.as_ref().map(|l| sun_paths(l, gb.as_ref())).unwrap_or_default();
-        for (&i, m) in masks.iter().zip(mask::sky_masks(&scene, &chosen)?) {
-            let p = points.position(i);
-            let svg = mask_svg(&format!("point {} at ({:.2}, {:.2}, {:.2})", i + 1, p.x, p.y, p.z), &m, &paths);
-            files.push((args.output.with_file_name(format!("{}.mask-{}.svg", stem(&args.output), i + 1)), svg.clone().into_bytes()));
-            svgs.push((i, svg));
-        }
+    let svgs = mask_svgs(&scene, &points, &masks, location.as_ref(), gb.as_ref())?;
+    for (i, svg) in &svgs {
+        files.push((args.output.with_file_name(format!("{}.mask-{}.svg", stem(&args.output), i + 1)), svg.clone().into_bytes()));
     }
     if let Some(html) = &args.html {
         files.push((html.clone(), report_html(&scene, &points, &tables, &svgs, &inputs).into_bytes()));
@@ -202,12 +191,12 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     let summary = json!({
         "points": points.len(),
-        "points_before": before.as_ref().map(|(_, p, _)| p.len()),
+        "points_before": former.as_ref().map(|f| f.points.len()),
         "seconds": round(seconds, 3),
         "seconds_by_part": {
             "load": round(load_seconds, 3),
             "proposed": now_seconds.iter().map(|(k, v)| (k.clone(), json!(round(*v, 3)))).collect::<serde_json::Map<_, _>>(),
-            "existing": former.as_ref().map(|(_, f)| f.iter().map(|(k, v)| (k.clone(), json!(round(*v, 3)))).collect::<serde_json::Map<_, _>>()),
+            "existing": former.as_ref().map(|_| former_seconds.iter().map(|(k, v)| (k.clone(), json!(round(*v, 3)))).collect::<serde_json::Map<_, _>>()),
         },
         "studies": tables.iter().map(|t| json!({
             "study": t.study,
@@ -224,37 +213,21 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     Ok(())
 }
 
-/// Runs `evaluate` with a `done(part)` that records the seconds each part took since the last.
-fn timed<T>(evaluate: impl FnOnce(&mut dyn FnMut(&str)) -> Result<T>) -> Result<(T, Vec<(String, f64)>)> {
-    let mut seconds = Vec::new();
-    let mut since = Instant::now();
-    let value = evaluate(&mut |part: &str| {
-        seconds.push((part.to_string(), since.elapsed().as_secs_f64()));
-        since = Instant::now();
-    })?;
-    Ok((value, seconds))
-}
-
 /// How the points were given, for the reports: a file, the windows' own points, or a grid.
 fn points_input(args: &MapArgs) -> Result<Value> {
-    Ok(match (&args.points, &args.window_points) {
-        (Some(file), _) => json!({"file": file}),
-        (None, Some(at)) => {
-            let at = WindowPoint::parse(at)?;
-            json!({"window_points": at.name(), "at": at.describe(), "offset_m": sunlit::map::planning::window_points::OFFSET})
-        }
+    let window = args.window_points.as_deref().map(WindowPoint::parse).transpose()?;
+    let file = args.points.as_ref().map(|p| p.display().to_string());
+    Ok(match (window, file) {
         (None, None) => json!({"grid_spacing_m": args.grid.unwrap_or(0.5)}),
+        (window, file) => {
+            let mut input = planning_points_input(window, file.as_deref());
+            if let Some(floor) = args.floor_level {
+                input["floor_level_m"] = json!(floor);
+                input["sill_height_m"] = json!(sunlit::map::planning::window_points::SILL_HEIGHT);
+            }
+            input
+        }
     })
-}
-
-fn subset(points: &Points, rows: &[usize]) -> Points {
-    let mut out = Points::default();
-    for &i in rows {
-        out.positions.extend_from_slice(&points.positions[3 * i..3 * i + 3]);
-        out.normals.extend_from_slice(&points.normals[3 * i..3 * i + 3]);
-        out.receivers.push(points.receivers[i]);
-    }
-    out
 }
 
 fn stem(path: &std::path::Path) -> String {

@@ -1,15 +1,20 @@
 //! The window studies' tables for their reports ([`StudyTable`]): each rule's source in words,
 //! every parameter, the values per point, with an existing scene its values and BRE's relative
-//! tests; and the sun paths drawn on the sky masks. The rules' texts live here, once, for every
-//! edge that reports a study.
+//! tests; the sun paths drawn on the sky masks, and the masks themselves; and the inputs a
+//! report states. The rules' texts live here, once, for every edge that reports a study, so the
+//! CLI's report and the page's are the same bytes.
 
 use serde_json::{Value, json};
 
-use super::planning_report::{StudyTable, SunPath};
+use super::planning_report::{StudyTable, SunPath, mask_svg};
+use crate::error::{Error, Result};
+use crate::map::Points;
 use crate::map::planning::compare::{self, Verdict};
 use crate::map::planning::gb50180::{self, Gb50180Rule};
-use crate::map::planning::run::StudyValues;
-use crate::map::planning::{apsh, bre_lines, vsc};
+use crate::map::planning::run::{Former, StudyValues};
+use crate::map::planning::window_points::{OFFSET, WindowPoint};
+use crate::map::planning::{apsh, bre_lines, mask, vsc};
+use crate::scene::Scene;
 use crate::sun::location::Location;
 
 /// 1.0 for true, 0.0 for false (the report's values are numbers).
@@ -196,4 +201,71 @@ pub fn sun_paths(location: &Location, gb: Option<&Gb50180Rule>) -> Vec<SunPath> 
         });
     }
     paths
+}
+
+/// [`tables`] of a [`crate::map::planning::run::before_after`] run: the proposed values at `n`
+/// points beside the existing scene's, if any.
+pub fn compared_tables(
+    now: &StudyValues,
+    former: Option<&Former>,
+    n: usize,
+    gb: Option<&Gb50180Rule>,
+    location: Option<&Location>,
+) -> Vec<StudyTable> {
+    tables(now, former.map(|f| (&f.values, f.index.as_slice())), n, gb, location)
+}
+
+/// The sky mask diagrams (SVG) of `points` at `rows` (0-based), each titled with its 1-based
+/// row and position, the sun paths drawn at `location` (none without a site). Refuses a row
+/// outside the points, naming `masks`.
+pub fn mask_svgs(
+    scene: &Scene,
+    points: &Points,
+    rows: &[usize],
+    location: Option<&Location>,
+    gb: Option<&Gb50180Rule>,
+) -> Result<Vec<(usize, String)>> {
+    if let Some(&row) = rows.iter().find(|&&r| r >= points.len()) {
+        return Err(Error::argument("masks", format!("row {} is not a point row 1..={}", row + 1, points.len())));
+    }
+    if rows.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut chosen = Points::default();
+    for &i in rows {
+        chosen.positions.extend_from_slice(&points.positions[3 * i..3 * i + 3]);
+        chosen.normals.extend_from_slice(&points.normals[3 * i..3 * i + 3]);
+        chosen.receivers.push(points.receivers[i]);
+    }
+    let paths = location.map(|l| sun_paths(l, gb)).unwrap_or_default();
+    Ok(rows
+        .iter()
+        .zip(mask::sky_masks(scene, &chosen)?)
+        .map(|(&i, m)| {
+            let p = points.position(i);
+            (i, mask_svg(&format!("point {} at ({:.2}, {:.2}, {:.2})", i + 1, p.x, p.y, p.z), &m, &paths))
+        })
+        .collect())
+}
+
+/// How a report states its points: one on each window (`window_points`, what it is, its offset
+/// out of the window), or from a file.
+pub fn points_input(window: Option<WindowPoint>, file: Option<&str>) -> Value {
+    match (window, file) {
+        (Some(at), _) => json!({"window_points": at.name(), "at": at.describe(), "offset_m": OFFSET}),
+        (None, Some(file)) => json!({"file": file}),
+        (None, None) => Value::Null,
+    }
+}
+
+/// A report's inputs: the proposed and existing models (as their files are named), the points
+/// ([`points_input`], or a grid's), the site and the EPW's name.
+pub fn report_inputs(models: &[String], before: &[String], points: Value, location: Option<&Location>, epw: Option<&str>) -> Value {
+    json!({
+        "models": models,
+        "before": before,
+        "points": points,
+        "site": location.map(|l| json!({"latitude": l.latitude, "longitude": l.longitude, "time_zone": l.time_zone})),
+        "epw": epw,
+    })
 }

@@ -1,7 +1,9 @@
 //! `engine.study`'s options object (`StudyOptions` in `www/sunlit.d.ts`) read into the library's
 //! terms: which window studies ([`run::STUDIES`]), where (the windows' own points, found by
 //! [`WindowPoint`], or given points), the site (a location or an EPW), GB 50180's rule
-//! ([`Gb50180Rule::from_options`]) and the sky model ([`run::check_sky_model`]). The studies
+//! ([`Gb50180Rule::from_options`]), the sky model ([`run::check_sky_model`]), and what the report
+//! draws and states (`masks`, the files' names). `before`, the existing scene, is a model, not
+//! JSON: sunlit.js hands it to the wasm call beside the options. The studies
 //! themselves are the library's ([`crate::map::planning::run`]); this only reads names. Plain
 //! JSON in, so it is tested natively too (`js_api`).
 
@@ -15,7 +17,7 @@ use crate::sun::location::Location;
 use crate::sun::weather::Weather;
 
 /// The keys of the options object.
-pub const STUDY_KEYS: [&str; 15] = [
+pub const STUDY_KEYS: [&str; 19] = [
     "study",
     "windows",
     "windowPoints",
@@ -31,6 +33,10 @@ pub const STUDY_KEYS: [&str; 15] = [
     "minPeriod",
     "maxPeriods",
     "windowWidth",
+    "before",
+    "masks",
+    "modelNames",
+    "beforeNames",
 ];
 
 /// GB 50180's own keys: refused beside the other studies, as `sunlit map` refuses `--day`….
@@ -56,8 +62,34 @@ pub struct StudyRequest {
     pub location: Option<Location>,
     /// The EPW's hours, for bre-apsh.
     pub weather: Option<Weather>,
+    /// The EPW's name (`epwName`, or `EPW`), as the report states it; none without an EPW.
+    pub epw_name: Option<String>,
     /// GB 50180's rule, when gb50180 is asked.
     pub gb: Option<Gb50180Rule>,
+    /// The points (0-based rows) whose sky masks the report draws, as `--mask`.
+    pub masks: Masks,
+    /// The proposed and the existing model's file names, as the report states them (the CLI's
+    /// `MODEL...` and `--before MODEL...`).
+    pub names: (Vec<String>, Vec<String>),
+}
+
+/// Which points' sky masks are drawn.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Masks {
+    /// Every point's (`--mask all`).
+    All,
+    /// These rows' (0-based).
+    Rows(Vec<usize>),
+}
+
+impl Masks {
+    /// The rows, 0-based, of `n` points.
+    pub fn rows(&self, n: usize) -> Vec<usize> {
+        match self {
+            Self::All => (0..n).collect(),
+            Self::Rows(rows) => rows.clone(),
+        }
+    }
 }
 
 impl StudyRequest {
@@ -76,10 +108,11 @@ impl StudyRequest {
         }
         run::check_sky_model(&studies, text_of(&all, "skyModel")?.as_deref())?;
         let place = place(&all)?;
-        let weather = match text_of(&all, "epw")? {
-            Some(text) => Some(Weather::from_epw_text(text_of(&all, "epwName")?.as_deref().unwrap_or("EPW"), &text)?),
-            None => None,
-        };
+        let epw_name = text_of(&all, "epw")?
+            .map(|text| Ok::<_, Error>((text_of(&all, "epwName")?.unwrap_or_else(|| "EPW".into()), text)))
+            .transpose()?;
+        let weather = epw_name.as_ref().map(|(name, text)| Weather::from_epw_text(name, text)).transpose()?;
+        let epw_name = epw_name.map(|(name, _)| name);
         let location = match (&weather, number(&all, "latitude")?) {
             (Some(w), _) => Some(w.location.clone()),
             (None, Some(latitude)) => {
@@ -105,8 +138,27 @@ impl StudyRequest {
                 )
             })
             .transpose()?;
-        Ok(Self { studies, place, location, weather, gb })
+        let masks = masks(all.get("masks"))?;
+        let names = (names_of(&all, "modelNames")?, names_of(&all, "beforeNames")?);
+        Ok(Self { studies, place, location, weather, epw_name, gb, masks, names })
     }
+}
+
+/// `masks`: `'all'` or an array of 0-based point rows; none by default.
+fn masks(value: Option<&Value>) -> Result<Masks> {
+    match value {
+        None => Ok(Masks::Rows(Vec::new())),
+        Some(Value::String(all)) if all == "all" => Ok(Masks::All),
+        Some(rows) => serde_json::from_value(rows.clone())
+            .map(Masks::Rows)
+            .map_err(|_| Error::argument("masks", "give 'all' or an array of point rows (whole numbers from 0)")),
+    }
+}
+
+/// A list of file names, if given.
+fn names_of(all: &Map<String, Value>, key: &str) -> Result<Vec<String>> {
+    all.get(key)
+        .map_or(Ok(Vec::new()), |v| serde_json::from_value(v.clone()).map_err(|_| Error::argument(key, "must be an array of file names")))
 }
 
 /// `study`: one name or an array of names, each a window study.

@@ -54,10 +54,11 @@ export async function downloadText(page, button, file) {
   return { name: (await download).suggestedFilename(), text: readFileSync(file, 'utf8') };
 }
 
-/** `sunlit ARGS…` with its scratch in `work` (stderr shown, stdout dropped). */
-export function sunlit(args, work) {
+/** `sunlit ARGS…` with its scratch in `work` (stderr shown, stdout dropped), run in `cwd` (the
+ * repository root unless given: a report states its files as they were named). */
+export function sunlit(args, work, cwd = ROOT) {
   execFileSync(join(ROOT, 'target/debug/sunlit'), args, {
-    cwd: ROOT,
+    cwd,
     stdio: ['ignore', 'ignore', 'inherit'],
     env: { ...process.env, XDG_RUNTIME_DIR: work },
   });

@@ -1,12 +1,13 @@
 //! Every window study asked, run on one scene at one set of points, sharing the scene's one
 //! shadow-ray tree: what `sunlit map --study` runs on the proposed scene and again on the
 //! existing one, so that the edges only read their options and write the reports
-//! ([`crate::export::planning_tables`] makes the tables).
+//! ([`crate::export::planning_tables`] makes the tables). [`before_after`] is that pair of runs,
+//! the proposed scene and the existing one at the same points, for every edge that compares them.
 
 use super::gb50180::{self, Gb50180Rule};
 use super::{SceneRays, Windows, apsh, bre_lines, vsc};
 use crate::error::{Error, Result};
-use crate::map::{Points, Site};
+use crate::map::{Points, Site, points};
 use crate::scene::Scene;
 
 /// The window studies' names.
@@ -86,4 +87,51 @@ pub fn evaluate(
         done(study);
     }
     Ok(values)
+}
+
+/// The existing scene's points: each of the proposed `points` that lies on one of its
+/// receivers, and where it sits in `points`. Refuses a scene with none in common, naming
+/// `before` and `from` (where the points came from, for the message).
+pub fn points_in(before: &Scene, points: &Points, from: &str) -> Result<(Points, Vec<usize>)> {
+    let all: Vec<u32> = (0..before.receivers.len() as u32).collect();
+    let (kept, index) = points::place_on(before, points, &all);
+    if index.is_empty() {
+        return Err(Error::argument("before", format!("no point of {from} lies on a receiver of the existing scene")));
+    }
+    Ok((kept, index))
+}
+
+/// The existing scene's side of a comparison: its values at its points, which are the proposed
+/// points at `index`.
+pub struct Former {
+    /// The studies' values on the existing scene.
+    pub values: StudyValues,
+    /// The proposed points that lie on the existing scene's receivers.
+    pub points: Points,
+    /// Where each of them sits among the proposed points.
+    pub index: Vec<usize>,
+}
+
+/// The studies on the proposed scene and, with `before` (the existing scene, and where the
+/// points came from for [`points_in`]'s message), on the existing one at the same points: what
+/// `sunlit map --study … --before` and the page's before/after run. The existing scene's points
+/// are checked before anything is computed. `done_now` and `done_before` are
+/// [`evaluate`]'s `done` for each scene.
+#[allow(clippy::too_many_arguments)]
+pub fn before_after(
+    studies: &[String],
+    scene: &Scene,
+    points: &Points,
+    before: Option<(&Scene, &str)>,
+    site: Option<Site<'_>>,
+    gb: Option<&Gb50180Rule>,
+    done_now: &mut dyn FnMut(&str),
+    done_before: &mut dyn FnMut(&str),
+) -> Result<(StudyValues, Option<Former>)> {
+    let existing = before.map(|(s, from)| points_in(s, points, from).map(|p| (s, p))).transpose()?;
+    let now = evaluate(studies, scene, points, site, gb, done_now)?;
+    let former = existing
+        .map(|(s, (kept, index))| evaluate(studies, s, &kept, site, gb, done_before).map(|values| Former { values, points: kept, index }))
+        .transpose()?;
+    Ok((now, former))
 }

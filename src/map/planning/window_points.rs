@@ -7,6 +7,10 @@
 //!   left to the one furthest right along the wall. A window whose bottom is one corner (a
 //!   diamond) has that corner as its sill.
 //!
+//! [`floor_sills`] takes GB 50180's sill at [`SILL_HEIGHT`] above a given ground-floor level
+//! where a window reaches lower (a 落地窗, reaching the floor, has no sill of its own): its point
+//! is raised within the window's plane, above the middle of its lowest edge.
+//!
 //! Each point sits [`OFFSET`] out of the window's plane along its outward normal: on the outside
 //! face, and within the map's on-surface tolerance ([`crate::map::points::ON_SURFACE_TOLERANCE`]) so that
 //! `--before` finds the same window in the existing scene. The studies answer a point from its
@@ -26,6 +30,9 @@ pub const OFFSET: f64 = 0.005;
 /// Vertices within this height (m) of a window's lowest vertex are on its lowest edge (its
 /// triangulation may put the edge's ends a rounding apart).
 pub const EDGE_TOLERANCE: f64 = 0.001;
+
+/// GB 50180's sill height above the ground floor's level (m), where a window reaches lower.
+pub const SILL_HEIGHT: f64 = 0.9;
 
 /// A window whose normal is within this of vertical (|n_z| above it) lies flat and has no sill.
 const FLAT: f64 = 0.999;
@@ -84,6 +91,37 @@ pub fn window_points(scene: &Scene, receivers: &[u32], at: WindowPoint) -> Resul
             WindowPoint::Sill => sill(r)?,
         };
         points.push(on + r.normal * OFFSET, r.normal, id);
+    }
+    Ok(points)
+}
+
+/// GB 50180's sill points of `receivers` with the ground floor at `floor` (m, the world's z):
+/// each window's [`WindowPoint::Sill`], raised within its plane to `floor` + [`SILL_HEIGHT`]
+/// where its lowest edge is lower (a window reaching the floor). Refuses, naming `floor_level`, a
+/// window whose top is below that height (it has no point there).
+pub fn floor_sills(scene: &Scene, receivers: &[u32], floor: f64) -> Result<Points> {
+    let sills = window_points(scene, receivers, WindowPoint::Sill)?;
+    let height = floor + SILL_HEIGHT;
+    let mut points = Points::default();
+    for (i, &id) in receivers.iter().enumerate() {
+        let r = scene.receivers.get(id as usize).ok_or_else(|| Error::argument("receiver", format!("id {id} out of range")))?;
+        let mut p = sills.position(i);
+        if p.z < height - EDGE_TOLERANCE {
+            let top = r.triangles.iter().flatten().map(|v| v.z).fold(f64::NEG_INFINITY, f64::max);
+            if top < height {
+                return Err(Error::argument(
+                    "floor_level",
+                    format!(
+                        "window '{}' ({}) reaches {top:.3} m, below its sill height {height:.3} m ({floor} + {SILL_HEIGHT})",
+                        r.name, r.origin
+                    ),
+                ));
+            }
+            // Up the window's plane (vertical for a wall's window), to the sill height.
+            let up = (DVec3::Z - r.normal * r.normal.z).normalize();
+            p += up * ((height - p.z) / up.z);
+        }
+        points.push(p, r.normal, id);
     }
     Ok(points)
 }
@@ -149,6 +187,25 @@ mod tests {
         assert!((sill.normal(0) - n).length() < 1e-5);
         let centre = window_points(&scene, &[0], WindowPoint::Centre).unwrap();
         assert!((centre.position(0) - DVec3::new(1.75, -OFFSET, 1.65)).length() < 1e-5, "{}", centre.position(0));
+    }
+
+    #[test]
+    fn a_window_reaching_the_floor_is_counted_at_the_sill_height_above_it() {
+        // A south door-window 0..2.4 m, the ground floor at 0: its sill point is 0.9 m up; one
+        // 0.9..2.4 m up keeps its own sill; one reaching only 0.8 m has none.
+        let floor_window =
+            window(&[DVec3::new(2.5, 0.0, 2.4), DVec3::new(1.0, 0.0, 2.4), DVec3::new(1.0, 0.0, 0.0), DVec3::new(2.5, 0.0, 0.0)]);
+        let raised = floor_sills(&floor_window, &[0], 0.0).unwrap();
+        assert!((raised.position(0) - DVec3::new(1.75, -OFFSET, SILL_HEIGHT)).length() < 1e-5, "{}", raised.position(0));
+        let lowest = window_points(&floor_window, &[0], WindowPoint::Sill).unwrap();
+        assert!((lowest.position(0).z).abs() < 1e-5, "without a floor level: the lowest edge");
+        let sill_window =
+            window(&[DVec3::new(2.5, 0.0, 2.4), DVec3::new(1.0, 0.0, 2.4), DVec3::new(1.0, 0.0, 0.9), DVec3::new(2.5, 0.0, 0.9)]);
+        assert!((floor_sills(&sill_window, &[0], -0.5).unwrap().position(0).z - 0.9).abs() < 1e-5, "a sill above 0.9 m stays");
+        let low = window(&[DVec3::new(2.5, 0.0, 0.8), DVec3::new(1.0, 0.0, 0.8), DVec3::new(1.0, 0.0, 0.0), DVec3::new(2.5, 0.0, 0.0)]);
+        let error = floor_sills(&low, &[0], 0.0).unwrap_err();
+        assert_eq!(error.parameter(), Some("floor_level"));
+        assert!(error.to_string().contains("WIN"), "{error}");
     }
 
     #[test]
