@@ -36,14 +36,11 @@
 //! the receiver, seen edge-on (its projection has no area) or see-through never proves a step
 //! dark; it only stops a step being proved lit.
 
-mod canopy;
 pub mod cone;
 mod never_dark;
 
 use glam::{DVec2, DVec3};
 
-#[cfg(test)]
-pub(crate) use canopy::tests as canopy_fixtures;
 pub use cone::DirectionCone;
 pub use never_dark::MIN_LIT_SHARE;
 use never_dark::Outline;

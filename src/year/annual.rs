@@ -91,9 +91,7 @@ pub const NEAR_DARK: f64 = 0.05;
 /// under its overhang and fins went from a mean |Δ| of 0.0059 to 0.0040 over lit steps for 7 %
 /// more views (docs/energyplus-fidelity.md). 0.01 (from 0.03) since refined steps are counted
 /// sparsely ([`super::refine`]): on NREL's 100-zone file at Timestep updates the north windows
-/// went from 0.0075 to 0.0045 against counting every timestep, for 31 % more views. Where the
-/// receiver is under a canopy of small casters (a tree's leaves), a step that `KINK` alone asks
-/// for is counted only beyond [`super::refine::KINK_UNDER_CANOPY`].
+/// went from 0.0075 to 0.0045 against counting every timestep, for 31 % more views.
 pub const KINK: f64 = 0.01;
 
 /// The default refinement threshold: 30% of the surface changing state between samples. On the
@@ -776,15 +774,7 @@ fn evaluate(
                     // guessed dark, since a slot of sun may light it between them.
                     if refine < 1.0 {
                         let at = regime.cells.at(grid_day, tau);
-                        rough.push(Rough {
-                            row,
-                            column,
-                            sun,
-                            day: day as f64,
-                            cell: (g, fit, at.0, at.1),
-                            corners: (0.0, 0.0),
-                            kink: None,
-                        });
+                        rough.push(Rough { row, column, sun, day: day as f64, cell: (g, fit, at.0, at.1), corners: (0.0, 0.0) });
                     }
                     continue;
                 };
@@ -792,9 +782,8 @@ fn evaluate(
                 schedule.set(row, column, as_energyplus(value));
                 let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
                 if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
-                    let kink = kink_only(&cell, value, refine);
                     let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
-                    rough.push(Rough { row, column, sun, day, cell, corners, kink });
+                    rough.push(Rough { row, column, sun, day, cell, corners });
                 } else if refine < 1.0 && prove_never_dark {
                     smooth.push(Smooth::new(row, column, fit, g, cell.at));
                 }
@@ -814,15 +803,6 @@ fn evaluate(
 /// appears, 0.14 with those cells counted, for 1.8 % more views.
 fn needs_count(cell: &Cell, value: f64) -> bool {
     cell.borrowed || cell.lowest < NEAR_DARK || value < NEAR_DARK || (value - cell.bilinear).abs() > KINK
-}
-
-/// Where [`KINK`] alone asks for a step to be counted (no other rule would): how far the fit
-/// leaves the cell's bilinear interpolation. Under a canopy a looser threshold applies
-/// ([`super::refine::leave_canopy_kinks`]).
-fn kink_only(cell: &Cell, value: f64, refine: f64) -> Option<f64> {
-    let deviation = (value - cell.bilinear).abs();
-    let others = cell.spread > refine || cell.borrowed || cell.lowest < NEAR_DARK || value < NEAR_DARK;
-    (!others && deviation > KINK).then_some(deviation)
 }
 
 /// Which of a regime's fits (by receiver and piece) serves receiver `column` at time `t`, given

@@ -37,9 +37,6 @@ pub(super) struct Rough {
     pub cell: (usize, usize, usize, usize),
     /// The lowest and highest of the cell's four samples.
     pub corners: (f64, f64),
-    /// Where `KINK` alone asked for it: how far the fit left the cell's bilinear interpolation
-    /// ([`super::refine::leave_canopy_kinks`] looks at it).
-    pub kink: Option<f64>,
 }
 
 /// A timestep the spline interpolates, kept small (a city's year has millions): its row,
@@ -90,7 +87,7 @@ pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of:
                 let s = cell[k];
                 let (sun, day) = suns[k];
                 let key = (usize::from(s.regime), s.fit as usize, usize::from(s.at.0), usize::from(s.at.1));
-                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0), kink: None }
+                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0) }
             }));
         }
         start = end;
@@ -165,7 +162,6 @@ pub(super) fn certify_steps(
         None => Certifier::new(scene),
     };
     let asked = rough.len();
-    let (rough, canopy) = super::refine::leave_canopy_kinks(&certifier, rough);
     let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
     let interpolated = smooth.len();
     let sun_of = |row: usize| {
@@ -174,7 +170,7 @@ pub(super) fn certify_steps(
     };
     let unproved = never_dark(&certifier, smooth, &sun_of);
     log::info!(
-        "refinement: {asked} timesteps to count, {canopy} left to the fit under a canopy, {dark} proved dark and {lit} proved lit; of {interpolated} interpolated, {} not proved never dark; {} counted",
+        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit; of {interpolated} interpolated, {} not proved never dark; {} counted",
         unproved.len(),
         rest.len() + unproved.len()
     );

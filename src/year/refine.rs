@@ -25,22 +25,10 @@
 //! So the views only go down: every refined step is counted at most once. Measured against
 //! counting every timestep in docs/energyplus-fidelity.md ("Refined steps counted sparsely").
 
-use glam::DVec3;
-
-use crate::count::certify::Certifier;
 use crate::count::{Engine, ViewRequest};
 use crate::error::Result;
 use crate::year::annual::{NEAR_DARK, Progress, Views};
 use crate::year::certified::Rough;
-
-/// Under a canopy (many small casters in the receiver's path, [`Certifier::under_canopy`]), the
-/// `KINK` rule's threshold; elsewhere `KINK` (0.01) holds. `KINK` is tight for the kink one long
-/// shadow edge makes as it enters a surface (an overhang's over NREL's 100-zone file's north
-/// windows, which it brings within 0.005 of counting every step); under a tree's leaves the fit
-/// wanders from the bilinear by a percent or two nearly everywhere, and the tight threshold
-/// counts many steps there for little (blaas-trees-summer 1.06× the views it took at 0.03;
-/// docs/energyplus-fidelity.md, "Refined steps counted sparsely").
-pub const KINK_UNDER_CANOPY: f64 = 0.03;
 
 /// How far, at most, a counted value may lie from the straight line between the counted days
 /// around it for the days between to be interpolated.
@@ -210,27 +198,6 @@ impl Sparse {
     }
 }
 
-/// Leaves to the fit the steps that `KINK` alone asked for, by no more than
-/// [`KINK_UNDER_CANOPY`], in cells whose receiver is under a canopy over the suns of those steps
-/// ([`Certifier::under_canopy`]): returns the rest, in order, and how many were left to the fit
-/// (their fitted values are already in the schedule).
-pub(super) fn leave_canopy_kinks(certifier: &Certifier, rough: Vec<Rough>) -> (Vec<Rough>, usize) {
-    let mild = |r: &Rough| r.kink.is_some_and(|d| d <= KINK_UNDER_CANOPY);
-    let mut order: Vec<usize> = (0..rough.len()).filter(|&i| mild(&rough[i])).collect();
-    order.sort_by_key(|&i| rough[i].cell);
-    let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
-    let suns: Vec<Vec<DVec3>> = cells.iter().map(|steps| steps.iter().map(|&i| rough[i].sun).collect()).collect();
-    let sets: Vec<(usize, &[DVec3])> = cells.iter().zip(&suns).map(|(steps, s)| (rough[steps[0]].column, s.as_slice())).collect();
-    let mut keep = vec![true; rough.len()];
-    for (steps, canopy) in cells.iter().zip(certifier.under_canopy_all(&sets)) {
-        if canopy {
-            steps.iter().for_each(|&i| keep[i] = false);
-        }
-    }
-    let left = keep.iter().filter(|k| !**k).count();
-    (rough.into_iter().zip(keep).filter_map(|(r, k)| k.then_some(r)).collect(), left)
-}
-
 /// Whether a span whose ends count `a` and `b` may be interpolated at all: both lit, of one kind.
 fn interpolable(a: f64, b: f64) -> bool {
     kind(a) != Kind::Dark && kind(a) == kind(b)
@@ -272,28 +239,26 @@ pub(super) async fn count_sparsely(
 }
 
 /// The refined steps and those of them counted, by the first refinement rule that asked for
-/// them: the spread rule, a near-dark corner (as far as the step's cell tells), `KINK` alone,
-/// and the rest (a near-dark fit, a borrowed day).
+/// them (as far as a step's cell tells): the spread rule, a near-dark corner, and the rest (a
+/// near-dark fit, `KINK`, a borrowed day).
 fn by_rule(rough: &[Rough], refine: f64, counted: &[bool]) -> String {
-    let mut tally = [(0usize, 0usize); 4];
+    let mut tally = [(0usize, 0usize); 3];
     for (r, &c) in rough.iter().zip(counted) {
         let (lowest, highest) = r.corners;
         let rule = if highest - lowest > refine {
             0
         } else if lowest < NEAR_DARK {
             1
-        } else if r.kink.is_some() {
-            2
         } else {
-            3
+            2
         };
         tally[rule].0 += 1;
         tally[rule].1 += usize::from(c);
     }
-    let [spread, dark, kink, other] = tally;
+    let [spread, dark, other] = tally;
     format!(
-        "spread {} / {}, near-dark corner {} / {}, KINK alone {} / {}, near-dark fit or borrowed day {} / {}",
-        spread.0, spread.1, dark.0, dark.1, kink.0, kink.1, other.0, other.1
+        "spread {} / {}, near-dark corner {} / {}, KINK or near-dark fit or borrowed day {} / {}",
+        spread.0, spread.1, dark.0, dark.1, other.0, other.1
     )
 }
 

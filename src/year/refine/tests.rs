@@ -10,15 +10,7 @@ const ROWS: usize = 96;
 
 /// A refined step of fitted piece `fit` at time of day `slot` on day `day` (0-based).
 fn step(fit: usize, slot: usize, day: usize) -> Rough {
-    Rough {
-        row: day * ROWS + slot,
-        column: fit,
-        sun: DVec3::Z,
-        day: day as f64 + 1.0,
-        cell: (0, fit, 0, 0),
-        corners: (0.0, 1.0),
-        kink: None,
-    }
+    Rough { row: day * ROWS + slot, column: fit, sun: DVec3::Z, day: day as f64 + 1.0, cell: (0, fit, 0, 0), corners: (0.0, 1.0) }
 }
 
 /// Runs the rounds of [`Sparse`] with `truth` answering every asked step: each step's value and
@@ -131,38 +123,5 @@ fn runs_break_at_gaps_times_of_day_and_pieces() {
     assert_eq!(lengths, vec![8, 8, 8, 10, 10, 10]);
     for run in &s.runs {
         assert!(run.windows(2).all(|w| rough[w[1]].row == rough[w[0]].row + ROWS), "consecutive days");
-    }
-}
-
-/// Under a crown of leaves, the steps that `KINK` alone asked for by no more than
-/// [`KINK_UNDER_CANOPY`] are left to the fit (their cell's); those it asked for by more, and
-/// those another rule asked for, are counted. Under an overhang over the same window every step
-/// is counted, as `KINK` (0.01) asks. Fails with the rule before it (every step counted), with a
-/// canopy threshold no looser than `KINK`, and with a rule that cannot tell leaves from an
-/// overhang.
-#[test]
-fn mild_kinks_under_a_canopy_are_left_to_the_fit_and_under_an_overhang_are_counted() {
-    use crate::count::certify::canopy_fixtures::{Caster, window_and};
-    for (caster, canopy) in [(Caster::Leaves(2000), true), (Caster::Overhang, false)] {
-        let (scene, suns) = window_and(caster);
-        // Three cells of the same steps: KINK alone by 0.02, KINK alone by 0.05, the spread rule.
-        let rough: Vec<Rough> = [(0, Some(0.02)), (1, Some(0.05)), (2, None)]
-            .into_iter()
-            .flat_map(|(cell, kink)| {
-                suns.iter().enumerate().map(move |(k, &sun)| Rough {
-                    row: k,
-                    column: 0,
-                    sun,
-                    day: 1.0 + (k / 9) as f64,
-                    cell: (0, 0, 0, cell),
-                    corners: (0.5, 0.9),
-                    kink,
-                })
-            })
-            .collect();
-        let (rest, left) = leave_canopy_kinks(&Certifier::new(&scene), rough.clone());
-        let kept: Vec<Rough> = if canopy { rough[suns.len()..].to_vec() } else { rough };
-        assert_eq!(left, if canopy { suns.len() } else { 0 }, "{caster:?}");
-        assert_eq!(rest, kept, "{caster:?}");
     }
 }
