@@ -591,6 +591,10 @@ pub fn default_receiver(surface: &CitySurface) -> bool {
 /// holes about its exterior ring's plane (a non-planar ring's triangles keep their 3D vertices),
 /// turned by `north_deg` about the local origin. A ring that cannot be triangulated is an error.
 pub fn city_model(city: &City, north_deg: f64) -> Result<GltfModel> {
+    if city.surfaces.is_empty() {
+        // Said here, with the file, rather than later as a scene that has no receiver.
+        return Err(Error::model(&city.file, "no CityObject has geometry to read (at the level of detail chosen)"));
+    }
     let turn = DMat4::from_rotation_z(-north_deg.to_radians());
     let mut meshes = Vec::with_capacity(city.surfaces.len());
     let mut nodes = Vec::with_capacity(city.surfaces.len());
