@@ -75,7 +75,13 @@ fn obj_groups_are_names_globs_select() {
 #[test]
 fn bad_city_input_is_refused_with_nothing_written() {
     let dir = scratch("bad-city");
-    let cases: [(&str, String, &str); 4] = [
+    let cases: [(&str, String, &str); 5] = [
+        (
+            // Found by the 10-minute mutation run: it was refused without the file's name.
+            "empty.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{},"vertices":[]}"#.into(),
+            "empty.city.json: no CityObject has geometry to read (at the level of detail chosen)",
+        ),
         (
             "version.city.json",
             r#"{"type":"CityJSON","version":"0.9","CityObjects":{},"vertices":[]}"#.into(),

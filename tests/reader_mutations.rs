@@ -9,6 +9,10 @@
 //! must neither panic nor take more than [`DEADLINE`]. A failing mutant is saved under the
 //! scratch folder with its seed, for `cargo fuzz run cityjson FILE` or `sunlit info FILE`.
 //!
+//! A longer run (a bounded fuzzing pass, docs/reliability.md) reads mutants from seed 0 on until
+//! `SUNLIT_MUTATION_SECONDS` have passed (and at least the usual [`MUTANTS`]):
+//! `SUNLIT_MUTATION_SECONDS=600 cargo test --test reader_mutations obj -- --nocapture`.
+//!
 //! The mutations are what the bad-input list and a reader's usual crashes are made of:
 //! truncations, values of the wrong type, huge and negative indices, NaN, infinity and numbers
 //! past f64, a missing `transform`, cycles in `parents`, empty rings, surfaces and shells,
@@ -29,6 +33,17 @@ const DEADLINE: Duration = Duration::from_secs(20);
 
 /// Mutants per kind of input.
 const MUTANTS: u64 = 2_000;
+
+/// The seeds to read: `0..MUTANTS`, or, with `SUNLIT_MUTATION_SECONDS` set, from 0 on until that
+/// many seconds have passed since the first (never fewer than `MUTANTS`).
+fn seeds() -> impl Iterator<Item = u64> {
+    let seconds: Option<f64> = std::env::var("SUNLIT_MUTATION_SECONDS").ok().and_then(|s| s.parse().ok());
+    let start = std::time::Instant::now();
+    (0..).take_while(move |&seed| match seconds {
+        Some(s) => seed < MUTANTS || start.elapsed().as_secs_f64() < s,
+        None => seed < MUTANTS,
+    })
+}
 
 const BLOCK: &str = include_str!("city/block.city.json");
 const HOUSE: &str = include_str!("../fuzz/seeds/obj/house.obj");
@@ -320,7 +335,7 @@ fn cityjson_mutants_read_or_are_refused_by_name() {
     check_all(
         "CityJSON",
         ".city.json",
-        (0..MUTANTS).map(|seed| {
+        seeds().map(|seed| {
             let mut rng = Rng::new(seed);
             if rng.below(5) == 0 {
                 return (seed, mutate_text(BLOCK, &mut rng));
@@ -341,7 +356,7 @@ fn cityjson_seq_mutants_read_or_are_refused_by_name() {
     check_all(
         "CityJSONSeq",
         ".city.jsonl",
-        (0..MUTANTS).map(|seed| {
+        seeds().map(|seed| {
             let mut rng = Rng::new(seed ^ 0x5EC);
             let mut lines: Vec<Value> = seq.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
             match rng.below(4) {
@@ -392,7 +407,7 @@ fn obj_mutants_read_or_are_refused_by_name() {
     check_all(
         "OBJ",
         ".obj",
-        (0..MUTANTS).map(|seed| {
+        seeds().map(|seed| {
             let mut rng = Rng::new(seed ^ 0x0B1);
             if rng.below(3) == 0 {
                 return (seed, mutate_text(HOUSE, &mut rng));

@@ -4,6 +4,7 @@
 //! (`--index`, what a child or a Slurm task runs), or a Slurm job array with a merge job.
 
 use sunlit::count::gpu::CounterOptions;
+use sunlit::model::cityjson::CitySource;
 use sunlit::sky::patches::SkyPatches;
 use sunlit::sun::weather::Weather;
 use sunlit::sweep::district::{self, TileCount, TileDone, TileSettings, Tiling};
@@ -178,19 +179,13 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     let bytes = std::fs::read(&city_path).map_err(|e| io(e, &city_path))?;
     let name = args.city.display().to_string();
     let lod = args.lod.as_deref();
-    let (city, tiling) = match args.index {
-        // One tile reads only its part of the city (after a pass that holds no surfaces).
-        Some(k) => {
-            let plan = district::CityPlan::read(&name, &bytes, lod, args.north)?;
-            let tiling = district::tiles_of(&plan, args.tile, args.context)?;
-            (district::read_tile_city(&name, &bytes, lod, &plan, &tiling, k)?, tiling)
-        }
-        None => {
-            let city = sunlit::model::cityjson::read_city(&name, &bytes, lod)?;
-            let tiling = district::tiles(&city, args.tile, args.context, args.north)?;
-            (city, tiling)
-        }
-    };
+    // The file is parsed once (a CityJSONSeq's feature lines as each pass reads them): the plan
+    // pass holds no surfaces, a tile then builds only its part, the merge only what it writes.
+    let source = CitySource::parse(&name, &bytes)?;
+    let plan = district::CityPlan::of_source(&name, &source, lod, args.north)?;
+    let tiling = district::tiles_of(&plan, args.tile, args.context)?;
+    let tile_city = args.index.map(|k| district::read_tile_city(&name, &source, lod, &plan, &tiling, k)).transpose()?;
+    drop(plan);
     let defining = args.defining(&city_path, &epw_path);
     let fingerprint = district::fingerprint(&defining, &city_path);
     let north = model::city_north_note(args.north);
@@ -203,7 +198,9 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
         words.extend(more.iter().cloned());
         words
     };
-    if let Some(k) = args.index {
+    if let (Some(k), Some(city)) = (args.index, tile_city) {
+        // The tile counts with its part alone.
+        drop(source);
         let tile = TileSettings {
             load: args.load(),
             settings: &settings,
@@ -218,7 +215,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }
     if args.merge {
-        return merge(&dir, &city, &bytes, &tiling, &fingerprint, &north);
+        return merge(&dir, source, &name, lod, &tiling, &fingerprint, &north);
     }
     let pending = district::pending(&dir, &tiling, &fingerprint);
     eprintln!(
@@ -231,7 +228,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     );
     if args.slurm {
         if pending.is_empty() {
-            return merge(&dir, &city, &bytes, &tiling, &fingerprint, &north);
+            return merge(&dir, source, &name, lod, &tiling, &fingerprint, &north);
         }
         let options = slurm::SlurmOptions {
             dir: dir.clone(),
@@ -246,7 +243,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
         return Ok(());
     }
     run_local(&exe, &dir, &pending, args.jobs, &|k| sunlit_district(&["--index".into(), k.to_string()]))?;
-    merge(&dir, &city, &bytes, &tiling, &fingerprint, &north)
+    merge(&dir, source, &name, lod, &tiling, &fingerprint, &north)
 }
 
 /// Counts tile `k` here and records it (or its failure).
@@ -318,13 +315,14 @@ fn run_local(
 /// Merges the finished tiles; fails listing the unfinished ones.
 fn merge(
     dir: &std::path::Path,
-    city: &sunlit::model::cityjson::City,
-    bytes: &[u8],
+    source: CitySource,
+    file: &str,
+    lod: Option<&str>,
     tiling: &Tiling,
     fingerprint: &sunlit::sweep::record::Fingerprint,
     north: &str,
 ) -> Result<()> {
-    let merged = district::merge(dir, city, bytes, tiling, fingerprint, north)?;
+    let merged = district::merge(dir, source, file, lod, tiling, fingerprint, north)?;
     if merged.unfinished.is_empty() {
         for path in &merged.written {
             eprintln!("wrote {}", path.display());

@@ -26,7 +26,7 @@ use super::irradiation::SurfaceSummary;
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
 use crate::export::wgs84::ToWgs84;
-use crate::model::cityjson::{City, CitySurface};
+use crate::model::cityjson::{City, CitySurface, OneDocument};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
@@ -186,41 +186,11 @@ pub fn single_document(file: &str, bytes: &[u8]) -> Result<Value> {
     }
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     let parse = |l: &str| serde_json::from_str::<Value>(l).map_err(|e| Error::model(file, format!("not JSON: {e}")));
-    let mut doc = parse(lines.next().unwrap_or(""))?;
-    let mut objects = Map::new();
-    let mut vertices: Vec<Value> = doc.get("vertices").and_then(Value::as_array).cloned().unwrap_or_default();
+    let mut one = OneDocument::new(parse(lines.next().unwrap_or(""))?);
     for line in lines {
-        let feature = parse(line)?;
-        let base = vertices.len() as u64;
-        for (id, object) in feature.get("CityObjects").and_then(Value::as_object).cloned().unwrap_or_default() {
-            let mut object = object;
-            if let Some(geometries) = object.get_mut("geometry").and_then(Value::as_array_mut) {
-                for g in geometries {
-                    if let Some(b) = g.get_mut("boundaries") {
-                        shift_indices(b, base);
-                    }
-                }
-            }
-            objects.insert(id, object);
-        }
-        vertices.extend(feature.get("vertices").and_then(Value::as_array).cloned().unwrap_or_default());
+        one.add(parse(line)?);
     }
-    doc["CityObjects"] = Value::Object(objects);
-    doc["vertices"] = Value::Array(vertices);
-    Ok(doc)
-}
-
-fn shift_indices(v: &mut Value, base: u64) {
-    match v {
-        Value::Array(items) => items.iter_mut().for_each(|i| shift_indices(i, base)),
-        Value::Number(n) => {
-            if let Some(k) = n.as_u64() {
-                // An index past every vertex (in a geometry the reader skipped) stays past them.
-                *v = json!(k.saturating_add(base));
-            }
-        }
-        _ => {}
-    }
+    Ok(one.finish())
 }
 
 /// A geometry's valued surfaces: surface index → (attribute, value) pairs.
@@ -228,7 +198,12 @@ type SurfaceValues<'a> = HashMap<usize, Vec<(&'a str, f64)>>;
 
 /// The city model with the cadastre's values on its surfaces (see the module doc).
 pub fn cadastre_cityjson(file: &str, bytes: &[u8], city: &City, rows: &[CadastreRow]) -> Result<Vec<u8>> {
-    let mut doc = single_document(file, bytes)?;
+    cadastre_document(file, single_document(file, bytes)?, city, rows)
+}
+
+/// [`cadastre_cityjson`] of the input already as one document ([`single_document`]'s); `city`
+/// needs only the surfaces `rows` name.
+pub fn cadastre_document(file: &str, mut doc: Value, city: &City, rows: &[CadastreRow]) -> Result<Vec<u8>> {
     let by_name: HashMap<&str, &CitySurface> = city.surfaces.iter().map(|s| (s.name.as_str(), s)).collect();
     // (object, geometry) → (surface index → values).
     let mut valued: HashMap<(&str, usize), SurfaceValues> = HashMap::new();

@@ -110,36 +110,178 @@ pub fn read_city_with(
     keep: Option<&dyn Fn(&str) -> bool>,
     out: &mut dyn FnMut(CitySurface),
 ) -> Result<City> {
-    let text = std::str::from_utf8(bytes).map_err(|e| Error::model(file, format!("not UTF-8 text ({e})")))?;
-    let whole: std::result::Result<Value, _> = serde_json::from_str(text);
-    let (header, seq) = match whole {
-        Ok(doc) => (doc, None),
-        Err(e) => {
-            // CityJSONSeq: every line a JSON object.
-            let mut lines = text.lines().filter(|l| !l.trim().is_empty()).enumerate();
-            let (_, first) = lines.next().ok_or_else(|| Error::model(file, "the file is empty"))?;
-            let header: Value = serde_json::from_str(first).map_err(|_| Error::model(file, format!("not JSON: {e}")))?;
-            (header, Some(lines))
+    read_city_from(file, &CitySource::parse(file, bytes)?, lod, keep, out)
+}
+
+/// A city file parsed once, for passes that each read what they need of it: a CityJSON
+/// document (one JSON value), or a CityJSONSeq's header and its feature lines, each parsed when
+/// a pass reads it (a sequence is never held parsed whole).
+pub enum CitySource<'a> {
+    /// A CityJSON document.
+    Document(Value),
+    /// A CityJSONSeq.
+    Seq {
+        /// Its first line.
+        header: Value,
+        /// Each feature line with its number among the non-blank lines from 0 (the header's).
+        lines: Vec<(usize, &'a str)>,
+    },
+}
+
+impl<'a> CitySource<'a> {
+    /// Parses a CityJSON document whole, or a CityJSONSeq's header; refuses what is not CityJSON.
+    pub fn parse(file: &str, bytes: &'a [u8]) -> Result<Self> {
+        let text = std::str::from_utf8(bytes).map_err(|e| Error::model(file, format!("not UTF-8 text ({e})")))?;
+        let whole: std::result::Result<Value, _> = serde_json::from_str(text);
+        let source = match whole {
+            Ok(doc) => Self::Document(doc),
+            Err(e) => {
+                // CityJSONSeq: every line a JSON object.
+                let mut lines = text.lines().filter(|l| !l.trim().is_empty()).enumerate();
+                let (_, first) = lines.next().ok_or_else(|| Error::model(file, "the file is empty"))?;
+                let header: Value = serde_json::from_str(first).map_err(|_| Error::model(file, format!("not JSON: {e}")))?;
+                Self::Seq { header, lines: lines.collect() }
+            }
+        };
+        if source.header().get("type").and_then(Value::as_str) != Some("CityJSON") {
+            return Err(Error::model(file, "not CityJSON: its \"type\" is not \"CityJSON\""));
         }
-    };
-    if header.get("type").and_then(Value::as_str) != Some("CityJSON") {
-        return Err(Error::model(file, "not CityJSON: its \"type\" is not \"CityJSON\""));
+        Ok(source)
     }
-    let mut reader = Reader::new(file, &header, lod)?;
-    reader.document(&header, keep, out)?;
+
+    /// The document, or the sequence's header.
+    fn header(&self) -> &Value {
+        match self {
+            Self::Document(doc) | Self::Seq { header: doc, .. } => doc,
+        }
+    }
+}
+
+/// [`read_city_with`] of a file already parsed.
+pub fn read_city_from(
+    file: &str,
+    source: &CitySource,
+    lod: Option<&str>,
+    keep: Option<&dyn Fn(&str) -> bool>,
+    out: &mut dyn FnMut(CitySurface),
+) -> Result<City> {
+    match source {
+        CitySource::Document(doc) => read_parts(file, doc, &[], lod, keep, out),
+        CitySource::Seq { header, lines } => read_parts(file, header, lines, lod, keep, out),
+    }
+}
+
+/// A document, or a sequence's header and feature lines, read.
+fn read_parts(
+    file: &str,
+    header: &Value,
+    lines: &[(usize, &str)],
+    lod: Option<&str>,
+    keep: Option<&dyn Fn(&str) -> bool>,
+    out: &mut dyn FnMut(CitySurface),
+) -> Result<City> {
+    let mut reader = Reader::new(file, header, lod)?;
+    reader.document(header, keep, out)?;
     let skip = keep.filter(|_| reader.scale.is_some());
-    // Lines are numbered among the non-blank ones, the header line 1.
-    for (i, line) in seq.into_iter().flatten() {
+    for &(i, line) in lines {
         if skip.is_some_and(|keep| !feature_kept(line, keep)) {
             continue;
         }
-        let feature: Value = serde_json::from_str(line).map_err(|e| Error::model(file, format!("line {}: not JSON: {e}", i + 1)))?;
-        if feature.get("type").and_then(Value::as_str) != Some("CityJSONFeature") {
-            return Err(Error::model(file, format!("line {}: not a CityJSONFeature", i + 1)));
-        }
-        reader.document(&feature, keep, out)?;
+        reader.document(&feature(file, i, line)?, keep, out)?;
     }
     Ok(reader.city)
+}
+
+/// Reads a city as [`read_city_from`] does (every line of a sequence read) and hands back the
+/// file as one CityJSON document too ([`OneDocument`] for a sequence), each line parsed once:
+/// what a writer of the model with values needs, in one pass.
+pub fn read_city_document(
+    file: &str,
+    source: CitySource,
+    lod: Option<&str>,
+    keep: Option<&dyn Fn(&str) -> bool>,
+    out: &mut dyn FnMut(CitySurface),
+) -> Result<(City, Value)> {
+    match source {
+        CitySource::Document(doc) => Ok((read_parts(file, &doc, &[], lod, keep, out)?, doc)),
+        CitySource::Seq { header, lines } => {
+            let mut reader = Reader::new(file, &header, lod)?;
+            reader.document(&header, keep, out)?;
+            let mut one = OneDocument::new(header);
+            for (i, line) in lines {
+                let feature = feature(file, i, line)?;
+                reader.document(&feature, keep, out)?;
+                one.add(feature);
+            }
+            Ok((reader.city, one.finish()))
+        }
+    }
+}
+
+/// Feature line `i` (numbered among the non-blank lines from 0, the header's) of a CityJSONSeq.
+fn feature(file: &str, i: usize, line: &str) -> Result<Value> {
+    // Lines are named among the non-blank ones, the header line 1.
+    let feature: Value = serde_json::from_str(line).map_err(|e| Error::model(file, format!("line {}: not JSON: {e}", i + 1)))?;
+    if feature.get("type").and_then(Value::as_str) != Some("CityJSONFeature") {
+        return Err(Error::model(file, format!("line {}: not a CityJSONFeature", i + 1)));
+    }
+    Ok(feature)
+}
+
+/// A CityJSONSeq as one CityJSON document: the header with every feature's objects and vertices
+/// appended (their vertex indices moved past the vertices before them).
+pub struct OneDocument {
+    doc: Value,
+    objects: serde_json::Map<String, Value>,
+    vertices: Vec<Value>,
+}
+
+impl OneDocument {
+    /// Starts from the sequence's header (its own objects are replaced by the features').
+    pub fn new(header: Value) -> Self {
+        let vertices = header.get("vertices").and_then(Value::as_array).cloned().unwrap_or_default();
+        Self { doc: header, objects: serde_json::Map::new(), vertices }
+    }
+
+    /// Appends one feature's objects and vertices.
+    pub fn add(&mut self, mut feature: Value) {
+        let base = self.vertices.len() as u64;
+        let objects = feature.get_mut("CityObjects").and_then(Value::as_object_mut).map(std::mem::take).unwrap_or_default();
+        for (id, mut object) in objects {
+            if let Some(geometries) = object.get_mut("geometry").and_then(Value::as_array_mut) {
+                for g in geometries {
+                    if let Some(b) = g.get_mut("boundaries") {
+                        shift_indices(b, base);
+                    }
+                }
+            }
+            self.objects.insert(id, object);
+        }
+        if let Some(Value::Array(v)) = feature.get_mut("vertices").map(Value::take) {
+            self.vertices.extend(v);
+        }
+    }
+
+    /// The one document.
+    pub fn finish(mut self) -> Value {
+        self.doc["CityObjects"] = Value::Object(self.objects);
+        self.doc["vertices"] = Value::Array(self.vertices);
+        self.doc
+    }
+}
+
+/// Adds `base` to every vertex index of `boundaries`.
+fn shift_indices(v: &mut Value, base: u64) {
+    match v {
+        Value::Array(items) => items.iter_mut().for_each(|i| shift_indices(i, base)),
+        Value::Number(n) => {
+            if let Some(k) = n.as_u64() {
+                // An index past every vertex (in a geometry the reader skipped) stays past them.
+                *v = Value::from(k.saturating_add(base));
+            }
+        }
+        _ => {}
+    }
 }
 
 /// Whether `keep` takes an object of a CityJSONSeq line, from its objects' ids alone (the rest of
@@ -449,6 +591,10 @@ pub fn default_receiver(surface: &CitySurface) -> bool {
 /// holes about its exterior ring's plane (a non-planar ring's triangles keep their 3D vertices),
 /// turned by `north_deg` about the local origin. A ring that cannot be triangulated is an error.
 pub fn city_model(city: &City, north_deg: f64) -> Result<GltfModel> {
+    if city.surfaces.is_empty() {
+        // Said here, with the file, rather than later as a scene that has no receiver.
+        return Err(Error::model(&city.file, "no CityObject has geometry to read (at the level of detail chosen)"));
+    }
     let turn = DMat4::from_rotation_z(-north_deg.to_radians());
     let mut meshes = Vec::with_capacity(city.surfaces.len());
     let mut nodes = Vec::with_capacity(city.surfaces.len());

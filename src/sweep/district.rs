@@ -23,7 +23,7 @@
 //!   with the map's exact rays ([`crate::map`]), each roof's usable area from its points; with
 //!   `pv`, their PV tools' files ([`super::district_pv`]).
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
@@ -41,6 +41,7 @@ use crate::export::pv::SamSums;
 use crate::export::write_atomic;
 use crate::map::{Mapper, Period, Site, point_sky};
 use crate::model::LoadOptions;
+use crate::model::cityjson::CitySource;
 use crate::model::cityjson::{City, CitySurface};
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
@@ -194,11 +195,17 @@ impl CityPlan {
     /// Reads a CityJSON file's plan, a surface at a time (a CityJSONSeq a line at a time);
     /// `north` (degrees) turns the model as the scene will.
     pub fn read(file: &str, bytes: &[u8], lod: Option<&str>, north: f64) -> Result<Self> {
+        Self::of_source(file, &CitySource::parse(file, bytes)?, lod, north)
+    }
+
+    /// [`Self::read`] of a file already parsed (which later passes read again without parsing a
+    /// document twice).
+    pub fn of_source(file: &str, source: &CitySource, lod: Option<&str>, north: f64) -> Result<Self> {
         let mut plan = Self::empty(
             City { file: file.to_string(), version: String::new(), reference_system: None, offset: DVec3::ZERO, surfaces: Vec::new() },
             north,
         );
-        let head = crate::model::cityjson::read_city_with(file, bytes, lod, None, &mut |s| plan.add(s))?;
+        let head = crate::model::cityjson::read_city_from(file, source, lod, None, &mut |s| plan.add(s))?;
         plan.head = head;
         Ok(plan)
     }
@@ -298,11 +305,11 @@ pub fn tile_city(city: &City, tiling: &Tiling, tile: &Tile) -> City {
 /// Reads only what tile `k` is counted with from the city file: the surfaces of the CityObjects
 /// [`CityPlan::keeps`] takes (a CityJSONSeq's other lines skipped unbuilt), so a tile's memory
 /// follows its tile and context. [`tile_city`] of it is [`tile_city`] of the whole city.
-pub fn read_tile_city(file: &str, bytes: &[u8], lod: Option<&str>, plan: &CityPlan, tiling: &Tiling, k: usize) -> Result<City> {
+pub fn read_tile_city(file: &str, source: &CitySource, lod: Option<&str>, plan: &CityPlan, tiling: &Tiling, k: usize) -> Result<City> {
     let tile = tile_of(tiling, k)?;
     let mut surfaces = Vec::new();
     let keep = |id: &str| plan.keeps(tiling, tile, id);
-    let mut city = crate::model::cityjson::read_city_with(file, bytes, lod, Some(&keep), &mut |s| surfaces.push(s))?;
+    let mut city = crate::model::cityjson::read_city_from(file, source, lod, Some(&keep), &mut |s| surfaces.push(s))?;
     city.surfaces = surfaces;
     Ok(city)
 }
@@ -498,11 +505,14 @@ pub struct DistrictMerged {
 }
 
 /// Merges every tile's rows into the cadastre's three files (atomically, only when every tile is
-/// finished), in the city's surface order; otherwise writes `failed.csv` and nothing else.
+/// finished), in the city's surface order; otherwise writes `failed.csv` and nothing else (and
+/// reads nothing of the city). The city file (`source`, read at `lod` as the tiles read it) is
+/// read once, building only the surfaces the rows name ([`merge_read`]).
 pub fn merge(
     dir: &Path,
-    city: &City,
-    city_bytes: &[u8],
+    source: CitySource,
+    file: &str,
+    lod: Option<&str>,
     tiling: &Tiling,
     fingerprint: &Fingerprint,
     north_note: &str,
@@ -538,11 +548,14 @@ pub fn merge(
         return Ok(DistrictMerged { written: Vec::new(), surfaces: rows.len(), unfinished });
     }
     let _ = std::fs::remove_file(&failed);
+    let names: HashSet<&str> = rows.iter().map(|r| r.surface.as_str()).chain(points.iter().map(|p| p.surface.as_str())).collect();
+    let (city, doc) = merge_read(source, file, lod, &names)?;
+    let city = &city;
     let position: HashMap<&str, usize> = city.surfaces.iter().enumerate().map(|(i, s)| (s.name.as_str(), i)).collect();
     rows.sort_by_key(|r| position.get(r.surface.as_str()).copied().unwrap_or(usize::MAX));
     points.sort_by_key(|p| position.get(p.surface.as_str()).copied().unwrap_or(usize::MAX));
     let mut files = vec![
-        (dir.join(CADASTRE_CITYJSON), cadastre::cadastre_cityjson(&city.file, city_bytes, city, &rows)?),
+        (dir.join(CADASTRE_CITYJSON), cadastre::cadastre_document(&city.file, doc, city, &rows)?),
         (dir.join(CADASTRE_CSV), cadastre::cadastre_csv(&rows).into_bytes()),
         (dir.join(CADASTRE_GEOJSON), cadastre::roofs_geojson(city, &rows, north_note)?.into_bytes()),
     ];
@@ -558,6 +571,26 @@ pub fn merge(
     }
     let written = files.into_iter().map(|(p, _)| p).chain(pv_files).collect();
     Ok(DistrictMerged { written, surfaces: rows.len(), unfinished })
+}
+
+/// What the merge needs of the city, in one read of the file: the input as one document (the
+/// one written back with values) and the surfaces `names` names (the rows' and points'), in file
+/// order, only their objects' geometry built. The rows' order, the values' places and the roofs'
+/// outlines are then those a whole read gives: every name is the same, and the surfaces keep
+/// their order.
+fn merge_read(source: CitySource, file: &str, lod: Option<&str>, names: &HashSet<&str>) -> Result<(City, serde_json::Value)> {
+    // A surface's name is `OBJECT/TYPE/INDEX`, and an id or a type may hold a `/` itself: every
+    // part of a name before one of its `/` may be its object's id.
+    let objects: HashSet<&str> = names.iter().flat_map(|n| n.match_indices('/').map(|(i, _)| &n[..i])).collect();
+    let keep = |id: &str| objects.contains(id);
+    let mut surfaces = Vec::new();
+    let (mut city, doc) = crate::model::cityjson::read_city_document(file, source, lod, Some(&keep), &mut |s| {
+        if names.contains(s.name.as_str()) {
+            surfaces.push(s);
+        }
+    })?;
+    city.surfaces = surfaces;
+    Ok((city, doc))
 }
 
 #[cfg(test)]
@@ -660,7 +693,8 @@ mod tests {
             assert!(planned.origin == tiling.origin, "{file}");
             assert!(tiling.tiles.len() >= 4, "{file}: {} tiles", tiling.tiles.len());
             for tile in &tiling.tiles {
-                let read = read_tile_city(file, text.as_bytes(), None, &plan, &tiling, tile.index).unwrap();
+                let source = CitySource::parse(file, text.as_bytes()).unwrap();
+                let read = read_tile_city(file, &source, None, &plan, &tiling, tile.index).unwrap();
                 assert!(read.surfaces.len() < whole.surfaces.len(), "{file}: tile {} read the whole city", tile.index);
                 let (alone, from_whole) = (tile_city(&read, &tiling, tile), tile_city(&whole, &tiling, tile));
                 assert!(
@@ -671,6 +705,53 @@ mod tests {
                     from_whole.surfaces.len()
                 );
             }
+        }
+    }
+
+    /// The merge reads the file once, building only the surfaces of the rows, and writes the
+    /// bytes a whole read plus a second parse of the file wrote (CityJSON and CityJSONSeq): the
+    /// cadastre's CityJSON, its roofs' GeoJSON and the rows' order.
+    #[test]
+    fn the_merge_reads_the_file_once_and_writes_what_a_whole_read_wrote() {
+        let doc = crate::model::city_write::district_cityjson(5, 4, 3);
+        let seq = as_seq(&doc);
+        for (file, text) in [("d.city.json", &doc), ("d.city.jsonl", &seq)] {
+            let whole = crate::model::cityjson::read_city(file, text.as_bytes(), None).unwrap();
+            let receivers = whole.surfaces.iter().filter(|s| crate::model::cityjson::default_receiver(s));
+            // Rows out of the city's order (as tiles give them), every third surface left out.
+            let mut rows: Vec<CadastreRow> = receivers
+                .enumerate()
+                .filter(|(i, _)| i % 3 != 1)
+                .map(|(i, s)| CadastreRow {
+                    surface: s.name.clone(),
+                    building: s.building.clone().unwrap_or_default(),
+                    area: 1.0 + i as f64,
+                    direct: 100.0 + i as f64 / 7.0,
+                    sky_diffuse: 50.0,
+                    ground_reflected: 3.0,
+                    total: 153.0 + i as f64 / 7.0,
+                    sun_hours: 1000.0,
+                    mean_fraction: 0.5,
+                    usable_area: None,
+                })
+                .collect();
+            rows.reverse();
+            let order = |city: &City, rows: &mut Vec<CadastreRow>| {
+                let position: HashMap<&str, usize> = city.surfaces.iter().enumerate().map(|(i, s)| (s.name.as_str(), i)).collect();
+                rows.sort_by_key(|r| position.get(r.surface.as_str()).copied().unwrap_or(usize::MAX));
+            };
+            let mut want_rows = rows.clone();
+            order(&whole, &mut want_rows);
+            let want_json = cadastre::cadastre_cityjson(file, text.as_bytes(), &whole, &want_rows).unwrap();
+            let want_roofs = cadastre::roofs_geojson(&whole, &want_rows, "north").unwrap();
+
+            let names: HashSet<&str> = rows.iter().map(|r| r.surface.as_str()).collect();
+            let (city, one) = merge_read(CitySource::parse(file, text.as_bytes()).unwrap(), file, None, &names).unwrap();
+            assert_eq!(city.surfaces.len(), rows.len(), "{file}: only the rows' surfaces are built");
+            order(&city, &mut rows);
+            assert!(rows.iter().map(|r| &r.surface).eq(want_rows.iter().map(|r| &r.surface)), "{file}: the rows' order");
+            assert!(cadastre::cadastre_document(file, one, &city, &rows).unwrap() == want_json, "{file}: CityJSON");
+            assert!(cadastre::roofs_geojson(&city, &rows, "north").unwrap() == want_roofs, "{file}: roofs");
         }
     }
 }

@@ -202,6 +202,26 @@ impl Boundary {
         self.polys.len()
     }
 
+    /// Where the pushes stand: polygons and points so far, for [`Self::truncate`].
+    pub(super) fn mark(&self) -> (usize, usize) {
+        (self.polys.len(), self.points.len())
+    }
+
+    /// Forgets the polygons pushed after `mark` (as if they never were).
+    pub(super) fn truncate(&mut self, (polys, points): (usize, usize)) {
+        self.polys.truncate(polys);
+        self.points.truncate(points);
+    }
+
+    /// Whether the polygon pushed last is a shadow that covers every receiver polygon (pushed
+    /// before any shadow) as [`Self::uncovered_area`] drops polygons: then it drops them all and
+    /// the area is 0, whatever else is pushed, so a caller may stop there.
+    pub(super) fn last_covers_receivers(&self) -> bool {
+        let Some(last) = self.polys.len().checked_sub(1) else { return false };
+        let receivers = self.polys.iter().take_while(|p| p.receiver).count();
+        receivers > 0 && !self.polys[last].receiver && (0..receivers).all(|p| self.covers(last, p))
+    }
+
     /// Snaps a polygon's vertices to the grid and pushes their convex hull; a receiver polygon
     /// (part of the region) or a shadow (taken away from it). Nothing is pushed when the snapped
     /// hull has no area. Polygons are counted in the order they are pushed (the order decides
