@@ -57,7 +57,9 @@ impl Case {
 
 /// Runs `sunlit annual` on the case in a fresh folder and checks everything the CLI promises.
 fn check_cli(label: &str, case: &Case) {
-    let dir = std::env::temp_dir().join(format!("sunlit-bad-{label}-{}", std::process::id()));
+    // A label may hold a date ("12/31"): one folder, not a folder inside another left behind.
+    let folder = label.replace('/', "-");
+    let dir = std::env::temp_dir().join(format!("sunlit-bad-{folder}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let mut models = Vec::new();
