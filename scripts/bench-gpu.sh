@@ -52,7 +52,8 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # The new path first: counts drawn from the GPU's culling (--cull gpu: one indirect draw a tile,
 # src/count/gpu/pulled.rs) on 20,040 nyt-blocks views with the CPU-culled count of the same views
 # beside it (same binary, --cull cpu), blaas-trees-summer's every view both ways, and the host's
-# cost of each on noop. Each JSON line's `cull` says which path ran.
+# cost of each on noop. Each JSON line's `cull` says which path ran, and `shading_tested_on_cpu`
+# how many views the GPU's shading test (shaders/may_shade.wgsl) left to the host.
 run nyt-blocks-cull-gpu 90 bench nyt-blocks --engine gpu --cull gpu --views "${VIEWS:-20040}" --check 10 "${gpu_flags[@]}"
 run nyt-blocks-cull-cpu 90 bench nyt-blocks --engine gpu --cull cpu --views "${VIEWS:-20040}" "${gpu_flags[@]}"
 run blaas-trees-summer-cull-gpu 40 bench blaas-trees-summer --engine gpu --cull gpu --check 20 "${views[@]}" "${gpu_flags[@]}"

@@ -24,15 +24,15 @@ fn bench_scene(name: &str) -> (Scene, Vec<ViewRequest>) {
 }
 
 /// `requests` counted at `side` by the CPU's culling and by the GPU's, with each counter's atlas
-/// after its last batch.
-fn both(scene: &Scene, requests: &[ViewRequest], side: u32) -> [(Vec<Counted>, Vec<[u32; 2]>); 2] {
+/// after its last batch and the views whose shading the host tested.
+fn both(scene: &Scene, requests: &[ViewRequest], side: u32) -> [(Vec<Counted>, Vec<[u32; 2]>, u64); 2] {
     [false, true].map(|gpu_cull| {
         let counter = culling_counter(side, gpu_cull);
         let gpu = counter.upload(scene).unwrap();
         assert_eq!(counter.culls_on_gpu_for(&gpu), gpu_cull, "the path under test is the one taken");
         let counted = pollster::block_on(counter.fractions(&gpu, requests)).unwrap();
         let (_, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
-        (counted, atlas)
+        (counted, atlas, counter.shading_tested_on_cpu())
     })
 }
 
@@ -51,7 +51,7 @@ fn rendered_views(scene: &Scene, all: &[ViewRequest], at_most: usize) -> Vec<Vie
 fn same_pixels_and_counts(name: &str, at_most: usize) {
     let (scene, all) = bench_scene(name);
     let requests = rendered_views(&scene, &all, at_most);
-    let [(by_cpu, cpu_atlas), (by_gpu, gpu_atlas)] = both(&scene, &requests, 128);
+    let [(by_cpu, cpu_atlas, _), (by_gpu, gpu_atlas, _)] = both(&scene, &requests, 128);
     let shaded = by_cpu.iter().filter(|c| c.visible > 0 && c.visible < c.covered).count();
     assert!(requests.len() >= 10 && shaded >= 3, "{name}: {} views, {shaded} partly shaded", requests.len());
     assert_eq!(by_gpu, by_cpu, "{name}: counts with the GPU's culling against the CPU's");
@@ -77,9 +77,11 @@ fn every_view_of_a_year_counts_alike_and_unshaded_ones_exactly_lit() {
     // culling renders the unshaded ones the CPU skips, and they must still count exactly 1.
     let (scene, all) = bench_scene("blaas-louvres");
     let requests = sunlit::bench::spread(&all, 300);
-    let [(by_cpu, _), (by_gpu, _)] = both(&scene, &requests, 64);
+    let [(by_cpu, _, _), (by_gpu, _, on_cpu)] = both(&scene, &requests, 64);
     let skipped = by_cpu.iter().filter(|c| c.side == 0 && c.fraction == 1.0).count();
     assert!(skipped > 0, "some views the CPU's culling skips as unshaded");
+    // The GPU's shading test settles them: the host tests only what f32 cannot decide.
+    assert!(on_cpu * 20 <= requests.len() as u64, "{on_cpu} of {} views tested on the CPU", requests.len());
     let differing: Vec<_> = (0..requests.len())
         .filter(|&i| by_gpu[i].fraction.to_bits() != by_cpu[i].fraction.to_bits())
         .map(|i| (i, by_cpu[i], by_gpu[i]))
@@ -102,4 +104,53 @@ fn an_overflowing_pair_list_is_counted_again_with_the_cpus_culling() {
     assert!(tight.culls_on_gpu_for(&gpu));
     let got = pollster::block_on(tight.fractions(&gpu, &requests)).unwrap();
     assert_eq!(got, want, "counted again in full, never truncated");
+}
+
+/// The GPU's shading test (shaders/may_shade.wgsl) of every lit view of `name`'s 9×9 year (at
+/// most `at_most`, spread) against the CPU's (`Culling::may_be_shaded`, f64): where the GPU
+/// decides, it decides as the CPU does. Returns (nothing, undecided, shaded) views.
+fn shading_verdicts(name: &str, leaf_triangles: u32, at_most: usize) -> [usize; 3] {
+    use sunlit::count::cull::{Culling, Target};
+    use sunlit::count::gpu::shade::ShadeVerdict;
+    let (scene, all) = bench_scene(name);
+    let culling = Culling::new(&scene, leaf_triangles);
+    let lit: Vec<ViewRequest> =
+        all.iter().filter(|r| !sunlit::count::is_dark(scene.receivers[r.receiver as usize].normal, r.sun)).copied().collect();
+    let requests = sunlit::bench::spread(&lit, at_most);
+    let (mut tests, mut truth) = (Vec::new(), Vec::new());
+    for r in &requests {
+        let receiver = &scene.receivers[r.receiver as usize];
+        let points: Vec<glam::DVec3> = receiver.triangles.iter().flatten().copied().collect();
+        let view = sunlit::count::view::fit(&points, r.sun, scene.bounds, scene.origin, 64);
+        let target = Target { points: &points, normal: receiver.normal, gpu_id: receiver.gpu_id };
+        tests.push(culling.shade_test(&view.view_proj, &target, r.sun));
+        truth.push(culling.may_be_shaded(&view.view_proj, &target, r.sun));
+    }
+    let counter = culling_counter(64, true);
+    let verdicts = pollster::block_on(counter.may_shade_on_gpu(&culling, &tests)).unwrap();
+    assert_eq!(verdicts.len(), tests.len());
+    let wrong: Vec<_> = verdicts
+        .iter()
+        .zip(&truth)
+        .enumerate()
+        .filter(|(_, (v, t))| matches!((v, t), (ShadeVerdict::Nothing, true) | (ShadeVerdict::Shaded, false)))
+        .collect();
+    assert!(wrong.is_empty(), "{name}: {} of {} views decided against the CPU: {wrong:?}", wrong.len(), tests.len());
+    let count = |k: ShadeVerdict| verdicts.iter().filter(|v| **v == k).count();
+    let tally = [count(ShadeVerdict::Nothing), count(ShadeVerdict::Undecided), count(ShadeVerdict::Shaded)];
+    let may = truth.iter().filter(|t| **t).count();
+    println!("{name}: {} lit views ({may} the CPU's test finds shadable): nothing / undecided / shaded {tally:?}", tests.len());
+    tally
+}
+
+#[test]
+fn the_gpu_shading_test_decides_as_the_cpus_wherever_it_decides() {
+    // Louvres: slats close in front of each window, grazing suns; buildings: a static mesh of
+    // blocks; trees: instanced meshes of more than 128 triangles cut in clusters.
+    for (name, leaf) in [("blaas-louvres", 64), ("blaas-buildings", 16), ("blaas-trees-summer", 64)] {
+        // Undecided views cost the host the CPU's test only where their render is not fully
+        // lit: `every_view_of_a_year_counts_alike_and_unshaded_ones_exactly_lit` bounds those.
+        let [nothing, _, shaded] = shading_verdicts(name, leaf, 400);
+        assert!(nothing > 0 && shaded > 0, "{name}: both answers occur ({nothing} nothing, {shaded} shaded)");
+    }
 }

@@ -247,6 +247,9 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             // count again by overflowing.
             "bin_pool_nodes": counters.iter().map(|c| c.bin_pool().0).max(),
             "bin_pool_reruns": counters.iter().map(|c| c.bin_pool().1).sum::<u64>(),
+            // GPU-culled views whose shading the host tested (the GPU's test undecided, and the
+            // render not fully lit), since the counters were made.
+            "shading_tested_on_cpu": counters.iter().map(|c| c.shading_tested_on_cpu()).sum::<u64>(),
             // The compute kernel's views a submission (its batches are not the atlas's).
             "compute_views_per_submission": compute_views_per_submission(&counters),
             "seconds_per_rendered_view": t.seconds / t.rendered.max(1) as f64,

@@ -140,16 +140,16 @@ impl Bvh {
         at
     }
 
-    /// Calls `f`, in item order, with the item range of every highest node holding at most `most`
-    /// triangles (`per_item` an item), or of a leaf holding more: the ranges cover every item
-    /// once.
-    fn cut(&self, most: usize, per_item: usize, mut f: impl FnMut(Range<u32>)) {
+    /// Calls `f`, in item order, with the item range and box of every highest node holding at
+    /// most `most` triangles (`per_item` an item), or of a leaf holding more: the ranges cover
+    /// every item once, and each node's box holds every leaf box below it.
+    fn cut(&self, most: usize, per_item: usize, mut f: impl FnMut(Range<u32>, [Vec3; 2])) {
         let mut stack = if self.nodes.is_empty() { Vec::new() } else { vec![0u32] };
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
             match node.right {
                 Some(r) if node.items.len() * per_item > most => stack.extend([r, n + 1]),
-                _ => f(node.items.clone()),
+                _ => f(node.items.clone(), [node.lo, node.hi]),
             }
         }
     }
@@ -473,15 +473,32 @@ impl Culling {
     /// nodes of the static mesh and of each shared mesh's instances; a leaf of one instance with
     /// more triangles than that is cut into even runs of it.
     pub fn clusters(&self) -> Vec<Cluster> {
+        self.clusters_and_reach().into_iter().map(|(c, _)| c).collect()
+    }
+
+    /// [`Self::clusters`], each with the box of the BVH node it was cut from (`[lo, hi]`): it
+    /// holds the box of every leaf any of the cluster's triangles belongs to, so a cluster whose
+    /// node box misses a view's clip volume holds no triangle [`Self::may_be_shaded`] tests for
+    /// that view (a cluster's own box can be smaller, where an instance of more than
+    /// [`CLUSTER_TRIANGLES`] triangles is a leaf cut in pieces).
+    pub fn clusters_and_reach(&self) -> Vec<(Cluster, [Vec3; 2])> {
         let most = CLUSTER_TRIANGLES as usize;
         let mut out = Vec::new();
-        self.static_bvh.cut(most, 1, |r| self.push_clusters(&mut out, r.start as usize..r.end as usize));
+        self.static_bvh.cut(most, 1, |r, reach| self.push_clusters(&mut out, r.start as usize..r.end as usize, reach));
         for g in &self.groups {
             let n = g.triangles_per_instance;
             let at = |i: u32| g.first_triangle + i as usize * n;
-            g.bvh.cut(most, n, |r| self.push_clusters(&mut out, at(r.start)..at(r.end)));
+            g.bvh.cut(most, n, |r, reach| self.push_clusters(&mut out, at(r.start)..at(r.end), reach));
         }
         out
+    }
+
+    /// What [`Self::may_be_shaded`] decides a view by, for a test made elsewhere (the GPU's,
+    /// shaders/may_shade.wgsl): the clip volume's rows and the receiver's prism.
+    pub fn shade_test(&self, view_proj: &DMat4, target: &Target<'_>, sun: DVec3) -> ShadeTest {
+        let prism = Prism::new(target, sun, self.origin, self.eps);
+        let Prism { p0, normal, u, v, lo, hi, sun, along, eps } = prism;
+        ShadeTest { clip_rows: ClipVolume::new(view_proj).rows, p0, normal, u, v, lo, hi, sun, along, eps, own: target.gpu_id }
     }
 
     /// The runs of [`Self::triangles`] each placed one way: the static mesh (one placement, at
@@ -501,13 +518,13 @@ impl Culling {
         out
     }
 
-    fn push_clusters(&self, out: &mut Vec<Cluster>, range: Range<usize>) {
+    fn push_clusters(&self, out: &mut Vec<(Cluster, [Vec3; 2])>, range: Range<usize>, reach: [Vec3; 2]) {
         let pieces = range.len().div_ceil(CLUSTER_TRIANGLES as usize);
         for k in 0..pieces {
             let (a, b) = (range.start + range.len() * k / pieces, range.start + range.len() * (k + 1) / pieces);
             let (lo, hi) =
                 self.triangles[a..b].iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-            out.push(Cluster { first: a as u32, count: (b - a) as u32, lo, hi });
+            out.push((Cluster { first: a as u32, count: (b - a) as u32, lo, hi }, reach));
         }
     }
 
@@ -525,6 +542,39 @@ fn push_merged(ranges: &mut Vec<Range<u32>>, r: Range<u32>) {
         Some(last) if last.end == r.start => last.end = r.end,
         _ => ranges.push(r),
     }
+}
+
+/// [`Culling::may_be_shaded`]'s inputs for one view, as the GPU's test reads them (scene
+/// coordinates relative to the origin): a triangle of a leaf whose box reaches into the clip
+/// volume (`clip_rows`, x, y in [−1, 1], depth in [0, 1], [`CLIP_SLACK`]) may shade the
+/// receiver when it is not the receiver's own (`own`), a corner lies more than `eps` in front of
+/// the plane through `p0` with normal `normal`, and the box of its corners cast along `sun` onto
+/// that plane (`along` = normal · sun), in the plane's axes `u`, `v`, meets the receiver's box
+/// `lo`..`hi`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadeTest {
+    /// Rows x, y and z of the view's clip transform.
+    pub clip_rows: [[f64; 4]; 3],
+    /// A point of the receiver's plane (its owner's first corner).
+    pub p0: DVec3,
+    /// The receiver's outward unit normal.
+    pub normal: DVec3,
+    /// The plane's first axis.
+    pub u: DVec3,
+    /// The plane's second axis.
+    pub v: DVec3,
+    /// The receiver's box in the plane's axes: lowest corner.
+    pub lo: DVec2,
+    /// Highest corner.
+    pub hi: DVec2,
+    /// Towards the sun (unit).
+    pub sun: DVec3,
+    /// `normal · sun`.
+    pub along: f64,
+    /// Heights within this of the plane are on it.
+    pub eps: f64,
+    /// The receiver's GPU id (its own triangles never shade it).
+    pub own: u32,
 }
 
 /// The receiver's plane and box, for the per-triangle "can its shadow reach?" test.

@@ -28,14 +28,15 @@ const GROUP: u32 = 64;
 /// Bytes of the args buffer: wgpu's DrawIndirectArgs (4 words) and the pairs needed.
 const ARGS_BYTES: u64 = 5 * 4;
 
-/// A cluster as the shader reads it (`Cluster` in cull_clusters.wgsl).
+/// A cluster as the shaders read it (`Cluster` in cull_clusters.wgsl and may_shade.wgsl): its
+/// triangles and a box.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct GpuCluster {
-    lo: [f32; 3],
-    first: u32,
-    hi: [f32; 3],
-    count: u32,
+pub(super) struct GpuCluster {
+    pub(super) lo: [f32; 3],
+    pub(super) first: u32,
+    pub(super) hi: [f32; 3],
+    pub(super) count: u32,
 }
 
 /// The first three rows of a view's clip transform (`ClipRows`).

@@ -135,7 +135,7 @@ impl Counter {
         let recording = Stopwatch::start();
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("batch") });
         if let Some(pulled) = scene.pulled.as_ref().filter(|_| batch.iter().any(|t| t.draws.is_none())) {
-            self.encode_gpu_cull(&mut encoder, pulled, batch, batch_in_chunk);
+            self.encode_gpu_cull(&mut encoder, scene, pulled, requests, batch, batch_in_chunk);
         }
         self.render_tiles(&mut encoder, scene, requests, batch, side);
         if count {

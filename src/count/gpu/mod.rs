@@ -37,7 +37,9 @@
 //! - [`cluster_cull`]: culling on the GPU, clusters against a batch's views into (view, cluster)
 //!   pairs and indirect draws;
 //! - `pulled`: counting from that culling ([`CounterOptions::gpu_cull`]): one indirect draw a
-//!   tile whose vertices pull the kept clusters' corners from storage.
+//!   tile whose vertices pull the kept clusters' corners from storage;
+//! - [`shade`]: the culling's shading test on the GPU (does anything a view draws shade its
+//!   receiver?), exact where f32 can decide, the CPU's test where it cannot.
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
@@ -53,6 +55,7 @@ mod pipelines;
 pub mod plan;
 mod pulled;
 mod readback;
+pub mod shade;
 mod upload;
 
 use std::collections::BTreeMap;
@@ -326,6 +329,9 @@ pub struct Counter {
     /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
     tiles_rendered: AtomicU64,
     triangles_drawn: AtomicU64,
+    /// GPU-culled tiles whose shading test the host ran (the GPU could not decide, or has no
+    /// test for the scene).
+    shading_on_cpu: AtomicU64,
     /// Host time by stage since the counter was made (benchmarks).
     stages: StageClock,
     faults: Faults,
@@ -382,6 +388,7 @@ impl Counter {
             batch,
             tiles_rendered: AtomicU64::new(0),
             triangles_drawn: AtomicU64::new(0),
+            shading_on_cpu: AtomicU64::new(0),
             stages: StageClock::default(),
             faults,
             compute,

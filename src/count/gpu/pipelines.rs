@@ -340,10 +340,11 @@ pub(super) fn attachment(device: &wgpu::Device, label: &str, side: u32, format: 
 }
 
 /// WGSL sources, for validation in tests.
-pub const SHADERS: [(&str, &str); 5] = [
+pub const SHADERS: [(&str, &str); 6] = [
     ("sun_view.wgsl", SUN_VIEW_WGSL),
     ("count_pixels.wgsl", COUNT_PIXELS_WGSL),
     ("point_masks.wgsl", POINT_MASKS_WGSL),
     ("compute_raster.wgsl", super::compute::COMPUTE_RASTER_WGSL),
     ("cull_clusters.wgsl", super::cluster_cull::CULL_CLUSTERS_WGSL),
+    ("may_shade.wgsl", super::shade::MAY_SHADE_WGSL),
 ];

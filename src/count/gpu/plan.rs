@@ -13,7 +13,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use super::{ADAPTIVE_FIRST_SIDE, Counted, CounterOptions};
-use crate::count::cull::{Culling, DrawList, Target};
+use crate::count::cull::{Culling, DrawList, ShadeTest, Target};
 use crate::count::group::{MAX_MEMBERS, ViewGroups};
 use crate::count::view::{self, SunView};
 use crate::count::{ViewRequest, check_receivers, cos_incidence, is_dark};
@@ -207,6 +207,15 @@ pub(super) fn may_be_shaded(scene: &SceneLayout, requests: &[ViewRequest], membe
     let points = tile_points(scene, requests, members);
     let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
     scene.culling.may_be_shaded(&view.view_proj, &target, requests[members[0]].sun)
+}
+
+/// What [`may_be_shaded`] decides the tile of `members` (owner first) seen by `view` by, for
+/// the GPU's test ([`super::shade`]).
+pub(super) fn shade_test(scene: &SceneLayout, requests: &[ViewRequest], members: &[usize], view: &SunView) -> ShadeTest {
+    let owner = &scene.receivers[requests[members[0]].receiver as usize];
+    let points = tile_points(scene, requests, members);
+    let target = Target { points: &points, normal: owner.normal, gpu_id: owner.gpu_id };
+    scene.culling.shade_test(&view.view_proj, &target, requests[members[0]].sun)
 }
 
 /// What the CPU's culling has the tile of `members` (owner first) seen by `view` draw, or `None`

@@ -19,10 +19,13 @@
 
 use super::cluster_cull::GpuClusters;
 use super::pipelines::{GpuVertex, Pipelines, buffer, entry, pulled_scene_pipeline, storage_entry};
-use super::plan::{SceneLayout, Tile};
+use super::plan::{SceneLayout, Tile, shade_test};
+use super::readback::BATCHES_PER_READBACK;
+use super::shade::{ShadePass, ShadeScene};
 use super::upload::{distinct_vertices, gpu_vertices};
 use super::{Counter, GpuScene};
-use crate::count::cull::{CLUSTER_TRIANGLES, TriangleRun};
+use crate::count::ViewRequest;
+use crate::count::cull::{CLUSTER_TRIANGLES, ShadeTest, TriangleRun};
 use crate::scene::Scene;
 
 /// Pairs a scene's list holds at most (8 bytes each): far more than a batch keeps on the bench
@@ -44,10 +47,12 @@ struct GpuRun {
     _pad: [u32; 2],
 }
 
-/// The pulled scene pipeline and its bind group layout, where the adapter can run them.
+/// The pulled scene pipeline and its bind group layout, where the adapter can run them, and
+/// the shading test's pass.
 pub(super) struct PulledPipelines {
     layout: wgpu::BindGroupLayout,
     pub(super) scene: wgpu::RenderPipeline,
+    shade: ShadePass,
 }
 
 impl PulledPipelines {
@@ -71,7 +76,7 @@ impl PulledPipelines {
         let entries: Vec<_> = (0..7).map(|b| storage_entry(b, vs, true)).collect();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("pulled"), entries: &entries });
         let scene = pulled_scene_pipeline(device, pipelines, &layout);
-        Some(Self { layout, scene })
+        Some(Self { layout, scene, shade: ShadePass::new(device) })
     }
 }
 
@@ -82,8 +87,14 @@ pub(super) struct PulledScene {
     pub(super) bind: wgpu::BindGroup,
     /// The cull pass's buffers for a batch.
     pub(super) batch: super::cluster_cull::ViewCullBuffers,
-    /// Each batch's pairs needed, copied out for the readback (one word a batch of a chunk).
-    pub(super) needed: wgpu::Buffer,
+    /// What the host reads of a chunk's batches: each batch's pairs needed (one word a batch,
+    /// [`BATCHES_PER_READBACK`] words), then each batch's views' shading verdicts (the batch's
+    /// tiles' words each).
+    pub(super) answers: wgpu::Buffer,
+    /// Tiles a batch holds at most (words of verdicts a batch in `answers`).
+    pub(super) tiles: usize,
+    /// The shading test's buffers (`None` where the corners do not fit: the CPU tests).
+    pub(super) shade: Option<ShadeScene>,
 }
 
 impl Counter {
@@ -131,9 +142,12 @@ impl Counter {
                 entry(6, index_buffer.as_entire_binding()),
             ],
         });
-        let needed_bytes = 4 * super::readback::BATCHES_PER_READBACK as u64;
-        let needed = buffer(d, "pairs needed", needed_bytes, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        Some(PulledScene { clusters: clusters_on_device, bind, batch, needed })
+        let answer_bytes = 4 * BATCHES_PER_READBACK as u64 * (1 + tiles);
+        let answers = buffer(d, "culling answers", answer_bytes, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let shade = ShadeScene::new(d, &pipelines.shade, &layout.culling, tiles as u32);
+        let tested = if shade.is_some() { "on the GPU" } else { "on the CPU" };
+        log::info!("culling on the GPU: {} clusters, {capacity} pairs a batch; shading test {tested}", clusters.len());
+        Some(PulledScene { clusters: clusters_on_device, bind, batch, answers, tiles: tiles as usize, shade })
     }
 
     /// Whether `tiles` are counted with the GPU's culling: this counter and scene have it, and
@@ -148,12 +162,26 @@ impl Counter {
         self.culls_on_gpu(scene)
     }
 
-    /// Records the culling pass for `batch` (tile `slot` is view `slot`), its pairs needed copied
-    /// to word `at` of the scene's `needed`.
-    pub(super) fn encode_gpu_cull(&self, encoder: &mut wgpu::CommandEncoder, pulled: &PulledScene, batch: &[Tile], at: usize) {
+    /// Records the culling pass and the shading test for `batch` (tile `slot` is view `slot`),
+    /// the `at`th batch of its readback chunk: its pairs needed copied to word `at` of the
+    /// scene's `answers`, its verdicts to its place after them.
+    pub(super) fn encode_gpu_cull(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        pulled: &PulledScene,
+        requests: &[ViewRequest],
+        batch: &[Tile],
+        at: usize,
+    ) {
         let views: Vec<glam::DMat4> = batch.iter().map(|t| t.view.view_proj).collect();
         pulled.clusters.encode_view_cull(self, encoder, &pulled.batch, &views, 3 * CLUSTER_TRIANGLES);
-        encoder.copy_buffer_to_buffer(&pulled.batch.args, 16, &pulled.needed, at as u64 * 4, 4);
+        encoder.copy_buffer_to_buffer(&pulled.batch.args, 16, &pulled.answers, at as u64 * 4, 4);
+        let (Some(shade), Some(pipelines)) = (pulled.shade.as_ref(), self.pulled.as_ref()) else { return };
+        let tests: Vec<ShadeTest> = batch.iter().map(|t| shade_test(&scene.layout, requests, &t.requests, &t.view)).collect();
+        shade.encode(self, &pipelines.shade, encoder, &tests);
+        let verdicts_at = 4 * (BATCHES_PER_READBACK + at * pulled.tiles) as u64;
+        encoder.copy_buffer_to_buffer(&shade.verdicts, 0, &pulled.answers, verdicts_at, 4 * batch.len() as u64);
     }
 
     /// Draws tile `slot`'s casters as the GPU's culling kept them: one indirect draw.

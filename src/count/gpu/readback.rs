@@ -9,6 +9,7 @@ use super::encode::Passes;
 use super::masks::{GpuPoints, MaskBatch, PointMask};
 use super::pipelines::COUNTS_PER_MEMBER;
 use super::plan::{Tile, tiles_at};
+use super::shade::ShadeVerdict;
 use super::{Counted, Counter, GpuScene};
 use crate::count::ViewRequest;
 use crate::error::{GpuError, Result};
@@ -107,8 +108,11 @@ impl Counter {
             self.note_rendered(scene, chunk);
             unpack(chunk, counts, side, out);
             self.stages.unpacking.fetch_add(unpacking.nanos(), Ordering::Relaxed);
-            self.settle_unshaded(scene, requests, chunk, out);
-            let overflowed = self.overflowed_batches(scene, chunk, per_batch).await?;
+            let answers = self.culling_answers(scene, chunk, per_batch).await?;
+            if let Some(answers) = answers.as_ref() {
+                self.settle_unshaded(scene, requests, chunk, answers, out);
+            }
+            let overflowed = answers.as_ref().map(|a| a.overflowed(chunk)).unwrap_or_default();
             if !overflowed.is_empty() {
                 let again = self.cull_again_on_cpu(scene, requests, &overflowed, out);
                 Box::pin(self.count_tiles(scene, requests, &again, side, out, None)).await?;
@@ -117,39 +121,50 @@ impl Counter {
         Ok(())
     }
 
-    /// The tiles of `chunk`'s batches (`per_batch` tiles each) whose GPU-culled pair list
-    /// overflowed: their scene pass drew nothing, so their counts are wrong and must be redone.
-    async fn overflowed_batches<'t>(&self, scene: &GpuScene, chunk: &'t [Tile], per_batch: usize) -> Result<Vec<&'t Tile>> {
-        let Some(pulled) = scene.pulled.as_ref().filter(|_| chunk.iter().any(|t| t.draws.is_none())) else { return Ok(Vec::new()) };
+    /// What the GPU's culling answered of `chunk`'s batches (`per_batch` tiles each): each
+    /// batch's pairs needed and each tile's shading verdict; `None` where no tile of `chunk` was
+    /// culled on the GPU.
+    async fn culling_answers(&self, scene: &GpuScene, chunk: &[Tile], per_batch: usize) -> Result<Option<CullingAnswers>> {
+        let Some(pulled) = scene.pulled.as_ref().filter(|_| chunk.iter().any(|t| t.draws.is_none())) else { return Ok(None) };
         let batches = chunk.len().div_ceil(per_batch);
-        let bytes = platform::read_buffer(&self.device, &pulled.needed, batches as u64 * 4).await;
-        self.check_errors("reading the GPU culling's pairs needed")?;
+        let words = BATCHES_PER_READBACK + batches.saturating_sub(1) * pulled.tiles + (chunk.len() - (batches - 1) * per_batch);
+        let bytes = platform::read_buffer(&self.device, &pulled.answers, words as u64 * 4).await;
+        self.check_errors("reading the GPU culling's answers")?;
         let bytes = bytes?;
-        let needed: &[u32] = bytemuck::try_cast_slice(&bytes).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
-        let capacity = pulled.batch.capacity;
-        let over = needed.iter().zip(chunk.chunks(per_batch)).filter(|(n, _)| **n > capacity);
-        let tiles: Vec<&Tile> = over
-            .flat_map(|(n, batch)| {
-                log::info!("GPU culling: {n} pairs needed, {capacity} held; counting the batch again with the CPU's culling");
-                batch.iter()
-            })
-            .collect();
-        Ok(tiles)
+        let words: &[u32] = bytemuck::try_cast_slice(&bytes).map_err(|e| GpuError::Readback(format!("bad readback: {e}")))?;
+        let (needed, verdicts) = words.split_at(BATCHES_PER_READBACK);
+        let verdicts = Counter::shades_on_gpu(scene)
+            .then(|| (0..chunk.len()).map(|k| ShadeVerdict::from_word(verdicts[(k / per_batch) * pulled.tiles + k % per_batch])).collect());
+        Ok(Some(CullingAnswers { needed: needed[..batches].to_vec(), capacity: pulled.batch.capacity, per_batch, verdicts }))
     }
 
     /// Gives the GPU-culled tiles of `chunk` that nothing can shade fraction 1 without a
     /// render, as the CPU's culling does. The GPU's culling renders every tile, and at grazing
     /// suns a receiver's neighbour can take a pixel of its edge where nothing shades it; so each
-    /// such tile with a member not counted fully lit gets the CPU's shading test (the first
-    /// triangle that can shade ends it), and the counts stay the CPU path's exactly.
-    fn settle_unshaded(&self, scene: &GpuScene, requests: &[ViewRequest], chunk: &[Tile], out: &mut [Counted]) {
+    /// such tile with a member not counted fully lit is settled by the GPU's shading test
+    /// ([`super::shade`]), or where it could not decide (or did not run) by the CPU's (the
+    /// first triangle that can shade ends it): the counts stay the CPU path's exactly.
+    fn settle_unshaded(&self, scene: &GpuScene, requests: &[ViewRequest], chunk: &[Tile], answers: &CullingAnswers, out: &mut [Counted]) {
         let started = Stopwatch::start();
-        let not_lit = |t: &&Tile| t.draws.is_none() && t.requests.iter().any(|&i| out[i].visible < out[i].covered || out[i].covered == 0);
-        let unshaded: Vec<&Tile> =
-            chunk.iter().filter(not_lit).filter(|t| !super::plan::may_be_shaded(&scene.layout, requests, &t.requests, &t.view)).collect();
-        for tile in unshaded {
-            tile.requests.iter().for_each(|&i| out[i] = lit_without_render(out[i]));
+        let mut on_cpu = 0;
+        for (k, tile) in chunk.iter().enumerate() {
+            let not_lit = tile.draws.is_none() && tile.requests.iter().any(|&i| out[i].visible < out[i].covered || out[i].covered == 0);
+            if !not_lit {
+                continue;
+            }
+            let unshaded = match answers.verdicts.as_ref().map_or(ShadeVerdict::Undecided, |v| v[k]) {
+                ShadeVerdict::Nothing => true,
+                ShadeVerdict::Shaded => false,
+                ShadeVerdict::Undecided => {
+                    on_cpu += 1;
+                    !super::plan::may_be_shaded(&scene.layout, requests, &tile.requests, &tile.view)
+                }
+            };
+            if unshaded {
+                tile.requests.iter().for_each(|&i| out[i] = lit_without_render(out[i]));
+            }
         }
+        self.shading_on_cpu.fetch_add(on_cpu, Ordering::Relaxed);
         let nanos = started.nanos();
         self.stages.planning.fetch_add(nanos, Ordering::Relaxed);
         self.stages.culling.fetch_add(nanos, Ordering::Relaxed);
@@ -177,6 +192,31 @@ impl Counter {
         let drawn: usize = chunk.iter().filter_map(|t| t.draws.as_ref()).map(|d| d.triangles(&scene.layout.culling)).sum();
         self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
         self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
+    }
+}
+
+/// What the GPU's culling answered of a readback chunk.
+struct CullingAnswers {
+    /// Pairs each batch needed.
+    needed: Vec<u32>,
+    /// Pairs a batch's list holds.
+    capacity: u32,
+    per_batch: usize,
+    /// Each tile's shading verdict (`None`: the GPU did not test).
+    verdicts: Option<Vec<ShadeVerdict>>,
+}
+
+impl CullingAnswers {
+    /// The tiles of the chunk's batches whose pair list overflowed: their scene pass drew
+    /// nothing, so their counts are wrong and must be redone.
+    fn overflowed<'t>(&self, chunk: &'t [Tile]) -> Vec<&'t Tile> {
+        let capacity = self.capacity;
+        let over = self.needed.iter().zip(chunk.chunks(self.per_batch)).filter(|(n, _)| **n > capacity);
+        over.flat_map(|(n, batch)| {
+            log::info!("GPU culling: {n} pairs needed, {capacity} held; counting the batch again with the CPU's culling");
+            batch.iter()
+        })
+        .collect()
     }
 }
 
