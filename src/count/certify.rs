@@ -36,6 +36,7 @@
 //! the receiver, seen edge-on (its projection has no area) or see-through never proves a step
 //! dark; it only stops a step being proved lit.
 
+mod cells;
 pub mod cone;
 mod never_dark;
 
@@ -118,6 +119,18 @@ struct Shape {
     outline: Option<Outline>,
 }
 
+/// Whether the receiver has points and every one of `suns` is up and in front of it, as the
+/// year's steps are.
+fn up_and_in_front(shape: &Shape, suns: &[DVec3]) -> bool {
+    !shape.points.is_empty() && suns.iter().all(|s| s.z >= MIN_COS_INCIDENCE && s.dot(shape.normal) > MIN_COS_INCIDENCE)
+}
+
+/// Whether the whole cone, not just the suns it was built on, lies in front of the receiver and
+/// above the horizon (every proof assumes both).
+fn in_front(shape: &Shape, cone: &DirectionCone) -> bool {
+    cone.generators().iter().all(|g| g.dot(shape.normal) > 0.0 && g.z > 0.0)
+}
+
 /// The exact engine's index of the scene: the certifier's own, or one an engine built.
 enum Index<'a> {
     Own(Box<ExactEngine>),
@@ -182,16 +195,12 @@ impl<'a> Certifier<'a> {
     /// The receiver's shape and a cone holding `suns`, where a proof may be looked for: every
     /// sun up and in front of the receiver, and so the whole cone.
     fn cone_of(&self, receiver: usize, suns: &[DVec3]) -> Option<(&Shape, DirectionCone)> {
-        let shape = self.shapes.get(receiver).filter(|s| !s.points.is_empty())?;
-        if suns.iter().any(|s| s.z < MIN_COS_INCIDENCE || s.dot(shape.normal) <= MIN_COS_INCIDENCE) {
+        let shape = self.shapes.get(receiver)?;
+        if !up_and_in_front(shape, suns) {
             return None;
         }
         let cone = DirectionCone::enclosing(suns)?;
-        // The whole cone in front of the receiver and above the horizon, not just its suns.
-        if cone.generators().iter().any(|g| g.dot(shape.normal) <= 0.0 || g.z <= 0.0) {
-            return None;
-        }
-        Some((shape, cone))
+        in_front(shape, &cone).then_some((shape, cone))
     }
 
     /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither

@@ -12,7 +12,7 @@
 //! of shadow between the samples may take a lit cell's receiver wholly dark for a step (a tall
 //! block passing the sun in a street canyon), which no rule on the samples can see. A step is
 //! interpolated only where some patch of its receiver is proved lit at its sun
-//! ([`Certifier::unproved_lit`]); the rest are counted, so no dark step is ever interpolated as
+//! ([`Certifier::unproved_lit_in_cells`]); the rest are counted, so no dark step is ever interpolated as
 //! lit.
 
 use glam::DVec3;
@@ -64,27 +64,32 @@ const SMOOTH_BATCH: usize = 1 << 18;
 
 /// The interpolated steps of `smooth` whose receiver is not proved partly lit at their sun
 /// (`sun_of` gives a row's sun and calendar day), as steps to count. The steps of one receiver
-/// in one cell are proved together, then in halves where the whole fails.
+/// and fitted piece are proved together, cell by cell in order of their days and times of day:
+/// runs of neighbouring cells at once, then single cells, then halves of a cell
+/// ([`Certifier::unproved_lit_in_cells`]).
 pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of: &dyn Fn(usize) -> (DVec3, f64)) -> Vec<Rough> {
     smooth.sort_by_key(|s| (s.regime, s.fit, s.at, s.row));
-    let cells: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit, a.at) == (b.regime, b.fit, b.at)).collect();
+    let pieces: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit) == (b.regime, b.fit)).collect();
     let mut out = Vec::new();
     let mut start = 0;
-    while start < cells.len() {
-        // Whole cells per batch, up to about SMOOTH_BATCH steps.
+    while start < pieces.len() {
+        // Whole pieces per batch, up to about SMOOTH_BATCH steps.
         let mut end = start;
         let mut steps = 0;
-        while end < cells.len() && (end == start || steps + cells[end].len() <= SMOOTH_BATCH) {
-            steps += cells[end].len();
+        while end < pieces.len() && (end == start || steps + pieces[end].len() <= SMOOTH_BATCH) {
+            steps += pieces[end].len();
             end += 1;
         }
-        let batch = &cells[start..end];
-        let suns: Vec<Vec<(DVec3, f64)>> = batch.iter().map(|c| c.iter().map(|s| sun_of(s.row as usize)).collect()).collect();
-        let directions: Vec<Vec<DVec3>> = suns.iter().map(|c| c.iter().map(|s| s.0).collect()).collect();
-        let sets: Vec<(usize, &[DVec3])> = batch.iter().zip(&directions).map(|(c, d)| (c[0].column as usize, d.as_slice())).collect();
-        for ((cell, suns), unproved) in batch.iter().zip(&suns).zip(certifier.unproved_lit(&sets)) {
+        let batch = &pieces[start..end];
+        let suns: Vec<Vec<(DVec3, f64)>> = batch.iter().map(|p| p.iter().map(|s| sun_of(s.row as usize)).collect()).collect();
+        let directions: Vec<Vec<DVec3>> = suns.iter().map(|p| p.iter().map(|s| s.0).collect()).collect();
+        // Where each cell starts among its piece's steps.
+        let starts: Vec<Vec<usize>> = batch.iter().map(|p| (0..p.len()).filter(|&i| i == 0 || p[i].at != p[i - 1].at).collect()).collect();
+        let sets: Vec<(usize, &[DVec3], &[usize])> =
+            batch.iter().zip(&directions).zip(&starts).map(|((p, d), c)| (p[0].column as usize, d.as_slice(), c.as_slice())).collect();
+        for ((piece, suns), unproved) in batch.iter().zip(&suns).zip(certifier.unproved_lit_in_cells(&sets)) {
             out.extend(unproved.into_iter().map(|k| {
-                let s = cell[k];
+                let s = piece[k];
                 let (sun, day) = suns[k];
                 let key = (usize::from(s.regime), s.fit as usize, usize::from(s.at.0), usize::from(s.at.1));
                 Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0) }

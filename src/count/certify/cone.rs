@@ -49,8 +49,52 @@ impl DirectionCone {
         let (u, v) = perpendicular_basis(axis);
         let diamond = [DVec2::X, -DVec2::X, DVec2::Y, -DVec2::Y].map(|o| o * MARGIN);
         let points: Vec<DVec2> = units.iter().flat_map(|d| diamond.map(|o| chart(*d, axis, u, v) + o)).collect();
-        let hull = without_short_edges(convex_hull(&points), 0.5 * MARGIN);
-        if hull.len() < 3 {
+        Self::of_polygon(axis, u, v, convex_hull(&points))
+    }
+
+    /// A cone holding every direction of `directions` at least [`MARGIN`] inside (up to the
+    /// dropped short edges' slivers, as [`Self::enclosing`]), with at most eight generators: in
+    /// the chart, the octagon bounded by the points' least and greatest extent along four
+    /// directions 45° apart, each pushed out by [`MARGIN`]. Looser than the hull, but built
+    /// without sorting, and a footprint over it is taken from eight generators however many
+    /// directions it holds: for the long runs of a receiver's suns (a day's arc, many days).
+    /// None as for [`Self::enclosing`].
+    pub fn bounding(directions: &[DVec3]) -> Option<Self> {
+        let units: Vec<DVec3> = directions.iter().map(|d| d.try_normalize()).collect::<Option<_>>()?;
+        let axis = units.iter().copied().sum::<DVec3>().try_normalize()?;
+        if units.iter().any(|d| d.dot(axis) < MIN_COS_AXIS) {
+            return None;
+        }
+        let (u, v) = perpendicular_basis(axis);
+        let normals = [
+            DVec2::X,
+            DVec2::new(1.0, 1.0) * std::f64::consts::FRAC_1_SQRT_2,
+            DVec2::Y,
+            DVec2::new(-1.0, 1.0) * std::f64::consts::FRAC_1_SQRT_2,
+        ];
+        let mut extent = [(f64::INFINITY, f64::NEG_INFINITY); 4];
+        for d in &units {
+            let q = chart(*d, axis, u, v);
+            for (e, n) in extent.iter_mut().zip(normals) {
+                let t = q.dot(n);
+                *e = (e.0.min(t), e.1.max(t));
+            }
+        }
+        // Each direction's chart point is MARGIN inside every half-plane, so MARGIN inside the
+        // octagon. The big square clipped down to it: every chart point lies within 1 / 0.25
+        // (MIN_COS_AXIS) of the origin.
+        let mut polygon = vec![DVec2::new(-8.0, -8.0), DVec2::new(8.0, -8.0), DVec2::new(8.0, 8.0), DVec2::new(-8.0, 8.0)];
+        for (n, (lo, hi)) in normals.into_iter().zip(extent) {
+            polygon = clip(&polygon, n, hi + MARGIN);
+            polygon = clip(&polygon, -n, -(lo - MARGIN));
+        }
+        Self::of_polygon(axis, u, v, polygon)
+    }
+
+    /// The cone over a convex chart polygon (counter-clockwise) about `axis` in the frame `u, v`.
+    fn of_polygon(axis: DVec3, u: DVec3, v: DVec3, polygon: Vec<DVec2>) -> Option<Self> {
+        let hull = without_short_edges(polygon, 0.5 * MARGIN);
+        if hull.len() < 3 || hull.iter().any(|q| !q.is_finite()) {
             return None;
         }
         let lift = |q: DVec2| q.x * u + q.y * v;
@@ -114,6 +158,23 @@ fn without_short_edges(polygon: Vec<DVec2>, shortest: f64) -> Vec<DVec2> {
     }
     while out.len() > 1 && out[out.len() - 1].distance(out[0]) < shortest {
         out.pop();
+    }
+    out
+}
+
+/// The part of the convex `polygon` (counter-clockwise) where `q · n ≤ limit`: still convex and
+/// counter-clockwise.
+fn clip(polygon: &[DVec2], n: DVec2, limit: f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (k, a) in polygon.iter().enumerate() {
+        let b = polygon[(k + 1) % polygon.len()];
+        let (da, db) = (a.dot(n) - limit, b.dot(n) - limit);
+        if da <= 0.0 {
+            out.push(*a);
+        }
+        if (da <= 0.0) != (db <= 0.0) {
+            out.push(*a + (b - *a) * (da / (da - db)));
+        }
     }
     out
 }

@@ -24,10 +24,11 @@
 
 use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{DVec2, DVec3};
 
-use super::{CHUNK, COVER_MARGIN, Certifier, DirectionCone, MAX_SWEPT, NEAR_REACH, PLANE_TOLERANCE};
+use super::{CHUNK, COVER_MARGIN, Certifier, DirectionCone, MAX_SWEPT, NEAR_REACH, PLANE_TOLERANCE, Shape};
 use crate::count::exact::engine::{parallel_chunks, worker_threads};
 use crate::count::view::{self, convex_hull};
 use crate::scene::NO_RECEIVER;
@@ -69,7 +70,10 @@ pub(super) struct Outline {
 /// polygon (counter-clockwise; one or two points where it has no area), with its bounds.
 #[derive(Debug)]
 struct Footprint {
-    hull: Vec<DVec2>,
+    /// Points whose convex hull it is; the hull is built when first needed (most casters a
+    /// candidate disc's volume reaches are ruled out by their bounds alone).
+    points: Vec<DVec2>,
+    hull: std::cell::OnceCell<Vec<DVec2>>,
     lo: DVec2,
     hi: DVec2,
     slack: f64,
@@ -88,11 +92,55 @@ struct Onto {
 #[derive(Default)]
 struct Seen {
     /// Convex casters, by object.
-    casters: HashSet<u32>,
+    casters: IntSet<u32>,
     /// Convex casters with a corner behind the receiver's plane: taken triangle by triangle.
-    straddling: HashSet<u32>,
+    straddling: IntSet<u32>,
     /// Triangles taken one by one (not convex, or of a straddling caster), by position.
-    triangles: HashSet<usize>,
+    triangles: IntSet<usize>,
+}
+
+/// A set of small integer keys (objects, triangle positions) hashed by one multiplication:
+/// with the default SipHash its look-ups took a few per cent of a proof's time.
+type IntSet<T> = HashSet<T, BuildHasherDefault<IntHasher>>;
+
+/// See [`IntSet`]: the keys need no defence against chosen collisions.
+#[derive(Default)]
+struct IntHasher(u64);
+
+impl Hasher for IntHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.write_u64(u64::from(*b));
+        }
+    }
+
+    fn write_u32(&mut self, n: u32) {
+        self.write_u64(u64::from(n));
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+
+    fn write_usize(&mut self, n: usize) {
+        self.write_u64(n as u64);
+    }
+}
+
+/// What one never-dark search hands the next, over nearby suns of the same receiver: the
+/// casters near the receiver, and the centre of the last disc proved lit. Both only guide the
+/// search.
+#[derive(Debug, Default)]
+pub(super) struct Hints {
+    pub(super) near: Option<Vec<usize>>,
+    disc: Option<DVec2>,
+    /// Runs of several cells proved and not ([`super::cells`]).
+    pub(super) runs_proved: usize,
+    pub(super) runs_failed: usize,
 }
 
 /// A bit-exact key of a point, for matching edges.
@@ -166,7 +214,14 @@ impl Outline {
     /// plane); None where `t` lies on or behind the plane (within `tolerance`), as both engines
     /// ignore it, or where the footprint stays `r` or more outside the polygon's bounds
     /// ([`Self::footprint_of`]).
+    #[cfg(test)]
     fn footprint(&self, t: &[DVec3; 3], onto: &Onto, tolerance: f64, r: f64) -> Option<Footprint> {
+        self.footprint_near(t, onto, tolerance, r, (self.lo, self.hi))
+    }
+
+    /// [`Self::footprint`], left out where it stays `r` off the box `near` (the polygon's
+    /// bounds, or one disc's centre).
+    fn footprint_near(&self, t: &[DVec3; 3], onto: &Onto, tolerance: f64, r: f64, near: (DVec2, DVec2)) -> Option<Footprint> {
         let h = t.map(|p| (p - self.origin).dot(self.normal));
         if h.iter().all(|x| *x <= tolerance) {
             return None;
@@ -185,7 +240,7 @@ impl Outline {
                 n += 1;
             }
         }
-        self.footprint_of(&front[..n], onto, r)
+        self.footprint_of(&front[..n], onto, r, near)
     }
 
     /// The footprint over the cone of a whole convex caster whose `corners` all lie on or in
@@ -196,7 +251,20 @@ impl Outline {
     /// thousands. None where it has no part in front (within `tolerance`), or where some
     /// corner lies behind the plane (its triangles are then taken one by one), or where it stays
     /// `r` off the polygon's bounds.
+    #[cfg(test)]
     fn caster_footprint(&self, corners: &[DVec3], onto: &Onto, tolerance: f64, r: f64) -> Option<Option<Footprint>> {
+        self.caster_footprint_near(corners, onto, tolerance, r, (self.lo, self.hi))
+    }
+
+    /// [`Self::caster_footprint`], left out where it stays `r` off the box `near`.
+    fn caster_footprint_near(
+        &self,
+        corners: &[DVec3],
+        onto: &Onto,
+        tolerance: f64,
+        r: f64,
+        near: (DVec2, DVec2),
+    ) -> Option<Option<Footprint>> {
         let front: Vec<(DVec3, f64)> = corners.iter().map(|p| (*p, (*p - self.origin).dot(self.normal))).collect();
         if front.iter().any(|(_, h)| *h < 0.0 || h.is_nan()) {
             return None;
@@ -204,7 +272,7 @@ impl Outline {
         if front.iter().all(|(_, h)| *h <= tolerance) {
             return Some(None);
         }
-        Some(self.footprint_of(&front, onto, r))
+        Some(self.footprint_of(&front, onto, r, near))
     }
 
     /// The footprint over the cone of the convex hull of `front` (points on or in front of the
@@ -212,7 +280,7 @@ impl Outline {
     /// so that no disc of radius `r` on the polygon is near it: its hull is then never built.
     /// Most casters a swept volume reaches in a city are such (the culling is a box about the
     /// volume, and a scrim's rods above and below the window pass their shadows past its bounds).
-    fn footprint_of(&self, front: &[(DVec3, f64)], onto: &Onto, r: f64) -> Option<Footprint> {
+    fn footprint_of(&self, front: &[(DVec3, f64)], onto: &Onto, r: f64, near: (DVec2, DVec2)) -> Option<Footprint> {
         // Along the axis alone, each corner moves at most `slack` from where a direction of the
         // cone would take it (the scaled directions are convex combinations of the scaled
         // generators). So a footprint whose corners moved along the axis stay `slack + r` off
@@ -221,23 +289,24 @@ impl Outline {
         let slack = highest * onto.spread;
         let along_axis: Vec<DVec2> = front.iter().map(|(p, hp)| self.flat(*p - onto.axis * *hp)).collect();
         let (lo, hi) = bounds(&along_axis);
-        if !(lo.is_finite() && hi.is_finite()) || self.apart(lo, hi, r + slack) {
+        if !(lo.is_finite() && hi.is_finite()) || apart(near, lo, hi, r + slack) {
             return None;
         }
         // Where the slack is small (a short run of suns) the footprint is the corners moved
         // along the axis, dilated by it; else the hull over every generator.
         if slack <= SLACK_SHARE * self.radius {
-            return Some(Footprint { hull: convex_hull(&along_axis), lo, hi, slack });
+            return Some(Footprint::new(along_axis, lo, hi, slack));
         }
         let moved: Vec<DVec2> = onto.generators.iter().flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - *g * *hp))).collect();
         // The hull's bounds are the moved corners' bounds.
         let (lo, hi) = bounds(&moved);
-        (!self.apart(lo, hi, r)).then(|| Footprint { hull: convex_hull(&moved), lo, hi, slack: 0.0 })
+        (!apart(near, lo, hi, r)).then(|| Footprint::new(moved, lo, hi, 0.0))
     }
 
     /// Whether the box `lo..hi` lies more than `reach` outside the polygon's bounds.
+    #[cfg(test)]
     fn apart(&self, lo: DVec2, hi: DVec2, reach: f64) -> bool {
-        lo.x > self.hi.x + reach || lo.y > self.hi.y + reach || hi.x < self.lo.x - reach || hi.y < self.lo.y - reach
+        apart((self.lo, self.hi), lo, hi, reach)
     }
 
     /// Whether `q` lies inside the polygon (even-odd rule over the boundary edges).
@@ -313,15 +382,25 @@ impl Outline {
 }
 
 impl Footprint {
+    fn new(points: Vec<DVec2>, lo: DVec2, hi: DVec2, slack: f64) -> Self {
+        Self { points, hull: std::cell::OnceCell::new(), lo, hi, slack }
+    }
+
+    /// The convex polygon, counter-clockwise (one or two points where it has no area).
+    fn hull(&self) -> &[DVec2] {
+        self.hull.get_or_init(|| convex_hull(&self.points))
+    }
+
     /// Whether `q` is at least `r` from the footprint.
     fn distance_at_least(&self, q: DVec2, r: f64) -> bool {
         let r = r + self.slack;
         if q.x < self.lo.x - r || q.x > self.hi.x + r || q.y < self.lo.y - r || q.y > self.hi.y + r {
             return true;
         }
-        let n = self.hull.len();
-        let inside = n >= 3 && (0..n).all(|k| (self.hull[(k + 1) % n] - self.hull[k]).perp_dot(q - self.hull[k]) >= 0.0);
-        !inside && (0..n).all(|k| segment_distance(q, self.hull[k], self.hull[(k + 1) % n]) >= r)
+        let hull = self.hull();
+        let n = hull.len();
+        let inside = n >= 3 && (0..n).all(|k| (hull[(k + 1) % n] - hull[k]).perp_dot(q - hull[k]) >= 0.0);
+        !inside && (0..n).all(|k| segment_distance(q, hull[k], hull[(k + 1) % n]) >= r)
     }
 
     /// The parameters along `o + t·d` (d a unit axis) within `r` of the footprint: one interval,
@@ -334,9 +413,15 @@ impl Footprint {
         if lo.min(hi) > r || lo.max(hi) < -r {
             return None;
         }
-        let n = self.hull.len();
-        (0..n).filter_map(|k| capsule_interval(o, d, self.hull[k], self.hull[(k + 1) % n], r)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+        let hull = self.hull();
+        let n = hull.len();
+        (0..n).filter_map(|k| capsule_interval(o, d, hull[k], hull[(k + 1) % n], r)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
     }
+}
+
+/// Whether the box `lo..hi` lies more than `reach` outside the box `near`.
+fn apart(near: (DVec2, DVec2), lo: DVec2, hi: DVec2, reach: f64) -> bool {
+    lo.x > near.1.x + reach || lo.y > near.1.y + reach || hi.x < near.0.x - reach || hi.y < near.0.y - reach
 }
 
 /// The bounds of `points`.
@@ -400,7 +485,7 @@ impl Certifier<'_> {
             || (),
             |i, _| {
                 let mut out = Vec::new();
-                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut None, &mut out);
+                self.bisect_not_dark(sets[i].0, sets[i].1, 0, &mut Hints::default(), &mut out);
                 out
             },
         )
@@ -408,10 +493,11 @@ impl Certifier<'_> {
 
     /// Pushes onto `out` the indices (from `first`) of `suns` not proved by [`Self::not_dark`],
     /// halving the set where the whole is not proved: a shorter stretch of the sun's path sweeps
-    /// thinner footprints, between which a disc may pass. `near`: the casters near the receiver
-    /// found for the first set tried, searched first in its halves too.
-    fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, near: &mut Option<Vec<usize>>, out: &mut Vec<usize>) {
-        if suns.is_empty() || self.not_dark_near(receiver, suns, near) {
+    /// thinner footprints, between which a disc may pass. `hints`: what the sets tried before
+    /// found (the casters near the receiver, the last disc proved lit), tried first in its
+    /// halves too.
+    pub(super) fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, hints: &mut Hints, out: &mut Vec<usize>) {
+        if suns.is_empty() || self.not_dark_near(receiver, suns, hints) {
             return;
         }
         if suns.len() == 1 {
@@ -419,33 +505,39 @@ impl Certifier<'_> {
             return;
         }
         let half = suns.len() / 2;
-        self.bisect_not_dark(receiver, &suns[..half], first, near, out);
-        self.bisect_not_dark(receiver, &suns[half..], first + half, near, out);
+        self.bisect_not_dark(receiver, &suns[..half], first, hints, out);
+        self.bisect_not_dark(receiver, &suns[half..], first + half, hints, out);
     }
 
     /// Whether some disc of the receiver holding [`MIN_LIT_SHARE`] of its area is lit at every
     /// one of `suns` (see the module's doc): its fraction is then above EnergyPlus's 1e-5 at
     /// each, never dark.
     pub fn not_dark(&self, receiver: usize, suns: &[DVec3]) -> bool {
-        self.not_dark_near(receiver, suns, &mut None)
+        self.not_dark_near(receiver, suns, &mut Hints::default())
     }
 
-    /// [`Self::not_dark`], the first candidate disc looked for among the casters `near` the
-    /// receiver (found here along these suns where None). Which casters those are only guides
-    /// the search: every caster in the volume the disc sweeps is checked.
-    fn not_dark_near(&self, receiver: usize, suns: &[DVec3], near: &mut Option<Vec<usize>>) -> bool {
+    /// [`Self::not_dark`] with the `hints` of the sets tried before.
+    fn not_dark_near(&self, receiver: usize, suns: &[DVec3], hints: &mut Hints) -> bool {
         let Some((shape, cone)) = self.cone_of(receiver, suns) else { return false };
+        self.not_dark_over(shape, &cone, hints)
+    }
+
+    /// Whether some disc of `shape` holding [`MIN_LIT_SHARE`] of its area is lit at every
+    /// direction of `cone` (every one in front of the receiver and above the horizon). The
+    /// first candidate disc is the last one `hints` proved, then one looked for among the
+    /// casters near the receiver (found here along the cone where the hints have none). Neither
+    /// hint decides anything: every caster in the volume the candidate disc sweeps is checked.
+    pub(super) fn not_dark_over(&self, shape: &Shape, cone: &DirectionCone, hints: &mut Hints) -> bool {
         let Some(outline) = &shape.outline else { return false };
         let tolerance = PLANE_TOLERANCE * (1.0 + self.extent);
         // The GPU rounds in f32 about the scene's origin: the disc keeps this much clear too.
         let r = outline.radius + COVER_MARGIN * (1.0 + self.extent);
-        let reach = self.reach(&cone);
-        let onto = outline.onto(&cone);
-        let mut seen = Seen::default();
+        let reach = self.reach(cone);
+        let onto = outline.onto(cone);
         let mut footprints = Vec::new();
         // Footprints of the fresh casters among `positions` that may come near a disc, and
         // which casters those were (one position each).
-        let mut add = |positions: &[usize], footprints: &mut Vec<Footprint>, kept: &mut Vec<usize>| {
+        let add = |positions: &[usize], footprints: &mut Vec<Footprint>, kept: &mut Vec<usize>, seen: &mut Seen, near: (DVec2, DVec2)| {
             let own = |p: usize| self.index.owner[p] == shape.gpu_id && shape.gpu_id != NO_RECEIVER;
             let start = footprints.len();
             for &p in positions {
@@ -460,12 +552,12 @@ impl Certifier<'_> {
                             continue;
                         }
                         let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c)).collect();
-                        match outline.caster_footprint(&corners, &onto, tolerance, r) {
+                        match outline.caster_footprint_near(&corners, &onto, tolerance, r, near) {
                             Some(footprint) => footprint,
                             None => {
                                 seen.straddling.insert(o);
                                 seen.triangles.insert(p);
-                                outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                                outline.footprint_near(&self.index.triangles[p], &onto, tolerance, r, near)
                             }
                         }
                     }
@@ -473,7 +565,7 @@ impl Certifier<'_> {
                         if !seen.triangles.insert(p) {
                             continue;
                         }
-                        outline.footprint(&self.index.triangles[p], &onto, tolerance, r)
+                        outline.footprint_near(&self.index.triangles[p], &onto, tolerance, r, near)
                     }
                 };
                 if let Some(f) = footprint {
@@ -483,23 +575,44 @@ impl Certifier<'_> {
             }
             start
         };
+        // The last disc proved lit first, against only what its own volume reaches, each caster
+        // stopping the check as soon as it comes near the disc (its footprint kept only near it).
+        let hinted = hints.disc.filter(|q| outline.clear(*q, r, &[]));
+        if let Some(found) = hinted.and_then(|q| Some((q, self.reached(&outline.square(q, r), cone, reach)?))) {
+            let (q, found) = found;
+            let (mut near_q, mut seen) = (Vec::new(), Seen::default());
+            let blocked = found.chunks(1).any(|p| {
+                let start = add(p, &mut near_q, &mut Vec::new(), &mut seen, (q, q));
+                near_q[start..].iter().any(|f| !f.distance_at_least(q, r))
+            });
+            if !blocked {
+                return true;
+            }
+        }
         // The casters near the receiver (a scrim's rods, a reveal) first, for a good candidate;
         // what the candidate's own volume holds decides. Found once per set, and only those
         // whose footprint came near the receiver are handed to its halves.
-        let (listed, first) = match near.take() {
+        let (listed, first) = match hints.near.take() {
             Some(listed) => (listed, false),
-            None => (self.reached(&shape.points, &cone, (NEAR_REACH * (1.0 + self.extent)).min(reach)).unwrap_or_default(), true),
+            None => (self.reached(&shape.points, cone, (NEAR_REACH * (1.0 + self.extent)).min(reach)).unwrap_or_default(), true),
         };
         let mut kept = Vec::new();
-        add(&listed, &mut footprints, &mut kept);
-        *near = Some(if first { kept } else { listed });
+        let mut seen = Seen::default();
+        let whole = (outline.lo, outline.hi);
+        add(&listed, &mut footprints, &mut kept, &mut seen, whole);
+        hints.near = Some(if first { kept } else { listed });
         for _ in 0..ROUNDS {
-            let Some(q) = outline.find(&footprints, r) else { return false };
-            let Some(found) = self.reached(&outline.square(q, r), &cone, reach) else { return false };
-            let start = add(&found, &mut footprints, &mut Vec::new());
+            // The disc that proved the last set, where it is still clear here; else a search.
+            let last = hints.disc.filter(|q| outline.clear(*q, r, &footprints));
+            let Some(q) = last.or_else(|| outline.find(&footprints, r)) else { return false };
+            let Some(found) = self.reached(&outline.square(q, r), cone, reach) else { return false };
+            let start = add(&found, &mut footprints, &mut Vec::new(), &mut seen, whole);
             if footprints[start..].iter().all(|f| f.distance_at_least(q, r)) {
+                hints.disc = Some(q);
                 return true;
             }
+            // Blocked: the next round searches again with what blocked it.
+            hints.disc = None;
         }
         false
     }
@@ -585,10 +698,11 @@ mod tests {
             let footprint =
                 outline.caster_footprint(&corners, &onto, 1e-9, outline.radius).expect("wholly in front").expect("near the window");
             assert_eq!(footprint.slack > 0.0, !wide, "the wide cone takes the generators' hull, the narrow one the axis's dilation");
-            let n = footprint.hull.len();
+            let hull = footprint.hull();
+            let n = hull.len();
             assert!(n >= 3, "a box's footprint has area");
             for k in 0..n {
-                let (a, b, c) = (footprint.hull[k], footprint.hull[(k + 1) % n], footprint.hull[(k + 2) % n]);
+                let (a, b, c) = (hull[k], hull[(k + 1) % n], hull[(k + 2) % n]);
                 assert!((b - a).perp_dot(c - b) > 0.0, "the footprint's hull turns right at {b}: not convex counter-clockwise");
             }
             // Every point of the box's surface (its faces sampled), along every sampled direction.

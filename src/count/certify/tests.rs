@@ -5,18 +5,18 @@ use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 
 /// A closed box [lo, hi], 12 triangles wound outward.
-fn block(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+pub(super) fn block(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
     let c = |i: u32| [[lo[0], hi[0]][(i & 1) as usize], [lo[1], hi[1]][(i >> 1 & 1) as usize], [lo[2], hi[2]][(i >> 2) as usize]];
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
 }
 
 /// A south-facing window (normal −y) at y = `y`, x in [x0, x1], z in [z0, z1].
-fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
+pub(super) fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
     SourceMesh { positions: vec![[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], indices: vec![0, 1, 2, 0, 2, 3] }
 }
 
-fn golden() -> Location {
+pub(super) fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
 }
 
@@ -66,7 +66,7 @@ fn a_block_proves_a_window_dark_and_an_empty_street_proves_it_lit() {
 }
 
 /// A reproducible uniform draw in [0, 1).
-fn random(mut seed: u64) -> impl FnMut() -> f64 {
+pub(super) fn random(mut seed: u64) -> impl FnMut() -> f64 {
     move || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (seed >> 11) as f64 / (1u64 << 53) as f64
