@@ -1,0 +1,186 @@
+//! The fast exact engine against the reference clipping, view by view.
+
+use super::*;
+use crate::scene::{SceneBuilder, SourceMesh, SourceNode};
+use glam::DMat4;
+
+/// A box [lo, hi] as 12 triangles, outward.
+fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+    open_cuboid(lo, hi, &[])
+}
+
+/// A box [lo, hi] without the faces whose outward normal is in `open` (±1, ±2, ±3 for ±x,
+/// ±y, ±z): a tube when two opposite faces are left out.
+fn open_cuboid(lo: [f32; 3], hi: [f32; 3], open: &[i32]) -> SourceMesh {
+    let c =
+        |i: u32| [if i & 1 == 0 { lo[0] } else { hi[0] }, if i & 2 == 0 { lo[1] } else { hi[1] }, if i & 4 == 0 { lo[2] } else { hi[2] }];
+    let quads: [([u32; 4], i32); 6] =
+        [([0, 2, 3, 1], -3), ([4, 5, 7, 6], 3), ([0, 1, 5, 4], -2), ([2, 6, 7, 3], 2), ([0, 4, 6, 2], -1), ([1, 3, 7, 5], 1)];
+    SourceMesh {
+        positions: (0..8).map(c).collect(),
+        indices: quads.iter().filter(|(_, n)| !open.contains(n)).flat_map(|(q, _)| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect(),
+    }
+}
+
+fn wall() -> SourceMesh {
+    SourceMesh { positions: vec![[0., 0., 0.], [4., 0., 0.], [4., 0., 3.], [0., 0., 3.]], indices: vec![0, 1, 2, 0, 2, 3] }
+}
+
+/// A south wall under 40 instanced slats and some baked boxes, one straddling the wall's plane.
+fn louvred_wall() -> Scene {
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WALL", wall(), true);
+    b.add_object("test", "BOX", cuboid([1.0, -1.0, 2.0], [1.5, -0.5, 2.4]), false);
+    b.add_object("test", "THROUGH", cuboid([2.5, -0.4, 1.0], [3.0, 0.3, 1.2]), false);
+    let slat = b.add_mesh("slat", cuboid([-0.5, -0.3, 0.0], [4.5, -0.1, 0.04]));
+    for k in 0..40 {
+        let transform = DMat4::from_translation(DVec3::new(0.0, 0.0, 0.075 * k as f64));
+        let name = format!("S{k}");
+        b.add_node(SourceNode { origin: name.clone(), name, mesh: slat, transform, receiver: false });
+    }
+    b.build().unwrap()
+}
+
+#[test]
+fn the_fast_engine_agrees_with_the_reference() {
+    let scene = louvred_wall();
+    let engine = ExactEngine::new(&scene);
+    assert_eq!(engine.convex_objects(), 1 + 2 + 40, "the wall (flat, it shades other receivers), two boxes, the slats");
+    let mut requests = Vec::new();
+    for az in [120.0f64, 150.0, 180.0, 200.0, 240.0] {
+        for alt in [5.0f64, 20.0, 35.0, 60.0] {
+            let (a, h) = (az.to_radians(), alt.to_radians());
+            requests.push(ViewRequest::new(0, DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin())));
+        }
+    }
+    let fast = engine.fractions(&requests);
+    let reference = super::super::sunlit_fractions(&scene, &requests);
+    let mut partly = 0;
+    for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+        assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+        partly += usize::from(*r > 0.01 && *r < 0.99);
+    }
+    assert!(partly >= 10, "only {partly} views partly shaded");
+}
+
+/// A roof under upright square tubes (both ends open), one of them through the roof's plane,
+/// and a cup (a box open at the bottom).
+fn tubes_over_a_roof() -> Scene {
+    let roof = SourceMesh { positions: vec![[0., 0., 0.], [4., 0., 0.], [4., 3., 0.], [0., 3., 0.]], indices: vec![0, 1, 2, 0, 2, 3] };
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "ROOF", roof, true);
+    b.add_object("test", "TUBE", open_cuboid([0.5, 1.0, 0.5], [1.1, 1.6, 2.0], &[-3, 3]), false);
+    b.add_object("test", "THROUGH", open_cuboid([2.0, 0.5, -0.5], [2.4, 0.9, 1.0], &[-3, 3]), false);
+    b.add_object("test", "CUP", open_cuboid([2.8, 1.8, 0.9], [3.4, 2.4, 1.5], &[-3]), false);
+    b.build().unwrap()
+}
+
+#[test]
+fn open_tubes_cast_their_hull_unless_the_sun_looks_down_their_bore() {
+    let scene = tubes_over_a_roof();
+    let engine = ExactEngine::new(&scene);
+    assert_eq!(engine.convex_objects(), 4, "the roof, the tubes and the cup are each one object");
+    let sun = |az: f64, alt: f64| {
+        let (a, h) = (az.to_radians(), alt.to_radians());
+        DVec3::new(h.cos() * a.sin(), h.cos() * a.cos(), h.sin())
+    };
+    // Straight down the bores (the tubes' sides are edge-on: only the cup shades), just off
+    // them (light through part of each bore) and well off them (the hull is the shadow).
+    let mut suns = vec![DVec3::Z];
+    for az in [0.0f64, 45.0, 100.0, 180.0, 250.0] {
+        for alt in [89.5f64, 87.0, 80.0, 72.0, 70.0, 60.0, 30.0] {
+            suns.push(sun(az, alt));
+        }
+    }
+    let requests: Vec<ViewRequest> = suns.iter().map(|&s| ViewRequest::new(0, s)).collect();
+    let fast = engine.fractions(&requests);
+    let reference = super::super::sunlit_fractions(&scene, &requests);
+    for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+        assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+    }
+    let cup = 0.6 * 0.6 / 12.0;
+    assert!((fast[0] - (1.0 - cup)).abs() < 1e-6, "overhead only the cup shades: {}", fast[0]);
+    let partly = reference.iter().filter(|r| **r > 0.01 && **r < 0.99).count();
+    assert!(partly >= 20, "only {partly} views partly shaded");
+}
+
+/// An open prism of `sides` faces around `axis` (no end faces), centred at `centre`.
+fn open_prism(centre: DVec3, axis: DVec3, length: f64, radius: f64, sides: usize) -> SourceMesh {
+    let u = axis.any_orthonormal_vector();
+    let v = axis.cross(u);
+    let ring = |k: usize, end: f64| {
+        let a = std::f64::consts::TAU * k as f64 / sides as f64;
+        let p = centre + (u * a.cos() + v * a.sin()) * radius + axis * (end * 0.5 * length);
+        p.as_vec3().to_array()
+    };
+    let positions: Vec<[f32; 3]> = (0..sides).flat_map(|k| [ring(k, -1.0), ring(k, 1.0)]).collect();
+    let indices = (0..sides as u32)
+        .flat_map(|k| {
+            let (a0, a1, b0, b1) = (2 * k, 2 * k + 1, 2 * ((k + 1) % sides as u32), 2 * ((k + 1) % sides as u32) + 1);
+            [a0, b0, b1, a0, b1, a1]
+        })
+        .collect();
+    SourceMesh { positions, indices }
+}
+
+#[test]
+fn random_open_prisms_agree_with_the_reference() {
+    // A small deterministic generator (SplitMix64), so a failure can be replayed.
+    let mut state = 0x5eed_u64;
+    let mut random = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WALL", wall(), true);
+    for k in 0..40 {
+        // Axes from any direction, a third of them nearly along the wall's normal (so some
+        // suns look down their bores); a few reach through the wall's plane.
+        let mut axis = DVec3::new(random() - 0.5, random() - 0.5, random() - 0.5).normalize();
+        if k % 3 == 0 {
+            axis = (DVec3::new(0.0, -1.0, 0.0) + 0.2 * axis).normalize();
+        }
+        let centre = DVec3::new(4.0 * random(), -0.1 - 1.5 * random(), 3.0 * random());
+        let sides = [3, 4, 6][k % 3];
+        let mesh = open_prism(centre, axis, 0.3 + 1.2 * random(), 0.05 + 0.2 * random(), sides);
+        b.add_object("test", &format!("PRISM{k}"), mesh, false);
+    }
+    let scene = b.build().unwrap();
+    let engine = ExactEngine::new(&scene);
+    assert_eq!(engine.convex_objects(), 41, "every prism is one object");
+    let mut requests = Vec::new();
+    for _ in 0..60 {
+        let (az, alt) = ((100.0 + 160.0 * random()).to_radians(), (2.0 + 80.0 * random()).to_radians());
+        requests.push(ViewRequest::new(0, DVec3::new(alt.cos() * az.sin(), alt.cos() * az.cos(), alt.sin())));
+    }
+    // And straight along the wall's normal, down the near-normal bores.
+    requests.push(ViewRequest::new(0, DVec3::new(0.0, -1.0, 0.02).normalize()));
+    let fast = engine.fractions(&requests);
+    let reference = super::super::sunlit_fractions(&scene, &requests);
+    for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+        assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+    }
+    let partly = reference.iter().filter(|r| **r > 0.01 && **r < 0.99).count();
+    assert!(partly >= 40, "only {partly} views partly shaded");
+}
+
+#[test]
+fn convex_polygons_overlap_unless_an_edge_separates_them() {
+    let square = |x: f64, y: f64| [DVec2::new(x, y), DVec2::new(x + 1.0, y), DVec2::new(x + 1.0, y + 1.0), DVec2::new(x, y + 1.0)];
+    let mut clockwise = square(0.5, 0.5);
+    clockwise.reverse();
+    assert!(convex_overlap(&square(0.0, 0.0), &clockwise));
+    assert!(!convex_overlap(&square(0.0, 0.0), &square(1.0, 0.0)), "touching along an edge");
+    assert!(!convex_overlap(&square(0.0, 0.0), &square(1.0, 1.0)), "touching at a corner");
+    // Separated only by a diagonal: an edge of the triangle.
+    let triangle = [DVec2::new(1.2, 0.0), DVec2::new(0.0, 1.2), DVec2::new(1.2, 1.2)];
+    assert!(convex_overlap(&square(0.0, 0.0), &triangle));
+    let far = [DVec2::new(2.05, 0.0), DVec2::new(0.0, 2.05), DVec2::new(2.05, 2.05)];
+    assert!(!convex_overlap(&square(0.0, 0.0), &far));
+    // A flattened cap (the sun in its plane) across the other is reported as overlapping.
+    let flat = [DVec2::new(-1.0, 0.5), DVec2::new(2.0, 0.5), DVec2::new(2.0, 0.5)];
+    assert!(convex_overlap(&square(0.0, 0.0), &flat));
+}
