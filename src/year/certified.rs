@@ -174,9 +174,14 @@ pub(super) fn certify_steps(
         (sun_direction(location, shading_sun_day(instant.day), instant.hour), f64::from(instant.day))
     };
     let unproved = never_dark(&certifier, smooth, &sun_of);
+    // Without the never-dark proof no interpolated step is handed over: say nothing of them then.
+    let proof = if interpolated == 0 {
+        String::new()
+    } else {
+        format!("; of {interpolated} interpolated, {} not proved never dark", unproved.len())
+    };
     log::info!(
-        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit; of {interpolated} interpolated, {} not proved never dark; {} counted",
-        unproved.len(),
+        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit{proof}; {} counted",
         rest.len() + unproved.len()
     );
     rest.extend(unproved);
