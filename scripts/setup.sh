@@ -54,9 +54,10 @@ fi
 
 # npm devDependencies: playwright-core (the browser tests; it uses Debian's Chromium, never
 # downloads one), @gltf-transform/cli and gltf-validator (tests/gltf_variants.rs makes glTF
-# variants with the first and checks sunlit's glb output with the second).
+# variants with the first and checks sunlit's glb output with the second), and webgpu (Dawn for
+# Node: tests/node/ runs the wasm bundle and the JS API on it; prebuilt, nothing compiled).
 if command -v npm >/dev/null; then
-  for package in playwright-core @gltf-transform/cli gltf-validator; do
+  for package in playwright-core @gltf-transform/cli gltf-validator webgpu; do
     if [ ! -d "node_modules/$package" ]; then
       say "installing the npm devDependencies (npm ci: $package is missing)"
       npm ci --silent --no-audit --no-fund

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every test: formatting, lints (no unwrap/expect in library code), all cargo tests on the GPU
 # (lavapipe here), then the browser: the wasm tests in headless Chromium's WebGPU (SwiftShader)
-# and the page end to end with Playwright. GPU tests never skip: without an adapter they fail.
+# and the page end to end with Playwright, then the JS API under Node on Dawn (tests/node/). GPU
+# tests never skip: without an adapter they fail (tests/node/ skips only where Dawn finds none).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SUNLIT_ENERGYPLUS=1 SUNLIT_RADIANCE=1 SUNLIT_CITY=1 SUNLIT_PV=1 SUNLIT_WEB=1 SUNLIT_BROWSER=1 . scripts/setup.sh
@@ -28,4 +29,7 @@ scripts/build-web.sh
 # tests/browser/npm.test.mjs packs the npm package (scripts/pack-npm.sh, reusing www/pkg) and
 # builds a fresh Vite app with it (npm install of three + vite: needs the npm registry).
 node --test tests/browser/ 2>&1 | tee target/test-browser.log || status=1
+# The same bundle and JS API under Node on Dawn's WebGPU (npm `webgpu`; SwiftShader's Vulkan driver
+# here, since Dawn refuses lavapipe 22.3): skips, saying why, only where Dawn finds no adapter.
+node --test tests/node/ 2>&1 | tee target/test-node.log || status=1
 exit $status
