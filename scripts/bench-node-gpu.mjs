@@ -1,28 +1,26 @@
 // One year of a model through the page's JS API (www/sunlit.js and the wasm bundle in www/pkg)
 // under Node, on Dawn's WebGPU (npm `webgpu`; tests/node/dawn.mjs stands in for the browser):
-//   node scripts/bench-node-gpu.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--engine gpu|compute|exact|auto] [--timesteps N] [--refine T] [--csv OUT.csv]
-// (`--refine T` as the CLI's; default the API's own, as the page runs.) Prints one JSON line: the Vulkan driver and adapter Dawn chose, seconds for the engine's start
-// (the module's import, the wasm's compile, the GPU device), the model's load and the year, and
-// the views counted. The engine runs in this thread and clips in this thread too: Node has no Web
-// Workers, so the page's pool cannot start (poolError says so), which only matters for views
-// routed to clipping (`exact`, and `auto`'s light views). Run by scripts/bench-node-gpu.sh beside
-// the native CLI's same year.
+//   node scripts/bench-node-gpu.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--engine gpu|compute|exact|auto]
+//     [--timesteps N] [--refine T] [--csv OUT.csv]
+// (`--refine T` as the CLI's; without it the API's default, as the page runs.) Prints one JSON
+// line: the Vulkan driver and adapter Dawn chose, seconds for the engine's start (the module's
+// import, the wasm's compile, the GPU device), the model's load and the year, and the views
+// counted. The engine runs in this thread and clips in this thread too: Node has no Web Workers,
+// so the page's pool cannot start (pool_error says so), which only matters for views routed to
+// clipping (`exact`, and `auto`'s light views). Run by scripts/bench-node-gpu.sh beside the
+// native CLI's same year.
 import { readFileSync, writeFileSync } from 'node:fs';
 import { basename } from 'node:path';
+import { parseArgs } from 'node:util';
 import { bundleMissing, findDriver, installDawn } from '../tests/node/dawn.mjs';
 
-const args = process.argv.slice(2);
-const flag = (name, fallback) => {
-  const i = args.indexOf(name);
-  if (i < 0) return fallback;
-  const [value] = args.splice(i, 2).slice(1);
-  return value;
-};
-const engineName = flag('--engine', 'gpu');
-const timesteps = Number(flag('--timesteps', '4'));
-const refine = flag('--refine', undefined);
-const csvOut = flag('--csv', null);
-const [model, samples = '27x19', resolution = '512'] = args;
+const { values: opts, positionals } = parseArgs({
+  allowPositionals: true,
+  options: { engine: { type: 'string', default: 'gpu' }, timesteps: { type: 'string', default: '4' }, refine: { type: 'string' }, csv: { type: 'string' } },
+});
+const engineName = opts.engine;
+const timesteps = Number(opts.timesteps);
+const [model, samples = '27x19', resolution = '512'] = positionals;
 if (!model) {
   console.error('usage: node scripts/bench-node-gpu.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--engine gpu|compute|exact|auto] [--timesteps N] [--refine T] [--csv OUT.csv]');
   process.exit(2);
@@ -52,7 +50,7 @@ const t3 = performance.now();
 let views = 0;
 let stage = null;
 const settings = { ...place, timestepsPerHour: timesteps, daysPerYear: days, samplesPerDay: perDay };
-if (refine !== undefined) settings.refine = Number(refine);
+if (opts.refine !== undefined) settings.refine = Number(opts.refine);
 const year = await engine.annual(loaded, settings, {
   onProgress: (done, total, counted) => {
     // Views an engine counted, summed over the year's stages (a new stage: another total, or
@@ -63,7 +61,7 @@ const year = await engine.annual(loaded, settings, {
 });
 const t4 = performance.now();
 views += stage?.counted ?? 0;
-if (csvOut) writeFileSync(csvOut, year.csv());
+if (opts.csv) writeFileSync(opts.csv, year.csv());
 console.log(
   JSON.stringify({
     side: `node-dawn-${engineName}`,
