@@ -124,6 +124,8 @@ async function browserRun(side) {
     const started = Date.now();
     page.on('console', (m) => {
       if (m.type() === 'error') console.error(m.text());
+      // The pool's sizing by its memory budget, and each instance's wasm once loaded.
+      if (m.text().startsWith('sunlit: ') || m.text().startsWith('loaded ')) console.error(m.text());
       const at = /^progress (\d+) (\d+)$/.exec(m.text());
       if (at) {
         const so = Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)]));
@@ -146,6 +148,9 @@ async function browserRun(side) {
         const loadedWasm = await wasmMemoryBytes();
         await engine.prepare(model);
         const t2 = performance.now();
+        const mbOf = (b) => Math.round(b / 1e6);
+        const loaded = { engine_wasm_mb: mbOf(await wasmMemoryBytes()), worker_wasm_mb: engine.workerMemoryBytes.map(mbOf), pool_sizing: engine.poolSizing };
+        console.log(`loaded ${JSON.stringify(loaded)}`);
         console.log(`progress 0 0`);
         let views = 0;
         if (loadOnly) {
@@ -158,6 +163,7 @@ async function browserRun(side) {
             engine_wasm_mb_loaded: Math.round(loadedWasm / 1e6),
             engine_wasm_mb: Math.round((await wasmMemoryBytes()) / 1e6),
             worker_wasm_mb: engine.workerMemoryBytes.map((b) => Math.round(b / 1e6)),
+            pool_sizing: engine.poolSizing,
           };
           engine.close();
           return out;
@@ -198,6 +204,7 @@ async function browserRun(side) {
           engine_wasm_mb_loaded: Math.round(loadedWasm / 1e6),
           engine_wasm_mb: Math.round((await wasmMemoryBytes()) / 1e6),
           worker_wasm_mb: engine.workerMemoryBytes.map((b) => Math.round(b / 1e6)),
+          pool_sizing: engine.poolSizing,
         };
         engine.close();
         return out;

@@ -519,6 +519,25 @@ impl Model {
         self.inner.scene.to_bytes()
     }
 
+    /// The exact engine's convex objects, encoded ([`ExactEngine::objects_bytes`]) for the pool's
+    /// clipping workers beside [`Self::scene_bytes`]: a worker takes them instead of grouping the
+    /// scene's triangles, the step that set its peak memory (docs/page-speed.md). Builds this
+    /// model's exact engine if it has none yet (`auto` builds it for its first batch anyway), so
+    /// call it after `sceneBytes`: the scene's encoding is then already out of this instance.
+    #[wasm_bindgen(js_name = objectsBytes)]
+    pub fn objects_bytes(&self) -> Vec<u8> {
+        self.inner.exact.get_or_init(|| ExactEngine::new(&self.inner.scene)).objects_bytes()
+    }
+
+    /// The exact fractions of packed requests (as the pool's workers take them: receiver, sun x,
+    /// y, z, leaf fraction), clipped in this thread with this model's exact engine: where the
+    /// memory budget kept fewer workers than asked, the engine's thread clips beside them.
+    #[wasm_bindgen(js_name = clipHere)]
+    pub fn clip_here(&self, packed: &[f64]) -> Result<Float64Array, JsValue> {
+        let exact = self.inner.exact.get_or_init(|| ExactEngine::new(&self.inner.scene));
+        clipper::clip(exact, self.inner.scene.receivers.len(), packed)
+    }
+
     /// Receiver names: the CSV's columns, in order.
     #[wasm_bindgen(getter, js_name = receiverNames)]
     pub fn receiver_names(&self) -> Vec<String> {

@@ -9,7 +9,7 @@ import init, { Clipper } from './pkg/sunlit_wasm.js';
 let clipper = null;
 let memory = null;
 
-/** A Clipper from the engine's encoded scene (what sunlit.js sends). */
+/** A Clipper from the engine's encoded scene and convex objects (what sunlit.js sends). */
 function build({ kind, args }) {
   if (kind === 'scene') return Clipper.fromScene(...args);
   throw Object.assign(new Error(`unknown model source '${kind}'`), { code: 'bad-option' });

@@ -46,6 +46,25 @@ export function defaultWorkers() {
   return Number.isInteger(n) && n > 0 ? n : 1;
 }
 
+/** A worker's wasm memory per byte of what it is handed (the encoded scene and objects), once
+ * it built its exact engine: 983 MB for nyt-blocks' 119 MB (8.2×; docs/page-speed.md, "Where
+ * the memory goes"), rounded up. An estimate: the budget is checked before any worker builds. */
+export const WORKER_BYTES_PER_BYTE = 8.5;
+
+/** The default memory budget: the wasm memory the engine's instance and its clipping workers
+ * may hold together once the pool has its model, chosen so that nyt-blocks' year stays within
+ * 4 GB of Chromium (docs/page-speed.md). */
+export const DEFAULT_MEMORY_BUDGET = 2.5e9;
+
+/** How many of `asked` workers fit `budgetBytes` beside the engine's `engineBytes`, each copy
+ * estimated from the bytes it is handed (`args`). 0 means none: the engine then clips alone. */
+export function fit(asked, args, budgetBytes, engineBytes) {
+  const handed = args.reduce((n, a) => n + (a?.byteLength ?? 0), 0);
+  const workerBytes = WORKER_BYTES_PER_BYTE * handed;
+  const room = workerBytes > 0 ? Math.floor((budgetBytes - engineBytes) / workerBytes) : asked;
+  return { budgetBytes, engineBytes, workerBytes, asked, workers: Math.max(0, Math.min(asked, room)) };
+}
+
 export class ClipPool {
   #url;
   #size;
@@ -59,6 +78,10 @@ export class ClipPool {
   #queue = [];
   #jobs = 0;
   #broken = null;
+  #sizing = null;
+  /** This thread's clipper: its task queue, and whether a chunk is queued for it. */
+  #tick = null;
+  #localPending = false;
 
   /** `size` workers running `url` (default: clip-worker.js beside this module). */
   constructor(size, url = null) {
@@ -104,7 +127,7 @@ export class ClipPool {
         return;
       }
       this.#spawned.push(worker);
-      const slot = { index, worker, busy: null, pending: null };
+      const slot = { index, worker, busy: [], pending: null };
       worker.onerror = (event) => {
         event.preventDefault?.();
         const error = coded(`clipping worker ${index} failed: ${event.message || 'it could not load its module'}`, 'worker', {
@@ -132,20 +155,26 @@ export class ClipPool {
 
   /** Makes `source` the pool's model; resolves when every worker holds it. The same source twice
    * loads once. `source`: { kind, args } (clip-worker.js's one kind, 'scene', takes the
-   * engine's encoded scene), or { kind, encode } where encode() gives the args once the workers have started (sunlit.js encodes the
-   * scene then; the encoding is copied to each worker and not kept here). */
-  use(source) {
+   * engine's encoded scene and its convex objects), or { kind, encode } where encode() gives the
+   * args once the workers have started (sunlit.js encodes them then; they are copied to each
+   * worker, transferred to the last, and not kept here). `budget` ({ bytes, used }: the wasm
+   * memory the engine's instance and the workers may hold together, and a function giving what
+   * the engine's instance holds now) sizes the pool before any worker builds: see [`fit`]. */
+  use(source, budget = null) {
     if (this.#broken) return Promise.reject(this.#broken);
     if (source === this.#source && this.#loading) return this.#loading;
     this.#source = source;
-    this.#loading = this.start().then(() => {
-      const message = { type: 'load', source: source.encode ? { kind: source.kind, args: source.encode() } : source };
+    this.#loading = this.start().then(async () => {
+      const args = source.encode ? source.encode() : source.args;
+      if (budget) this.#shrink(fit(this.#size, args, budget.bytes, await budget.used()));
+      const last = this.#workers.length - 1;
       return Promise.all(
         this.#workers.map(
-          (slot) =>
+          (slot, i) =>
             new Promise((resolve, reject) => {
               slot.pending = { resolve, reject };
-              slot.worker.postMessage(message);
+              const transfer = i === last ? args.filter((a) => ArrayBuffer.isView(a)).map((a) => a.buffer) : [];
+              slot.worker.postMessage({ type: 'load', source: { kind: source.kind, args } }, transfer);
             }),
         ),
       );
@@ -157,13 +186,39 @@ export class ClipPool {
     return this.#loading;
   }
 
-  /** The fractions of packed requests (Float64Array, PACKED numbers a view), in order. */
-  async clip(packed, signal) {
+  /** How the memory budget sized the pool at its last load: { budgetBytes, engineBytes,
+   * workerBytes (the estimate for one worker's copy), workers (kept), asked }; null before a
+   * load with a budget. */
+  get sizing() {
+    return this.#sizing;
+  }
+
+  /** Keeps the first `sizing.workers` workers and stops the others (their memory is freed);
+   * says so on the console when it drops any. */
+  #shrink(sizing) {
+    this.#sizing = sizing;
+    if (sizing.workers >= this.#size) return;
+    const mb = (b) => Math.round(b / 1e6);
+    console.info(
+      `sunlit: ${sizing.workers} of ${sizing.asked} clipping workers: each copy of this model needs about ${mb(sizing.workerBytes)} MB, ` +
+        `the engine holds ${mb(sizing.engineBytes)} MB, and the memory budget is ${mb(sizing.budgetBytes)} MB (createEngine's memoryBudget)`,
+    );
+    for (const slot of this.#workers.splice(sizing.workers)) slot.worker.terminate();
+    this.#spawned = this.#workers.map((slot) => slot.worker);
+    this.#size = sizing.workers;
+  }
+
+  /** The fractions of packed requests (Float64Array, PACKED numbers a view), in order. `local`
+   * (optional): clips packed requests in this thread, with the engine's own copy of the model;
+   * it then takes chunks from the same queue as the workers, one per task, so their replies are
+   * read between its chunks (the pool uses it where the budget kept fewer workers than asked:
+   * the engine's instance, which holds the model anyway, is then one clipper more). */
+  async clip(packed, signal, local = null) {
     await this.start();
     if (this.#broken) throw this.#broken;
     const views = packed.length / PACKED;
     const out = new Float64Array(views);
-    const job = { id: ++this.#jobs, left: 0, out };
+    const job = { id: ++this.#jobs, left: 0, out, local };
     return new Promise((resolve, reject) => {
       Object.assign(job, { resolve, reject });
       for (let start = 0; start < views; start += CHUNK) {
@@ -180,14 +235,45 @@ export class ClipPool {
     });
   }
 
-  /** Hands queued chunks to idle workers. */
+  /** Hands queued chunks to idle workers, and one to this thread's clipper when the job has one.
+   * Where this thread clips too, each worker holds two chunks, so that it has the next one while
+   * this thread is busy with its own and cannot read the worker's reply. */
   #deal() {
+    const depth = this.#queue[0]?.job.local ? 2 : 1;
     for (const slot of this.#workers) {
-      if (slot.busy || !this.#queue.length) continue;
-      const item = this.#queue.shift();
-      slot.busy = item;
-      slot.worker.postMessage({ type: 'clip', job: item.job.id, data: item.data }, [item.data.buffer]);
+      while (slot.busy.length < depth && this.#queue.length) {
+        const item = this.#queue.shift();
+        slot.busy.push(item);
+        slot.worker.postMessage({ type: 'clip', job: item.job.id, data: item.data }, [item.data.buffer]);
+      }
     }
+    if (this.#queue[0]?.job.local && !this.#localPending) {
+      this.#localPending = true;
+      this.#tick ??= this.#ticker();
+      this.#tick.port2.postMessage(0);
+    }
+  }
+
+  /** A task queue for this thread's chunks: a message to itself runs after the workers' replies
+   * already queued, without a timer's clamping. */
+  #ticker() {
+    const channel = new MessageChannel();
+    channel.port1.onmessage = () => this.#clipHere();
+    return channel;
+  }
+
+  /** Clips the next queued chunk in this thread. */
+  #clipHere() {
+    this.#localPending = false;
+    const item = this.#queue[0]?.job.local ? this.#queue.shift() : null;
+    if (!item) return;
+    try {
+      item.job.out.set(item.job.local(item.data), item.start);
+      if (--item.job.left === 0) this.#finish(item.job, null);
+    } catch (error) {
+      this.#drop(item.job, coded(`clipping in the engine's thread failed: ${error?.message ?? error}`, error?.code ?? 'worker'));
+    }
+    this.#deal();
   }
 
   #reply(slot, data) {
@@ -201,8 +287,7 @@ export class ClipPool {
       else pending?.reject(Object.assign(new Error(data.message), { code: data.code, worker: slot.index }));
       return;
     }
-    const item = slot.busy;
-    slot.busy = null;
+    const item = slot.busy.shift();
     if (data.type === 'clipped' && item && item.job.id === data.job && !item.job.finished) {
       item.job.out.set(data.fractions, item.start);
       if (--item.job.left === 0) this.#finish(item.job, null);
@@ -221,7 +306,7 @@ export class ClipPool {
     this.#broken = error;
     slot.pending?.reject(error);
     const jobs = new Set(this.#queue.map((q) => q.job));
-    for (const s of this.#workers) if (s.busy) jobs.add(s.busy.job);
+    for (const s of this.#workers) s.busy.forEach((item) => jobs.add(item.job));
     for (const job of jobs) this.#drop(job, error);
     this.terminate();
   }
@@ -242,6 +327,9 @@ export class ClipPool {
   /** Stops every worker (their memory is freed). */
   terminate() {
     for (const worker of this.#spawned) worker.terminate();
+    this.#tick?.port1.close();
+    this.#tick = null;
+    this.#localPending = false;
     this.#spawned = [];
     this.#workers = [];
     this.#source = null;

@@ -88,6 +88,12 @@ export function createEngine(options?: {
   /** The same for the sky views (a year with weather), as Annual.skyProfile gives it: sky views
    * are routed by their own profile, measured on sky views and kept under their own key. */
   skyProfile?: string | object;
+  /** Wasm memory, in bytes, that the engine's instance and its clipping workers may hold
+   * together (default 2.5e9). When a model reaches the pool, each worker's copy is estimated
+   * from what it is handed, and the pool keeps only the workers that fit beside the engine's
+   * instance (0: this thread clips), saying so on the console; `poolSizing` tells the figures.
+   * Not a positive number: rejects with code 'bad-option', option 'memoryBudget'. */
+  memoryBudget?: number;
 }): Promise<SunlitEngine>;
 
 /** An EPW weather file's LOCATION record (throws naming `name` and the reason). */
@@ -223,6 +229,10 @@ export interface SunlitEngine {
   } | null;
   /** Why the pool could not start (clipping then runs in the engine's thread), or null. */
   readonly poolError: string | null;
+  /** How the memory budget sized the pool for the last model (null before one reached it):
+   * `workers` kept of `asked`, each copy estimated at `workerBytes` beside the engine's
+   * `engineBytes`, within `budgetBytes`. */
+  readonly poolSizing: { budgetBytes: number; engineBytes: number; workerBytes: number; asked: number; workers: number } | null;
   /** Has the pool's workers build their copies of the model now (else the first year does). */
   prepare(model: Model): Promise<void>;
   /** Stops the pool's workers. */

@@ -5,7 +5,7 @@
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
-import { ClipPool, defaultWorkers, wasmModule } from './pool.js';
+import { ClipPool, DEFAULT_MEMORY_BUDGET, defaultWorkers, wasmModule } from './pool.js';
 import { cachedProfile, storeProfile } from './profiles.js';
 
 let wasmReady;
@@ -51,10 +51,14 @@ function coded(message, code, names = {}) {
  * WebGPU the engine still clips (`hasGpu` false);
  * only `engine: 'gpu'` or 'compute' is refused there, with code 'no-webgpu'. 'bad-option' (naming the option)
  * for another engine name or pool size. */
-export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile } = {}) {
+export async function createEngine({ resolution, accuracy, device, engine, workers, profile, skyProfile, memoryBudget } = {}) {
   const size = workers === undefined ? defaultWorkers() : Number(workers);
   if (!Number.isInteger(size) || size < 0) {
     throw coded(`workers: ${workers} is not a whole number of at least 0`, 'bad-option', { option: 'workers' });
+  }
+  const budget = memoryBudget === undefined ? DEFAULT_MEMORY_BUDGET : Number(memoryBudget);
+  if (!(budget > 0) || !Number.isFinite(budget)) {
+    throw coded(`memoryBudget: ${memoryBudget} is not a positive number of bytes`, 'bad-option', { option: 'memoryBudget' });
   }
   // The engines that count on WebGPU alone.
   const wantsGpu = engine !== undefined && ['gpu', 'compute'].includes(String(engine).trim().toLowerCase());
@@ -79,7 +83,7 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
     throw error;
   }
   const text = (p) => (p === undefined || p === null ? undefined : typeof p === 'string' ? p : JSON.stringify(p));
-  return new SunlitEngine(made, pool, { sun: text(profile), sky: text(skyProfile) });
+  return new SunlitEngine(made, pool, { sun: text(profile), sky: text(skyProfile) }, budget);
 }
 
 /** The wasm engine on `device`, on a device of its own, or clipping only where there is none. */
@@ -145,13 +149,16 @@ function abortError() {
   return new DOMException('cancelled', 'AbortError');
 }
 
-/** Each model's source for the pool's workers: its scene, encoded when the pool first needs it
- * (Model.sceneBytes), so a worker decodes the scene instead of reading the model files again
- * (docs/page-speed.md). Nothing of the model's input (a glb's bytes) is kept for it. */
+/** Each model's source for the pool's workers: its scene and its exact engine's convex objects,
+ * encoded when the pool first needs them (Model.sceneBytes, then Model.objectsBytes, which
+ * builds this instance's exact engine), so a worker decodes the scene instead of reading the
+ * model files again, and takes the objects instead of grouping the triangles itself, the step
+ * that set its peak memory (docs/page-speed.md). Nothing of the model's input (a glb's bytes) is
+ * kept for it. */
 const sources = new WeakMap();
 
 function remember(model) {
-  sources.set(model, { kind: 'scene', encode: () => [model.sceneBytes()] });
+  sources.set(model, { kind: 'scene', encode: () => [model.sceneBytes(), model.objectsBytes()] });
   return model;
 }
 
@@ -161,11 +168,18 @@ class SunlitEngine {
   #pinned;
   #routed = null;
   #poolError = null;
+  #budget;
+  /** Workers asked for, and the model source the pool last took (a pool shrunk by the budget for
+   * one model starts afresh at its asked size for the next). */
+  #asked;
+  #pooled = null;
 
-  constructor(engine, pool, pinned) {
+  constructor(engine, pool, pinned, budget) {
     this.#engine = engine;
     this.#pool = pool;
     this.#pinned = pinned;
+    this.#budget = budget;
+    this.#asked = pool?.size ?? 0;
   }
 
   /** Whether a GPU device is in use (false where the browser has no WebGPU: views are clipped). */
@@ -191,6 +205,13 @@ class SunlitEngine {
     return this.#pool?.memoryBytes ?? [];
   }
 
+  /** How the memory budget sized the pool for the last model ({ budgetBytes, engineBytes,
+   * workerBytes, asked, workers }: fewer workers than asked where a copy of the model would not
+   * fit, 0 clipping in this thread), or null before a model reached the pool. */
+  get poolSizing() {
+    return this.#pool?.sizing ?? null;
+  }
+
   /** Why the pool could not start (clipping then runs in this thread), or null. */
   get poolError() {
     return this.#poolError;
@@ -211,11 +232,18 @@ class SunlitEngine {
   async #routing(model, signal) {
     const source = sources.get(model);
     // A pool closed by a failed worker (its error went to the call that hit it) starts afresh.
-    if (this.#pool?.broken) this.#pool = new ClipPool(this.#pool.size);
+    if (this.#pool?.broken) this.#pool = new ClipPool(this.#asked);
+    // A pool the budget shrank for another model starts afresh for this one.
+    if (this.#pool && source && source !== this.#pooled && this.#pool.size < this.#asked) {
+      this.#pool.terminate();
+      this.#pool = new ClipPool(this.#asked);
+    }
     if (this.#pool && source) {
       try {
-        await this.#pool.use(source);
+        this.#pooled = source;
+        await this.#pool.use(source, { bytes: this.#budget, used: wasmMemoryBytes });
       } catch (error) {
+        this.#pooled = null;
         if (error?.workerCode !== 'start') throw error;
         // A worker that cannot start (a CSP, a missing module): clip here instead, and say why.
         this.#poolError = error.message;
@@ -223,8 +251,13 @@ class SunlitEngine {
         this.#pool = null;
       }
     }
-    const pool = source ? this.#pool : null;
-    const workers = pool?.size ?? 1;
+    // The budget left no worker: this thread clips, as with `workers: 0`.
+    const pool = source && this.#pool?.size > 0 ? this.#pool : null;
+    // Where the budget kept fewer workers than asked, this thread clips too, with the copy of the
+    // model its instance holds anyway (Model.clipHere): one clipper more for no memory.
+    const sizing = pool?.sizing;
+    const local = sizing && sizing.workers < sizing.asked ? (packed) => model.clipHere(packed) : null;
+    const workers = (pool?.size ?? 1) + (local ? 1 : 0);
     const auto = this.engine === 'auto';
     // Sun and sky views each have their own profile, kept under their own key (the sky's says
     // `sky views`), so a sun profile is never taken for a sky one (src/web/choice.rs).
@@ -236,7 +269,7 @@ class SunlitEngine {
     const [profile, profileSource] = await given('sun');
     const [skyProfile, skyProfileSource] = await given('sky');
     const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
-    if (pool) routing.clip = (packed) => pool.clip(packed, signal);
+    if (pool) routing.clip = (packed) => pool.clip(packed, signal, local);
     return { routing, key };
   }
 

@@ -108,10 +108,11 @@ fn write_receiver(w: &mut Writer, r: &Receiver) {
     w.u32(r.gpu_id);
 }
 
-struct Writer(Vec<u8>);
+/// Appends little-endian values (also [`crate::count::exact::engine::ExactEngine::objects_bytes`]).
+pub(crate) struct Writer(pub(crate) Vec<u8>);
 
 impl Writer {
-    fn u32(&mut self, x: u32) {
+    pub(crate) fn u32(&mut self, x: u32) {
         self.0.extend_from_slice(&x.to_le_bytes());
     }
     fn f32(&mut self, x: f32) {
@@ -120,7 +121,7 @@ impl Writer {
     fn f64(&mut self, x: f64) {
         self.0.extend_from_slice(&x.to_le_bytes());
     }
-    fn len(&mut self, n: usize) {
+    pub(crate) fn len(&mut self, n: usize) {
         self.0.extend_from_slice(&(n as u64).to_le_bytes());
     }
     /// `xs` as runs of equal items: the run count, then each run's length (u64) and item.
@@ -146,7 +147,7 @@ impl Writer {
             item(self, &xs[start]);
         }
     }
-    fn u32s(&mut self, xs: &[u32]) {
+    pub(crate) fn u32s(&mut self, xs: &[u32]) {
         self.len(xs.len());
         self.0.reserve(4 * xs.len());
         xs.iter().for_each(|&x| self.u32(x));
@@ -163,7 +164,7 @@ impl Writer {
     }
 }
 
-type Decoded<T> = std::result::Result<T, SceneBytesError>;
+pub(crate) type Decoded<T> = std::result::Result<T, SceneBytesError>;
 
 fn decode(bytes: &[u8]) -> Decoded<Scene> {
     let mut r = Reader { bytes, at: 0 };
@@ -294,21 +295,32 @@ fn check(scene: &Scene) -> Decoded<()> {
     Ok(())
 }
 
-fn in_range(range: &Range<u32>, len: usize) -> bool {
+pub(crate) fn in_range(range: &Range<u32>, len: usize) -> bool {
     range.start <= range.end && range.end as usize <= len
 }
 
-fn invalid(what: impl Into<String>, reason: impl Into<String>) -> SceneBytesError {
+pub(crate) fn invalid(what: impl Into<String>, reason: impl Into<String>) -> SceneBytesError {
     SceneBytesError::Invalid { what: what.into(), reason: reason.into() }
 }
 
-struct Reader<'a> {
+/// Reads what [`Writer`] wrote, refusing what runs past the bytes.
+pub(crate) struct Reader<'a> {
     bytes: &'a [u8],
     at: usize,
 }
 
 impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize, reading: &'static str) -> Decoded<&'a [u8]> {
+    pub(crate) fn new(bytes: &'a [u8]) -> Self {
+        Self { bytes, at: 0 }
+    }
+    /// Refuses bytes left after what was read.
+    pub(crate) fn end(&self) -> Decoded<()> {
+        match self.bytes.len() - self.at {
+            0 => Ok(()),
+            extra => Err(SceneBytesError::TrailingBytes { extra }),
+        }
+    }
+    pub(crate) fn take(&mut self, n: usize, reading: &'static str) -> Decoded<&'a [u8]> {
         let left = self.bytes.len() - self.at;
         if n > left {
             return Err(SceneBytesError::Truncated { reading, offset: self.at, need: n, left });
@@ -322,7 +334,7 @@ impl<'a> Reader<'a> {
         out.copy_from_slice(self.take(N, reading)?);
         Ok(out)
     }
-    fn u32(&mut self, reading: &'static str) -> Decoded<u32> {
+    pub(crate) fn u32(&mut self, reading: &'static str) -> Decoded<u32> {
         Ok(u32::from_le_bytes(self.array(reading)?))
     }
     fn f32(&mut self, reading: &'static str) -> Decoded<f32> {
@@ -372,7 +384,7 @@ impl<'a> Reader<'a> {
         }
         Ok(out)
     }
-    fn u32s(&mut self, reading: &'static str) -> Decoded<Vec<u32>> {
+    pub(crate) fn u32s(&mut self, reading: &'static str) -> Decoded<Vec<u32>> {
         let n = self.count(reading, 4)?;
         let raw = self.take(4 * n, reading)?;
         Ok(raw.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())

@@ -216,12 +216,13 @@ impl<'a> Chosen<'a> {
     }
 
     /// The native calibration on this page: the exact engine timed on one thread (a pool
-    /// worker's speed) and spread over the pool's workers; the GPU only where it could pay.
+    /// worker's speed) and spread over the pool's workers; the GPU only where it could pay, and
+    /// never a CPU fallback adapter ([`cpu_adapter`]).
     /// The device is opened before the GPU is timed, so its start-up is not in the profile (0 s).
     async fn measure(&self, requests: &[ViewRequest], loads: &[ViewLoad]) -> Result<Profile> {
         let probe = probe_views(loads, PROBE_EXACT_VIEWS);
         let (exact, mean_us) = probe_exact(self.exact(), requests, loads, &probe, self.routing.threads);
-        let gpu = if self.gpu.is_some() && gpu_worth_probing(mean_us, loads) {
+        let gpu = if self.gpu.as_ref().is_some_and(|g| !cpu_adapter(g.gpu.info())) && gpu_worth_probing(mean_us, loads) {
             Some(probe_gpu(std::slice::from_ref(self.lane().await?), requests, loads).await?)
         } else {
             None
@@ -258,6 +259,15 @@ impl<'a> Chosen<'a> {
         *self.pool_error.borrow_mut() = Some(error);
         Error::Cancelled
     }
+}
+
+/// Whether the page's adapter is the browser's fallback, drawing on the CPU (SwiftShader; wgpu
+/// reports it as [`wgpu::DeviceType::Cpu`]). `auto` does not probe it: it would draw on the cores
+/// the pool of clipping workers already fills, and probing uploads the scene, which on
+/// nyt-blocks held 315 MB more in the GPU process besides the engine's staging
+/// (docs/page-speed.md, "Where the memory goes"); every profile measured on it was exact-only.
+fn cpu_adapter(info: &wgpu::AdapterInfo) -> bool {
+    info.device_type == wgpu::DeviceType::Cpu
 }
 
 /// How a refusal names a profile handed in: the pinned one, or the page's stored one (where),

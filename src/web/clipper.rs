@@ -18,26 +18,32 @@ pub struct Clipper {
     receivers: usize,
 }
 
-impl Clipper {
-    fn of(scene: &Scene) -> Clipper {
-        Clipper { exact: ExactEngine::new(scene), receivers: scene.receivers.len() }
-    }
-}
-
 #[wasm_bindgen]
 impl Clipper {
     /// From the engine's scene as `Model.sceneBytes` encodes it ([`Scene::to_bytes`]): no model
-    /// file is read again. The bytes are dropped once decoded, the scene once indexed.
+    /// file is read again. With `objects` (`Model.objectsBytes`, the engine's convex objects over
+    /// that scene), the worker takes them instead of grouping the triangles itself, the step that
+    /// set its peak memory. Each byte list is dropped once decoded, the scene once indexed.
     #[wasm_bindgen(js_name = fromScene)]
-    pub fn from_scene(bytes: Vec<u8>) -> Result<Clipper, JsValue> {
+    pub fn from_scene(bytes: Vec<u8>, objects: Option<Vec<u8>>) -> Result<Clipper, JsValue> {
         let scene = Scene::from_bytes(&bytes).map_err(js_error)?;
         drop(bytes);
-        Ok(Self::of(&scene))
+        let exact = match objects {
+            Some(objects) => ExactEngine::with_objects(&scene, &objects).map_err(js_error)?,
+            None => ExactEngine::new(&scene),
+        };
+        Ok(Clipper { exact, receivers: scene.receivers.len() })
     }
 
     /// The sunlit fraction of each packed request (receiver, sun x, y, z, leaf fraction), exact.
     pub fn fractions(&self, packed: &[f64]) -> Result<Float64Array, JsValue> {
-        let requests = unpack(packed, self.receivers).map_err(js_error)?;
-        Ok(Float64Array::from(self.exact.fractions(&requests).as_slice()))
+        clip(&self.exact, self.receivers, packed)
     }
+}
+
+/// `exact`'s fractions of packed requests over a scene of `receivers` receivers: a worker's, or
+/// the engine's own thread's where it clips beside its workers (`Model.clipHere`).
+pub(super) fn clip(exact: &ExactEngine, receivers: usize, packed: &[f64]) -> Result<Float64Array, JsValue> {
+    let requests = unpack(packed, receivers).map_err(js_error)?;
+    Ok(Float64Array::from(exact.fractions(&requests).as_slice()))
 }

@@ -311,3 +311,78 @@ test('without WebGPU the engine clips (auto and exact agree), and only the GPU e
     await plain.close();
   }
 });
+
+test('the memory budget keeps only the workers whose copies fit beside the engine, and they answer the same', async () => {
+  // One page per engine, so each engine's instance starts from the same fresh wasm memory and
+  // holds the same bytes when the pool takes the model.
+  const run = async (workers, memoryBudget) => {
+    const { p, errors } = await apiPage();
+    const said = [];
+    p.on('console', (m) => m.type() === 'info' && said.push(m.text()));
+    const r = await p.evaluate(
+      async ({ scene, year, workers, memoryBudget }) => {
+        eval(scene);
+        const { createEngine } = await import('/sunlit.js');
+        const engine = await createEngine({ resolution: 128, engine: 'exact', workers, memoryBudget });
+        // 2,000 small crates in a yard to the north make each worker's copy some MB, far above
+        // the few hundred kB by which the engine's instance differs between pages.
+        const block = louvredBlock();
+        for (let k = 0; k < 2000; k++) {
+          const [x, y] = [-20 + (k % 50), 40 + Math.floor(k / 50)];
+          const i = block.positions.length / 3;
+          for (const [dx, dy, dz] of [[0, 0, 0], [0.5, 0, 0], [0.5, 0.5, 0], [0, 0.5, 0], [0, 0, 0.5], [0.5, 0, 0.5], [0.5, 0.5, 0.5], [0, 0.5, 0.5]]) {
+            block.positions.push(x + dx, y + dy, dz);
+          }
+          const faces = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]];
+          for (const f of faces) block.indices.push(...f.map((v) => i + v));
+          for (let t = 0; t < 12; t++) block.triangleReceivers.push(-1);
+        }
+        const model = engine.fromArrays(block);
+        const y = await engine.annual(model, year);
+        const out = { csv: y.csv(), pool: engine.workers, sizing: engine.poolSizing, memory: engine.workerMemoryBytes.length };
+        engine.close();
+        return out;
+      },
+      { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;`, year: YEAR, workers, memoryBudget },
+    );
+    await p.close();
+    assert.deepEqual(errors, []);
+    return { ...r, said };
+  };
+  const all = await run(2, 1e12);
+  const s = all.sizing;
+  assert.equal(all.pool, 2, JSON.stringify(s));
+  assert.ok(s.workerBytes > 0 && s.engineBytes > 0, JSON.stringify(s));
+  assert.deepEqual(all.said.filter((t) => t.includes('clipping workers')), [], 'nothing dropped, nothing said');
+  // Room for one and a half copies beside the engine: one worker.
+  const one = await run(2, s.engineBytes + 1.5 * s.workerBytes);
+  assert.ok(Math.abs(one.sizing.engineBytes - s.engineBytes) < 0.25 * s.workerBytes, `the engines differ by less than a copy: ${JSON.stringify([s, one.sizing])}`);
+  assert.deepEqual([one.pool, one.sizing.workers, one.sizing.asked, one.memory], [1, 1, 2, 1], JSON.stringify(one.sizing));
+  assert.ok(one.said.some((t) => t.startsWith('sunlit: 1 of 2 clipping workers')), one.said.join('\n'));
+  assert.equal(one.csv, all.csv, 'one worker kept by the budget = two workers');
+  // No room: the engine's own thread clips.
+  const none = await run(2, 1);
+  assert.deepEqual([none.pool, none.sizing.workers], [0, 0]);
+  assert.equal(none.csv, all.csv, 'no worker = two workers');
+});
+
+test('a memory budget that is not a positive number is refused by name', async () => {
+  const { p } = await apiPage();
+  const r = await p.evaluate(async () => {
+    const { createEngine } = await import('/sunlit.js');
+    return Promise.all(
+      [0, -1, 'lots', Infinity].map((memoryBudget) =>
+        createEngine({ workers: 0, memoryBudget }).then(
+          () => null,
+          (e) => ({ code: e.code, option: e.option, message: e.message }),
+        ),
+      ),
+    );
+  });
+  await p.close();
+  for (const e of r) {
+    assert.equal(e?.code, 'bad-option');
+    assert.equal(e.option, 'memoryBudget');
+    assert.match(e.message, /^memoryBudget: .* is not a positive number of bytes$/);
+  }
+});

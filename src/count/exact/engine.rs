@@ -37,6 +37,7 @@ use super::placed::PlacedObjects;
 use super::{AREA_EPS, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN};
 use crate::count::cull::{CPU_LEAF_TRIANGLES, Culling};
 use crate::count::{ViewRequest, is_dark, view};
+use crate::error::{Error, Result};
 use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
 
 /// Side passed to [`view::fit`] for a view's clip volume: the margin it adds (a pixel at this
@@ -148,6 +149,32 @@ pub struct ViewLoad {
 impl ExactEngine {
     /// Indexes `scene`: world triangles in BVH order, objects and their convexity, outlines.
     pub fn new(scene: &Scene) -> Self {
+        // Grouping cannot fail; only decoded objects can.
+        match Self::build::<std::convert::Infallible>(scene, |sources, triangles| Ok(PlacedObjects::new(scene, sources, triangles))) {
+            Ok(engine) => engine,
+            Err(never) => match never {},
+        }
+    }
+
+    /// As [`Self::new`], taking the convex objects another engine over the same scene encoded
+    /// ([`Self::objects_bytes`]) instead of grouping the scene's triangles: a page's clipping
+    /// worker skips the grouping's memory this way. Refuses bytes that are not such objects or
+    /// that do not fit this scene's triangles ([`Error::SceneBytes`]).
+    pub fn with_objects(scene: &Scene, objects: &[u8]) -> Result<Self> {
+        Self::build(scene, |_, triangles| PlacedObjects::from_bytes(objects, triangles)).map_err(Error::SceneBytes)
+    }
+
+    /// This engine's convex objects, encoded for [`Self::with_objects`].
+    pub fn objects_bytes(&self) -> Vec<u8> {
+        self.objects.to_bytes()
+    }
+
+    /// Indexes `scene`, its convex objects made by `objects` from each position's source and
+    /// world triangle.
+    fn build<E>(
+        scene: &Scene,
+        objects: impl FnOnce(&[(usize, u32)], &[[DVec3; 3]]) -> std::result::Result<PlacedObjects, E>,
+    ) -> std::result::Result<Self, E> {
         let culling = Culling::new(scene, CPU_LEAF_TRIANGLES);
         let sources = culling.triangle_sources();
         let extent = (scene.bounds.1 - scene.bounds.0).length();
@@ -177,11 +204,12 @@ impl ExactEngine {
             see_through_before.push(last + u32::from(veil.transmittance > 0.0));
             veils.push(veil);
         }
-        let objects = PlacedObjects::new(scene, &sources, &triangles);
+        let objects = objects(&sources, &triangles)?;
+        drop(sources);
         let frames: Vec<Option<PlaneFrame>> = scene.receivers.iter().map(|r| PlaneFrame::new(r, DVec3::Z, eps)).collect();
         let outlines =
             scene.receivers.iter().zip(&frames).enumerate().map(|(i, (r, f))| f.as_ref().and_then(|f| outline(r, i, f, eps))).collect();
-        Self {
+        Ok(Self {
             outlines,
             frames,
             culling,
@@ -194,7 +222,7 @@ impl ExactEngine {
             origin: scene.origin,
             area_eps: AREA_EPS * scale * scale,
             cover_hints: scene.receivers.iter().map(|_| AtomicU32::new(NO_HINT)).collect(),
-        }
+        })
     }
 
     /// Fresh scratch memory for one thread.

@@ -184,3 +184,98 @@ fn convex_polygons_overlap_unless_an_edge_separates_them() {
     let flat = [DVec2::new(-1.0, 0.5), DVec2::new(2.0, 0.5), DVec2::new(2.0, 0.5)];
     assert!(convex_overlap(&square(0.0, 0.0), &flat));
 }
+
+/// Suns from overhead to low, all round, with some straight down the tubes' bores.
+fn suns_all_round() -> Vec<DVec3> {
+    let mut suns = vec![DVec3::Z, DVec3::new(0.0, -1.0, 0.02).normalize()];
+    for az in [0.0f64, 45.0, 100.0, 160.0, 180.0, 250.0] {
+        for alt in [89.5f64, 87.0, 80.0, 70.0, 45.0, 20.0] {
+            let (a, h) = (az.to_radians(), alt.to_radians());
+            suns.push(DVec3::new(h.cos() * a.sin(), -h.cos() * a.cos(), h.sin()));
+        }
+    }
+    suns
+}
+
+fn all_views(scene: &Scene) -> Vec<ViewRequest> {
+    (0..scene.receivers.len() as u32).flat_map(|r| suns_all_round().into_iter().map(move |s| ViewRequest::new(r, s))).collect()
+}
+
+/// The lists of encoded objects (after magic and version): per position its object, the
+/// objects' cap ranges, the caps, the cap corners; and the bytes rebuilt from such lists.
+fn object_lists(bytes: &[u8]) -> Vec<Vec<u32>> {
+    let mut at = 12;
+    let mut lists = Vec::new();
+    while at < bytes.len() {
+        let n = u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap_or_default()) as usize;
+        at += 8;
+        lists.push(bytes[at..at + 4 * n].chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect());
+        at += 4 * n;
+    }
+    lists
+}
+
+fn object_bytes(head: &[u8], lists: &[Vec<u32>]) -> Vec<u8> {
+    let mut out = head[..12].to_vec();
+    for list in lists {
+        out.extend((list.len() as u64).to_le_bytes());
+        list.iter().for_each(|x| out.extend(x.to_le_bytes()));
+    }
+    out
+}
+
+#[test]
+fn an_engine_given_anothers_objects_answers_bit_for_bit() {
+    let bits = |f: Vec<f64>| f.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+    for (what, scene) in [("tubes", tubes_over_a_roof()), ("louvres", louvred_wall())] {
+        let engine = ExactEngine::new(&scene);
+        let bytes = engine.objects_bytes();
+        let given = ExactEngine::with_objects(&scene, &bytes).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_eq!(given.objects_bytes(), bytes, "{what}: encoded again, the same bytes");
+        assert_eq!(given.convex_objects(), engine.convex_objects(), "{what}");
+        let requests = all_views(&scene);
+        assert_eq!(bits(given.fractions(&requests)), bits(engine.fractions(&requests)), "{what}");
+    }
+    // The caps travel and matter: the tubes with their caps dropped (closed, as the bytes would
+    // say if the encoding lost them) answer otherwise down their bores.
+    let scene = tubes_over_a_roof();
+    let bytes = ExactEngine::new(&scene).objects_bytes();
+    let mut lists = object_lists(&bytes);
+    assert!(!lists[3].is_empty(), "the tubes have open caps");
+    lists[1].iter_mut().for_each(|x| *x = 0);
+    let closed = ExactEngine::with_objects(&scene, &object_bytes(&bytes, &lists)).unwrap();
+    let requests = all_views(&scene);
+    assert_ne!(bits(closed.fractions(&requests)), bits(ExactEngine::new(&scene).fractions(&requests)));
+}
+
+#[test]
+fn objects_that_do_not_fit_the_scene_are_refused_by_their_reason() {
+    let scene = tubes_over_a_roof();
+    let bytes = ExactEngine::new(&scene).objects_bytes();
+    let why = |b: &[u8]| match ExactEngine::with_objects(&scene, b) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("{} bytes taken", b.len()),
+    };
+    for cut in (0..bytes.len()).step_by(7) {
+        let reason = why(&bytes[..cut]);
+        assert!(reason.contains("truncated") || reason.contains("SUNLITOB"), "{cut}: {reason}");
+    }
+    assert!(why(&[&bytes[..], &[0]].concat()).contains("1 bytes follow"), "trailing");
+    let mut other = bytes.clone();
+    other[8] = 2;
+    assert!(why(&other).contains("version 2"), "{}", why(&other));
+    let lists = object_lists(&bytes);
+    let objects = (lists[1].len() / 2) as u32;
+    let mut past = lists.clone();
+    past[0][0] = objects;
+    assert!(why(&object_bytes(&bytes, &past)).contains(&format!("object {objects} past the {objects} objects")));
+    let mut corner = lists.clone();
+    corner[3][0] = 3 * lists[0].len() as u32;
+    assert!(why(&object_bytes(&bytes, &corner)).contains("past the"), "{}", why(&object_bytes(&bytes, &corner)));
+    let mut odd = lists.clone();
+    odd[2].pop();
+    assert!(why(&object_bytes(&bytes, &odd)).contains("an odd number"));
+    // Another scene's objects: its triangles are not this scene's.
+    let louvres = ExactEngine::new(&louvred_wall()).objects_bytes();
+    assert!(why(&louvres).contains("triangles, where the scene has"), "{}", why(&louvres));
+}

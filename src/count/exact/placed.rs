@@ -6,13 +6,26 @@
 //! Owns the numbering: objects are numbered in the order of their first triangle's position (the
 //! order a view's walk meets them); a corner is `3 · position + k`, corner `k` of the triangle at
 //! that position, so nothing here copies a point. Built once per scene; read per view.
+//!
+//! Also their encoding ([`PlacedObjects::to_bytes`]), so that another wasm instance over the same
+//! scene (a page's clipping worker) takes them instead of grouping the scene's triangles itself:
+//! grouping sets a worker's peak memory (docs/page-speed.md, "Where the memory goes"). Only
+//! what cannot be derived cheaply travels: each position's object and each object's caps; the
+//! per-object triangle and corner lists are rebuilt from them and the world triangles.
 
 use std::ops::Range;
 
 use glam::DVec3;
 
 use super::objects::{self, MeshObjects};
+use crate::error::SceneBytesError;
 use crate::scene::Scene;
+use crate::scene::codec::{Decoded, Reader, Writer, in_range, invalid};
+
+/// The first bytes of encoded objects.
+const MAGIC: [u8; 8] = *b"SUNLITOB";
+/// The encoding's version; bytes of any other version are refused.
+const VERSION: u32 = 1;
 
 /// No object: the triangle casts its own shadow.
 const NO_OBJECT: u32 = u32::MAX;
@@ -61,9 +74,52 @@ impl PlacedObjects {
             .collect();
         let (of, numbered) = renumber_by_position(of, total as usize);
         let cap_ranges = numbered.iter().map(|&o| cap_ranges[o as usize].clone()).collect();
-        let (ranges, object_triangles) = group_positions(&of, numbered.len());
+        Self::assemble(of, cap_ranges, caps, cap_corners, triangles)
+    }
+
+    /// The objects from each position's object and each object's caps: their triangle and corner
+    /// lists follow.
+    fn assemble(of: Vec<u32>, cap_ranges: Vec<Range<u32>>, caps: Vec<Range<u32>>, cap_corners: Vec<u32>, triangles: &[[DVec3; 3]]) -> Self {
+        let (ranges, object_triangles) = group_positions(&of, cap_ranges.len());
         let (corner_ranges, corners) = distinct_corners(&ranges, &object_triangles, triangles);
         Self { of, ranges, triangles: object_triangles, corner_ranges, corners, cap_ranges, caps, cap_corners }
+    }
+
+    /// The objects as bytes ([`Self::from_bytes`] reads them back): magic, version, then each
+    /// position's object, each object's caps, each cap's corners and the corners, as u32 lists.
+    pub(super) fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer(Vec::with_capacity(
+            8 + 4 * (self.of.len() + 2 * self.cap_ranges.len() + 2 * self.caps.len() + self.cap_corners.len()) + 64,
+        ));
+        w.0.extend_from_slice(&MAGIC);
+        w.u32(VERSION);
+        w.u32s(&self.of);
+        w.u32s(&flat(&self.cap_ranges));
+        w.u32s(&flat(&self.caps));
+        w.u32s(&self.cap_corners);
+        w.0
+    }
+
+    /// The objects encoded by [`Self::to_bytes`] for the same scene, whose world triangles (in
+    /// the culling's order) are `triangles`. Refuses bytes that are not such objects, another
+    /// version, truncated ones, or any number past its list (so nothing read can index out of
+    /// bounds); objects encoded for another scene with as many triangles are not told apart.
+    pub(super) fn from_bytes(bytes: &[u8], triangles: &[[DVec3; 3]]) -> Decoded<Self> {
+        let mut r = Reader::new(bytes);
+        if r.take(MAGIC.len(), "magic").ok() != Some(&MAGIC[..]) {
+            return Err(invalid("convex objects", "not encoded convex objects (no SUNLITOB magic)"));
+        }
+        let version = r.u32("version")?;
+        if version != VERSION {
+            return Err(SceneBytesError::Version { found: version, supported: VERSION });
+        }
+        let of = r.u32s("objects of triangles")?;
+        let cap_ranges = ranges(r.u32s("objects' caps")?, "objects' caps")?;
+        let caps = ranges(r.u32s("caps")?, "caps")?;
+        let cap_corners = r.u32s("cap corners")?;
+        r.end()?;
+        check_objects(&of, &cap_ranges, &caps, &cap_corners, triangles.len())?;
+        Ok(Self::assemble(of, cap_ranges, caps, cap_corners, triangles))
     }
 
     /// Objects numbered (every convex one): the size of a per-object stamp.
@@ -101,6 +157,40 @@ impl PlacedObjects {
         let range = &self.cap_ranges[o as usize];
         self.caps[range.start as usize..range.end as usize].iter().map(|cap| slice(&self.cap_corners, cap))
     }
+}
+
+/// Ranges as their ends, in order.
+fn flat(ranges: &[Range<u32>]) -> Vec<u32> {
+    ranges.iter().flat_map(|r| [r.start, r.end]).collect()
+}
+
+/// Pairs of ends as ranges; an odd count is refused ([`flat`] writes pairs).
+fn ranges(ends: Vec<u32>, what: &str) -> Decoded<Vec<Range<u32>>> {
+    if ends.len() % 2 == 1 {
+        return Err(invalid(what, format!("{} range ends, an odd number", ends.len())));
+    }
+    Ok(ends.chunks_exact(2).map(|p| p[0]..p[1]).collect())
+}
+
+/// Refuses decoded objects any of whose numbers lies past its list.
+fn check_objects(of: &[u32], cap_ranges: &[Range<u32>], caps: &[Range<u32>], cap_corners: &[u32], positions: usize) -> Decoded<()> {
+    if of.len() != positions {
+        return Err(invalid("convex objects", format!("{} triangles, where the scene has {positions}", of.len())));
+    }
+    let objects = cap_ranges.len();
+    if let Some(p) = of.iter().position(|&o| o != NO_OBJECT && o as usize >= objects) {
+        return Err(invalid(format!("triangle {p}"), format!("object {} past the {objects} objects", of[p])));
+    }
+    if let Some(o) = cap_ranges.iter().position(|r| !in_range(r, caps.len())) {
+        return Err(invalid(format!("object {o}"), format!("caps past the {} caps", caps.len())));
+    }
+    if let Some(c) = caps.iter().position(|r| !in_range(r, cap_corners.len())) {
+        return Err(invalid(format!("cap {c}"), format!("corners past the {} cap corners", cap_corners.len())));
+    }
+    if let Some(k) = cap_corners.iter().position(|&c| c as usize >= 3 * positions) {
+        return Err(invalid(format!("cap corner {k}"), format!("corner {} past the {positions} triangles' corners", cap_corners[k])));
+    }
+    Ok(())
 }
 
 fn slice<'a>(items: &'a [u32], range: &Range<u32>) -> &'a [u32] {
