@@ -284,6 +284,44 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
     assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
 }
 
+/// A ray exactly along a closed room's inside corner, edge or vertex (where two or three of its
+/// faces meet) meets the shell: no sky through the crack between two walls. On a 0.25 m work
+/// plane, suns along the north-east corner (16 points on its diagonal), the north wall's top edge
+/// (a row) and the top north-east vertex light nothing, as numpy's caster (whose rays leave only
+/// through the window) says point by point; a sun along the south-east corner agrees with it point
+/// by point too. Behind a screen hiding all the sky no point sees sky, though Tregenza's 45°
+/// sub-patches run along the corners' diagonals from this grid's points.
+#[test]
+fn no_ray_leaves_a_closed_room_through_the_crack_where_its_faces_meet() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, 0.76).unwrap();
+    let rise = ROOM[2] - 0.76;
+    // Grid points lie at x, y = 0.125 + 0.25 k: (1.125, 2.875) sees the edge and the vertex.
+    let suns = [[1.0, 1.0, 0.5], [0.0, ROOM[1] - 2.875, rise], [ROOM[0] - 1.125, ROOM[1] - 2.875, rise], [1.0, -1.0, 0.6]];
+    let on_diagonal = positions(&at).iter().filter(|p| (p[1] - p[0] - 1.0).abs() < 1e-9).count();
+    assert_eq!(on_diagonal, 16);
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let suns: Vec<DVec3> = suns.iter().map(|s| DVec3::from_array(*s).normalize()).collect();
+    let query = json!({"window": WINDOW, "overhang": null, "points": positions(&at), "normal": [0, 0, 1],
+        "suns": suns.iter().map(|s| s.to_array()).collect::<Vec<_>>()});
+    let reference = numpy_reference(&query);
+    for (k, &sun) in suns.iter().enumerate() {
+        let ours = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0).lit;
+        let theirs: Vec<f64> = reference["lit"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let leaks: Vec<[f64; 3]> = (0..ours.len()).filter(|&i| ours[i] != theirs[i]).map(|i| at.points.position(i).to_array()).collect();
+        assert!(leaks.is_empty(), "sun {sun}: {} points differ from numpy, e.g. {:?}", leaks.len(), &leaks[..leaks.len().min(4)]);
+        assert_eq!(theirs.iter().sum::<f64>() > 0.0, k == 3, "sun {sun}: numpy lights points only through the window");
+    }
+    let patches = sunlit::sky::patches::SkyPatches::parse("tregenza").unwrap();
+    let screen = "Shading:Site:Detailed,Screen,,4,-50,-0.3,50,-50,-0.3,0,54,-0.3,0,54,-0.3,50;\n";
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, screen)).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, inside::NSL_WORK_PLANE).unwrap();
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let (sees, _) = inside::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &patches, &mut |_, _| {});
+    let leaks: Vec<[f64; 3]> = (0..sees.len()).filter(|&i| sees[i]).map(|i| at.points.position(i).to_array()).collect();
+    assert!(leaks.is_empty(), "{} points see sky behind the screen, e.g. {:?}", leaks.len(), &leaks[..leaks.len().min(4)]);
+}
+
 /// The proposed model's obstruction for the No-Sky Line: a wall 400 m long (x), `height` m high,
 /// `distance` m south of the window's wall, so the line is drawn in the room's section alone.
 fn long_wall(distance: f64, height: f64) -> String {
