@@ -825,3 +825,42 @@ fn a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle() {
         assert!(!out.exists(), "{curve}: output written");
     }
 }
+
+/// An EnergyPlus window whose construction sunlit cannot read (two panes and a gap) takes the
+/// curve `--glass-curve` gives (the glTF test's pairs): each lit work-plane point's solar weight
+/// is the curve at its beam's incidence on the window, as numpy's caster interpolating the same
+/// pairs says point by point, and its visible weight the given visible transmittance's share of
+/// it. The CLI refuses a curve not starting at 0° naming the flag, and writes nothing.
+#[test]
+fn an_unread_idf_window_takes_the_curve_it_is_given() {
+    use sunlit::model::inside::curve::TransmittanceCurve;
+    use sunlit::model::inside::{UnreadGlass, rooms_with};
+    let idf = room_idf(WINDOW, true, "").replace("Construction,Glass,SimpleGlass;", "Construction,Glass,Pane,Gap,Pane;");
+    let loaded = model::load_bytes_all(&[("room.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default()).unwrap();
+    let ep = loaded.energyplus.unwrap();
+    let curve = TransmittanceCurve::parse("0:0.8,30:0.78,50:0.72,70:0.5").unwrap();
+    assert!(rooms(&ep, None).is_err(), "without a transmittance or a curve the window is refused");
+    let (mut scene, rooms) =
+        (inside_scene(&ep).unwrap(), rooms_with(&ep, &UnreadGlass { transmittance: Some(0.6), curve: Some(curve) }).unwrap());
+    assert_eq!((rooms.glazing[0].solar, rooms.glazing[0].visible), (0.8, 0.6));
+    let at = inside::floor_grid(&mut scene, &rooms, 0.1, 0.76).unwrap();
+    let suns = [[0.2, -0.8, 0.7], [-0.5, -0.5, 0.5], [0.35, -0.7, 0.6]];
+    // numpy's `visible` at vt 0.8 (the curve's normal value) is the curve itself at the incidence.
+    let (answers, reference) = lit_against_numpy(&scene, &rooms, &at, &suns, json!({"vt": 0.8, "angular": CURVE}));
+    for (k, (sun, ours, theirs)) in answers.into_iter().enumerate() {
+        let numpy = reference["visible"][k].as_array().unwrap();
+        let mut weighted = 0;
+        for i in (0..theirs.len()).filter(|&i| ours.lit[i] == theirs[i] && theirs[i] == 1.0) {
+            let (s, v, t) = (ours.solar_transmittance[i], ours.visible_transmittance[i], numpy[i].as_f64().unwrap());
+            assert!((s - t).abs() < 1e-9 && (v - 0.75 * t).abs() < 1e-9, "sun {sun}: point {i}: solar {s}, visible {v}, the curve {t}");
+            weighted += usize::from(t < 0.795);
+        }
+        assert!(weighted > 100, "sun {sun}: the curve should take something off ({weighted} points)");
+    }
+    let (model_path, out) = (scratch("unread.idf"), scratch("unread.csv"));
+    std::fs::write(&model_path, &idf).unwrap();
+    let args = ["map", model_path.to_str().unwrap(), "--inside", "--at", "06-21", "12:00", "--location", "39.74,-105.18,-7"];
+    let bad = sunlit(&[&args[..], &["--glass-curve", "10:0.8,40:0.7", "-o", out.to_str().unwrap()]].concat());
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--glass-curve"), "{bad:?}");
+    assert!(!out.exists());
+}
