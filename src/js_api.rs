@@ -164,15 +164,17 @@ fn the_sky_model_names_are_the_same_on_both_sides() {
 #[path = "web/map_options.rs"]
 mod map_options;
 
-use map_options::{MAP_KEYS, MapRequest, MapValue, SITE_KEYS, Where};
+use map_options::{INSIDE_KEYS, InsideAsk, MAP_KEYS, MapRequest, MapValue, SITE_KEYS, Where};
 use serde_json::json;
 
 use crate::map::Period;
 
 #[test]
 fn the_map_options_are_the_same_on_both_sides() {
-    let rust: BTreeSet<String> = MAP_KEYS.iter().chain(&SITE_KEYS).map(|k| k.to_string()).collect();
+    let rust: BTreeSet<String> = MAP_KEYS.iter().chain(&SITE_KEYS).chain(&INSIDE_KEYS).map(|k| k.to_string()).collect();
     assert_eq!(fields(interface("MapOptions")), rust);
+    let patch: BTreeSet<String> = ["surface", "zone", "areaM2", "fraction"].map(String::from).into();
+    assert_eq!(fields(interface("SunPatch")), patch, "the patches' JSON keys (web/inside.rs)");
     let annual: BTreeSet<String> = match serde_json::to_value(AnnualSettings::default()).unwrap() {
         serde_json::Value::Object(map) => map.keys().cloned().collect(),
         other => panic!("{other}"),
@@ -207,6 +209,10 @@ fn map_options_read_as_sunlit_map_reads_its_flags() {
     assert_eq!(range.period, Period::days(152, 158, 2).unwrap());
     let at = request(json!({"at": "03-21 09:30"})).unwrap();
     assert_eq!((at.period, at.value), (Period::at(80, 570).unwrap(), MapValue::Lit));
+    let inside = request(json!({"at": "12-21 15:00", "inside": true, "workPlane": 0.76, "glassTransmittance": 0.6})).unwrap();
+    assert_eq!(inside.inside, Some(InsideAsk { work_plane: 0.76, glass: Some(0.6) }));
+    assert_eq!(request(json!({"at": "12-21 15:00", "inside": true})).unwrap().inside, Some(InsideAsk { work_plane: 0.0, glass: None }));
+    assert_eq!(request(json!({"at": "12-21 15:00", "inside": false})).unwrap().inside, None);
     let given = request(json!({"points": [1, 2, 3, 0, 0, 1]})).unwrap();
     assert_eq!(given.place, Where::Given(vec![1.0, 2.0, 3.0, 0.0, 0.0, 1.0]));
     assert_eq!(map_options::points_csv(&[1.0, 2.5, 3.0, 0.0, 0.0, 1.0]).unwrap(), "x,y,z,nx,ny,nz\n1.0,2.5,3.0,0.0,0.0,1.0\n");
@@ -234,6 +240,10 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"skyModel": "uniform"})), bad("sky_model"), "a sky model needs an EPW");
     assert_eq!(named(json!({"skyModel": "perez"})), bad("sky_model"));
     assert_eq!(named(json!({"timestepsPerHour": 4})), bad("options"));
+    assert_eq!(named(json!({"inside": true})), bad("inside"), "inside at an instant only");
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": "yes"})), bad("inside"));
+    assert_eq!(named(json!({"at": "12-21 15:00", "workPlane": 0.76})), bad("workPlane"), "a work plane without inside");
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glassTransmittance": "clear"})), bad("glassTransmittance"));
     assert_eq!(MapRequest::from_value(json!({"grid": 1})).err().map(|e| e.code()), Some("bad-option"), "no location");
 }
 

@@ -15,6 +15,7 @@ use std::rc::Rc;
 mod choice;
 mod clipper;
 mod embed;
+mod inside;
 mod lazy;
 mod map;
 mod map_options;

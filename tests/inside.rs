@@ -284,6 +284,44 @@ fn no_sky_line_is_all_of_an_open_room_and_none_behind_a_screen() {
     assert_eq!(share(&room_idf(WINDOW, false, screen)), 0.0);
 }
 
+/// A ray exactly along a closed room's inside corner, edge or vertex (where two or three of its
+/// faces meet) meets the shell: no sky through the crack between two walls. On a 0.25 m work
+/// plane, suns along the north-east corner (16 points on its diagonal), the north wall's top edge
+/// (a row) and the top north-east vertex light nothing, as numpy's caster (whose rays leave only
+/// through the window) says point by point; a sun along the south-east corner agrees with it point
+/// by point too. Behind a screen hiding all the sky no point sees sky, though Tregenza's 45°
+/// sub-patches run along the corners' diagonals from this grid's points.
+#[test]
+fn no_ray_leaves_a_closed_room_through_the_crack_where_its_faces_meet() {
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, "")).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, 0.76).unwrap();
+    let rise = ROOM[2] - 0.76;
+    // Grid points lie at x, y = 0.125 + 0.25 k: (1.125, 2.875) sees the edge and the vertex.
+    let suns = [[1.0, 1.0, 0.5], [0.0, ROOM[1] - 2.875, rise], [ROOM[0] - 1.125, ROOM[1] - 2.875, rise], [1.0, -1.0, 0.6]];
+    let on_diagonal = positions(&at).iter().filter(|p| (p[1] - p[0] - 1.0).abs() < 1e-9).count();
+    assert_eq!(on_diagonal, 16);
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let suns: Vec<DVec3> = suns.iter().map(|s| DVec3::from_array(*s).normalize()).collect();
+    let query = json!({"window": WINDOW, "overhang": null, "points": positions(&at), "normal": [0, 0, 1],
+        "suns": suns.iter().map(|s| s.to_array()).collect::<Vec<_>>()});
+    let reference = numpy_reference(&query);
+    for (k, &sun) in suns.iter().enumerate() {
+        let ours = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0).lit;
+        let theirs: Vec<f64> = reference["lit"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let leaks: Vec<[f64; 3]> = (0..ours.len()).filter(|&i| ours[i] != theirs[i]).map(|i| at.points.position(i).to_array()).collect();
+        assert!(leaks.is_empty(), "sun {sun}: {} points differ from numpy, e.g. {:?}", leaks.len(), &leaks[..leaks.len().min(4)]);
+        assert_eq!(theirs.iter().sum::<f64>() > 0.0, k == 3, "sun {sun}: numpy lights points only through the window");
+    }
+    let patches = sunlit::sky::patches::SkyPatches::parse("tregenza").unwrap();
+    let screen = "Shading:Site:Detailed,Screen,,4,-50,-0.3,50,-50,-0.3,0,54,-0.3,0,54,-0.3,50;\n";
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, screen)).unwrap();
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, inside::NSL_WORK_PLANE).unwrap();
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let (sees, _) = inside::no_sky_line(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, &patches, &mut |_, _| {});
+    let leaks: Vec<[f64; 3]> = (0..sees.len()).filter(|&i| sees[i]).map(|i| at.points.position(i).to_array()).collect();
+    assert!(leaks.is_empty(), "{} points see sky behind the screen, e.g. {:?}", leaks.len(), &leaks[..leaks.len().min(4)]);
+}
+
 /// The proposed model's obstruction for the No-Sky Line: a wall 400 m long (x), `height` m high,
 /// `distance` m south of the window's wall, so the line is drawn in the room's section alone.
 fn long_wall(distance: f64, height: f64) -> String {
@@ -786,4 +824,43 @@ fn a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle() {
         }
         assert!(!out.exists(), "{curve}: output written");
     }
+}
+
+/// An EnergyPlus window whose construction sunlit cannot read (two panes and a gap) takes the
+/// curve `--glass-curve` gives (the glTF test's pairs): each lit work-plane point's solar weight
+/// is the curve at its beam's incidence on the window, as numpy's caster interpolating the same
+/// pairs says point by point, and its visible weight the given visible transmittance's share of
+/// it. The CLI refuses a curve not starting at 0° naming the flag, and writes nothing.
+#[test]
+fn an_unread_idf_window_takes_the_curve_it_is_given() {
+    use sunlit::model::inside::curve::TransmittanceCurve;
+    use sunlit::model::inside::{UnreadGlass, rooms_with};
+    let idf = room_idf(WINDOW, true, "").replace("Construction,Glass,SimpleGlass;", "Construction,Glass,Pane,Gap,Pane;");
+    let loaded = model::load_bytes_all(&[("room.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default()).unwrap();
+    let ep = loaded.energyplus.unwrap();
+    let curve = TransmittanceCurve::parse("0:0.8,30:0.78,50:0.72,70:0.5").unwrap();
+    assert!(rooms(&ep, None).is_err(), "without a transmittance or a curve the window is refused");
+    let (mut scene, rooms) =
+        (inside_scene(&ep).unwrap(), rooms_with(&ep, &UnreadGlass { transmittance: Some(0.6), curve: Some(curve) }).unwrap());
+    assert_eq!((rooms.glazing[0].solar, rooms.glazing[0].visible), (0.8, 0.6));
+    let at = inside::floor_grid(&mut scene, &rooms, 0.1, 0.76).unwrap();
+    let suns = [[0.2, -0.8, 0.7], [-0.5, -0.5, 0.5], [0.35, -0.7, 0.6]];
+    // numpy's `visible` at vt 0.8 (the curve's normal value) is the curve itself at the incidence.
+    let (answers, reference) = lit_against_numpy(&scene, &rooms, &at, &suns, json!({"vt": 0.8, "angular": CURVE}));
+    for (k, (sun, ours, theirs)) in answers.into_iter().enumerate() {
+        let numpy = reference["visible"][k].as_array().unwrap();
+        let mut weighted = 0;
+        for i in (0..theirs.len()).filter(|&i| ours.lit[i] == theirs[i] && theirs[i] == 1.0) {
+            let (s, v, t) = (ours.solar_transmittance[i], ours.visible_transmittance[i], numpy[i].as_f64().unwrap());
+            assert!((s - t).abs() < 1e-9 && (v - 0.75 * t).abs() < 1e-9, "sun {sun}: point {i}: solar {s}, visible {v}, the curve {t}");
+            weighted += usize::from(t < 0.795);
+        }
+        assert!(weighted > 100, "sun {sun}: the curve should take something off ({weighted} points)");
+    }
+    let (model_path, out) = (scratch("unread.idf"), scratch("unread.csv"));
+    std::fs::write(&model_path, &idf).unwrap();
+    let args = ["map", model_path.to_str().unwrap(), "--inside", "--at", "06-21", "12:00", "--location", "39.74,-105.18,-7"];
+    let bad = sunlit(&[&args[..], &["--glass-curve", "10:0.8,40:0.7", "-o", out.to_str().unwrap()]].concat());
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--glass-curve"), "{bad:?}");
+    assert!(!out.exists());
 }

@@ -3,6 +3,7 @@
 // a day/time slider that maps the instant as it moves; the points CSV and the map glb to
 // download (the library's own writers, as `sunlit map` writes them), written by the worker only
 // when a download is clicked: a slider's move asks for nothing the view does not draw.
+import { insideOptions, patchSummary, wireInside } from './insidemode.js';
 import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 const MONTH_DAYS = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
@@ -50,7 +51,7 @@ export function mapMode(page) {
   async function options() {
     const o = { ...(await page.location()), grid: Number($('mapgrid').value) };
     if (page.skyModel()) o.skyModel = page.skyModel();
-    if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit' };
+    if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit', ...insideOptions($) };
     o.value = $('mapvalue').value;
     const period = $('mapperiod').value;
     if (period === 'range') o.period = `${$('mapstart').value.trim()}..${$('mapend').value.trim()}`;
@@ -104,6 +105,7 @@ export function mapMode(page) {
     view.dataset.cells = String(map.values.length);
     view.dataset.lit = lit === null ? '' : String(lit);
     view.dataset.at = map.value === 'lit' ? `${tag.day},${tag.time}` : '';
+    view.dataset.patches = map.patches ? JSON.stringify(map.patches) : '';
     state.id = id;
     $('downloadmap').disabled = false;
     $('downloadglb').disabled = false;
@@ -111,7 +113,7 @@ export function mapMode(page) {
     const summary =
       lit === null
         ? `${info.title} from ${map.min.toFixed(2)} to ${map.max.toFixed(2)}${info.unit ? ` ${info.unit}` : ''} over ${map.instants.toLocaleString()} instants`
-        : `${lit.toLocaleString()} in the sun`;
+        : `${lit.toLocaleString()} in the sun${patchSummary(map.patches)}`;
     page.status(`Map in ${seconds.toFixed(1)} s (${tag.kind}): ${map.values.length.toLocaleString()} points on ${receivers} receivers; ${summary}.`);
   }
 
@@ -150,6 +152,7 @@ export function mapMode(page) {
     const ask = (kind) => state.map && page.worker.postMessage({ type: 'mapFile', id: state.id, kind });
     $('downloadmap').addEventListener('click', () => ask('csv'));
     $('downloadglb').addEventListener('click', () => ask('glb'));
+    wireInside(page);
     showFields();
   }
 
@@ -166,6 +169,8 @@ export function mapMode(page) {
       state.id = null;
       $('downloadmap').disabled = true;
       $('downloadglb').disabled = true;
+      $('mapcut').value = '';
+      $('view').dataset.cut = '';
       showFields();
     },
   };

@@ -401,6 +401,26 @@ export interface MapOptions {
   /** The sky for 'skyDiffuse' and 'total' (needs `epw`), as `sunlit map --sky-model`:
    * 'energyplus' (the default), 'perez-all-weather', 'cie-overcast' or 'uniform'. */
   skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
+  /** Map the inside of an EnergyPlus model's zones at the instant `at`, as `sunlit map --inside
+   * --at`: a grid on their floors (or `points` in them), each point lit or not by the beam
+   * through the windows; the answer adds the glass's weights and each inside face's sun patch. */
+  inside?: boolean;
+  /** With `inside`: the grid this many metres above each floor (default 0: on the floors). */
+  workPlane?: number;
+  /** With `inside`: transmittance (0..1) of glazing whose construction gives none. */
+  glassTransmittance?: number;
+}
+
+/** One inside face's sun patch at the instant (`inside: true`). */
+export interface SunPatch {
+  /** The inside face, `SURFACE:inside`. */
+  surface: string;
+  /** Its zone. */
+  zone: string;
+  /** Sunlit area, m² (geometry: the glass's weight not applied). */
+  areaM2: number;
+  /** Sunlit share of the face's net area. */
+  fraction: number;
 }
 
 export interface MapRunOptions extends AnnualRunOptions {
@@ -470,8 +490,15 @@ export interface SunlitMap {
   /** The legend's range: 0 and the largest value (lit: 0 and 1). */
   min: number;
   max: number;
-  /** The model's receiver names. */
+  /** The model's receiver names; inside rooms, the inside faces' and work planes' names. */
   receiverNames: string[];
+  /** Inside rooms: per point the solar transmittance of the glass its beam came through (0
+   * shaded). */
+  solarTransmittance?: Float32Array;
+  /** Inside rooms: per point the visible transmittance likewise. */
+  visibleTransmittance?: Float32Array;
+  /** Inside rooms: the sun patch on each inside face that has one. */
+  patches?: SunPatch[];
 }
 
 /** A scene on the engine's GPU device; use it only with the engine that made it. */

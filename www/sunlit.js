@@ -393,7 +393,8 @@ class SunlitEngine {
         skyViewFactor: map.skyViewFactor,
         min: map.min,
         max: map.max,
-        receiverNames: model.receiverNames,
+        receiverNames: map.insideNames ?? model.receiverNames,
+        ...insideOf(map),
         csv: csv ? map.csv() : undefined,
         glb: glb ? map.glb() : undefined,
         files: files ? mapFiles(map) : undefined,
@@ -430,6 +431,14 @@ class SunlitEngine {
       study.free();
     }
   }
+}
+
+/** An inside map's own fields (`inside: true`): the glass's weights per point and the sun patches;
+ * none for a map outside. */
+function insideOf(map) {
+  const patches = map.patches;
+  if (patches === undefined) return {};
+  return { solarTransmittance: map.solarTransmittance, visibleTransmittance: map.visibleTransmittance, patches: JSON.parse(patches) };
 }
 
 /** A map's files on demand: the wasm map is kept (its values in full precision, as the CLI writes

@@ -4,6 +4,7 @@
 // and release without a drag) asks `onPick(receiver)` with the receiver of the nearest triangle
 // under the pointer (−1: shading geometry or nothing).
 import { GREY } from './colour.js';
+import { isCut } from './insidemode.js';
 
 const FLOATS_PER_VERTEX = 9; // position, normal, colour
 
@@ -54,6 +55,7 @@ export class Viewer {
   /** New geometry: 9 floats per triangle, and per triangle its receiver (−1: shading). */
   setModel(positions, receivers) {
     this.positions = positions;
+    this.cut = null;
     this.receivers = receivers;
     const lo = [Infinity, Infinity, Infinity];
     const hi = [-Infinity, -Infinity, -Infinity];
@@ -67,18 +69,28 @@ export class Viewer {
     this.orbit.distance = 1.6 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 10;
   }
 
+  /** Cuts away the triangles beyond a plane ({ axis, side, at }: insidemode.js's cutOf), or
+   * none with `null`: a roof or a wall taken off to see the rooms' floors. */
+  setCut(cut) {
+    this.cut = cut;
+    if (this.colourOfReceiver) this.setColours(this.colourOfReceiver);
+  }
+
   /** Colours per receiver (RGB 0..1); shading geometry stays grey. */
   setColours(colourOfReceiver) {
     const { positions, receivers } = this;
     if (!positions) return;
-    const triangles = receivers.length;
-    const data = new Float32Array(triangles * 3 * FLOATS_PER_VERTEX);
-    for (let t = 0; t < triangles; t++) {
+    this.colourOfReceiver = colourOfReceiver;
+    const kept = [];
+    for (let t = 0; t < receivers.length; t++) if (!isCut(this.cut, positions, 9 * t)) kept.push(t);
+    this.canvas.dataset.triangles = String(kept.length);
+    const data = new Float32Array(kept.length * 3 * FLOATS_PER_VERTEX);
+    for (const [k, t] of kept.entries()) {
       const p = positions.subarray(9 * t, 9 * t + 9);
       const n = normal(p);
       const c = receivers[t] >= 0 ? colourOfReceiver(receivers[t]) : GREY;
       for (let v = 0; v < 3; v++) {
-        data.set([p[3 * v], p[3 * v + 1], p[3 * v + 2], n[0], n[1], n[2], c[0], c[1], c[2]], (3 * t + v) * FLOATS_PER_VERTEX);
+        data.set([p[3 * v], p[3 * v + 1], p[3 * v + 2], n[0], n[1], n[2], c[0], c[1], c[2]], (3 * k + v) * FLOATS_PER_VERTEX);
       }
     }
     this.base = data;
@@ -183,6 +195,7 @@ export class Viewer {
     let best = Infinity;
     let hit = -1;
     for (let t = 0; t < receivers.length; t++) {
+      if (isCut(this.cut, positions, 9 * t)) continue;
       const d = rayTriangle(eye, ray, positions, 9 * t);
       if (d < best) {
         best = d;

@@ -113,6 +113,12 @@ pub(super) struct MapArgs {
     /// WindowMaterial:SimpleGlazingSystem, and of every --glazing node.
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     glass_transmittance: Option<f64>,
+    /// With --inside and an EnergyPlus model: the solar transmittance by angle of incidence of
+    /// glazing whose construction sunlit cannot read, ANGLE:T pairs from 0° (degrees, never
+    /// rising), e.g. 0:0.6,40:0.58,60:0.5,80:0.25; --glass-transmittance then gives the visible
+    /// value (else the curve's at 0°), which falls off in the same proportion.
+    #[arg(long, value_name = "ANGLE:T,...", requires = "inside")]
+    glass_curve: Option<String>,
     /// With --inside and a grid: put it this many metres above each floor (default 0: on the
     /// floors; 0.76 with --study leed-ase).
     #[arg(long, value_name = "METRES", allow_hyphen_values = true)]

@@ -2,12 +2,14 @@
 //! model, their points, and the instant, period or LEED ASE outputs. The library owns the rooms,
 //! the glass, the sums and the rule.
 
+use sunlit::export::map_table::inside_instant_columns;
 use sunlit::map::inside::{
     self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, InsideMap, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
 };
 use sunlit::map::planning::compare::FORMER_RATIO;
+use sunlit::model::inside::curve::TransmittanceCurve;
 use sunlit::model::inside::gltf::rooms as gltf_rooms;
-use sunlit::model::inside::{Rooms, inside_scene, rooms};
+use sunlit::model::inside::{Rooms, UnreadGlass, inside_scene, rooms_with};
 
 use super::*;
 
@@ -68,6 +70,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
     {
         return Err(Error::argument("spacing", format!("{g} m: a grid spacing must be a positive number of metres")));
     }
+    unread_glass(&args)?;
     let (location, weather) = args.site()?;
     let (mut scene, rooms) = read_rooms(&args, &args.model)?;
     let defaults = match ask {
@@ -203,6 +206,12 @@ fn nsl_report(args: &MapArgs, patches: &SkyPatches, areas: &[rooms_map::NslArea]
 /// glass `--interior` and `--glazing` pick; `model` is the proposed model's or the existing one's.
 fn read_rooms(args: &MapArgs, model: &ModelArgs) -> Result<(Scene, Rooms)> {
     if !args.interior.is_empty() {
+        if args.glass_curve.is_some() {
+            return Err(Error::argument(
+                "--glass-curve",
+                "is for an EnergyPlus model's glazing: a glTF pane's curve is its material's extras",
+            ));
+        }
         let mut loaded = model.load_rooms(&args.interior, &args.glazing)?;
         if let Some(ep) = &loaded.energyplus {
             return Err(Error::model(&ep.file, "--interior picks the rooms of mesh models: an EnergyPlus model's zones are its rooms"));
@@ -217,7 +226,15 @@ fn read_rooms(args: &MapArgs, model: &ModelArgs) -> Result<(Scene, Rooms)> {
             "maps the zones of one EnergyPlus model (IDF or epJSON), given alone, or the rooms --interior picks in mesh models",
         ));
     };
-    Ok((inside_scene(ep)?, rooms(ep, args.glass_transmittance)?))
+    Ok((inside_scene(ep)?, rooms_with(ep, &unread_glass(args)?)?))
+}
+
+/// What `--glass-transmittance` and `--glass-curve` give glazing whose construction sunlit cannot
+/// read; a bad curve is refused naming the flag and why.
+fn unread_glass(args: &MapArgs) -> Result<UnreadGlass> {
+    let curve = args.glass_curve.as_deref().map(TransmittanceCurve::parse).transpose();
+    let curve = curve.map_err(|why| Error::argument("--glass-curve", why))?;
+    Ok(UnreadGlass { transmittance: args.glass_transmittance, curve })
 }
 
 /// One instant: the points' `lit` and glass weights, and each inside face's sun patch.
@@ -232,15 +249,9 @@ fn instant(
     let s = period.samples()[0];
     let sun = sunlit::sun::position::sun_direction(location, sunlit::year::annual::shading_sun_day(s.day), s.hour);
     let leaves = calendar.fraction(f64::from(s.day)) as f32;
-    let values = rooms_map::instant(map, sun, leaves);
-    let columns = [
-        Column { name: "lit", values: &values.lit, decimals: 0 },
-        Column { name: "solar_transmittance", values: &values.solar_transmittance, decimals: 4 },
-        Column { name: "visible_transmittance", values: &values.visible_transmittance, decimals: 4 },
-    ];
-    let up = sun.z >= sunlit::count::MIN_COS_INCIDENCE;
-    let patches = if up { rooms_map::sun_patches(scene, map.rooms, sun, leaves) } else { Vec::new() };
-    summary["sun_up"] = json!(up);
+    let (values, patches) = rooms_map::instant_with_patches(scene, map, sun, leaves);
+    let columns = inside_instant_columns(&values);
+    summary["sun_up"] = json!(sun.z >= sunlit::count::MIN_COS_INCIDENCE);
     summary["lit_points"] = json!(values.lit.iter().filter(|&&v| v >= 0.5).count());
     summary["sun_patches"] = json!(
         patches

@@ -25,6 +25,16 @@ pub struct Column<'a> {
     pub decimals: usize,
 }
 
+/// An inside instant's value columns ([`crate::map::inside::InsideInstant`]): `lit`, then the
+/// glass's solar and visible weights.
+pub fn inside_instant_columns(values: &crate::map::inside::InsideInstant) -> [Column<'_>; 3] {
+    [
+        Column { name: "lit", values: &values.lit, decimals: 0 },
+        Column { name: "solar_transmittance", values: &values.solar_transmittance, decimals: 4 },
+        Column { name: "visible_transmittance", values: &values.visible_transmittance, decimals: 4 },
+    ]
+}
+
 /// A period's sums as the points CSV's value columns, in the order the module doc gives.
 pub fn value_columns(values: &MapValues) -> Vec<Column<'_>> {
     let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];

@@ -254,6 +254,15 @@ pub fn sun_patches(scene: &Scene, rooms: &Rooms, sun: DVec3, leaves: f32) -> Vec
         .collect()
 }
 
+/// One instant inside, as `sunlit map --inside --at` and the page's interior view answer it: the
+/// points ([`instant`]) and, with the sun up, every inside face's sun patch ([`sun_patches`]).
+pub fn instant_with_patches(scene: &Scene, map: InsideMap<'_>, sun: DVec3, leaves: f32) -> (InsideInstant, Vec<Patch>) {
+    let rooms = map.rooms;
+    let values = instant(map, sun, leaves);
+    let up = sun.z >= crate::count::MIN_COS_INCIDENCE;
+    (values, if up { sun_patches(scene, rooms, sun, leaves) } else { Vec::new() })
+}
+
 /// Per point sums inside over a period.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct InsideValues {

@@ -8,8 +8,9 @@
 //! field (the solar value where it is blank), solar from its U-factor and SHGC by EnergyPlus's
 //! simple glazing correlation (Engineering Reference, "Simple Window Model", step 4: one formula
 //! for U > 4.5 W/m²K, one for U < 3.4, linear in U between). Any other construction takes the
-//! caller's `glass` value for both, except one `WindowMaterial:Glazing` pane given by spectral
-//! averages, whose normal-incidence fields are read as they are. The solar transmittance's
+//! caller's `glass` value for both ([`UnreadGlass`], with an angular curve of the caller's if it
+//! gives one), except one `WindowMaterial:Glazing` pane given by spectral averages, whose
+//! normal-incidence fields are read as they are. The solar transmittance's
 //! angular dependence ([`Glazing::solar_at`], [`Glazing::visible_at`]: the interior beam and the
 //! maps alike) is EnergyPlus's: its curves A–J chosen by U and SHGC for simple glazing
 //! ([`super::simple_glazing`]), Fresnel's physics for one pane; a glTF pane's own, from its
@@ -189,11 +190,30 @@ pub fn inside_scene_glazed(input: &EnergyPlusInput) -> Result<Scene> {
     builder.build()
 }
 
+/// What the caller says of glazing whose construction sunlit cannot read (several layers,
+/// spectral data, a window construction from a file): its normal-incidence transmittance, and
+/// how its solar transmittance falls off with the angle of incidence.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct UnreadGlass {
+    /// Normal-incidence transmittance: solar and visible without a curve, visible with one
+    /// (the curve's normal value then without it).
+    pub transmittance: Option<f64>,
+    /// The solar transmittance by angle (its value at 0° the normal one), the visible one
+    /// falling off in the same proportion; without it the value is the same at every angle.
+    pub curve: Option<TransmittanceCurve>,
+}
+
 /// The model's zones and openings. `glass` is the transmittance of glazing whose construction
 /// gives none (see the module doc); refused outside 0..=1, and needed only when such glazing
 /// exists (the error names the window).
 pub fn rooms(input: &EnergyPlusInput, glass: Option<f64>) -> Result<Rooms> {
-    if let Some(t) = glass
+    rooms_with(input, &UnreadGlass { transmittance: glass, curve: None })
+}
+
+/// [`rooms`], glazing whose construction sunlit cannot read taking `glass`: its transmittance
+/// and, with a curve, the curve's angular dependence ([`Angular::Curve`]).
+pub fn rooms_with(input: &EnergyPlusInput, glass: &UnreadGlass) -> Result<Rooms> {
+    if let Some(t) = glass.transmittance
         && !(0.0..=1.0).contains(&t)
     {
         return Err(Error::argument("glass_transmittance", format!("{t} is outside 0..=1")));
@@ -248,18 +268,19 @@ fn ray_hits_triangle(p: DVec3, dir: DVec3, t: &[DVec3; 3], slack: f64) -> bool {
     u >= -slack && v >= -slack && u + v <= 1.0 + slack && e2.dot(q) / a > 0.0
 }
 
-fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: Option<f64>) -> Result<Glazing> {
-    let (solar, visible, angular) = match simple_glazing(input, s)? {
-        Some(t) => t,
-        None => {
-            let Some(t) = glass else {
-                return Err(Error::object(
-                    &input.file,
-                    s.label(),
-                    "has no WindowMaterial:SimpleGlazingSystem construction to take a transmittance from: give a glass transmittance",
-                ));
-            };
-            (t, t, Angular::Normal)
+fn glazing_of(input: &EnergyPlusInput, s: &EpSurface, glass: &UnreadGlass) -> Result<Glazing> {
+    let (solar, visible, angular) = match (simple_glazing(input, s)?, glass) {
+        (Some(t), _) => t,
+        (None, UnreadGlass { transmittance, curve: Some(curve) }) => {
+            (curve.normal(), transmittance.unwrap_or(curve.normal()), Angular::Curve(curve.clone()))
+        }
+        (None, UnreadGlass { transmittance: Some(t), curve: None }) => (*t, *t, Angular::Normal),
+        (None, UnreadGlass { transmittance: None, curve: None }) => {
+            return Err(Error::object(
+                &input.file,
+                s.label(),
+                "has no WindowMaterial:SimpleGlazingSystem construction to take a transmittance from: give a glass transmittance",
+            ));
         }
     };
     let base = input.building.surface(s.base.as_deref().unwrap_or_default());

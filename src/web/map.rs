@@ -14,6 +14,7 @@ use js_sys::{Float32Array, Function, Promise, Uint8Array, Uint32Array};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::{JsFuture, future_to_promise};
 
+use super::inside::{Inside, inside_at};
 use super::map_options::{MapRequest, MapValue, Where, points_csv as given_points};
 use super::{Engine, Model, ModelInner, js_error};
 use crate::error::{Error, Result};
@@ -81,6 +82,9 @@ pub struct PointMap {
     /// A period's sums (None for an instant), as `sunlit map` writes them.
     sums: Option<MapValues>,
     instants: usize,
+    /// Inside rooms (`inside: true`): the inside scene the points lie on, the glass's weights
+    /// and the sun patches.
+    inside: Option<Inside>,
 }
 
 impl PointMap {
@@ -199,9 +203,39 @@ impl PointMap {
         if self.value == MapValue::Lit || top <= 0.0 { 1.0 } else { top }
     }
 
+    /// Inside rooms: per point the glass's solar transmittance on its beam (0 shaded; undefined
+    /// outside).
+    #[wasm_bindgen(getter, js_name = solarTransmittance)]
+    pub fn solar_transmittance(&self) -> Option<Float32Array> {
+        self.inside.as_ref().map(|i| to_f32(&i.values.solar_transmittance))
+    }
+
+    /// Inside rooms: per point the glass's visible transmittance likewise.
+    #[wasm_bindgen(getter, js_name = visibleTransmittance)]
+    pub fn visible_transmittance(&self) -> Option<Float32Array> {
+        self.inside.as_ref().map(|i| to_f32(&i.values.visible_transmittance))
+    }
+
+    /// Inside rooms: the inside scene's receiver names, which `receivers` index (undefined
+    /// outside: the model's `receiverNames`).
+    #[wasm_bindgen(getter, js_name = insideNames)]
+    pub fn inside_names(&self) -> Option<Vec<String>> {
+        self.inside.as_ref().map(Inside::receiver_names)
+    }
+
+    /// Inside rooms: each inside face's sun patch, as JSON (`surface`, `zone`, `areaM2`,
+    /// `fraction`), as `map --inside --at --json` reports `sun_patches`.
+    #[wasm_bindgen(getter)]
+    pub fn patches(&self) -> Option<String> {
+        self.inside.as_ref().map(Inside::patches_json)
+    }
+
     /// The points CSV as `sunlit map -o POINTS.csv` writes it for the same options.
     pub fn csv(&self) -> String {
-        points_csv(&self.model.scene, &self.points, &self.columns())
+        match &self.inside {
+            Some(inside) => inside.csv(&self.points),
+            None => points_csv(&self.model.scene, &self.points, &self.columns()),
+        }
     }
 
     /// The map glb as `sunlit map --glb-out` writes it, coloured by the value asked.
@@ -213,7 +247,10 @@ impl PointMap {
             MapValue::Total => ("total_kwh_m2", "kWh/m²"),
             MapValue::Lit => ("lit", ""),
         };
-        Uint8Array::from(map_glb(&self.model.scene, &self.points, &self.values, name, unit).as_slice())
+        match &self.inside {
+            Some(inside) => Uint8Array::from(inside.glb(&self.points).as_slice()),
+            None => Uint8Array::from(map_glb(&self.model.scene, &self.points, &self.values, name, unit).as_slice()),
+        }
     }
 }
 
@@ -231,6 +268,12 @@ impl Engine {
         let model = model.inner.clone();
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
+            if let Some(ask) = &request.inside {
+                let (points, inside) = inside_at(&model, &request, ask).map_err(map_error)?;
+                let values = inside.values.lit.clone();
+                let (value, points) = (MapValue::Lit, Rc::new(points));
+                return Ok(PointMap { model, points, value, values, sums: None, instants: 1, inside: Some(inside) }.into());
+            }
             let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
             let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper, request.site.sky_model));
             let site = Site {
@@ -243,7 +286,7 @@ impl Engine {
             let value = request.value;
             let map = if value == MapValue::Lit {
                 let values = lit_at(&mapper, site, &samples, points.len()).into_iter().map(f64::from).collect();
-                PointMap { model, points, value, values, sums: None, instants: samples.len() }
+                PointMap { model, points, value, values, sums: None, instants: samples.len(), inside: None }
             } else {
                 let sums = summed(&mapper, site, &samples, progress.as_ref(), signal.as_ref()).await.map_err(map_error)?;
                 let values = match value {
@@ -253,7 +296,7 @@ impl Engine {
                     MapValue::SunHours | MapValue::Lit => Some(sums.sun_hours.clone()),
                 }
                 .unwrap_or_default();
-                PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums) }
+                PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums), inside: None }
             };
             Ok(map.into())
         })
@@ -273,6 +316,8 @@ fn request_from_js(options: &JsValue) -> Result<MapRequest> {
 fn map_error(error: Error) -> JsValue {
     js_error(match error {
         Error::Argument { what, reason } if what == "spacing" => Error::Argument { what: "grid".into(), reason },
+        Error::Argument { what, reason } if what == "work_plane" => Error::Argument { what: "workPlane".into(), reason },
+        Error::Argument { what, reason } if what == "glass_transmittance" => Error::Argument { what: "glassTransmittance".into(), reason },
         other => other,
     })
 }

@@ -1,7 +1,8 @@
 //! `engine.map`'s options object (`MapOptions` in `www/sunlit.d.ts`) read into the library's
 //! terms: the site and leaf calendar as an annual run resolves them ([`AnnualSettings`]), where
 //! (a grid or given points), when ([`Period`], with `sunlit map`'s defaults) and what
-//! ([`MapValue`]). Plain JSON in, so it is tested natively too (`js_api`).
+//! ([`MapValue`]), and whether inside rooms ([`InsideAsk`], `sunlit map --inside --at`). Plain
+//! JSON in, so it is tested natively too (`js_api`).
 
 use serde_json::Value;
 
@@ -22,6 +23,9 @@ pub const DEFAULT_DAY_STEP: u32 = 10;
 
 /// The keys of the options object that say where, when and what.
 pub const MAP_KEYS: [&str; 8] = ["grid", "points", "period", "step", "from", "to", "at", "value"];
+
+/// The keys that map the inside of an EnergyPlus model's zones instead of its outside.
+pub const INSIDE_KEYS: [&str; 3] = ["inside", "workPlane", "glassTransmittance"];
 
 /// The annual settings' keys a map also takes: the site, the foliage's calendar and the sky model
 /// ([`AnnualSettings`], resolved as an annual run resolves them).
@@ -102,6 +106,18 @@ pub struct MapRequest {
     pub period: Period,
     /// What.
     pub value: MapValue,
+    /// Inside the zones (`inside: true`), at an instant only.
+    pub inside: Option<InsideAsk>,
+}
+
+/// The inside map asked (`sunlit map --inside --at`): points on the zones' floors (a grid at
+/// `work_plane` m above them) or given ones, the beam through the windows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InsideAsk {
+    /// Height of the grid above the floors (m): 0, on the floors' inside faces (`--work-plane`).
+    pub work_plane: f64,
+    /// Transmittance of glazing whose construction gives none (`--glass-transmittance`).
+    pub glass: Option<f64>,
 }
 
 /// Given points (6 numbers each) as the `x,y,z,nx,ny,nz` text the library reads, so a JS array
@@ -126,12 +142,14 @@ impl MapRequest {
         let Value::Object(mut all) = options else {
             return Err(Error::argument("options", "give an object with at least a location (latitude, longitude, timeZone) or an EPW"));
         };
-        if let Some(key) = all.keys().find(|k| !MAP_KEYS.contains(&k.as_str()) && !SITE_KEYS.contains(&k.as_str())) {
+        let known = |k: &String| MAP_KEYS.contains(&k.as_str()) || SITE_KEYS.contains(&k.as_str()) || INSIDE_KEYS.contains(&k.as_str());
+        if let Some(key) = all.keys().find(|k| !known(k)) {
             return Err(Error::argument(
                 "options",
-                format!("'{key}' is not a map option ({}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", ")),
+                format!("'{key}' is not a map option ({}, {}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", "), INSIDE_KEYS.join(", ")),
             ));
         }
+        let inside = inside_ask(all.remove("inside"), all.remove("workPlane"), all.remove("glassTransmittance"))?;
         let mut take = |key: &str| all.remove(key);
         let (grid, points, period, step, from, to, at, value) =
             (take("grid"), take("points"), take("period"), take("step"), take("from"), take("to"), take("at"), take("value"));
@@ -181,8 +199,29 @@ impl MapRequest {
             (true, None) => return Err(Error::argument("value", format!("'{}' needs an EPW (its solar irradiance)", value.name()))),
             (false, _) => None,
         };
-        Ok(Self { site, weather, place, period, value })
+        if inside.is_some() && value != MapValue::Lit {
+            return Err(Error::argument("inside", "the inside is mapped at an instant here: give 'at' (MM-DD HH:MM)"));
+        }
+        Ok(Self { site, weather, place, period, value, inside })
     }
+}
+
+/// `inside`, `workPlane` and `glassTransmittance`: the inside asked, or none (the latter two
+/// need the first).
+fn inside_ask(inside: Option<Value>, work_plane: Option<Value>, glass: Option<Value>) -> Result<Option<InsideAsk>> {
+    let inside = match inside {
+        None | Some(Value::Bool(false)) => false,
+        Some(Value::Bool(true)) => true,
+        Some(other) => return Err(Error::argument("inside", format!("{other} is not true or false"))),
+    };
+    let (work_plane, glass) = (number("workPlane", work_plane)?, number("glassTransmittance", glass)?);
+    if !inside {
+        if let Some(name) = [("workPlane", work_plane), ("glassTransmittance", glass)].iter().find(|(_, v)| v.is_some()).map(|(n, _)| *n) {
+            return Err(Error::argument(name, "maps the inside of rooms: add inside: true"));
+        }
+        return Ok(None);
+    }
+    Ok(Some(InsideAsk { work_plane: work_plane.unwrap_or(0.0), glass }))
 }
 
 /// A number option, if given.

@@ -10,7 +10,7 @@ import { readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
-import { ROOT, closePage, downloadText, servePage, statusAfter as statusAfterOn, sunlit, waitForStatus as statusIs } from './pagetest.mjs';
+import { ROOT, closePage, downloadText, servePage, setMapSliders, statusAfter as statusAfterOn, sunlit, waitForStatus as statusIs } from './pagetest.mjs';
 import { SYDNEY, syntheticEpw } from './epw.mjs';
 
 const EXAMPLE = join(ROOT, 'www/pkg/office.glb');
@@ -93,15 +93,7 @@ async function mapReplies() {
   return page.evaluate(() => globalThis.mapReplies.splice(0));
 }
 
-async function setSlider(day, hour) {
-  await page.evaluate(([d, h]) => {
-    for (const [id, v] of [['mapday', d], ['maptime', h]]) {
-      const input = document.getElementById(id);
-      input.value = String(v);
-      input.dispatchEvent(new Event('input', { bubbles: true }));
-    }
-  }, [day, hour]);
-}
+const setSlider = (day, hour) => setMapSliders(page, day, hour);
 
 test('the Map mode: a day of sun hours on a 1 m grid is drawn, and its points CSV equals `sunlit map`', { timeout: 300_000 }, async () => {
   assert.match(await statusAfter(() => page.setInputFiles('#model', EXAMPLE), /^Loaded|^Could not/), /^Loaded office\.glb/);

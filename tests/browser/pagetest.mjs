@@ -63,3 +63,15 @@ export function sunlit(args, work, cwd = ROOT) {
     env: { ...process.env, XDG_RUNTIME_DIR: work },
   });
 }
+
+/** Moves the Map mode's day and time sliders to `day` (1..365) and `hour`, as a person would
+ * (each fires its input event). */
+export async function setMapSliders(page, day, hour) {
+  await page.evaluate(([d, h]) => {
+    for (const [id, v] of [['mapday', d], ['maptime', h]]) {
+      const input = document.getElementById(id);
+      input.value = String(v);
+      input.dispatchEvent(new Event('input', { bubbles: true }));
+    }
+  }, [day, hour]);
+}

@@ -7,8 +7,13 @@
 //! receiver's own triangles never casting. What changes is the last step: instead of integrating
 //! `receiver − ∪ shadows`, each point is tested against the shadows that reach its bin (a uniform
 //! grid over the receiver's points, built once), and a bin wholly inside a shadow takes the shadow
-//! without a test per point. A point on a shadow's edge counts as lit (the edge has no area, so
-//! the area mean of a fine grid is unaffected).
+//! without a test per point. A point on the edge of the shadows' union counts as lit (the edge has
+//! no area, so the area mean of a fine grid is unaffected), but a point inside the union is dark
+//! even where it lies on the edges of the shadows that make it up: a ray exactly through the edge
+//! two opaque casters share (the corner where a room's two walls meet, a wall's triangulation)
+//! meets the casters, it does not pass between them. Such a point is tested after the shadows:
+//! the directions around it that each opaque shadow touching it covers (an arc of the circle)
+//! are joined, and it is dark when they close the circle ([`closes_circle`]).
 //!
 //! Foliage: a leaf casts when the request's leaf fraction says it does, as in the engine. A
 //! see-through caster (transmittance `t > 0`) lets `t` of the sun through: a point's visibility is
@@ -16,10 +21,20 @@
 //! convex see-through object is one shadow, so its two faces count once (the GPU's per-pixel
 //! dither, seeded per object, keeps or drops both faces together: the same expectation).
 
+use std::f64::consts::{FRAC_PI_2, TAU};
+
 use glam::{DVec2, DVec3};
 
 use super::engine::{ExactEngine, Scratch};
 use crate::count::ViewRequest;
+
+/// A point this close to a shadow's edge (times `1 +` the largest coordinate of the shadow's
+/// corners, in the receiver's frame) lies on it: rounding moves the ends of an edge two casters
+/// share by about 1e-15 of the coordinates.
+const ON_EDGE: f64 = 1e-9;
+/// Arcs of directions closer than this (radians) touch: edges two shadows share are the same
+/// corners' differences, or collinear pieces of them.
+const ARC_GAP: f64 = 1e-9;
 
 /// Points a bin holds on average: few enough that a partly covered bin costs little, enough
 /// that a large shadow does not walk many empty bins.
@@ -78,8 +93,14 @@ impl PlanePoints {
 /// Per-thread memory for point queries.
 pub struct PointScratch {
     view: Scratch,
-    /// The current shadow's edges as inward half-planes `n·p > c`.
-    edges: Vec<(DVec2, f64)>,
+    /// The current shadow's edges as inward half-planes `n·p > c`, with `ON_EDGE`'s distance
+    /// times `|n|`.
+    edges: Vec<(DVec2, f64, f64)>,
+    /// Per point on an opaque shadow's edge (not strictly inside it): the point and the arc of
+    /// directions the shadow covers around it (start, end in radians, end ≥ start).
+    touching: Vec<(u32, f64, f64)>,
+    /// One point's arcs, for [`closes_circle`].
+    arcs: Vec<(f64, f64)>,
     /// The current shadow in the bins' axes.
     turned: Vec<DVec2>,
 }
@@ -87,7 +108,7 @@ pub struct PointScratch {
 impl ExactEngine {
     /// Fresh per-thread memory for [`Self::visibility`].
     pub fn point_scratch(&self) -> PointScratch {
-        PointScratch { view: self.scratch(), edges: Vec::new(), turned: Vec::new() }
+        PointScratch { view: self.scratch(), edges: Vec::new(), touching: Vec::new(), arcs: Vec::new(), turned: Vec::new() }
     }
 
     /// Indexes points lying on `receiver` (world positions; each is projected orthogonally into
@@ -140,42 +161,55 @@ impl ExactEngine {
     pub fn visibility(&self, points: &PlanePoints, sun: DVec3, leaves: f32, scratch: &mut PointScratch, out: &mut [f32]) {
         let request = ViewRequest::new(points.receiver, sun).with_leaves(leaves);
         out.fill(1.0);
-        let PointScratch { view, edges, turned } = scratch;
+        let PointScratch { view, edges, touching, arcs, turned } = scratch;
+        touching.clear();
         // Each shadow is applied as soon as it is cast; once every point is dark (0 times any
         // transmittance stays 0) the remaining casters cannot change an answer and are skipped.
         let mut applied = 0;
         let mut lit = out.len();
         let seen = self.keep_shadows(request, view, |view| {
             for (range, transmittance) in &view.kept[applied..] {
-                lit -= apply_shadow(points, &view.kept_points[range.clone()], *transmittance, edges, turned, out);
+                let shadow = Shadow { corners: &view.kept_points[range.clone()], transmittance: *transmittance };
+                lit -= apply_shadow(points, shadow, edges, touching, turned, out);
             }
             applied = view.kept.len();
             lit == 0
         });
         if !seen {
             out.fill(0.0);
+        } else if lit > 0 {
+            close_cracks(touching, arcs, out);
         }
     }
 }
 
-/// Multiplies the visibility of the points inside one kept shadow (`shadow`, in the receiver's
-/// frame) by its `transmittance`; returns how many points it turned dark.
+/// One kept shadow: its corners in the receiver's frame and the share of the sun it lets by.
+#[derive(Clone, Copy)]
+struct Shadow<'a> {
+    corners: &'a [DVec2],
+    transmittance: f32,
+}
+
+/// Multiplies the visibility of the points inside one kept shadow (in the receiver's frame) by
+/// its transmittance; returns how many points it turned dark. A point on an opaque shadow's edge
+/// adds the shadow's arc around it to `touching`.
 fn apply_shadow(
     points: &PlanePoints,
-    shadow: &[DVec2],
-    transmittance: f32,
-    edges: &mut Vec<(DVec2, f64)>,
+    shadow: Shadow<'_>,
+    edges: &mut Vec<(DVec2, f64, f64)>,
+    touching: &mut Vec<(u32, f64, f64)>,
     turned: &mut Vec<DVec2>,
     out: &mut [f32],
 ) -> usize {
     turned.clear();
-    turned.extend(shadow.iter().map(|&q| turn(points.axis, q)));
+    turned.extend(shadow.corners.iter().map(|&q| turn(points.axis, q)));
     let polygon = &turned[..];
     if !inward_edges(polygon, edges) {
         return 0;
     }
     let (lo, hi) = polygon.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let Some(((c0, r0), (c1, r1))) = points.bins_over(lo, hi) else { return 0 };
+    let opaque = shadow.transmittance == 0.0;
     let mut darkened = 0;
     for row in r0..=r1 {
         for column in c0..=c1 {
@@ -188,9 +222,21 @@ fn apply_shadow(
             let whole = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y].iter().all(|k| inside(edges, corner + points.cell * *k));
             for &i in members {
                 let i = i as usize;
-                if out[i] > 0.0 && (whole || inside(edges, points.flat[i])) {
-                    out[i] *= transmittance;
-                    darkened += usize::from(out[i] == 0.0);
+                if out[i] <= 0.0 {
+                    continue;
+                }
+                let side = if whole { Side::Inside } else { side_of(edges, points.flat[i]) };
+                match side {
+                    Side::Inside => {
+                        out[i] *= shadow.transmittance;
+                        darkened += usize::from(out[i] == 0.0);
+                    }
+                    Side::Edge if opaque => {
+                        if let Some((start, end)) = arc_at(edges, points.flat[i]) {
+                            touching.push((i as u32, start, end));
+                        }
+                    }
+                    Side::Edge | Side::Outside => {}
                 }
             }
         }
@@ -198,14 +244,110 @@ fn apply_shadow(
     darkened
 }
 
+/// Where a point lies against a convex shadow.
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Side {
+    /// Strictly inside every edge (as [`inside`] finds it).
+    Inside,
+    /// On an edge (within [`ON_EDGE`]) and inside the others.
+    Edge,
+    Outside,
+}
+
+/// [`inside`], telling a point on an edge from one outside.
+fn side_of(edges: &[(DVec2, f64, f64)], p: DVec2) -> Side {
+    let mut side = Side::Inside;
+    for &(n, c, near) in edges {
+        let d = n.dot(p) - c;
+        if d > 0.0 {
+            continue;
+        }
+        if d < -near {
+            return Side::Outside;
+        }
+        side = Side::Edge;
+    }
+    side
+}
+
+/// The directions from `p` (on the shadow's edge) into the shadow, as an arc (start, end in
+/// radians): the half-planes of the edges through `p` (within [`ON_EDGE`]) intersected. `None`
+/// when they leave no direction.
+fn arc_at(edges: &[(DVec2, f64, f64)], p: DVec2) -> Option<(f64, f64)> {
+    let mut arc: Option<(f64, f64)> = None;
+    for &(n, c, near) in edges {
+        if n.dot(p) - c > near {
+            continue;
+        }
+        // The half-plane n·d ≥ 0: the half circle centred on n's angle, unwrapped to lie within
+        // half a turn of the first one's so that intersecting is taking the inner ends.
+        let mut angle = n.y.atan2(n.x);
+        if let Some((start, end)) = arc {
+            let centre = 0.5 * (start + end);
+            angle += std::f64::consts::TAU * ((centre - angle) / std::f64::consts::TAU).round();
+            let (s, e) = (start.max(angle - FRAC_PI_2), end.min(angle + FRAC_PI_2));
+            if s > e {
+                return None;
+            }
+            arc = Some((s, e));
+        } else {
+            arc = Some((angle - FRAC_PI_2, angle + FRAC_PI_2));
+        }
+    }
+    arc
+}
+
+/// Darkens each point still lit whose opaque shadows' arcs around it close the circle: it lies
+/// inside their union, on a crack between shadows that share an edge or a corner.
+fn close_cracks(touching: &mut [(u32, f64, f64)], arcs: &mut Vec<(f64, f64)>, out: &mut [f32]) {
+    touching.sort_unstable_by_key(|t| t.0);
+    for group in touching.chunk_by(|a, b| a.0 == b.0) {
+        let i = group[0].0 as usize;
+        if group.len() < 2 || out[i] <= 0.0 {
+            continue;
+        }
+        arcs.clear();
+        arcs.extend(group.iter().map(|&(_, s, e)| (s, e)));
+        if closes_circle(arcs) {
+            out[i] = 0.0;
+        }
+    }
+}
+
+/// Whether arcs (start, end in radians, each shorter than a turn) cover every direction, gaps
+/// under [`ARC_GAP`] closed: `[0, 2π]` swept with each arc also a turn earlier and later.
+fn closes_circle(arcs: &mut Vec<(f64, f64)>) -> bool {
+    let n = arcs.len();
+    for k in 0..n {
+        let (s, e) = arcs[k];
+        let turns = (s / TAU).floor();
+        let (s, e) = (s - turns * TAU, e - turns * TAU);
+        arcs[k] = (s, e);
+        arcs.push((s - TAU, e - TAU));
+        arcs.push((s + TAU, e + TAU));
+    }
+    arcs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let mut reach = 0.0f64;
+    for &(s, e) in arcs.iter() {
+        if s > reach + ARC_GAP {
+            return false;
+        }
+        reach = reach.max(e);
+        if reach >= TAU - ARC_GAP {
+            return true;
+        }
+    }
+    false
+}
+
 /// `q` in axes turned so that `axis` is the first.
 fn turn(axis: DVec2, q: DVec2) -> DVec2 {
     DVec2::new(q.dot(axis), axis.perp_dot(q))
 }
 
-/// The convex polygon's edges as inward half-planes (either orientation); `false` for a polygon
-/// without area.
-fn inward_edges(polygon: &[DVec2], edges: &mut Vec<(DVec2, f64)>) -> bool {
+/// The convex polygon's edges as inward half-planes (either orientation), each with its
+/// [`ON_EDGE`] distance times `|n|`; `false` for a polygon without area.
+fn inward_edges(polygon: &[DVec2], edges: &mut Vec<(DVec2, f64, f64)>) -> bool {
     edges.clear();
     let n = polygon.len();
     let twice_area: f64 = (0..n).map(|i| polygon[i].perp_dot(polygon[(i + 1) % n])).sum();
@@ -213,6 +355,7 @@ fn inward_edges(polygon: &[DVec2], edges: &mut Vec<(DVec2, f64)>) -> bool {
         return false;
     }
     let sign = twice_area.signum();
+    let scale = 1.0 + polygon.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     for i in 0..n {
         let (a, b) = (polygon[i], polygon[(i + 1) % n]);
         // perp of (b − a) points left of the edge: inside for a counter-clockwise polygon.
@@ -220,12 +363,52 @@ fn inward_edges(polygon: &[DVec2], edges: &mut Vec<(DVec2, f64)>) -> bool {
         if normal == DVec2::ZERO {
             continue;
         }
-        edges.push((normal, normal.dot(a)));
+        edges.push((normal, normal.dot(a), ON_EDGE * scale * normal.length()));
     }
     true
 }
 
 /// Strictly inside every half-plane (a point on an edge is outside: lit).
-fn inside(edges: &[(DVec2, f64)], p: DVec2) -> bool {
-    edges.iter().all(|(n, c)| n.dot(p) > *c)
+fn inside(edges: &[(DVec2, f64, f64)], p: DVec2) -> bool {
+    edges.iter().all(|(n, c, _)| n.dot(p) > *c)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+    use glam::DVec2;
+
+    use super::{Side, arc_at, closes_circle, inward_edges, side_of};
+
+    fn closes(arcs: &[(f64, f64)]) -> bool {
+        closes_circle(&mut arcs.to_vec())
+    }
+
+    #[test]
+    fn arcs_close_the_circle_only_when_no_direction_is_left() {
+        // Two half-planes on either side of a shared edge, and on the same side (a fold).
+        assert!(closes(&[(0.0, PI), (PI, TAU)]));
+        assert!(!closes(&[(0.0, PI), (0.0, PI)]));
+        // Three walls' wedges at a vertex, one arc wrapping past a full turn.
+        assert!(closes(&[(-FRAC_PI_2, FRAC_PI_2), (FRAC_PI_2, PI), (PI, 1.5 * PI)]));
+        assert!(closes(&[(0.0, 0.1), (1.0, 4.0), (3.5, 7.5)]));
+        // A gap wider than rounding stays open.
+        assert!(!closes(&[(0.0, PI), (PI + 1e-6, TAU)]));
+    }
+
+    #[test]
+    fn a_point_on_a_shadows_edge_gets_the_directions_into_it() {
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let mut edges = Vec::new();
+        assert!(inward_edges(&square, &mut edges));
+        assert_eq!(side_of(&edges, DVec2::splat(0.5)), Side::Inside);
+        assert_eq!(side_of(&edges, DVec2::new(0.5, 0.0)), Side::Edge);
+        assert_eq!(side_of(&edges, DVec2::new(0.5, -1e-6)), Side::Outside);
+        // On the bottom edge: the upper half circle; at the corner (0, 0): the first quadrant.
+        let (s, e) = arc_at(&edges, DVec2::new(0.5, 0.0)).unwrap();
+        assert!((s - 0.0).abs() < 1e-12 && (e - PI).abs() < 1e-12, "{s} {e}");
+        let (s, e) = arc_at(&edges, DVec2::ZERO).unwrap();
+        assert!((s.rem_euclid(TAU)).abs() < 1e-12 && (e - s - FRAC_PI_2).abs() < 1e-12, "{s} {e}");
+    }
 }

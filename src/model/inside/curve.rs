@@ -58,6 +58,17 @@ impl TransmittanceCurve {
         Ok(TransmittanceCurve { points })
     }
 
+    /// A curve written `ANGLE:T,ANGLE:T,…` (degrees, transmittance; `--glass-curve`), checked as
+    /// [`Self::new`] checks one; the error says why.
+    pub fn parse(text: &str) -> std::result::Result<Self, String> {
+        let pair = |item: &str| -> std::result::Result<(f64, f64), String> {
+            let (angle, t) = item.split_once(':').ok_or_else(|| format!("'{item}' is not ANGLE:T"))?;
+            let number = |v: &str| v.trim().parse::<f64>().map_err(|_| format!("'{}' in '{item}' is not a number", v.trim()));
+            Ok((number(angle)?, number(t)?))
+        };
+        Self::new(text.split(',').map(|item| pair(item.trim())).collect::<std::result::Result<_, _>>()?)
+    }
+
     /// The transmittance at normal incidence.
     pub fn normal(&self) -> f64 {
         self.points.first().map_or(0.0, |p| p.1)
@@ -150,6 +161,18 @@ fn pairs(value: &Value) -> Option<Vec<(f64, f64)>> {
 #[cfg(test)]
 mod tests {
     use super::{TransmittanceCurve, glass_from_extras};
+
+    #[test]
+    fn a_curve_is_read_from_angle_and_transmittance_pairs() {
+        let curve = TransmittanceCurve::parse("0:0.8, 40:0.76,60:0.6").unwrap();
+        assert_eq!(curve, TransmittanceCurve::new(vec![(0.0, 0.8), (40.0, 0.76), (60.0, 0.6)]).unwrap());
+        for (text, why) in
+            [("0.8", "is not ANGLE:T"), ("0:x", "'x' in '0:x' is not a number"), ("10:0.8", "starts at 10°"), ("0:0.7,40:0.75", "rises")]
+        {
+            let error = TransmittanceCurve::parse(text).unwrap_err();
+            assert!(error.contains(why), "{text}: {error}");
+        }
+    }
 
     #[test]
     fn a_curve_interpolates_in_angle_and_runs_on_to_zero_at_grazing() {

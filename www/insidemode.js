@@ -1,0 +1,58 @@
+// The page's interior view (Map mode, one instant, "Inside rooms"): engine.map with `inside: true`
+// (sunlit map --inside --at) on an EnergyPlus model's zones, a grid on their floors at a work
+// plane's height; the sun patches each inside face gets, said in the status; and the 3D view able
+// to cut away the roof or one wall, so the floors' cells are seen from outside. No inside logic
+// lives here: the points, lit state and patches are the library's.
+
+/** The faces a cut takes away: [axis (0 x east, 1 y north, 2 z up), side (+1: the high end)]. */
+export const CUTS = { roof: [2, 1], north: [1, 1], south: [1, -1], east: [0, 1], west: [0, -1] };
+
+/** The options the inside adds to an instant's map request ({} when not asked). */
+export function insideOptions($) {
+  if (!$('mapinside').checked) return {};
+  const workPlane = Number($('mapworkplane').value);
+  return { inside: true, workPlane: Number.isFinite(workPlane) ? workPlane : 0 };
+}
+
+/** The cut named `name` for triangles `positions` (9 floats each): { axis, side, at }, where a
+ * triangle with every corner at or beyond `at` on that side is not drawn; `at` lies 1 % of the
+ * model's extent inside its bounds on that side, so the outermost faces (a flat roof, one
+ * façade's walls) go and the floors stay. `null` for no cut. */
+export function cutOf(name, positions) {
+  const cut = CUTS[name];
+  if (!cut || !positions?.length) return null;
+  const [axis, side] = cut;
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let i = axis; i < positions.length; i += 3) {
+    lo = Math.min(lo, positions[i]);
+    hi = Math.max(hi, positions[i]);
+  }
+  const margin = 0.01 * (hi - lo);
+  return { axis, side, at: side > 0 ? hi - margin : lo + margin };
+}
+
+/** Whether the triangle at `positions[at..at + 9]` is cut away by `cut`. */
+export function isCut(cut, positions, at) {
+  if (!cut) return false;
+  for (let v = 0; v < 3; v++) if (cut.side * (positions[at + 3 * v + cut.axis] - cut.at) < 0) return false;
+  return true;
+}
+
+/** The status line's words on an inside map's sun patches. */
+export function patchSummary(patches) {
+  if (!patches) return '';
+  if (!patches.length) return '; no sun patch inside';
+  const faces = patches.map((p) => `${p.surface} ${p.areaM2.toFixed(2)} m²`).join(', ');
+  return `; sun patches: ${faces}`;
+}
+
+/** Wires the inside's controls: the cut redraws the view at once. `page`: { $, viewer() }. */
+export function wireInside(page) {
+  const { $ } = page;
+  $('mapcut').addEventListener('change', () => {
+    const viewer = page.viewer();
+    viewer?.setCut(cutOf($('mapcut').value, viewer.positions));
+    $('view').dataset.cut = $('mapcut').value;
+  });
+}
