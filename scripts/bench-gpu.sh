@@ -15,6 +15,8 @@
 # BEFORE=path/to/an/older/sunlit adds that binary's compute run on the same spread right after,
 # for a before/after on the same lease.
 # ONLY=REGEX runs only the runs whose label matches (e.g. ONLY=cull for the GPU culling pass).
+# TIMEOUT_SCALE=N multiplies every run's timeout (sized for the lease's 16 cores): the lavapipe
+# form on a loaded 2-core machine needs about 6 (generating nyt-blocks alone took 47-68 s there).
 # Counting with the GPU's culling (--cull gpu) is timed first, beside the CPU-culled count of the
 # same views, then the culling pass alone (--gpu-cull: clusters of <= 128 triangles against 1,024
 # views a dispatch, src/count/gpu/cluster_cull.rs). ONLY=cull runs just those.
@@ -28,7 +30,7 @@ T0=$(date +%s)
 gpu_flags=(); [ -n "${ATLAS:-}" ] && gpu_flags+=(--atlas "$ATLAS"); [ -n "${LANES:-}" ] && gpu_flags+=(--lanes "$LANES")
 views=(); [ -n "${VIEWS:-}" ] && views=(--views "$VIEWS")
 run() { # label timeout args...
-  local label=$1 t=$2; shift 2
+  local label=$1 t=$(( $2 * ${TIMEOUT_SCALE:-1} )); shift 2
   if [ -n "${ONLY:-}" ] && ! [[ $label =~ $ONLY ]]; then return; fi
   if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-480}" ]; then echo "skip $label" >> "$OUT/stderr.txt"; return; fi
   # SKIP_EXACT=1: a second lease on the same machine need not time the CPU again.

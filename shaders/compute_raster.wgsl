@@ -161,14 +161,12 @@ struct Setup {
     live: bool,
 }
 
-// Clip → atlas pixels as the viewport transform does, snapped to 1/256 pixel, made relative to
-// the tile's corner (exactly, in integers).
+// Clip → subpixels (1/256 pixel) from the tile's corner, as the raster path places a corner:
+// snapped from the tile's centre (sun_view.wgsl's `shade`), then offset by half the tile.
 fn snap(clip: vec4<f32>, view: View) -> vec3<f32> {
-    let half = f32(view.side) * 0.5;
-    let fx = clip.x * half + (f32(view.tile.x) + half);
-    let fy = -clip.y * half + (f32(view.tile.y) + half);
-    let sx = clamp(round(fx * 256.0), -CLAMP, CLAMP) - f32(view.tile.x) * 256.0;
-    let sy = clamp(round(fy * 256.0), -CLAMP, CLAMP) - f32(view.tile.y) * 256.0;
+    let half = f32(view.side) * 128.0;
+    let sx = clamp(round(clip.x * half), -CLAMP, CLAMP) + half;
+    let sy = clamp(round(-clip.y * half), -CLAMP, CLAMP) + half;
     return vec3<f32>(sx, sy, clip.z);
 }
 

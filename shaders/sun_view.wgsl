@@ -36,8 +36,9 @@ struct TileView {
     leaves: f32,
     // The tile's place in its batch (the GPU culling's view index).
     slot: u32,
+    // Subpixels (1/256 pixel) across half the tile: clip x and y are snapped to them (`shade`).
+    snap: f32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 struct Params {
@@ -90,7 +91,10 @@ fn vs_static(v: VertexIn) -> VertexOut {
 // (NO_RECEIVER for shading-only geometry), the transmittance and the dither seed.
 fn shade(clip: vec4<f32>, v: VertexIn, leaf_shift: f32, receiver_base: u32, slot: u32) -> VertexOut {
     var out: VertexOut;
-    out.position = clip;
+    // Snapped to 1/256 pixel of the tile (w is 1: the view is orthographic), so the viewport's
+    // offset to the tile's slot in the atlas adds whole subpixels and rounds nothing: a triangle
+    // gives the same pixels in every slot (subpixels_per_half_tile in pipelines.rs).
+    out.position = vec4<f32>(round(clip.xy * view.snap) / view.snap, clip.zw);
     if v.veil.x >= 0.0 && fract(v.veil.x + leaf_shift) >= view.leaves {
         out.position = DROPPED;
     }

@@ -8,6 +8,7 @@ use std::sync::atomic::Ordering;
 use super::masks::{GpuPoints, MaskBatch};
 use super::pipelines::{
     COUNTS_PER_MEMBER, DEPTH_FORMAT, GpuTileView, GpuView, ID_FORMAT, Pipelines, ROWS_PER_GROUP, attachment, buffer, entry,
+    subpixels_per_half_tile,
 };
 use super::plan::{Tile, tile_origin};
 use super::readback::BATCHES_PER_READBACK;
@@ -125,7 +126,8 @@ impl Counter {
                 view_proj: tile.view.view_proj.as_mat4().to_cols_array_2d(),
                 leaves: requests[tile.requests[0]].leaves,
                 slot: slot as u32,
-                _pad: [0; 2],
+                snap: subpixels_per_half_tile(side),
+                _pad: 0,
             };
             at[..size_of::<GpuTileView>()].copy_from_slice(bytemuck::bytes_of(&view));
         }

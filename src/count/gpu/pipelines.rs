@@ -47,7 +47,22 @@ pub(super) struct GpuTileView {
     pub(super) leaves: f32,
     /// The tile's place in its batch: which of the GPU culling's per-view lists it draws.
     pub(super) slot: u32,
-    pub(super) _pad: [u32; 2],
+    /// Subpixels across half the tile ([`subpixels_per_half_tile`]): clip x and y are snapped
+    /// to 1/256 pixel of the tile before the viewport places it.
+    pub(super) snap: f32,
+    pub(super) _pad: u32,
+}
+
+/// What `shade` in sun_view.wgsl snaps clip x and y by at tile side `side`: 1/256 pixel, the
+/// finest subpixel step a rasterizer keeps (8 bits; lavapipe and desktop GPUs). A corner snapped
+/// so is a whole number of subpixels from the tile's centre, so the viewport's scale and offset
+/// (a whole pixel) add nothing to round: the same triangle gives the same pixels in every atlas
+/// slot. Unsnapped, the offset's rounding grows with the slot's distance from the atlas's
+/// corner, and a corner near a subpixel's edge snapped one way in one slot and the other way in
+/// another: counts then depended on which tiles shared a batch (the GPU's culling renders tiles
+/// the CPU's skips, and lanes split a run differently).
+pub(super) fn subpixels_per_half_tile(side: u32) -> f32 {
+    side as f32 * 128.0
 }
 
 /// One view's map points as the mask pass reads them (`MaskView` in point_masks.wgsl).

@@ -7,9 +7,9 @@
 //! single buffer, instead of a BVH walk and a draw per merged range.
 //!
 //! Why not one multi-draw over the whole batch: each tile is placed in the atlas by its
-//! viewport, so every pixel is the one the CPU-culled draws give (the same transform, the same
-//! viewport arithmetic); placing tiles in the vertex shader instead would move corners by a
-//! rounding now and then, and the counts would no longer equal the CPU path's.
+//! viewport, as the CPU-culled draws are. Corners are snapped to whole subpixels of the tile
+//! (`shade` in sun_view.wgsl), so placing tiles in the vertex shader by whole pixels would now
+//! round nothing either; that draw is not built yet.
 //!
 //! Where it is not used (the reason logged once, the CPU's culling counting instead): an adapter
 //! without indirect draws or storage buffers in vertex shaders, fewer than 8 storage buffers a
