@@ -64,11 +64,11 @@ const SMOOTH_BATCH: usize = 1 << 18;
 
 /// The interpolated steps of `smooth` whose receiver is not proved partly lit at their sun
 /// (`sun_of` gives a row's sun and calendar day), as steps to count. The steps of one receiver
-/// and fitted piece are proved together, cell by cell in order of their days and times of day:
-/// runs of neighbouring cells at once, then single cells, then halves of a cell
-/// ([`Certifier::unproved_lit_in_cells`]).
+/// and fitted piece are proved together, cell by cell in [`block_order`]: runs of neighbouring
+/// cells at once (a half of a run is a block of days by times of day), then single cells, then
+/// halves of a cell ([`Certifier::unproved_lit_in_cells`]).
 pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of: &dyn Fn(usize) -> (DVec3, f64)) -> Vec<Rough> {
-    smooth.sort_by_key(|s| (s.regime, s.fit, s.at, s.row));
+    smooth.sort_by_key(|s| (s.regime, s.fit, block_order(s.at), s.row));
     let pieces: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit) == (b.regime, b.fit)).collect();
     let mut out = Vec::new();
     let mut start = 0;
@@ -98,6 +98,16 @@ pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of:
         start = end;
     }
     out
+}
+
+/// A cell's place in an order where each half of a run of cells is a compact block of the
+/// sample grid (days by times of day), not a stretch of whole days: the bits of its day and
+/// time-of-day indices interleaved, the day's lowest first. A block's suns then span about as
+/// much of the sky each way (a cell is some 14 days, a few degrees of declination, by some 40
+/// minutes, 10° of hour angle), so its footprints are short and a disc passes between them
+/// over more cells: on blaas-louvres 4,029 proofs instead of 6,987 in order of days.
+fn block_order((k, j): (u16, u16)) -> u64 {
+    (0..16).fold(0, |key, b| key | (u64::from(k >> b & 1) << (2 * b)) | (u64::from(j >> b & 1) << (2 * b + 1)))
 }
 
 /// Cells with fewer steps to settle than this are counted: one view costs about what a proof

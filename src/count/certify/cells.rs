@@ -1,6 +1,7 @@
 //! Never-dark proofs over many cells of one receiver at once. The year hands over a receiver's
 //! interpolated steps cell by cell (a cell: its steps between two sample days and two
-//! neighbouring samples of a day), in the order of its days and times of day. Proved cell by
+//! neighbouring samples of a day), in an order where a run's halves are blocks of days by times
+//! of day (`year::certified`). Proved cell by
 //! cell, blaas-louvres' year spent about 7 µs a step, where every step is proved: as much as
 //! the year's counting. Here a run of neighbouring cells is proved at once, over one cone
 //! holding every cell's cone, then in halves where the run is not proved, down to single cells,
@@ -26,7 +27,7 @@ impl Certifier<'_> {
     /// core.
     pub fn unproved_lit_in_cells(&self, sets: &[(usize, &[DVec3], &[usize])]) -> Vec<Vec<usize>> {
         let threads = worker_threads().min(sets.len()).max(1);
-        parallel_chunks(
+        let answers = parallel_chunks(
             sets.len(),
             threads,
             1,
@@ -37,13 +38,16 @@ impl Certifier<'_> {
                 let mut starts: Vec<usize> = [0].into_iter().chain(starts.iter().copied().filter(|s| *s < suns.len())).collect();
                 starts.sort_unstable();
                 starts.dedup();
-                let mut out = Vec::new();
+                let (mut out, mut hints) = (Vec::new(), Hints::default());
                 if let Some(shape) = self.shapes.get(receiver) {
-                    self.prove_run(receiver, shape, suns, &starts, &mut Hints::default(), &mut out);
+                    self.prove_run(receiver, shape, suns, &starts, &mut hints, &mut out);
                 }
-                out
+                (out, [hints.proofs, hints.runs_proved + hints.runs_failed, hints.runs_proved])
             },
-        )
+        );
+        let counts = answers.iter().fold([0; 3], |s, (_, c)| [s[0] + c[0], s[1] + c[1], s[2] + c[2]]);
+        log::debug!("never dark: {} proofs looked for, {} of them over runs of cells, {} runs proved", counts[0], counts[1], counts[2]);
+        answers.into_iter().map(|(out, _)| out).collect()
     }
 
     /// Pushes onto `out` the indices (into `suns`) of the suns of the run of cells starting at
