@@ -329,6 +329,60 @@ fn gb50180_matches_the_analytic_canyon_within_a_minute() {
     assert!(StandardDay::parse("06-21").unwrap_err().to_string().contains("day"));
 }
 
+/// EN 17037's sunlight exposure at a south window facing the canyon's slab (height over distance
+/// `k`), in the day's declination δ: the sun reaches the window while it is in front of the wall
+/// (cos h > tan δ / tan φ), above the slab (as [`canyon_hours`]) and at or above the minimum
+/// altitude a (sin φ sin δ + cos φ cos δ cos h ≥ sin a); each bound is |h| below an angle, so the
+/// hours are 2 acos(the largest cosine)/15. The whole day counts (no window in time).
+fn en17037_canyon_hours(latitude: f64, declination: f64, k: f64, min_altitude: f64) -> f64 {
+    let (sp, cp) = latitude.to_radians().sin_cos();
+    let (sd, cd) = declination.to_radians().sin_cos();
+    let slab = -sd * (sp + k * cp) / (cd * (cp - k * sp));
+    let altitude = (min_altitude.to_radians().sin() - sp * sd) / (cp * cd);
+    let front = (sd / cd) * (cp / sp);
+    let bound = slab.max(altitude).max(front);
+    if bound >= 1.0 { 0.0 } else { 2.0 * bound.max(-1.0).acos().to_degrees() / 15.0 }
+}
+
+/// EN 17037 as a window study against the analytic canyon within a minute, at London on 1
+/// February, 1 March and 21 March, with the default minimum altitude (10°) and two others; the
+/// slab decides some cases and the altitude others, and both are seen to (the bounds differ by
+/// more than a minute between the cases). The declination is sunlit's own for the day (the sun
+/// model is held to EnergyPlus elsewhere); the geometry and the counting are what is checked.
+#[test]
+fn en17037_matches_the_analytic_canyon_within_a_minute() {
+    use sunlit::map::planning::en17037::{self, En17037Rule};
+    let london = Location::new(51.5, -0.12, 0.0).unwrap();
+    let calendar = LeafCalendar::for_latitude(london.latitude);
+    let site = Site { location: &london, calendar: &calendar, weather: None, sky: None };
+    let (distance, z) = (20.0, 1.5);
+    let mut decided_by = (0, 0);
+    for k in [0.1f64, 0.3, 0.5] {
+        let scene = canyon(distance, Some(z + k * distance));
+        let pts = points(&scene, &[[0.0, 0.0, z, 0.0, -1.0, 0.0], [-4.0, 0.0, z, 0.0, -1.0, 0.0]]);
+        let windows = Windows::new(&scene, &pts).unwrap();
+        for (day, min_altitude) in [(32u32, 10.0f64), (60, 10.0), (80, 10.0), (80, 5.0), (60, 15.0)] {
+            let rule = En17037Rule::new(Some(day), Some(min_altitude)).unwrap();
+            let got = en17037::evaluate(&windows, site, &rule, &mut |_, _| {}).unwrap();
+            let (sin_declination, _) = sunlit::sun::position::declination_and_equation_of_time(f64::from(day));
+            let declination = sin_declination.asin().to_degrees();
+            let truth = en17037_canyon_hours(london.latitude, declination, k, min_altitude);
+            let no_slab = en17037_canyon_hours(london.latitude, declination, 0.0, min_altitude);
+            if truth < no_slab - 2.0 / 60.0 {
+                decided_by.0 += 1
+            } else {
+                decided_by.1 += 1
+            }
+            for (i, h) in got.hours.iter().enumerate() {
+                assert!((h - truth).abs() <= 1.0 / 60.0, "day {day}, k = {k}, {min_altitude}°, point {i}: {h:.4} h vs {truth:.4} h");
+            }
+        }
+    }
+    assert!(decided_by.0 >= 3 && decided_by.1 >= 3, "slab-decided and altitude-decided cases: {decided_by:?}");
+    assert!(En17037Rule::new(Some(81), None).unwrap_err().to_string().contains("period"));
+    assert!(En17037Rule::new(None, Some(-1.0)).unwrap_err().to_string().contains("min_altitude"));
+}
+
 /// GB 50180 counts at the ground-floor window sill: given a window (not a point), the study finds
 /// its sill, the middle of its lowest edge. A south window 0.9..2.4 m up in a wall faces a long
 /// garden wall 20 m away, 12.3 m high, whose shadow on 大寒日 at Beijing covers the sill for all
@@ -509,6 +563,8 @@ fn cli_window_studies_before_and_after_and_bad_input() {
             "gb50180",
             "--window-width",
             "1.0",
+            "--study",
+            "en17037",
             "--before",
             office,
             "--mask",
@@ -525,12 +581,13 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     assert_eq!(summary["points"], 5);
     assert_eq!(summary["points_before"], 5);
     let table = std::fs::read_to_string(dir.join("w.csv")).unwrap();
-    assert!(table.starts_with("receiver,x,y,z,nx,ny,nz,vsc,apsh,wpsh,hours,hours_whole_window\n"), "{table}");
+    assert!(table.starts_with("receiver,x,y,z,nx,ny,nz,vsc,apsh,wpsh,hours,hours_whole_window,hours_en17037\n"), "{table}");
     let read = |name: &str| -> Value { serde_json::from_str(&std::fs::read_to_string(dir.join(name)).unwrap()).unwrap() };
     let vsc = read("w.study-bre-vsc.json");
     let apsh = read("w.study-bre-apsh.json");
     let gb = read("w.study-gb50180.json");
-    for report in [&vsc, &apsh, &gb] {
+    let en = read("w.study-en17037.json");
+    for report in [&vsc, &apsh, &gb, &en] {
         let points = report["points"].as_array().unwrap();
         assert_eq!(points.len(), 5, "one entry per input row");
         for (p, name) in points.iter().zip(&seen) {
@@ -540,6 +597,15 @@ fn cli_window_studies_before_and_after_and_bad_input() {
         assert!(report["rule"].is_object() && report["source"].is_string() && report["areas"].is_array());
     }
     assert_eq!(gb["rule"]["day"], "大寒日");
+    assert_eq!((en["rule"]["day"].as_str(), en["rule"]["min_altitude_deg"].as_f64()), (Some("03-21"), Some(10.0)));
+    for p in en["points"].as_array().unwrap() {
+        let (now, before) = (p["hours"].as_f64().unwrap(), p["hours_before"].as_f64().unwrap());
+        assert!(now <= before + 1e-9, "the block adds no sun: {p}");
+        for (key, need) in [("passes", 1.5), ("passes_medium", 3.0), ("passes_high", 4.0)] {
+            assert_eq!(p[key], now + 1e-9 >= need, "{key}: {p}");
+        }
+        assert!(p["passes_relative"].is_null(), "EN 17037 has no relative test");
+    }
     assert!((gb["rule"]["declination_deg"].as_f64().unwrap() + 20.15).abs() < 0.01);
     for p in vsc["points"].as_array().unwrap() {
         let (now, before) = (p["vsc"].as_f64().unwrap(), p["vsc_before"].as_f64().unwrap());
@@ -589,6 +655,10 @@ fn cli_window_studies_before_and_after_and_bad_input() {
         (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--day", "06-21"], "--day"),
         (vec!["--study", "bre-vsc", "--sky-model", "perez-all-weather"], "--sky-model"),
         (vec!["--study", "bre-vsc", "--period", "03-21"], "--period"),
+        (vec!["--study", "bre-vsc", "--study", "en17037", "--location", "51.5,0,0", "--period", "06-21"], "--period"),
+        (vec!["--study", "bre-vsc", "--study", "en17037", "--location", "51.5,0,0", "--min-altitude", "90"], "--min-altitude"),
+        (vec!["--study", "bre-vsc", "--study", "en17037"], "--location"),
+        (vec!["--study", "bre-vsc", "--min-altitude", "12"], "--min-altitude"),
         (vec!["--study", "bre-vsc", "--study", "bre-ground", "--location", "0,0,0"], "--study"),
         (vec!["--study", "bre-vsc", "--mask", "9"], "--mask"),
         (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--floor-level", "0"], "--floor-level"),
