@@ -172,6 +172,52 @@ fn bre_25deg_line_is_the_canyons_elevation() {
     }
 }
 
+/// BRE draws the 25° line to the new development only. A window under its own overhang (1 m
+/// deep, 1.0–1.2 m above the point: where its top meets the wall, 1 mm out, it stands at
+/// atan(1.2/0.001) = 89.95°) faces a proposed long slab at θ: against the existing scene (the façade
+/// and its overhang) the angle is the slab's, θ, and the overhang's is `angle_deg_all`; without
+/// it everything counts.
+#[test]
+fn bre_25deg_line_is_drawn_to_the_development_alone() {
+    use sunlit::map::planning::run::{self, Rules};
+    let (distance, z) = (12.0, 1.5);
+    let overhang_deg = 1.2f64.atan2(bre_lines::FRONT).to_degrees();
+    let building = |slab: Option<f64>| {
+        let mut s = TestScene::new();
+        s.polygon("FACADE", &south_rect(-5.0, 5.0, 0.0, 6.0, 0.0), true);
+        s.cuboid("OVERHANG", DVec3::new(-2.0, -1.0, z + 1.0), DVec3::new(2.0, 0.0, z + 1.2));
+        if let Some(h) = slab {
+            s.cuboid("SLAB", DVec3::new(-1000.0, -distance - 2.0, 0.0), DVec3::new(1000.0, -distance, h));
+        }
+        s.build()
+    };
+    let existing = building(None);
+    let studies = ["bre-25deg".to_string()];
+    for (theta_deg, passes) in [(20.0f64, true), (24.9, true), (25.1, false), (30.0, false)] {
+        let proposed = building(Some(z + distance * theta_deg.to_radians().tan()));
+        let pts = points(&proposed, &[[0.0, 0.0, z, 0.0, -1.0, 0.0], [1.0, 0.0, z, 0.0, -1.0, 0.0]]);
+        let rules = Rules::default();
+        let (now, _) =
+            run::before_after_rules(&studies, &proposed, &pts, Some((&existing, "test")), None, rules, &mut |_| {}, &mut |_| {}).unwrap();
+        let lines = now.lines.unwrap();
+        let development = lines.development_deg.unwrap();
+        assert_eq!(development.len(), 2);
+        for (i, (&angle, &all)) in development.iter().zip(&lines.angle_deg).enumerate() {
+            assert!((angle - theta_deg).abs() < 1e-4, "θ = {theta_deg}°, point {i}: {angle}°");
+            assert!((all - overhang_deg).abs() < 1e-4, "everything: {all}°");
+            assert_eq!(compare::line_25(angle).passes, passes, "θ = {theta_deg}°");
+        }
+        // Without the existing scene the overhang stands in the section and fails every window.
+        let (alone, _) = run::before_after_rules(&studies, &proposed, &pts, None, None, rules, &mut |_| {}, &mut |_| {}).unwrap();
+        let alone = alone.lines.unwrap();
+        assert!(alone.development_deg.is_none() && (alone.angle_deg[0] - overhang_deg).abs() < 1e-4);
+    }
+    // The existing scene loaded apart (its own centre, so its f32 corners round differently) still
+    // holds every triangle of the building: the development is the slab's 12 triangles.
+    let proposed = building(Some(8.0));
+    assert_eq!(sunlit::map::planning::bre_lines::development(&proposed, &existing).len(), 12);
+}
+
 /// BRE 209's 45° lines against their plan and elevation construction: a block standing on the
 /// wall beside the window, `offset` m from the window's centre to its near side, `depth` m out
 /// and `top` m above the centre, is within both lines exactly when offset ≤ depth (plan) and
@@ -625,9 +671,9 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     assert!(html.contains("<table") && html.contains("bre-apsh") && html.contains("<svg") && html.contains("GB 50180"));
 
-    // BRE's pre-checks, before and after: the block raises no angle it does not stand in (the
-    // north window's is as it was) and lowers none; the south windows' own overhangs stand in
-    // their sections already (a section drawing shows them too), so they fail before and after.
+    // BRE's pre-checks, before and after: the 25° angle is the block's alone (the new
+    // development; the south windows' own overhangs are in `angle_deg_all`, before and after),
+    // none behind the north window, and the block lowers no angle of everything in the section.
     let windows_of_both = [office, "block.gltf", "--receivers", "WIN_*", "--points", "windows.csv"];
     let lines = ["--study", "bre-25deg", "--study", "bre-45deg", "--before", office, "-o", "lines.csv"];
     let out = run_map(&dir, &[&windows_of_both[..], &lines[..]].concat());
@@ -635,12 +681,14 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     let line25 = read("lines.study-bre-25deg.json");
     let line45 = read("lines.study-bre-45deg.json");
     for p in line25["points"].as_array().unwrap() {
-        let (now, before) = (p["angle_deg"].as_f64().unwrap(), p["angle_deg_before"].as_f64().unwrap());
-        assert!(now >= before && p["passes"] == (now <= 25.0), "{p}");
+        let (now, all) = (p["angle_deg"].as_f64().unwrap(), p["angle_deg_all"].as_f64().unwrap());
+        assert!(all >= now && all >= p["angle_deg_all_before"].as_f64().unwrap() && p["passes"] == (now <= 25.0), "{p}");
+        assert_eq!(p["angle_deg_before"], 0.0, "no development before: {p}");
     }
-    assert_eq!(line25["points"][0]["passes"], false);
+    let s1 = &line25["points"][0];
+    assert!(s1["passes"] == false && s1["angle_deg"].as_f64().unwrap() > 45.0, "{s1}");
     let n = &line25["points"][3];
-    assert_eq!(n["angle_deg"], n["angle_deg_before"], "{n}");
+    assert!(n["angle_deg"] == 0.0 && n["passes"] == true && n["angle_deg_all"] == n["angle_deg_all_before"], "{n}");
     assert!(line45["points"].as_array().unwrap().iter().all(|p| p["within_45deg"].is_number() && p["passes"].is_boolean()));
     assert_eq!(line25["rule"]["line_deg"], 25.0);
 

@@ -107,15 +107,42 @@ pub fn tables(
         };
         for study in [&"bre-25deg", &"bre-45deg"].into_iter().filter(|s| now.asked.iter().any(|a| a == *s)) {
             out.push(if *study == "bre-25deg" {
-                line(
-                    study,
-                    "BRE 209, 3rd ed. (2022), 2.2.5: in the section perpendicular to the window wall, from the centre of the lowest window, a new development subtending more than 25° to the horizontal may affect the diffuse daylight (check the VSC)",
-                    json!({"line_deg": bre_lines::LINE_25_DEG, "section": "vertical, through the point, along its normal's horizontal part", "reference_point": "the points given (BRE: the centre of the lowest window)"}),
-                    "angle_deg",
-                    v.angle_deg.clone(),
-                    former.as_ref().map(|(a, _)| a.clone()),
-                    v.angle_deg.iter().map(|&a| compare::line_25(a)).collect(),
-                )
+                let source = "BRE 209, 3rd ed. (2022), 2.2.5: in the section perpendicular to the window wall, from the centre of the lowest window, a new development subtending more than 25° to the horizontal may affect the diffuse daylight (check the VSC)";
+                let rule = json!({
+                    "line_deg": bre_lines::LINE_25_DEG,
+                    "section": "vertical, through the point, along its normal's horizontal part",
+                    "reference_point": "the points given (BRE: the centre of the lowest window)",
+                    "development": if v.development_deg.is_some() {
+                        "the proposed scene's triangles the existing scene lacks (corners matched within 1 mm): the window's own building, its overhangs and fins, stands in both and is not the development; angle_deg_all is everything in the section"
+                    } else {
+                        "everything in the section: without the existing scene (--before) the window's own building cannot be told from the development"
+                    },
+                });
+                match &v.development_deg {
+                    // The development did not exist before: it subtended nothing at the points
+                    // the existing scene holds.
+                    Some(dev) => StudyTable {
+                        study: study.to_string(),
+                        source: source.into(),
+                        rule,
+                        values: vec![("angle_deg".into(), dev.clone()), ("angle_deg_all".into(), v.angle_deg.clone())],
+                        before: before.map(|(_, index)| vec![spread(&vec![0.0; index.len()], index, n)]).map(|mut b| {
+                            b.push(former.as_ref().map_or_else(|| vec![None; n], |(a, _)| a.clone()));
+                            b
+                        }),
+                        verdicts: vec![("passes".into(), dev.iter().map(|&a| compare::line_25(a)).collect())],
+                        assessed: None,
+                    },
+                    None => line(
+                        study,
+                        source,
+                        rule,
+                        "angle_deg",
+                        v.angle_deg.clone(),
+                        former.as_ref().map(|(a, _)| a.clone()),
+                        v.angle_deg.iter().map(|&a| compare::line_25(a)).collect(),
+                    ),
+                }
             } else {
                 line(
                     study,

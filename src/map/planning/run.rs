@@ -4,6 +4,8 @@
 //! ([`crate::export::planning_tables`] makes the tables). [`before_after`] is that pair of runs,
 //! the proposed scene and the existing one at the same points, for every edge that compares them.
 
+use glam::DVec3;
+
 use super::en17037::{self, En17037Rule};
 use super::gb50180::{self, Gb50180Rule};
 use super::{SceneRays, Windows, apsh, bre_lines, vsc};
@@ -88,8 +90,7 @@ pub fn evaluate(
             ("bre-vsc", Some(windows)) => values.vsc = Some(vsc::vsc(windows, &mut |_, _| {})),
             ("bre-25deg" | "bre-45deg", _) => {
                 if values.lines.is_none() {
-                    let positions: Vec<_> = (0..points.len()).map(|i| points.position(i)).collect();
-                    let normals: Vec<_> = (0..points.len()).map(|i| points.normal(i)).collect();
+                    let (positions, normals) = placed(points);
                     values.lines = Some(bre_lines::evaluate(scene, &positions, &normals));
                 }
             }
@@ -109,6 +110,11 @@ pub fn evaluate(
         done(study);
     }
     Ok(values)
+}
+
+/// Each point's position and normal.
+fn placed(points: &Points) -> (Vec<DVec3>, Vec<DVec3>) {
+    (0..points.len()).map(|i| (points.position(i), points.normal(i))).unzip()
 }
 
 /// The existing scene's points: each of the proposed `points` that lies on one of its
@@ -166,7 +172,14 @@ pub fn before_after_rules(
     done_before: &mut dyn FnMut(&str),
 ) -> Result<(StudyValues, Option<Former>)> {
     let existing = before.map(|(s, from)| points_in(s, points, from).map(|p| (s, p))).transpose()?;
-    let now = evaluate(studies, scene, points, site, rules, done_now)?;
+    let mut now = evaluate(studies, scene, points, site, rules, done_now)?;
+    // BRE's 25° line is drawn to the new development alone: what the existing scene lacks.
+    if let (Some(lines), Some((old, _))) = (now.lines.as_mut(), before)
+        && studies.iter().any(|s| s == "bre-25deg")
+    {
+        let (positions, normals) = placed(points);
+        lines.development_deg = Some(bre_lines::section_angles(&bre_lines::development(scene, old), &positions, &normals));
+    }
     let former = existing
         .map(|(s, (kept, index))| {
             evaluate(studies, s, &kept, site, rules, done_before).map(|values| Former { values, points: kept, index })
