@@ -131,11 +131,9 @@ fn sunlit(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).output().unwrap()
 }
 
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-annual-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("annual", name)
 }
 
 #[test]

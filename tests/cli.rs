@@ -6,7 +6,7 @@
 mod common;
 use common::runtime_dir;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use sunlit::model::glb_write::GlbWriter;
@@ -16,12 +16,9 @@ fn sunlit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("run sunlit")
 }
 
-/// A fresh folder per test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("cli", name)
 }
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {

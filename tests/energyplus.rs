@@ -11,17 +11,17 @@ use std::process::Command;
 use sunlit::model::office_idf::{Shading, office_idf};
 
 mod common;
+use common::Scratch;
 use common::energyplus::{columns, energyplus};
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-ep-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test's runs (an annual EnergyPlus run writes tens of MB): removed
+/// when the test passes, kept when it fails.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("ep", name)
 }
 
 /// Runs EnergyPlus (with ReadVarsESO) and returns its .err text.
@@ -38,7 +38,7 @@ fn severe_count(err: &str) -> usize {
 
 /// A fresh folder with the generated office as `office.idf`, run by EnergyPlus's own
 /// PolygonClipping into `clipping/`; returns the folder, the model and the .err text.
-fn clipping_run(name: &str, louvres: usize, concave: bool) -> (PathBuf, PathBuf, String) {
+fn clipping_run(name: &str, louvres: usize, concave: bool) -> (Scratch, PathBuf, String) {
     let dir = scratch(name);
     let idf = dir.join("office.idf");
     std::fs::write(&idf, office_idf(louvres, concave, Shading::PolygonClipping)).unwrap();

@@ -23,6 +23,7 @@ use serde_json::Value;
 use sunlit::model::office_idf::{Shading, office_idf};
 
 mod common;
+use common::Scratch;
 use common::energyplus::{columns, energyplus};
 
 const ISO: &str = "Debug Surface Solar Shading Model DifShdgRatioIsoSky";
@@ -38,11 +39,9 @@ fn weather(name: &str) -> PathBuf {
 const CHICAGO: &str = "USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw";
 const GOLDEN: &str = "USA_CO_Golden-NREL.724666_TMY3.epw";
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-epsky-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test's runs: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("epsky", name)
 }
 
 fn testfile(name: &str) -> String {

@@ -43,12 +43,9 @@ fn npm_tool(name: &str) -> PathBuf {
     path
 }
 
-/// A fresh folder per test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-gltf-variants-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("gltf-variants", name)
 }
 
 /// `gltf-transform COMMAND original OUT [OPTIONS]`; returns OUT.

@@ -4,9 +4,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
+use common::Scratch;
 use common::inside::{golden_epw, numpy_reference};
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use glam::DVec3;
@@ -58,12 +59,6 @@ fn room_idf(window: [f64; 4], overhang: bool, extra: &str) -> String {
         idf += &format!("Shading:Building:Detailed,Overhang,,4,{ox0},0,{oz},{ox0},{},{oz},{ox1},{},{oz},{ox1},0,{oz};\n", -depth, -depth);
     }
     idf + extra
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-inside-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
 }
 
 fn load(idf: &str) -> sunlit::Result<(Scene, Rooms)> {
@@ -224,9 +219,10 @@ fn sunlit(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn map_inside_cli_writes_lit_weights_patches_and_ase() {
-    let idf = scratch("room.idf");
+    let tmp = Scratch::new("inside", "map_inside_cli_writes_lit_weights_patches_and_ase");
+    let idf = tmp.join("room.idf");
     std::fs::write(&idf, room_idf(WINDOW, false, "")).unwrap();
-    let csv = scratch("at.csv");
+    let csv = tmp.join("at.csv");
     let out = sunlit(&[
         "map",
         idf.to_str().unwrap(),
@@ -256,7 +252,7 @@ fn map_inside_cli_writes_lit_weights_patches_and_ase() {
     assert!(text.lines().any(|l| l.starts_with("Floor:inside,") && l.contains(",1,")), "no lit floor point");
 
     // Refused before anything is written: a glass transmittance outside 0..1, a study without --inside.
-    let bad = scratch("bad.csv");
+    let bad = tmp.join("bad.csv");
     for args in [
         vec!["--inside", "--glass-transmittance", "1.5", "--location", "40,-105,-7"],
         vec!["--study", "leed-ase", "--location", "40,-105,-7"],
@@ -344,6 +340,7 @@ fn sky_margin_deg(y: f64, distance: f64, height: f64) -> f64 {
 /// the CLI's report has before, after, the ratio and the verdict.
 #[test]
 fn no_sky_line_before_and_after_matches_the_line_drawn_by_hand() {
+    let tmp = Scratch::new("inside", "no_sky_line_before_and_after_matches_the_line_drawn_by_hand");
     const DISTANCE: f64 = 6.0;
     const HEIGHT: f64 = 5.8;
     let patches = sunlit::sky::patches::SkyPatches::parse("tregenza").unwrap();
@@ -376,13 +373,13 @@ fn no_sky_line_before_and_after_matches_the_line_drawn_by_hand() {
     assert_eq!((change.before, change.passes), (Some(100.0), Some(false)));
     assert!((change.ratio.unwrap() - now[0].sees_sky / 100.0).abs() < 1e-12);
 
-    let (old, new, csv) = (scratch("nsl-before.idf"), scratch("nsl-after.idf"), scratch("nsl.csv"));
+    let (old, new, csv) = (tmp.join("nsl-before.idf"), tmp.join("nsl-after.idf"), tmp.join("nsl.csv"));
     std::fs::write(&old, &before).unwrap();
     std::fs::write(&new, &after).unwrap();
     let args = ["map", new.to_str().unwrap(), "--inside", "--study", "bre-nsl", "--grid", "0.3", "--location", "51.5,-0.1,0"];
     let out = sunlit(&[&args[..], &["--before", old.to_str().unwrap(), "-o", csv.to_str().unwrap()]].concat());
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let report: Value = serde_json::from_str(&std::fs::read_to_string(scratch("nsl.study-bre-nsl.json")).unwrap()).unwrap();
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(tmp.join("nsl.study-bre-nsl.json")).unwrap()).unwrap();
     let room = &report["areas"][0];
     assert_eq!(
         (room["zone"].as_str(), room["sees_sky_before"].as_f64(), room["passes"].as_bool()),
@@ -393,7 +390,7 @@ fn no_sky_line_before_and_after_matches_the_line_drawn_by_hand() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.lines().next().unwrap().ends_with(",sees_sky,sees_sky_before"), "{}", &text[..80]);
     // `--before` with the other inside study is refused, before anything is written.
-    let bad = scratch("nsl-bad.csv");
+    let bad = tmp.join("nsl-bad.csv");
     let out = sunlit(&[
         "map",
         new.to_str().unwrap(),
@@ -437,8 +434,9 @@ fn free_csv_points_answer_as_the_work_plane_grid_does() {
 /// 0.6 / VT 0.7 and U 5.0 / SHGC 0.4 / VT 0.5 (tests/inside/glass.idf, a one-day run).
 #[test]
 fn simple_glazing_transmittance_matches_energyplus() {
+    let tmp = Scratch::new("inside", "simple_glazing_transmittance_matches_energyplus");
     let idf = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/glass.idf");
-    let out = scratch("glass-run");
+    let out = tmp.join("glass-run");
     let run = Command::new(common::energyplus::energyplus())
         .args(["-w", golden_epw().to_str().unwrap(), "-d", out.to_str().unwrap(), idf.to_str().unwrap()])
         .output()
@@ -472,6 +470,7 @@ fn simple_glazing_transmittance_matches_energyplus() {
 /// incident beam times the 3 m² of glass) at the incidence EnergyPlus reports.
 #[test]
 fn simple_glazing_angular_transmittance_matches_energyplus() {
+    let tmp = Scratch::new("inside", "simple_glazing_angular_transmittance_matches_energyplus");
     let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/inside/glass.idf")).unwrap();
     let outputs = "Output:Variable,Win,Surface Window Transmitted Beam Solar Radiation Rate,Timestep;\n\
                    Output:Variable,Win,Surface Outside Face Incident Beam Solar Radiation Rate per Area,Timestep;\n\
@@ -481,7 +480,7 @@ fn simple_glazing_angular_transmittance_matches_energyplus() {
     for (construction, case) in [("Glass", "curve E"), ("Glass2", "D to BDCD")] {
         let idf = two_weeks
             .replace("FenestrationSurface:Detailed,Win,Window,Glass,", &format!("FenestrationSurface:Detailed,Win,Window,{construction},"));
-        let dir = scratch(&format!("angular-{construction}"));
+        let dir = tmp.join(format!("angular-{construction}"));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("glass.idf");
         std::fs::write(&path, &idf).unwrap();
@@ -672,9 +671,10 @@ fn a_gltf_room_with_glazing_answers_as_the_analytic_and_numpy_truths() {
 
 #[test]
 fn map_inside_of_a_gltf_room_writes_its_sun_patch_and_refuses_bad_marks() {
-    let glb = scratch("room.glb");
+    let tmp = Scratch::new("inside", "map_inside_of_a_gltf_room_writes_its_sun_patch_and_refuses_bad_marks");
+    let glb = tmp.join("room.glb");
     std::fs::write(&glb, room_glb(false)).unwrap();
-    let csv = scratch("glb-at.csv");
+    let csv = tmp.join("glb-at.csv");
     let base = ["map", glb.to_str().unwrap(), "--inside", "--interior", "Room", "--location", "40,-105,-7", "-o", csv.to_str().unwrap()];
     let mut args = base.to_vec();
     args.extend(["--glazing", "Glass", "--glass-transmittance", "0.6", "--grid", "0.25", "--at", "03-21", "12:00", "--json"]);
@@ -692,7 +692,7 @@ fn map_inside_of_a_gltf_room_writes_its_sun_patch_and_refuses_bad_marks() {
     assert!(!text.contains("-0.0000"), "a negative zero in the CSV");
 
     // Each refused by name, before anything is written.
-    let bad = scratch("glb-bad.csv");
+    let bad = tmp.join("glb-bad.csv");
     let _ = std::fs::remove_file(&bad);
     for (extra, needle) in [
         (vec!["--glazing", "Pane*", "--glass-transmittance", "0.6"], "Pane*"),
@@ -747,6 +747,7 @@ const CURVE: [[f64; 2]; 4] = [[0.0, 0.8], [30.0, 0.78], [50.0, 0.72], [70.0, 0.5
 /// ray caster (its own interpolation of the same pairs) agrees point by point and on LEED ASE.
 #[test]
 fn a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle() {
+    let tmp = Scratch::new("inside", "a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle");
     const VISIBLE: f64 = 0.85;
     // No glass transmittance given: the material gives the glass.
     let load = |overhang: bool| {
@@ -796,9 +797,9 @@ fn a_gltf_panes_transmittance_curve_weights_the_beam_by_its_angle() {
 
     // A curve that rises with the angle, or leaves 0..1, is refused by file, material and field,
     // and `map` writes nothing.
-    let out = scratch("curve-bad.csv");
+    let out = tmp.join("curve-bad.csv");
     for (curve, needle) in [(json!([[0, 0.7], [40, 0.75]]), "rises"), (json!([[0, 1.3]]), "outside 0..=1")] {
-        let glb = scratch("curve-bad.glb");
+        let glb = tmp.join("curve-bad.glb");
         std::fs::write(&glb, with_material(&room_glb(false), "glass", json!({"sunlit": {"transmittance_curve": curve}}))).unwrap();
         let run = sunlit(&[
             "map",

@@ -6,9 +6,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
 mod common;
+use common::Scratch;
 use common::inside::{golden_epw, numpy_reference};
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use serde_json::{Value, json};
@@ -35,12 +36,6 @@ const EAST_WINDOW: [f64; 4] = [5.0, 7.5, 0.9, 2.4];
 /// Days whose beam is kept in the test's weather (clear days in the Golden TMY3: 15 December,
 /// 31 March).
 const DAYS: [u32; 2] = [349, 90];
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-interior-beam-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
 
 fn corners(points: &[[f64; 3]]) -> String {
     points.iter().map(|c| format!("{},{},{}", c[0], c[1], c[2])).collect::<Vec<_>>().join(",")
@@ -203,7 +198,8 @@ fn l_shaped_zone_beam_per_face_agrees_with_numpy_rays() {
 /// exactly the beam the faces got.
 #[test]
 fn l_shaped_zone_hooked_run_completes() {
-    let (idf, epw, csv, hooked) = (scratch("l.idf"), scratch("two-days.epw"), scratch("l.csv"), scratch("l-hooked.idf"));
+    let dir = Scratch::new("interior-beam", "l-shaped");
+    let (idf, epw, csv, hooked) = (dir.join("l.idf"), dir.join("two-days.epw"), dir.join("l.csv"), dir.join("l-hooked.idf"));
     std::fs::write(&idf, l_room_idf()).unwrap();
     std::fs::write(&epw, two_day_epw()).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
@@ -218,7 +214,7 @@ fn l_shaped_zone_hooked_run_completes() {
     assert_eq!(text.matches("SurfaceProperty:SolarIncidentInside,").count(), 9, "8 faces and the balance");
 
     // The balance column is minus the faces' beam (W) over the window's area, row by row.
-    let beam_csv = std::fs::read_to_string(scratch("l.interior-beam.csv")).unwrap();
+    let beam_csv = std::fs::read_to_string(dir.join("l.interior-beam.csv")).unwrap();
     let header: Vec<&str> = beam_csv.lines().next().unwrap().split(',').collect();
     assert_eq!(header.last(), Some(&"WinS"));
     let ep = load(&l_room_idf());
@@ -251,8 +247,8 @@ fn l_shaped_zone_hooked_run_completes() {
         assert!(severe.iter().all(|l| l.contains("(CHKBKS)")), "EnergyPlus on {}:\n{err}", model.display());
         severe.len()
     };
-    assert!(run(&idf, &scratch("l-own")) > 0, "EnergyPlus's own FullInterior calls the L unfit (CHKBKS)");
-    run(&hooked, &scratch("l-hooked"));
+    assert!(run(&idf, &dir.join("l-own")) > 0, "EnergyPlus's own FullInterior calls the L unfit (CHKBKS)");
+    run(&hooked, &dir.join("l-hooked"));
 }
 
 fn polygon_area(v: &[glam::DVec3]) -> f64 {
@@ -298,10 +294,11 @@ fn interzone_windows_are_skipped_by_name() {
 /// written: no `--idf-out`, no `--epw`, or the Imported hook.
 #[test]
 fn interior_beam_refusals_name_the_flag_and_write_nothing() {
-    let (idf, epw) = (scratch("refused.idf"), scratch("refused.epw"));
+    let dir = Scratch::new("interior-beam", "refusals");
+    let (idf, epw) = (dir.join("refused.idf"), dir.join("refused.epw"));
     std::fs::write(&idf, l_room_idf()).unwrap();
     std::fs::write(&epw, two_day_epw()).unwrap();
-    let (csv, hooked) = (scratch("refused.csv"), scratch("refused-hooked.idf"));
+    let (csv, hooked) = (dir.join("refused.csv"), dir.join("refused-hooked.idf"));
     let cases: [(&[&str], &str); 3] = [
         (&["--epw", epw.to_str().unwrap()], "add --idf-out"),
         (&["--location", "39.74,-105.18,-7", "--idf-out", hooked.to_str().unwrap()], "needs --epw"),
@@ -315,7 +312,7 @@ fn interior_beam_refusals_name_the_flag_and_write_nothing() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && stderr.contains("--interior-beam") && stderr.contains(why), "{args:?}: {stderr}");
-        assert!(!csv.exists() && !hooked.exists() && !scratch("refused.interior-beam.csv").exists(), "{args:?} wrote a file");
+        assert!(!csv.exists() && !hooked.exists() && !dir.join("refused.interior-beam.csv").exists(), "{args:?} wrote a file");
     }
 }
 
@@ -330,6 +327,7 @@ fn interior_beam_refusals_name_the_flag_and_write_nothing() {
 /// off the wall (docs/energyplus-fidelity.md, "The interior beam handed back").
 #[test]
 fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
+    let dir = Scratch::new("interior-beam", "four-zone");
     const FIRST_DAY: usize = 32;
     const LAST_DAY: usize = 45;
     const INTERZONE_WINDOW_WALLS: [&str; 2] = ["ZN003:WALL004", "ZN004:WALL004"];
@@ -350,7 +348,7 @@ fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
     }
     idf += "ShadowCalculation,PolygonClipping,Timestep,1,15000,SutherlandHodgman,512,SimpleSkyDiffuseModeling,Yes;\n\
             Output:Variable,*,Surface Inside Face Exterior Windows Incident Beam Solar Radiation Rate per Area,Timestep;\n";
-    let (model, run) = (scratch("four-zone.idf"), scratch("four-zone-own"));
+    let (model, run) = (dir.join("four-zone.idf"), dir.join("four-zone-own"));
     std::fs::write(&model, &idf).unwrap();
     let epw = common::energyplus::energyplus().parent().unwrap().join("WeatherData/USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw");
     let out = Command::new(common::energyplus::energyplus())

@@ -7,17 +7,15 @@
 mod common;
 use common::runtime_dir;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use sunlit::model::office::office;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-interrupt-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("interrupt", name)
 }
 
 /// A dense annual run on the example office, counted by the GPU path: tens of seconds on lavapipe

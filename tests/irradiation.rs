@@ -7,7 +7,7 @@ mod common;
 use common::runtime_dir;
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use sunlit::model::glb_write::GlbWriter;
@@ -21,11 +21,9 @@ fn sunlit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("run sunlit")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-irradiation-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("irradiation", name)
 }
 
 /// An EPW with a constant direct normal irradiance (field 15) every hour.

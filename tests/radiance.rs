@@ -58,11 +58,9 @@ pub fn golden_epw() -> PathBuf {
     epw
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-radiance-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("radiance", name)
 }
 
 fn sunlit(args: &[&str]) -> Output {

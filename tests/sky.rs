@@ -10,7 +10,7 @@ use common::{TestScene, closed_form_perez, counter, flat_rect, runtime_dir};
 
 use std::f64::consts::PI;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use glam::DVec3;
@@ -184,11 +184,9 @@ fn sunlit(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().expect("run sunlit")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-sky-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A scratch folder for one test: removed when the test passes, kept when it fails.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("sky", name)
 }
 
 /// An EPW whose records hold `dni`, `dhi`, `ghi` and `albedo`, with `bad` put in field

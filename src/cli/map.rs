@@ -83,11 +83,12 @@ pub(super) struct MapArgs {
     #[arg(long, value_name = "MAP.glb")]
     glb_out: Option<PathBuf>,
     /// Study: bre-ground or en17037 (sun hours on areas), or the window studies bre-vsc,
-    /// bre-apsh, gb50180, bre-25deg, bre-45deg (per reference point; docs/planning.md); repeatable. Reports go beside the output as
-    /// POINTS.study-NAME.json and .csv.
+    /// bre-apsh, gb50180, bre-25deg, bre-45deg, and en17037 beside them or with --window-points
+    /// or --before (per reference point; docs/planning.md); repeatable. Reports go beside the
+    /// output as POINTS.study-NAME.json and .csv.
     #[arg(long, value_name = "NAME")]
     study: Vec<String>,
-    /// Minimum sun altitude (degrees) for en17037 (default 10).
+    /// Minimum sun altitude (degrees) for en17037, the area or the window study (default 10).
     #[arg(long, value_name = "DEGREES")]
     min_altitude: Option<f64>,
     /// Who answers each point: exact (a shadow ray through the exact engine's BVH), gpu (its

@@ -1,4 +1,6 @@
-//! `sunlit map --study bre-vsc|bre-apsh|gb50180|bre-25deg|bre-45deg`: the window studies' edge.
+//! `sunlit map --study bre-vsc|bre-apsh|gb50180|bre-25deg|bre-45deg|en17037`: the window studies'
+//! edge (`en17037` is one beside another window study, or with `--window-points` or `--before`;
+//! alone it is the area study of [`sunlit::map::study`]).
 //! Checks which options each study takes, reads the proposed scene (and with `--before` the
 //! existing one), runs the library's studies ([`sunlit::map::planning::run`]) on both, has the
 //! library make their tables ([`sunlit::export::planning_tables`]), and writes the points CSV (one value
@@ -9,8 +11,9 @@ use serde_json::{Value, json};
 use sunlit::export::planning_report::{report_html, study_csv, study_json};
 use sunlit::export::planning_tables::{compared_tables, mask_svgs, points_input as planning_points_input, report_inputs};
 use sunlit::map::Site;
+use sunlit::map::planning::en17037::En17037Rule;
 use sunlit::map::planning::gb50180::Gb50180Rule;
-use sunlit::map::planning::run;
+use sunlit::map::planning::run::{self, Rules, WINDOW_STUDIES};
 use sunlit::map::planning::window_points::WindowPoint;
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -19,9 +22,12 @@ use super::*;
 
 pub(super) use sunlit::map::planning::run::STUDIES;
 
-/// Whether `args` ask for a window study (then [`run`] answers them).
+/// Whether `args` ask for a window study (then [`run`] answers them): one of [`STUDIES`], or
+/// `en17037` at the windows' own points or against an existing scene (alone on given points or a
+/// grid it stays the area study).
 pub(super) fn wanted(args: &MapArgs) -> bool {
-    args.study.iter().any(|s| STUDIES.contains(&s.as_str()))
+    let en17037 = args.study.iter().any(|s| s == "en17037") && (args.window_points.is_some() || !args.before.is_empty());
+    en17037 || args.study.iter().any(|s| STUDIES.contains(&s.as_str()))
 }
 
 /// Refuses what the window studies do not take, naming the option.
@@ -32,19 +38,20 @@ fn check_options(args: &MapArgs) -> Result<()> {
     if args.floor_level.is_some() && args.window_points.as_deref().map(WindowPoint::parse).transpose()? != Some(WindowPoint::Sill) {
         return Err(Error::argument("--floor-level", "places the sill of --window-points sill: give --window-points sill with it"));
     }
-    if let Some(other) = args.study.iter().find(|s| !STUDIES.contains(&s.as_str())) {
+    if let Some(other) = args.study.iter().find(|s| !WINDOW_STUDIES.contains(&s.as_str())) {
         return Err(Error::argument(
             "study",
-            format!("'{other}' cannot run beside the window studies ({}): give it in a run of its own", STUDIES.join(", ")),
+            format!("'{other}' cannot run beside the window studies ({}): give it in a run of its own", WINDOW_STUDIES.join(", ")),
         ));
     }
     let names = args.study.join(", ");
+    let en17037 = args.study.iter().any(|s| s == "en17037");
     let not_taken = [
-        ("--period", args.period.is_some()),
+        ("--period", args.period.is_some() && !en17037),
         ("--from", args.from.is_some()),
         ("--to", args.to.is_some()),
         ("--step", args.step.is_some()),
-        ("--min-altitude", args.min_altitude.is_some()),
+        ("--min-altitude", args.min_altitude.is_some() && !en17037),
         ("--albedo", args.albedo.is_some()),
         ("--sky-patches", args.sky_patches.is_some()),
     ];
@@ -75,6 +82,9 @@ fn check_options(args: &MapArgs) -> Result<()> {
     if gb && args.epw.is_none() && args.location.is_none() {
         return Err(Error::argument("--location", "gb50180 needs the site (--location LAT,LON,TZ or --epw): its sun is the latitude's"));
     }
+    if en17037 && args.epw.is_none() && args.location.is_none() {
+        return Err(Error::argument("--location", "en17037 needs the site (--location LAT,LON,TZ or --epw): its sun is the site's"));
+    }
     if !args.before.is_empty() && args.points.is_none() && args.window_points.is_none() {
         return Err(Error::argument(
             "--before",
@@ -86,6 +96,12 @@ fn check_options(args: &MapArgs) -> Result<()> {
 
 fn gb_rule(args: &MapArgs) -> Result<Gb50180Rule> {
     Gb50180Rule::from_options(args.day.as_deref(), args.required_hours, args.min_period, args.max_periods, args.window_width)
+}
+
+/// en17037's rule: `--period MM-DD` (one day, 1 February – 21 March) and `--min-altitude`.
+fn en17037_rule(args: &MapArgs) -> Result<En17037Rule> {
+    let day = args.period.as_deref().map(|text| parse_date("period", text)).transpose()?;
+    En17037Rule::new(day, args.min_altitude)
 }
 
 /// The 1-based rows `--mask` asks diagrams for (`all`, or a comma list), as 0-based indices.
@@ -105,6 +121,7 @@ fn mask_rows(text: Option<&str>, points: usize) -> Result<Vec<usize>> {
 pub(super) fn run(args: MapArgs) -> Result<()> {
     check_options(&args)?;
     let gb = args.study.iter().any(|s| s == "gb50180").then(|| gb_rule(&args)).transpose()?;
+    let en17037 = args.study.iter().any(|s| s == "en17037").then(|| en17037_rule(&args)).transpose()?;
     let weather = args.epw.as_ref().map(|p| Weather::from_epw(p)).transpose()?;
     let location = match (&weather, &args.location) {
         (Some(w), _) => Some(w.location.clone()),
@@ -140,13 +157,13 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         since.set(Instant::now());
     };
     let (mut now_seconds, mut former_seconds) = (Vec::new(), Vec::new());
-    let (now, former) = run::before_after(
+    let (now, former) = run::before_after_rules(
         &args.study,
         &scene,
         &points,
         before.as_ref().map(|s| (s, from.as_str())),
         site,
-        gb.as_ref(),
+        Rules { gb: gb.as_ref(), en17037: en17037.as_ref() },
         &mut |name| part(&mut now_seconds, name),
         &mut |name| part(&mut former_seconds, name),
     )?;
@@ -161,7 +178,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         args.epw.as_ref().map(|p| p.display().to_string()).as_deref(),
     );
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    let columns: Vec<(String, Vec<f64>)> = tables.iter().flat_map(|t| t.values.clone()).collect();
+    let columns = point_columns(&tables);
     let csv_columns: Vec<Column<'_>> = columns.iter().map(|(name, values)| Column { name, values, decimals: 4 }).collect();
     files.push((args.output.clone(), points_csv(&scene, &points, &csv_columns).into_bytes()));
     for t in &tables {
@@ -211,6 +228,19 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         eprintln!("{} points, {} in {seconds:.2} s → {}", points.len(), args.study.join(", "), args.output.display());
     }
     Ok(())
+}
+
+/// The points CSV's value columns, each study's values in order; a key an earlier study already
+/// wrote (en17037's `hours` beside gb50180's) takes its study's name: `hours_en17037`.
+fn point_columns(tables: &[sunlit::export::planning_report::StudyTable]) -> Vec<(String, Vec<f64>)> {
+    let mut columns: Vec<(String, Vec<f64>)> = Vec::new();
+    for t in tables {
+        for (key, values) in &t.values {
+            let name = if columns.iter().any(|(k, _)| k == key) { format!("{key}_{}", t.study) } else { key.clone() };
+            columns.push((name, values.clone()));
+        }
+    }
+    columns
 }
 
 /// How the points were given, for the reports: a file, the windows' own points, or a grid.

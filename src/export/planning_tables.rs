@@ -13,7 +13,7 @@ use crate::map::planning::compare::{self, Verdict};
 use crate::map::planning::gb50180::{self, Gb50180Rule};
 use crate::map::planning::run::{Former, StudyValues};
 use crate::map::planning::window_points::{OFFSET, WindowPoint};
-use crate::map::planning::{apsh, bre_lines, mask, vsc};
+use crate::map::planning::{apsh, bre_lines, en17037, mask, vsc};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 
@@ -107,15 +107,42 @@ pub fn tables(
         };
         for study in [&"bre-25deg", &"bre-45deg"].into_iter().filter(|s| now.asked.iter().any(|a| a == *s)) {
             out.push(if *study == "bre-25deg" {
-                line(
-                    study,
-                    "BRE 209, 3rd ed. (2022), 2.2.5: in the section perpendicular to the window wall, from the centre of the lowest window, a new development subtending more than 25° to the horizontal may affect the diffuse daylight (check the VSC)",
-                    json!({"line_deg": bre_lines::LINE_25_DEG, "section": "vertical, through the point, along its normal's horizontal part", "reference_point": "the points given (BRE: the centre of the lowest window)"}),
-                    "angle_deg",
-                    v.angle_deg.clone(),
-                    former.as_ref().map(|(a, _)| a.clone()),
-                    v.angle_deg.iter().map(|&a| compare::line_25(a)).collect(),
-                )
+                let source = "BRE 209, 3rd ed. (2022), 2.2.5: in the section perpendicular to the window wall, from the centre of the lowest window, a new development subtending more than 25° to the horizontal may affect the diffuse daylight (check the VSC)";
+                let rule = json!({
+                    "line_deg": bre_lines::LINE_25_DEG,
+                    "section": "vertical, through the point, along its normal's horizontal part",
+                    "reference_point": "the points given (BRE: the centre of the lowest window)",
+                    "development": if v.development_deg.is_some() {
+                        "the proposed scene's triangles the existing scene lacks (corners matched within 1 mm): the window's own building, its overhangs and fins, stands in both and is not the development; angle_deg_all is everything in the section"
+                    } else {
+                        "everything in the section: without the existing scene (--before) the window's own building cannot be told from the development"
+                    },
+                });
+                match &v.development_deg {
+                    // The development did not exist before: it subtended nothing at the points
+                    // the existing scene holds.
+                    Some(dev) => StudyTable {
+                        study: study.to_string(),
+                        source: source.into(),
+                        rule,
+                        values: vec![("angle_deg".into(), dev.clone()), ("angle_deg_all".into(), v.angle_deg.clone())],
+                        before: before.map(|(_, index)| vec![spread(&vec![0.0; index.len()], index, n)]).map(|mut b| {
+                            b.push(former.as_ref().map_or_else(|| vec![None; n], |(a, _)| a.clone()));
+                            b
+                        }),
+                        verdicts: vec![("passes".into(), dev.iter().map(|&a| compare::line_25(a)).collect())],
+                        assessed: None,
+                    },
+                    None => line(
+                        study,
+                        source,
+                        rule,
+                        "angle_deg",
+                        v.angle_deg.clone(),
+                        former.as_ref().map(|(a, _)| a.clone()),
+                        v.angle_deg.iter().map(|&a| compare::line_25(a)).collect(),
+                    ),
+                }
             } else {
                 line(
                     study,
@@ -172,7 +199,42 @@ pub fn tables(
             assessed: None,
         });
     }
+    if let Some(v) = &now.en17037 {
+        out.push(en17037_table(v, before.and_then(|(b, index)| b.en17037.as_ref().map(|b| spread(&b.hours, index, n)))));
+    }
     out
+}
+
+/// EN 17037's table: `hours`, and a verdict per level (`passes` the minimum, `passes_medium`,
+/// `passes_high`); the standard has no relative test.
+fn en17037_table(v: &en17037::En17037Values, former: Option<Vec<Option<f64>>>) -> StudyTable {
+    let rule = v.rule.sun_rule();
+    let verdicts = rule
+        .levels
+        .iter()
+        .enumerate()
+        .map(|(k, (name, need))| {
+            let key = if k == 0 { "passes".to_string() } else { format!("passes_{name}") };
+            (key, v.hours.iter().map(|&h| compare::hours(h, *need)).collect())
+        })
+        .collect();
+    let (month, day) = crate::year::samples::month_day(v.rule.day);
+    StudyTable {
+        study: "en17037".into(),
+        source: "EN 17037:2018 (+A1:2021), 5.4 and Annex A.6: exposure to sunlight at the window's reference point on one day from 1 February to 21 March, the sun counted at or above a minimum altitude; minimum 1.5 h, medium 3 h, high 4 h".into(),
+        rule: json!({
+            "day": format!("{month:02}-{day:02}"),
+            "levels_hours": rule.levels.iter().map(|(name, h)| (name.clone(), json!(h))).collect::<serde_json::Map<_, _>>(),
+            "min_altitude_deg": v.rule.min_altitude_deg,
+            "min_altitude_source": "a parameter (default 10°): EN 17037 tabulates it by site; give your national annex's value",
+            "time": "every minute of the day, local standard time; sunlit's sun (EnergyPlus's)",
+            "step_minutes": en17037::STEP_MINUTES,
+        }),
+        values: vec![("hours".into(), v.hours.clone())],
+        before: former.map(|f| vec![f]),
+        verdicts,
+        assessed: None,
+    }
 }
 
 /// Sun paths for a diagram at `location`: 21 June, 21 March and 21 December in sunlit's sun

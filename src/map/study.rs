@@ -61,18 +61,24 @@ pub fn preset(name: &str) -> Result<SunRule> {
             days: (80, 80),
             default_day: 80,
         }),
-        "en17037" => Ok(SunRule {
-            name: name.into(),
-            source: "EN 17037:2018, sunlight exposure at the reference point on a day between 1 February and 21 March: minimum 1.5 h, medium 3 h, high 4 h, sun above a minimum altitude".into(),
-            min_altitude_deg: EN17037_MIN_ALTITUDE,
-            min_period_minutes: 0.0,
-            longest: None,
-            levels: vec![("minimum".into(), 1.5), ("medium".into(), 3.0), ("high".into(), 4.0)],
-            share: 1.0,
-            days: (32, 80),
-            default_day: 80,
-        }),
+        "en17037" => Ok(en17037()),
         other => Err(Error::argument("study", format!("'{other}' is not a study (known: {})", PRESETS.join(", ")))),
+    }
+}
+
+/// EN 17037's sunlight exposure rule: the `en17037` preset, and the levels and days of the
+/// window study [`crate::map::planning::en17037`].
+pub fn en17037() -> SunRule {
+    SunRule {
+        name: "en17037".into(),
+        source: "EN 17037:2018, sunlight exposure at the reference point on a day between 1 February and 21 March: minimum 1.5 h, medium 3 h, high 4 h, sun above a minimum altitude".into(),
+        min_altitude_deg: EN17037_MIN_ALTITUDE,
+        min_period_minutes: 0.0,
+        longest: None,
+        levels: vec![("minimum".into(), 1.5), ("medium".into(), 3.0), ("high".into(), 4.0)],
+        share: 1.0,
+        days: (32, 80),
+        default_day: 80,
     }
 }
 

@@ -17,6 +17,14 @@
 //!
 //! Geometry in the wall's own plane (within [`FRONT`] of it: the wall, the window) is not in front
 //! of the point and never counts.
+//!
+//! BRE draws the 25° line to the *new development* only: the window's own building (its
+//! overhangs, fins, balconies) is not the development. Given the existing scene,
+//! [`development`] is the proposed scene's geometry the existing one lacks (triangle by triangle,
+//! corners matched to [`MATCH`]), and [`section_angles`] on it is BRE's angle; without it the
+//! section holds everything, the window's own building too.
+
+use std::collections::HashMap;
 
 use glam::DVec3;
 
@@ -26,6 +34,9 @@ use crate::scene::Scene;
 pub const LINE_25_DEG: f64 = 25.0;
 /// How far in front of the wall's plane geometry must be to count, metres.
 pub const FRONT: f64 = 1e-3;
+/// Corners closer than this (metres, per axis) are the same corner when the proposed scene's
+/// triangles are matched to the existing scene's.
+pub const MATCH: f64 = 1e-3;
 
 /// Per point, the 25° and 45° tests' values.
 #[derive(Debug, Clone, PartialEq)]
@@ -35,6 +46,9 @@ pub struct LineValues {
     pub angle_deg: Vec<f64>,
     /// Whether some obstruction lies within both 45° lines.
     pub within_45: Vec<bool>,
+    /// With the existing scene known: the highest angle of the [`development`] alone, BRE's
+    /// 25° angle (the window's own building left out).
+    pub development_deg: Option<Vec<f64>>,
 }
 
 /// The point's axes: x along the wall (horizontal), y out of it (the normal's horizontal part),
@@ -50,30 +64,57 @@ fn axes(normal: DVec3) -> Option<(DVec3, DVec3)> {
 /// Both tests at every point of `positions`/`normals` against every triangle of `scene`.
 pub fn evaluate(scene: &Scene, positions: &[DVec3], normals: &[DVec3]) -> LineValues {
     let triangles: Vec<[DVec3; 3]> = scene.world_triangles().map(|(t, _)| t).collect();
-    let mut values = LineValues { angle_deg: Vec::with_capacity(positions.len()), within_45: Vec::with_capacity(positions.len()) };
-    for (&origin, &normal) in positions.iter().zip(normals) {
-        let Some((along, out)) = axes(normal) else {
-            values.angle_deg.push(0.0);
-            values.within_45.push(false);
-            continue;
-        };
-        let local = |p: DVec3| {
-            let d = p - origin;
-            DVec3::new(d.dot(along), d.dot(out), d.z)
-        };
-        let mut angle = 0.0f64;
-        let mut within = false;
-        for t in &triangles {
-            let l = t.map(local);
-            if let Some(a) = section_angle(&l) {
-                angle = angle.max(a);
-            }
-            within = within || in_wedge(&l);
+    let (angle_deg, within_45) = positions.iter().zip(normals).map(|(&p, &n)| point_lines(&triangles, p, n)).unzip();
+    LineValues { angle_deg, within_45, development_deg: None }
+}
+
+/// The 25° section's highest angle (degrees) at each point against `triangles` alone (e.g. the
+/// [`development`]).
+pub fn section_angles(triangles: &[[DVec3; 3]], positions: &[DVec3], normals: &[DVec3]) -> Vec<f64> {
+    positions.iter().zip(normals).map(|(&p, &n)| point_lines(triangles, p, n).0).collect()
+}
+
+/// One point's highest section angle (degrees) and whether anything is within its 45° lines.
+fn point_lines(triangles: &[[DVec3; 3]], origin: DVec3, normal: DVec3) -> (f64, bool) {
+    let Some((along, out)) = axes(normal) else { return (0.0, false) };
+    let local = |p: DVec3| {
+        let d = p - origin;
+        DVec3::new(d.dot(along), d.dot(out), d.z)
+    };
+    let mut angle = 0.0f64;
+    let mut within = false;
+    for t in triangles {
+        let l = t.map(local);
+        if let Some(a) = section_angle(&l) {
+            angle = angle.max(a);
         }
-        values.angle_deg.push(angle.to_degrees());
-        values.within_45.push(within);
+        within = within || in_wedge(&l);
     }
-    values
+    (angle.to_degrees(), within)
+}
+
+/// The triangles of `proposed` that `existing` does not hold (the same three corners, each
+/// within [`MATCH`] per axis, in any order): the new development, without the buildings that
+/// stand in both. The existing triangles are binned by their centroids in 1 cm cells, and each
+/// proposed triangle looks in the cells its centroid could fall in given [`MATCH`] (the two
+/// scenes' f32 vertices are stored about their own centres, so the same corner may differ in
+/// its last bits).
+pub fn development(proposed: &Scene, existing: &Scene) -> Vec<[DVec3; 3]> {
+    const CELL: f64 = 0.01;
+    let cell = |p: DVec3| (p / CELL).floor().as_i64vec3().to_array();
+    let centroid = |t: &[DVec3; 3]| (t[0] + t[1] + t[2]) / 3.0;
+    let mut old: HashMap<[i64; 3], Vec<[DVec3; 3]>> = HashMap::new();
+    for (t, _) in existing.world_triangles() {
+        old.entry(cell(centroid(&t))).or_default().push(t);
+    }
+    let same = |a: &[DVec3; 3], b: &[DVec3; 3]| a.iter().all(|p| b.iter().any(|q| (*p - *q).abs().max_element() <= MATCH));
+    let held = |t: &[DVec3; 3]| {
+        let c = centroid(t);
+        let (lo, hi) = (cell(c - DVec3::splat(MATCH)), cell(c + DVec3::splat(MATCH)));
+        (lo[0]..=hi[0])
+            .any(|x| (lo[1]..=hi[1]).any(|y| (lo[2]..=hi[2]).any(|z| old.get(&[x, y, z]).is_some_and(|v| v.iter().any(|o| same(t, o))))))
+    };
+    proposed.world_triangles().map(|(t, _)| t).filter(|t| !held(t)).collect()
 }
 
 /// The largest angle above the horizontal (radians, ≥ 0 counted from 0) of the triangle's cut by

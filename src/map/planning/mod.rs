@@ -4,6 +4,7 @@
 //! - [`apsh`]: BRE 209's annual and winter probable sunlight hours, approximated from an EPW's
 //!   direct normal irradiance;
 //! - [`gb50180`]: GB 50180-2018's sunlight hours on 大寒日 or 冬至日 in true solar time;
+//! - [`en17037`]: EN 17037's sunlight exposure, hours of sun on one day of 1 February – 21 March;
 //! - [`bre_lines`]: BRE 209's 25° and 45° pre-checks, exact on the scene's triangles;
 //! - [`compare`]: each rule's pass/fail, alone and against the existing scene's values
 //!   (BRE's 0.8 × former value and 4-point APSH loss);
@@ -18,6 +19,7 @@
 pub mod apsh;
 pub mod bre_lines;
 pub mod compare;
+pub mod en17037;
 pub mod gb50180;
 pub mod mask;
 pub mod run;

@@ -4,14 +4,30 @@
 //! ([`crate::export::planning_tables`] makes the tables). [`before_after`] is that pair of runs,
 //! the proposed scene and the existing one at the same points, for every edge that compares them.
 
+use glam::DVec3;
+
+use super::en17037::{self, En17037Rule};
 use super::gb50180::{self, Gb50180Rule};
 use super::{SceneRays, Windows, apsh, bre_lines, vsc};
 use crate::error::{Error, Result};
 use crate::map::{Points, Site, points};
 use crate::scene::Scene;
 
-/// The window studies' names.
+/// The window studies' names that the page runs too ([`crate::web`]'s `engine.study`).
 pub const STUDIES: [&str; 5] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg"];
+
+/// Every window study's name: [`STUDIES`] and `en17037` (the CLI's alone so far).
+pub const WINDOW_STUDIES: [&str; 6] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg", "en17037"];
+
+/// The rules whose parameters a run sets: gb50180's and en17037's (each needed only when its
+/// study is asked).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Rules<'a> {
+    /// gb50180's.
+    pub gb: Option<&'a Gb50180Rule>,
+    /// en17037's.
+    pub en17037: Option<&'a En17037Rule>,
+}
 
 /// Refuses a sky model the studies do not take, naming `sky_model`: only bre-vsc looks at the
 /// sky, and it is defined under the CIE standard overcast sky; the others count the sun alone.
@@ -40,29 +56,33 @@ pub struct StudyValues {
     pub gb: Option<gb50180::Gb50180Values>,
     /// `bre-25deg`'s and `bre-45deg`'s (one pass gives both).
     pub lines: Option<bre_lines::LineValues>,
+    /// `en17037`'s.
+    pub en17037: Option<en17037::En17037Values>,
     /// The studies asked for, in order.
     pub asked: Vec<String>,
 }
 
-/// Every study of `studies` ([`STUDIES`]' names, in order) at `points` of `scene`: `site` for
-/// bre-apsh (with its weather) and gb50180, `gb` gb50180's rule. `done(part)` is called once the
-/// scene is indexed (`index`) and after each study (its name), so a caller can time the parts.
-/// Refuses a study it does not know, and bre-apsh or gb50180 without what they need, by name.
+/// Every study of `studies` ([`WINDOW_STUDIES`]' names, in order) at `points` of `scene`: `site`
+/// for bre-apsh (with its weather), gb50180 and en17037, `rules` the rules' parameters.
+/// `done(part)` is called once the scene is indexed (`index`) and after each study (its name), so
+/// a caller can time the parts. Refuses a study it does not know, and a study without what it
+/// needs, by name.
 pub fn evaluate(
     studies: &[String],
     scene: &Scene,
     points: &Points,
     site: Option<Site<'_>>,
-    gb: Option<&Gb50180Rule>,
+    rules: Rules<'_>,
     done: &mut dyn FnMut(&str),
 ) -> Result<StudyValues> {
-    if let Some(other) = studies.iter().find(|s| !STUDIES.contains(&s.as_str())) {
-        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", STUDIES.join(", "))));
+    if let Some(other) = studies.iter().find(|s| !WINDOW_STUDIES.contains(&s.as_str())) {
+        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", WINDOW_STUDIES.join(", "))));
     }
     // One tree for the scene; gb50180 places its own points (with its sill samples) on it, and
-    // the BRE studies share these.
+    // the other sun and sky studies share these.
     let tree = SceneRays::new(scene);
-    let windows = studies.iter().any(|s| s == "bre-vsc" || s == "bre-apsh").then(|| Windows::on(scene, &tree, points)).transpose()?;
+    let shared = studies.iter().any(|s| matches!(s.as_str(), "bre-vsc" | "bre-apsh" | "en17037"));
+    let windows = shared.then(|| Windows::on(scene, &tree, points)).transpose()?;
     let mut values = StudyValues { asked: studies.to_vec(), ..StudyValues::default() };
     done("index");
     for study in studies {
@@ -70,8 +90,7 @@ pub fn evaluate(
             ("bre-vsc", Some(windows)) => values.vsc = Some(vsc::vsc(windows, &mut |_, _| {})),
             ("bre-25deg" | "bre-45deg", _) => {
                 if values.lines.is_none() {
-                    let positions: Vec<_> = (0..points.len()).map(|i| points.position(i)).collect();
-                    let normals: Vec<_> = (0..points.len()).map(|i| points.normal(i)).collect();
+                    let (positions, normals) = placed(points);
                     values.lines = Some(bre_lines::evaluate(scene, &positions, &normals));
                 }
             }
@@ -79,14 +98,23 @@ pub fn evaluate(
                 let site = site.ok_or_else(|| Error::argument("epw", "bre-apsh needs a weather file"))?;
                 values.apsh = Some(apsh::apsh(windows, site, &mut |_, _| {})?);
             }
+            ("en17037", Some(windows)) => {
+                let (site, rule) = site.zip(rules.en17037).ok_or_else(|| Error::argument("location", "en17037 needs the site"))?;
+                values.en17037 = Some(en17037::evaluate(windows, site, rule, &mut |_, _| {})?);
+            }
             _ => {
-                let (site, rule) = site.zip(gb).ok_or_else(|| Error::argument("location", "gb50180 needs the site"))?;
+                let (site, rule) = site.zip(rules.gb).ok_or_else(|| Error::argument("location", "gb50180 needs the site"))?;
                 values.gb = Some(gb50180::evaluate_on(scene, &tree, points, site.location, rule, &mut |_, _| {})?);
             }
         }
         done(study);
     }
     Ok(values)
+}
+
+/// Each point's position and normal.
+fn placed(points: &Points) -> (Vec<DVec3>, Vec<DVec3>) {
+    (0..points.len()).map(|i| (points.position(i), points.normal(i))).unzip()
 }
 
 /// The existing scene's points: each of the proposed `points` that lies on one of its
@@ -128,10 +156,34 @@ pub fn before_after(
     done_now: &mut dyn FnMut(&str),
     done_before: &mut dyn FnMut(&str),
 ) -> Result<(StudyValues, Option<Former>)> {
+    before_after_rules(studies, scene, points, before, site, Rules { gb, en17037: None }, done_now, done_before)
+}
+
+/// [`before_after`] of any of [`WINDOW_STUDIES`] ([`evaluate`]).
+#[allow(clippy::too_many_arguments)]
+pub fn before_after_rules(
+    studies: &[String],
+    scene: &Scene,
+    points: &Points,
+    before: Option<(&Scene, &str)>,
+    site: Option<Site<'_>>,
+    rules: Rules<'_>,
+    done_now: &mut dyn FnMut(&str),
+    done_before: &mut dyn FnMut(&str),
+) -> Result<(StudyValues, Option<Former>)> {
     let existing = before.map(|(s, from)| points_in(s, points, from).map(|p| (s, p))).transpose()?;
-    let now = evaluate(studies, scene, points, site, gb, done_now)?;
+    let mut now = evaluate(studies, scene, points, site, rules, done_now)?;
+    // BRE's 25° line is drawn to the new development alone: what the existing scene lacks.
+    if let (Some(lines), Some((old, _))) = (now.lines.as_mut(), before)
+        && studies.iter().any(|s| s == "bre-25deg")
+    {
+        let (positions, normals) = placed(points);
+        lines.development_deg = Some(bre_lines::section_angles(&bre_lines::development(scene, old), &positions, &normals));
+    }
     let former = existing
-        .map(|(s, (kept, index))| evaluate(studies, s, &kept, site, gb, done_before).map(|values| Former { values, points: kept, index }))
+        .map(|(s, (kept, index))| {
+            evaluate(studies, s, &kept, site, rules, done_before).map(|values| Former { values, points: kept, index })
+        })
         .transpose()?;
     Ok((now, former))
 }
