@@ -349,3 +349,45 @@ fn tin_relief_terrain_shades_a_roof_as_a_numpy_ray_cast_does() {
     }
     assert!(expected.iter().any(|&f| f < 0.5), "the terrain shades the roof for some sun: {expected:?}");
 }
+
+/// `district --grid --pv` with more tiles than the process may open files (`ulimit -n 16`, for
+/// this run alone): the merge opens the tiles' pvlib CSVs one at a time, so it writes the merged
+/// files with every tile's columns. A merge holding a file open a tile (as it once did) fails here
+/// with "Too many open files".
+#[test]
+fn district_pv_merges_more_tiles_than_the_open_file_limit() {
+    const HOUSES: usize = 20;
+    let dir = scratch("district-many-tiles");
+    // 4 m × 4 m houses 10 m apart, each alone in its 10 m tile.
+    let names: Vec<String> = (0..HOUSES).map(|i| format!("H{i}")).collect();
+    let boxes: Vec<(&str, [f64; 3], [f64; 3])> = names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let (x, y) = ((i % 5) as f64 * 10.0, (i / 5) as f64 * 10.0);
+            (name.as_str(), [x + 3.0, y + 3.0, 0.0], [x + 7.0, y + 7.0, 3.0])
+        })
+        .collect();
+    let (city, epw, out) = (dir.join("houses.city.json"), dir.join("site.epw"), dir.join("out"));
+    std::fs::write(&city, boxes_city(&boxes)).unwrap();
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let (c, e, o) = (city.display().to_string(), epw.display().to_string(), out.display().to_string());
+    #[rustfmt::skip]
+    let args = [
+        "district", &c, "--epw", &e, "-o", &o, "--tile", "10", "--context", "1", "--receivers", "RoofSurface", "--engine", "exact",
+        "--days-per-year", "3", "--samples-per-day", "3", "--grid", "2", "--pv", "--jobs", "2",
+    ];
+    let run = std::process::Command::new("sh")
+        .args(["-c", "ulimit -n 16 && exec \"$@\"", "sh", env!("CARGO_BIN_EXE_sunlit")])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert_eq!(std::fs::read_dir(out.join(".done")).unwrap().count(), HOUSES);
+    let merged = std::fs::read_to_string(out.join("cadastre-points-pvlib.csv")).unwrap();
+    let header: Vec<&str> = merged.lines().next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 1 + 4 * HOUSES, "a column a point (4 a roof): {header:?}");
+    assert!(names.iter().all(|n| header.contains(&format!("{n}/RoofSurface/0/p3").as_str())), "{header:?}");
+    assert_eq!(merged.lines().count(), 1 + 8760);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -43,6 +43,7 @@ pub mod engine;
 mod objects;
 pub(crate) mod placed;
 pub mod rays;
+mod reach;
 
 /// A closed 2D polygon as i_overlay takes and returns it (no repeated first point).
 type Contour = Vec<[f64; 2]>;

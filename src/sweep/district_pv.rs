@@ -9,12 +9,13 @@
 //!   per point of the tile) and `pv/tile-K-sam.json` (the tile's points as one array), and in the
 //!   record the tile's [`SamSums`], which add over tiles;
 //! - the merge: `cadastre-points-pvlib.csv`, the tiles' columns side by side in the points CSV's
-//!   order (streamed: one line of each tile's file at a time, so a merge holds one row of the city,
-//!   not the year), and `cadastre-points-sam.json` from the tiles' sums added, which is the SAM file of every
+//!   order (streamed: a block of rows of each tile's file at a time, one file open at a time, so a
+//!   merge holds a block of the city's rows, not the year, and any number of tiles stays under the
+//!   open-file limit), and `cadastre-points-sam.json` from the tiles' sums added, which is the SAM file of every
 //!   point taken as one array (the sums of disjoint sets are the sums of their union).
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
@@ -125,10 +126,15 @@ pub fn write_merged(dir: &Path, tiles: &[(usize, SamSums)], position: &HashMap<&
     Ok(vec![csv_path, sam_path])
 }
 
-/// The tiles' pvlib CSVs side by side, `columns` in order, streamed row by row into `out` (the
-/// file at `path`): one line of each tile's file read at a time, so a merge holds one row of the
-/// city, not the year (the whole CSV is about 9 bytes a point and hour: 0.8 GB for 10,000
-/// points). Every file must hold its tile's columns and the same time index.
+/// Bytes of the tiles' lines a merge holds at a time: a block of rows of every tile.
+const BLOCK_BYTES: usize = 32 << 20;
+
+/// The tiles' pvlib CSVs side by side, `columns` in order, streamed into `out` (the file at
+/// `path`) a block of rows at a time: a merge holds a block of rows of the city, not the year (the
+/// whole CSV is about 9 bytes a point and hour: 0.8 GB for 10,000 points), and one tile file open
+/// at a time, whatever the number of tiles (a file held open a tile would pass the process's
+/// open-file limit, 1,024 by default, at a city of more tiles). Every file must hold its tile's
+/// columns and the same time index.
 fn write_merged_pvlib(
     dir: &Path,
     tiles: &[(usize, SamSums)],
@@ -136,26 +142,22 @@ fn write_merged_pvlib(
     path: &Path,
     out: &mut dyn Write,
 ) -> Result<()> {
-    let mut files = tiles
-        .iter()
-        .map(|(k, _)| {
-            let path = tile_paths(dir, *k).0;
-            std::fs::File::open(&path).map(|f| (path.clone(), BufReader::new(f))).map_err(|source| Error::Io { path, source })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let mut lines = vec![String::new(); tiles.len()];
-    let next_line = |t: usize, files: &mut Vec<(PathBuf, BufReader<std::fs::File>)>, lines: &mut Vec<String>| -> Result<bool> {
-        let (tile_path, reader) = &mut files[t];
-        lines[t].clear();
-        let read = reader.read_line(&mut lines[t]).map_err(|source| Error::Io { path: tile_path.clone(), source })?;
-        let trimmed = lines[t].trim_end_matches(['\n', '\r']).len();
-        lines[t].truncate(trimmed);
-        Ok(read > 0)
-    };
-    // The names come from the records; the files' own headers are skipped.
-    for t in 0..tiles.len() {
-        next_line(t, &mut files, &mut lines)?;
-    }
+    let rows = tiles.first().map_or(0, |(_, s)| s.rows.len());
+    // About a line's bytes: its time and six decimals and a comma a point.
+    let row_bytes: usize = tiles.iter().map(|(_, s)| 32 + 9 * s.names.len()).sum();
+    merge_in_blocks(dir, tiles, columns, path, out, (BLOCK_BYTES / row_bytes.max(1)).clamp(1, rows.max(1)))
+}
+
+/// [`write_merged_pvlib`] with `block` rows a block.
+fn merge_in_blocks(
+    dir: &Path,
+    tiles: &[(usize, SamSums)],
+    columns: &[(usize, usize, &str)],
+    path: &Path,
+    out: &mut dyn Write,
+    block: usize,
+) -> Result<()> {
+    let mut files: Vec<TileLines> = tiles.iter().map(|(k, _)| TileLines::new(tile_paths(dir, *k).0)).collect();
     let mut header = String::from("time");
     for &(_, _, name) in columns {
         header.push(',');
@@ -164,31 +166,74 @@ fn write_merged_pvlib(
     header.push('\n');
     let write_err = |source: std::io::Error| Error::Io { path: path.to_path_buf(), source };
     out.write_all(header.as_bytes()).map_err(write_err)?;
-    let rows = tiles[0].1.rows.len();
+    let rows = tiles.first().map_or(0, |(_, s)| s.rows.len());
     let mut row_text = String::new();
-    for row in 0..rows {
-        for t in 0..tiles.len() {
-            if !next_line(t, &mut files, &mut lines)? {
-                return Err(Error::model(files[t].0.display().to_string(), format!("ends before row {} of {rows}", row + 1)));
+    for first in (0..rows).step_by(block.max(1)) {
+        let n = block.max(1).min(rows - first);
+        for file in &mut files {
+            file.read_block(first, n, rows)?;
+        }
+        for i in 0..n {
+            let fields: Vec<Vec<&str>> = files.iter().map(|f| f.lines[i].split(',').collect()).collect();
+            for (t, f) in fields.iter().enumerate() {
+                if f.len() != tiles[t].1.names.len() + 1 || f[0] != fields[0][0] {
+                    let why = format!("row {} is not {} columns at {}", first + i + 1, tiles[t].1.names.len() + 1, fields[0][0]);
+                    return Err(Error::model(files[t].path.display().to_string(), why));
+                }
             }
-        }
-        let fields: Vec<Vec<&str>> = lines.iter().map(|l| l.split(',').collect()).collect();
-        for (t, f) in fields.iter().enumerate() {
-            if f.len() != tiles[t].1.names.len() + 1 || f[0] != fields[0][0] {
-                let why = format!("row {} is not {} columns at {}", row + 1, tiles[t].1.names.len() + 1, fields[0][0]);
-                return Err(Error::model(files[t].0.display().to_string(), why));
+            row_text.clear();
+            row_text.push_str(fields[0][0]);
+            for &(t, c, _) in columns {
+                row_text.push(',');
+                row_text.push_str(fields[t][c + 1]);
             }
+            row_text.push('\n');
+            out.write_all(row_text.as_bytes()).map_err(write_err)?;
         }
-        row_text.clear();
-        row_text.push_str(fields[0][0]);
-        for &(t, c, _) in columns {
-            row_text.push(',');
-            row_text.push_str(fields[t][c + 1]);
-        }
-        row_text.push('\n');
-        out.write_all(row_text.as_bytes()).map_err(write_err)?;
     }
     Ok(())
+}
+
+/// One tile's pvlib CSV read a block of lines at a time, opened for each block and closed after.
+struct TileLines {
+    path: PathBuf,
+    /// Where the next block starts; `None` before the header is skipped (the names come from the
+    /// records).
+    offset: Option<u64>,
+    /// The block's lines, without their line ends.
+    lines: Vec<String>,
+}
+
+impl TileLines {
+    fn new(path: PathBuf) -> Self {
+        Self { path, offset: None, lines: Vec::new() }
+    }
+
+    /// Reads rows `first..first + n` (of `rows`) into `lines`.
+    fn read_block(&mut self, first: usize, n: usize, rows: usize) -> Result<()> {
+        let io = |source: std::io::Error| Error::Io { path: self.path.clone(), source };
+        let mut file = std::fs::File::open(&self.path).map_err(io)?;
+        file.seek(SeekFrom::Start(self.offset.unwrap_or(0))).map_err(io)?;
+        let mut reader = BufReader::new(file);
+        let mut offset = self.offset.unwrap_or(0);
+        if self.offset.is_none() {
+            let mut header = String::new();
+            offset += reader.read_line(&mut header).map_err(io)? as u64;
+        }
+        self.lines.resize(n, String::new());
+        for (i, line) in self.lines.iter_mut().enumerate() {
+            line.clear();
+            let read = reader.read_line(line).map_err(io)?;
+            if read == 0 {
+                return Err(Error::model(self.path.display().to_string(), format!("ends before row {} of {rows}", first + i + 1)));
+            }
+            offset += read as u64;
+            let trimmed = line.trim_end_matches(['\n', '\r']).len();
+            line.truncate(trimmed);
+        }
+        self.offset = Some(offset);
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -236,6 +281,13 @@ mod tests {
         assert_eq!(files, [dir.join(POINTS_PVLIB), dir.join(POINTS_SAM)]);
         let csv = std::fs::read_to_string(dir.join(POINTS_PVLIB)).unwrap();
         assert!(csv == expected, "the merged CSV differs from the tiles' columns in order");
+        // Any block of rows gives the same bytes: a row a block, a block ending mid-file, one block.
+        let columns = [(1, 0, "a,x/RoofSurface/0/p0"), (0, 0, "b/RoofSurface/1/p0"), (0, 1, "b/RoofSurface/1/p1")];
+        for block in [1, 1000, rows] {
+            let mut out = Vec::new();
+            merge_in_blocks(&dir, &tiles, &columns, &dir.join(POINTS_PVLIB), &mut out, block).unwrap();
+            assert!(out == expected.as_bytes(), "blocks of {block} rows differ");
+        }
         // A tile file a row short is refused, naming it, and no merged file is left.
         let last = tile3.trim_end().rfind('\n').unwrap() + 1;
         std::fs::write(tile_paths(&dir, 3).0, &tile3[..last]).unwrap();
