@@ -858,7 +858,8 @@ fn an_unread_idf_window_takes_the_curve_it_is_given() {
         }
         assert!(weighted > 100, "sun {sun}: the curve should take something off ({weighted} points)");
     }
-    let (model_path, out) = (scratch("unread.idf"), scratch("unread.csv"));
+    let tmp = Scratch::new("inside", "an_unread_idf_window_takes_the_curve_it_is_given");
+    let (model_path, out) = (tmp.join("unread.idf"), tmp.join("unread.csv"));
     std::fs::write(&model_path, &idf).unwrap();
     let args = ["map", model_path.to_str().unwrap(), "--inside", "--at", "06-21", "12:00", "--location", "39.74,-105.18,-7"];
     let bad = sunlit(&[&args[..], &["--glass-curve", "10:0.8,40:0.7", "-o", out.to_str().unwrap()]].concat());
