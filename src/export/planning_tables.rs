@@ -115,7 +115,7 @@ pub fn tables(
                     "development": if v.development_deg.is_some() {
                         "the proposed scene's triangles the existing scene lacks (corners matched within 1 mm): the window's own building, its overhangs and fins, stands in both and is not the development; angle_deg_all is everything in the section"
                     } else {
-                        "everything in the section: without the existing scene (--before) the window's own building cannot be told from the development"
+                        "everything in the section: without an existing scene to compare with, the window's own building cannot be told from the development"
                     },
                 });
                 match &v.development_deg {
