@@ -195,6 +195,12 @@ struct AnnualArgs {
     /// none sunlit reads (one simple glazing layer or one spectral-average pane).
     #[arg(long, value_name = "T", requires = "interior_beam")]
     glass_transmittance: Option<f64>,
+    /// With --interior-beam: the solar transmittance by angle of incidence of windows whose
+    /// construction sunlit cannot read, ANGLE:T pairs from 0° (degrees, never rising), e.g.
+    /// 0:0.6,40:0.58,60:0.5,80:0.25 (as `map --inside --glass-curve`); it takes precedence over
+    /// --glass-transmittance, which then only the visible light would use (the beam has none).
+    #[arg(long, value_name = "ANGLE:T,...", requires = "interior_beam")]
+    glass_curve: Option<String>,
     /// Foliage keeps its leaves all year.
     #[arg(long, conflicts_with_all = ["leaf_out", "leaf_fall"])]
     evergreen: bool,

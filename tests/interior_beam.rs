@@ -391,3 +391,77 @@ fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
     }
     assert!(compared >= 10, "the beam reaches floors and walls of every zone ({compared} faces)");
 }
+
+/// The solar transmittance `--glass-curve`'s pairs give at incidence `cos` (the curve's rule,
+/// written out here: linear in the angle between pairs, past the last pair linear to 0 at 90°).
+fn curve_at(pairs: &[(f64, f64)], cos: f64) -> f64 {
+    let angle = cos.clamp(0.0, 1.0).acos().to_degrees();
+    let mut points = pairs.to_vec();
+    points.push((90.0, 0.0));
+    let k = points.windows(2).position(|w| angle <= w[1].0).unwrap();
+    let ((a0, t0), (a1, t1)) = (points[k], points[k + 1]);
+    t0 + (t1 - t0) * (angle - a0) / (a1 - a0)
+}
+
+/// An EnergyPlus window whose construction sunlit cannot read (two panes and a gap) takes the
+/// curve `--glass-curve` gives in `annual --interior-beam`: the L with its south window alone,
+/// run once with a flat `--glass-transmittance 0.8` and once with the curve from 0.8, gives on
+/// every inside face at every timestep the flat run's beam × curve(θ)/0.8, θ the sun's incidence
+/// on the window at that timestep (to the CSV's 1 mW/m²). Without either flag the window is
+/// refused by name, and a bad curve by the flag's; neither writes anything.
+#[test]
+fn an_unread_window_takes_the_glass_curve_in_the_interior_beam() {
+    let dir = Scratch::new("interior-beam", "glass-curve");
+    let idf: String = l_room_idf()
+        .lines()
+        .filter(|l| !l.starts_with("FenestrationSurface:Detailed,WinW") && !l.starts_with("FenestrationSurface:Detailed,WinE"))
+        .map(|l| format!("{l}\n"))
+        .collect::<String>()
+        .replace("Construction,Glass,SimpleGlass;", "Construction,Glass,Pane,Gap,Pane;");
+    let (model, epw) = (dir.join("unread.idf"), dir.join("two-days.epw"));
+    std::fs::write(&model, &idf).unwrap();
+    std::fs::write(&epw, two_day_epw()).unwrap();
+    let run = |name: &str, glass: &[&str]| {
+        let (csv, hooked) = (dir.join(format!("{name}.csv")), dir.join(format!("{name}-hooked.idf")));
+        let out = Command::new(env!("CARGO_BIN_EXE_sunlit"))
+            .args(["annual", model.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "--engine", "exact", "--days-per-year", "3"])
+            .args(["--samples-per-day", "5", "-o", csv.to_str().unwrap(), "--idf-out", hooked.to_str().unwrap(), "--interior-beam"])
+            .args(glass)
+            .output()
+            .unwrap();
+        let beam = dir.join(format!("{name}.interior-beam.csv"));
+        (out, std::fs::read_to_string(&beam).ok(), [csv, hooked, beam])
+    };
+    let pairs = [(0.0, 0.8), (30.0, 0.78), (50.0, 0.72), (70.0, 0.5)];
+    let (flat, flat_csv, _) = run("flat", &["--glass-transmittance", "0.8"]);
+    assert!(flat.status.success(), "{}", String::from_utf8_lossy(&flat.stderr));
+    let (curved, curved_csv, _) = run("curved", &["--glass-transmittance", "0.8"]);
+    assert!(curved.status.success(), "{}", String::from_utf8_lossy(&curved.stderr));
+    let (flat_csv, curved_csv) = (flat_csv.unwrap(), curved_csv.unwrap());
+    assert_eq!(flat_csv.lines().next(), curved_csv.lines().next(), "the same faces");
+
+    let weather = Weather::from_epw_text("two-days.epw", &two_day_epw()).unwrap();
+    let timesteps = Timesteps::new(4).unwrap();
+    let (mut compared, mut oblique) = (0, 0);
+    for (row, (a, b)) in flat_csv.lines().skip(1).zip(curved_csv.lines().skip(1)).enumerate() {
+        let numbers = |line: &str| -> Vec<f64> { line.split(',').skip(1).map(|x| x.parse().unwrap()).collect() };
+        let (a, b) = (numbers(a), numbers(b));
+        let at = timesteps.instant(row);
+        let sun = sun_direction(&weather.location, shading_sun_day(at.day), at.hour);
+        // The south window faces -y: the beam's incidence on it.
+        let ratio = curve_at(&pairs, -sun.y) / 0.8;
+        for (x, y) in a.iter().zip(&b) {
+            assert!((y - x * ratio).abs() <= 1.2e-3, "row {row}: {y} W/m² with the curve, {x} flat, ratio {ratio}");
+            compared += usize::from(*x > 1.0);
+            oblique += usize::from(*x > 1.0 && ratio < 0.95);
+        }
+    }
+    assert!(compared > 100 && oblique > 20, "{compared} lit cells, {oblique} where the curve takes 5 % or more");
+
+    for (glass, why) in [(&[][..], "WinS"), (&["--glass-curve", "10:0.8,40:0.7"][..], "--glass-curve")] {
+        let (out, beam, files) = run("refused", glass);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(why), "{glass:?}: {stderr}");
+        assert!(beam.is_none() && files.iter().all(|f| !f.exists()), "{glass:?} wrote a file");
+    }
+}

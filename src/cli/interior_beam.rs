@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use sunlit::export::hook::Hook;
 use sunlit::export::interior_beam::{interior_beam_csv, interior_beam_objects};
 use sunlit::model::EnergyPlusInput;
-use sunlit::model::inside::{Rooms, rooms};
+use sunlit::model::inside::curve::TransmittanceCurve;
+use sunlit::model::inside::{Rooms, UnreadGlass, rooms_with};
 use sunlit::sun::location::Location;
 use sunlit::sun::periods::ShadingPeriods;
 use sunlit::sun::weather::Weather;
@@ -56,7 +57,10 @@ pub fn beam_plan(args: &AnnualArgs, hook: Option<Hook>, ep: Option<&EnergyPlusIn
     }
     let csv = csv_path(&args.output);
     super::check_writable(&csv)?;
-    Ok(Some(BeamPlan { rooms: rooms(ep, args.glass_transmittance)?, weather: Weather::from_epw(epw)?, csv }))
+    let curve = args.glass_curve.as_deref().map(TransmittanceCurve::parse).transpose();
+    let curve = curve.map_err(|why| Error::argument("--glass-curve", why))?;
+    let glass = UnreadGlass { transmittance: args.glass_transmittance, curve };
+    Ok(Some(BeamPlan { rooms: rooms_with(ep, &glass)?, weather: Weather::from_epw(epw)?, csv }))
 }
 
 /// The CSV's bytes and the objects to append to the hooked model, with the notes to print.
