@@ -164,7 +164,7 @@ fn the_sky_model_names_are_the_same_on_both_sides() {
 #[path = "web/map_options.rs"]
 mod map_options;
 
-use map_options::{INSIDE_KEYS, InsideAsk, MAP_KEYS, MapRequest, MapValue, SITE_KEYS, Where};
+use map_options::{INSIDE_KEYS, InsideAsk, InsideStudy, MAP_KEYS, MapRequest, MapValue, SITE_KEYS, Where};
 use serde_json::json;
 
 use crate::map::Period;
@@ -186,7 +186,13 @@ fn the_map_options_are_the_same_on_both_sides() {
     assert_eq!(all.map(MapValue::needs_weather), [false, true, true, true, false], "the irradiation values need an EPW");
     let values: BTreeSet<String> = MapValue::NAMES.iter().map(|v| v.to_string()).collect();
     assert_eq!(literals_after("  value?: "), values, "MapOptions.value");
-    assert_eq!(union(interface("SunlitMap"), "value"), values, "SunlitMap.value");
+    let shown: BTreeSet<String> = MapValue::NAMES.iter().chain(&MapValue::STUDY_NAMES).map(|v| v.to_string()).collect();
+    assert_eq!(union(interface("SunlitMap"), "value"), shown, "SunlitMap.value: the values asked and the inside studies'");
+    assert_eq!([MapValue::AseHours, MapValue::SeesSky].map(MapValue::name), MapValue::STUDY_NAMES);
+    let studies: BTreeSet<String> = InsideStudy::NAMES.iter().map(|v| v.to_string()).collect();
+    assert_eq!(union(interface("MapOptions"), "study"), studies, "MapOptions.study: the CLI's inside studies");
+    let area: BTreeSet<String> = ["zone", "points", "ase", "seesSky"].map(String::from).into();
+    assert_eq!(fields(interface("InsideArea")), area, "a study's rooms' JSON keys (web/inside.rs)");
 }
 
 fn request(extra: serde_json::Value) -> crate::error::Result<MapRequest> {
@@ -210,12 +216,47 @@ fn map_options_read_as_sunlit_map_reads_its_flags() {
     let at = request(json!({"at": "03-21 09:30"})).unwrap();
     assert_eq!((at.period, at.value), (Period::at(80, 570).unwrap(), MapValue::Lit));
     let inside = request(json!({"at": "12-21 15:00", "inside": true, "workPlane": 0.76, "glassTransmittance": 0.6})).unwrap();
-    assert_eq!(inside.inside, Some(InsideAsk { work_plane: 0.76, glass: Some(0.6) }));
-    assert_eq!(request(json!({"at": "12-21 15:00", "inside": true})).unwrap().inside, Some(InsideAsk { work_plane: 0.0, glass: None }));
+    assert_eq!(inside.inside, Some(InsideAsk { work_plane: 0.76, glass: Some(0.6), study: None }));
+    let bare = Some(InsideAsk { work_plane: 0.0, glass: None, study: None });
+    assert_eq!(request(json!({"at": "12-21 15:00", "inside": true})).unwrap().inside, bare);
+    // Inside over a period (`--inside --period`): the CLI's defaults, and its EPW read for the beam.
+    let days = request(json!({"inside": true, "period": "12-01..12-07"})).unwrap();
+    assert_eq!((days.inside, days.period, days.value), (bare, Period::days(335, 341, 1).unwrap(), MapValue::SunHours));
+    let epw = year_epw();
+    let beam = request(json!({"inside": true, "period": "12-21", "value": "direct", "epw": epw})).unwrap();
+    assert!(beam.weather.is_some() && beam.value == MapValue::Direct);
+    assert!(request(json!({"inside": true, "period": "12-21", "epw": epw})).unwrap().weather.is_some(), "sun hours and the beam, as --epw");
+    // A study (`--study leed-ase`, `bre-nsl`): its grid, work plane, year and value.
+    let ase = request(json!({"inside": true, "study": "leed-ase", "epw": epw})).unwrap();
+    let ask = Some(InsideAsk { work_plane: 0.76, glass: None, study: Some(InsideStudy::LeedAse) });
+    assert_eq!((ase.inside, ase.place, ase.period, ase.value), (ask, Where::Grid(0.6), Period::annual(1).unwrap(), MapValue::AseHours));
+    let nsl = request(json!({"inside": true, "study": "bre-nsl", "grid": 0.25, "workPlane": 1.0})).unwrap();
+    let ask = Some(InsideAsk { work_plane: 1.0, glass: None, study: Some(InsideStudy::BreNsl) });
+    assert_eq!((nsl.inside, nsl.place, nsl.value), (ask, Where::Grid(0.25), MapValue::SeesSky));
+    assert_eq!(request(json!({"inside": true, "study": "bre-nsl"})).unwrap().inside.map(|i| i.work_plane), Some(0.85));
     assert_eq!(request(json!({"at": "12-21 15:00", "inside": false})).unwrap().inside, None);
     let given = request(json!({"points": [1, 2, 3, 0, 0, 1]})).unwrap();
     assert_eq!(given.place, Where::Given(vec![1.0, 2.0, 3.0, 0.0, 0.0, 1.0]));
     assert_eq!(map_options::points_csv(&[1.0, 2.5, 3.0, 0.0, 0.0, 1.0]).unwrap(), "x,y,z,nx,ny,nz\n1.0,2.5,3.0,0.0,0.0,1.0\n");
+}
+
+/// A year of EPW rows at Golden (as tests/browser/epw.mjs's), enough for the map options' reader.
+fn year_epw() -> String {
+    let mut text = String::from("LOCATION,Golden,CO,USA,test,724666,39.74,-105.18,-7.0,1829\nDESIGN CONDITIONS,0\n");
+    text.push_str("TYPICAL/EXTREME PERIODS,0\nGROUND TEMPERATURES,0\nHOLIDAYS/DAYLIGHT SAVINGS,No,0,0,0\nCOMMENTS 1,\n");
+    text.push_str("COMMENTS 2,\nDATA PERIODS,1,1,Data,Sunday,1/1,12/31\n");
+    let days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+    for (m, count) in days.iter().enumerate() {
+        for d in 1..=*count {
+            for h in 1..=24 {
+                text.push_str(&format!(
+                    "1999,{},{d},{h},60,x,20,10,50,101000,0,1300,300,500,600,100,0,0,0,0,0,0,0,0,0,0,9,0,0,0,0,0,0,0,0\n",
+                    m + 1
+                ));
+            }
+        }
+    }
+    text
 }
 
 #[test]
@@ -240,7 +281,12 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"skyModel": "uniform"})), bad("sky_model"), "a sky model needs an EPW");
     assert_eq!(named(json!({"skyModel": "perez"})), bad("sky_model"));
     assert_eq!(named(json!({"timestepsPerHour": 4})), bad("options"));
-    assert_eq!(named(json!({"inside": true})), bad("inside"), "inside at an instant only");
+    assert_eq!(named(json!({"inside": true, "value": "total"})), bad("value"), "inside, no sky");
+    assert_eq!(named(json!({"study": "leed-ase"})), bad("study"), "a study of the inside without inside");
+    assert_eq!(named(json!({"inside": true, "study": "bre-vsc"})), bad("study"), "a window study is engine.study's");
+    assert_eq!(named(json!({"inside": true, "study": "leed-ase"})), bad("study"), "ASE needs an EPW");
+    assert_eq!(named(json!({"inside": true, "study": "bre-nsl", "period": "12-21"})), bad("period"));
+    assert_eq!(named(json!({"inside": true, "study": "bre-nsl", "value": "sunHours"})), bad("value"));
     assert_eq!(named(json!({"at": "12-21 15:00", "inside": "yes"})), bad("inside"));
     assert_eq!(named(json!({"at": "12-21 15:00", "workPlane": 0.76})), bad("workPlane"), "a work plane without inside");
     assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glassTransmittance": "clear"})), bad("glassTransmittance"));

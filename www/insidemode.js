@@ -1,17 +1,27 @@
-// The page's interior view (Map mode, one instant, "Inside rooms"): engine.map with `inside: true`
-// (sunlit map --inside --at) on an EnergyPlus model's zones, a grid on their floors at a work
-// plane's height; the sun patches each inside face gets, said in the status; and the 3D view able
-// to cut away the roof or one wall, so the floors' cells are seen from outside. No inside logic
-// lives here: the points, lit state and patches are the library's.
+// The page's interior view (Map mode, "Inside rooms"): engine.map with `inside: true` (sunlit map
+// --inside) on an EnergyPlus model's zones, a grid on their floors at a work plane's height, at
+// an instant (the sun patches each inside face gets, said in the status), over the period, or a
+// study of the rooms (LEED ASE, BRE 209's No-Sky Line: each room's share said in the status);
+// and the 3D view able to cut away the roof or one wall, so the floors' cells are seen from
+// outside. No inside logic lives here: the points, values, patches and shares are the library's.
 
 /** The faces a cut takes away: [axis (0 x east, 1 y north, 2 z up), side (+1: the high end)]. */
 export const CUTS = { roof: [2, 1], north: [1, 1], south: [1, -1], east: [0, 1], west: [0, -1] };
 
-/** The options the inside adds to an instant's map request ({} when not asked). */
+/** The options the inside adds to a map request ({} when not asked): an empty work plane is the
+ * library's default (0, or the study's own, as the CLI's). */
 export function insideOptions($) {
   if (!$('mapinside').checked) return {};
-  const workPlane = Number($('mapworkplane').value);
-  return { inside: true, workPlane: Number.isFinite(workPlane) ? workPlane : 0 };
+  const o = { inside: true };
+  const workPlane = $('mapworkplane').value.trim();
+  if (workPlane !== '') o.workPlane = Number(workPlane);
+  if ($('mapinsidestudy').value) o.study = $('mapinsidestudy').value;
+  return o;
+}
+
+/** Whether an inside study is asked: it sets its own period and value. */
+export function insideStudy($) {
+  return $('mapinside').checked && $('mapinsidestudy').value !== '';
 }
 
 /** The cut named `name` for triangles `positions` (9 floats each): { axis, side, at }, where a
@@ -45,6 +55,13 @@ export function patchSummary(patches) {
   if (!patches.length) return '; no sun patch inside';
   const faces = patches.map((p) => `${p.surface} ${p.areaM2.toFixed(2)} m²`).join(', ');
   return `; sun patches: ${faces}`;
+}
+
+/** The status line's words on an inside study's rooms. */
+export function areaSummary(areas) {
+  if (!areas) return '';
+  const share = (a) => (a.ase ?? a.seesSky).toFixed(1);
+  return `; ${areas.map((a) => `${a.zone} ${share(a)} %`).join(', ')}`;
 }
 
 /** Wires the inside's controls: the cut redraws the view at once. `page`: { $, viewer() }. */

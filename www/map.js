@@ -11,6 +11,9 @@ export const MAP_VALUES = {
   skyDiffuse: { title: 'Sky-diffuse irradiation', unit: 'kWh/m²' },
   total: { title: 'Total irradiation', unit: 'kWh/m²' },
   lit: { title: 'Sunlit at the instant', unit: '' },
+  // An inside study's values (engine.map with inside and study).
+  aseHours: { title: 'Occupied hours over 1000 lux of direct sun', unit: 'h' },
+  seesSky: { title: 'Sees sky (No-Sky Line)', unit: '' },
 };
 
 /** A point in the sun at the instant, and one in shadow: the palette's two ends. */

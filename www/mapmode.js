@@ -3,7 +3,7 @@
 // a day/time slider that maps the instant as it moves; the points CSV and the map glb to
 // download (the library's own writers, as `sunlit map` writes them), written by the worker only
 // when a download is clicked: a slider's move asks for nothing the view does not draw.
-import { insideOptions, patchSummary, wireInside } from './insidemode.js';
+import { areaSummary, insideOptions, insideStudy, patchSummary, wireInside } from './insidemode.js';
 import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 const MONTH_DAYS = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
@@ -34,7 +34,8 @@ export function mapMode(page) {
   const state = { map: null, id: null, pending: null, inFlight: false };
 
   const mode = () => $('mode').value;
-  const instant = () => $('mapperiod').value === 'instant' || $('mapvalue').value === 'lit';
+  // An inside study sets its own period: never an instant, so the sliders do not rerun it.
+  const instant = () => !insideStudy($) && ($('mapperiod').value === 'instant' || $('mapvalue').value === 'lit');
 
   function showFields() {
     const map = mode() === 'map';
@@ -51,8 +52,9 @@ export function mapMode(page) {
   async function options() {
     const o = { ...(await page.location()), grid: Number($('mapgrid').value) };
     if (page.skyModel()) o.skyModel = page.skyModel();
+    if (insideStudy($)) return { ...o, ...insideOptions($) };
     if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit', ...insideOptions($) };
-    o.value = $('mapvalue').value;
+    Object.assign(o, { value: $('mapvalue').value, ...insideOptions($) });
     const period = $('mapperiod').value;
     if (period === 'range') o.period = `${$('mapstart').value.trim()}..${$('mapend').value.trim()}`;
     else if (period === 'day') {
@@ -106,13 +108,14 @@ export function mapMode(page) {
     view.dataset.lit = lit === null ? '' : String(lit);
     view.dataset.at = map.value === 'lit' ? `${tag.day},${tag.time}` : '';
     view.dataset.patches = map.patches ? JSON.stringify(map.patches) : '';
+    view.dataset.areas = map.areas ? JSON.stringify(map.areas) : '';
     state.id = id;
     $('downloadmap').disabled = false;
     $('downloadglb').disabled = false;
     const receivers = new Set(map.receivers).size;
     const summary =
       lit === null
-        ? `${info.title} from ${map.min.toFixed(2)} to ${map.max.toFixed(2)}${info.unit ? ` ${info.unit}` : ''} over ${map.instants.toLocaleString()} instants`
+        ? `${info.title} from ${map.min.toFixed(2)} to ${map.max.toFixed(2)}${info.unit ? ` ${info.unit}` : ''} over ${map.instants.toLocaleString()} instants${areaSummary(map.areas)}`
         : `${lit.toLocaleString()} in the sun${patchSummary(map.patches)}`;
     page.status(`Map in ${seconds.toFixed(1)} s (${tag.kind}): ${map.values.length.toLocaleString()} points on ${receivers} receivers; ${summary}.`);
   }

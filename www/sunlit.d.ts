@@ -401,14 +401,34 @@ export interface MapOptions {
   /** The sky for 'skyDiffuse' and 'total' (needs `epw`), as `sunlit map --sky-model`:
    * 'energyplus' (the default), 'perez-all-weather', 'cie-overcast' or 'uniform'. */
   skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
-  /** Map the inside of an EnergyPlus model's zones at the instant `at`, as `sunlit map --inside
-   * --at`: a grid on their floors (or `points` in them), each point lit or not by the beam
-   * through the windows; the answer adds the glass's weights and each inside face's sun patch. */
+  /** Map the inside of an EnergyPlus model's zones, as `sunlit map --inside`: a grid on their
+   * floors (or `points` in them) and the beam through the windows. At the instant `at`, each
+   * point lit or not, and the answer adds the glass's weights and each inside face's sun patch;
+   * over a period, 'sunHours' or 'direct' (the beam through the glass, kWh/m², needs an EPW),
+   * the CSV adding with an EPW the beam and the direct-sun illuminance; or a `study`. */
   inside?: boolean;
-  /** With `inside`: the grid this many metres above each floor (default 0: on the floors). */
+  /** With `inside`: the grid this many metres above each floor (default 0: on the floors; a
+   * study's own: 0.76 for 'leed-ase', 0.85 for 'bre-nsl'). */
   workPlane?: number;
+  /** With `inside`, a study of the rooms, as `sunlit map --inside --study`: 'leed-ase' (LEED
+   * v4.1's Annual Sunlight Exposure over the year's occupied hours; needs an EPW; grid 0.6 m by
+   * default; value 'aseHours') or 'bre-nsl' (BRE 209's No-Sky Line; value 'seesSky'). No `at`,
+   * `period`, `step`, `from`, `to` or `value`: the study sets them. The answer adds `areas`. */
+  study?: 'leed-ase' | 'bre-nsl';
   /** With `inside`: transmittance (0..1) of glazing whose construction gives none. */
   glassTransmittance?: number;
+}
+
+/** One room's share in an inside study (`inside: true, study`), as the study's report's `areas`. */
+export interface InsideArea {
+  /** The zone. */
+  zone: string;
+  /** Its points. */
+  points: number;
+  /** 'leed-ase': ASE1000,250, % of its points. */
+  ase?: number;
+  /** 'bre-nsl': % of its points that see sky. */
+  seesSky?: number;
 }
 
 /** One inside face's sun patch at the instant (`inside: true`). */
@@ -446,8 +466,9 @@ export interface MapFiles {
  * point, in sunlit's world axes (x east, y north, z up, metres). */
 export interface SunlitMap {
   /** The value held: 'sunHours' (h), 'direct', 'skyDiffuse', 'total' (kWh/m²) or 'lit' (1 sunlit,
-   * 0 shaded). */
-  value: 'sunHours' | 'direct' | 'skyDiffuse' | 'total' | 'lit';
+   * 0 shaded); an inside study's: 'aseHours' (occupied hours over 1000 lux of direct sun) or
+   * 'seesSky' (1 or 0). */
+  value: 'sunHours' | 'direct' | 'skyDiffuse' | 'total' | 'lit' | 'aseHours' | 'seesSky';
   /** The legend's title and unit. */
   title: string;
   unit: string;
@@ -492,13 +513,15 @@ export interface SunlitMap {
   max: number;
   /** The model's receiver names; inside rooms, the inside faces' and work planes' names. */
   receiverNames: string[];
-  /** Inside rooms: per point the solar transmittance of the glass its beam came through (0
-   * shaded). */
+  /** Inside rooms at an instant: per point the solar transmittance of the glass its beam came
+   * through (0 shaded). */
   solarTransmittance?: Float32Array;
   /** Inside rooms: per point the visible transmittance likewise. */
   visibleTransmittance?: Float32Array;
-  /** Inside rooms: the sun patch on each inside face that has one. */
+  /** Inside rooms at an instant: the sun patch on each inside face that has one. */
   patches?: SunPatch[];
+  /** Inside rooms, a study: each room's share. */
+  areas?: InsideArea[];
 }
 
 /** A scene on the engine's GPU device; use it only with the engine that made it. */

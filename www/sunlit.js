@@ -433,10 +433,11 @@ class SunlitEngine {
   }
 }
 
-/** An inside map's own fields (`inside: true`): the glass's weights per point and the sun patches;
- * none for a map outside. */
+/** An inside map's own fields (`inside: true`): at an instant the glass's weights per point and
+ * the sun patches, for a study each room's share; none for a map outside. */
 function insideOf(map) {
-  const patches = map.patches;
+  const [patches, areas] = [map.patches, map.areas];
+  if (areas !== undefined) return { areas: JSON.parse(areas) };
   if (patches === undefined) return {};
   return { solarTransmittance: map.solarTransmittance, visibleTransmittance: map.visibleTransmittance, patches: JSON.parse(patches) };
 }

@@ -2,7 +2,7 @@
 //! model, their points, and the instant, period or LEED ASE outputs. The library owns the rooms,
 //! the glass, the sums and the rule.
 
-use sunlit::export::map_table::inside_instant_columns;
+use sunlit::export::map_table::{ase_column, inside_instant_columns, inside_period_columns, inside_period_shown};
 use sunlit::map::inside::{
     self as rooms_map, ASE_HOURS, ASE_LUX, ASE_SPACING, BEAM_EFFICACY, InsideMap, NSL_WORK_PLANE, OCCUPIED, RoomPoints, WORK_PLANE_HEIGHT,
 };
@@ -93,14 +93,9 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
             let values = rooms_map::accumulate(map, &samples, site, &mut |_, _| {});
             summary["instants"] = json!(values.instants);
             summary["efficacy_hours"] = json!(values.efficacy_hours);
-            let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
-            if let (Some(b), Some(l)) = (&values.beam_kwh_m2, &values.direct_klux_h) {
-                columns.push(Column { name: "beam_kwh_m2", values: b, decimals: 4 });
-                columns.push(Column { name: "direct_klux_h", values: l, decimals: 4 });
-            }
-            let csv = points_csv(&scene, &at.points, &columns);
-            let glb = values.beam_kwh_m2.clone().map_or(("sun_hours", "h", values.sun_hours.clone()), |b| ("beam_kwh_m2", "kWh/m²", b));
-            (csv, glb)
+            let csv = points_csv(&scene, &at.points, &inside_period_columns(&values));
+            let (name, unit, shown) = inside_period_shown(&values);
+            (csv, (name, unit, shown.to_vec()))
         }
         Ask::Ase => {
             let samples = rooms_map::occupied_hours(&Period::annual(1)?.samples());
@@ -108,8 +103,7 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
             let report = ase_report(&args, &location, &result, &at);
             summary["studies"] = json!([{"study": "leed-ase", "areas": report["areas"].clone()}]);
             files.push((args.study_path("leed-ase", "json"), format!("{report:#}\n").into_bytes()));
-            let columns = [Column { name: "hours_over_1000_lux", values: &result.hours, decimals: 1 }];
-            (points_csv(&scene, &at.points, &columns), ("hours_over_1000_lux", "h", result.hours.clone()))
+            (points_csv(&scene, &at.points, &[ase_column(&result)]), ("hours_over_1000_lux", "h", result.hours.clone()))
         }
         Ask::Nsl => {
             let patches = SkyPatches::parse(args.sky_patches.as_deref().unwrap_or("tregenza"))?;

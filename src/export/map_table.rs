@@ -35,6 +35,31 @@ pub fn inside_instant_columns(values: &crate::map::inside::InsideInstant) -> [Co
     ]
 }
 
+/// An inside period's value columns ([`crate::map::inside::InsideValues`]): `sun_hours`, then
+/// with weather `beam_kwh_m2` and `direct_klux_h`.
+pub fn inside_period_columns(values: &crate::map::inside::InsideValues) -> Vec<Column<'_>> {
+    let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];
+    if let (Some(b), Some(l)) = (&values.beam_kwh_m2, &values.direct_klux_h) {
+        columns.push(Column { name: "beam_kwh_m2", values: b, decimals: 4 });
+        columns.push(Column { name: "direct_klux_h", values: l, decimals: 4 });
+    }
+    columns
+}
+
+/// What an inside period's map glb is coloured by (name, unit, values): the beam through the
+/// glass where the weather gives it, else the sun hours.
+pub fn inside_period_shown(values: &crate::map::inside::InsideValues) -> (&'static str, &'static str, &[f64]) {
+    match &values.beam_kwh_m2 {
+        Some(b) => ("beam_kwh_m2", "kWh/m²", b),
+        None => ("sun_hours", "h", &values.sun_hours),
+    }
+}
+
+/// LEED ASE's value column ([`crate::map::inside::AseResult`]): occupied hours over 1,000 lux.
+pub fn ase_column(result: &crate::map::inside::AseResult) -> Column<'_> {
+    Column { name: "hours_over_1000_lux", values: &result.hours, decimals: 1 }
+}
+
 /// A period's sums as the points CSV's value columns, in the order the module doc gives.
 pub fn value_columns(values: &MapValues) -> Vec<Column<'_>> {
     let mut columns = vec![Column { name: "sun_hours", values: &values.sun_hours, decimals: 4 }];

@@ -14,7 +14,7 @@ use js_sys::{Float32Array, Function, Promise, Uint8Array, Uint32Array};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::{JsFuture, future_to_promise};
 
-use super::inside::{Inside, inside_at};
+use super::inside::{Inside, inside_map};
 use super::map_options::{MapRequest, MapValue, Where, points_csv as given_points};
 use super::{Engine, Model, ModelInner, js_error};
 use crate::error::{Error, Result};
@@ -154,16 +154,19 @@ impl PointMap {
         to_f32(&self.values)
     }
 
-    /// A period's sun hours per point (undefined for an instant).
+    /// A period's sun hours per point (undefined for an instant or an inside study).
     #[wasm_bindgen(getter, js_name = sunHours)]
     pub fn sun_hours(&self) -> Option<Float32Array> {
-        self.sums.as_ref().map(|s| to_f32(&s.sun_hours))
+        let inside = || self.inside.as_ref().and_then(Inside::sums).map(|(hours, _)| to_f32(hours));
+        self.sums.as_ref().map(|s| to_f32(&s.sun_hours)).or_else(inside)
     }
 
-    /// A period's direct irradiation per point, kWh/m² (undefined without an EPW or for an instant).
+    /// A period's direct irradiation per point, kWh/m² (undefined without an EPW or for an
+    /// instant); inside rooms, the beam through the glass.
     #[wasm_bindgen(getter)]
     pub fn direct(&self) -> Option<Float32Array> {
-        self.sums.as_ref().and_then(|s| s.direct_kwh_m2.as_deref()).map(to_f32)
+        let inside = || self.inside.as_ref().and_then(Inside::sums).and_then(|(_, beam)| beam).map(to_f32);
+        self.sums.as_ref().and_then(|s| s.direct_kwh_m2.as_deref()).map(to_f32).or_else(inside)
     }
 
     /// A period's sky-diffuse irradiation per point, kWh/m² (with an irradiation value: `direct`, `skyDiffuse` or `total`).
@@ -207,13 +210,13 @@ impl PointMap {
     /// outside).
     #[wasm_bindgen(getter, js_name = solarTransmittance)]
     pub fn solar_transmittance(&self) -> Option<Float32Array> {
-        self.inside.as_ref().map(|i| to_f32(&i.values.solar_transmittance))
+        self.inside.as_ref().and_then(Inside::weights).map(|(solar, _)| to_f32(solar))
     }
 
     /// Inside rooms: per point the glass's visible transmittance likewise.
     #[wasm_bindgen(getter, js_name = visibleTransmittance)]
     pub fn visible_transmittance(&self) -> Option<Float32Array> {
-        self.inside.as_ref().map(|i| to_f32(&i.values.visible_transmittance))
+        self.inside.as_ref().and_then(Inside::weights).map(|(_, visible)| to_f32(visible))
     }
 
     /// Inside rooms: the inside scene's receiver names, which `receivers` index (undefined
@@ -227,7 +230,14 @@ impl PointMap {
     /// `fraction`), as `map --inside --at --json` reports `sun_patches`.
     #[wasm_bindgen(getter)]
     pub fn patches(&self) -> Option<String> {
-        self.inside.as_ref().map(Inside::patches_json)
+        self.inside.as_ref().and_then(Inside::patches_json)
+    }
+
+    /// Inside rooms, a study: each room's share, as JSON (`zone`, `points`, and `ase` or
+    /// `seesSky` in %), as the study's report gives its `areas`.
+    #[wasm_bindgen(getter)]
+    pub fn areas(&self) -> Option<String> {
+        self.inside.as_ref().and_then(Inside::areas_json)
     }
 
     /// The points CSV as `sunlit map -o POINTS.csv` writes it for the same options.
@@ -245,7 +255,7 @@ impl PointMap {
             MapValue::Direct => ("direct_kwh_m2", "kWh/m²"),
             MapValue::SkyDiffuse => ("sky_diffuse_kwh_m2", "kWh/m²"),
             MapValue::Total => ("total_kwh_m2", "kWh/m²"),
-            MapValue::Lit => ("lit", ""),
+            MapValue::Lit | MapValue::AseHours | MapValue::SeesSky => ("lit", ""),
         };
         match &self.inside {
             Some(inside) => Uint8Array::from(inside.glb(&self.points).as_slice()),
@@ -269,10 +279,9 @@ impl Engine {
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
             if let Some(ask) = &request.inside {
-                let (points, inside) = inside_at(&model, &request, ask).map_err(map_error)?;
-                let values = inside.values.lit.clone();
-                let (value, points) = (MapValue::Lit, Rc::new(points));
-                return Ok(PointMap { model, points, value, values, sums: None, instants: 1, inside: Some(inside) }.into());
+                let (points, inside) = inside_map(&model, &request, ask).map_err(map_error)?;
+                let ((value, values), instants, points) = (inside.values(), inside.instants(), Rc::new(points));
+                return Ok(PointMap { model, points, value, values, sums: None, instants, inside: Some(inside) }.into());
             }
             let (points, mapper) = points_for(&model, &request.place).map_err(map_error)?;
             let sky = request.value.needs_weather().then(|| sky_for(&model, &request.place, &mapper, request.site.sky_model));
@@ -293,7 +302,7 @@ impl Engine {
                     MapValue::Direct => sums.direct_kwh_m2.clone(),
                     MapValue::SkyDiffuse => sums.sky_diffuse_kwh_m2.clone(),
                     MapValue::Total => sums.total_kwh_m2.clone(),
-                    MapValue::SunHours | MapValue::Lit => Some(sums.sun_hours.clone()),
+                    MapValue::SunHours | MapValue::Lit | MapValue::AseHours | MapValue::SeesSky => Some(sums.sun_hours.clone()),
                 }
                 .unwrap_or_default();
                 PointMap { model, points, value, values, instants: sums.instants, sums: Some(sums), inside: None }

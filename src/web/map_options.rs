@@ -1,13 +1,14 @@
 //! `engine.map`'s options object (`MapOptions` in `www/sunlit.d.ts`) read into the library's
 //! terms: the site and leaf calendar as an annual run resolves them ([`AnnualSettings`]), where
 //! (a grid or given points), when ([`Period`], with `sunlit map`'s defaults) and what
-//! ([`MapValue`]), and whether inside rooms ([`InsideAsk`], `sunlit map --inside --at`). Plain
-//! JSON in, so it is tested natively too (`js_api`).
+//! ([`MapValue`]), and whether inside rooms ([`InsideAsk`], `sunlit map --inside` at an instant,
+//! over a period or for a study). Plain JSON in, so it is tested natively too (`js_api`).
 
 use serde_json::Value;
 
 use crate::error::{Error, Result};
 use crate::map::Period;
+use crate::map::inside::{ASE_SPACING, NSL_WORK_PLANE, WORK_PLANE_HEIGHT};
 use crate::map::period::{parse_clock, parse_date};
 use crate::sun::weather::Weather;
 use crate::year::settings::{AnnualSettings, Resolved};
@@ -25,7 +26,7 @@ pub const DEFAULT_DAY_STEP: u32 = 10;
 pub const MAP_KEYS: [&str; 8] = ["grid", "points", "period", "step", "from", "to", "at", "value"];
 
 /// The keys that map the inside of an EnergyPlus model's zones instead of its outside.
-pub const INSIDE_KEYS: [&str; 3] = ["inside", "workPlane", "glassTransmittance"];
+pub const INSIDE_KEYS: [&str; 4] = ["inside", "workPlane", "glassTransmittance", "study"];
 
 /// The annual settings' keys a map also takes: the site, the foliage's calendar and the sky model
 /// ([`AnnualSettings`], resolved as an annual run resolves them).
@@ -44,11 +45,18 @@ pub enum MapValue {
     Total,
     /// Sun seen (1) or not (0) at one instant.
     Lit,
+    /// Inside, LEED ASE: occupied hours over 1,000 lux of direct sun (`study: 'leed-ase'`).
+    AseHours,
+    /// Inside, BRE 209's No-Sky Line: sees sky (1) or not (0) (`study: 'bre-nsl'`).
+    SeesSky,
 }
 
 impl MapValue {
     /// The JS API's names, as `value` takes them.
     pub const NAMES: [&str; 5] = ["sunHours", "direct", "skyDiffuse", "total", "lit"];
+
+    /// The names of the values an inside study gives (not asked by `value`: the study decides).
+    pub const STUDY_NAMES: [&str; 2] = ["aseHours", "seesSky"];
 
     fn parse(text: &str) -> Result<Self> {
         match text {
@@ -63,7 +71,11 @@ impl MapValue {
 
     /// The JS API's name.
     pub fn name(self) -> &'static str {
-        Self::NAMES[self as usize]
+        match self {
+            Self::AseHours => Self::STUDY_NAMES[0],
+            Self::SeesSky => Self::STUDY_NAMES[1],
+            other => Self::NAMES[other as usize],
+        }
     }
 
     /// Whether the value is an irradiation: it needs the EPW, and the map then sums every part
@@ -81,6 +93,8 @@ impl MapValue {
             Self::SkyDiffuse => ("Sky-diffuse irradiation", "kWh/m²"),
             Self::Total => ("Total irradiation", "kWh/m²"),
             Self::Lit => ("Sunlit at the instant", ""),
+            Self::AseHours => ("Occupied hours over 1000 lux of direct sun", "h"),
+            Self::SeesSky => ("Sees sky (No-Sky Line)", ""),
         }
     }
 }
@@ -110,14 +124,61 @@ pub struct MapRequest {
     pub inside: Option<InsideAsk>,
 }
 
-/// The inside map asked (`sunlit map --inside --at`): points on the zones' floors (a grid at
-/// `work_plane` m above them) or given ones, the beam through the windows.
+/// The inside map asked (`sunlit map --inside`): points on the zones' floors (a grid at
+/// `work_plane` m above them) or given ones, the beam through the windows; at an instant, over a
+/// period, or a study.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InsideAsk {
-    /// Height of the grid above the floors (m): 0, on the floors' inside faces (`--work-plane`).
+    /// Height of the grid above the floors (m) (`--work-plane`): by default 0, on the floors'
+    /// inside faces; a study's own work plane for a study.
     pub work_plane: f64,
     /// Transmittance of glazing whose construction gives none (`--glass-transmittance`).
     pub glass: Option<f64>,
+    /// A study of the inside (`--study leed-ase` or `bre-nsl`), or none.
+    pub study: Option<InsideStudy>,
+}
+
+/// A study of the inside, as `sunlit map --inside --study` names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InsideStudy {
+    /// LEED v4.1's Annual Sunlight Exposure (needs an EPW; the year's occupied hours).
+    LeedAse,
+    /// BRE 209's No-Sky Line (geometry: no period).
+    BreNsl,
+}
+
+impl InsideStudy {
+    /// The names `study` takes (the CLI's).
+    pub const NAMES: [&str; 2] = ["leed-ase", "bre-nsl"];
+
+    fn parse(text: &str) -> Result<Self> {
+        match text {
+            "leed-ase" => Ok(Self::LeedAse),
+            "bre-nsl" => Ok(Self::BreNsl),
+            other => Err(Error::argument("study", format!("'{other}' is not a study of the inside (known: {})", Self::NAMES.join(", ")))),
+        }
+    }
+
+    /// The name, as `study` takes it.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// The grid spacing (m) and work plane height (m) when not given, as the CLI's.
+    fn defaults(self) -> (f64, f64) {
+        match self {
+            Self::LeedAse => (ASE_SPACING, WORK_PLANE_HEIGHT),
+            Self::BreNsl => (DEFAULT_GRID, NSL_WORK_PLANE),
+        }
+    }
+
+    /// The value the study gives per point.
+    pub fn value(self) -> MapValue {
+        match self {
+            Self::LeedAse => MapValue::AseHours,
+            Self::BreNsl => MapValue::SeesSky,
+        }
+    }
 }
 
 /// Given points (6 numbers each) as the `x,y,z,nx,ny,nz` text the library reads, so a JS array
@@ -149,7 +210,8 @@ impl MapRequest {
                 format!("'{key}' is not a map option ({}, {}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", "), INSIDE_KEYS.join(", ")),
             ));
         }
-        let inside = inside_ask(all.remove("inside"), all.remove("workPlane"), all.remove("glassTransmittance"))?;
+        let inside = inside_ask(all.remove("inside"), all.remove("workPlane"), all.remove("glassTransmittance"), all.remove("study"))?;
+        let study = inside.as_ref().and_then(|i| i.study);
         let mut take = |key: &str| all.remove(key);
         let (grid, points, period, step, from, to, at, value) =
             (take("grid"), take("points"), take("period"), take("step"), take("from"), take("to"), take("at"), take("value"));
@@ -157,7 +219,7 @@ impl MapRequest {
         let site = settings.resolve()?;
         let place = match (number("grid", grid)?, points) {
             (Some(_), Some(_)) => return Err(Error::argument("points", "give a grid spacing or points, not both")),
-            (spacing, None) => Where::Grid(spacing.unwrap_or(DEFAULT_GRID)),
+            (spacing, None) => Where::Grid(spacing.unwrap_or(study.map_or(DEFAULT_GRID, |s| s.defaults().0))),
             (None, Some(points)) => {
                 Where::Given(serde_json::from_value(points).map_err(|_| Error::argument("points", "must be an array of numbers"))?)
             }
@@ -171,6 +233,23 @@ impl MapRequest {
             text_of("value", value)?,
         );
         let value = value.as_deref().map(MapValue::parse).transpose()?;
+        let epw = |asked: bool| match (asked, &settings.epw) {
+            (true, Some(epw)) => Weather::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw).map(Some),
+            _ => Ok(None),
+        };
+        if let Some(study) = study {
+            let given = [("at", at.is_some()), ("period", period.is_some()), ("step", step.is_some())];
+            let given = given.into_iter().chain([("from", from.is_some()), ("to", to.is_some()), ("value", value.is_some())]);
+            if let Some((name, _)) = given.into_iter().find(|(_, g)| *g) {
+                return Err(Error::argument(name, format!("the {} study sets its own period and value: drop '{name}'", study.name())));
+            }
+            if study == InsideStudy::LeedAse && settings.epw.is_none() {
+                return Err(Error::argument("study", "leed-ase needs an EPW (direct normal illuminance, or irradiance)"));
+            }
+            // The year at hourly steps, as `--study leed-ase` (the occupied hours are the study's).
+            let (weather, period) = (epw(true)?, Period::annual(1)?);
+            return Ok(Self { site, weather, place, period, value: study.value(), inside });
+        }
         let period = match at {
             Some(at) => {
                 if let Some((name, _)) =
@@ -194,34 +273,37 @@ impl MapRequest {
             }
             (Some(v), false) => v,
         };
-        let weather = match (value.needs_weather(), &settings.epw) {
-            (true, Some(epw)) => Some(Weather::from_epw_text(settings.epw_name.as_deref().unwrap_or("EPW"), epw)?),
-            (true, None) => return Err(Error::argument("value", format!("'{}' needs an EPW (its solar irradiance)", value.name()))),
-            (false, _) => None,
-        };
-        if inside.is_some() && value != MapValue::Lit {
-            return Err(Error::argument("inside", "the inside is mapped at an instant here: give 'at' (MM-DD HH:MM)"));
+        if value.needs_weather() && settings.epw.is_none() {
+            return Err(Error::argument("value", format!("'{}' needs an EPW (its solar irradiance)", value.name())));
         }
+        if inside.is_some() && matches!(value, MapValue::SkyDiffuse | MapValue::Total) {
+            return Err(Error::argument("value", "inside, a period's value is 'sunHours' or 'direct' (the beam through the glass)"));
+        }
+        // Inside, an EPW adds the beam and the direct-sun illuminance, as `--inside --epw` does.
+        let weather = epw(value.needs_weather() || (inside.is_some() && !is_instant))?;
         Ok(Self { site, weather, place, period, value, inside })
     }
 }
 
-/// `inside`, `workPlane` and `glassTransmittance`: the inside asked, or none (the latter two
-/// need the first).
-fn inside_ask(inside: Option<Value>, work_plane: Option<Value>, glass: Option<Value>) -> Result<Option<InsideAsk>> {
+/// `inside`, `workPlane`, `glassTransmittance` and `study`: the inside asked, or none (the
+/// latter three need the first).
+fn inside_ask(inside: Option<Value>, work_plane: Option<Value>, glass: Option<Value>, study: Option<Value>) -> Result<Option<InsideAsk>> {
     let inside = match inside {
         None | Some(Value::Bool(false)) => false,
         Some(Value::Bool(true)) => true,
         Some(other) => return Err(Error::argument("inside", format!("{other} is not true or false"))),
     };
     let (work_plane, glass) = (number("workPlane", work_plane)?, number("glassTransmittance", glass)?);
+    let study = text_of("study", study)?.as_deref().map(InsideStudy::parse).transpose()?;
     if !inside {
-        if let Some(name) = [("workPlane", work_plane), ("glassTransmittance", glass)].iter().find(|(_, v)| v.is_some()).map(|(n, _)| *n) {
-            return Err(Error::argument(name, "maps the inside of rooms: add inside: true"));
+        let given = [("workPlane", work_plane.is_some()), ("glassTransmittance", glass.is_some()), ("study", study.is_some())];
+        if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(Error::argument(*name, "maps the inside of rooms: add inside: true"));
         }
         return Ok(None);
     }
-    Ok(Some(InsideAsk { work_plane: work_plane.unwrap_or(0.0), glass }))
+    let work_plane = work_plane.unwrap_or(study.map_or(0.0, |s| s.defaults().1));
+    Ok(Some(InsideAsk { work_plane, glass, study }))
 }
 
 /// A number option, if given.

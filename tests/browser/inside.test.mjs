@@ -3,14 +3,18 @@
 // an instant with "Inside rooms" maps a grid on the floor; its points CSV equals `sunlit map
 // --inside --at` byte for byte, its lit count and each inside face's sun patch equal the CLI's
 // JSON summary; cutting away the roof or the south wall takes exactly those faces out of the 3D
-// view. The view is saved to target/artifacts/inside.png for a person to look at.
+// view. The view is saved to target/artifacts/inside.png for a person to look at. Over a period
+// (the beam through the glass under an EPW) and for LEED ASE (`study: 'leed-ase'`), the page's
+// CSV equals `sunlit map --inside --period` and `--study leed-ase` byte for byte, and each room's
+// ASE the CLI's.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { writeFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
 import { ROOT, closePage, downloadText, servePage, setMapSliders, statusAfter, waitForStatus } from './pagetest.mjs';
+import { goldenEpw, roomIdf } from './room.mjs';
 
 const WORK = join(tmpdir(), `sunlit-inside-${process.pid}`);
 const LOCATION = { latitude: '39.74', longitude: '-105.18', timezone: '-7' };
@@ -18,25 +22,6 @@ const LOCATION = { latitude: '39.74', longitude: '-105.18', timezone: '-7' };
 const DAY = 355;
 const HOUR = 13;
 const GRID = '0.25';
-
-/** A 4 m × 5 m × 3 m room, its window x 1–3 m, z 1–2.5 m in the south wall (y = 0), as
- * tests/inside.rs builds it. */
-function roomIdf() {
-  const surface = (name, kind, boundary, corners) =>
-    `BuildingSurface:Detailed,${name},${kind},Opaque,Office,,${boundary},,${boundary === 'Outdoors' ? 'SunExposed,WindExposed' : 'NoSun,NoWind'},,${corners.length},${corners.flat().join(',')};\n`;
-  return [
-    'Version,25.2;\nBuilding,Box,0,Suburbs,0.04,0.4,FullInteriorAndExterior,25,6;\n',
-    'GlobalGeometryRules,UpperLeftCorner,Counterclockwise,Relative;\nZone,Office,0,0,0,0;\n',
-    'Construction,Opaque,Layer;\nConstruction,Glass,SimpleGlass;\nWindowMaterial:SimpleGlazingSystem,SimpleGlass,2.0,0.6,0.7;\n',
-    surface('South', 'Wall', 'Outdoors', [[0, 0, 3], [0, 0, 0], [4, 0, 0], [4, 0, 3]]),
-    surface('North', 'Wall', 'Outdoors', [[4, 5, 3], [4, 5, 0], [0, 5, 0], [0, 5, 3]]),
-    surface('East', 'Wall', 'Outdoors', [[4, 0, 3], [4, 0, 0], [4, 5, 0], [4, 5, 3]]),
-    surface('West', 'Wall', 'Outdoors', [[0, 5, 3], [0, 5, 0], [0, 0, 0], [0, 0, 3]]),
-    surface('Floor', 'Floor', 'Ground', [[4, 0, 0], [0, 0, 0], [0, 5, 0], [4, 5, 0]]),
-    surface('Roof', 'Roof', 'Outdoors', [[0, 0, 3], [4, 0, 3], [4, 5, 3], [0, 5, 3]]),
-    'FenestrationSurface:Detailed,Win,Window,Glass,South,,,,1,4,1,0,2.5,1,0,1,3,0,1,3,0,2.5;\n',
-  ].join('');
-}
 
 let served;
 let page;
@@ -103,5 +88,51 @@ test('the interior view: the floor\'s sun patch at an instant equals `sunlit map
   assert.ok(south >= 4, `the south wall with its window's hole and the window go: ${south} triangles`);
   await page.selectOption('#mapcut', 'roof');
   await page.locator('#view').screenshot({ path: join(ROOT, 'target/artifacts/inside.png') });
+  assert.deepEqual(pageErrors, []);
+});
+
+/** `sunlit map` on the room with `flags`: its JSON summary and its points CSV. */
+function native(flags) {
+  const csv = join(WORK, 'native-inside.csv');
+  const args = ['map', model, '--inside', ...flags, '--grid', GRID, '--json', '-o', csv];
+  const summary = JSON.parse(execFileSync(join(ROOT, 'target/debug/sunlit'), args, { cwd: ROOT, env: { ...process.env, XDG_RUNTIME_DIR: WORK } }));
+  return { summary, csv: readFileSync(csv, 'utf8') };
+}
+
+test('the interior over a period and LEED ASE: the page\'s CSV and rooms equal `sunlit map --inside --period` and `--study leed-ase`', { timeout: 600_000 }, async () => {
+  const epw = join(WORK, 'golden.epw');
+  writeFileSync(epw, goldenEpw());
+  // The first test's model and "Inside rooms" stay; the EPW gives the site and the beam.
+  await page.setInputFiles('#epw', epw);
+  await page.fill('#mapworkplane', '');
+  await page.selectOption('#mapperiod', 'day');
+  await page.fill('#mapstart', '12-21');
+  await page.fill('#mapstep', '10');
+  await page.fill('#mapfrom', '08:00');
+  await page.fill('#mapto', '16:00');
+  await page.selectOption('#mapvalue', 'direct');
+  const period = await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 240_000);
+  assert.match(period, /^Map in .*: 320 points on 1 receivers; Direct irradiation from 0\.00 to \d/);
+  const day = native(['--epw', epw, '--period', '12-21', '--step', '10', '--from', '08:00', '--to', '16:00']);
+  const web = await downloadText(page, '#downloadmap', join(WORK, 'web-period.csv'));
+  assert.match(day.csv.split('\n')[0], /,sun_hours,beam_kwh_m2,direct_klux_h$/);
+  assert.equal(web.text, day.csv, 'the page\'s period CSV is `--inside --period`\'s, byte for byte');
+  const beams = day.csv.trim().split('\n').slice(1).map((l) => Number(l.split(',').at(-2)));
+  assert.ok(beams.some((b) => b > 0) && beams.some((b) => b === 0), 'the beam lights part of the floor over the day');
+
+  await page.selectOption('#mapinsidestudy', 'leed-ase');
+  const ase = await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 400_000);
+  assert.match(ase, /^Map in .*: 320 points on 1 receivers; Occupied hours over 1000 lux of direct sun .* over 3,650 instants; OFFICE \d+(\.\d)? %\.$/);
+  const year = native(['--epw', epw, '--study', 'leed-ase']);
+  const webAse = await downloadText(page, '#downloadmap', join(WORK, 'web-ase.csv'));
+  assert.match(year.csv.split('\n')[0], /,hours_over_1000_lux$/);
+  assert.match(year.csv.split('\n')[1], /^Floor:work-plane,/, 'the grid lies on the work plane (0.76 m, the study\'s)');
+  assert.equal(webAse.text, year.csv, 'the page\'s ASE CSV is `--study leed-ase`\'s, byte for byte');
+  const areas = JSON.parse(await page.getAttribute('#view', 'data-areas'));
+  const expected = year.summary.studies[0].areas;
+  assert.deepEqual(areas.map((a) => [a.zone, a.points]), expected.map((a) => [a.zone, a.points]));
+  areas.forEach((a, i) => assert.ok(Math.abs(a.ase - expected[i].ase) < 1e-3, `${a.zone}: ASE ${a.ase} % against ${expected[i].ase} %`));
+  assert.ok(expected[0].ase > 0 && expected[0].ase < 100, `ASE between 0 and 100 %: ${expected[0].ase}`);
+  await page.selectOption('#mapinsidestudy', '');
   assert.deepEqual(pageErrors, []);
 });
