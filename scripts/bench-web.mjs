@@ -2,7 +2,8 @@
 // the default engine and with each engine forced, and the same year with the native CLI:
 //   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides LIST] [--load-only] [--interleave]
 // Sides (default all): default (auto, the default pool; a first visit: it probes its profile),
-// default-cached (auto with the profile a first run measured, as a returning visit), exact, gpu, exact-1 (one clipping
+// default-cached (auto with the profile a first run measured, as a returning visit), default-0 (auto with no
+// clipping workers: the engine's thread alone), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto),
 // native-first (the same with an empty profile cache: it probes, as the page's first visit does;
 // SUNLIT_BIN names another binary than target/release/sunlit), page (the page itself: open it,
@@ -13,7 +14,9 @@
 // memory of the engine's instance (the page's thread here) after the load and at the end, and
 // of each clipping worker once it built the model; the API's and the CLI's sides their CPU seconds (`cpu_s`:
 // Chromium's processes from the API's import to the year's end; the CLI's user + system), which
-// a loaded machine's wall clock hides. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
+// a loaded machine's wall clock hides, and Chromium's by process type and thread (`cpu_s_by_thread`); the API's
+// year lines also the engine's `timings` (each first-visit step, in ms from createEngine). As the page does, the
+// year does not wait for the workers to build their copies (--load-only does). The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
 import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
