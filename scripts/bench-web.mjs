@@ -2,7 +2,8 @@
 // the default engine and with each engine forced, and the same year with the native CLI:
 //   node scripts/bench-web.mjs MODEL.glb [DAYSxPERDAY] [RESOLUTION] [--runs N] [--timesteps N] [--sides LIST] [--load-only] [--interleave]
 // Sides (default all): default (auto, the default pool; a first visit: it probes its profile),
-// default-cached (auto with the profile a first run measured, as a returning visit), exact, gpu, exact-1 (one clipping
+// default-cached (auto with the profile a first run measured, as a returning visit), default-0 (auto with no
+// clipping workers: the engine's thread alone), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto),
 // native-first (the same with an empty profile cache: it probes, as the page's first visit does;
 // SUNLIT_BIN names another binary than target/release/sunlit), page (the page itself: open it,
@@ -13,7 +14,9 @@
 // memory of the engine's instance (the page's thread here) after the load and at the end, and
 // of each clipping worker once it built the model; the API's and the CLI's sides their CPU seconds (`cpu_s`:
 // Chromium's processes from the API's import to the year's end; the CLI's user + system), which
-// a loaded machine's wall clock hides. The page's `auto` measures its profile in the first run (IndexedDB is fresh in
+// a loaded machine's wall clock hides, and Chromium's by process type and thread (`cpu_s_by_thread`); the API's
+// year lines also the engine's `timings` (each first-visit step, in ms from createEngine). As the page does, the
+// year does not wait for the workers to build their copies (--load-only does). The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
 import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
@@ -50,7 +53,7 @@ if (!model) {
 }
 const [days, perDay] = samples.split('x').map(Number);
 const place = { latitude: 39.74, longitude: -105.18, timeZone: -7 };
-const ENGINES = { default: {}, 'default-cached': {}, exact: { engine: 'exact' }, gpu: { engine: 'gpu' }, 'exact-1': { engine: 'exact', workers: 1 } };
+const ENGINES = { default: {}, 'default-cached': {}, 'default-0': { workers: 0 }, exact: { engine: 'exact' }, gpu: { engine: 'gpu' }, 'exact-1': { engine: 'exact', workers: 1 } };
 
 /** Every process below `root` (not `root` itself), each with the fields of its /proc stat line
  * after its name (state, ppid, …; utime and stime are [11] and [12], in clock ticks). */
@@ -102,6 +105,36 @@ function treeCpu(root) {
   return ticks / 100;
 }
 
+/** CPU seconds so far of every thread below `root`, summed by Chromium's process type and the
+ * thread's name (`renderer/CrRendererMain`: the page's thread, the engine's instance here;
+ * `renderer/DedicatedWorker thread`: the clipping workers; `renderer/V8 DefaultWorke`: wasm
+ * compiles; `gpu-process/…`: WebGPU on SwiftShader), from /proc/PID/task: where a first visit's
+ * CPU goes. */
+function threadCpu(root) {
+  const out = {};
+  for (const pid of descendants(root).keys()) {
+    try {
+      const type = /--type=([\w-]+)/.exec(readFileSync(`/proc/${pid}/cmdline`, 'utf8'))?.[1] ?? 'browser';
+      for (const tid of readdirSync(`/proc/${pid}/task`)) {
+        const line = readFileSync(`/proc/${pid}/task/${tid}/stat`, 'utf8');
+        const name = line.slice(line.indexOf('(') + 1, line.lastIndexOf(')'));
+        const fields = line.slice(line.lastIndexOf(')') + 2).split(' ');
+        const key = `${type}/${name}`;
+        out[key] = (out[key] ?? 0) + (Number(fields[11]) + Number(fields[12])) / 100;
+      }
+    } catch {
+      // Gone.
+    }
+  }
+  return out;
+}
+
+/** `after` less `before`, by key, rounded; keys under 0.01 s left out. */
+function cpuSpent(before, after) {
+  const spent = Object.entries(after).map(([k, v]) => [k, Number((v - (before[k] ?? 0)).toFixed(2))]);
+  return Object.fromEntries(spent.filter(([, v]) => v >= 0.01).sort((a, b) => b[1] - a[1]));
+}
+
 /** The larger of each field. */
 function peakOf(a, b) {
   return Object.fromEntries(Object.keys(b).map((k) => [k, Math.max(a[k] ?? 0, b[k])]));
@@ -134,6 +167,7 @@ async function browserRun(side) {
     });
     await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
     const cpuBefore = treeCpu(process.pid);
+    const threadsBefore = threadCpu(process.pid);
     const result = await page.evaluate(
       async ({ name, file, days, perDay, resolution, place, options, loadOnly, timesteps }) => {
         // A first visit starts here: the module's import, the wasm's compile, the device, the pool.
@@ -146,7 +180,10 @@ async function browserRun(side) {
         const model = engine.loadFiles([{ name, bytes }]);
         const t1 = performance.now();
         const loadedWasm = await wasmMemoryBytes();
-        await engine.prepare(model);
+        // The workers build their copies while the year starts, as the page has them do
+        // (worker.js); --load-only waits for them.
+        const preparing = engine.prepare(model);
+        if (loadOnly) await preparing;
         const t2 = performance.now();
         const mbOf = (b) => Math.round(b / 1e6);
         const loaded = { engine_wasm_mb: mbOf(await wasmMemoryBytes()), worker_wasm_mb: engine.workerMemoryBytes.map(mbOf), pool_sizing: engine.poolSizing };
@@ -185,11 +222,11 @@ async function browserRun(side) {
           },
         });
         const t3 = performance.now();
+        await preparing;
         views += globalThis.stage?.counted ?? 0;
         const out = {
           create_s: (created - tImport) / 1000,
           load_s: (t1 - t0) / 1000,
-          workers_load_s: (t2 - t1) / 1000,
           annual_s: (t3 - t2) / 1000,
           total_s: (t3 - t0) / 1000,
           // What a first visit waits for: the engine's start, then load, workers and year (the
@@ -199,6 +236,8 @@ async function browserRun(side) {
           receivers: year.names.length,
           triangles: model.triangles,
           workers: engine.workers,
+          // Milliseconds from createEngine to each step, and who clipped (sunlit.d.ts, timings).
+          timings: engine.timings,
           profile_source: year.profileSource,
           profile: year.profile,
           engine_wasm_mb_loaded: Math.round(loadedWasm / 1e6),
@@ -214,8 +253,9 @@ async function browserRun(side) {
     // Chromium's CPU seconds over the run (all its processes: the page, its workers, the GPU
     // process), from the API's import to the year's end.
     const cpu = treeCpu(process.pid) - cpuBefore;
+    const cpuByThread = cpuSpent(threadsBefore, threadCpu(process.pid));
     peak = peakOf(peak, treeRss(process.pid));
-    return { side: `page-${side}`, ...result, cpu_s: Number(cpu.toFixed(2)), peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
+    return { side: `page-${side}`, ...result, cpu_s: Number(cpu.toFixed(2)), cpu_s_by_thread: cpuByThread, peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
   } finally {
     clearInterval(sampler);
     await browser.close();

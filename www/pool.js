@@ -79,6 +79,9 @@ export class ClipPool {
   #jobs = 0;
   #broken = null;
   #sizing = null;
+  #sized = null;
+  /** Views clipped by this thread's clipper and by the workers (`clipped`). */
+  #clipped = { here: 0, workers: 0 };
   /** This thread's clipper: its task queue, and whether a chunk is queued for it. */
   #tick = null;
   #localPending = false;
@@ -90,7 +93,12 @@ export class ClipPool {
   }
 
   get size() {
-    return this.#size;
+    return Math.min(this.#size, this.#sizing?.workers ?? Infinity);
+  }
+
+  /** Views clipped so far by this thread's clipper (`here`) and by the workers (`workers`). */
+  get clipped() {
+    return { ...this.#clipped };
   }
 
   /** Each worker's wasm memory in bytes once it built the pool's model (its load's peak: wasm
@@ -108,7 +116,7 @@ export class ClipPool {
    * module), after which the pool is closed. */
   start() {
     this.#started ??= Promise.all(Array.from({ length: this.#size }, (_, i) => this.#spawn(i))).catch((error) => {
-      this.terminate();
+      this.#stopWorkers(error);
       throw error;
     });
     return this.#started;
@@ -156,17 +164,27 @@ export class ClipPool {
   /** Makes `source` the pool's model; resolves when every worker holds it. The same source twice
    * loads once. `source`: { kind, args } (clip-worker.js's one kind, 'scene', takes the
    * engine's encoded scene and its convex objects), or { kind, encode } where encode() gives the
-   * args once the workers have started (sunlit.js encodes them then; they are copied to each
-   * worker, transferred to the last, and not kept here). `budget` ({ bytes, used }: the wasm
-   * memory the engine's instance and the workers may hold together, and a function giving what
-   * the engine's instance holds now) sizes the pool before any worker builds: see [`fit`]. */
+   * args (sunlit.js encodes them in this thread at once, while the workers may still be
+   * starting; they are copied to each worker, transferred to the last, and not kept here).
+   * `budget` ({ bytes, used }: the wasm memory the engine's instance and the workers may hold
+   * together, and a function giving what the engine's instance holds now) sizes the pool before
+   * any worker builds: see [`fit`]. [`sized`] resolves once that is decided, before the workers
+   * hold the model: a year need not wait for them (see [`clip`]). */
   use(source, budget = null) {
     if (this.#broken) return Promise.reject(this.#broken);
     if (source === this.#source && this.#loading) return this.#loading;
     this.#source = source;
-    this.#loading = this.start().then(async () => {
+    // Workers still starting fill their places in #workers as they become ready.
+    for (const slot of this.#workers) if (slot) slot.loaded = false;
+    const encoded = (async () => {
       const args = source.encode ? source.encode() : source.args;
-      if (budget) this.#shrink(fit(this.#size, args, budget.bytes, await budget.used()));
+      if (budget) this.#sizing = fit(this.#size, args, budget.bytes, await budget.used());
+      return args;
+    })();
+    this.#sized = encoded.then(() => this.#sizing);
+    this.#loading = encoded.then(async (args) => {
+      await this.start();
+      if (this.#sizing && source === this.#source) this.#shrink(this.#sizing);
       const last = this.#workers.length - 1;
       return Promise.all(
         this.#workers.map(
@@ -186,6 +204,12 @@ export class ClipPool {
     return this.#loading;
   }
 
+  /** The sizing of the model last handed to [`use`] (see [`sizing`]), once its bytes are encoded
+   * and the budget applied: the workers may not hold it yet. */
+  get sized() {
+    return this.#sized ?? Promise.resolve(this.#sizing);
+  }
+
   /** How the memory budget sized the pool at its last load: { budgetBytes, engineBytes,
    * workerBytes (the estimate for one worker's copy), workers (kept), asked }; null before a
    * load with a budget. */
@@ -196,8 +220,7 @@ export class ClipPool {
   /** Keeps the first `sizing.workers` workers and stops the others (their memory is freed);
    * says so on the console when it drops any. */
   #shrink(sizing) {
-    this.#sizing = sizing;
-    if (sizing.workers >= this.#size) return;
+    if (sizing.workers >= this.#workers.length) return;
     const mb = (b) => Math.round(b / 1e6);
     console.info(
       `sunlit: ${sizing.workers} of ${sizing.asked} clipping workers: each copy of this model needs about ${mb(sizing.workerBytes)} MB, ` +
@@ -209,13 +232,17 @@ export class ClipPool {
   }
 
   /** The fractions of packed requests (Float64Array, PACKED numbers a view), in order. `local`
-   * (optional): clips packed requests in this thread, with the engine's own copy of the model;
-   * it then takes chunks from the same queue as the workers, one per task, so their replies are
-   * read between its chunks (the pool uses it where the budget kept fewer workers than asked:
-   * the engine's instance, which holds the model anyway, is then one clipper more). */
+   * (optional): clips packed requests in this thread, with the engine's own copy of the model; it
+   * then takes chunks from the same queue as the workers, one per task, so their replies are read
+   * between its chunks, while it is [`#helps`]: until every worker holds the model (a first
+   * visit's year starts at once instead of waiting for the workers to start and build their
+   * copies; docs/page-speed.md, "The first visit"), and throughout where the budget kept fewer
+   * workers than asked (the engine's instance, which holds the model anyway, is then one clipper
+   * more). Without `local`, chunks wait for the workers. */
   async clip(packed, signal, local = null) {
-    await this.start();
     if (this.#broken) throw this.#broken;
+    if (!local) await this.start();
+    else this.start().catch(() => {}); // A pool that cannot start leaves the job to `local`.
     const views = packed.length / PACKED;
     const out = new Float64Array(views);
     const job = { id: ++this.#jobs, left: 0, out, local };
@@ -235,19 +262,31 @@ export class ClipPool {
     });
   }
 
-  /** Hands queued chunks to idle workers, and one to this thread's clipper when the job has one.
-   * Where this thread clips too, each worker holds two chunks, so that it has the next one while
-   * this thread is busy with its own and cannot read the worker's reply. */
+  /** Whether this thread's clipper takes `job`'s chunks now: while fewer workers hold the model
+   * than the pool keeps (they are starting, or building their copies), and always where the
+   * budget kept fewer workers than asked. */
+  #helps(job) {
+    if (!job?.local) return false;
+    const holding = this.#workers.filter((slot) => slot.loaded).length;
+    return holding < this.size || (this.#sizing !== null && this.#sizing.workers < this.#sizing.asked);
+  }
+
+  /** Hands queued chunks to idle workers that hold the model, and one to this thread's clipper
+   * when it [`#helps`]. Where this thread clips too, each worker holds two chunks, so that it has
+   * the next one while this thread is busy with its own and cannot read the worker's reply. */
   #deal() {
-    const depth = this.#queue[0]?.job.local ? 2 : 1;
+    const helps = this.#helps(this.#queue[0]?.job);
+    const depth = helps ? 2 : 1;
     for (const slot of this.#workers) {
-      while (slot.busy.length < depth && this.#queue.length) {
+      // A worker takes chunks once it holds the pool's model (with no model handed, it answers
+      // 'no-model').
+      while (slot && (slot.loaded || this.#source === null) && slot.busy.length < depth && this.#queue.length) {
         const item = this.#queue.shift();
         slot.busy.push(item);
         slot.worker.postMessage({ type: 'clip', job: item.job.id, data: item.data }, [item.data.buffer]);
       }
     }
-    if (this.#queue[0]?.job.local && !this.#localPending) {
+    if (this.#helps(this.#queue[0]?.job) && !this.#localPending) {
       this.#localPending = true;
       this.#tick ??= this.#ticker();
       this.#tick.port2.postMessage(0);
@@ -265,10 +304,11 @@ export class ClipPool {
   /** Clips the next queued chunk in this thread. */
   #clipHere() {
     this.#localPending = false;
-    const item = this.#queue[0]?.job.local ? this.#queue.shift() : null;
+    const item = this.#helps(this.#queue[0]?.job) ? this.#queue.shift() : null;
     if (!item) return;
     try {
       item.job.out.set(item.job.local(item.data), item.start);
+      this.#clipped.here += item.data.length / PACKED;
       if (--item.job.left === 0) this.#finish(item.job, null);
     } catch (error) {
       this.#drop(item.job, coded(`clipping in the engine's thread failed: ${error?.message ?? error}`, error?.code ?? 'worker'));
@@ -282,14 +322,23 @@ export class ClipPool {
       slot.pending = null;
       if (data.type === 'loaded') {
         slot.wasmBytes = data.wasmBytes;
+        slot.loaded = true;
         pending?.resolve();
+        this.#deal();
       }
-      else pending?.reject(Object.assign(new Error(data.message), { code: data.code, worker: slot.index }));
+      else {
+        // A worker that cannot build the model fails the pool: a year that went on in this
+        // thread meanwhile is rejected with its error rather than finished without it.
+        const error = Object.assign(new Error(data.message), { code: data.code, worker: slot.index });
+        pending?.reject(error);
+        this.#fail(slot, error);
+      }
       return;
     }
     const item = slot.busy.shift();
     if (data.type === 'clipped' && item && item.job.id === data.job && !item.job.finished) {
       item.job.out.set(data.fractions, item.start);
+      this.#clipped.workers += data.fractions.length;
       if (--item.job.left === 0) this.#finish(item.job, null);
     } else if (data.type === 'clipError' && item && !item.job.finished) {
       const error = coded(`clipping worker ${slot.index} failed: ${data.message}`, 'worker', { worker: slot.index, workerCode: data.code });
@@ -306,7 +355,7 @@ export class ClipPool {
     this.#broken = error;
     slot.pending?.reject(error);
     const jobs = new Set(this.#queue.map((q) => q.job));
-    for (const s of this.#workers) s.busy.forEach((item) => jobs.add(item.job));
+    for (const s of this.#workers) s?.busy.forEach((item) => jobs.add(item.job));
     for (const job of jobs) this.#drop(job, error);
     this.terminate();
   }
@@ -322,6 +371,19 @@ export class ClipPool {
     job.done?.();
     if (error) job.reject(error);
     else job.resolve(job.out);
+  }
+
+  /** The workers could not start (`error`): they are stopped; jobs this thread clips go on, the
+   * others fail with `error`. */
+  #stopWorkers(error) {
+    for (const worker of this.#spawned) worker.terminate();
+    this.#spawned = [];
+    this.#workers = [];
+    this.#source = null;
+    this.#loading = null;
+    // #started stays rejected: the pool does not start again (a new engine call makes a new one).
+    for (const job of new Set(this.#queue.map((q) => q.job))) if (!job.local) this.#drop(job, error);
+    this.#deal();
   }
 
   /** Stops every worker (their memory is freed). */

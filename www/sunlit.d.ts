@@ -233,8 +233,23 @@ export interface SunlitEngine {
    * `workers` kept of `asked`, each copy estimated at `workerBytes` beside the engine's
    * `engineBytes`, within `budgetBytes`. */
   readonly poolSizing: { budgetBytes: number; engineBytes: number; workerBytes: number; asked: number; workers: number } | null;
-  /** Has the pool's workers build their copies of the model now (else the first year does). */
+  /** Has the pool's workers build their copies of the model now (else the first year has them
+   * do it), resolving once they hold it. A year does not wait for them: the engine's thread
+   * clips until they hold the model. */
   prepare(model: Model): Promise<void>;
+  /** Milliseconds from createEngine to each step of a first visit, where reached: `wasm` (the
+   * engine's wasm instance started), `engine` (createEngine resolved), `workersReady` (every
+   * clipping worker started), `encoded` (the last model encoded for the workers), `workersHold`
+   * (every worker built its copy); `clipped`: views clipped so far in the engine's thread and by
+   * the workers. */
+  readonly timings: {
+    wasm?: number;
+    engine?: number;
+    workersReady?: number;
+    encoded?: number;
+    workersHold?: number;
+    clipped: { here: number; workers: number };
+  };
   /** Stops the pool's workers. */
   close(): void;
   /** Reads model files; throws a SunlitError naming the file, object and reason when one is bad. */

@@ -73,8 +73,18 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
   // thread starts its own and opens the GPU device: a first visit waits for the slower of the
   // two, not their sum (docs/page-speed.md, "The first visit"). A worker that cannot start is
   // said by the first call that needs the pool (#routing), which then clips in this thread.
+  const started = performance.now();
+  const since = () => Math.round(performance.now() - started);
+  const timings = {};
   const pool = size > 0 ? new ClipPool(size) : null;
-  pool?.start().catch(() => {});
+  pool?.start().then(
+    () => (timings.workersReady = since()),
+    () => {},
+  );
+  ready().then(
+    () => (timings.wasm ??= since()),
+    () => {},
+  );
   let made;
   try {
     made = await openEngine({ resolution, accuracy, device, engine, wantsGpu, noGpu });
@@ -83,7 +93,8 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
     throw error;
   }
   const text = (p) => (p === undefined || p === null ? undefined : typeof p === 'string' ? p : JSON.stringify(p));
-  return new SunlitEngine(made, pool, { sun: text(profile), sky: text(skyProfile) }, budget);
+  timings.engine = since();
+  return new SunlitEngine(made, pool, { sun: text(profile), sky: text(skyProfile) }, budget, timings, since);
 }
 
 /** The wasm engine on `device`, on a device of its own, or clipping only where there is none. */
@@ -173,8 +184,14 @@ class SunlitEngine {
    * one model starts afresh at its asked size for the next). */
   #asked;
   #pooled = null;
+  /** Each pool load watched once (its failure and its end are kept). */
+  #watched = new WeakSet();
+  #timings;
+  #since;
 
-  constructor(engine, pool, pinned, budget) {
+  constructor(engine, pool, pinned, budget, timings, since) {
+    this.#timings = timings;
+    this.#since = since;
     this.#engine = engine;
     this.#pool = pool;
     this.#pinned = pinned;
@@ -217,9 +234,25 @@ class SunlitEngine {
     return this.#poolError;
   }
 
-  /** Has the pool's workers build their copies of `model` now (else the first year does). */
+  /** Has the pool's workers build their copies of `model` now, and resolves when they hold it
+   * (a year does not wait for them: this thread clips until they do). */
   async prepare(model) {
     await this.#routing(model);
+    const source = sources.get(model);
+    if (!this.#pool || !source || this.#pooled !== source) return;
+    await this.#pool.use(source).catch((error) => {
+      // Workers that cannot start are not fatal: this thread clips (`poolError` says why).
+      if (error?.workerCode !== 'start') throw error;
+    });
+  }
+
+  /** Milliseconds from `createEngine` to each step of a first visit: `wasm` (this thread's
+   * instance started), `engine` (the adapter found: `createEngine` resolves), `workersReady`
+   * (every clipping worker started its instance), `encoded` (the first model encoded for the
+   * workers), `workersHold` (every worker built its copy); and `clipped`: views clipped in this
+   * thread (`here`) and by the workers so far (docs/page-speed.md, "The first visit"). */
+  get timings() {
+    return { ...this.#timings, clipped: this.#pool?.clipped ?? { here: 0, workers: 0 } };
   }
 
   /** Stops the pool's workers; the engine then clips in this thread. */
@@ -228,7 +261,9 @@ class SunlitEngine {
     this.#pool = null;
   }
 
-  /** The pool and profile for a call on `model` (see src/web/choice.rs, Routing). */
+  /** The pool and profile for a call on `model` (see src/web/choice.rs, Routing). The call does
+   * not wait for the workers to hold the model: this thread clips until they do (pool.js,
+   * `clip`), so a first visit's year starts at once. */
   async #routing(model, signal) {
     const source = sources.get(model);
     // A pool closed by a failed worker (its error went to the call that hit it) starts afresh.
@@ -238,26 +273,15 @@ class SunlitEngine {
       this.#pool.terminate();
       this.#pool = new ClipPool(this.#asked);
     }
-    if (this.#pool && source) {
-      try {
-        this.#pooled = source;
-        await this.#pool.use(source, { bytes: this.#budget, used: wasmMemoryBytes });
-      } catch (error) {
-        this.#pooled = null;
-        if (error?.workerCode !== 'start') throw error;
-        // A worker that cannot start (a CSP, a missing module): clip here instead, and say why.
-        this.#poolError = error.message;
-        this.#pool.terminate();
-        this.#pool = null;
-      }
-    }
+    if (this.#pool && source) await this.#hand(this.#pool, source);
     // The budget left no worker: this thread clips, as with `workers: 0`.
     const pool = source && this.#pool?.size > 0 ? this.#pool : null;
-    // Where the budget kept fewer workers than asked, this thread clips too, with the copy of the
-    // model its instance holds anyway (Model.clipHere): one clipper more for no memory.
+    // This thread clips too, with the copy of the model its instance holds anyway
+    // (Model.clipHere): until the workers hold the model, and throughout where the budget kept
+    // fewer workers than asked (one clipper more for no memory).
+    const local = pool ? (packed) => model.clipHere(packed) : null;
     const sizing = pool?.sizing;
-    const local = sizing && sizing.workers < sizing.asked ? (packed) => model.clipHere(packed) : null;
-    const workers = (pool?.size ?? 1) + (local ? 1 : 0);
+    const workers = (pool?.size ?? 1) + (sizing && sizing.workers < sizing.asked ? 1 : 0);
     const auto = this.engine === 'auto';
     // Sun and sky views each have their own profile, kept under their own key (the sky's says
     // `sky views`), so a sun profile is never taken for a sky one (src/web/choice.rs).
@@ -271,6 +295,27 @@ class SunlitEngine {
     const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
     if (pool) routing.clip = (packed) => pool.clip(packed, signal, local);
     return { routing, key };
+  }
+
+  /** Hands `source` to `pool` (once per model); resolves once the pool is sized by the memory
+   * budget, not when its workers hold the model. A pool whose workers cannot start (a CSP, a
+   * missing module) is dropped, and why is kept in `poolError`: this thread clips instead. */
+  async #hand(pool, source) {
+    this.#pooled = source;
+    const loading = pool.use(source, { bytes: this.#budget, used: wasmMemoryBytes });
+    if (this.#watched.has(loading)) return pool.sized;
+    this.#watched.add(loading);
+    loading.then(
+      () => (this.#timings.workersHold = this.#since()),
+      (error) => {
+        if (this.#pooled === source) this.#pooled = null;
+        if (error?.workerCode !== 'start' || this.#pool !== pool) return;
+        this.#poolError = error.message;
+        this.#pool = null;
+      },
+    );
+    await pool.sized;
+    this.#timings.encoded = this.#since();
   }
 
   /** Keeps what `auto` routed by, and caches each freshly measured profile under its key. */

@@ -386,3 +386,54 @@ test('a memory budget that is not a positive number is refused by name', async (
     assert.match(e.message, /^memoryBudget: .* is not a positive number of bytes$/);
   }
 });
+
+test("a year does not wait for the workers: the engine's thread clips until they hold the model, then leaves the chunks to them", async () => {
+  const { p, errors } = await apiPage();
+  const r = await p.evaluate(
+    async ({ scene }) => {
+      eval(scene);
+      const { createEngine } = await import('/sunlit.js');
+      const { ClipPool } = await import('/pool.js');
+      const engine = await createEngine({ resolution: 128, engine: 'exact', workers: 0 });
+      const model = engine.fromArrays(louvredBlock());
+      // 320 views (10 chunks): every receiver under suns all round the sky.
+      const views = [];
+      for (let k = 0; k < 320; k++) {
+        const [az, alt] = [(k * 0.37) % (2 * Math.PI), 0.05 + ((k * 0.11) % 1.4)];
+        views.push(k % 5, Math.sin(az) * Math.cos(alt), Math.cos(az) * Math.cos(alt), Math.sin(alt), 1);
+      }
+      const packed = Float64Array.from(views);
+      const reference = Array.from(model.clipHere(packed.slice()));
+      const local = (chunk) => model.clipHere(chunk);
+      // A fresh pool, as on a first visit: its workers have not started when the views come.
+      const pool = new ClipPool(2);
+      const loading = pool.use({ kind: 'scene', encode: () => [model.sceneBytes(), model.objectsBytes()] });
+      const first = Array.from(await pool.clip(packed.slice(), null, local));
+      const whileStarting = pool.clipped;
+      await loading;
+      const second = Array.from(await pool.clip(packed.slice(), null, local));
+      const once = pool.clipped;
+      pool.terminate();
+      // The engine's own timings of a first visit's steps.
+      const pooled = await createEngine({ resolution: 128, engine: 'exact', workers: 2 });
+      const year = await pooled.annual(pooled.fromArrays(louvredBlock()), { latitude: 39.74, longitude: -105.18, timeZone: -7, timestepsPerHour: 1, daysPerYear: 6, samplesPerDay: 7 });
+      const timings = pooled.timings;
+      pooled.close();
+      return { reference, first, second, whileStarting, once, timings, rows: year.csv().split('\n').length };
+    },
+    { scene: `${SCENE}; globalThis.louvredBlock = louvredBlock;` },
+  );
+  await p.close();
+  assert.deepEqual(errors, []);
+  // The first job came before any worker held the model: this thread took chunks of it.
+  assert.ok(r.whileStarting.here >= 32, JSON.stringify(r.whileStarting));
+  assert.equal(r.whileStarting.here + r.whileStarting.workers, 320);
+  // Once the workers hold it, this thread leaves every chunk to them.
+  assert.deepEqual(r.once, { here: r.whileStarting.here, workers: r.whileStarting.workers + 320 });
+  // Whoever clipped, the same fractions, bit for bit.
+  assert.deepEqual(r.first, r.reference);
+  assert.deepEqual(r.second, r.reference);
+  for (const step of ['wasm', 'engine', 'encoded']) assert.ok(Number.isFinite(r.timings[step]), `${step}: ${JSON.stringify(r.timings)}`);
+  assert.equal(r.timings.clipped.here + r.timings.clipped.workers > 0, true, JSON.stringify(r.timings));
+  assert.ok(r.rows > 8760);
+});
