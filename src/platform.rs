@@ -63,6 +63,36 @@ impl Stopwatch {
     }
 }
 
+/// Seconds since some fixed point, for timing engines. Natively a monotonic clock. On the web the
+/// global scope's `performance.now()` (a window's or a worker's: Chrome coarsens it to 100 µs),
+/// and `Date.now()` (1 ms) only where that is missing: at 1 ms every light view timed 0 µs, and
+/// the probe then priced a model's views at nothing.
+pub(crate) fn seconds() -> f64 {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use std::sync::OnceLock;
+        static START: OnceLock<std::time::Instant> = OnceLock::new();
+        START.get_or_init(std::time::Instant::now).elapsed().as_secs_f64()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        performance_now_ms().unwrap_or_else(js_sys::Date::now) / 1e3
+    }
+}
+
+/// The shortest interval [`seconds`] times well: natively 0; on the web some twenty ticks of a
+/// coarsened clock, so a probe repeats a light view until it has run this long.
+pub(crate) const CLOCK_FLOOR_S: f64 = if cfg!(target_arch = "wasm32") { 2e-3 } else { 0.0 };
+
+/// `performance.now()` of whatever global scope runs this (window or worker), if it has one.
+#[cfg(target_arch = "wasm32")]
+fn performance_now_ms() -> Option<f64> {
+    use wasm_bindgen::JsCast;
+    let performance = js_sys::Reflect::get(&js_sys::global(), &"performance".into()).ok()?;
+    let now: js_sys::Function = js_sys::Reflect::get(&performance, &"now".into()).ok()?.dyn_into().ok()?;
+    now.call0(&performance).ok()?.as_f64()
+}
+
 /// What to tell a user who has no adapter at all.
 pub(crate) fn no_adapter_hint() -> &'static str {
     if cfg!(target_arch = "wasm32") {

@@ -32,7 +32,7 @@ use super::gpu::{Counter, CounterOptions, GpuScene, Kernel};
 use super::lanes::{Lane, Lanes, default_lanes};
 use super::{Engine, ViewAnswer, ViewKind, ViewRequest, check_receivers, cos_incidence};
 use crate::error::{Error, GpuError, Result};
-use crate::platform;
+use crate::platform::{self, CLOCK_FLOOR_S, seconds as now};
 use crate::scene::Scene;
 
 pub use keys::{
@@ -781,9 +781,7 @@ pub fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewL
         // another process would otherwise count as milliseconds of clipping.
         let mut best = f64::INFINITY;
         for _ in 0..PROBE_EXACT_REPEATS {
-            let t0 = now();
-            exact.fraction(requests[i], leaves_of(i), true, &mut scratch);
-            best = best.min(now() - t0);
+            best = best.min(time_view(|| exact.fraction(requests[i], leaves_of(i), true, &mut scratch)));
             if best > PROBE_REPEAT_BELOW {
                 break;
             }
@@ -798,6 +796,22 @@ pub fn probe_exact(exact: &ExactEngine, requests: &[ViewRequest], loads: &[ViewL
     let line = fit_line(&samples);
     let mean_us = samples.iter().map(|(_, us)| us).sum::<f64>() / samples.len().max(1) as f64;
     (Cost { per_view_us: line.per_view_us / threads, per_triangle_us: line.per_triangle_us / threads }, mean_us / threads)
+}
+
+/// Seconds one run of `view` takes: natively one run; where the clock is coarse (the web) the
+/// mean of as many runs as fill [`CLOCK_FLOOR_S`], so a view shorter than a tick is not timed 0.
+fn time_view<T>(mut view: impl FnMut() -> T) -> f64 {
+    const MOST_RUNS: u32 = 10_000;
+    let t0 = now();
+    let mut runs = 0;
+    loop {
+        view();
+        runs += 1;
+        let elapsed = now() - t0;
+        if elapsed >= CLOCK_FLOOR_S || runs == MOST_RUNS {
+            return elapsed / f64::from(runs);
+        }
+    }
 }
 
 /// Times a light and a heavy batch of views on the GPU lanes and fits its cost line.
@@ -862,20 +876,6 @@ pub fn gpu_worth_probing(mean_us: f64, loads: &[ViewLoad]) -> bool {
 /// This machine's threads for clipping (1 where it cannot tell).
 fn cpu_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
-/// Seconds since some fixed point (for timing engines; not on the web).
-fn now() -> f64 {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        use std::sync::OnceLock;
-        static START: OnceLock<std::time::Instant> = OnceLock::new();
-        START.get_or_init(std::time::Instant::now).elapsed().as_secs_f64()
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        js_sys::Date::now() / 1e3
-    }
 }
 
 mod keys;
