@@ -311,6 +311,8 @@ mod tests {
         s.names[0] = "A,B".into();
         assert!(s.validate().is_err());
         assert!(!path.exists());
+        // Left for a look only when an assertion fails.
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -366,6 +368,7 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         assert!(partials().iter().all(|p| !p.starts_with(&dir)), "finished writes are unregistered");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -380,5 +383,6 @@ mod tests {
         let mut list = vec![tmp.clone()];
         remove_listed(&mut list);
         assert!(!tmp.exists() && !path.exists() && list.is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
