@@ -21,6 +21,7 @@ use crate::year::samples::Timesteps;
 
 pub mod cadastre;
 pub mod cadastre_points;
+pub mod glitches;
 pub mod hook;
 pub mod interior_beam;
 pub mod irradiation;
