@@ -660,11 +660,15 @@ fn annual(args: AnnualArgs) -> Result<()> {
     let bytes = schedule.csv_bytes()?;
     // The hooked model is made before anything is written, so a refusal leaves no files.
     let mut patched = match (&args.idf_out, energyplus.as_ref(), hooked) {
-        (Some(out), Some(ep), Some(form)) => Some((out, form, patch_model(ep, &args.output, &schedule.names, timesteps, form, periods)?)),
+        (Some(out), Some(ep), Some(form)) => {
+            let text = patch_model(ep, &args.output, &schedule.names, timesteps, form, periods)?;
+            let glitches = sunlit::export::glitches::known_glitches(ep, &schedule.names, form);
+            Some((out, form, sunlit::export::glitches::with_comments(ep, text, &glitches), glitches))
+        }
         _ => None,
     };
     let beam_files = match (&beam, energyplus.as_ref(), patched.as_mut()) {
-        (Some(plan), Some(ep), Some((_, _, text))) => {
+        (Some(plan), Some(ep), Some((_, _, text, _))) => {
             meter.stage("interior beam", "views");
             let (csv, objects, notes) = beam_outputs(plan, ep, &settings.location, timesteps, periods)?;
             text.push_str(&objects);
@@ -689,7 +693,7 @@ fn annual(args: AnnualArgs) -> Result<()> {
             eprintln!("note: {note}");
         }
     }
-    if let Some((out, form, text)) = patched {
+    if let Some((out, form, text, glitches)) = patched {
         sunlit::export::write_atomic(out, text.as_bytes())?;
         eprintln!("wrote {} (EnergyPlus reads {} through {form:?} schedules)", out.display(), args.output.display());
         if let (Hook::Scheduled, Some(ep)) = (form, energyplus.as_ref()) {
@@ -698,6 +702,10 @@ fn annual(args: AnnualArgs) -> Result<()> {
             for cause in sunlit::export::hook::scheduled_method_gap(ep, &schedule.names) {
                 eprintln!("note: {cause}");
             }
+        }
+        // EnergyPlus's own glitches are named, not copied into the model (docs/energyplus-fidelity.md).
+        for glitch in &glitches {
+            eprintln!("EnergyPlus glitch {}", glitch.line());
         }
     }
     eprintln!(

@@ -263,22 +263,15 @@ fn gltf_marks_and_options_choose_foliage_and_screens() {
 }
 
 fn cli(args: &[&str]) -> std::process::Output {
-    let runtime = std::env::temp_dir().join("sunlit-test-runtime");
-    std::fs::create_dir_all(&runtime).unwrap();
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        std::fs::set_permissions(&runtime, std::fs::Permissions::from_mode(0o700)).unwrap();
-    }
-    std::process::Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime).output().unwrap()
+    std::process::Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args).env("XDG_RUNTIME_DIR", runtime_dir()).output().unwrap()
 }
 
 /// The example office's neighbouring block east of it, taken as foliage or as a screen from the
 /// command line: the east window gets more sun with fewer leaves, and bad values are refused.
 #[test]
 fn the_command_line_takes_foliage_screens_and_leaf_fractions() {
-    let dir = std::env::temp_dir().join(format!("sunlit-foliage-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    // Removed when the test passes, kept for a look when it fails.
+    let dir = Scratch::new("foliage", "cli");
     let model = dir.join("office.glb");
     std::fs::write(&model, sunlit::model::office::office(6).to_glb()).unwrap();
     let model = model.display().to_string();

@@ -3,7 +3,7 @@
 //! for byte, and the GPU path still answers alone.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
-use std::path::PathBuf;
+use std::path::Path;
 use std::process::Command;
 
 use glam::{DMat4, DVec3};
@@ -11,6 +11,9 @@ use sunlit::count::gpu::CounterOptions;
 use sunlit::count::hybrid::{Cost, EngineKind, HybridEngine, Profile, ProfileSource, write_profile};
 use sunlit::count::{ViewAnswer, ViewRequest, exact};
 use sunlit::scene::{Scene, SceneBuilder, SourceMesh, SourceNode};
+
+mod common;
+use common::Scratch;
 
 /// |GPU − exact| allowed at 256² (the GPU tests' bound at 512² is 0.005 on random scenes).
 const GPU_TOLERANCE: f64 = 0.01;
@@ -57,10 +60,9 @@ fn options() -> CounterOptions {
     CounterOptions { resolution: 256, ..Default::default() }
 }
 
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-hybrid-{}-{:?}", std::process::id(), std::thread::current().id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A test's scratch folder (profiles, caches, CSVs): removed when it passes, kept when it fails.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new("hybrid", name)
 }
 
 fn answers(scene: &Scene, kind: EngineKind, source: ProfileSource) -> (Vec<ViewAnswer>, usize) {
@@ -69,8 +71,9 @@ fn answers(scene: &Scene, kind: EngineKind, source: ProfileSource) -> (Vec<ViewA
     (out, engine.stats().gpu_views)
 }
 
-/// A pinned profile: `gpu_cheap` makes every loaded view cheaper on the GPU, else on the CPU.
-fn pinned(gpu_cheap: bool) -> ProfileSource {
+/// A pinned profile, written into `dir`: `gpu_cheap` makes every loaded view cheaper on the GPU,
+/// else on the CPU.
+fn pinned(dir: &Path, gpu_cheap: bool) -> ProfileSource {
     let (exact, gpu) = if gpu_cheap { (1e6, 1.0) } else { (1.0, 1e6) };
     let profile = Profile {
         device: "test".into(),
@@ -80,19 +83,20 @@ fn pinned(gpu_cheap: bool) -> ProfileSource {
         compute: None,
         compute_startup_seconds: None,
     };
-    let path = temp_dir().join(if gpu_cheap { "gpu.json" } else { "exact.json" });
+    let path = dir.join(if gpu_cheap { "gpu.json" } else { "exact.json" });
     write_profile(&path, &profile).unwrap();
     ProfileSource::File(path)
 }
 
 #[test]
 fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
+    let dir = scratch("agree");
     let scene = louvred_walls();
     let reference = exact::sunlit_fractions(&scene, &requests(&scene));
     let (exact_answers, exact_gpu_views) = answers(&scene, EngineKind::Exact, ProfileSource::Probe);
     let (gpu_answers, _) = answers(&scene, EngineKind::Gpu, ProfileSource::Probe);
-    let (auto_cpu, cpu_routed) = answers(&scene, EngineKind::Auto, pinned(false));
-    let (auto_gpu, gpu_routed) = answers(&scene, EngineKind::Auto, pinned(true));
+    let (auto_cpu, cpu_routed) = answers(&scene, EngineKind::Auto, pinned(&dir, false));
+    let (auto_gpu, gpu_routed) = answers(&scene, EngineKind::Auto, pinned(&dir, true));
     assert_eq!(exact_gpu_views, 0);
     assert_eq!(cpu_routed, 0, "a profile with a dear GPU routes nothing to it");
     assert!(gpu_routed > 0, "a profile with a cheap GPU routes the loaded views to it");
@@ -118,6 +122,7 @@ fn auto_exact_and_gpu_agree_and_either_calibration_gives_the_same_answers() {
 /// exact reference.
 #[test]
 fn auto_routes_to_the_compute_kernel_where_it_is_cheapest() {
+    let dir = scratch("compute");
     let scene = louvred_walls();
     let profile = Profile {
         device: "test".into(),
@@ -127,7 +132,7 @@ fn auto_routes_to_the_compute_kernel_where_it_is_cheapest() {
         compute: Some(Cost { per_view_us: 1.0, per_triangle_us: 0.0 }),
         compute_startup_seconds: Some(0.0),
     };
-    let path = temp_dir().join("compute.json");
+    let path = dir.join("compute.json");
     write_profile(&path, &profile).unwrap();
     let auto = HybridEngine::new(&scene, EngineKind::Auto, options(), Some(1), ProfileSource::File(path)).unwrap();
     let routed = pollster::block_on(auto.count(&requests(&scene))).unwrap();
@@ -150,8 +155,9 @@ fn auto_routes_to_the_compute_kernel_where_it_is_cheapest() {
 /// views after it are routed by the sun's profile again.
 #[test]
 fn sky_views_are_routed_by_a_profile_of_their_own() {
+    let dir = scratch("sky");
     let scene = louvred_walls();
-    let ProfileSource::File(sun_file) = pinned(true) else { unreachable!() };
+    let ProfileSource::File(sun_file) = pinned(&dir, true) else { unreachable!() };
     let sky_file = sunlit::count::hybrid::profile_file(&sun_file, sunlit::count::ViewKind::Sky);
     assert_eq!(sky_file, sun_file.with_file_name("gpu.sky.json"));
     let _ = std::fs::remove_file(&sky_file);
@@ -176,7 +182,7 @@ fn sunlit(args: &[&str], cache: &std::path::Path) -> std::process::Output {
 
 #[test]
 fn the_same_profile_gives_the_same_csv_byte_for_byte() {
-    let dir = temp_dir();
+    let dir = scratch("csv");
     let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
     let profile = dir.join("profile.json");
     let mut csvs = Vec::new();
@@ -210,7 +216,7 @@ fn the_same_profile_gives_the_same_csv_byte_for_byte() {
 /// again asks for none), and the run that finds it writes the same CSV.
 #[test]
 fn an_exact_only_profile_is_cached_without_the_adapter() {
-    let dir = temp_dir();
+    let dir = scratch("cached");
     let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
     let mut csvs = Vec::new();
     for run in 0..2 {
@@ -231,7 +237,7 @@ fn an_exact_only_profile_is_cached_without_the_adapter() {
 
 #[test]
 fn the_gpu_engine_answers_alone() {
-    let dir = temp_dir();
+    let dir = scratch("alone");
     let glb = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/office.glb");
     let run = |engine: &str| {
         let out = sunlit(&["fraction", glb, "--sun", "200,35", "--resolution", "256", "--engine", engine, "--json"], &dir);

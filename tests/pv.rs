@@ -19,6 +19,7 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)] // Tests may panic on the unexpected.
 
+mod common;
 mod sweep_fixture;
 
 use std::path::PathBuf;

@@ -21,6 +21,7 @@ use crate::year::samples::Timesteps;
 
 pub mod cadastre;
 pub mod cadastre_points;
+pub mod glitches;
 pub mod hook;
 pub mod interior_beam;
 pub mod irradiation;
@@ -311,6 +312,8 @@ mod tests {
         s.names[0] = "A,B".into();
         assert!(s.validate().is_err());
         assert!(!path.exists());
+        // Left for a look only when an assertion fails.
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -366,6 +369,7 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         assert!(partials().iter().all(|p| !p.starts_with(&dir)), "finished writes are unregistered");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
@@ -380,5 +384,6 @@ mod tests {
         let mut list = vec![tmp.clone()];
         remove_listed(&mut list);
         assert!(!tmp.exists() && !path.exists() && list.is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

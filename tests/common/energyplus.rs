@@ -138,13 +138,20 @@ pub fn stamp(step: usize, per_hour: usize, first_day: usize, leap: bool) -> Stri
 /// caller checks its status).
 #[allow(dead_code)] // Not every test file that uses `common` runs sunlit on an EnergyPlus model.
 pub fn sunlit_annual(model: &Path, weather: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
+    sunlit_annual_on("exact", model, weather, csv, extra)
+}
+
+/// `sunlit annual MODEL --epw WEATHER --engine ENGINE -o CSV EXTRA…`: the command's output (the
+/// caller checks its status).
+#[allow(dead_code)] // Not every test file that uses `common` runs sunlit on an EnergyPlus model.
+pub fn sunlit_annual_on(engine: &str, model: &Path, weather: &Path, csv: &Path, extra: &[&str]) -> std::process::Output {
     #[allow(clippy::unwrap_used)] // A test helper: failing to start the binary fails the test.
     std::process::Command::new(env!("CARGO_BIN_EXE_sunlit"))
         .arg("annual")
         .arg(model)
         .arg("--epw")
         .arg(weather)
-        .args(["--engine", "exact", "-o"])
+        .args(["--engine", engine, "-o"])
         .arg(csv)
         .args(extra)
         .output()

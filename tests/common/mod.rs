@@ -162,7 +162,12 @@ pub struct Scratch(PathBuf);
 impl Scratch {
     /// `sunlit-PREFIX-NAME-PID` in the temporary folder, emptied first.
     pub fn new(prefix: &str, name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("sunlit-{prefix}-{name}-{}", std::process::id()));
+        Self::named(&format!("{prefix}-{name}"))
+    }
+
+    /// `sunlit-NAME-PID` in the temporary folder, emptied first.
+    pub fn named(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("sunlit-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         Self(dir)

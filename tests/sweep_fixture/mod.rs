@@ -23,12 +23,9 @@ pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
-/// A fresh folder.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sunlit-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh folder `sunlit-NAME-PID`: removed when the test passes, kept for a look when it fails.
+pub fn scratch(name: &str) -> crate::common::Scratch {
+    crate::common::Scratch::named(name)
 }
 
 /// Six slats `depth` m deep in front of the office's south windows (x 1.25–8.75 m, sill 1 m to
