@@ -299,14 +299,14 @@ mod study_options;
 
 use study_options::{Masks, STUDY_KEYS, StudyPlace, StudyRequest};
 
-use crate::map::planning::run::STUDIES;
+use crate::map::planning::run::WINDOW_STUDIES;
 use crate::map::planning::window_points::WindowPoint;
 
 #[test]
 fn the_study_options_are_the_same_on_both_sides() {
     let rust: BTreeSet<String> = STUDY_KEYS.iter().map(|k| k.to_string()).collect();
     assert_eq!(fields(interface("StudyOptions")), rust);
-    let studies: BTreeSet<String> = STUDIES.iter().map(|s| s.to_string()).collect();
+    let studies: BTreeSet<String> = WINDOW_STUDIES.iter().map(|s| s.to_string()).collect();
     assert_eq!(literals_after("export type StudyName "), studies, "StudyName: the window studies run.rs runs");
     let at: BTreeSet<String> = WindowPoint::NAMES.iter().map(|s| s.to_string()).collect();
     assert_eq!(union(interface("StudyOptions"), "windowPoints"), at, "StudyOptions.windowPoints");
@@ -338,6 +338,16 @@ fn study_options_read_as_sunlit_map_reads_its_flags() {
     .unwrap();
     assert_eq!((report.masks.rows(3), report.names.1), (vec![0, 1, 2], vec!["office.glb".to_string()]), "--mask all");
     assert_eq!(study(json!({"study": "bre-vsc", "windows": [0], "masks": [2, 0]})).unwrap().masks, Masks::Rows(vec![2, 0]));
+    // EN 17037's day and altitude (`--period 02-21 --min-altitude 15`), and the sills above a
+    // floor level (`--window-points sill --floor-level 0.2`).
+    let en = study(json!({"study": ["en17037", "gb50180"], "windows": [0], "windowPoints": "sill", "floorLevel": 0.2,
+        "latitude": 51.5, "longitude": 0, "timeZone": 0, "period": "02-21", "minAltitude": 15}))
+    .unwrap();
+    let rule = en.en17037.unwrap();
+    assert_eq!((rule.day, rule.min_altitude_deg, en.floor_level), (52, 15.0, Some(0.2)));
+    let default = study(json!({"study": "en17037", "windows": [0], "latitude": 51.5, "longitude": 0, "timeZone": 0})).unwrap();
+    assert_eq!(default.en17037.map(|r| (r.day, r.min_altitude_deg)), Some((80, 10.0)), "21 March, 10°: the CLI's defaults");
+    assert_eq!(default.floor_level, None);
 }
 
 #[test]
@@ -367,4 +377,16 @@ fn bad_study_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "masks": "some"})), bad("masks"));
     assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "masks": [-1]})), bad("masks"));
     assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "modelNames": "office.glb"})), bad("modelNames"));
+    let en = |extra: serde_json::Value| {
+        let mut o = json!({"study": "en17037", "windows": [0], "latitude": 51.5, "longitude": 0, "timeZone": 0});
+        o.as_object_mut().unwrap().extend(extra.as_object().unwrap().clone());
+        named(o)
+    };
+    assert_eq!(named(json!({"study": "bre-vsc", "windows": [0], "period": "03-01"})), bad("period"), "only en17037 takes a period");
+    assert_eq!(named(json!({"study": "gb50180", "windows": [0], "minAltitude": 5})), bad("minAltitude"));
+    assert_eq!(en(json!({"period": "06-21"})), bad("period"), "outside 1 February – 21 March");
+    assert_eq!(en(json!({"period": "02-30"})), bad("period"), "no such day");
+    assert_eq!(en(json!({"minAltitude": 95})), bad("min_altitude"));
+    assert_eq!(en(json!({"floorLevel": 0})), bad("floor_level"), "a floor level raises sills: windowPoints 'sill' only");
+    assert_eq!(en(json!({"windowPoints": "sill", "floorLevel": "low"})), bad("floorLevel"));
 }

@@ -198,7 +198,7 @@ fn bre_25deg_line_is_drawn_to_the_development_alone() {
         let pts = points(&proposed, &[[0.0, 0.0, z, 0.0, -1.0, 0.0], [1.0, 0.0, z, 0.0, -1.0, 0.0]]);
         let rules = Rules::default();
         let (now, _) =
-            run::before_after_rules(&studies, &proposed, &pts, Some((&existing, "test")), None, rules, &mut |_| {}, &mut |_| {}).unwrap();
+            run::before_after(&studies, &proposed, &pts, Some((&existing, "test")), None, rules, &mut |_| {}, &mut |_| {}).unwrap();
         let lines = now.lines.unwrap();
         let development = lines.development_deg.unwrap();
         assert_eq!(development.len(), 2);
@@ -208,7 +208,7 @@ fn bre_25deg_line_is_drawn_to_the_development_alone() {
             assert_eq!(compare::line_25(angle).passes, passes, "θ = {theta_deg}°");
         }
         // Without the existing scene the overhang stands in the section and fails every window.
-        let (alone, _) = run::before_after_rules(&studies, &proposed, &pts, None, None, rules, &mut |_| {}, &mut |_| {}).unwrap();
+        let (alone, _) = run::before_after(&studies, &proposed, &pts, None, None, rules, &mut |_| {}, &mut |_| {}).unwrap();
         let alone = alone.lines.unwrap();
         assert!(alone.development_deg.is_none() && (alone.angle_deg[0] - overhang_deg).abs() < 1e-4);
     }
@@ -492,6 +492,66 @@ fn gb50180_counts_a_window_reaching_the_floor_at_0_9_m() {
     assert!((at_floor - canyon(0.0)).abs() <= 1.0 / 60.0 && at_floor < at_sill - 0.1, "the floor sees less: {at_floor:.4} h");
 }
 
+/// 满窗 with each window's own width: a south window's sill beside a tall fin standing out of the
+/// wall `depth` m, `gap` m east of the sill's centre. A sill point x m east of the centre sees the
+/// sun (d, in front of the wall) unless the ray meets the fin's face, x = gap, within its depth:
+/// d.x > 0 and (gap − x)·|d.y|/d.x ≤ depth. The sample nearest the fin is the last lit, so the whole
+/// sill of width w is lit exactly when its east end (x = w/2) is: the truth, counted over the
+/// rule's minutes. Two windows, 1.2 m and 3 m wide, each read its own width from a CSV.
+#[test]
+fn gb50180_whole_window_takes_each_windows_own_width() {
+    use sunlit::map::planning::sill_widths::sill_widths;
+    use sunlit::map::planning::window_points::{WindowPoint, window_points};
+    let (gap, depth, sill_z) = (2.0, 3.0, 0.9);
+    let windows = [("WIN_A", 0.0, 1.2), ("WIN_B", 100.0, 3.0)];
+    let mut s = TestScene::new();
+    for (name, x, width) in windows {
+        s.polygon(name, &south_rect(x - width / 2.0, x + width / 2.0, sill_z, 2.4, 0.0), true);
+        s.cuboid(&format!("FIN_{name}"), DVec3::new(x + gap, -depth, 0.0), DVec3::new(x + gap + 0.2, 0.0, 1000.0));
+    }
+    let scene = s.build();
+    let ids: Vec<u32> = windows.iter().map(|(name, ..)| common::receiver_id(&scene, name)).collect();
+    let sills = window_points(&scene, &ids, WindowPoint::Sill).unwrap();
+    let csv = "receiver,width\nWIN_B,3.0\nWIN_A,1.2\n";
+    let widths = sill_widths(&scene, &sills, "widths.csv", csv).unwrap();
+    assert_eq!(widths, vec![1.2, 3.0], "by each point's window, in the points' order");
+    let beijing = Location::new(39.9, 116.4, 8.0).unwrap();
+    let day = StandardDay::Dahan;
+    let mut rule = Gb50180Rule::new(day);
+    rule.window_widths = Some(widths);
+    let got = gb50180::evaluate(&scene, &sills, &beijing, &rule, &mut |_, _| {}).unwrap();
+    let whole = got.whole_window_hours.unwrap();
+    let lit_minutes = |x: f64| {
+        let instants = gb50180::instants(day);
+        let lit = |d: DVec3| {
+            let in_front = -d.y > 1e-5 && d.z >= 1e-5;
+            in_front && !(d.x > 0.0 && (gap - x) * -d.y / d.x <= depth && sill_z + d.z * (gap - x) / d.x <= 1000.0)
+        };
+        instants.iter().filter(|s| lit(gb50180::sun_at_true_solar_time(39.9, day.declination_deg(), s.hour))).count() as f64 / 60.0
+    };
+    for (i, (name, _, width)) in windows.iter().enumerate() {
+        let truth = lit_minutes(width / 2.0);
+        assert!((whole[i] - truth).abs() <= 1.0 / 60.0, "{name} ({width} m): {:.4} h vs {truth:.4} h", whole[i]);
+        assert!((got.hours[i] - lit_minutes(0.0)).abs() <= 1.0 / 60.0, "{name}'s centre: {:.4} h", got.hours[i]);
+    }
+    assert!(whole[1] < whole[0] - 0.25, "the wider sill reaches nearer the fin and sees less: {whole:?}");
+
+    // Bad widths files are refused naming the file, the line and the reason.
+    let refused = |text: &str| sill_widths(&scene, &sills, "widths.csv", text).unwrap_err().to_string();
+    for (text, says) in [
+        ("window,width\nWIN_A,1\n", "expected 'receiver,width'"),
+        ("receiver,width\nWIN_A,1\nWIN_B,wide\n", "line 3"),
+        ("receiver,width\nWIN_A,0\nWIN_B,1\n", "line 2"),
+        ("receiver,width\nWIN_A,1\nWIN_B,1,2\n", "line 3"),
+        ("receiver,width\nWIN_A,1\nWIN_C,1\n", "'WIN_C' is not one of the model's chosen receivers"),
+        ("receiver,width\nWIN_A,1\nWIN_A,2\n", "given a width twice"),
+        ("receiver,width\nWIN_A,1\n", "no row gives the width of window 'WIN_B'"),
+    ] {
+        let error = refused(text);
+        assert!(error.contains("widths.csv") && error.contains(says), "{text:?}: {error}");
+    }
+}
+
 /// True solar time = standard time + EoT + (longitude − 15° · zone)/15, with EoT from the
 /// equation-of-time table of K. Krisciunas (Texas A&M, "Equation of time", values by day of a
 /// non-leap year from Meeus's approximate formula, stated within 30 s):
@@ -692,6 +752,16 @@ fn cli_window_studies_before_and_after_and_bad_input() {
     assert!(line45["points"].as_array().unwrap().iter().all(|p| p["within_45deg"].is_number() && p["passes"].is_boolean()));
     assert_eq!(line25["rule"]["line_deg"], 25.0);
 
+    // Each window's own 满窗 width from a CSV: the report states them per point.
+    std::fs::write(dir.join("widths.csv"), "receiver,width\nWIN_S1,1.5\nWIN_S2,3\nWIN_E,1\nWIN_N,1\nWIN_W,2\n").unwrap();
+    let gb_widths = ["--study", "gb50180", "--location", "39.9,116.4,8", "--window-widths", "widths.csv", "-o", "widths-out.csv"];
+    let out = run_map(&dir, &[&windows_of_both[..], &gb_widths[..]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let widths = read("widths-out.study-gb50180.json");
+    assert_eq!(widths["rule"]["whole_window_widths_m"], serde_json::json!([1.5, 3.0, 1.0, 1.0, 2.0]), "{}", widths["rule"]);
+    assert!(widths["points"].as_array().unwrap().iter().all(|p| p["hours_whole_window"].as_f64().unwrap() <= p["hours"].as_f64().unwrap()));
+    std::fs::write(dir.join("bad-widths.csv"), "receiver,width\nWIN_S1,1.5\nWIN_S2,wide\n").unwrap();
+
     std::fs::write(dir.join("dull.epw"), epw_without_dni()).unwrap();
     // A window far away: a receiver of the same name pattern, but none of the points on it.
     std::fs::write(dir.join("elsewhere.gltf"), box_gltf("WIN_FAR", DVec3::new(500.0, 500.0, 0.0), DVec3::new(501.0, 501.0, 1.0))).unwrap();
@@ -710,6 +780,12 @@ fn cli_window_studies_before_and_after_and_bad_input() {
         (vec!["--study", "bre-vsc", "--study", "bre-ground", "--location", "0,0,0"], "--study"),
         (vec!["--study", "bre-vsc", "--mask", "9"], "--mask"),
         (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--floor-level", "0"], "--floor-level"),
+        (vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--window-widths", "bad-widths.csv"], "bad-widths.csv: line 3"),
+        (
+            vec!["--study", "gb50180", "--location", "39.9,116.4,8", "--window-widths", "widths.csv", "--window-width", "1"],
+            "--window-widths",
+        ),
+        (vec!["--study", "bre-vsc", "--window-widths", "widths.csv"], "--window-widths"),
     ] {
         let mut all = vec![office, "--receivers", "WIN_*", "--points", "windows.csv"];
         all.extend(args.iter().copied());

@@ -1,5 +1,6 @@
 // The page's Study mode: planning rules per window (engine.study, run by the worker): a rule, a
-// point on each ticked window (a receiver), GB 50180's parameters; the results as a table per
+// point on each ticked window (a receiver), GB 50180's and EN 17037's parameters and the ground
+// floor's level that sills are raised above (handed on as typed); the results as a table per
 // window and the windows coloured pass/fail in the 3D view; the study's CSV to download, as
 // `sunlit map --study NAME` writes POINTS.study-NAME.csv (the library's own writer), and its HTML
 // report as `--html` writes it (with every window's sky mask, `--mask all`). An existing scene
@@ -82,11 +83,17 @@ export function studyMode(page) {
     if ($('studymasks').checked) o.masks = 'all';
     const sky = page.skyModel();
     if (sky) o.skyModel = sky;
+    // A floor level is handed on whenever one is typed: the library refuses it without the sill.
+    if ($('floorlevel').value.trim() !== '') o.floorLevel = Number($('floorlevel').value);
     if (o.study === 'gb50180') {
       o.day = $('gbday').value;
       for (const [id, key] of [['gbhours', 'requiredHours'], ['gbminperiod', 'minPeriod'], ['gbmaxperiods', 'maxPeriods'], ['gbwidth', 'windowWidth']]) {
         if ($(id).value.trim() !== '') o[key] = Number($(id).value);
       }
+    }
+    if (o.study === 'en17037') {
+      if ($('enperiod').value.trim() !== '') o.period = $('enperiod').value.trim();
+      if ($('enminaltitude').value.trim() !== '') o.minAltitude = Number($('enminaltitude').value);
     }
     return o;
   }

@@ -274,7 +274,7 @@ export interface SunlitEngine {
 }
 
 /** A window study, as `sunlit map --study` names it. */
-export type StudyName = 'bre-vsc' | 'bre-apsh' | 'gb50180' | 'bre-25deg' | 'bre-45deg';
+export type StudyName = 'bre-vsc' | 'bre-apsh' | 'gb50180' | 'bre-25deg' | 'bre-45deg' | 'en17037';
 
 /** engine.study's options, as `sunlit map --study` takes them (docs/planning.md). */
 export interface StudyOptions {
@@ -286,9 +286,12 @@ export interface StudyOptions {
   /** Where on each window: 'centre' (BRE's reference point, the default) or 'sill' (GB 50180's
    * ground-floor sill, the middle of the lowest edge). */
   windowPoints?: 'centre' | 'sill';
+  /** With windowPoints 'sill': the ground floor's level (m, the model's heights); a window
+   * reaching lower is counted at GB 50180's sill, 0.9 m above it (`--floor-level`). */
+  floorLevel?: number;
   /** Or given points: 6 numbers per point, x y z nx ny nz, each on a receiver (as `--points`). */
   points?: ArrayLike<number>;
-  /** Degrees north; with longitude and timeZone (gb50180 needs a site; bre-vsc none). */
+  /** Degrees north; with longitude and timeZone (gb50180 and en17037 need a site; bre-vsc none). */
   latitude?: number;
   /** Degrees east. */
   longitude?: number;
@@ -310,6 +313,10 @@ export interface StudyOptions {
   maxPeriods?: number;
   /** gb50180: the 满窗 (whole window) variant over a sill this wide, in metres. */
   windowWidth?: number;
+  /** en17037: the day, 'MM-DD' from '02-01' to '03-21' (default '03-21'; `--period`). */
+  period?: string;
+  /** en17037: the sun counts at or above this altitude, degrees (default 10; `--min-altitude`). */
+  minAltitude?: number;
   /** The existing scene (`sunlit map --before MODEL`), loaded as the proposed one is: the same
    * points are studied on it too, and each table gains the former values, their ratios and
    * BRE's relative tests (0.8 × former; APSH's 4-point loss). Points not on its receivers have
@@ -331,13 +338,13 @@ export interface StudyTable {
   source: string;
   /** Every parameter of the rule, as the report states them. */
   rule: Record<string, unknown>;
-  /** Per value key ('vsc'; 'apsh', 'wpsh'; 'hours', 'hours_whole_window'; 'angle_deg';
+  /** Per value key ('vsc'; 'apsh', 'wpsh'; 'hours', 'hours_whole_window' (gb50180); 'hours' (en17037); 'angle_deg';
    * 'within_45deg'), the value per point. */
   values: Record<string, number[]>;
   /** Per point: passes (true), fails (false), or not assessed (null: APSH of a window facing
    * more than 90° from due south). */
   passes: (boolean | null)[];
-  /** Per verdict key ('passes', 'passes_whole_window'), per point. */
+  /** Per verdict key ('passes', 'passes_whole_window'; en17037's 'passes_medium', 'passes_high'), per point. */
   verdicts: Record<string, boolean[]>;
   /** Per point, the study's own absolute test ('passes_absolute' of the report). */
   absolute: boolean[];

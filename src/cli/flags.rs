@@ -45,6 +45,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("min_period", "--min-period"),
     ("max_periods", "--max-periods"),
     ("window_width", "--window-width"),
+    ("window_widths", "--window-widths"),
     ("window_points", "--window-points"),
     ("before", "--before"),
     ("floor_level", "--floor-level"),

@@ -156,6 +156,10 @@ pub(super) struct MapArgs {
     /// gb50180: also the 满窗 (whole window) hours, the sun over the whole sill of this width (m).
     #[arg(long, value_name = "METRES")]
     window_width: Option<f64>,
+    /// gb50180: the 满窗 hours with each window's own sill width, from a CSV `receiver,width`
+    /// (instead of one --window-width).
+    #[arg(long, value_name = "FILE.csv")]
+    window_widths: Option<PathBuf>,
     /// The sky that weighs the patches, with --epw: energyplus (the default), perez-all-weather
     /// (Radiance's gendaymtx sky), cie-overcast or uniform; bre-vsc takes only cie-overcast (its
     /// definition).
@@ -299,6 +303,7 @@ pub(super) fn map(args: MapArgs) -> Result<()> {
         ("--min-period", args.min_period.is_some()),
         ("--max-periods", args.max_periods.is_some()),
         ("--window-width", args.window_width.is_some()),
+        ("--window-widths", args.window_widths.is_some()),
         ("--window-points", args.window_points.is_some()),
         ("--floor-level", args.floor_level.is_some()),
         ("--mask", args.mask.is_some()),

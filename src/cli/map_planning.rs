@@ -14,6 +14,7 @@ use sunlit::map::Site;
 use sunlit::map::planning::en17037::En17037Rule;
 use sunlit::map::planning::gb50180::Gb50180Rule;
 use sunlit::map::planning::run::{self, Rules, WINDOW_STUDIES};
+use sunlit::map::planning::sill_widths::sill_widths;
 use sunlit::map::planning::window_points::WindowPoint;
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -68,6 +69,7 @@ fn check_options(args: &MapArgs) -> Result<()> {
         ("--min-period", args.min_period.is_some()),
         ("--max-periods", args.max_periods.is_some()),
         ("--window-width", args.window_width.is_some()),
+        ("--window-widths", args.window_widths.is_some()),
     ];
     if !gb && let Some((flag, _)) = gb_only.iter().find(|(_, given)| *given) {
         return Err(Error::argument(*flag, format!("{names} does not take it: only gb50180 does")));
@@ -120,7 +122,7 @@ fn mask_rows(text: Option<&str>, points: usize) -> Result<Vec<usize>> {
 
 pub(super) fn run(args: MapArgs) -> Result<()> {
     check_options(&args)?;
-    let gb = args.study.iter().any(|s| s == "gb50180").then(|| gb_rule(&args)).transpose()?;
+    let mut gb = args.study.iter().any(|s| s == "gb50180").then(|| gb_rule(&args)).transpose()?;
     let en17037 = args.study.iter().any(|s| s == "en17037").then(|| en17037_rule(&args)).transpose()?;
     let weather = args.epw.as_ref().map(|p| Weather::from_epw(p)).transpose()?;
     let location = match (&weather, &args.location) {
@@ -136,6 +138,11 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     let scene = args.model.load()?;
     let load_seconds = start.elapsed().as_secs_f64();
     let points = args.points(&scene)?;
+    if let (Some(rule), Some(path)) = (gb.as_mut(), &args.window_widths) {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+        rule.window_widths = Some(sill_widths(&scene, &points, &path.display().to_string(), &text)?);
+        rule.check()?;
+    }
     let masks = mask_rows(args.mask.as_deref(), points.len())?;
     let before = (!args.before.is_empty()).then(|| model::load(&args.before, &args.model.options())).transpose()?;
     let from = match (&args.points, &args.window_points) {
@@ -157,7 +164,7 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
         since.set(Instant::now());
     };
     let (mut now_seconds, mut former_seconds) = (Vec::new(), Vec::new());
-    let (now, former) = run::before_after_rules(
+    let (now, former) = run::before_after(
         &args.study,
         &scene,
         &points,
@@ -249,14 +256,7 @@ fn points_input(args: &MapArgs) -> Result<Value> {
     let file = args.points.as_ref().map(|p| p.display().to_string());
     Ok(match (window, file) {
         (None, None) => json!({"grid_spacing_m": args.grid.unwrap_or(0.5)}),
-        (window, file) => {
-            let mut input = planning_points_input(window, file.as_deref());
-            if let Some(floor) = args.floor_level {
-                input["floor_level_m"] = json!(floor);
-                input["sill_height_m"] = json!(sunlit::map::planning::window_points::SILL_HEIGHT);
-            }
-            input
-        }
+        (window, file) => planning_points_input(window, file.as_deref(), args.floor_level),
     })
 }
 

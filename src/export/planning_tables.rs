@@ -12,7 +12,7 @@ use crate::map::Points;
 use crate::map::planning::compare::{self, Verdict};
 use crate::map::planning::gb50180::{self, Gb50180Rule};
 use crate::map::planning::run::{Former, StudyValues};
-use crate::map::planning::window_points::{OFFSET, WindowPoint};
+use crate::map::planning::window_points::{OFFSET, SILL_HEIGHT, WindowPoint};
 use crate::map::planning::{apsh, bre_lines, en17037, mask, vsc};
 use crate::scene::Scene;
 use crate::sun::location::Location;
@@ -177,22 +177,28 @@ pub fn tables(
             let day = rule.day.day_of_year();
             json!({"from": clock(gb50180::standard_time(l, day, from)), "to": clock(gb50180::standard_time(l, day, to))})
         });
+        let mut rule_json = json!({
+            "day": rule.day.chinese(),
+            "day_name": rule.day.name(),
+            "declination_deg": (rule.day.declination_deg() * 1e4).round() / 1e4,
+            "ecliptic_longitude_deg": rule.day.ecliptic_longitude_deg(),
+            "true_solar_window": [clock(from), clock(to)],
+            "standard_time_window": standard,
+            "required_hours": rule.required_hours,
+            "min_period_minutes": rule.min_period_minutes,
+            "max_periods": rule.max_periods,
+            "whole_window_width_m": rule.whole_window,
+            "step_minutes": gb50180::STEP_MINUTES,
+        });
+        // Each window's own width, per point in order, only where given (the reports stay as
+        // they were with one width).
+        if let Some(widths) = &rule.window_widths {
+            rule_json["whole_window_widths_m"] = json!(widths);
+        }
         out.push(StudyTable {
             study: "gb50180".into(),
             source: "GB 50180-2018, 4.0.9: sunlight hours at the ground-floor window sill on the standard day in true solar time (大寒日 8–16 h, 冬至日 9–15 h); table 4.0.9: 大寒日 ≥ 2 h or ≥ 3 h, 冬至日 ≥ 1 h; housing for the elderly ≥ 2 h on 冬至日; new dwellings in old districts ≥ 1 h on 大寒日".into(),
-            rule: json!({
-                "day": rule.day.chinese(),
-                "day_name": rule.day.name(),
-                "declination_deg": (rule.day.declination_deg() * 1e4).round() / 1e4,
-                "ecliptic_longitude_deg": rule.day.ecliptic_longitude_deg(),
-                "true_solar_window": [clock(from), clock(to)],
-                "standard_time_window": standard,
-                "required_hours": rule.required_hours,
-                "min_period_minutes": rule.min_period_minutes,
-                "max_periods": rule.max_periods,
-                "whole_window_width_m": rule.whole_window,
-                "step_minutes": gb50180::STEP_MINUTES,
-            }),
+            rule: rule_json,
             values,
             before: before_values,
             verdicts,
@@ -311,13 +317,19 @@ pub fn mask_svgs(
 }
 
 /// How a report states its points: one on each window (`window_points`, what it is, its offset
-/// out of the window), or from a file.
-pub fn points_input(window: Option<WindowPoint>, file: Option<&str>) -> Value {
-    match (window, file) {
+/// out of the window, and the ground floor's level its sills were raised above with the sill
+/// height, where one was given), or from a file.
+pub fn points_input(window: Option<WindowPoint>, file: Option<&str>, floor_level: Option<f64>) -> Value {
+    let mut input = match (window, file) {
         (Some(at), _) => json!({"window_points": at.name(), "at": at.describe(), "offset_m": OFFSET}),
         (None, Some(file)) => json!({"file": file}),
-        (None, None) => Value::Null,
+        (None, None) => return Value::Null,
+    };
+    if let Some(floor) = floor_level {
+        input["floor_level_m"] = json!(floor);
+        input["sill_height_m"] = json!(SILL_HEIGHT);
     }
+    input
 }
 
 /// A report's inputs: the proposed and existing models (as their files are named), the points

@@ -1,7 +1,7 @@
 //! `engine.study`: the window studies in the browser ([`crate::map::planning`]), translated to
 //! and from JS. Its options are read by [`super::study_options`]; the points are the library's
-//! (each window's by [`window_points`], or given ones, as `sunlit map --window-points` and
-//! `--points` take them), the studies [`run::before_after`]'s (with an existing scene, `--before`),
+//! (each window's by [`window_points`], its sill raised above a floor level by [`floor_sills`],
+//! or given ones, as `sunlit map --window-points`, `--floor-level` and `--points` take them), the studies [`run::before_after`]'s (with an existing scene, `--before`),
 //! the tables, their CSV, the sky masks and the HTML report the library's writers', so a study's
 //! CSV is `sunlit map`'s `POINTS.study-NAME.csv` and its report `--html`'s, byte for byte. No
 //! study logic lives here or in JS.
@@ -16,8 +16,8 @@ use crate::error::{Error, Result};
 use crate::export::planning_report::{StudyTable, report_html, study_csv};
 use crate::export::planning_tables::{compared_tables, mask_svgs, points_input, report_inputs};
 use crate::map::planning::compare::ratio;
-use crate::map::planning::run;
-use crate::map::planning::window_points::window_points;
+use crate::map::planning::run::{self, Rules};
+use crate::map::planning::window_points::{floor_sills, window_points};
 use crate::map::{Points, Site, from_csv};
 use crate::scene::Scene;
 use crate::year::season::LeafCalendar;
@@ -119,7 +119,7 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
     let model = model.inner.clone();
     let before = before.map(|m| m.inner.clone());
     let request = request_from_js(options).map_err(study_error)?;
-    let points = points_of(&model.scene, &request.place).map_err(study_error)?;
+    let points = points_of(&model.scene, &request.place, request.floor_level).map_err(study_error)?;
     let calendar = request.location.as_ref().map(|l| LeafCalendar::for_latitude(l.latitude));
     let site = request.location.as_ref().zip(calendar.as_ref()).map(|(location, calendar)| Site {
         location,
@@ -137,7 +137,7 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
         &points,
         before.as_ref().map(|b| (&b.scene, from.as_str())),
         site,
-        request.gb.as_ref(),
+        Rules { gb: request.gb.as_ref(), en17037: request.en17037.as_ref() },
         &mut |_| {},
         &mut |_| {},
     )
@@ -146,8 +146,8 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
     let tables = compared_tables(&now, former.as_ref(), points.len(), gb, location);
     let masks = mask_svgs(&model.scene, &points, &request.masks.rows(points.len()), location, gb).map_err(study_error)?;
     let place = match &request.place {
-        StudyPlace::Windows(_, at) => points_input(Some(*at), None),
-        StudyPlace::Given(_) => points_input(None, Some("points")),
+        StudyPlace::Windows(_, at) => points_input(Some(*at), None, request.floor_level),
+        StudyPlace::Given(_) => points_input(None, Some("points"), None),
     };
     let (models, befores) = &request.names;
     let inputs = report_inputs(models, befores, place, location, request.epw_name.as_deref());
@@ -155,9 +155,9 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
     Ok(Study { model, points, tables, masks, html })
 }
 
-/// The studies' points on `scene`: one on each window asked, or the given ones (each on a
-/// receiver).
-fn points_of(scene: &Scene, place: &StudyPlace) -> Result<Points> {
+/// The studies' points on `scene`: one on each window asked (the sills raised above
+/// `floor_level` where given), or the given ones (each on a receiver).
+fn points_of(scene: &Scene, place: &StudyPlace, floor_level: Option<f64>) -> Result<Points> {
     match place {
         StudyPlace::Windows(ids, at) => {
             if let Some(id) = ids.iter().find(|&&id| id as usize >= scene.receivers.len()) {
@@ -166,7 +166,10 @@ fn points_of(scene: &Scene, place: &StudyPlace) -> Result<Points> {
                     format!("{id} is not a receiver's index (the model has {})", scene.receivers.len()),
                 ));
             }
-            window_points(scene, ids, *at)
+            match floor_level {
+                Some(floor) => floor_sills(scene, ids, floor),
+                None => window_points(scene, ids, *at),
+            }
         }
         StudyPlace::Given(numbers) => {
             let all: Vec<u32> = (0..scene.receivers.len() as u32).collect();

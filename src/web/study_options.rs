@@ -1,7 +1,8 @@
 //! `engine.study`'s options object (`StudyOptions` in `www/sunlit.d.ts`) read into the library's
-//! terms: which window studies ([`run::STUDIES`]), where (the windows' own points, found by
-//! [`WindowPoint`], or given points), the site (a location or an EPW), GB 50180's rule
-//! ([`Gb50180Rule::from_options`]), the sky model ([`run::check_sky_model`]), and what the report
+//! terms: which window studies ([`run::WINDOW_STUDIES`]), where (the windows' own points, found by
+//! [`WindowPoint`], the sills raised above a ground-floor level as `--floor-level` raises them,
+//! or given points), the site (a location or an EPW), GB 50180's rule
+//! ([`Gb50180Rule::from_options`]), EN 17037's ([`En17037Rule::new`]), the sky model ([`run::check_sky_model`]), and what the report
 //! draws and states (`masks`, the files' names). `before`, the existing scene, is a model, not
 //! JSON: sunlit.js hands it to the wasm call beside the options. The studies
 //! themselves are the library's ([`crate::map::planning::run`]); this only reads names. Plain
@@ -10,6 +11,8 @@
 use serde_json::{Map, Value};
 
 use crate::error::{Error, Result};
+use crate::map::period::parse_date;
+use crate::map::planning::en17037::En17037Rule;
 use crate::map::planning::gb50180::Gb50180Rule;
 use crate::map::planning::run;
 use crate::map::planning::window_points::WindowPoint;
@@ -17,10 +20,11 @@ use crate::sun::location::Location;
 use crate::sun::weather::Weather;
 
 /// The keys of the options object.
-pub const STUDY_KEYS: [&str; 19] = [
+pub const STUDY_KEYS: [&str; 22] = [
     "study",
     "windows",
     "windowPoints",
+    "floorLevel",
     "points",
     "latitude",
     "longitude",
@@ -33,6 +37,8 @@ pub const STUDY_KEYS: [&str; 19] = [
     "minPeriod",
     "maxPeriods",
     "windowWidth",
+    "period",
+    "minAltitude",
     "before",
     "masks",
     "modelNames",
@@ -41,6 +47,9 @@ pub const STUDY_KEYS: [&str; 19] = [
 
 /// GB 50180's own keys: refused beside the other studies, as `sunlit map` refuses `--day`….
 const GB_KEYS: [&str; 5] = ["day", "requiredHours", "minPeriod", "maxPeriods", "windowWidth"];
+
+/// EN 17037's own keys (`--period`, `--min-altitude`): refused without en17037.
+const EN17037_KEYS: [&str; 2] = ["period", "minAltitude"];
 
 /// Where the studies' points are.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,6 +75,11 @@ pub struct StudyRequest {
     pub epw_name: Option<String>,
     /// GB 50180's rule, when gb50180 is asked.
     pub gb: Option<Gb50180Rule>,
+    /// EN 17037's rule, when en17037 is asked.
+    pub en17037: Option<En17037Rule>,
+    /// The ground floor's level (m, the model's heights) that the windows' sills are raised
+    /// above, as `--floor-level` (with `windowPoints: 'sill'` only).
+    pub floor_level: Option<f64>,
     /// The points (0-based rows) whose sky masks the report draws, as `--mask`.
     pub masks: Masks,
     /// The proposed and the existing model's file names, as the report states them (the CLI's
@@ -106,6 +120,10 @@ impl StudyRequest {
         if !gb && let Some(key) = GB_KEYS.iter().find(|k| all.contains_key(**k)) {
             return Err(Error::argument(*key, format!("{} does not take it: only gb50180 does", studies.join(", "))));
         }
+        let en17037 = studies.iter().any(|s| s == "en17037");
+        if !en17037 && let Some(key) = EN17037_KEYS.iter().find(|k| all.contains_key(**k)) {
+            return Err(Error::argument(*key, format!("{} does not take it: only en17037 does", studies.join(", "))));
+        }
         run::check_sky_model(&studies, text_of(&all, "skyModel")?.as_deref())?;
         let place = place(&all)?;
         let epw_name = text_of(&all, "epw")?
@@ -138,10 +156,27 @@ impl StudyRequest {
                 )
             })
             .transpose()?;
+        let en17037 = en17037
+            .then(|| {
+                let day = text_of(&all, "period")?.map(|text| parse_date("period", &text)).transpose()?;
+                En17037Rule::new(day, number(&all, "minAltitude")?)
+            })
+            .transpose()?;
+        let floor_level = floor_level(&all, &place)?;
         let masks = masks(all.get("masks"))?;
         let names = (names_of(&all, "modelNames")?, names_of(&all, "beforeNames")?);
-        Ok(Self { studies, place, location, weather, epw_name, gb, masks, names })
+        Ok(Self { studies, place, location, weather, epw_name, gb, en17037, floor_level, masks, names })
     }
+}
+
+/// `floorLevel`, taken only with the windows' sills (`--floor-level` beside `--window-points
+/// sill`), naming `floor_level` otherwise.
+fn floor_level(all: &Map<String, Value>, place: &StudyPlace) -> Result<Option<f64>> {
+    let Some(level) = number(all, "floorLevel")? else { return Ok(None) };
+    if !level.is_finite() || !matches!(place, StudyPlace::Windows(_, WindowPoint::Sill)) {
+        return Err(Error::argument("floor_level", "raises the windows' sills: give it with windowPoints: 'sill' and a finite level"));
+    }
+    Ok(Some(level))
 }
 
 /// `masks`: `'all'` or an array of 0-based point rows; none by default.
@@ -164,7 +199,7 @@ fn names_of(all: &Map<String, Value>, key: &str) -> Result<Vec<String>> {
 /// `study`: one name or an array of names, each a window study.
 fn studies(value: Option<&Value>) -> Result<Vec<String>> {
     let names: Vec<String> = match value {
-        None => return Err(Error::argument("study", format!("give one of {}", run::STUDIES.join(", ")))),
+        None => return Err(Error::argument("study", format!("give one of {}", run::WINDOW_STUDIES.join(", ")))),
         Some(Value::String(name)) => vec![name.clone()],
         Some(Value::Array(names)) => names
             .iter()
@@ -173,10 +208,10 @@ fn studies(value: Option<&Value>) -> Result<Vec<String>> {
         Some(other) => return Err(Error::argument("study", format!("{other} is not a study's name or an array of them"))),
     };
     if names.is_empty() {
-        return Err(Error::argument("study", format!("no study asked: give one of {}", run::STUDIES.join(", "))));
+        return Err(Error::argument("study", format!("no study asked: give one of {}", run::WINDOW_STUDIES.join(", "))));
     }
-    if let Some(other) = names.iter().find(|s| !run::STUDIES.contains(&s.as_str())) {
-        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", run::STUDIES.join(", "))));
+    if let Some(other) = names.iter().find(|s| !run::WINDOW_STUDIES.contains(&s.as_str())) {
+        return Err(Error::argument("study", format!("'{other}' is not a window study ({})", run::WINDOW_STUDIES.join(", "))));
     }
     Ok(names)
 }

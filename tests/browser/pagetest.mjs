@@ -24,6 +24,14 @@ export async function servePage(work) {
   return { server, origin, browser, page, pageErrors };
 }
 
+/** [`servePage`] with the page opened and ready (its status line says so). */
+export async function readyPage(work) {
+  const served = await servePage(work);
+  await served.page.goto(`${served.origin}/`);
+  await waitForStatus(served.page, /^Ready/);
+  return served;
+}
+
 /** Closes what [`servePage`] opened and removes `work`. */
 export async function closePage(served, work) {
   await served?.browser?.close();

@@ -16,10 +16,15 @@
 //! day in a 365-day year (EnergyPlus's SUN3 fit, [`declination_and_equation_of_time`]).
 //!
 //! 满窗 (whole window): the window's sill is sampled across its width ([`whole_window_points`]) and
-//! an instant counts only when every sample sees the sun.
+//! an instant counts only when every sample sees the sun; one width for every window
+//! ([`Gb50180Rule::whole_window`]) or each window's own ([`Gb50180Rule::window_widths`], read by
+//! [`super::sill_widths`]).
+
+use std::ops::Range;
 
 use glam::DVec3;
 
+use super::sill_widths;
 use crate::error::{Error, Result};
 use crate::map::study::SunRule;
 use crate::map::{LitSeries, Points, Sample};
@@ -122,12 +127,22 @@ pub struct Gb50180Rule {
     pub max_periods: Option<usize>,
     /// 满窗: the sill's width (m) over which every sample must see the sun.
     pub whole_window: Option<f64>,
+    /// 满窗 with each point's own sill width (m, in the points' order) instead of
+    /// [`Self::whole_window`]'s one.
+    pub window_widths: Option<Vec<f64>>,
 }
 
 impl Gb50180Rule {
     /// The day's rule with its default hours and no local additions.
     pub fn new(day: StandardDay) -> Self {
-        Self { day, required_hours: day.default_hours(), min_period_minutes: 0.0, max_periods: None, whole_window: None }
+        Self {
+            day,
+            required_hours: day.default_hours(),
+            min_period_minutes: 0.0,
+            max_periods: None,
+            whole_window: None,
+            window_widths: None,
+        }
     }
 
     /// The rule as asked: `day` (default 大寒日, by [`StandardDay::parse`]), then each local
@@ -164,11 +179,34 @@ impl Gb50180Rule {
             return Err(Error::argument("max_periods", "0: at least one period must count"));
         }
         if let Some(w) = self.whole_window
-            && !(w.is_finite() && w > 0.0 && w <= 20.0)
+            && !sill_widths::valid(w)
         {
-            return Err(Error::argument("window_width", format!("{w} m is not in (0, 20]")));
+            return Err(Error::argument("window_width", format!("{w} m is not in (0, {}]", sill_widths::MAX_WIDTH)));
+        }
+        if let Some(widths) = &self.window_widths {
+            if self.whole_window.is_some() {
+                return Err(Error::argument("window_widths", "give one width for every window or each window's own, not both"));
+            }
+            if let Some((i, w)) = widths.iter().enumerate().find(|(_, w)| !sill_widths::valid(**w)) {
+                return Err(Error::argument("window_widths", format!("point {}: {w} m is not in (0, {}]", i + 1, sill_widths::MAX_WIDTH)));
+            }
         }
         Ok(())
+    }
+
+    /// The rule at the points `index` of the points it was given (the existing scene's share of
+    /// them): each keeps its own sill width.
+    pub fn at_points(&self, index: &[usize]) -> Self {
+        let window_widths = self.window_widths.as_ref().map(|w| index.iter().filter_map(|&i| w.get(i).copied()).collect());
+        Self { window_widths, ..self.clone() }
+    }
+
+    /// Point `i`'s 满窗 width, if the rule asks for the whole window.
+    fn sill_width(&self, i: usize) -> Option<f64> {
+        match &self.window_widths {
+            Some(widths) => widths.get(i).copied(),
+            None => self.whole_window,
+        }
     }
 
     /// The period rule of [`SunRule::hours`] with this rule's minimum and longest periods.
@@ -211,20 +249,23 @@ pub fn instants(day: StandardDay) -> Vec<Sample> {
     (0..count).map(|k| Sample { day: day.day_of_year(), hour: from + (k as f64 + 0.5) * hours, hours, epw_hour: 0 }).collect()
 }
 
-/// `points` with, per point, `samples` sill samples across `width` metres (horizontal in its
-/// plane, centred on it) appended in order: point `i`'s are `n + i·samples .. n + (i+1)·samples`.
-pub fn whole_window_points(points: &Points, width: f64) -> (Points, usize) {
-    let samples = ((width / SILL_SPACING).ceil() as usize + 1).max(3);
+/// `points` with, per point, its sill samples across `width(i)` metres (horizontal in its
+/// plane, centred on it, every [`SILL_SPACING`] or less, at least 3) appended in order, and where
+/// each point's samples are among them.
+pub fn whole_window_points(points: &Points, width: impl Fn(usize) -> f64) -> (Points, Vec<Range<usize>>) {
     let mut out = points.clone();
+    let mut ranges = Vec::with_capacity(points.len());
     for i in 0..points.len() {
-        let (p, n) = (points.position(i), points.normal(i));
+        let (p, n, width) = (points.position(i), points.normal(i), width(i));
+        let samples = ((width / SILL_SPACING).ceil() as usize + 1).max(3);
         let across = if n.z.abs() < 0.9 { DVec3::Z.cross(n).normalize() } else { DVec3::X };
+        ranges.push(out.len()..out.len() + samples);
         for k in 0..samples {
             let offset = width * (k as f64 / (samples - 1) as f64 - 0.5);
             out.push(p + across * offset, n, points.receivers[i]);
         }
     }
-    (out, samples)
+    (out, ranges)
 }
 
 /// Each point's hours under the rule, and with [`Gb50180Rule::whole_window`] its 满窗 hours.
@@ -258,10 +299,12 @@ pub fn evaluate_on(
 ) -> Result<Gb50180Values> {
     rule.check()?;
     let n = points.len();
-    let (all, per_window) = match rule.whole_window {
-        Some(width) => whole_window_points(points, width),
-        None => (points.clone(), 0),
-    };
+    if let Some(widths) = rule.window_widths.as_ref().filter(|w| w.len() != n) {
+        return Err(Error::argument("window_widths", format!("{} widths for {n} points", widths.len())));
+    }
+    let whole = rule.sill_width(0).is_some();
+    let (all, ranges) =
+        if whole { whole_window_points(points, |i| rule.sill_width(i).unwrap_or(0.0)) } else { (points.clone(), Vec::new()) };
     let windows = super::Windows::on(scene, tree, &all)?;
     let samples = instants(rule.day);
     let leaves = LeafCalendar::for_latitude(location.latitude).fraction(f64::from(rule.day.day_of_year())) as f32;
@@ -271,13 +314,12 @@ pub fn evaluate_on(
     let lit = super::lit_bits(&windows, &asks, progress);
     let periods = rule.periods();
     let hours = (0..n).map(|i| periods.hours(&samples, &lit, i)).collect();
-    let whole_window_hours = rule.whole_window.map(|_| {
+    let whole_window_hours = whole.then(|| {
         let words = samples.len().div_ceil(64);
         let mut bits = vec![0u64; n * words];
-        for i in 0..n {
-            let first = n + i * per_window;
+        for (i, range) in ranges.iter().enumerate() {
             for k in 0..samples.len() {
-                if (first..first + per_window).all(|j| lit.lit(j, k)) {
+                if range.clone().all(|j| lit.lit(j, k)) {
                     bits[i * words + k / 64] |= 1 << (k % 64);
                 }
             }

@@ -10,7 +10,8 @@
 //!   (BRE's 0.8 × former value and 4-point APSH loss);
 //! - [`mask`]: what a point sees of the sky and the sun's paths, for its stereographic diagram;
 //! - [`run`]: every study asked, on one scene, sharing its shadow-ray tree;
-//! - [`window_points`]: each window's reference point or sill, found from its geometry.
+//! - [`window_points`]: each window's reference point or sill, found from its geometry;
+//! - [`sill_widths`]: each window's own 满窗 sill width, read from a CSV.
 //!
 //! The points are [`Windows`]: any list of directions is asked of them (not a period's suns),
 //! answered by shadow rays through a BVH of the scene ([`crate::count::rays`]), or by the
@@ -23,6 +24,7 @@ pub mod en17037;
 pub mod gb50180;
 pub mod mask;
 pub mod run;
+pub mod sill_widths;
 pub mod vsc;
 pub mod window_points;
 

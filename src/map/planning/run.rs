@@ -13,10 +13,12 @@ use crate::error::{Error, Result};
 use crate::map::{Points, Site, points};
 use crate::scene::Scene;
 
-/// The window studies' names that the page runs too ([`crate::web`]'s `engine.study`).
+/// The studies that are window studies wherever they are asked; `en17037` is one beside them,
+/// at windows' own points or against an existing scene, and alone on given points or a grid the
+/// CLI's area study ([`crate::map::study`]).
 pub const STUDIES: [&str; 5] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg"];
 
-/// Every window study's name: [`STUDIES`] and `en17037` (the CLI's alone so far).
+/// Every window study's name: [`STUDIES`] and `en17037` (what the page's `engine.study` runs).
 pub const WINDOW_STUDIES: [&str; 6] = ["bre-vsc", "bre-apsh", "gb50180", "bre-25deg", "bre-45deg", "en17037"];
 
 /// The rules whose parameters a run sets: gb50180's and en17037's (each needed only when its
@@ -140,28 +142,13 @@ pub struct Former {
     pub index: Vec<usize>,
 }
 
-/// The studies on the proposed scene and, with `before` (the existing scene, and where the
-/// points came from for [`points_in`]'s message), on the existing one at the same points: what
-/// `sunlit map --study … --before` and the page's before/after run. The existing scene's points
-/// are checked before anything is computed. `done_now` and `done_before` are
-/// [`evaluate`]'s `done` for each scene.
+/// The studies of `studies` ([`WINDOW_STUDIES`], [`evaluate`]) on the proposed scene and, with
+/// `before` (the existing scene, and where the points came from for [`points_in`]'s message), on
+/// the existing one at the same points: what `sunlit map --study … --before` and the page's
+/// before/after run. The existing scene's points are checked before anything is computed.
+/// `done_now` and `done_before` are [`evaluate`]'s `done` for each scene.
 #[allow(clippy::too_many_arguments)]
 pub fn before_after(
-    studies: &[String],
-    scene: &Scene,
-    points: &Points,
-    before: Option<(&Scene, &str)>,
-    site: Option<Site<'_>>,
-    gb: Option<&Gb50180Rule>,
-    done_now: &mut dyn FnMut(&str),
-    done_before: &mut dyn FnMut(&str),
-) -> Result<(StudyValues, Option<Former>)> {
-    before_after_rules(studies, scene, points, before, site, Rules { gb, en17037: None }, done_now, done_before)
-}
-
-/// [`before_after`] of any of [`WINDOW_STUDIES`] ([`evaluate`]).
-#[allow(clippy::too_many_arguments)]
-pub fn before_after_rules(
     studies: &[String],
     scene: &Scene,
     points: &Points,
@@ -182,6 +169,9 @@ pub fn before_after_rules(
     }
     let former = existing
         .map(|(s, (kept, index))| {
+            // Each window keeps its own 满窗 width at its row among the existing scene's points.
+            let gb = rules.gb.map(|g| g.at_points(&index));
+            let rules = Rules { gb: gb.as_ref(), ..rules };
             evaluate(studies, s, &kept, site, rules, done_before).map(|values| Former { values, points: kept, index })
         })
         .transpose()?;
