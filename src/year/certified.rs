@@ -68,7 +68,7 @@ const SMOOTH_BATCH: usize = 1 << 18;
 /// cells at once (a half of a run is a block of days by times of day), then single cells, then
 /// halves of a cell ([`Certifier::unproved_lit_in_cells`]).
 pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of: &dyn Fn(usize) -> (DVec3, f64)) -> Vec<Rough> {
-    smooth.sort_by_key(|s| (s.regime, s.fit, block_order(s.at), s.row));
+    smooth.sort_unstable_by_key(|s| (s.regime, s.fit, block_order(s.at), s.row));
     let pieces: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit) == (b.regime, b.fit)).collect();
     let mut out = Vec::new();
     let mut start = 0;
@@ -107,7 +107,17 @@ pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of:
 /// minutes, 10° of hour angle), so its footprints are short and a disc passes between them
 /// over more cells: on blaas-louvres 4,029 proofs instead of 6,987 in order of days.
 fn block_order((k, j): (u16, u16)) -> u64 {
-    (0..16).fold(0, |key, b| key | (u64::from(k >> b & 1) << (2 * b)) | (u64::from(j >> b & 1) << (2 * b + 1)))
+    spread_bits(k) | spread_bits(j) << 1
+}
+
+/// `x`'s bits at the even places of a `u64` (bit b at 2b): the sort calls it for every
+/// comparison, where a loop over the bits was 2 % of a year's samples.
+fn spread_bits(x: u16) -> u64 {
+    let mut x = u64::from(x);
+    x = (x | x << 8) & 0x00ff_00ff;
+    x = (x | x << 4) & 0x0f0f_0f0f;
+    x = (x | x << 2) & 0x3333_3333;
+    (x | x << 1) & 0x5555_5555
 }
 
 /// Cells with fewer steps to settle than this are counted: one view costs about what a proof
@@ -196,4 +206,24 @@ pub(super) fn certify_steps(
     );
     rest.extend(unproved);
     rest
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cheap interleaving is the bits' own: every day and τ index a grid can have (below
+    /// 2¹⁶) against a loop over the bits, at all indices below 600 and the largest ones.
+    #[test]
+    fn block_order_interleaves_the_bits_of_day_and_time_of_day() {
+        let slow =
+            |k: u16, j: u16| (0..16).fold(0, |key, b| key | (u64::from(k >> b & 1) << (2 * b)) | (u64::from(j >> b & 1) << (2 * b + 1)));
+        let edges = (0..600).chain(u16::MAX - 600..=u16::MAX);
+        for k in edges.clone() {
+            for j in (0..600).chain([u16::MAX - 1, u16::MAX]) {
+                assert_eq!(block_order((k, j)), slow(k, j), "({k}, {j})");
+            }
+        }
+        assert_eq!(edges.count(), 1201);
+    }
 }

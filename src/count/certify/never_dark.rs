@@ -33,7 +33,7 @@ use glam::{DVec2, DVec3};
 
 use super::{CHUNK, COVER_MARGIN, Certifier, DirectionCone, MAX_SWEPT, NEAR_REACH, PLANE_TOLERANCE, Shape};
 use crate::count::exact::engine::{parallel_chunks, worker_threads};
-use crate::count::view::{self, convex_hull};
+use crate::count::view::{self, convex_hull, perpendicular_basis};
 use crate::scene::NO_RECEIVER;
 
 /// Least share of the receiver's area the lit disc holds: ten times EnergyPlus's 1e-5 (a
@@ -534,6 +534,19 @@ fn capsule_interval(o: DVec2, d: DVec2, a: DVec2, b: DVec2, r: f64) -> Option<(f
     [disc(a), disc(b), band()].into_iter().flatten().reduce(|x, y| (x.0.min(y.0), x.1.max(y.1)))
 }
 
+/// Orders `set` (indices into `suns`) along the wider of the two axes of the suns' gnomonic
+/// chart about their mean, so that each half spans about half the sky the set does that way: a
+/// cell's steps in order of rows split into its first and last days, which the sun's path
+/// across an hour or so of each day spans much more widely. Only the order of trying changes.
+fn split_widest(suns: &[DVec3], set: &mut [usize]) {
+    let Some(axis) = set.iter().map(|&i| suns[i]).sum::<DVec3>().try_normalize() else { return };
+    let (u, v) = perpendicular_basis(axis);
+    let chart = |i: usize| DVec2::new(suns[i].dot(u), suns[i].dot(v)) / suns[i].dot(axis);
+    let (lo, hi) = bounds(&set.iter().map(|&i| chart(i)).collect::<Vec<_>>());
+    let along = if hi.x - lo.x >= hi.y - lo.y { DVec2::X } else { DVec2::Y };
+    set.sort_by(|a, b| chart(*a).dot(along).total_cmp(&chart(*b).dot(along)).then(a.cmp(b)));
+}
+
 impl Certifier<'_> {
     /// For many sets (receiver, its suns), in order, the suns of each at which the receiver is
     /// not proved partly lit ([`Self::not_dark`]): the set is tried whole, then in halves, down
@@ -559,16 +572,31 @@ impl Certifier<'_> {
     /// found (the casters near the receiver, the last disc proved lit), tried first in its
     /// halves too.
     pub(super) fn bisect_not_dark(&self, receiver: usize, suns: &[DVec3], first: usize, hints: &mut Hints, out: &mut Vec<usize>) {
-        if suns.is_empty() || self.not_dark_near(receiver, suns, hints) {
+        let mut set: Vec<usize> = (0..suns.len()).collect();
+        let start = out.len();
+        self.bisect_set(receiver, suns, &mut set, hints, out);
+        out[start..].sort_unstable();
+        out[start..].iter_mut().for_each(|i| *i += first);
+    }
+
+    /// [`Self::bisect_not_dark`] over the suns at `set` (indices into `suns`), each half taken
+    /// across the set's widest extent ([`split_widest`]).
+    fn bisect_set(&self, receiver: usize, suns: &[DVec3], set: &mut [usize], hints: &mut Hints, out: &mut Vec<usize>) {
+        if set.is_empty() {
             return;
         }
-        if suns.len() == 1 {
-            out.push(first);
+        let chosen: Vec<DVec3> = set.iter().map(|&i| suns[i]).collect();
+        if self.not_dark_near(receiver, &chosen, hints) {
             return;
         }
-        let half = suns.len() / 2;
-        self.bisect_not_dark(receiver, &suns[..half], first, hints, out);
-        self.bisect_not_dark(receiver, &suns[half..], first + half, hints, out);
+        if let [only] = set {
+            out.push(*only);
+            return;
+        }
+        split_widest(suns, set);
+        let (low, high) = set.split_at_mut(set.len() / 2);
+        self.bisect_set(receiver, suns, low, hints, out);
+        self.bisect_set(receiver, suns, high, hints, out);
     }
 
     /// Whether some disc of the receiver holding [`MIN_LIT_SHARE`] of its area is lit at every
@@ -737,6 +765,49 @@ mod tests {
             if footprint.is_some() { kept += 1 } else { left_out += 1 }
         }
         assert_eq!((kept, left_out), (1, 1));
+    }
+
+    /// A cell's suns (14 days by an hour of steps every 15 minutes, in order of rows, as the year
+    /// hands them over) are halved across their widest extent: along that axis of the chart each
+    /// half spans at most 60 % of the whole, where the rows' own halves (the first and last seven
+    /// days) each span over 90 % of it, the hour's sweep; and the order is a permutation of the
+    /// set. Spring, summer and winter cells of a south and an east window.
+    #[test]
+    fn a_sets_halves_are_taken_across_its_widest_extent() {
+        let location = crate::count::certify::tests::golden();
+        let mut tried = 0;
+        for (first, hour, normal) in [(60, 10.0, -DVec3::Y), (160, 13.0, -DVec3::Y), (330, 11.0, -DVec3::Y), (172, 8.0, DVec3::X)] {
+            let suns: Vec<DVec3> = (first..first + 14)
+                .flat_map(|day| (0..5).map(move |k| (day, hour + 0.25 * f64::from(k))))
+                .map(|(day, h)| crate::sun::position::sun_direction(&location, f64::from(day), h))
+                .filter(|s| s.z > 0.1 && s.dot(normal) > 0.1)
+                .collect();
+            assert_eq!(suns.len(), 70, "day {first}: every step up and in front");
+            let axis = suns.iter().copied().sum::<DVec3>().normalize();
+            let (u, v) = perpendicular_basis(axis);
+            let chart = |d: DVec3| DVec2::new(d.dot(u), d.dot(v)) / d.dot(axis);
+            let span = |set: &[usize], along: DVec2| {
+                let at: Vec<f64> = set.iter().map(|&i| chart(suns[i]).dot(along)).collect();
+                at.iter().copied().fold(f64::NEG_INFINITY, f64::max) - at.iter().copied().fold(f64::INFINITY, f64::min)
+            };
+            let rows: Vec<usize> = (0..suns.len()).collect();
+            let along = if span(&rows, DVec2::X) >= span(&rows, DVec2::Y) { DVec2::X } else { DVec2::Y };
+            let whole = span(&rows, along);
+            let mut set = rows.clone();
+            split_widest(&suns, &mut set);
+            let mut sorted = set.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, rows, "not a permutation");
+            let (low, high) = set.split_at(set.len() / 2);
+            assert!(
+                span(low, along) <= 0.6 * whole && span(high, along) <= 0.6 * whole,
+                "day {first}: halves not across the widest extent"
+            );
+            let (early, late) = rows.split_at(rows.len() / 2);
+            assert!(span(early, along) > 0.9 * whole && span(late, along) > 0.9 * whole, "day {first}: the rows' halves already halve it");
+            tried += 1;
+        }
+        assert_eq!(tried, 4);
     }
 
     /// The hull-free test ([`separated`]) agrees with the distance to the hull wherever it
