@@ -10,17 +10,20 @@
 # Environment (defaults in brackets): COLUMNS [50] ROWS [40] (buildings, one a block), SEED [1],
 # TILE [330] (metres; 330 cuts the default district into 4 × 4), CONTEXT [150], EPW [Golden CO's
 # TMY3 from EnergyPlus's WeatherData: `SUNLIT_ENERGYPLUS=1 . scripts/setup.sh` sets $ENERGYPLUS],
-# WHOLE [1] (0 skips the one-process run), and DISTRICT_ARGS, more
+# WHOLE [1] (0 skips the one-process run), ROOFTOPS [0] (1: a stair housing or chimney on every
+# roof, make_district --rooftops: about 11 receivers a building instead of 6), and DISTRICT_ARGS, more
 # `sunlit district` options for every run (e.g. "--days-per-year 27 --samples-per-day 19").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-$(mktemp -d)}
 mkdir -p "$out"
-: "${COLUMNS:=50}" "${ROWS:=40}" "${SEED:=1}" "${TILE:=330}" "${CONTEXT:=150}" "${EPW:=$(dirname "${ENERGYPLUS:-.}")/WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw}" "${WHOLE:=1}"
+: "${COLUMNS:=50}" "${ROWS:=40}" "${SEED:=1}" "${ROOFTOPS:=0}" "${TILE:=330}" "${CONTEXT:=150}" "${EPW:=$(dirname "${ENERGYPLUS:-.}")/WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw}" "${WHOLE:=1}"
 read -r -a more <<<"${DISTRICT_ARGS:-}"
 cargo build --release --quiet --bin sunlit --example make_district
 city="$out/district.city.json"
-./target/release/examples/make_district "$city" --columns "$COLUMNS" --rows "$ROWS" --seed "$SEED" >&2
+rooftops=()
+[ "$ROOFTOPS" = 1 ] && rooftops=(--rooftops)
+./target/release/examples/make_district "$city" --columns "$COLUMNS" --rows "$ROWS" --seed "$SEED" "${rooftops[@]}" >&2
 ./target/release/sunlit info "$city" --json | python3 -c 'import json, sys; v = json.load(sys.stdin); print("city:", len(v["receivers"]), "receiver surfaces,", v["triangles"], "triangles")'
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start"
 

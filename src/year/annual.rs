@@ -538,15 +538,20 @@ async fn spline_year(
     let SampleViews { requests, cells } = sample_views(scene, location, &regimes, &taus);
     let work = YearWork { samples: requests.len(), timesteps: facing_timesteps(scene, location, schedule.timesteps).count() };
     let counted = views.count(&requests, &mut |p| progress(work.sampling(p))).await?;
+    // Each step below keeps only what the next reads, freed before the year is evaluated: a
+    // city's views, counts and samples are a sixth of its peak memory (docs/district.md).
+    drop(requests);
     let mut samples: Vec<Vec<Option<f64>>> =
         regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
     for (request, g, cell) in cells {
         samples[g][cell] = Some(counted[request]);
     }
+    drop(counted);
     let mut fits = Vec::with_capacity(regimes.len());
     for (regime, samples) in regimes.iter().zip(&samples) {
         fits.push(fit_regime(regime, samples, taus.len())?);
     }
+    drop(samples);
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
     let (refine, prove) = (options.refine, options.prove_never_dark);
     let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, schedule);

@@ -64,8 +64,11 @@ fn kind(v: f64) -> Kind {
 pub(super) struct Sparse {
     /// Per step (index into the refined steps): its value once counted or interpolated.
     values: Vec<Option<f64>>,
-    /// Runs: steps of one fitted piece at one time of day on consecutive days, in day order.
-    runs: Vec<Vec<usize>>,
+    /// The steps grouped into runs: steps of one fitted piece at one time of day on consecutive
+    /// days, in day order, run after run.
+    order: Vec<usize>,
+    /// Each run's positions in `order` (ranges, not a list each: a city has millions of steps).
+    runs: Vec<std::ops::Range<usize>>,
     /// Spans (run, first, last position) whose ends are counted and whose inside is not known.
     spans: Vec<(usize, usize, usize)>,
     /// Of `spans`, those whose middle is asked this round (the rest are counted whole).
@@ -87,15 +90,17 @@ impl Sparse {
         };
         let mut order: Vec<usize> = (0..rough.len()).collect();
         order.sort_by_key(|&i| key(i));
-        let runs = order
-            .chunk_by(|&a, &b| {
-                let (ka, kb) = (key(a), key(b));
-                (ka.0, ka.1, ka.2) == (kb.0, kb.1, kb.2) && kb.3 == ka.3 + 1
-            })
-            .map(<[usize]>::to_vec)
-            .collect();
+        let mut runs = Vec::new();
+        for run in order.chunk_by(|&a, &b| {
+            let (ka, kb) = (key(a), key(b));
+            (ka.0, ka.1, ka.2) == (kb.0, kb.1, kb.2) && kb.3 == ka.3 + 1
+        }) {
+            let start = runs.last().map_or(0, |r: &std::ops::Range<usize>| r.end);
+            runs.push(start..start + run.len());
+        }
         Sparse {
             values: vec![None; rough.len()],
+            order,
             runs,
             spans: Vec::new(),
             asked_middles: Vec::new(),
@@ -123,7 +128,7 @@ impl Sparse {
         }
         let mut asked = Vec::new();
         for (run, a, b) in std::mem::take(&mut self.spans) {
-            let steps = &self.runs[run];
+            let steps = self.run(run);
             let (va, vb) = (self.value(steps[a]), self.value(steps[b]));
             if interpolable(va, vb) {
                 asked.push(steps[(a + b) / 2]);
@@ -138,7 +143,8 @@ impl Sparse {
     /// Every run's first and last day, and the whole of runs of one or two days.
     fn first_round(&mut self) -> Vec<usize> {
         let mut asked = Vec::new();
-        for (run, steps) in self.runs.iter().enumerate() {
+        for run in 0..self.runs.len() {
+            let steps = self.run(run);
             let last = steps.len() - 1;
             asked.push(steps[0]);
             if last > 0 {
@@ -161,7 +167,7 @@ impl Sparse {
         self.counted += asked.len();
         for (run, a, b) in std::mem::take(&mut self.asked_middles) {
             let m = (a + b) / 2;
-            let steps = &self.runs[run];
+            let steps = self.run(run);
             let (va, vm, vb) = (self.value(steps[a]), self.value(steps[m]), self.value(steps[b]));
             let straight = va + (vb - va) * (m - a) as f64 / (b - a) as f64;
             let agrees = kind(vm) == kind(va) && (vm - straight).abs() <= TOLERANCE;
@@ -181,11 +187,16 @@ impl Sparse {
     /// Fills the steps strictly between positions `a` and `b` of `run` on the straight line
     /// between their counted values.
     fn interpolate(&mut self, run: usize, a: usize, b: usize) {
-        let (va, vb) = (self.value(self.runs[run][a]), self.value(self.runs[run][b]));
+        let (va, vb) = (self.value(self.run(run)[a]), self.value(self.run(run)[b]));
         for p in a + 1..b {
-            let step = self.runs[run][p];
+            let step = self.run(run)[p];
             self.values[step] = Some(va + (vb - va) * (p - a) as f64 / (b - a) as f64);
         }
+    }
+
+    /// Run `k`'s steps, in day order.
+    fn run(&self, k: usize) -> &[usize] {
+        &self.order[self.runs[k].clone()]
     }
 
     fn value(&self, step: usize) -> f64 {

@@ -118,10 +118,42 @@ fn runs_break_at_gaps_times_of_day_and_pieces() {
         rough.push(step(1, 40, d));
     }
     let s = Sparse::new(&rough, ROWS);
-    let mut lengths: Vec<usize> = s.runs.iter().map(Vec::len).collect();
+    let mut lengths: Vec<usize> = s.runs.iter().map(|r| r.len()).collect();
     lengths.sort_unstable();
     assert_eq!(lengths, vec![8, 8, 8, 10, 10, 10]);
-    for run in &s.runs {
-        assert!(run.windows(2).all(|w| rough[w[1]].row == rough[w[0]].row + ROWS), "consecutive days");
+    for k in 0..s.runs.len() {
+        assert!(s.run(k).windows(2).all(|w| rough[w[1]].row == rough[w[0]].row + ROWS), "consecutive days");
     }
+}
+
+/// The runs kept as ranges of one sorted list of steps (a city's millions of steps without a
+/// list each) are the runs a list each gave, step for step and in order: so every round asks
+/// the same steps and takes the same answers, bit for bit.
+#[test]
+fn runs_as_ranges_are_the_lists_they_replace() {
+    // Steps of three pieces and four times of day over days with gaps, in a scrambled order.
+    let mut rough = Vec::new();
+    for d in (0..40).filter(|d| d % 7 != 3 && d % 11 != 5) {
+        for (fit, slot) in [(0, 40), (0, 41), (1, 40), (2, 12)] {
+            rough.push(step(fit, slot, d));
+        }
+    }
+    let n = rough.len();
+    rough = (0..n).map(|i| rough[(i * 37) % n]).collect();
+    // The lists as they were made: the steps sorted by piece, time of day and day, cut where a
+    // day is missing.
+    let key = |i: usize| (rough[i].cell.0, rough[i].cell.1, rough[i].row % ROWS, rough[i].row / ROWS);
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&i| key(i));
+    let lists: Vec<Vec<usize>> = order
+        .chunk_by(|&a, &b| {
+            let (ka, kb) = (key(a), key(b));
+            (ka.0, ka.1, ka.2) == (kb.0, kb.1, kb.2) && kb.3 == ka.3 + 1
+        })
+        .map(<[usize]>::to_vec)
+        .collect();
+    let s = Sparse::new(&rough, ROWS);
+    let ranges: Vec<Vec<usize>> = (0..s.runs.len()).map(|k| s.run(k).to_vec()).collect();
+    assert!(lists.len() > 20, "{} runs", lists.len());
+    assert_eq!(ranges, lists);
 }
