@@ -162,10 +162,7 @@ fn a_view_counts_the_same_in_every_atlas_slot_so_both_cullings_agree_on_a_year()
     // tiles the CPU's skips as unshaded, so every other tile lands in another atlas slot; a
     // corner's viewport offset used to round by slot (11 of 240 rendered views changed count
     // with the tiles' order, 4 of 620 differed between the cullings).
-    let model = sunlit::bench::models::generate("blaas-louvres").unwrap();
-    let scene = sunlit::model::load_bytes(&[("louvres.glb".to_string(), model.glb.to_glb())], &Default::default()).unwrap();
-    let plan = sunlit::year::samples::SamplingPlan::new(3, 5).unwrap();
-    let requests = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    let (scene, requests) = louvres_3x5();
     let [(by_cpu, _, _), (by_gpu, _, _)] = both(&scene, &requests, 64);
     let differing: Vec<_> = (0..requests.len()).filter(|&i| by_gpu[i].fraction.to_bits() != by_cpu[i].fraction.to_bits()).collect();
     assert!(differing.is_empty(), "{} of {} views differ between the cullings: {differing:?}", differing.len(), requests.len());
@@ -179,6 +176,15 @@ fn a_view_counts_the_same_in_every_atlas_slot_so_both_cullings_agree_on_a_year()
     assert!(rendered.len() >= 200 && shaded >= 50, "{} rendered, {shaded} partly shaded", rendered.len());
     let moved = (0..rendered.len()).filter(|&i| forward[i] != backward[i]).count();
     assert_eq!(moved, 0, "views whose count changed with their atlas slot, of {}", rendered.len());
+}
+
+/// blaas-louvres and every sample view of its 3×5 year.
+fn louvres_3x5() -> (Scene, Vec<ViewRequest>) {
+    let model = sunlit::bench::models::generate("blaas-louvres").unwrap();
+    let scene = sunlit::model::load_bytes(&[("louvres.glb".to_string(), model.glb.to_glb())], &Default::default()).unwrap();
+    let plan = sunlit::year::samples::SamplingPlan::new(3, 5).unwrap();
+    let requests = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    (scene, requests)
 }
 
 /// `requests` counted at `side` with the GPU's culling, drawn a batch at a time (one mask draw,
@@ -218,10 +224,7 @@ fn one_draw_a_batch_counts_louvres_within_a_lit_pixel_of_one_draw_a_tile() {
     // reaching far past their tile): the same covered pixels, and lit pixels within one of the
     // per-tile draws' (about 70 of the 620 views are one apart on lavapipe; cause not isolated).
     // A view one draw renders and the other settles unrendered as unshaded must be lit alike.
-    let model = sunlit::bench::models::generate("blaas-louvres").unwrap();
-    let scene = sunlit::model::load_bytes(&[("louvres.glb".to_string(), model.glb.to_glb())], &Default::default()).unwrap();
-    let plan = sunlit::year::samples::SamplingPlan::new(3, 5).unwrap();
-    let requests = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    let (scene, requests) = louvres_3x5();
     let (by_tile, _) = by_draw(&scene, &requests, 64, false);
     let (by_batch, _) = by_draw(&scene, &requests, 64, true);
     let shaded = by_tile.iter().filter(|c| c.visible > 0 && c.visible < c.covered).count();
