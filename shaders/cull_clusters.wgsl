@@ -143,6 +143,12 @@ fn view_layout_main() {
         at += n;
     }
     atomicStore(&args.needed, at);
+    // The batch draw (src/count/gpu/batched.rs): every pair an instance, none where the list
+    // overflowed (the host counts that batch again).
+    args.vertex_count = params.vertices;
+    args.instance_count = select(0u, at, at <= params.capacity);
+    args.first_vertex = 0u;
+    args.first_instance = 0u;
 }
 
 @compute @workgroup_size(64)

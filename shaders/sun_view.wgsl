@@ -90,12 +90,17 @@ fn vs_static(v: VertexIn) -> VertexOut {
 // What both entry points pass on: the clip position (DROPPED for a leaf not in leaf), the id
 // (NO_RECEIVER for shading-only geometry), the transmittance and the dither seed.
 fn shade(clip: vec4<f32>, v: VertexIn, leaf_shift: f32, receiver_base: u32, slot: u32) -> VertexOut {
+    return shade_at(clip, v, leaf_shift, receiver_base, slot, view.snap, view.leaves);
+}
+
+// `shade` for a view's `snap` and `leaves` given (the batch draw reads them from storage).
+fn shade_at(clip: vec4<f32>, v: VertexIn, leaf_shift: f32, receiver_base: u32, slot: u32, snap: f32, leaves: f32) -> VertexOut {
     var out: VertexOut;
     // Snapped to 1/256 pixel of the tile (w is 1: the view is orthographic), so the viewport's
     // offset to the tile's slot in the atlas adds whole subpixels and rounds nothing: a triangle
     // gives the same pixels in every slot (subpixels_per_half_tile in pipelines.rs).
-    out.position = vec4<f32>(round(clip.xy * view.snap) / view.snap, clip.zw);
-    if v.veil.x >= 0.0 && fract(v.veil.x + leaf_shift) >= view.leaves {
+    out.position = vec4<f32>(round(clip.xy * snap) / snap, clip.zw);
+    if v.veil.x >= 0.0 && fract(v.veil.x + leaf_shift) >= leaves {
         out.position = DROPPED;
     }
     if v.surface == NO_RECEIVER || receiver_base == NO_RECEIVER {
@@ -163,24 +168,130 @@ fn vs_pulled(@builtin(vertex_index) corner: u32, @builtin(instance_index) instan
     let k = corner / 3u;
     if k >= cluster.count {
         // Past the cluster's last triangle: a triangle of DROPPED corners, clipped away.
-        var out: VertexOut;
-        out.position = DROPPED;
-        out.id = NO_RECEIVER;
-        return out;
+        return dropped();
     }
     let run = runs[cluster_runs[c]];
     let local = cluster.first + k - run.first;
-    let placement = local / run.per_instance;
-    let t = local % run.per_instance;
-    let p = pulled_vertices[run.vertex_base + pulled_indices[run.index_base + 3u * t + corner % 3u]];
-    let v = VertexIn(vec3<f32>(p.x, p.y, p.z), p.surface, vec2<f32>(p.rank, p.transmittance), p.seed);
+    let v = pulled_corner(run, local % run.per_instance, corner % 3u);
+    return place_pulled(run, local / run.per_instance, v, view.view_proj, view.snap, view.leaves);
+}
+
+// A corner outside every clip volume (its triangle is clipped away).
+fn dropped() -> VertexOut {
+    var out: VertexOut;
+    out.position = DROPPED;
+    out.id = NO_RECEIVER;
+    return out;
+}
+
+// Corner `corner` (0..3) of triangle `t` of one placement of `run`.
+fn pulled_corner(run: Run, t: u32, corner: u32) -> VertexIn {
+    let p = pulled_vertices[run.vertex_base + pulled_indices[run.index_base + 3u * t + corner]];
+    return VertexIn(vec3<f32>(p.x, p.y, p.z), p.surface, vec2<f32>(p.rank, p.transmittance), p.seed);
+}
+
+// Corner `v` of `run`'s placement `placement` seen by `view_proj`: the expressions of vs_static
+// (the static mesh) and vs_main (a placement), so the pixels are theirs.
+fn place_pulled(run: Run, placement: u32, v: VertexIn, view_proj: mat4x4<f32>, snap: f32, leaves: f32) -> VertexOut {
     if run.placed == 0u {
-        return shade(view.view_proj * vec4<f32>(v.position, 1.0), v, 0.0, 0u, params.static_slot);
+        return shade_at(view_proj * vec4<f32>(v.position, 1.0), v, 0.0, 0u, params.static_slot, snap, leaves);
     }
     let slot = run.first_slot + placement;
     let instance = instances[slot];
-    let clip = view.view_proj * (instance.transform * vec4<f32>(v.position, 1.0));
-    return shade(clip, v, instance.leaf_shift, instance.receiver_base, slot);
+    let clip = view_proj * (instance.transform * vec4<f32>(v.position, 1.0));
+    return shade_at(clip, v, instance.leaf_shift, instance.receiver_base, slot, snap, leaves);
+}
+
+// One draw a batch (src/count/gpu/batched.rs): every tile of the batch drawn by one draw with
+// the whole atlas as its viewport. The scene draw's instances are the culling's (view, cluster)
+// pairs of the whole batch (`kept`, each view's clusters in triangle order, views in slot
+// order), the mask draw's the members' triangles in runs of up to 128 (`mask_items`). Each
+// corner is placed by `shade_at` as in the tile's own draw, then moved into the view's tile in
+// whole subpixels (`in_tile`), and its fragments outside the tile are discarded (`fs_tiled`):
+// the same pixels as a draw with the tile's viewport and scissor.
+
+// A view as the batch draw reads it: its clip transform, leaf fraction and snap (TileView's),
+// the tile's top-left pixel in the atlas, its side and the atlas's side (GpuBatchView).
+struct BatchView {
+    view_proj: mat4x4<f32>,
+    leaves: f32,
+    snap: f32,
+    side: f32,
+    atlas: f32,
+    origin: vec2<f32>,
+    _pad: vec2<f32>,
+}
+
+// Triangles `first`..`first + count` of `run`'s placement `placement`, a member's mask in view
+// `view` (GpuMaskItem).
+struct MaskItem {
+    view: u32,
+    run: u32,
+    first: u32,
+    count: u32,
+    placement: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(1) @binding(1) var<storage, read> batch_views: array<BatchView>;
+@group(1) @binding(2) var<storage, read> mask_items: array<MaskItem>;
+
+struct TiledOut {
+    @invariant @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) id: u32,
+    @location(1) @interpolate(flat) transmittance: f32,
+    @location(2) @interpolate(flat) seed: u32,
+    // The tile's pixels: x and y from (inclusive) and to (exclusive).
+    @location(3) @interpolate(flat) tile: vec4<f32>,
+}
+
+// `out` (clip x, y whole subpixels of the tile over `snap`) moved into `bv`'s tile of the atlas.
+// In subpixels from the atlas's top-left corner the tile's centre is a whole number and so is the
+// corner's offset from it, and the atlas's half side in subpixels is a power of two where the
+// atlas's side is: the sum and the division are exact, and the viewport's scale gives back the
+// whole subpixels the tile's own viewport gives (the rasterizer's snap, 8 bits, does the rest
+// where the atlas's side is not a power of two).
+fn in_tile(out: VertexOut, bv: BatchView) -> TiledOut {
+    let centre = 256.0 * (bv.origin + 0.5 * bv.side);
+    let k = round(out.position.xy * bv.snap);
+    let half = 128.0 * bv.atlas;
+    var tiled: TiledOut;
+    tiled.position = vec4<f32>((centre.x + k.x) / half - 1.0, 1.0 - (centre.y - k.y) / half, out.position.zw);
+    tiled.id = out.id;
+    tiled.transmittance = out.transmittance;
+    tiled.seed = out.seed;
+    tiled.tile = vec4<f32>(bv.origin, bv.origin + bv.side);
+    return tiled;
+}
+
+@vertex
+fn vs_batch(@builtin(vertex_index) corner: u32, @builtin(instance_index) pair: u32) -> TiledOut {
+    let p = kept[pair];
+    let bv = batch_views[p.x];
+    let cluster = clusters[p.y];
+    let k = corner / 3u;
+    if k >= cluster.count {
+        return in_tile(dropped(), bv);
+    }
+    let run = runs[cluster_runs[p.y]];
+    let local = cluster.first + k - run.first;
+    let v = pulled_corner(run, local % run.per_instance, corner % 3u);
+    return in_tile(place_pulled(run, local / run.per_instance, v, bv.view_proj, bv.snap, bv.leaves), bv);
+}
+
+@vertex
+fn vs_batch_mask(@builtin(vertex_index) corner: u32, @builtin(instance_index) i: u32) -> TiledOut {
+    let item = mask_items[i];
+    let bv = batch_views[item.view];
+    let k = corner / 3u;
+    if k >= item.count {
+        return in_tile(dropped(), bv);
+    }
+    let run = runs[item.run];
+    let v = pulled_corner(run, item.first + k, corner % 3u);
+    return in_tile(place_pulled(run, item.placement, v, bv.view_proj, bv.snap, bv.leaves), bv);
 }
 
 // PCG hash (Jarzynski & Olano 2020): well-mixed 32 bits from 32.
@@ -194,12 +305,29 @@ fn pcg(v: u32) -> u32 {
 // pipeline only green (the covering member's id).
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec2<u32> {
-    if in.transmittance > 0.0 {
-        let pixel = vec2<u32>(in.position.xy);
-        let h = pcg(pixel.x ^ pcg(pixel.y ^ pcg(in.seed)));
-        if f32(h >> 8u) * (1.0 / 16777216.0) < in.transmittance {
+    return receiver_id(in.position.xy, in.id, in.transmittance, in.seed);
+}
+
+// The batch draw's: fs_main within the fragment's tile, nothing outside it (what the tile's
+// scissor does for a draw of its own).
+@fragment
+fn fs_tiled(in: TiledOut) -> @location(0) vec2<u32> {
+    let p = in.position.xy;
+    if p.x < in.tile.x || p.y < in.tile.y || p.x >= in.tile.z || p.y >= in.tile.w {
+        discard;
+    }
+    return receiver_id(p, in.id, in.transmittance, in.seed);
+}
+
+// What a fragment at `position` of receiver `id` writes, or discarded where the see-through
+// dither lets the sun through.
+fn receiver_id(position: vec2<f32>, id: u32, transmittance: f32, seed: u32) -> vec2<u32> {
+    if transmittance > 0.0 {
+        let pixel = vec2<u32>(position);
+        let h = pcg(pixel.x ^ pcg(pixel.y ^ pcg(seed)));
+        if f32(h >> 8u) * (1.0 / 16777216.0) < transmittance {
             discard;
         }
     }
-    return vec2<u32>(in.id, in.id);
+    return vec2<u32>(id, id);
 }

@@ -162,10 +162,7 @@ fn a_view_counts_the_same_in_every_atlas_slot_so_both_cullings_agree_on_a_year()
     // tiles the CPU's skips as unshaded, so every other tile lands in another atlas slot; a
     // corner's viewport offset used to round by slot (11 of 240 rendered views changed count
     // with the tiles' order, 4 of 620 differed between the cullings).
-    let model = sunlit::bench::models::generate("blaas-louvres").unwrap();
-    let scene = sunlit::model::load_bytes(&[("louvres.glb".to_string(), model.glb.to_glb())], &Default::default()).unwrap();
-    let plan = sunlit::year::samples::SamplingPlan::new(3, 5).unwrap();
-    let requests = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    let (scene, requests) = louvres_3x5();
     let [(by_cpu, _, _), (by_gpu, _, _)] = both(&scene, &requests, 64);
     let differing: Vec<_> = (0..requests.len()).filter(|&i| by_gpu[i].fraction.to_bits() != by_cpu[i].fraction.to_bits()).collect();
     assert!(differing.is_empty(), "{} of {} views differ between the cullings: {differing:?}", differing.len(), requests.len());
@@ -179,4 +176,72 @@ fn a_view_counts_the_same_in_every_atlas_slot_so_both_cullings_agree_on_a_year()
     assert!(rendered.len() >= 200 && shaded >= 50, "{} rendered, {shaded} partly shaded", rendered.len());
     let moved = (0..rendered.len()).filter(|&i| forward[i] != backward[i]).count();
     assert_eq!(moved, 0, "views whose count changed with their atlas slot, of {}", rendered.len());
+}
+
+/// blaas-louvres and every sample view of its 3×5 year.
+fn louvres_3x5() -> (Scene, Vec<ViewRequest>) {
+    let model = sunlit::bench::models::generate("blaas-louvres").unwrap();
+    let scene = sunlit::model::load_bytes(&[("louvres.glb".to_string(), model.glb.to_glb())], &Default::default()).unwrap();
+    let plan = sunlit::year::samples::SamplingPlan::new(3, 5).unwrap();
+    let requests = sunlit::year::annual::sample_requests(&scene, &model.location, plan).unwrap();
+    (scene, requests)
+}
+
+/// `requests` counted at `side` with the GPU's culling, drawn a batch at a time (one mask draw,
+/// one scene draw) or a tile at a time, with the atlas after the last batch.
+fn by_draw(scene: &Scene, requests: &[ViewRequest], side: u32, batch_draw: bool) -> (Vec<Counted>, Vec<[u32; 2]>) {
+    let options = CounterOptions { resolution: side, gpu_cull: true, batch_draw, ..Default::default() };
+    let counter = pollster::block_on(Counter::new(options)).expect("a GPU adapter (lavapipe) — GPU tests never skip");
+    let gpu = counter.upload(scene).unwrap();
+    assert_eq!(counter.draws_by_batch_for(&gpu), batch_draw, "the path under test is the one taken");
+    let counted = pollster::block_on(counter.fractions(&gpu, requests)).unwrap();
+    let (_, atlas) = pollster::block_on(counter.read_atlas()).unwrap();
+    (counted, atlas)
+}
+
+#[test]
+fn one_draw_a_batch_counts_the_pixels_of_one_draw_a_tile() {
+    // Blocks of a static mesh and placed see-through trees at 128²: the batch draw places each
+    // corner in its tile and clips its fragments to it; a tile clip off by a pixel, or none,
+    // paints neighbours' slots and changes counts and texels.
+    for (name, at_most) in [("blaas-buildings", 40), ("blaas-trees-summer", 24)] {
+        let (scene, all) = bench_scene(name);
+        let requests = rendered_views(&scene, &all, at_most);
+        let (by_tile, tile_atlas) = by_draw(&scene, &requests, 128, false);
+        let (by_batch, batch_atlas) = by_draw(&scene, &requests, 128, true);
+        let shaded = by_tile.iter().filter(|c| c.visible > 0 && c.visible < c.covered).count();
+        assert!(requests.len() >= 10 && shaded >= 3, "{name}: {} views, {shaded} partly shaded", requests.len());
+        let differing: Vec<_> = (0..requests.len()).filter(|&i| by_batch[i] != by_tile[i]).map(|i| (i, by_tile[i], by_batch[i])).collect();
+        assert!(differing.is_empty(), "{name}: {} of {} views differ: {differing:?}", differing.len(), requests.len());
+        let texels = tile_atlas.iter().zip(&batch_atlas).filter(|(a, b)| a != b).count();
+        assert_eq!(texels, 0, "{name}: atlas texels differing");
+    }
+}
+
+#[test]
+fn one_draw_a_batch_counts_louvres_within_a_lit_pixel_of_one_draw_a_tile() {
+    // One batch of blaas-louvres' 3×5 year at 64² (620 views, tiles of several members, slats
+    // reaching far past their tile): the same covered pixels, and lit pixels within one of the
+    // per-tile draws' (about 70 of the 620 views are one apart on lavapipe; cause not isolated).
+    // A view one draw renders and the other settles unrendered as unshaded must be lit alike.
+    let (scene, requests) = louvres_3x5();
+    let (by_tile, _) = by_draw(&scene, &requests, 64, false);
+    let (by_batch, _) = by_draw(&scene, &requests, 64, true);
+    let shaded = by_tile.iter().filter(|c| c.visible > 0 && c.visible < c.covered).count();
+    assert!(shaded >= 50, "{shaded} partly shaded views");
+    let both_rendered = |i: usize| by_batch[i].side > 0 && by_tile[i].side > 0;
+    let apart: Vec<_> = (0..requests.len())
+        .filter(|&i| {
+            if both_rendered(i) {
+                by_batch[i].covered != by_tile[i].covered || by_batch[i].visible.abs_diff(by_tile[i].visible) > 1
+            } else {
+                by_batch[i].fraction != by_tile[i].fraction
+            }
+        })
+        .map(|i| (i, by_tile[i], by_batch[i]))
+        .collect();
+    assert!(apart.is_empty(), "{} of {} views more than a lit pixel apart: {apart:?}", apart.len(), requests.len());
+    let one = (0..requests.len()).filter(|&i| both_rendered(i) && by_batch[i] != by_tile[i]).count();
+    let unrendered = (0..requests.len()).filter(|&i| (by_batch[i].side > 0) != (by_tile[i].side > 0)).count();
+    println!("blaas-louvres 3x5 at 64²: {one} of {} views one lit pixel apart, {unrendered} rendered by one draw only", requests.len());
 }

@@ -65,10 +65,10 @@ pub(super) struct BenchArgs {
     #[arg(long)]
     gpu_cull: bool,
     /// Where the raster kernel's views get their casters: `cpu` (the BVH walk, one draw per
-    /// merged range) or `gpu` (the GPU's culling pass, one indirect draw a view; the CPU's where
-    /// the adapter or the scene cannot). Only with --engine gpu. The JSON line's `cull` says which
-    /// ran.
-    #[arg(long, value_name = "cpu|gpu", default_value = "cpu")]
+    /// merged range), `gpu` (the GPU's culling pass, one indirect draw a view; the CPU's where
+    /// the adapter or the scene cannot) or `gpu-batch` (the GPU's culling, one draw a batch).
+    /// Only with --engine gpu. The JSON line's `cull` says which ran.
+    #[arg(long, value_name = "cpu|gpu|gpu-batch", default_value = "cpu")]
     cull: String,
     /// Time each model's sky pass instead: every receiver's sky views over the given patch
     /// scheme (`tregenza` or `reinhart:N`), once, on the chosen engine.
@@ -168,13 +168,13 @@ fn counter_options(args: &BenchArgs) -> Result<CounterOptions> {
         other => return Err(Error::argument("--limits", format!("'{other}' is not adapter, lavapipe or webgpu"))),
     };
     let kernel = if args.engine.kind()? == EngineKind::Compute { Kernel::Compute } else { Kernel::Raster };
-    let gpu_cull = match args.cull.as_str() {
-        "cpu" => false,
-        "gpu" if kernel == Kernel::Raster => true,
-        "gpu" => return Err(Error::argument("--cull", "gpu culls for the raster kernel: use it with --engine gpu")),
-        other => return Err(Error::argument("--cull", format!("'{other}' is not cpu or gpu"))),
+    let (gpu_cull, batch_draw) = match args.cull.as_str() {
+        "cpu" => (false, false),
+        "gpu" | "gpu-batch" if kernel == Kernel::Raster => (true, args.cull == "gpu-batch"),
+        "gpu" | "gpu-batch" => return Err(Error::argument("--cull", "gpu culls for the raster kernel: use it with --engine gpu")),
+        other => return Err(Error::argument("--cull", format!("'{other}' is not cpu, gpu or gpu-batch"))),
     };
-    let options = CounterOptions { max_atlas: args.atlas, backend, limits, kernel, gpu_cull, ..args.pixels.options() };
+    let options = CounterOptions { max_atlas: args.atlas, backend, limits, kernel, gpu_cull, batch_draw, ..args.pixels.options() };
     if backend == Backend::Noop {
         if args.check > 0 {
             return Err(Error::argument("--check", "the noop backend counts nothing to check: drop --check or use --backend platform"));
@@ -230,7 +230,11 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             "triangles": scene.triangle_count(),
             "samples": format!("{days}x{per_day}"),
             "resolution": counter.resolution(),
-            "cull": if counter.culls_on_gpu_for(&gpus[0]) { "gpu" } else { "cpu" },
+            "cull": match (counter.culls_on_gpu_for(&gpus[0]), counter.draws_by_batch_for(&gpus[0])) {
+                (true, true) => "gpu-batch",
+                (true, false) => "gpu",
+                _ => "cpu",
+            },
             "accuracy": counter.options().accuracy,
             "sides": t.sides,
             "lanes": lanes.len(),

@@ -141,7 +141,8 @@ impl GpuClusters {
         let rows = buffer(d, "cull views", views as u64 * size_of::<GpuClipRows>() as u64, storage | copy_dst);
         let params = buffer(d, "cull params", size_of::<CullParams>() as u64, wgpu::BufferUsages::UNIFORM | copy_dst);
         let pairs = buffer(d, "culled pairs per view", capacity as u64 * 8, storage);
-        let args = buffer(d, "cull needed", ARGS_BYTES, storage | wgpu::BufferUsages::COPY_SRC);
+        // The batch draw's indirect draw and the pairs needed.
+        let args = buffer(d, "cull needed", ARGS_BYTES, storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::INDIRECT);
         let kept = buffer(d, "kept per view", views as u64 * 4, storage);
         let heads = buffer(d, "view heads", views as u64 * 4, storage);
         let draws = buffer(d, "view draws", views as u64 * 16, storage | wgpu::BufferUsages::INDIRECT);

@@ -188,6 +188,9 @@ impl Counter {
             ..Default::default()
         });
         pass.set_bind_group(0, &scene.render_bind, &[]);
+        if batch.iter().all(|t| t.draws.is_none()) && self.draw_batch(&mut pass, scene, requests, batch, side) {
+            return;
+        }
         for (slot, tile) in batch.iter().enumerate() {
             let [x, y] = tile_origin(self.atlas_side, slot, side);
             pass.set_viewport(x as f32, y as f32, side as f32, side as f32, 0.0, 1.0);

@@ -38,12 +38,14 @@
 //!   pairs and indirect draws;
 //! - `pulled`: counting from that culling ([`CounterOptions::gpu_cull`]): one indirect draw a
 //!   tile whose vertices pull the kept clusters' corners from storage;
+//! - `batched`: drawing a GPU-culled batch with one draw, tiles placed by the vertex shader;
 //! - [`shade`]: the culling's shading test on the GPU (does anything a view draws shade its
 //!   receiver?), exact where f32 can decide, the CPU's test where it cannot.
 //!
 //! Test hooks (reading the atlas, forcing a device loss, …) are compiled only with the
 //! `test-hooks` feature, which the crate's own tests enable.
 
+mod batched;
 pub mod cluster_cull;
 pub mod compute;
 mod device;
@@ -166,6 +168,11 @@ pub struct CounterOptions {
     /// only fits views. Off by default: on lavapipe its brute-force pass costs more than the
     /// CPU's walk, and on real GPUs it is not measured yet.
     pub gpu_cull: bool,
+    /// With `gpu_cull`: draw each batch with one draw (instances are the culling's (view,
+    /// cluster) pairs, each placed in its tile by the vertex shader, [`batched`]) rather than
+    /// one draw a tile. Off by default: on lavapipe its counts equal the per-tile draws' on the
+    /// bench models but for one pixel on some louvre views (see `batched`).
+    pub batch_draw: bool,
 }
 
 impl Default for CounterOptions {
@@ -178,6 +185,7 @@ impl Default for CounterOptions {
             limits: LimitsProfile::Adapter,
             kernel: Kernel::Raster,
             gpu_cull: false,
+            batch_draw: false,
         }
     }
 }
@@ -377,7 +385,7 @@ impl Counter {
         let batch = BatchBuffers::new(&device, &pipelines, atlas_side, smallest);
         let compute = compute::ComputeState::new(&device, options.kernel);
         let culls_on_gpu = options.gpu_cull && options.kernel == Kernel::Raster;
-        let pulled = culls_on_gpu.then(|| pulled::PulledPipelines::new(&device, &pipelines, downlevel)).flatten();
+        let pulled = culls_on_gpu.then(|| pulled::PulledPipelines::new(&device, &pipelines, downlevel, options.batch_draw)).flatten();
         let counter = Self {
             device,
             queue,

@@ -186,13 +186,51 @@ pub(super) fn pulled_scene_pipeline(
     view_pipeline(device, &module, &pipeline_layout, entry, true, wgpu::CompareFunction::Less, wgpu::ColorWrites::RED)
 }
 
+/// A pipeline of the batch draw ([`super::batched`]): `vertex` with groups 1 and 2 of `layouts`,
+/// the scene's depth state and channel where `scene`, else the mask's; fragments clipped to their
+/// tile by `fs_tiled`.
+pub(super) fn batch_view_pipeline(
+    device: &wgpu::Device,
+    pipelines: &Pipelines,
+    layouts: [&wgpu::BindGroupLayout; 2],
+    vertex: &str,
+    scene: bool,
+) -> wgpu::RenderPipeline {
+    let module = sun_view_module(device);
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(vertex),
+        bind_group_layouts: &[Some(&pipelines.render_layout), Some(layouts[0]), Some(layouts[1])],
+        immediate_size: 0,
+    });
+    let (compare, channels) = if scene {
+        (wgpu::CompareFunction::Less, wgpu::ColorWrites::RED)
+    } else {
+        (wgpu::CompareFunction::Always, wgpu::ColorWrites::GREEN)
+    };
+    let entry = ((vertex, vertex, &[][..]), "fs_tiled");
+    tiled_view_pipeline(device, &module, &pipeline_layout, entry, scene, compare, channels)
+}
+
 /// A sun-view pipeline: `(label, vertex entry point, vertex buffers)`, its depth state and the
 /// channel it writes.
 fn view_pipeline(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
     pipeline_layout: &wgpu::PipelineLayout,
-    (label, vertex, buffers): (&str, &str, &[Option<wgpu::VertexBufferLayout<'_>>]),
+    entry: (&str, &str, &[Option<wgpu::VertexBufferLayout<'_>>]),
+    depth_write: bool,
+    compare: wgpu::CompareFunction,
+    channels: wgpu::ColorWrites,
+) -> wgpu::RenderPipeline {
+    tiled_view_pipeline(device, module, pipeline_layout, (entry, "fs_main"), depth_write, compare, channels)
+}
+
+/// [`view_pipeline`] with the fragment entry point named.
+fn tiled_view_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    pipeline_layout: &wgpu::PipelineLayout,
+    ((label, vertex, buffers), fragment): ((&str, &str, &[Option<wgpu::VertexBufferLayout<'_>>]), &str),
     depth_write: bool,
     compare: wgpu::CompareFunction,
     channels: wgpu::ColorWrites,
@@ -212,7 +250,7 @@ fn view_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(fragment),
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState { format: ID_FORMAT, blend: None, write_mask: channels })],
         }),

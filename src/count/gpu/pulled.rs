@@ -6,10 +6,9 @@
 //! host records per tile is its viewport, its members' masks and one indirect draw from a
 //! single buffer, instead of a BVH walk and a draw per merged range.
 //!
-//! Why not one multi-draw over the whole batch: each tile is placed in the atlas by its
-//! viewport, as the CPU-culled draws are. Corners are snapped to whole subpixels of the tile
-//! (`shade` in sun_view.wgsl), so placing tiles in the vertex shader by whole pixels would now
-//! round nothing either; that draw is not built yet.
+//! With [`super::CounterOptions::batch_draw`] (the default) a batch is drawn by one draw
+//! instead ([`super::batched`]), each tile placed in the atlas by the vertex shader; the per-tile
+//! draws here remain for batches that form does not take.
 //!
 //! Where it is not used (the reason logged once, the CPU's culling counting instead): an adapter
 //! without indirect draws or storage buffers in vertex shaders, fewer than 8 storage buffers a
@@ -17,6 +16,7 @@
 //! overflows is counted again with the CPU's culling ([`Counter::count_tiles`]): never
 //! truncated.
 
+use super::batched::{BatchPipelines, BatchScene, PulledBuffers, RunPlacements};
 use super::cluster_cull::GpuClusters;
 use super::pipelines::{GpuVertex, Pipelines, buffer, entry, pulled_scene_pipeline, storage_entry};
 use super::plan::{SceneLayout, Tile, shade_test};
@@ -53,11 +53,13 @@ pub(super) struct PulledPipelines {
     layout: wgpu::BindGroupLayout,
     pub(super) scene: wgpu::RenderPipeline,
     shade: ShadePass,
+    /// The batch draw's (`None` without [`super::CounterOptions::batch_draw`]).
+    pub(super) batch: Option<BatchPipelines>,
 }
 
 impl PulledPipelines {
     /// `None`, the reason logged, where the adapter lacks what the pulled draw needs.
-    pub(super) fn new(device: &wgpu::Device, pipelines: &Pipelines, downlevel: wgpu::DownlevelFlags) -> Option<Self> {
+    pub(super) fn new(device: &wgpu::Device, pipelines: &Pipelines, downlevel: wgpu::DownlevelFlags, batch_draw: bool) -> Option<Self> {
         let stage_buffers = device.limits().max_storage_buffers_per_shader_stage;
         let missing = if !downlevel.contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION) {
             Some("indirect draws".to_string())
@@ -76,7 +78,8 @@ impl PulledPipelines {
         let entries: Vec<_> = (0..7).map(|b| storage_entry(b, vs, true)).collect();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("pulled"), entries: &entries });
         let scene = pulled_scene_pipeline(device, pipelines, &layout);
-        Some(Self { layout, scene, shade: ShadePass::new(device) })
+        let batch = batch_draw.then(|| BatchPipelines::new(device, pipelines));
+        Some(Self { layout, scene, shade: ShadePass::new(device), batch })
     }
 }
 
@@ -95,6 +98,8 @@ pub(super) struct PulledScene {
     pub(super) tiles: usize,
     /// The shading test's buffers (`None` where the corners do not fit: the CPU tests).
     pub(super) shade: Option<ShadeScene>,
+    /// The batch draw's state (`None` where this counter draws a tile at a time).
+    pub(super) batched: Option<BatchScene>,
 }
 
 impl Counter {
@@ -104,7 +109,7 @@ impl Counter {
     pub(super) fn upload_pulled(&self, scene: &Scene, layout: &SceneLayout, pairs: Option<u32>) -> Option<PulledScene> {
         let pipelines = self.pulled.as_ref()?;
         let d = &self.device;
-        let (vertices, indices, runs) = pulled_geometry(scene, layout);
+        let (vertices, indices, runs, run_meshes) = pulled_geometry(scene, layout);
         let limits = d.limits();
         let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         let need = (vertices.len() * size_of::<GpuVertex>()).max(indices.len() * 4) as u64;
@@ -146,8 +151,18 @@ impl Counter {
         let answers = buffer(d, "culling answers", answer_bytes, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         let shade = ShadeScene::new(d, &pipelines.shade, &layout.culling, tiles as u32);
         let tested = if shade.is_some() { "on the GPU" } else { "on the CPU" };
-        log::info!("culling on the GPU: {} clusters, {capacity} pairs a batch; shading test {tested}", clusters.len());
-        Some(PulledScene { clusters: clusters_on_device, bind, batch, answers, tiles: tiles as usize, shade })
+        let corners = PulledBuffers {
+            pairs: &batch.pairs,
+            clusters: clusters_on_device.buffer(),
+            cluster_runs: &cluster_runs_buffer,
+            runs: &runs_buffer,
+            vertices: &vertex_buffer,
+            indices: &index_buffer,
+        };
+        let batched = self.upload_batched(&layout.receivers, &run_meshes, corners);
+        let drawn = if batched.is_some() { "one draw a batch" } else { "one draw a tile" };
+        log::info!("culling on the GPU: {} clusters, {capacity} pairs a batch; shading test {tested}; {drawn}", clusters.len());
+        Some(PulledScene { clusters: clusters_on_device, bind, batch, answers, tiles: tiles as usize, shade, batched })
     }
 
     /// Whether `tiles` are counted with the GPU's culling: this counter and scene have it, and
@@ -196,9 +211,9 @@ impl Counter {
 /// Every run's corners as `vs_pulled` reads them: the vertices and indices of the static mesh
 /// (its triangles in the culling's order, indexed into their distinct vertices, as the static
 /// chunks hold them) and of each shared mesh (as its vertex and index buffers hold them), and the
-/// runs pointing into them.
-fn pulled_geometry(scene: &Scene, layout: &SceneLayout) -> (Vec<GpuVertex>, Vec<u32>, Vec<GpuRun>) {
-    let (mut vertices, mut indices, mut runs) = (Vec::new(), Vec::new(), Vec::new());
+/// runs pointing into them, with each run's mesh and placements' slots.
+fn pulled_geometry(scene: &Scene, layout: &SceneLayout) -> (Vec<GpuVertex>, Vec<u32>, Vec<GpuRun>, Vec<RunPlacements>) {
+    let (mut vertices, mut indices, mut runs, mut run_meshes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for run in layout.culling.runs() {
         let TriangleRun { mesh, first, per_instance, ref slots } = run;
         let Some(m) = scene.meshes.get(mesh) else { continue };
@@ -215,6 +230,7 @@ fn pulled_geometry(scene: &Scene, layout: &SceneLayout) -> (Vec<GpuVertex>, Vec<
         }
         let placed = (mesh != 0) as u32;
         runs.push(GpuRun { first, per_instance, first_slot: slots.start, index_base, vertex_base, placed, _pad: [0; 2] });
+        run_meshes.push((mesh, slots.clone()));
     }
-    (vertices, indices, runs)
+    (vertices, indices, runs, run_meshes)
 }
