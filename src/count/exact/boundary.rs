@@ -25,7 +25,13 @@
 //! them when there are few, a grid of square buckets about a typical polygon wide when there are
 //! many, as leaves give; square whatever the window's shape, since a façade's window may be 10:1;
 //! a polygon over many buckets, a wall's shadow, in coarse buckets of 4 × 4 of them),
-//! so a view with `n` shadows of bounded overlap costs about `n` times their edges. A cover that
+//! so a view with `n` shadows of bounded overlap costs about `n` times their edges. A bucket's
+//! polygons are copied into it (box and vertices) in the order of their boxes' left sides, so a
+//! search stops at the first that starts right of its box, and a pair sharing several buckets is
+//! met in one (the one holding their boxes' common lower corner) without marks. An edge stops
+//! being integrated once covers that leave no region beside it (a shadow on both sides, or on
+//! the outer side of a shadow's edge, or an earlier polygon's edge on its line) hold every one of
+//! 64 slots of it: its pieces would all be 0 (under a canopy, the edges inside the union). A cover that
 //! runs from an edge's start or to its end moves the counters without an event (a leaf's edges
 //! lie across a receiver triangle end to end), so most edges sort only their leaf neighbours'
 //! crossings. A polygon inside one shadow (most leaves of a crowded canopy) is dropped first: it
@@ -160,9 +166,8 @@ pub(super) struct Boundary {
     /// Buckets: per cell its range of `cell_items` (prefix sums), the polygons in each cell.
     cell_start: Vec<u32>,
     cell_items: Vec<u32>,
-    /// Per polygon: the edge that last tested it (so a polygon in several cells is tested once).
-    stamp: Vec<u32>,
-    epoch: u32,
+    /// The same polygons' boxes and vertices (what each polygon's search for candidates reads).
+    cell_near: Vec<Near>,
     /// Candidates of the current polygon (the others whose boxes overlap its box), their boxes
     /// copied beside their index so each edge's scan reads one contiguous array.
     candidates: Vec<Near>,
@@ -274,9 +279,6 @@ impl Boundary {
         let receivers = self.polys.iter().filter(|p| p.receiver).fold(([i64::MAX; 2], [i64::MIN; 2]), |(lo, hi), p| {
             ([lo[0].min(p.lo[0]), lo[1].min(p.lo[1])], [hi[0].max(p.hi[0]), hi[1].max(p.hi[1])])
         });
-        if self.stamp.len() < self.polys.len() {
-            self.stamp.resize(self.polys.len(), 0);
-        }
         let mut total = 0.0;
         for p in 0..self.polys.len() {
             let poly = self.polys[p];
@@ -306,6 +308,10 @@ impl Boundary {
         let mut count = [0i32; 8];
         count[if own.receiver { 0 } else { 2 }] = 1;
         let (events, points) = (&mut self.events, &self.points);
+        // The counters that leave no region beside the edge: a shadow on its outer side for a
+        // shadow's edge, on both sides for a receiver's.
+        let zeroing = if own.receiver { SHADOW_LEFT | SHADOW_RIGHT } else { SHADOW_RIGHT };
+        let mut shaded = 0u64;
         for near in &self.candidates {
             if !boxes_overlap(lo, hi, near.lo, near.hi) {
                 continue;
@@ -319,14 +325,14 @@ impl Boundary {
             };
             if side != Side::Both && (near.poly as usize) < p {
                 counters |= EARLIER_EDGE;
-                if t0 <= 0.0 && t1 >= 1.0 {
+            }
+            // Where this cover holds, every piece is 0: once such covers hold all of the edge,
+            // so is its integral, whatever the rest add.
+            if counters & EARLIER_EDGE != 0 || counters & zeroing == zeroing {
+                shaded |= slots_within(t0, t1);
+                if shaded == u64::MAX {
                     return 0.0;
                 }
-            }
-            // A shadow over the whole edge on the side the region could lie (both sides for a
-            // receiver's edge, the outer side for a shadow's): nothing of it bounds the region.
-            if !near.receiver && t0 <= 0.0 && t1 >= 1.0 && (side == Side::Both || (side == Side::Right && !own.receiver)) {
-                return 0.0;
             }
             // Ends at the edge's ends move the counters before or after every piece, so they
             // need no events (most leaves' edges lie across a receiver triangle, end to end).
@@ -421,7 +427,7 @@ impl Boundary {
         // coarse cell (a container of a big polygon spans at least as many cells, so is big too).
         let [cx, cy, _, _] = self.spans[p];
         let cell = cy * b.n[0] + cx;
-        let bucketed = &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
+        let bucketed = &self.cell_near[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
         let coarse = (cy / COARSE) * b.coarse_columns() + cx / COARSE;
         let big = &self.big_items[self.big_start[coarse] as usize..self.big_start[coarse + 1] as usize];
         // The boxes first, here: most candidates fail them, and that test is cheaper inline.
@@ -429,7 +435,12 @@ impl Boundary {
         // Receivers (big, around most boxes) never contain: skipped before the call.
         let boxed = |q: usize| !self.polys[q].receiver && box_within(lo, hi, self.polys[q].lo, self.polys[q].hi);
         let found = |list: &[u32]| list.iter().map(|&q| q as usize).find(|&q| boxed(q) && self.covers(q, p));
-        found(big).or_else(|| found(bucketed))
+        // A cell's polygons go by their boxes' left sides: past `lo`'s, none holds it.
+        let in_cell = || {
+            let holding = bucketed.iter().take_while(|n| n.lo[0] <= lo[0]);
+            holding.filter(|n| !n.receiver && box_within(lo, hi, n.lo, n.hi)).map(|n| n.poly as usize).find(|&q| self.covers(q, p))
+        };
+        found(big).or_else(in_cell)
     }
 
     /// Polygons other than `own` whose boxes overlap `[lo, hi]` into `self.candidates`.
@@ -441,23 +452,21 @@ impl Boundary {
             self.candidates.extend(hits.map(|(i, q)| Near::of(i, q)));
             return;
         }
-        self.epoch = self.epoch.wrapping_add(1);
-        if self.epoch == 0 {
-            self.stamp.fill(0);
-            self.epoch = 1;
-        }
         let [x0, y0, x1, y1] = self.spans[own];
         self.collect_big(own, lo, hi);
+        // A polygon sharing several buckets with `own` is taken in one: the bucket holding the
+        // two boxes' common lower corner (as in `collect_big`).
         for cy in y0..=y1 {
             for cx in x0..=x1 {
                 let cell = cy * b.n[0] + cx;
-                for k in self.cell_start[cell]..self.cell_start[cell + 1] {
-                    let q = self.cell_items[k as usize];
-                    if self.stamp[q as usize] != self.epoch {
-                        self.stamp[q as usize] = self.epoch;
-                        let poly = &self.polys[q as usize];
-                        if q as usize != own && boxes_overlap(lo, hi, poly.lo, poly.hi) {
-                            self.candidates.push(Near::of(q as usize, poly));
+                for near in &self.cell_near[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize] {
+                    if near.lo[0] > hi[0] {
+                        break;
+                    }
+                    if boxes_overlap(lo, hi, near.lo, near.hi) && near.poly as usize != own {
+                        let [qx, qy, _, _] = self.spans[near.poly as usize];
+                        if cx == x0.max(qx) && cy == y0.max(qy) {
+                            self.candidates.push(*near);
                         }
                     }
                 }
@@ -511,6 +520,12 @@ impl Boundary {
         let spans = &self.spans;
         let small = || spans.iter().enumerate().filter(|(_, s)| !is_big(s)).map(|(i, &s)| (i as u32, s));
         fill_cells(buckets.n[0], cells, small, &mut self.cell_start, &mut self.cell_items, &mut self.next_slot);
+        self.cell_near.clear();
+        let polys = &self.polys;
+        self.cell_near.extend(self.cell_items.iter().map(|&q| Near::of(q as usize, &polys[q as usize])));
+        for c in 0..cells {
+            self.cell_near[self.cell_start[c] as usize..self.cell_start[c + 1] as usize].sort_unstable_by_key(|n| n.lo[0]);
+        }
         // The big ones in coarse buckets of COARSE × COARSE buckets.
         let columns = buckets.coarse_columns();
         let coarse_cells = columns * buckets.n[1].div_ceil(COARSE);
@@ -613,6 +628,18 @@ fn convex_contains(outer: &[Point], inner: &[Point]) -> bool {
         let q0 = std::mem::replace(&mut before, q1);
         inner.iter().all(|&v| orient(q0, q1, v) >= 0)
     })
+}
+
+/// The slots `[k/64, (k+1)/64]` of an edge's parameter that lie within `[t0, t1]`, as bits.
+fn slots_within(t0: f64, t1: f64) -> u64 {
+    // Truncation is the floor here (both are ≥ 0); the first whole slot starts at the ceiling.
+    let (from, end) = (t0 * 64.0, (t1 * 64.0) as u32);
+    let first = from as u32 + u32::from(f64::from(from as u32) < from);
+    if first >= end {
+        return 0;
+    }
+    let below_end = if end >= 64 { u64::MAX } else { (1u64 << end) - 1 };
+    below_end & !((1u64 << first) - 1)
 }
 
 fn boxes_overlap(lo: Point, hi: Point, lo2: Point, hi2: Point) -> bool {

@@ -282,3 +282,32 @@ fn many_shadows_use_buckets_and_agree() {
     }
     assert!(b.len() > SCAN_ALL);
 }
+
+#[test]
+fn a_dense_canopy_off_the_lattice_agrees() {
+    // Leaves anywhere (not on a lattice), several deep over most of the wall: most edges lie
+    // inside the union, covered by several leaves together and by none alone, where an edge
+    // stops being integrated once its covers hold all of it; the rest bound small gaps. Against
+    // the reference, which has no such shortcut.
+    let mut rng = Rng(0x5eed_1eaf);
+    for case in 0..4 {
+        let mut shadows: Vec<Vec<DVec2>> = Vec::new();
+        for _ in 0..150 + 60 * case {
+            let c = DVec2::new(rng.unit() * 4.6 - 0.3, rng.unit() * 3.6 - 0.3);
+            let r = 0.15 + 0.35 * rng.unit();
+            let turn = rng.unit() * std::f64::consts::TAU;
+            let corners = 3 + rng.below(3) as usize;
+            shadows.push(
+                (0..corners)
+                    .map(|k| {
+                        let a = turn + std::f64::consts::TAU * k as f64 / corners as f64;
+                        c + r * DVec2::new(a.cos(), a.sin())
+                    })
+                    .collect(),
+            );
+        }
+        let receiver = if case % 2 == 0 { wall() } else { holed_wall() };
+        let got = assert_agrees(&receiver, &shadows, &format!("canopy case {case}"));
+        assert!(got > 0.0 && got < 0.5, "case {case}: {got}");
+    }
+}
