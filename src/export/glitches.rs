@@ -162,7 +162,7 @@ fn imported_ignored(ep: &EnergyPlusInput, hook: Hook) -> Option<KnownGlitch> {
     }
     let (applies, sunlit) = match hook {
         Hook::Imported => (
-            "--hook imported was asked for".to_string(),
+            "the Imported hook was asked for".to_string(),
             "wrote the Imported form as asked: EnergyPlus 25.2 will run as if every surface were unshaded; use the \
              default Scheduled form"
                 .to_string(),
