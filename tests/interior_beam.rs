@@ -435,7 +435,7 @@ fn an_unread_window_takes_the_glass_curve_in_the_interior_beam() {
     let pairs = [(0.0, 0.8), (30.0, 0.78), (50.0, 0.72), (70.0, 0.5)];
     let (flat, flat_csv, _) = run("flat", &["--glass-transmittance", "0.8"]);
     assert!(flat.status.success(), "{}", String::from_utf8_lossy(&flat.stderr));
-    let (curved, curved_csv, _) = run("curved", &["--glass-transmittance", "0.8"]);
+    let (curved, curved_csv, _) = run("curved", &["--glass-curve", "0:0.8,30:0.78,50:0.72,70:0.5"]);
     assert!(curved.status.success(), "{}", String::from_utf8_lossy(&curved.stderr));
     let (flat_csv, curved_csv) = (flat_csv.unwrap(), curved_csv.unwrap());
     assert_eq!(flat_csv.lines().next(), curved_csv.lines().next(), "the same faces");

@@ -371,6 +371,16 @@ export class ClipPool {
     job.done?.();
     if (error) job.reject(error);
     else job.resolve(job.out);
+    // With nothing queued this thread's task queue is closed (the next chunk opens a new one):
+    // an open port keeps Node's event loop alive, and a pool whose workers could not start is
+    // dropped by the engine without `terminate`, so the Node/Dawn test hung after its year.
+    if (this.#queue.length === 0) this.#closeTick();
+  }
+
+  #closeTick() {
+    this.#tick?.port1.close();
+    this.#tick = null;
+    this.#localPending = false;
   }
 
   /** The workers could not start (`error`): they are stopped; jobs this thread clips go on, the
@@ -389,9 +399,7 @@ export class ClipPool {
   /** Stops every worker (their memory is freed). */
   terminate() {
     for (const worker of this.#spawned) worker.terminate();
-    this.#tick?.port1.close();
-    this.#tick = null;
-    this.#localPending = false;
+    this.#closeTick();
     this.#spawned = [];
     this.#workers = [];
     this.#source = null;
