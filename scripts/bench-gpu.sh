@@ -56,6 +56,12 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # beside it (same binary, --cull cpu), blaas-trees-summer's every view both ways, and the host's
 # cost of each on noop. Each JSON line's `cull` says which path ran, and `shading_tested_on_cpu`
 # how many views the GPU's shading test (shaders/may_shade.wgsl) left to the host.
+# The cheapest host form first (--cull gpu-batch: the GPU's culling drawn with one draw a batch,
+# src/count/gpu/batched.rs; the least host time a view on noop, docs/benchmarks-gpu.md), with its
+# answers checked, and its host cost on noop; then the per-tile form and the CPU's culling.
+run nyt-blocks-cull-gpu-batch 90 bench nyt-blocks --engine gpu --cull gpu-batch --views "${VIEWS:-20040}" --check 10 "${gpu_flags[@]}"
+run blaas-trees-summer-cull-gpu-batch 40 bench blaas-trees-summer --engine gpu --cull gpu-batch --check 20 "${views[@]}" "${gpu_flags[@]}"
+run nyt-blocks-noop-cull-gpu-batch 60 bench nyt-blocks --engine gpu --backend noop --cull gpu-batch --lanes 1 --views "${VIEWS:-20040}"
 run nyt-blocks-cull-gpu 90 bench nyt-blocks --engine gpu --cull gpu --views "${VIEWS:-20040}" --check 10 "${gpu_flags[@]}"
 run nyt-blocks-cull-cpu 90 bench nyt-blocks --engine gpu --cull cpu --views "${VIEWS:-20040}" "${gpu_flags[@]}"
 run blaas-trees-summer-cull-gpu 40 bench blaas-trees-summer --engine gpu --cull gpu --check 20 "${views[@]}" "${gpu_flags[@]}"

@@ -245,3 +245,29 @@ fn one_draw_a_batch_counts_louvres_within_a_lit_pixel_of_one_draw_a_tile() {
     let unrendered = (0..requests.len()).filter(|&i| (by_batch[i].side > 0) != (by_tile[i].side > 0)).count();
     println!("blaas-louvres 3x5 at 64²: {one} of {} views one lit pixel apart, {unrendered} rendered by one draw only", requests.len());
 }
+
+#[test]
+fn a_view_fitted_to_a_receivers_distinct_corners_is_the_view_of_all_its_corners() {
+    // Planning fits each tile's view from its receivers' bitwise-distinct corners (a triangulated
+    // polygon repeats each corner in several triangles), a third to two thirds fewer: the view
+    // must be bit for bit the one the corners with their repeats give, or the counts change.
+    let bits = |v: &sunlit::count::view::SunView| (v.view_proj.to_cols_array().map(f64::to_bits), v.pixel_area.to_bits());
+    for name in ["blaas-louvres", "blaas-buildings"] {
+        let (scene, all) = bench_scene(name);
+        let mut repeats = 0;
+        for req in sunlit::bench::spread(&all, 400) {
+            let corners: Vec<glam::DVec3> = scene.receivers[req.receiver as usize].triangles.iter().flatten().copied().collect();
+            let mut distinct: Vec<glam::DVec3> = Vec::new();
+            for p in &corners {
+                if !distinct.iter().any(|q| q.to_array().map(f64::to_bits) == p.to_array().map(f64::to_bits)) {
+                    distinct.push(*p);
+                }
+            }
+            repeats += corners.len() - distinct.len();
+            let all_corners = sunlit::count::view::fit(&corners, req.sun, scene.bounds, scene.origin, 512);
+            let distinct_corners = sunlit::count::view::fit(&distinct, req.sun, scene.bounds, scene.origin, 512);
+            assert_eq!(bits(&all_corners), bits(&distinct_corners), "{name}: receiver {} at sun {:?}", req.receiver, req.sun);
+        }
+        assert!(repeats > 0, "{name}: its receivers repeat corners");
+    }
+}

@@ -174,6 +174,10 @@ pub struct ViewTiming {
     pub rendered: usize,
     /// Views answered without a render (sun behind the surface, or nothing in front of it).
     pub skipped: usize,
+    /// Views in the tiles the GPU drew: `rendered` and those the GPU's culling then settled as
+    /// unshaded (on the noop backend, whose verdicts read as zeros, every drawn view; there
+    /// `seconds / drawn` is the host's cost a view).
+    pub drawn: u64,
     /// Seconds for the timed views (after a warm-up batch, not counted).
     pub seconds: f64,
     /// Views timed per second (rendered or not).
@@ -272,10 +276,13 @@ pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: im
     let start = now();
     let rendered_so_far = || lanes.iter().fold((0, 0), |(t, n), l| (t + l.counter.rendered().0, n + l.counter.rendered().1));
     let before = rendered_so_far();
+    let drawn_so_far = || lanes.iter().map(|l| l.counter.views_drawn()).sum::<u64>();
+    let drawn_before = drawn_so_far();
     let stages_before = lanes_host_stages(lanes);
     let counted = fractions_side_by_side(lanes, requests).await?;
     let seconds = now() - start;
     let after = rendered_so_far();
+    let views_drawn = drawn_so_far() - drawn_before;
     let stages_after = lanes_host_stages(lanes);
     let host_stages = stages_after - stages_before;
     let (tiles, triangles) = (after.0 - before.0, after.1 - before.1);
@@ -287,6 +294,7 @@ pub async fn time_requests(lanes: &[Lane<'_>], requests: &[ViewRequest], now: im
         views: requests.len(),
         rendered,
         skipped: requests.len() - rendered,
+        drawn: views_drawn,
         seconds,
         views_per_second: requests.len() as f64 / seconds.max(1e-9),
         planning_seconds,

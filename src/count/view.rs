@@ -30,8 +30,9 @@ pub struct SunView {
 /// coordinates; `sun` points towards the sun (unit); `resolution` is the tile size in pixels.
 pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, resolution: u32) -> SunView {
     let (u0, v0) = perpendicular_basis(sun);
-    let rel: Vec<DVec3> = points.iter().map(|p| *p - origin).collect();
-    let flat: Vec<DVec2> = rel.iter().map(|p| DVec2::new(p.dot(u0), p.dot(v0))).collect();
+    // One buffer a view, not three: this runs once a tile, and on the GPU's culling it is most of
+    // the host's work a view.
+    let flat: Vec<DVec2> = points.iter().map(|p| *p - origin).map(|p| DVec2::new(p.dot(u0), p.dot(v0))).collect();
     let (angle, lo, hi) = min_area_rectangle(&flat);
     let (c, s) = (angle.cos(), angle.sin());
     let u = u0 * c + v0 * s;
@@ -52,7 +53,7 @@ pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, 
     let row_y = ((a.0 * gs + b.0 * gc) * k).extend((a.1 * gs + b.1 * gc) * k);
 
     let near = corners(bounds).iter().map(|p| (*p - origin).dot(sun)).fold(f64::NEG_INFINITY, f64::max);
-    let far = rel.iter().map(|p| p.dot(sun)).fold(f64::INFINITY, f64::min);
+    let far = points.iter().map(|p| (*p - origin).dot(sun)).fold(f64::INFINITY, f64::min);
     // Pads keep the scene's nearest point and the receiver's farthest point strictly inside [0, 1].
     let pad = extent * 1e-4;
     let (near, far) = (near + pad, far - pad);
@@ -82,14 +83,9 @@ fn corners((lo, hi): (DVec3, DVec3)) -> [DVec3; 8] {
 fn min_area_rectangle(points: &[DVec2]) -> (f64, DVec2, DVec2) {
     let hull = convex_hull(points);
     let mut best = (f64::INFINITY, 0.0, DVec2::ZERO, DVec2::ZERO);
-    let mut candidates: Vec<f64> = vec![0.0];
-    for i in 0..hull.len() {
-        let e = hull[(i + 1) % hull.len()] - hull[i];
-        if e.length_squared() > 0.0 {
-            candidates.push(e.y.atan2(e.x));
-        }
-    }
-    for angle in candidates {
+    // The axis-aligned frame first, then each hull edge's.
+    let edges = (0..hull.len()).map(|i| hull[(i + 1) % hull.len()] - hull[i]).filter(|e| e.length_squared() > 0.0);
+    for angle in std::iter::once(0.0).chain(edges.map(|e| e.y.atan2(e.x))) {
         let (lo, hi) = rotated_extents(points, angle);
         let area = (hi.x - lo.x) * (hi.y - lo.y);
         // Prefer strictly smaller areas so near-ties keep the first (axis-aligned) frame.
@@ -122,17 +118,19 @@ pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
     }
     let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
     let mut hull: Vec<DVec2> = Vec::with_capacity(2 * p.len());
-    for pass in 0..2 {
+    // The lower chain left to right, then the upper right to left.
+    let chain = |hull: &mut Vec<DVec2>, points: &mut dyn Iterator<Item = &DVec2>| {
         let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 { Box::new(p.iter()) } else { Box::new(p.iter().rev()) };
-        for &q in iter {
+        for &q in points {
             while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
                 hull.pop();
             }
             hull.push(q);
         }
         hull.pop();
-    }
+    };
+    chain(&mut hull, &mut p.iter());
+    chain(&mut hull, &mut p.iter().rev());
     hull
 }
 

@@ -337,6 +337,8 @@ pub struct Counter {
     /// Tiles rendered and triangles drawn in them since the counter was made (benchmarks).
     tiles_rendered: AtomicU64,
     triangles_drawn: AtomicU64,
+    /// Views in the tiles rendered (before the GPU's culling settles unshaded ones as unrendered).
+    views_drawn: AtomicU64,
     /// GPU-culled tiles whose shading test the host ran (the GPU could not decide, or has no
     /// test for the scene).
     shading_on_cpu: AtomicU64,
@@ -396,6 +398,7 @@ impl Counter {
             batch,
             tiles_rendered: AtomicU64::new(0),
             triangles_drawn: AtomicU64::new(0),
+            views_drawn: AtomicU64::new(0),
             shading_on_cpu: AtomicU64::new(0),
             stages: StageClock::default(),
             faults,
@@ -440,6 +443,13 @@ impl Counter {
     /// view group), and the triangles drawn in them by the scene pass.
     pub fn rendered(&self) -> (u64, u64) {
         (self.tiles_rendered.load(Ordering::Relaxed), self.triangles_drawn.load(Ordering::Relaxed))
+    }
+
+    /// Views drawn since this counter was made: the requests of the tiles rendered, counted
+    /// when their tile is, so also those the GPU's culling then settles as unshaded without
+    /// their count (on the noop backend, whose verdicts read back as "nothing can shade", all).
+    pub fn views_drawn(&self) -> u64 {
+        self.views_drawn.load(Ordering::Relaxed)
     }
 
     /// Host time spent by stage since this counter was made (native builds; zeros on the web).

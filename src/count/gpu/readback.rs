@@ -191,6 +191,7 @@ impl Counter {
         // The GPU's culling's draws are not read back: their triangles are not counted.
         let drawn: usize = chunk.iter().filter_map(|t| t.draws.as_ref()).map(|d| d.triangles(&scene.layout.culling)).sum();
         self.tiles_rendered.fetch_add(chunk.len() as u64, Ordering::Relaxed);
+        self.views_drawn.fetch_add(chunk.iter().map(|t| t.requests.len() as u64).sum(), Ordering::Relaxed);
         self.triangles_drawn.fetch_add(drawn as u64, Ordering::Relaxed);
     }
 }
