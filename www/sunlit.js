@@ -6,7 +6,7 @@
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
 import { ClipPool, DEFAULT_MEMORY_BUDGET, defaultWorkers, wasmModule } from './pool.js';
-import { cachedProfile, storeProfile } from './profiles.js';
+import { cachedProfile, storeProfile, warmProfiles } from './profiles.js';
 
 let wasmReady;
 
@@ -76,6 +76,9 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
   const started = performance.now();
   const since = () => Math.round(performance.now() - started);
   const timings = {};
+  // The profiles' store opens now, beside the wasm's compile: a first year otherwise waits for
+  // the database to be made (docs/page-speed.md, "The first visit").
+  if (engine === undefined || String(engine).trim().toLowerCase() === 'auto') warmProfiles();
   const pool = size > 0 ? new ClipPool(size) : null;
   pool?.start().then(
     () => (timings.workersReady = since()),
@@ -290,8 +293,7 @@ class SunlitEngine {
       if (this.#pinned[views] !== undefined) return [this.#pinned[views], 'pinned'];
       return [key === undefined ? undefined : await cachedProfile(key[views]), 'cache'];
     };
-    const [profile, profileSource] = await given('sun');
-    const [skyProfile, skyProfileSource] = await given('sky');
+    const [[profile, profileSource], [skyProfile, skyProfileSource]] = await Promise.all([given('sun'), given('sky')]);
     const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
     if (pool) routing.clip = (packed) => pool.clip(packed, signal, local);
     return { routing, key };
