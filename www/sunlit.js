@@ -252,8 +252,10 @@ class SunlitEngine {
   /** Milliseconds from `createEngine` to each step of a first visit: `wasm` (this thread's
    * instance started), `engine` (the adapter found: `createEngine` resolves), `workersReady`
    * (every clipping worker started its instance), `encoded` (the first model encoded for the
-   * workers), `workersHold` (every worker built its copy); and `clipped`: views clipped in this
-   * thread (`here`) and by the workers so far (docs/page-speed.md, "The first visit"). */
+   * workers), `workersHold` (every worker built its copy), `yearStarted` and `yearCounted` (the
+   * last year's counting began, its model encoded and its profile looked up, and ended, before
+   * its profile is stored); and `clipped`: views clipped in this thread (`here`) and by the
+   * workers so far (docs/page-speed.md, "The first visit"). */
   get timings() {
     return { ...this.#timings, clipped: this.#pool?.clipped ?? { here: 0, workers: 0 } };
   }
@@ -396,7 +398,9 @@ class SunlitEngine {
     try {
       const { routing, key } = await this.#routing(model, signal);
       if (signal?.aborted) throw coded('cancelled', 'cancelled');
+      this.#timings.yearStarted = this.#since();
       const year = await this.#engine.annual(model, settings, onProgress, signal, routing);
+      this.#timings.yearCounted = this.#since();
       await this.#keepRouting(year, key);
       return year;
     } catch (error) {
