@@ -6,28 +6,56 @@
 const DB = 'sunlit';
 const STORE = 'engine-profiles';
 
+/** The page's one connection to the store, opened once and kept (a first visit's year waited
+ * 25-53 ms for each fresh open of a new profile's database, measured in headless Chromium on the
+ * shared VM; docs/page-speed.md), or null before the first use and after it failed or was closed. */
+let connection = null;
+
 function open() {
-  return new Promise((resolve, reject) => {
+  if (connection) return connection;
+  const opening = new Promise((resolve, reject) => {
     const request = indexedDB.open(DB, 1);
     request.onupgradeneeded = () => request.result.createObjectStore(STORE);
-    request.onsuccess = () => resolve(request.result);
+    request.onsuccess = () => {
+      const db = request.result;
+      // Another page asking for a newer version (none does today) gets the database: this page
+      // opens it again when it next needs it.
+      const forget = () => {
+        if (connection === opening) connection = null;
+      };
+      db.onversionchange = () => {
+        db.close();
+        forget();
+      };
+      db.onclose = forget;
+      resolve(db);
+    };
     request.onerror = () => reject(request.error);
   });
+  connection = opening;
+  opening.catch(() => {
+    if (connection === opening) connection = null;
+  });
+  return opening;
+}
+
+/** Opens the store now (createEngine calls it while the wasm compiles), so that the first
+ * year's look-up does not wait for the database to be made; a store that cannot be opened is
+ * said by nothing, as a cache that cannot be used costs only a probe. */
+export function warmProfiles() {
+  if (typeof indexedDB === 'undefined') return;
+  open().catch(() => {});
 }
 
 async function transact(mode, job) {
   if (typeof indexedDB === 'undefined') return undefined;
   try {
     const db = await open();
-    try {
-      return await new Promise((resolve, reject) => {
-        const request = job(db.transaction(STORE, mode).objectStore(STORE));
-        request.onsuccess = () => resolve(request.result);
-        request.onerror = () => reject(request.error);
-      });
-    } finally {
-      db.close();
-    }
+    return await new Promise((resolve, reject) => {
+      const request = job(db.transaction(STORE, mode).objectStore(STORE));
+      request.onsuccess = () => resolve(request.result);
+      request.onerror = () => reject(request.error);
+    });
   } catch {
     return undefined;
   }

@@ -240,14 +240,18 @@ export interface SunlitEngine {
   /** Milliseconds from createEngine to each step of a first visit, where reached: `wasm` (the
    * engine's wasm instance started), `engine` (createEngine resolved), `workersReady` (every
    * clipping worker started), `encoded` (the last model encoded for the workers), `workersHold`
-   * (every worker built its copy); `clipped`: views clipped so far in the engine's thread and by
-   * the workers. */
+   * (every worker built its copy), `yearStarted` (the last year routed: its model encoded, its
+   * profile looked up, its counting begins), `yearCounted` (that year's schedule made, before its
+   * profile is stored); `clipped`: views clipped so far in the engine's thread and by the
+   * workers. */
   readonly timings: {
     wasm?: number;
     engine?: number;
     workersReady?: number;
     encoded?: number;
     workersHold?: number;
+    yearStarted?: number;
+    yearCounted?: number;
     clipped: { here: number; workers: number };
   };
   /** Stops the pool's workers. */

@@ -6,7 +6,7 @@
 import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
 import { ClipPool, DEFAULT_MEMORY_BUDGET, defaultWorkers, wasmModule } from './pool.js';
-import { cachedProfile, storeProfile } from './profiles.js';
+import { cachedProfile, storeProfile, warmProfiles } from './profiles.js';
 
 let wasmReady;
 
@@ -76,6 +76,9 @@ export async function createEngine({ resolution, accuracy, device, engine, worke
   const started = performance.now();
   const since = () => Math.round(performance.now() - started);
   const timings = {};
+  // The profiles' store opens now, beside the wasm's compile: a first year otherwise waits for
+  // the database to be made (docs/page-speed.md, "The first visit").
+  if (engine === undefined || String(engine).trim().toLowerCase() === 'auto') warmProfiles();
   const pool = size > 0 ? new ClipPool(size) : null;
   pool?.start().then(
     () => (timings.workersReady = since()),
@@ -249,8 +252,10 @@ class SunlitEngine {
   /** Milliseconds from `createEngine` to each step of a first visit: `wasm` (this thread's
    * instance started), `engine` (the adapter found: `createEngine` resolves), `workersReady`
    * (every clipping worker started its instance), `encoded` (the first model encoded for the
-   * workers), `workersHold` (every worker built its copy); and `clipped`: views clipped in this
-   * thread (`here`) and by the workers so far (docs/page-speed.md, "The first visit"). */
+   * workers), `workersHold` (every worker built its copy), `yearStarted` and `yearCounted` (the
+   * last year's counting began, its model encoded and its profile looked up, and ended, before
+   * its profile is stored); and `clipped`: views clipped in this thread (`here`) and by the
+   * workers so far (docs/page-speed.md, "The first visit"). */
   get timings() {
     return { ...this.#timings, clipped: this.#pool?.clipped ?? { here: 0, workers: 0 } };
   }
@@ -290,8 +295,7 @@ class SunlitEngine {
       if (this.#pinned[views] !== undefined) return [this.#pinned[views], 'pinned'];
       return [key === undefined ? undefined : await cachedProfile(key[views]), 'cache'];
     };
-    const [profile, profileSource] = await given('sun');
-    const [skyProfile, skyProfileSource] = await given('sky');
+    const [[profile, profileSource], [skyProfile, skyProfileSource]] = await Promise.all([given('sun'), given('sky')]);
     const routing = { workers, profile, profileSource, skyProfile, skyProfileSource };
     if (pool) routing.clip = (packed) => pool.clip(packed, signal, local);
     return { routing, key };
@@ -394,7 +398,9 @@ class SunlitEngine {
     try {
       const { routing, key } = await this.#routing(model, signal);
       if (signal?.aborted) throw coded('cancelled', 'cancelled');
+      this.#timings.yearStarted = this.#since();
       const year = await this.#engine.annual(model, settings, onProgress, signal, routing);
+      this.#timings.yearCounted = this.#since();
       await this.#keepRouting(year, key);
       return year;
     } catch (error) {

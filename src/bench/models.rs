@@ -6,6 +6,10 @@
 //!   the south windows (one shared box mesh, instanced); + 34 neighbouring buildings within two
 //!   blocks (578 wall and roof polygons, 1,045 shading surfaces in all); + 22 street trees whose
 //!   leaves (one triangle each) bring the total to 35,905 (winter) or 233,866 (summer).
+//! - **Office in context** (`office-context`, Golden CO, the page's default place): the Blaas-like
+//!   office with its louvres, one neighbouring block across the street to the south and six
+//!   street trees of 400 leaves between them; 69,836 views at the page's default year (27×19,
+//!   Timestep 4): the model a first visit of the page is timed on (docs/page-speed.md).
 //! - **NYT-like** (Manhattan): a cruciform tower of 55 floors × 12 wall segments, each a wall with
 //!   one ribbon window, and a roof in 10 parts: 1,330 receivers; + scrims of 194,544 horizontal
 //!   rods 0.6 m in front of the walls, as flat planes (1 polygon) or hexagonal prisms (6), with
@@ -41,12 +45,13 @@ pub struct BenchModel {
 }
 
 /// Every generated model: (name, description).
-pub const CATALOGUE: [(&str, &str); 10] = [
+pub const CATALOGUE: [(&str, &str); 11] = [
     ("blaas-self", "Blaas-like office, Bolzano: 10 zones, 62 receivers, self-shading only"),
     ("blaas-louvres", "blaas-self + 467 louvre slats (instanced): 467 shading surfaces"),
     ("blaas-buildings", "blaas-louvres + 34 neighbouring buildings: 1,045 shading surfaces"),
     ("blaas-trees-winter", "blaas-buildings + 22 street trees, fewest leaves: 35,905 shading surfaces"),
     ("blaas-trees-summer", "blaas-buildings + 22 street trees, most leaves: 233,866 shading surfaces"),
+    ("office-context", "blaas-louvres + a neighbouring block across the street + 6 street trees, Golden CO: a first visit's model"),
     ("nyt-self", "NYT-like cruciform tower, Manhattan: 55 floors, 1,330 receivers, self-shading only"),
     ("nyt-flat", "nyt-self + 194,544 flat rods, supports and spire: 220,843 shading surfaces"),
     ("nyt-rods", "nyt-self + 194,544 hexagonal rods, supports and spire: 1,193,563 shading surfaces"),
@@ -67,6 +72,9 @@ pub fn generate(name: &str) -> Result<BenchModel> {
         Location::new(46.50, 11.35, 1.0)?
     } else if *name == "canyon-slots" {
         g.canyon();
+        Location::new(39.74, -105.18, -7.0)?
+    } else if *name == "office-context" {
+        g.office_context();
         Location::new(39.74, -105.18, -7.0)?
     } else {
         g.nyt(name);
@@ -381,6 +389,29 @@ impl Generator {
 }
 
 impl Generator {
+    /// The Blaas-like office with its louvres in a street: one neighbouring block of 4 floors
+    /// across a 20 m street to the south (its north face 20 m from the louvred facade, a polygon
+    /// per floor and bay) and six street trees of 400 leaves each on the pavement between them.
+    /// The place is the page's default (Golden CO), where a first visit's year is timed: a model
+    /// of about the size the issue names (69,836 views at 27×19, Timestep 4; docs/page-speed.md,
+    /// "The first visit on an office in context").
+    fn office_context(&mut self) {
+        self.blaas("blaas-louvres");
+        let mut unlimited = usize::MAX;
+        let mut m = Mesh::default();
+        block(&mut m, Vec3::new(-10.0, -50.0, 0.0), Vec3::new(60.0, 30.0, 0.0), 4, 3.5, 12, &mut unlimited);
+        self.shading("NEIGHBOUR", m);
+        let mut rng = SplitMix64(65_708);
+        for k in 0..6 {
+            let centre = Vec3::new(-2.0 + 8.8 * k as f32, -10.0, 6.0);
+            let mut m = Mesh::default();
+            for _ in 0..400 {
+                leaf(&mut m, &mut rng, centre, 2.5, 0.15);
+            }
+            self.shading(&format!("TREE_{}", k + 1), m);
+        }
+    }
+
     /// A street canyon running east–west: on its north side a street front (a closed box) with
     /// 4 floors × 30 windows facing south (the receivers, 1 cm proud of its face); across the 12 m
     /// street, 24 closed boxes 12 m deep, 10–30 m high and 3–8 m long, one after the other with
