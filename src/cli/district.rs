@@ -257,16 +257,22 @@ fn count_one(
 ) -> Result<()> {
     let start = Instant::now();
     let log = record::log_path(dir, &district::tile_id(k));
-    let counted = district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, casters }| {
-        let seconds = start.elapsed().as_secs_f64();
-        eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
-        // The PV files before the record: a finished tile has them.
-        if let Some(pv) = &pv {
-            sunlit::sweep::district_pv::write_tile_pv(dir, k, pv)?;
-        }
-        let pv = pv.map(|p| p.sums);
-        district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv })
-    });
+    let counted =
+        district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, casters, stages }| {
+            let seconds = start.elapsed().as_secs_f64();
+            eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
+            eprintln!("tile {k} stages: {}", stages.line());
+            let written = Instant::now();
+            // The PV files before the record: a finished tile has them.
+            if let Some(pv) = &pv {
+                sunlit::sweep::district_pv::write_tile_pv(dir, k, pv)?;
+            }
+            let pv = pv.map(|p| p.sums);
+            let stages = Some(stages);
+            district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, stages })?;
+            eprintln!("tile {k}: record written in {:.1} s", written.elapsed().as_secs_f64());
+            Ok(())
+        });
     if let Err(e) = &counted {
         let _ = district::write_tile_failure(dir, k, Some(1), &e.render(&flag), &log);
     }

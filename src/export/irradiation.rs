@@ -31,7 +31,7 @@ use std::fmt::Write as _;
 use crate::count::MIN_COS_INCIDENCE;
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::scene::Scene;
+use crate::scene::{Receiver, Scene};
 pub use crate::sky::energyplus::EnergyPlusRatios;
 use crate::sky::perez::PerezSky;
 use crate::sky::views::SkyViews;
@@ -82,9 +82,23 @@ fn for_each_incident(
     schedule: &Schedule,
     location: &Location,
     solar: &Solar<'_>,
-    mut each: impl FnMut(usize, usize, &Incident),
+    each: impl FnMut(usize, usize, &Incident),
 ) -> Result<()> {
     check_columns(scene, schedule)?;
+    for_each_incident_from(scene, 0, schedule, location, solar, each)
+}
+
+/// [`for_each_incident`] for a schedule whose columns are the scene's receivers from `first`
+/// on (a batch of a city's, [`summarize_from`]); `each` gets the schedule's column.
+fn for_each_incident_from(
+    scene: &Scene,
+    first: usize,
+    schedule: &Schedule,
+    location: &Location,
+    solar: &Solar<'_>,
+    mut each: impl FnMut(usize, usize, &Incident),
+) -> Result<()> {
+    let receivers = columns_from(scene, first, schedule)?;
     if solar.sky.receivers() != scene.receivers.len() {
         return Err(Error::argument("sky", format!("sky views of {} receivers for {}", solar.sky.receivers(), scene.receivers.len())));
     }
@@ -102,17 +116,19 @@ fn for_each_incident(
         let perez = PerezSky::new(hour.dni, hour.dhi, sun.z, location.elevation);
         let radiances = distribution.as_ref().and_then(|d| d.radiances(hour.dni, hour.dhi, sun, instant.day));
         let leaves = solar.calendar.fraction(f64::from(instant.day));
-        for (c, receiver) in scene.receivers.iter().enumerate() {
+        for (c, receiver) in receivers.iter().enumerate() {
             let fraction = f64::from(schedule.get(row, c));
+            // The sky views are the whole scene's.
+            let r = first + c;
             let cos = receiver.normal.dot(sun).max(0.0);
             let sin_tilt = receiver.normal.truncate().length();
             let ground = hour.ghi * hour.albedo * (1.0 - receiver.normal.z) / 2.0;
             let (sky, unshaded_sky) = match (&radiances, perez) {
-                (Some(r), _) => (solar.sky.distribution_diffuse(c, leaves, r), solar.sky.distribution_open(c, r)),
+                (Some(radiances), _) => (solar.sky.distribution_diffuse(r, leaves, radiances), solar.sky.distribution_open(r, radiances)),
                 (None, _) if distribution.is_some() => (0.0, 0.0),
                 (None, Some(p)) => (
-                    p.diffuse(hour.dhi, cos, solar.sky.isotropic(c, leaves), fraction, sin_tilt, solar.sky.horizon(c, leaves)),
-                    p.diffuse(hour.dhi, cos, solar.sky.unobstructed(c), if cos > 0.0 { 1.0 } else { 0.0 }, sin_tilt, 1.0),
+                    p.diffuse(hour.dhi, cos, solar.sky.isotropic(r, leaves), fraction, sin_tilt, solar.sky.horizon(r, leaves)),
+                    p.diffuse(hour.dhi, cos, solar.sky.unobstructed(r), if cos > 0.0 { 1.0 } else { 0.0 }, sin_tilt, 1.0),
                 ),
                 (None, None) => (0.0, 0.0),
             };
@@ -138,6 +154,15 @@ fn check_columns(scene: &Scene, schedule: &Schedule) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// The scene's receivers that `schedule`'s columns are, from `first` on: refused where they
+/// leave the scene.
+fn columns_from<'a>(scene: &'a Scene, first: usize, schedule: &Schedule) -> Result<&'a [Receiver]> {
+    let columns = schedule.names.len();
+    scene.receivers.get(first..first + columns).ok_or_else(|| {
+        Error::argument("schedule", format!("columns {first}..{} for {} receivers of the scene", first + columns, scene.receivers.len()))
+    })
 }
 
 /// Total incident solar (W/m², shaded) per receiver per timestep, in the schedule's layout:
@@ -202,6 +227,24 @@ pub fn summarize(
     energyplus: &[Option<EnergyPlusRatios>],
 ) -> Result<Vec<SurfaceSummary>> {
     check_columns(scene, schedule)?;
+    summarize_from(scene, 0, schedule, location, sky, weather, energyplus)
+}
+
+/// [`summarize`] for a schedule whose columns are the scene's receivers from `first` on: a batch
+/// of a city's receivers, its year counted alone ([`crate::year::annual::annual_receivers_with`]).
+/// Each column's sums run over the rows in the same order, so a receiver's summary is the one
+/// the whole schedule gives it, bit for bit. `sky` holds the whole scene's views and
+/// `energyplus` the whole scene's ratios.
+pub fn summarize_from(
+    scene: &Scene,
+    first: usize,
+    schedule: &Schedule,
+    location: &Location,
+    sky: Option<(&SkyViews, &LeafCalendar)>,
+    weather: Option<&Weather>,
+    energyplus: &[Option<EnergyPlusRatios>],
+) -> Result<Vec<SurfaceSummary>> {
+    let receivers = columns_from(scene, first, schedule)?;
     let columns = schedule.names.len();
     let hours_per_step = 1.0 / f64::from(schedule.timesteps.per_hour());
     let (mut fraction_sums, mut sun_up_rows) = (vec![0.0; columns], 0usize);
@@ -218,7 +261,7 @@ pub fn summarize(
     let energy = match (sky, weather) {
         (Some((views, calendar)), Some(weather)) => {
             let solar = Solar { weather, sky: views, calendar };
-            for_each_incident(scene, schedule, location, &solar, |_, c, i| {
+            for_each_incident_from(scene, first, schedule, location, &solar, |_, c, i| {
                 let s = &mut sums[c];
                 s.direct += i.direct;
                 s.unshaded_direct += i.unshaded_direct;
@@ -233,8 +276,7 @@ pub fn summarize(
     };
     let kwh = |wh: f64| energy.then_some(wh * hours_per_step / 1000.0);
     let days = schedule.timesteps.days();
-    Ok(scene
-        .receivers
+    Ok(receivers
         .iter()
         .enumerate()
         .map(|(c, r)| {
@@ -250,9 +292,9 @@ pub fn summarize(
                 total: kwh(s.total()),
                 unshaded_total: kwh(s.unshaded_total),
                 sky_view_factor: sky.map(|(views, calendar)| {
-                    (1..=days).map(|d| views.isotropic(c, calendar.fraction(f64::from(d)))).sum::<f64>() / f64::from(days)
+                    (1..=days).map(|d| views.isotropic(first + c, calendar.fraction(f64::from(d)))).sum::<f64>() / f64::from(days)
                 }),
-                energyplus: energyplus.get(c).copied().flatten(),
+                energyplus: energyplus.get(first + c).copied().flatten(),
             }
         })
         .collect())

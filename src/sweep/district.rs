@@ -36,18 +36,18 @@ use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
 use crate::error::{Error, Result};
 use crate::export::cadastre::{self, CadastreRow};
 use crate::export::cadastre_points::{self, PointRow};
-use crate::export::irradiation::summarize;
 use crate::export::pv::SamSums;
 use crate::export::write_atomic;
 use crate::map::{Mapper, Period, Site, point_sky};
 use crate::model::LoadOptions;
 use crate::model::cityjson::CitySource;
 use crate::model::cityjson::{City, CitySurface};
+use crate::platform::seconds as now;
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
-use crate::sky::views::sky_views;
 use crate::sun::weather::Weather;
-use crate::year::annual::{Progress, annual_with};
+use crate::sweep::district_year::{RECEIVER_BATCH, TileStages, TileYear, tile_year};
+use crate::year::annual::Progress;
 use crate::year::settings::Resolved;
 
 /// The merged outputs' names in the output folder.
@@ -357,6 +357,8 @@ pub struct TileCount {
     pub pv: Option<TilePv>,
     /// Surfaces it was counted with.
     pub casters: usize,
+    /// Where its time went.
+    pub stages: TileStages,
 }
 
 /// Counts tile `k`: its buildings' receivers against its context, the year and the sky, into
@@ -368,13 +370,27 @@ pub fn count_tile(
     s: &TileSettings,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<TileCount> {
+    count_tile_in_batches(city, tiling, k, s, RECEIVER_BATCH, progress)
+}
+
+/// [`count_tile`], the year counted `batch` receivers at a time ([`super::district_year`]).
+pub fn count_tile_in_batches(
+    city: &City,
+    tiling: &Tiling,
+    k: usize,
+    s: &TileSettings,
+    batch: usize,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<TileCount> {
+    let start = now();
+    let mut stages = TileStages::default();
     let tile = tile_of(tiling, k)?;
     let part = tile_city(city, tiling, tile);
     let buildings: Vec<String> = match s.load.buildings.as_slice() {
         [] => tile.buildings.clone(),
         asked => tile.buildings.iter().filter(|b| asked.contains(b)).cloned().collect(),
     };
-    let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, casters: part.surfaces.len() };
+    let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, casters: part.surfaces.len(), stages };
     if buildings.is_empty() {
         return Ok(empty);
     }
@@ -386,18 +402,16 @@ pub fn count_tile(
         Err(e) => return Err(e),
     };
     let engine = HybridEngine::new(&scene, s.engine, s.counter, s.lanes, ProfileSource::Cache)?;
-    let options = s.settings.options(None)?;
-    let location = &s.settings.location;
-    let schedule = pollster::block_on(annual_with(&engine, &scene, location, &options, &s.settings.calendar, progress))?;
-    let views = pollster::block_on(sky_views(&engine, &scene, s.patches, progress))?;
-    let summaries = summarize(&scene, &schedule, location, Some((&views, &s.settings.calendar)), Some(s.weather), &[])?;
-    let hours = cadastre::sun_hours(&schedule, location);
+    stages.scene = now() - start;
+    let TileYear { summaries, hours } = tile_year(&engine, &scene, s, batch, &mut stages, progress)?;
     let mut rows = cadastre::rows(&part, &scene, &summaries, &hours)?;
+    let start = now();
     let (points, pv) = match s.grid {
         Some(grid) => roof_points(&part, &scene, grid, s, &mut rows)?,
         None => (Vec::new(), None),
     };
-    Ok(TileCount { rows, points, pv, casters: part.surfaces.len() })
+    stages.points = now() - start;
+    Ok(TileCount { rows, points, pv, casters: part.surfaces.len(), stages })
 }
 
 /// The grid on the scene's roofs, each point's year counted directly (never interpolated: the
@@ -454,6 +468,9 @@ pub struct TileDone {
     /// With a grid and PV files: its points' SAM sums (its pvlib CSV is in `pv/`).
     #[serde(default)]
     pub pv: Option<SamSums>,
+    /// Where its time went (absent in records written before it was kept).
+    #[serde(default)]
+    pub stages: Option<TileStages>,
 }
 
 /// The record id of tile `k`.

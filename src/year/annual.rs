@@ -23,6 +23,8 @@
 //! [`DayMap::Ramp`]), with the samples mirrored at both ends so the same periodic fit applies.
 //! A day takes the fit of its phase. Without foliage (or evergreen) there is one regime, all leaves.
 
+use std::ops::Range;
+
 use glam::DVec3;
 
 use crate::count::gpu::{Counter, GpuScene};
@@ -30,16 +32,21 @@ use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
+use crate::platform::seconds as now;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
-use crate::sun::position::{declination_and_equation_of_time, lit_intervals, solar_noon_hour, sun_direction};
+use crate::sun::position::{lit_intervals, sun_direction};
 use crate::year::certified::{self, Rough, Smooth};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::refine;
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
 use crate::year::season::{LeafCalendar, Phase};
 use crate::year::spline::{AnnualGrid, AnnualSpline};
+pub(super) use columns::Columns;
+pub use columns::YearStages;
+pub use sampling::sample_requests;
+use sampling::{SampleViews, sample_views};
 
 /// How the year is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,23 +221,70 @@ pub async fn annual_fitted_with<E: Engine>(
     calendar: &LeafCalendar,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<(Schedule, Option<FittedYear>)> {
-    let names = scene.receivers.iter().map(|r| r.name.clone()).collect();
-    let mut schedule = Schedule::zeros(names, options.timesteps);
+    let mut year = Columns::new(scene, 0..scene.receivers.len(), options.timesteps)?;
+    let calendar = year_calendar(scene, calendar);
+    let fitted = count_columns(engine, scene, location, options, &calendar, &mut year, progress).await?;
+    let days = year.schedule.timesteps.days();
+    let fitted = fitted.map(|(surfaces, regime_of)| FittedYear::new(scene, location, calendar, surfaces, regime_of, days));
+    year.schedule.validate()?;
+    Ok((year.schedule, fitted))
+}
+
+/// The year of the scene's `receivers` alone (a range of them, in order), each answer what
+/// [`annual_with`] gives that receiver, bit for bit: every view is the same receiver at the
+/// same sun on the same engine, and each receiver's samples, fit, refined steps and
+/// certificates are its own. Its schedule's columns are those receivers. A city's year is
+/// counted so a batch at a time ([`crate::sweep::district`]): its memory then follows the batch,
+/// not the city (the whole-year table alone is 4 bytes a receiver and timestep). With it, where
+/// the year's time went ([`YearStages`]).
+#[allow(clippy::too_many_arguments)] // As annual_with, and which receivers.
+pub async fn annual_receivers_with<E: Engine>(
+    engine: &E,
+    scene: &Scene,
+    receivers: Range<usize>,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<(Schedule, YearStages)> {
+    let mut year = Columns::new(scene, receivers, options.timesteps)?;
+    let calendar = year_calendar(scene, calendar);
+    count_columns(engine, scene, location, options, &calendar, &mut year, progress).await?;
+    year.schedule.validate()?;
+    Ok((year.schedule, year.stages))
+}
+
+/// The leaf calendar a year follows: `calendar` where the scene has foliage, else evergreen
+/// (one regime).
+fn year_calendar(scene: &Scene, calendar: &LeafCalendar) -> LeafCalendar {
+    if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() }
+}
+
+/// Counts the year of `year`'s receivers by `options`' method; a spline year's fitted surfaces
+/// and which regime serves each leaf phase.
+async fn count_columns<E: Engine>(
+    engine: &E,
+    scene: &Scene,
+    location: &Location,
+    options: &AnnualOptions,
+    calendar: &LeafCalendar,
+    year: &mut Columns,
+    progress: &mut dyn FnMut(Progress) -> Result<()>,
+) -> Result<Option<(Vec<FittedSurfaces>, RegimeOf)>> {
     let views = Views { engine };
-    let calendar = if scene.has_foliage() { *calendar } else { LeafCalendar::evergreen() };
-    let fitted = match options.method {
-        Method::Spline(plan) => Some(spline_year(&views, scene, location, plan, &calendar, *options, &mut schedule, progress).await?),
+    match options.method {
+        Method::Spline(plan) => Ok(Some(spline_year(&views, scene, location, plan, calendar, *options, year, progress).await?)),
         Method::Dense => {
-            dense_year(&views, scene, location, &calendar, &mut schedule, progress).await?;
-            None
+            dense_year(&views, scene, location, calendar, year, progress).await?;
+            Ok(None)
         }
         Method::Periodic(periods) => {
-            super::periodic::periodic_year(&views, scene, location, periods, &calendar, &mut schedule, progress).await?;
-            None
+            let start = now();
+            super::periodic::periodic_year(&views, scene, location, periods, calendar, year, progress).await?;
+            year.stages.sampling += now() - start;
+            Ok(None)
         }
-    };
-    schedule.validate()?;
-    Ok((schedule, fitted))
+    }
 }
 
 /// [`annual_on`] the lanes' counters, surviving one loss of a GPU device (a driver reset, a GPU
@@ -343,38 +397,41 @@ async fn dense_year(
     scene: &Scene,
     location: &Location,
     calendar: &LeafCalendar,
-    schedule: &mut Schedule,
+    year: &mut Columns,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
+    let start = now();
     let mut requests = Vec::new();
     let mut cells = Vec::new();
-    for (row, column, sun, day) in facing_timesteps(scene, location, schedule.timesteps) {
+    for (row, column, sun, day) in facing_timesteps(scene, year.range(), location, year.schedule.timesteps) {
         requests.push(ViewRequest::new(column as u32, sun).with_leaves(calendar.fraction(f64::from(day)) as f32));
         cells.push((row, column));
     }
     let values = views.count(&requests, progress).await?;
     for ((row, column), v) in cells.into_iter().zip(values) {
-        schedule.set(row, column, as_energyplus(v));
+        year.set(row, column, as_energyplus(v));
     }
+    year.stages.sampling += now() - start;
+    year.stages.sample_views += requests.len();
     Ok(())
 }
 
-/// Every sun-up timestep at which a receiver faces the sun, as (row, receiver, sun, calendar
-/// day): the views a dense year counts, and those a spline year settles or counts.
+/// Every sun-up timestep at which one of the scene's `receivers` faces the sun, as (row,
+/// receiver, sun, calendar day): the views a dense year counts, and those a spline year settles
+/// or counts.
 fn facing_timesteps<'a>(
     scene: &'a Scene,
+    receivers: Range<usize>,
     location: &'a Location,
     timesteps: Timesteps,
 ) -> impl Iterator<Item = (usize, usize, DVec3, u32)> + 'a {
     timesteps.instants().enumerate().flat_map(move |(row, instant)| {
         let sun = sun_direction(location, shading_sun_day(instant.day), instant.hour);
         let up = sun_is_up(sun);
-        scene
-            .receivers
-            .iter()
-            .enumerate()
-            .filter(move |(_, r)| up && !is_dark(r.normal, sun))
-            .map(move |(column, _)| (row, column, sun, instant.day))
+        receivers
+            .clone()
+            .filter(move |&column| up && !is_dark(scene.receivers[column].normal, sun))
+            .map(move |column| (row, column, sun, instant.day))
     })
 }
 
@@ -522,6 +579,8 @@ fn sun_day(day: f64) -> f64 {
     (day - 1.0).rem_euclid(DAYS as f64) + 1.0
 }
 
+/// The spline year of `year`'s receivers, written into its schedule; their fitted surfaces by
+/// regime and which regime serves each leaf phase.
 #[allow(clippy::too_many_arguments)] // The year's inputs and its two outputs; grouping them would hide nothing.
 async fn spline_year(
     views: &Views<'_, impl Engine>,
@@ -530,19 +589,25 @@ async fn spline_year(
     plan: SamplingPlan,
     calendar: &LeafCalendar,
     options: AnnualOptions,
-    schedule: &mut Schedule,
+    year: &mut Columns,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
-) -> Result<FittedYear> {
+) -> Result<(Vec<FittedSurfaces>, RegimeOf)> {
+    let start = now();
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
-    let SampleViews { requests, cells } = sample_views(scene, location, &regimes, &taus);
-    let work = YearWork { samples: requests.len(), timesteps: facing_timesteps(scene, location, schedule.timesteps).count() };
+    let receivers = year.range();
+    let SampleViews { requests, cells } = sample_views(scene, receivers.clone(), location, &regimes, &taus);
+    let timesteps = year.schedule.timesteps;
+    let work = YearWork { samples: requests.len(), timesteps: facing_timesteps(scene, receivers.clone(), location, timesteps).count() };
     let counted = views.count(&requests, &mut |p| progress(work.sampling(p))).await?;
+    year.stages.sample_views += requests.len();
+    year.stages.sampling += now() - start;
+    let start = now();
     // Each step below keeps only what the next reads, freed before the year is evaluated: a
     // city's views, counts and samples are a sixth of its peak memory (docs/district.md).
     drop(requests);
     let mut samples: Vec<Vec<Option<f64>>> =
-        regimes.iter().map(|g| vec![None; scene.receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
+        regimes.iter().map(|g| vec![None; receivers.len() * MAX_PIECES * g.days.len() * taus.len()]).collect();
     for (request, g, cell) in cells {
         samples[g][cell] = Some(counted[request]);
     }
@@ -554,111 +619,37 @@ async fn spline_year(
     drop(samples);
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
     let (refine, prove) = (options.refine, options.prove_never_dark);
-    let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, schedule);
+    let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, year);
+    year.stages.fitting += now() - start;
+    let start = now();
     let rough = if rough.is_empty() && smooth.is_empty() {
         rough
     } else {
-        certified::certify_steps(scene, views.engine.index(), location, schedule.timesteps, rough, smooth, schedule)
+        certified::certify_steps(scene, views.engine.index(), location, timesteps, rough, smooth, year)
     };
+    year.stages.certifying += now() - start;
+    let start = now();
     // Certified timesteps are settled like interpolated ones: done, not counted.
-    let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
+    let rows_per_day = timesteps.rows() / timesteps.days() as usize;
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
-    let refined = refine::count_sparsely(views, &rough, rows_per_day, refine, &leaves, &mut |n, p| progress(work.refining(n, p))).await?;
+    // The last report says how many refined steps were counted in all.
+    let mut refined_views = 0;
+    let refined = refine::count_sparsely(views, &rough, rows_per_day, refine, &leaves, &mut |n, p| {
+        refined_views = n;
+        progress(work.refining(n, p))
+    })
+    .await?;
     for (r, v) in rough.into_iter().zip(refined) {
-        schedule.set(r.row, r.column, as_energyplus(v));
+        year.set(r.row, r.column, as_energyplus(v));
     }
+    year.stages.refining += now() - start;
+    year.stages.refined_views += refined_views;
     let surfaces = regimes
         .iter()
         .zip(fits)
         .map(|(g, f)| FittedSurfaces { map: g.map, splines: f.into_iter().map(|p| p.map(|p| p.spline)).collect() })
         .collect();
-    Ok(FittedYear::new(scene, location, *calendar, surfaces, regime_of, schedule.timesteps.days()))
-}
-
-/// The views the sample grids need, and where each count goes.
-struct SampleViews {
-    /// Each at its regime's leaf fraction.
-    requests: Vec<ViewRequest>,
-    /// (request, regime, cell): the count of `request` fills `cell` of `regime`'s samples.
-    cells: Vec<(usize, usize, usize)>,
-}
-
-/// Lists the views of every regime's samples: per receiver, sample day, lit piece and time of
-/// day. A day whose twin (same declination, see [`SeasonAxis`]) has been listed and whose lit
-/// pieces are the twin's, shifted by the difference in solar noon, takes the twin's views: the
-/// sun directions are the same, so the counts would be.
-fn sample_views(scene: &Scene, location: &Location, regimes: &[Regime], taus: &[f64]) -> SampleViews {
-    let mut out = SampleViews { requests: Vec::new(), cells: Vec::new() };
-    for (g, regime) in regimes.iter().enumerate() {
-        let per_piece = regime.days.len() * taus.len();
-        for (id, r) in scene.receivers.iter().enumerate() {
-            // First request of each (day, piece), to share with the twin day.
-            let mut first: Vec<Vec<(f64, f64, usize)>> = vec![Vec::new(); regime.days.len()];
-            for (d, &day) in regime.days.iter().enumerate() {
-                let day = sun_day(day);
-                let noon = solar_noon_hour(location, day);
-                let pieces: Vec<(f64, f64)> =
-                    lit_intervals(location, r.normal, day, MIN_COS_INCIDENCE).into_iter().take(MAX_PIECES).collect();
-                let twin = regime.twins[d];
-                let shared = twin < d && same_declination(day, sun_day(regime.days[twin])) && same_pieces(&first[twin], &pieces, noon);
-                for (p, (start, end)) in pieces.into_iter().enumerate() {
-                    let base = if shared { first[twin][p].2 } else { out.requests.len() };
-                    first[d].push((start - noon, end - noon, base));
-                    for (j, tau) in taus.iter().enumerate() {
-                        if !shared {
-                            let sun = sun_direction(location, day, start + tau * (end - start));
-                            out.requests.push(ViewRequest::new(id as u32, sun).with_leaves(regime.leaves[d]));
-                        }
-                        out.cells.push((base + j, g, (id * MAX_PIECES + p) * per_piece + d * taus.len() + j));
-                    }
-                }
-            }
-        }
-    }
-    by_sun(out)
-}
-
-/// Reorders the views so that those at one sun (and leaf fraction) are adjacent: receivers of
-/// one view group (a wall and its windows, [`crate::count::group`]) then share a tile even when
-/// the views are counted a batch at a time.
-fn by_sun(views: SampleViews) -> SampleViews {
-    let key = |k: usize| {
-        let r = views.requests[k];
-        (r.sun.x.to_bits(), r.sun.y.to_bits(), r.sun.z.to_bits(), r.leaves.to_bits(), r.receiver)
-    };
-    let mut order: Vec<usize> = (0..views.requests.len()).collect();
-    order.sort_by_key(|&k| key(k));
-    let mut new_index = vec![0; order.len()];
-    for (new, &old) in order.iter().enumerate() {
-        new_index[old] = new;
-    }
-    SampleViews {
-        requests: order.iter().map(|&k| views.requests[k]).collect(),
-        cells: views.cells.into_iter().map(|(request, g, cell)| (new_index[request], g, cell)).collect(),
-    }
-}
-
-/// Whether two days have the same declination (to rounding): no twin exists across New Year,
-/// where the sun model's 366-day series meets the schedule's 365-day year.
-fn same_declination(a: f64, b: f64) -> bool {
-    (declination_and_equation_of_time(a).0 - declination_and_equation_of_time(b).0).abs() < 1e-10
-}
-
-/// Whether a day's lit pieces (clock hours, solar noon at `noon`) are the twin's (hours from its
-/// solar noon): the same hour angles, so the same sun directions. They differ only where a piece
-/// is cut at midnight (polar day), which the equation of time moves.
-fn same_pieces(twin: &[(f64, f64, usize)], pieces: &[(f64, f64)], noon: f64) -> bool {
-    const HOURS: f64 = 1e-6;
-    twin.len() == pieces.len()
-        && twin.iter().zip(pieces).all(|(t, p)| (t.0 - (p.0 - noon)).abs() < HOURS && (t.1 - (p.1 - noon)).abs() < HOURS)
-}
-
-/// The views the spline pass counts for a scene without foliage: the plan's samples, a day that
-/// shares its twin's views listed once. What `sunlit bench` times.
-pub fn sample_requests(scene: &Scene, location: &Location, plan: SamplingPlan) -> Result<Vec<ViewRequest>> {
-    let taus = plan.taus();
-    let regime = Regime::year(plan, &taus, 1.0)?;
-    Ok(sample_views(scene, location, std::slice::from_ref(&regime), &taus).requests)
+    Ok((surfaces, regime_of))
 }
 
 /// Fits every (receiver, piece) of a regime from its samples (None where the piece is never lit).
@@ -753,27 +744,33 @@ fn evaluate(
     regime_of: &dyn Fn(f64) -> usize,
     refine: f64,
     prove_never_dark: bool,
-    schedule: &mut Schedule,
+    year: &mut Columns,
 ) -> (Vec<Rough>, Vec<Smooth>) {
     let (mut rough, mut smooth) = (Vec::new(), Vec::new());
-    let rows_per_day = schedule.timesteps.rows() / schedule.timesteps.days() as usize;
-    for day in 1..=schedule.timesteps.days() {
+    // The fits and the schedule's columns are numbered from the range's first receiver, the
+    // steps by the scene's receiver (what their views and certificates name).
+    let first = year.first;
+    let receivers = &scene.receivers[year.range()];
+    let timesteps = year.schedule.timesteps;
+    let rows_per_day = timesteps.rows() / timesteps.days() as usize;
+    for day in 1..=timesteps.days() {
         let pieces: Vec<Vec<(f64, f64)>> =
-            scene.receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
+            receivers.iter().map(|r| lit_intervals(location, r.normal, shading_sun_day(day), MIN_COS_INCIDENCE)).collect();
         let g = regime_of(day as f64);
         let regime = &regimes[g];
         let grid_day = regime.map.grid_day(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
-            let instant = schedule.timesteps.instant(row);
+            let instant = timesteps.instant(row);
             let sun = sun_direction(location, shading_sun_day(day), instant.hour);
             if !sun_is_up(sun) {
                 continue;
             }
-            for (column, r) in scene.receivers.iter().enumerate() {
+            for (local, r) in receivers.iter().enumerate() {
                 if is_dark(r.normal, sun) {
                     continue;
                 }
-                let Some((fit, tau)) = fit_at(&pieces[column], column, instant.hour) else { continue };
+                let column = first + local;
+                let Some((fit, tau)) = fit_at(&pieces[local], local, instant.hour) else { continue };
                 let Some(piece) = &regime.fits[fit] else {
                     // Dark at every sample: counted (or proved dark) with refinement on, not
                     // guessed dark, since a slot of sun may light it between them.
@@ -784,7 +781,7 @@ fn evaluate(
                     continue;
                 };
                 let value = piece.spline.eval(grid_day, tau);
-                schedule.set(row, column, as_energyplus(value));
+                year.schedule.set(row, local, as_energyplus(value));
                 let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
                 if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
                     let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
@@ -889,5 +886,7 @@ pub fn compare(a: &Schedule, b: &Schedule) -> Result<(f64, f64, f64)> {
     Ok((sum / n, (sq / n).sqrt(), max))
 }
 
+mod columns;
+mod sampling;
 #[cfg(test)]
 mod tests;

@@ -19,11 +19,10 @@ use glam::DVec3;
 
 use crate::count::certify::{Certificate, Certifier, Wanted};
 use crate::count::exact::engine::ExactEngine;
-use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
-use crate::year::annual::shading_sun_day;
+use crate::year::annual::{Columns, shading_sun_day};
 use crate::year::samples::Timesteps;
 
 /// A timestep the refinement counts directly unless a certificate settles it.
@@ -140,7 +139,7 @@ fn wanted((lowest, highest): (f64, f64)) -> Wanted {
 
 /// Writes the steps of `rough` that a certificate settles into `schedule` and returns the rest
 /// (to count), in their order, with the numbers of steps proved dark and lit.
-pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Schedule) -> (Vec<Rough>, usize, usize) {
+pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Columns) -> (Vec<Rough>, usize, usize) {
     let mut order: Vec<usize> = (0..rough.len()).collect();
     order.sort_by_key(|&i| rough[i].cell);
     let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
@@ -180,7 +179,7 @@ pub(super) fn certify_steps(
     timesteps: Timesteps,
     rough: Vec<Rough>,
     smooth: Vec<Smooth>,
-    schedule: &mut Schedule,
+    schedule: &mut Columns,
 ) -> Vec<Rough> {
     let certifier = match index {
         Some(index) => Certifier::sharing(scene, index),

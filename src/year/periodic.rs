@@ -12,16 +12,15 @@
 
 use std::collections::HashMap;
 
-use super::annual::{Progress, Views, as_energyplus, sun_is_up};
+use super::annual::{Columns, Progress, Views, as_energyplus, sun_is_up};
 use super::season::LeafCalendar;
 use crate::count::{Engine, ViewRequest, is_dark};
 use crate::error::Result;
-use crate::export::Schedule;
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
 
-/// Counts the year of `schedule` under `periods`' suns: each period's timesteps of one day once,
+/// Counts the year of `year`'s receivers under `periods`' suns: each period's timesteps of one day once,
 /// written to every day of it. Foliage takes the period's first day's leaves (EnergyPlus reads a
 /// shade's schedules on the day it computes the period's shading).
 pub(super) async fn periodic_year(
@@ -30,10 +29,10 @@ pub(super) async fn periodic_year(
     location: &Location,
     periods: ShadingPeriods,
     calendar: &LeafCalendar,
-    schedule: &mut Schedule,
+    year: &mut Columns,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<()> {
-    let timesteps = schedule.timesteps;
+    let timesteps = year.schedule.timesteps;
     let year_days = timesteps.days();
     let per_day = timesteps.rows() / year_days as usize;
     // (period's first day, timestep of the day, receiver) → the request's index.
@@ -46,8 +45,8 @@ pub(super) async fn periodic_year(
         if !sun_is_up(sun) {
             continue;
         }
-        for (column, receiver) in scene.receivers.iter().enumerate() {
-            if is_dark(receiver.normal, sun) {
+        for column in year.range() {
+            if is_dark(scene.receivers[column].normal, sun) {
                 continue;
             }
             let index = *counted.entry((start, row % per_day, column)).or_insert_with(|| {
@@ -58,10 +57,11 @@ pub(super) async fn periodic_year(
         }
     }
     // Later passes weigh these fractions by this sun's incidence, as EnergyPlus does.
-    schedule.periods = Some(periods);
+    year.schedule.periods = Some(periods);
     let values = views.count(&requests, progress).await?;
+    year.stages.sample_views += requests.len();
     for (row, column, index) in cells {
-        schedule.set(row, column, as_energyplus(values[index]));
+        year.set(row, column, as_energyplus(values[index]));
     }
     Ok(())
 }

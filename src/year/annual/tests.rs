@@ -53,3 +53,51 @@ fn dark_samples_take_the_nearest_lit_value() {
     assert_eq!(filled, vec![0.2, 0.2, 0.2, 0.8, 0.2, 0.2, 0.2, 0.8]);
     assert_eq!(fill_dark(&[None, None, None], 1, 3), None);
 }
+
+/// A year counted a batch of receivers at a time ([`annual_receivers_with`]) is the whole year's
+/// ([`annual_with`]), column for column and bit for bit, on a generated district with stair
+/// housings and chimneys (self-shading, steps refined and certified, interpolated ones proved
+/// never dark): uneven batches, the last shorter, and one batch of all.
+#[test]
+fn a_year_by_batches_of_receivers_is_the_whole_year() {
+    use crate::count::gpu::CounterOptions;
+    use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
+
+    let text = crate::model::city_write::district_cityjson_with(2, 1, 3, true);
+    let city = crate::model::cityjson::read_city("district.city.json", text.as_bytes(), None).unwrap();
+    let scene = crate::model::load_city(&city, &crate::model::LoadOptions::default()).unwrap().scene;
+    let engine = HybridEngine::new(&scene, EngineKind::Exact, CounterOptions::default(), None, ProfileSource::Cache).unwrap();
+    let location = Location::new(39.74, -105.18, -7.0).unwrap();
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method: Method::Spline(SamplingPlan::new(13, 9).unwrap()),
+        refine: DEFAULT_REFINE,
+        prove_never_dark: true,
+    };
+    let calendar = LeafCalendar::evergreen();
+    let year = |receivers: Range<usize>| {
+        pollster::block_on(annual_receivers_with(&engine, &scene, receivers, &location, &options, &calendar, &mut |_| Ok(()))).unwrap()
+    };
+    let whole = pollster::block_on(annual_with(&engine, &scene, &location, &options, &calendar, &mut |_| Ok(()))).unwrap();
+    let n = scene.receivers.len();
+    assert!(n > 10, "{n} receivers");
+    for batch in [7, n] {
+        let mut stages = YearStages::default();
+        for first in (0..n).step_by(batch) {
+            let (part, s) = year(first..(first + batch).min(n));
+            stages.add(&s);
+            assert_eq!(part.names, whole.names[first..(first + batch).min(n)]);
+            for row in 0..whole.timesteps.rows() {
+                for (c, name) in part.names.iter().enumerate() {
+                    let (a, b) = (part.get(row, c), whole.get(row, first + c));
+                    assert_eq!(a.to_bits(), b.to_bits(), "batches of {batch}: {name} at row {row}: {a} against {b}");
+                }
+            }
+        }
+        // The batches went through every stage: samples, refined steps counted.
+        assert!(stages.sample_views > 0 && stages.refined_views > 0, "batches of {batch}: {stages:?}");
+    }
+    // A range past the scene is refused, naming the parameter.
+    let past = pollster::block_on(annual_receivers_with(&engine, &scene, n - 1..n + 1, &location, &options, &calendar, &mut |_| Ok(())));
+    assert!(past.is_err_and(|e| e.to_string().contains("receivers")));
+}
