@@ -565,6 +565,11 @@ fn read_ring(ring: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<DVec3>
     for i in indices {
         let k = i.as_u64().ok_or_else(|| format!("vertex index {i} is not an index"))? as usize;
         let p = *vertices.get(k).ok_or_else(|| format!("vertex index {k} is out of range ({} vertices)", vertices.len()))?;
+        // Finite as written, a vertex can still overflow once scaled, shifted by the offset or
+        // placed by a template's matrix; said here, or the ring fails later as "not triangulated".
+        if !p.is_finite() {
+            return Err(format!("vertex index {k} is not finite once scaled and placed (check transform.scale and the coordinates)"));
+        }
         // Repeated consecutive points (and a closing repeat) add nothing.
         if points.last() != Some(&p) {
             points.push(p);

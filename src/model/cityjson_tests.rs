@@ -92,6 +92,12 @@ fn bad_input_names_file_object_and_reason() {
         error(&doc("2.0", true, SQUARE, &pointing_nowhere)),
         "c.city.json: CityObject 'b1': geometry 0: surface 0: semantic value 4 points nowhere (1 semantic surfaces)"
     );
+    // Finite as written, infinite once the offset (the smallest vertex) is taken off.
+    let overflowing = "[[-1e308,0,0],[1e308,0,0],[1e308,1,0]]";
+    assert_eq!(
+        error(&doc("2.0", false, overflowing, &building("[[[0,1,2]]]", ""))),
+        "c.city.json: CityObject 'b1': geometry 0: surface 0, ring 0: vertex index 1 is not finite once scaled and placed (check transform.scale and the coordinates)"
+    );
     // Real-valued vertices need no transform (the smallest vertex is then the offset).
     let floats = "[[1000.5,2000,3],[1001.5,2000,3],[1001.5,2001,3]]";
     let city = read_city("c.city.json", doc("1.1", false, floats, &building("[[[0,1,2]]]", "")).as_bytes(), None).unwrap();
