@@ -4,6 +4,9 @@
 // window and the windows coloured pass/fail in the 3D view; the study's CSV to download, as
 // `sunlit map --study NAME` writes POINTS.study-NAME.csv (the library's own writer), and its HTML
 // report as `--html` writes it (with every window's sky mask, `--mask all`). An existing scene
+// GB 50180's 满窗 (whole window) rule takes one sill width, each window's own sill measured from its
+// geometry (`--window-width sill`), or each window's width from a table the user types, a
+// `receiver,width` CSV as `--window-widths` reads it. An existing scene
 // (`--before`) may be loaded beside the model: the table then shows each window's former value,
 // the ratio and BRE's relative test (0.8 × former). Windows are ticked in a list or by clicking
 // them in the 3D view. Nothing here
@@ -36,6 +39,8 @@ export function studyMode(page) {
     // The colour bar is a value scale; the windows' colours are verdicts, named in the title.
     document.querySelector('#legend .bar').hidden = study;
     for (const el of document.querySelectorAll('[data-study]')) el.hidden = !el.dataset.study.split(' ').includes($('study').value);
+    // The 满窗 width's own fields, for the way it is asked.
+    for (const el of document.querySelectorAll('[data-whole]')) el.hidden ||= el.dataset.whole !== $('gbwhole').value;
     if (study) $('compute').textContent = 'Run study';
     $('studywrap').hidden = !study || !state.study;
     recolour();
@@ -87,9 +92,15 @@ export function studyMode(page) {
     if ($('floorlevel').value.trim() !== '') o.floorLevel = Number($('floorlevel').value);
     if (o.study === 'gb50180') {
       o.day = $('gbday').value;
-      for (const [id, key] of [['gbhours', 'requiredHours'], ['gbminperiod', 'minPeriod'], ['gbmaxperiods', 'maxPeriods'], ['gbwidth', 'windowWidth']]) {
+      for (const [id, key] of [['gbhours', 'requiredHours'], ['gbminperiod', 'minPeriod'], ['gbmaxperiods', 'maxPeriods']]) {
         if ($(id).value.trim() !== '') o[key] = Number($(id).value);
       }
+      // 满窗: one width (as typed, empty refused by the library as no number), each window's own
+      // sill ('sill'), or the table's text as the CSV `--window-widths` reads.
+      const whole = $('gbwhole').value;
+      if (whole === 'width') o.windowWidth = $('gbwidth').value.trim() === '' ? '' : Number($('gbwidth').value);
+      if (whole === 'sill') o.windowWidth = 'sill';
+      if (whole === 'table') o.windowWidths = $('gbwidths').value;
     }
     if (o.study === 'en17037') {
       if ($('enperiod').value.trim() !== '') o.period = $('enperiod').value.trim();
@@ -231,7 +242,7 @@ export function studyMode(page) {
   }
 
   function wire() {
-    for (const id of ['mode', 'study']) $(id).addEventListener('change', showFields);
+    for (const id of ['mode', 'study', 'gbwhole']) $(id).addEventListener('change', showFields);
     // GB 50180 counts at the sill, BRE at the window's centre: the picker follows the rule.
     $('study').addEventListener('change', () => {
       $('windowpoints').value = $('study').value === 'gb50180' ? 'sill' : 'centre';

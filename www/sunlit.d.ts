@@ -315,8 +315,15 @@ export interface StudyOptions {
   minPeriod?: number;
   /** gb50180: only the longest N periods count. */
   maxPeriods?: number;
-  /** gb50180: the 满窗 (whole window) variant over a sill this wide, in metres. */
-  windowWidth?: number;
+  /** gb50180: the 满窗 (whole window) variant, the sun over the whole sill: a sill this wide, in
+   * metres, centred on every point, or 'sill', each window's own sill line measured from its
+   * geometry (its lowest edge; with floorLevel, its width at the sill height), with
+   * windowPoints 'sill' only (`--window-width METRES|sill`). */
+  windowWidth?: number | 'sill';
+  /** gb50180: the 满窗 variant with each window's own sill width: the text of a `receiver,width`
+   * CSV (as `--window-widths FILE.csv` reads it), or widths in metres by window name,
+   * `{ WIN_S1: 1.5 }`; every studied window needs one. */
+  windowWidths?: string | Record<string, number>;
   /** en17037: the day, 'MM-DD' from '02-01' to '03-21' (default '03-21'; `--period`). */
   period?: string;
   /** en17037: the sun counts at or above this altitude, degrees (default 10; `--min-altitude`). */

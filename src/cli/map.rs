@@ -153,9 +153,11 @@ pub(super) struct MapArgs {
     /// gb50180: only the longest N periods count (default all).
     #[arg(long, value_name = "N")]
     max_periods: Option<usize>,
-    /// gb50180: also the 满窗 (whole window) hours, the sun over the whole sill of this width (m).
-    #[arg(long, value_name = "METRES")]
-    window_width: Option<f64>,
+    /// gb50180: also the 满窗 (whole window) hours, the sun over the whole sill: one width (m)
+    /// for every window, centred on each point, or `sill`, each window's own sill line measured
+    /// from its geometry (with --window-points sill).
+    #[arg(long, value_name = "METRES|sill")]
+    window_width: Option<String>,
     /// gb50180: the 满窗 hours with each window's own sill width, from a CSV `receiver,width`
     /// (instead of one --window-width).
     #[arg(long, value_name = "FILE.csv")]

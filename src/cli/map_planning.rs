@@ -14,7 +14,8 @@ use sunlit::map::Site;
 use sunlit::map::planning::en17037::En17037Rule;
 use sunlit::map::planning::gb50180::Gb50180Rule;
 use sunlit::map::planning::run::{self, Rules, WINDOW_STUDIES};
-use sunlit::map::planning::sill_widths::sill_widths;
+use sunlit::map::planning::sill_lines::sill_lines;
+use sunlit::map::planning::sill_widths::{WholeWindow, sill_widths};
 use sunlit::map::planning::window_points::WindowPoint;
 use sunlit::sun::weather::Weather;
 use sunlit::year::season::LeafCalendar;
@@ -96,8 +97,25 @@ fn check_options(args: &MapArgs) -> Result<()> {
     Ok(())
 }
 
+/// gb50180's rule as the flags give it; `--window-width sill`'s sill lines are measured once the
+/// points are placed ([`whole_window_of_each`]).
 fn gb_rule(args: &MapArgs) -> Result<Gb50180Rule> {
-    Gb50180Rule::from_options(args.day.as_deref(), args.required_hours, args.min_period, args.max_periods, args.window_width)
+    let width = args.window_width.as_deref().map(WholeWindow::parse).transpose()?.and_then(WholeWindow::width);
+    Gb50180Rule::from_options(args.day.as_deref(), args.required_hours, args.min_period, args.max_periods, width)
+}
+
+/// Each window's own 满窗 sill: `--window-widths`' rows, or `--window-width sill`'s sill lines
+/// measured from the windows at their sill points.
+fn whole_window_of_each(args: &MapArgs, rule: &mut Gb50180Rule, scene: &Scene, points: &Points) -> Result<()> {
+    if let Some(path) = &args.window_widths {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
+        rule.window_widths = Some(sill_widths(scene, points, &path.display().to_string(), &text)?);
+    }
+    if args.window_width.as_deref().map(WholeWindow::parse).transpose()? == Some(WholeWindow::Sill) {
+        let at = args.window_points.as_deref().map(WindowPoint::parse).transpose()?;
+        rule.sill_lines = Some(sill_lines(scene, points, at, args.floor_level)?);
+    }
+    rule.check()
 }
 
 /// en17037's rule: `--period MM-DD` (one day, 1 February – 21 March) and `--min-altitude`.
@@ -138,10 +156,8 @@ pub(super) fn run(args: MapArgs) -> Result<()> {
     let scene = args.model.load()?;
     let load_seconds = start.elapsed().as_secs_f64();
     let points = args.points(&scene)?;
-    if let (Some(rule), Some(path)) = (gb.as_mut(), &args.window_widths) {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
-        rule.window_widths = Some(sill_widths(&scene, &points, &path.display().to_string(), &text)?);
-        rule.check()?;
+    if let Some(rule) = gb.as_mut() {
+        whole_window_of_each(&args, rule, &scene, &points)?;
     }
     let masks = mask_rows(args.mask.as_deref(), points.len())?;
     let before = (!args.before.is_empty()).then(|| model::load(&args.before, &args.model.options())).transpose()?;

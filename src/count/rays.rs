@@ -105,22 +105,23 @@ impl RayCaster {
             })
             .collect();
         let mut nodes = vec![Node { lo: Vec3::ZERO, hi: Vec3::ZERO, start: 0, count: 0 }];
-        let mut todo = vec![(0usize, 0usize, items.len(), 1usize)];
+        // Each node's bounds come with it (the root's from one pass, a child's from its parent's
+        // bins), so a split reads its items twice: once to bin them, once to part them.
+        let mut todo = vec![(0usize, 0usize, items.len(), 1usize, Span::of(&items))];
         let mut depth = 1;
-        while let Some((node, from, to, level)) = todo.pop() {
+        while let Some((node, from, to, level, span)) = todo.pop() {
             depth = depth.max(level);
-            let (lo, hi) = bounds(&items[from..to]);
-            nodes[node].lo = lo;
-            nodes[node].hi = hi;
-            match split(&mut items[from..to]) {
-                Some(mid) => {
+            nodes[node].lo = span.lo;
+            nodes[node].hi = span.hi;
+            match split(&mut items[from..to], &span) {
+                Some((mid, left, right)) => {
                     let first = nodes.len();
                     nodes.push(nodes[node]);
                     nodes.push(nodes[node]);
                     nodes[node].start = first as u32;
                     nodes[node].count = 0;
-                    todo.push((first, from, from + mid, level + 1));
-                    todo.push((first + 1, from + mid, to, level + 1));
+                    todo.push((first, from, from + mid, level + 1, left));
+                    todo.push((first + 1, from + mid, to, level + 1, right));
                 }
                 None => {
                     nodes[node].start = from as u32;
@@ -240,8 +241,30 @@ fn next_down(f: f32, x: f64) -> f32 {
     if f64::from(f) <= x { f } else { f.next_down() }
 }
 
-fn bounds(items: &[Item]) -> (Vec3, Vec3) {
-    items.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), it| (lo.min(it.lo), hi.max(it.hi)))
+/// A set of items' bounds: their boxes' (`lo`..`hi`) and their centres' (`clo`..`chi`).
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    lo: Vec3,
+    hi: Vec3,
+    clo: Vec3,
+    chi: Vec3,
+}
+
+impl Span {
+    /// Nothing: the identity of [`Self::add`].
+    const EMPTY: Self = Self { lo: Vec3::MAX, hi: Vec3::MIN, clo: Vec3::MAX, chi: Vec3::MIN };
+
+    fn of(items: &[Item]) -> Self {
+        items.iter().fold(Self::EMPTY, |s, it| s.add(it))
+    }
+
+    fn add(self, it: &Item) -> Self {
+        Self { lo: self.lo.min(it.lo), hi: self.hi.max(it.hi), clo: self.clo.min(it.centre), chi: self.chi.max(it.centre) }
+    }
+
+    fn union(self, o: Self) -> Self {
+        Self { lo: self.lo.min(o.lo), hi: self.hi.max(o.hi), clo: self.clo.min(o.clo), chi: self.chi.max(o.chi) }
+    }
 }
 
 fn area(lo: Vec3, hi: Vec3) -> f32 {
@@ -249,13 +272,14 @@ fn area(lo: Vec3, hi: Vec3) -> f32 {
     d.x * d.y + d.y * d.z + d.z * d.x
 }
 
-/// Splits `items` in place by the binned surface-area heuristic; the first part's length, or
-/// `None` for a leaf.
-fn split(items: &mut [Item]) -> Option<usize> {
+/// Splits `items` (bounded by `span`) in place by the binned surface-area heuristic: the first
+/// part's length and each part's bounds (min and max are exact, so a part's bounds gathered from
+/// its bins are the ones its items would give), or `None` for a leaf.
+fn split(items: &mut [Item], span: &Span) -> Option<(usize, Span, Span)> {
     if items.len() <= LEAF_TRIANGLES {
         return None;
     }
-    let (clo, chi) = items.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), it| (lo.min(it.centre), hi.max(it.centre)));
+    let (clo, chi) = (span.clo, span.chi);
     let extent = chi - clo;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -270,26 +294,26 @@ fn split(items: &mut [Item]) -> Option<usize> {
     let scale = BINS as f32 / extent[axis];
     let bin = |it: &Item| (((it.centre[axis] - clo[axis]) * scale) as usize).min(BINS - 1);
     let mut counts = [0usize; BINS];
-    let mut boxes = [(Vec3::MAX, Vec3::MIN); BINS];
+    let mut boxes = [Span::EMPTY; BINS];
     for it in items.iter() {
         let b = bin(it);
         counts[b] += 1;
-        boxes[b] = (boxes[b].0.min(it.lo), boxes[b].1.max(it.hi));
+        boxes[b] = boxes[b].add(it);
     }
     // Costs of splitting after bin k: left areas from the left, right ones from the right.
     let mut right = [0.0f32; BINS];
-    let (mut acc, mut n) = ((Vec3::MAX, Vec3::MIN), 0usize);
+    let (mut acc, mut n) = (Span::EMPTY, 0usize);
     for k in (1..BINS).rev() {
-        acc = (acc.0.min(boxes[k].0), acc.1.max(boxes[k].1));
+        acc = acc.union(boxes[k]);
         n += counts[k];
-        right[k] = area(acc.0, acc.1) * n as f32;
+        right[k] = area(acc.lo, acc.hi) * n as f32;
     }
     let (mut best, mut best_cost) = (0usize, f32::MAX);
-    let (mut acc, mut n) = ((Vec3::MAX, Vec3::MIN), 0usize);
+    let (mut acc, mut n) = (Span::EMPTY, 0usize);
     for k in 0..BINS - 1 {
-        acc = (acc.0.min(boxes[k].0), acc.1.max(boxes[k].1));
+        acc = acc.union(boxes[k]);
         n += counts[k];
-        let cost = area(acc.0, acc.1) * n as f32 + right[k + 1];
+        let cost = area(acc.lo, acc.hi) * n as f32 + right[k + 1];
         if n > 0 && n < items.len() && cost < best_cost {
             best_cost = cost;
             best = k;
@@ -305,7 +329,9 @@ fn split(items: &mut [Item]) -> Option<usize> {
             mid += 1;
         }
     }
-    Some(mid)
+    let left = boxes[..=best].iter().fold(Span::EMPTY, |a, &b| a.union(b));
+    let right = boxes[best + 1..].iter().fold(Span::EMPTY, |a, &b| a.union(b));
+    Some((mid, left, right))
 }
 
 #[cfg(test)]

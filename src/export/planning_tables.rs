@@ -17,6 +17,9 @@ use crate::map::planning::{apsh, bre_lines, en17037, mask, vsc};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 
+/// How gb50180's 满窗 rule takes each window's sill from its geometry, as the report states it.
+pub const SILL_LINE_RULE: &str = "each window's own sill line, from its geometry: its lowest edge (the vertices within 1 mm of its lowest height, from the leftmost to the rightmost along the wall), or with a ground-floor level where the window reaches below the sill height, its chord at that height; sampled from end to end every 0.1 m or less, a minute counting only when every sample sees the sun";
+
 /// 1.0 for true, 0.0 for false (the report's values are numbers).
 pub fn zero_one(flags: &[bool]) -> Vec<f64> {
     flags.iter().map(|&f| if f { 1.0 } else { 0.0 }).collect()
@@ -190,10 +193,13 @@ pub fn tables(
             "whole_window_width_m": rule.whole_window,
             "step_minutes": gb50180::STEP_MINUTES,
         });
-        // Each window's own width, per point in order, only where given (the reports stay as
-        // they were with one width).
-        if let Some(widths) = &rule.window_widths {
-            rule_json["whole_window_widths_m"] = json!(widths);
+        // Each window's own width, per point in order, only where each has one (the reports
+        // stay as they were with one width); measured sills to the 0.1 mm.
+        if let Some(widths) = rule.own_widths() {
+            rule_json["whole_window_widths_m"] = json!(widths.iter().map(|w| (w * 1e4).round() / 1e4).collect::<Vec<_>>());
+        }
+        if rule.sill_lines.is_some() {
+            rule_json["whole_window_sill"] = json!(SILL_LINE_RULE);
         }
         out.push(StudyTable {
             study: "gb50180".into(),

@@ -504,7 +504,9 @@ impl LitBits {
 
 /// Runs `work` on every core (natively; on the web once, on the calling thread: it has no
 /// threads to spawn) and returns what each run returned. `done` counts finished units of
-/// `total`, reported through `progress` from the calling thread every 100 ms.
+/// `total`, reported through `progress` from the calling thread every 100 ms. The calling thread
+/// wakes as soon as the last run ends (each says so on a channel), not at its next report: a
+/// window study runs a dozen short sweeps, and a sleep's remainder after each was wall time.
 fn run_on_every_core<S: Send>(
     total: usize,
     done: &AtomicUsize,
@@ -517,11 +519,31 @@ fn run_on_every_core<S: Send>(
         return vec![s];
     }
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, total.max(1));
+    let (ended, ends) = std::sync::mpsc::channel::<()>();
     std::thread::scope(|scope| {
-        let workers: Vec<_> = (0..threads).map(|_| scope.spawn(&work)).collect();
-        while workers.iter().any(|w| !w.is_finished()) {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                let (ended, work) = (ended.clone(), &work);
+                scope.spawn(move || {
+                    let s = work();
+                    // The receiver outlives every worker (the scope joins them first).
+                    let _ = ended.send(());
+                    s
+                })
+            })
+            .collect();
+        // Only the workers hold senders now: a worker that unwinds drops its own, so the channel
+        // closes once every worker has ended either way.
+        drop(ended);
+        let mut running = threads;
+        while running > 0 {
             progress(done.load(Ordering::Relaxed), total);
-            std::thread::sleep(std::time::Duration::from_millis(100));
+            match ends.recv_timeout(std::time::Duration::from_millis(100)) {
+                Ok(()) => running -= 1,
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+                // Every sender gone: each worker has ended or unwound (join says which).
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+            }
         }
         progress(total, total);
         workers.into_iter().filter_map(|w| w.join().ok()).collect()

@@ -1,7 +1,9 @@
 //! `engine.study`: the window studies in the browser ([`crate::map::planning`]), translated to
 //! and from JS. Its options are read by [`super::study_options`]; the points are the library's
 //! (each window's by [`window_points`], its sill raised above a floor level by [`floor_sills`],
-//! or given ones, as `sunlit map --window-points`, `--floor-level` and `--points` take them), the studies [`run::before_after`]'s (with an existing scene, `--before`),
+//! or given ones, as `sunlit map --window-points`, `--floor-level` and `--points` take them), GB
+//! 50180's 满窗 sills each window's own where asked (measured or given, as `--window-width sill`
+//! and `--window-widths`), the studies [`run::before_after`]'s (with an existing scene, `--before`),
 //! the tables, their CSV, the sky masks and the HTML report the library's writers', so a study's
 //! CSV is `sunlit map`'s `POINTS.study-NAME.csv` and its report `--html`'s, byte for byte. No
 //! study logic lives here or in JS.
@@ -120,6 +122,10 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
     let before = before.map(|m| m.inner.clone());
     let request = request_from_js(options).map_err(study_error)?;
     let points = points_of(&model.scene, &request.place, request.floor_level).map_err(study_error)?;
+    let mut gb = request.gb.clone();
+    if let Some(rule) = gb.as_mut() {
+        request.whole_window_of_each(rule, &model.scene, &points).map_err(study_error)?;
+    }
     let calendar = request.location.as_ref().map(|l| LeafCalendar::for_latitude(l.latitude));
     let site = request.location.as_ref().zip(calendar.as_ref()).map(|(location, calendar)| Site {
         location,
@@ -137,12 +143,12 @@ fn run_study(model: &Model, before: Option<&Model>, options: &JsValue) -> Result
         &points,
         before.as_ref().map(|b| (&b.scene, from.as_str())),
         site,
-        Rules { gb: request.gb.as_ref(), en17037: request.en17037.as_ref() },
+        Rules { gb: gb.as_ref(), en17037: request.en17037.as_ref() },
         &mut |_| {},
         &mut |_| {},
     )
     .map_err(study_error)?;
-    let (gb, location) = (request.gb.as_ref(), request.location.as_ref());
+    let (gb, location) = (gb.as_ref(), request.location.as_ref());
     let tables = compared_tables(&now, former.as_ref(), points.len(), gb, location);
     let masks = mask_svgs(&model.scene, &points, &request.masks.rows(points.len()), location, gb).map_err(study_error)?;
     let place = match &request.place {

@@ -2,7 +2,8 @@
 //! terms: which window studies ([`run::WINDOW_STUDIES`]), where (the windows' own points, found by
 //! [`WindowPoint`], the sills raised above a ground-floor level as `--floor-level` raises them,
 //! or given points), the site (a location or an EPW), GB 50180's rule
-//! ([`Gb50180Rule::from_options`]), EN 17037's ([`En17037Rule::new`]), the sky model ([`run::check_sky_model`]), and what the report
+//! ([`Gb50180Rule::from_options`], with each window's own 满窗 sill: `windowWidth: 'sill'` measured
+//! from the geometry, or `windowWidths` given by name), EN 17037's ([`En17037Rule::new`]), the sky model ([`run::check_sky_model`]), and what the report
 //! draws and states (`masks`, the files' names). `before`, the existing scene, is a model, not
 //! JSON: sunlit.js hands it to the wasm call beside the options. The studies
 //! themselves are the library's ([`crate::map::planning::run`]); this only reads names. Plain
@@ -11,16 +12,20 @@
 use serde_json::{Map, Value};
 
 use crate::error::{Error, Result};
+use crate::map::Points;
 use crate::map::period::parse_date;
 use crate::map::planning::en17037::En17037Rule;
 use crate::map::planning::gb50180::Gb50180Rule;
 use crate::map::planning::run;
+use crate::map::planning::sill_lines::sill_lines;
+use crate::map::planning::sill_widths::{WholeWindow, named_widths, sill_widths};
 use crate::map::planning::window_points::WindowPoint;
+use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::weather::Weather;
 
 /// The keys of the options object.
-pub const STUDY_KEYS: [&str; 22] = [
+pub const STUDY_KEYS: [&str; 23] = [
     "study",
     "windows",
     "windowPoints",
@@ -37,6 +42,7 @@ pub const STUDY_KEYS: [&str; 22] = [
     "minPeriod",
     "maxPeriods",
     "windowWidth",
+    "windowWidths",
     "period",
     "minAltitude",
     "before",
@@ -46,7 +52,7 @@ pub const STUDY_KEYS: [&str; 22] = [
 ];
 
 /// GB 50180's own keys: refused beside the other studies, as `sunlit map` refuses `--day`….
-const GB_KEYS: [&str; 5] = ["day", "requiredHours", "minPeriod", "maxPeriods", "windowWidth"];
+const GB_KEYS: [&str; 6] = ["day", "requiredHours", "minPeriod", "maxPeriods", "windowWidth", "windowWidths"];
 
 /// EN 17037's own keys (`--period`, `--min-altitude`): refused without en17037.
 const EN17037_KEYS: [&str; 2] = ["period", "minAltitude"];
@@ -73,8 +79,13 @@ pub struct StudyRequest {
     pub weather: Option<Weather>,
     /// The EPW's name (`epwName`, or `EPW`), as the report states it; none without an EPW.
     pub epw_name: Option<String>,
-    /// GB 50180's rule, when gb50180 is asked.
+    /// GB 50180's rule, when gb50180 is asked (each window's own sill is set on it once the
+    /// points are placed: [`Self::whole_window_of_each`]).
     pub gb: Option<Gb50180Rule>,
+    /// `windowWidth: 'sill'`: each window's own sill line, measured from its geometry.
+    pub sill_of_each: bool,
+    /// `windowWidths`: each window's own sill width, by its name.
+    pub window_widths: Option<GivenWidths>,
     /// EN 17037's rule, when en17037 is asked.
     pub en17037: Option<En17037Rule>,
     /// The ground floor's level (m, the model's heights) that the windows' sills are raised
@@ -85,6 +96,15 @@ pub struct StudyRequest {
     /// The proposed and the existing model's file names, as the report states them (the CLI's
     /// `MODEL...` and `--before MODEL...`).
     pub names: (Vec<String>, Vec<String>),
+}
+
+/// Each window's own 满窗 width, as `windowWidths` gives it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GivenWidths {
+    /// The text of a `receiver,width` CSV, as `--window-widths FILE.csv` reads it.
+    Csv(String),
+    /// Width (m) by window name: `{ WIN_S1: 1.5, … }`.
+    Named(Vec<(String, f64)>),
 }
 
 /// Which points' sky masks are drawn.
@@ -140,6 +160,8 @@ impl StudyRequest {
             }
             (None, None) => None,
         };
+        let whole = whole_window(&all)?;
+        let window_widths = given_widths(&all)?;
         let gb = gb
             .then(|| {
                 let max_periods = match number(&all, "maxPeriods")? {
@@ -152,7 +174,7 @@ impl StudyRequest {
                     number(&all, "requiredHours")?,
                     number(&all, "minPeriod")?,
                     max_periods,
-                    number(&all, "windowWidth")?,
+                    whole.and_then(WholeWindow::width),
                 )
             })
             .transpose()?;
@@ -165,7 +187,60 @@ impl StudyRequest {
         let floor_level = floor_level(&all, &place)?;
         let masks = masks(all.get("masks"))?;
         let names = (names_of(&all, "modelNames")?, names_of(&all, "beforeNames")?);
-        Ok(Self { studies, place, location, weather, epw_name, gb, en17037, floor_level, masks, names })
+        let sill_of_each = whole == Some(WholeWindow::Sill);
+        Ok(Self { studies, place, location, weather, epw_name, gb, sill_of_each, window_widths, en17037, floor_level, masks, names })
+    }
+
+    /// `rule` with each window's own 满窗 sill at `points` of `scene`, where asked: `windowWidths`'
+    /// widths, or `windowWidth: 'sill'`'s sill lines (the points must be the windows' sills);
+    /// checked.
+    pub fn whole_window_of_each(&self, rule: &mut Gb50180Rule, scene: &Scene, points: &Points) -> Result<()> {
+        rule.window_widths = match &self.window_widths {
+            Some(GivenWidths::Csv(text)) => Some(sill_widths(scene, points, "windowWidths", text)?),
+            Some(GivenWidths::Named(widths)) => Some(named_widths(scene, points, widths)?),
+            None => None,
+        };
+        if self.sill_of_each {
+            let at = match &self.place {
+                StudyPlace::Windows(_, at) => Some(*at),
+                StudyPlace::Given(_) => None,
+            };
+            rule.sill_lines = Some(sill_lines(scene, points, at, self.floor_level)?);
+        }
+        rule.check()
+    }
+}
+
+/// `windowWidth`: a width in metres for every window, or `'sill'` (each window's own, measured).
+fn whole_window(all: &Map<String, Value>) -> Result<Option<WholeWindow>> {
+    match all.get("windowWidth") {
+        None => Ok(None),
+        Some(Value::String(text)) => WholeWindow::parse(text).map(Some),
+        Some(Value::Number(n)) => {
+            let width = n.as_f64().ok_or_else(|| Error::argument("window_width", format!("{n} is not a number")))?;
+            Ok(Some(WholeWindow::Width(width)))
+        }
+        Some(other) => Err(Error::argument("window_width", format!("{other} is neither a width in metres nor 'sill'"))),
+    }
+}
+
+/// `windowWidths`: a `receiver,width` CSV's text, or an object of widths by window name.
+fn given_widths(all: &Map<String, Value>) -> Result<Option<GivenWidths>> {
+    match all.get("windowWidths") {
+        None => Ok(None),
+        Some(Value::String(text)) => Ok(Some(GivenWidths::Csv(text.clone()))),
+        Some(Value::Object(named)) => named
+            .iter()
+            .map(|(name, w)| {
+                w.as_f64()
+                    .map(|w| (name.clone(), w))
+                    .ok_or_else(|| Error::argument("window_widths", format!("'{name}': {w} is not a width in metres")))
+            })
+            .collect::<Result<_>>()
+            .map(|widths| Some(GivenWidths::Named(widths))),
+        Some(other) => {
+            Err(Error::argument("window_widths", format!("{other} is neither a receiver,width CSV nor an object of widths by window")))
+        }
     }
 }
 

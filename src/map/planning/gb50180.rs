@@ -15,15 +15,17 @@
 //! for the report, is t − EoT − (longitude − 15° · zone)/15 with the equation of time of the
 //! day in a 365-day year (EnergyPlus's SUN3 fit, [`declination_and_equation_of_time`]).
 //!
-//! 满窗 (whole window): the window's sill is sampled across its width ([`whole_window_points`]) and
-//! an instant counts only when every sample sees the sun; one width for every window
-//! ([`Gb50180Rule::whole_window`]) or each window's own ([`Gb50180Rule::window_widths`], read by
-//! [`super::sill_widths`]).
+//! 满窗 (whole window): the window's sill is sampled across its width ([`sill_points`]) and an
+//! instant counts only when every sample sees the sun; one width for every window
+//! ([`Gb50180Rule::whole_window`]), each window's own ([`Gb50180Rule::window_widths`], read by
+//! [`super::sill_widths`]), both centred on the point, or each window's own sill line measured
+//! from its geometry ([`Gb50180Rule::sill_lines`], by [`super::sill_lines`]).
 
 use std::ops::Range;
 
 use glam::DVec3;
 
+use super::sill_lines::SillLine;
 use super::sill_widths;
 use crate::error::{Error, Result};
 use crate::map::study::SunRule;
@@ -130,6 +132,9 @@ pub struct Gb50180Rule {
     /// 满窗 with each point's own sill width (m, in the points' order) instead of
     /// [`Self::whole_window`]'s one.
     pub window_widths: Option<Vec<f64>>,
+    /// 满窗 along each point's window's own sill line (in the points' order), measured from the
+    /// geometry, instead of a width centred on the point.
+    pub sill_lines: Option<Vec<SillLine>>,
 }
 
 impl Gb50180Rule {
@@ -142,6 +147,7 @@ impl Gb50180Rule {
             max_periods: None,
             whole_window: None,
             window_widths: None,
+            sill_lines: None,
         }
     }
 
@@ -191,6 +197,14 @@ impl Gb50180Rule {
                 return Err(Error::argument("window_widths", format!("point {}: {w} m is not in (0, {}]", i + 1, sill_widths::MAX_WIDTH)));
             }
         }
+        if self.sill_lines.is_some() {
+            if self.whole_window.is_some() {
+                return Err(Error::argument("window_width", "give one width for every window or each window's own sill, not both"));
+            }
+            if self.window_widths.is_some() {
+                return Err(Error::argument("window_widths", "give each window's width or measure its sill (window_width sill), not both"));
+            }
+        }
         Ok(())
     }
 
@@ -198,15 +212,36 @@ impl Gb50180Rule {
     /// them): each keeps its own sill width.
     pub fn at_points(&self, index: &[usize]) -> Self {
         let window_widths = self.window_widths.as_ref().map(|w| index.iter().filter_map(|&i| w.get(i).copied()).collect());
-        Self { window_widths, ..self.clone() }
+        let sill_lines = self.sill_lines.as_ref().map(|l| index.iter().filter_map(|&i| l.get(i).copied()).collect());
+        Self { window_widths, sill_lines, ..self.clone() }
     }
 
-    /// Point `i`'s 满窗 width, if the rule asks for the whole window.
-    fn sill_width(&self, i: usize) -> Option<f64> {
-        match &self.window_widths {
+    /// Whether the rule asks for the whole window (满窗).
+    pub fn asks_whole_window(&self) -> bool {
+        self.whole_window.is_some() || self.window_widths.is_some() || self.sill_lines.is_some()
+    }
+
+    /// Each point's 满窗 width (m, in the points' order), where each window has its own: given
+    /// ([`Self::window_widths`]) or its sill line's ([`Self::sill_lines`]).
+    pub fn own_widths(&self) -> Option<Vec<f64>> {
+        match (&self.window_widths, &self.sill_lines) {
+            (Some(widths), _) => Some(widths.clone()),
+            (None, Some(lines)) => Some(lines.iter().map(SillLine::width).collect()),
+            (None, None) => None,
+        }
+    }
+
+    /// Point `i`'s sill, at `points`, if the rule asks for the whole window: its window's sill
+    /// line, or a width centred on the point (horizontal in its plane).
+    fn sill_of(&self, points: &Points, i: usize) -> Option<SillLine> {
+        if let Some(lines) = &self.sill_lines {
+            return lines.get(i).copied();
+        }
+        let width = match &self.window_widths {
             Some(widths) => widths.get(i).copied(),
             None => self.whole_window,
-        }
+        }?;
+        Some(centred(points.position(i), points.normal(i), width))
     }
 
     /// The period rule of [`SunRule::hours`] with this rule's minimum and longest periods.
@@ -249,20 +284,25 @@ pub fn instants(day: StandardDay) -> Vec<Sample> {
     (0..count).map(|k| Sample { day: day.day_of_year(), hour: from + (k as f64 + 0.5) * hours, hours, epw_hour: 0 }).collect()
 }
 
-/// `points` with, per point, its sill samples across `width(i)` metres (horizontal in its
-/// plane, centred on it, every [`SILL_SPACING`] or less, at least 3) appended in order, and where
+/// A sill `width` m wide centred on `p` (normal `n`), horizontal in its plane.
+fn centred(p: DVec3, n: DVec3, width: f64) -> SillLine {
+    let across = if n.z.abs() < 0.9 { DVec3::Z.cross(n).normalize() } else { DVec3::X };
+    SillLine { from: p - across * (width / 2.0), to: p + across * (width / 2.0) }
+}
+
+/// `points` with, per point, samples along its sill `sill(i)` from end to end (every
+/// [`SILL_SPACING`] or less, at least 3, on the point's receiver) appended in order, and where
 /// each point's samples are among them.
-pub fn whole_window_points(points: &Points, width: impl Fn(usize) -> f64) -> (Points, Vec<Range<usize>>) {
+pub fn sill_points(points: &Points, sill: impl Fn(usize) -> SillLine) -> (Points, Vec<Range<usize>>) {
     let mut out = points.clone();
     let mut ranges = Vec::with_capacity(points.len());
     for i in 0..points.len() {
-        let (p, n, width) = (points.position(i), points.normal(i), width(i));
-        let samples = ((width / SILL_SPACING).ceil() as usize + 1).max(3);
-        let across = if n.z.abs() < 0.9 { DVec3::Z.cross(n).normalize() } else { DVec3::X };
+        let (line, n) = (sill(i), points.normal(i));
+        let samples = ((line.width() / SILL_SPACING).ceil() as usize + 1).max(3);
         ranges.push(out.len()..out.len() + samples);
         for k in 0..samples {
-            let offset = width * (k as f64 / (samples - 1) as f64 - 0.5);
-            out.push(p + across * offset, n, points.receivers[i]);
+            let t = k as f64 / (samples - 1) as f64;
+            out.push(line.from + (line.to - line.from) * t, n, points.receivers[i]);
         }
     }
     (out, ranges)
@@ -302,9 +342,15 @@ pub fn evaluate_on(
     if let Some(widths) = rule.window_widths.as_ref().filter(|w| w.len() != n) {
         return Err(Error::argument("window_widths", format!("{} widths for {n} points", widths.len())));
     }
-    let whole = rule.sill_width(0).is_some();
-    let (all, ranges) =
-        if whole { whole_window_points(points, |i| rule.sill_width(i).unwrap_or(0.0)) } else { (points.clone(), Vec::new()) };
+    if let Some(lines) = rule.sill_lines.as_ref().filter(|l| l.len() != n) {
+        return Err(Error::argument("window_width", format!("{} sill lines for {n} points", lines.len())));
+    }
+    let whole = rule.asks_whole_window();
+    let (all, ranges) = if whole {
+        sill_points(points, |i| rule.sill_of(points, i).unwrap_or(SillLine { from: points.position(i), to: points.position(i) }))
+    } else {
+        (points.clone(), Vec::new())
+    };
     let windows = super::Windows::on(scene, tree, &all)?;
     let samples = instants(rule.day);
     let leaves = LeafCalendar::for_latitude(location.latitude).fraction(f64::from(rule.day.day_of_year())) as f32;

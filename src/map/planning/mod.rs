@@ -11,7 +11,8 @@
 //! - [`mask`]: what a point sees of the sky and the sun's paths, for its stereographic diagram;
 //! - [`run`]: every study asked, on one scene, sharing its shadow-ray tree;
 //! - [`window_points`]: each window's reference point or sill, found from its geometry;
-//! - [`sill_widths`]: each window's own 满窗 sill width, read from a CSV.
+//! - [`sill_widths`]: each window's own 满窗 sill width, read from a CSV (or given by name);
+//! - [`sill_lines`]: each window's own 满窗 sill line, measured from its geometry.
 //!
 //! The points are [`Windows`]: any list of directions is asked of them (not a period's suns),
 //! answered by shadow rays through a BVH of the scene ([`crate::count::rays`]), or by the
@@ -24,6 +25,7 @@ pub mod en17037;
 pub mod gb50180;
 pub mod mask;
 pub mod run;
+pub mod sill_lines;
 pub mod sill_widths;
 pub mod vsc;
 pub mod window_points;

@@ -139,6 +139,14 @@ fn centroid(r: &Receiver) -> DVec3 {
 
 /// The middle of a receiver's lowest edge (see the module's docs).
 fn sill(r: &Receiver) -> Result<DVec3> {
+    lowest_edge(r).map(|(a, b)| (a + b) / 2.0)
+}
+
+/// A receiver's lowest edge, its ends left and right along the wall (seen from outside): the
+/// lowest vertices, within [`EDGE_TOLERANCE`] of the lowest height, furthest apart along the
+/// wall (one corner at both ends where the window stands on it). Refuses a receiver lying flat,
+/// naming `window_points`.
+pub fn lowest_edge(r: &Receiver) -> Result<(DVec3, DVec3)> {
     if r.normal.z.abs() > FLAT {
         return Err(Error::argument(
             "window_points",
@@ -153,7 +161,7 @@ fn sill(r: &Receiver) -> Result<DVec3> {
     let left = bottom().min_by(|a, b| a.dot(along).total_cmp(&b.dot(along)));
     let right = bottom().max_by(|a, b| a.dot(along).total_cmp(&b.dot(along)));
     match left.zip(right) {
-        Some((a, b)) => Ok((*a + *b) / 2.0),
+        Some((a, b)) => Ok((*a, *b)),
         None => Err(Error::argument("window_points", format!("receiver '{}' ({}) has no finite vertices", r.name, r.origin))),
     }
 }
