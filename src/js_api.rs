@@ -237,7 +237,8 @@ fn map_options_read_as_sunlit_map_reads_its_flags() {
     assert_eq!(request(json!({"at": "12-21 15:00", "inside": false})).unwrap().inside, None);
     // A mesh model's rooms and panes (`--interior`, `--glazing`), as text or an array of globs;
     // an EnergyPlus model's unread glass by its curve (`--glass-curve`).
-    let rooms = request(json!({"at": "12-21 15:00", "inside": true, "interior": "Room*, Hall", "glazing": ["Glass*"], "glassTransmittance": 0.6}));
+    let rooms =
+        request(json!({"at": "12-21 15:00", "inside": true, "interior": "Room*, Hall", "glazing": ["Glass*"], "glassTransmittance": 0.6}));
     let globs = |g: &[&str]| g.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     let ask = InsideAsk { glass: Some(0.6), interior: globs(&["Room*", "Hall"]), glazing: globs(&["Glass*"]), ..Default::default() };
     assert_eq!(rooms.unwrap().inside, Some(ask));

@@ -222,7 +222,8 @@ impl Engine {
         transmittance: Option<String>,
     ) -> Result<Model, JsValue> {
         let kept = (names.clone(), contents.clone());
-        let (loaded, variants, reload, options) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
+        let (loaded, variants, reload, options) =
+            load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
         let model = self.model(loaded.scene, loaded.energyplus, loaded.notes)?;
         let mut inner = Rc::try_unwrap(model.inner).map_err(|_| js_error(Error::argument("model", "shared while loading")))?;
         inner.variants.extend(variants.into_iter().map(Variant::new));

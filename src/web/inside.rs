@@ -99,7 +99,8 @@ fn build(model: &ModelInner, key: &InsideKey) -> Result<InsideScene> {
     let ask = &key.ask;
     let (mut scene, rooms) = match (&model.energyplus, ask.interior.is_empty()) {
         (Some(ep), true) => {
-            let curve = ask.curve.as_deref().map(TransmittanceCurve::parse).transpose().map_err(|why| Error::argument("glassCurve", why))?;
+            let curve =
+                ask.curve.as_deref().map(TransmittanceCurve::parse).transpose().map_err(|why| Error::argument("glassCurve", why))?;
             (inside_scene(ep)?, rooms_with(ep, &UnreadGlass { transmittance: ask.glass, curve })?)
         }
         (Some(ep), false) => {

@@ -302,7 +302,8 @@ fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideA
         Some(Value::Bool(true)) => true,
         Some(other) => return Err(Error::argument("inside", format!("{other} is not true or false"))),
     };
-    let (work_plane, glass) = (number("workPlane", all.remove("workPlane"))?, number("glassTransmittance", all.remove("glassTransmittance"))?);
+    let (work_plane, glass) =
+        (number("workPlane", all.remove("workPlane"))?, number("glassTransmittance", all.remove("glassTransmittance"))?);
     let curve = text_of("glassCurve", all.remove("glassCurve"))?;
     let study = text_of("study", all.remove("study"))?.as_deref().map(InsideStudy::parse).transpose()?;
     let (interior, glazing) = (globs_of("interior", all.remove("interior"))?, globs_of("glazing", all.remove("glazing"))?);
@@ -325,7 +326,10 @@ fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideA
     }
     if let Some(text) = &curve {
         if !interior.is_empty() {
-            return Err(Error::argument("glassCurve", "is for an EnergyPlus model's glazing: a glTF pane's curve is its material's extras"));
+            return Err(Error::argument(
+                "glassCurve",
+                "is for an EnergyPlus model's glazing: a glTF pane's curve is its material's extras",
+            ));
         }
         TransmittanceCurve::parse(text).map_err(|why| Error::argument("glassCurve", why))?;
     }
