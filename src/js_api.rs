@@ -216,8 +216,8 @@ fn map_options_read_as_sunlit_map_reads_its_flags() {
     let at = request(json!({"at": "03-21 09:30"})).unwrap();
     assert_eq!((at.period, at.value), (Period::at(80, 570).unwrap(), MapValue::Lit));
     let inside = request(json!({"at": "12-21 15:00", "inside": true, "workPlane": 0.76, "glassTransmittance": 0.6})).unwrap();
-    assert_eq!(inside.inside, Some(InsideAsk { work_plane: 0.76, glass: Some(0.6), study: None }));
-    let bare = Some(InsideAsk { work_plane: 0.0, glass: None, study: None });
+    assert_eq!(inside.inside, Some(InsideAsk { work_plane: 0.76, glass: Some(0.6), ..Default::default() }));
+    let bare = Some(InsideAsk::default());
     assert_eq!(request(json!({"at": "12-21 15:00", "inside": true})).unwrap().inside, bare);
     // Inside over a period (`--inside --period`): the CLI's defaults, and its EPW read for the beam.
     let days = request(json!({"inside": true, "period": "12-01..12-07"})).unwrap();
@@ -228,13 +228,22 @@ fn map_options_read_as_sunlit_map_reads_its_flags() {
     assert!(request(json!({"inside": true, "period": "12-21", "epw": epw})).unwrap().weather.is_some(), "sun hours and the beam, as --epw");
     // A study (`--study leed-ase`, `bre-nsl`): its grid, work plane, year and value.
     let ase = request(json!({"inside": true, "study": "leed-ase", "epw": epw})).unwrap();
-    let ask = Some(InsideAsk { work_plane: 0.76, glass: None, study: Some(InsideStudy::LeedAse) });
+    let ask = Some(InsideAsk { work_plane: 0.76, study: Some(InsideStudy::LeedAse), ..Default::default() });
     assert_eq!((ase.inside, ase.place, ase.period, ase.value), (ask, Where::Grid(0.6), Period::annual(1).unwrap(), MapValue::AseHours));
     let nsl = request(json!({"inside": true, "study": "bre-nsl", "grid": 0.25, "workPlane": 1.0})).unwrap();
-    let ask = Some(InsideAsk { work_plane: 1.0, glass: None, study: Some(InsideStudy::BreNsl) });
+    let ask = Some(InsideAsk { work_plane: 1.0, study: Some(InsideStudy::BreNsl), ..Default::default() });
     assert_eq!((nsl.inside, nsl.place, nsl.value), (ask, Where::Grid(0.25), MapValue::SeesSky));
     assert_eq!(request(json!({"inside": true, "study": "bre-nsl"})).unwrap().inside.map(|i| i.work_plane), Some(0.85));
     assert_eq!(request(json!({"at": "12-21 15:00", "inside": false})).unwrap().inside, None);
+    // A mesh model's rooms and panes (`--interior`, `--glazing`), as text or an array of globs;
+    // an EnergyPlus model's unread glass by its curve (`--glass-curve`).
+    let rooms =
+        request(json!({"at": "12-21 15:00", "inside": true, "interior": "Room*, Hall", "glazing": ["Glass*"], "glassTransmittance": 0.6}));
+    let globs = |g: &[&str]| g.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let ask = InsideAsk { glass: Some(0.6), interior: globs(&["Room*", "Hall"]), glazing: globs(&["Glass*"]), ..Default::default() };
+    assert_eq!(rooms.unwrap().inside, Some(ask));
+    let curve = request(json!({"at": "12-21 15:00", "inside": true, "glassCurve": "0:0.6,60:0.5"})).unwrap().inside;
+    assert_eq!(curve.and_then(|i| i.curve).as_deref(), Some("0:0.6,60:0.5"));
     let given = request(json!({"points": [1, 2, 3, 0, 0, 1]})).unwrap();
     assert_eq!(given.place, Where::Given(vec![1.0, 2.0, 3.0, 0.0, 0.0, 1.0]));
     assert_eq!(map_options::points_csv(&[1.0, 2.5, 3.0, 0.0, 0.0, 1.0]).unwrap(), "x,y,z,nx,ny,nz\n1.0,2.5,3.0,0.0,0.0,1.0\n");
@@ -290,6 +299,14 @@ fn bad_map_options_are_refused_naming_the_option() {
     assert_eq!(named(json!({"at": "12-21 15:00", "inside": "yes"})), bad("inside"));
     assert_eq!(named(json!({"at": "12-21 15:00", "workPlane": 0.76})), bad("workPlane"), "a work plane without inside");
     assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glassTransmittance": "clear"})), bad("glassTransmittance"));
+    assert_eq!(named(json!({"at": "12-21 15:00", "interior": "Room"})), bad("interior"), "rooms without inside");
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glazing": "Glass"})), bad("glazing"), "panes without rooms");
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "interior": 3})), bad("interior"));
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "interior": ["Room", 1]})), bad("interior"));
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glassCurve": "10:0.6"})), bad("glassCurve"), "not from 0°");
+    assert_eq!(named(json!({"at": "12-21 15:00", "inside": true, "glassCurve": "0:0.5,40:0.6"})), bad("glassCurve"), "rising");
+    let with_rooms = json!({"at": "12-21 15:00", "inside": true, "interior": "Room", "glassCurve": "0:0.6"});
+    assert_eq!(named(with_rooms), bad("glassCurve"), "a glTF pane's curve is its material's");
     assert_eq!(MapRequest::from_value(json!({"grid": 1})).err().map(|e| e.code()), Some("bad-option"), "no location");
 }
 

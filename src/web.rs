@@ -221,11 +221,18 @@ impl Engine {
         foliage: Option<String>,
         transmittance: Option<String>,
     ) -> Result<Model, JsValue> {
-        let (loaded, variants, reload) = load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
+        let kept = (names.clone(), contents.clone());
+        let (loaded, variants, reload, options) =
+            load_files(names, contents, receivers, north, foliage, transmittance).map_err(js_error)?;
         let model = self.model(loaded.scene, loaded.energyplus, loaded.notes)?;
         let mut inner = Rc::try_unwrap(model.inner).map_err(|_| js_error(Error::argument("model", "shared while loading")))?;
         inner.variants.extend(variants.into_iter().map(Variant::new));
         inner.reload = reload;
+        // A mesh model's rooms are read again from its files when an inside map marks them
+        // (`interior`, `glazing`); an EnergyPlus model's zones need no files.
+        if inner.energyplus.is_none() {
+            inner.source = Some(inside::Source { names: kept.0, contents: kept.1, options });
+        }
         Ok(Model { inner: Rc::new(inner) })
     }
 
@@ -252,6 +259,8 @@ impl Engine {
             notes,
             exact: Default::default(),
             maps: Default::default(),
+            inside: Default::default(),
+            source: None,
             variants: Vec::new(),
             reload: None,
         };
@@ -395,7 +404,7 @@ fn load_files(
     north: Option<f64>,
     foliage: Option<String>,
     transmittance: Option<String>,
-) -> Result<(crate::model::Loaded, Vec<Scene>, Option<Reload>)> {
+) -> Result<(crate::model::Loaded, Vec<Scene>, Option<Reload>, LoadOptions)> {
     if names.len() != contents.length() as usize {
         return Err(Error::argument("files", format!("{} names for {} contents", names.len(), contents.length())));
     }
@@ -410,16 +419,16 @@ fn load_files(
         ..Default::default()
     };
     let mut loaded = load_bytes_all(&files, &options)?;
-    let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new(), None)) };
+    let Some(ep) = &loaded.energyplus else { return Ok((loaded, Vec::new(), None, options)) };
     // Which shades vary does not depend on the run's calendar. The scene shown has each at its
     // mean τ over hourly values without the weather file's holidays (not known yet); a year's
     // one-scene passes reload it with the run's ([`Reload`]).
     let hourly = RunCalendar { per_hour: 1, leap: false, weather: None };
-    let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new(), None)) };
-    let reload = Reload { files, options };
+    let Some(varying) = VaryingShades::new(&ep.file, &ep.shades, hourly)? else { return Ok((loaded, Vec::new(), None, options)) };
+    let reload = Reload { files, options: options.clone() };
     loaded.scene = reload.scene_with(varying.mean_transmittance())?;
     let variants = (0..varying.variants()).map(|v| reload.scene_with(varying.shade_transmittance(v))).collect::<Result<Vec<_>>>()?;
-    Ok((loaded, variants, Some(reload)))
+    Ok((loaded, variants, Some(reload), options))
 }
 
 /// A model's files and load options, kept when its shades are mixed by τ: a year's one-scene
@@ -459,6 +468,11 @@ struct ModelInner {
     exact: std::cell::OnceCell<ExactEngine>,
     /// The last points `engine.map` was asked for, indexed for shadow rays ([`map`]).
     maps: std::cell::RefCell<Option<map::MapCache>>,
+    /// The inside scene of the last inside map, for the rooms, glass and points it was made for
+    /// ([`inside`]).
+    inside: std::cell::RefCell<Option<(inside::InsideKey, Rc<inside::InsideScene>)>>,
+    /// A mesh model's files and load options, from which an inside map reads its rooms ([`inside`]).
+    source: Option<inside::Source>,
     /// With EnergyPlus shades whose transmittance changes in time: the scene with each such
     /// shade opaque or removed, in [`VaryingShades`]'s order (empty otherwise).
     variants: Vec<Variant>,

@@ -1,5 +1,6 @@
 // The page's interior view (Map mode, "Inside rooms"): engine.map with `inside: true` (sunlit map
-// --inside) on an EnergyPlus model's zones, a grid on their floors at a work plane's height, at
+// --inside) on an EnergyPlus model's zones or a glTF model's rooms (Rooms and Glazing: node
+// globs, as --interior and --glazing), a grid on their floors at a work plane's height, at
 // an instant (the sun patches each inside face gets, said in the status), over the period, or a
 // study of the rooms (LEED ASE, BRE 209's No-Sky Line: each room's share said in the status);
 // and the 3D view able to cut away the roof or one wall, so the floors' cells are seen from
@@ -9,13 +10,18 @@
 export const CUTS = { roof: [2, 1], north: [1, 1], south: [1, -1], east: [0, 1], west: [0, -1] };
 
 /** The options the inside adds to a map request ({} when not asked): an empty work plane is the
- * library's default (0, or the study's own, as the CLI's). */
+ * library's default (0, or the study's own, as the CLI's); a glTF model's rooms and glazing are
+ * globs over its node names, as the fields give them (the library reads and checks them). */
 export function insideOptions($) {
   if (!$('mapinside').checked) return {};
   const o = { inside: true };
   const workPlane = $('mapworkplane').value.trim();
   if (workPlane !== '') o.workPlane = Number(workPlane);
   if ($('mapinsidestudy').value) o.study = $('mapinsidestudy').value;
+  const [interior, glazing, glass] = ['mapinterior', 'mapglazing', 'mapglass'].map((id) => $(id).value.trim());
+  if (interior !== '') o.interior = interior;
+  if (glazing !== '') o.glazing = glazing;
+  if (glass !== '') o.glassTransmittance = Number(glass);
   return o;
 }
 

@@ -434,8 +434,12 @@ export interface MapOptions {
   /** The sky for 'skyDiffuse' and 'total' (needs `epw`), as `sunlit map --sky-model`:
    * 'energyplus' (the default), 'perez-all-weather', 'cie-overcast' or 'uniform'. */
   skyModel?: 'energyplus' | 'perez-all-weather' | 'cie-overcast' | 'uniform';
-  /** Map the inside of an EnergyPlus model's zones, as `sunlit map --inside`: a grid on their
-   * floors (or `points` in them) and the beam through the windows. At the instant `at`, each
+  /** Map the inside of an EnergyPlus model's zones, or of a mesh model's rooms (`interior`), as
+   * `sunlit map --inside`: a grid on their floors (or `points` in them) and the beam through the
+   * windows. The inside scene (the rooms, the points and their shadow-ray index) is kept on the
+   * model for the last rooms, glass and points asked, so a map of the same points again (a time
+   * slider, a study) does not rebuild it. A period or 'leed-ase' calls `onProgress` between
+   * chunks of instants and stops at the next chunk when `signal` aborts. At the instant `at`, each
    * point lit or not, and the answer adds the glass's weights and each inside face's sun patch;
    * over a period, 'sunHours' or 'direct' (the beam through the glass, kWh/m², needs an EPW),
    * the CSV adding with an EPW the beam and the direct-sun illuminance; or a `study`. */
@@ -448,8 +452,21 @@ export interface MapOptions {
    * default; value 'aseHours') or 'bre-nsl' (BRE 209's No-Sky Line; value 'seesSky'). No `at`,
    * `period`, `step`, `from`, `to` or `value`: the study sets them. The answer adds `areas`. */
   study?: 'leed-ase' | 'bre-nsl';
-  /** With `inside`: transmittance (0..1) of glazing whose construction gives none. */
+  /** With `inside`: transmittance (0..1) of glazing whose construction gives none (`--glass-transmittance`);
+   * with `interior`, of panes whose material's extras describe no glass. */
   glassTransmittance?: number;
+  /** With `inside`, an EnergyPlus model's glazing whose construction sunlit cannot read follows
+   * this curve (`--glass-curve`): 'ANGLE:T,...', angles of incidence from 0° and the solar
+   * transmittance there, never rising; `glassTransmittance` is then the visible one. Refused
+   * with `interior` (a glTF pane's curve is its material's extras). */
+  glassCurve?: string;
+  /** With `inside`, a mesh model (loaded with `loadFiles`): globs over node names (as text,
+   * comma-separated, or an array), each matching node one room, its closed shell
+   * (`--interior`). */
+  interior?: string | string[];
+  /** With `interior`: globs over node names, each matching node glass in an opening
+   * (`--glazing`), its material's extras giving its curve, else `glassTransmittance`. */
+  glazing?: string | string[];
 }
 
 /** One room's share in an inside study (`inside: true, study`), as the study's report's `areas`. */

@@ -278,6 +278,21 @@ pub struct InsideValues {
     pub efficacy_hours: usize,
 }
 
+impl InsideValues {
+    /// Adds the sums of `other` (another stretch of the same points' period), so a period summed
+    /// in chunks (the page's, with progress and abort between them) adds up to the one call.
+    pub fn merge(&mut self, other: &InsideValues) {
+        super::add_into(&mut self.sun_hours, &other.sun_hours);
+        for (mine, theirs) in [(&mut self.beam_kwh_m2, &other.beam_kwh_m2), (&mut self.direct_klux_h, &other.direct_klux_h)] {
+            if let (Some(a), Some(b)) = (mine.as_mut(), theirs.as_ref()) {
+                super::add_into(a, b);
+            }
+        }
+        self.instants += other.instants;
+        self.efficacy_hours += other.efficacy_hours;
+    }
+}
+
 /// The direct beam at an instant: DNI (W/m²) and direct normal illuminance (lux), the latter
 /// from [`BEAM_EFFICACY`] when the EPW has none.
 fn beam(weather: &Weather, s: &Sample) -> (f64, f64) {
@@ -288,8 +303,9 @@ fn beam(weather: &Weather, s: &Sample) -> (f64, f64) {
     }
 }
 
-/// Instants of `samples` whose EPW hour has no direct normal illuminance.
-fn efficacy_hours(weather: &Weather, samples: &[Sample]) -> usize {
+/// Instants of `samples` whose EPW hour has no direct normal illuminance ([`BEAM_EFFICACY`]
+/// used): a period's and LEED ASE's `efficacy_hours`.
+pub fn efficacy_hours(weather: &Weather, samples: &[Sample]) -> usize {
     samples.iter().filter(|s| weather.direct_normal_illuminance(s.epw_hour).is_none()).count()
 }
 
@@ -370,9 +386,18 @@ pub fn occupied_hours(samples: &[Sample]) -> Vec<Sample> {
 
 /// LEED v4.1's ASE1000,250 (IES LM-83-12) per room: per point, the occupied hours of `samples`
 /// (see [`occupied_hours`]) when its direct-sun illuminance through the glass (visible
-/// transmittance) exceeds [`ASE_LUX`]; per room the share of its points over [`ASE_HOURS`].
-/// Refuses a site without weather.
+/// transmittance) exceeds [`ASE_LUX`] ([`ase_hours`]); per room the share of its points over
+/// [`ASE_HOURS`] ([`ase_areas`]). Refuses a site without weather.
 pub fn leed_ase(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<AseResult> {
+    let hours = ase_hours(map, samples, site, progress)?;
+    let efficacy_hours = site.weather.map_or(0, |w| efficacy_hours(w, samples));
+    Ok(AseResult { areas: ase_areas(map, &hours), hours, occupied: samples.len(), efficacy_hours })
+}
+
+/// Per point, the hours of `samples` with more than [`ASE_LUX`] of direct sun through the glass:
+/// [`leed_ase`]'s sums, which add over stretches of the year (the page sums them in chunks).
+/// Refuses a site without weather.
+pub fn ase_hours(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress: &mut dyn FnMut(usize, usize)) -> Result<Vec<f64>> {
     let InsideMap { mapper, rooms, at } = map;
     let Some(weather) = site.weather else {
         return Err(Error::argument("weather", "LEED ASE needs a weather file: its direct normal illuminance"));
@@ -403,12 +428,19 @@ pub fn leed_ase(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress
     for part in parts {
         super::add_into(&mut hours, &part);
     }
-    let areas = rooms
+    Ok(hours)
+}
+
+/// Per room with points, the share of its points whose `hours` ([`ase_hours`] over the year's
+/// occupied hours) exceed [`ASE_HOURS`].
+pub fn ase_areas(map: InsideMap<'_>, hours: &[f64]) -> Vec<AseArea> {
+    let InsideMap { rooms, at, .. } = map;
+    rooms
         .rooms
         .iter()
         .enumerate()
         .filter_map(|(k, room)| {
-            let mine: Vec<f64> = at.room.iter().zip(&hours).filter(|(r, _)| **r == k as u32).map(|(_, h)| *h).collect();
+            let mine: Vec<f64> = at.room.iter().zip(hours).filter(|(r, _)| **r == k as u32).map(|(_, h)| *h).collect();
             let over = mine.iter().filter(|&&h| h > ASE_HOURS).count();
             (!mine.is_empty()).then(|| AseArea {
                 zone: room.name.clone(),
@@ -416,8 +448,7 @@ pub fn leed_ase(map: InsideMap<'_>, samples: &[Sample], site: Site<'_>, progress
                 ase: 100.0 * over as f64 / mine.len() as f64,
             })
         })
-        .collect();
-    Ok(AseResult { hours, areas, occupied: samples.len(), efficacy_hours: efficacy_hours(weather, samples) })
+        .collect()
 }
 
 /// BRE 209's working plane height in dwellings (m), where its No-Sky Line is drawn.

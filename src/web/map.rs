@@ -278,8 +278,9 @@ impl Engine {
         let model = model.inner.clone();
         future_to_promise(async move {
             let request = request_from_js(&options).map_err(map_error)?;
+            let run = Run { progress: progress.as_ref(), signal: signal.as_ref() };
             if let Some(ask) = &request.inside {
-                let (points, inside) = inside_map(&model, &request, ask).map_err(map_error)?;
+                let (points, inside) = inside_map(&model, &request, ask, run).await.map_err(map_error)?;
                 let ((value, values), instants, points) = (inside.values(), inside.instants(), Rc::new(points));
                 return Ok(PointMap { model, points, value, values, sums: None, instants, inside: Some(inside) }.into());
             }
@@ -297,7 +298,7 @@ impl Engine {
                 let values = lit_at(&mapper, site, &samples, points.len()).into_iter().map(f64::from).collect();
                 PointMap { model, points, value, values, sums: None, instants: samples.len(), inside: None }
             } else {
-                let sums = summed(&mapper, site, &samples, progress.as_ref(), signal.as_ref()).await.map_err(map_error)?;
+                let sums = summed(&mapper, site, &samples, run).await.map_err(map_error)?;
                 let values = match value {
                     MapValue::Direct => sums.direct_kwh_m2.clone(),
                     MapValue::SkyDiffuse => sums.sky_diffuse_kwh_m2.clone(),
@@ -339,36 +340,47 @@ fn lit_at(mapper: &Mapper, site: Site<'_>, samples: &[Sample], points: usize) ->
     mapper.visibility(sun, site.calendar.fraction(f64::from(s.day)) as f32)
 }
 
-/// The period's sums, chunk by chunk with a turn of the event loop between (progress, abort).
-async fn summed(
-    mapper: &Mapper,
-    site: Site<'_>,
-    samples: &[Sample],
-    progress: Option<&Function>,
-    signal: Option<&web_sys::AbortSignal>,
-) -> Result<MapValues> {
-    let mut total: Option<MapValues> = None;
+/// What a call hands its long sums: the progress callback and the abort signal.
+#[derive(Clone, Copy)]
+pub(super) struct Run<'a> {
+    pub(super) progress: Option<&'a Function>,
+    pub(super) signal: Option<&'a web_sys::AbortSignal>,
+}
+
+/// `samples` summed in [`CHUNKS`] stretches: each by `part`, folded into the first by `add`,
+/// with progress (instants done, of all) and a turn of the event loop after each, where an abort
+/// is seen: then nothing is returned but [`Error::Cancelled`]. None for no samples.
+pub(super) async fn in_chunks<S, T>(
+    samples: &[S],
+    run: Run<'_>,
+    mut part: impl FnMut(&[S]) -> Result<T>,
+    mut add: impl FnMut(&mut T, T),
+) -> Result<Option<T>> {
+    let mut total: Option<T> = None;
     let size = samples.len().div_ceil(CHUNKS).max(1);
     let mut done = 0usize;
     for chunk in samples.chunks(size) {
-        let part = mapper.accumulate(chunk, site, &mut |_, _| {})?;
+        let sums = part(chunk)?;
         done += chunk.len();
-        total = Some(match total {
-            None => part,
-            Some(mut t) => {
-                t.merge(&part);
-                t
-            }
-        });
-        if let Some(f) = progress {
+        match total.as_mut() {
+            None => total = Some(sums),
+            Some(t) => add(t, sums),
+        }
+        if let Some(f) = run.progress {
             // A throwing progress callback is the caller's bug, not a reason to stop.
             let _ = f.call2(&JsValue::NULL, &JsValue::from(done as f64), &JsValue::from(samples.len() as f64));
         }
         next_turn().await;
-        if signal.is_some_and(|s| s.aborted()) {
+        if run.signal.is_some_and(|s| s.aborted()) {
             return Err(Error::Cancelled);
         }
     }
+    Ok(total)
+}
+
+/// The period's sums, chunk by chunk with a turn of the event loop between (progress, abort).
+async fn summed(mapper: &Mapper, site: Site<'_>, samples: &[Sample], run: Run<'_>) -> Result<MapValues> {
+    let total = in_chunks(samples, run, |chunk| mapper.accumulate(chunk, site, &mut |_, _| {}), |t: &mut MapValues, p| t.merge(&p)).await?;
     match total {
         Some(t) => Ok(t),
         None => mapper.accumulate(&[], site, &mut |_, _| {}),

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::map::Period;
 use crate::map::inside::{ASE_SPACING, NSL_WORK_PLANE, WORK_PLANE_HEIGHT};
 use crate::map::period::{parse_clock, parse_date};
+use crate::model::inside::curve::TransmittanceCurve;
 use crate::sun::weather::Weather;
 use crate::year::settings::{AnnualSettings, Resolved};
 
@@ -26,7 +27,7 @@ pub const DEFAULT_DAY_STEP: u32 = 10;
 pub const MAP_KEYS: [&str; 8] = ["grid", "points", "period", "step", "from", "to", "at", "value"];
 
 /// The keys that map the inside of an EnergyPlus model's zones instead of its outside.
-pub const INSIDE_KEYS: [&str; 4] = ["inside", "workPlane", "glassTransmittance", "study"];
+pub const INSIDE_KEYS: [&str; 7] = ["inside", "workPlane", "glassTransmittance", "glassCurve", "study", "interior", "glazing"];
 
 /// The annual settings' keys a map also takes: the site, the foliage's calendar and the sky model
 /// ([`AnnualSettings`], resolved as an annual run resolves them).
@@ -126,14 +127,23 @@ pub struct MapRequest {
 
 /// The inside map asked (`sunlit map --inside`): points on the zones' floors (a grid at
 /// `work_plane` m above them) or given ones, the beam through the windows; at an instant, over a
-/// period, or a study.
-#[derive(Debug, Clone, PartialEq)]
+/// period, or a study. The rooms are an EnergyPlus model's zones, or the mesh nodes `interior`
+/// picks with the panes `glazing` picks (`--interior`, `--glazing`).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct InsideAsk {
     /// Height of the grid above the floors (m) (`--work-plane`): by default 0, on the floors'
     /// inside faces; a study's own work plane for a study.
     pub work_plane: f64,
     /// Transmittance of glazing whose construction gives none (`--glass-transmittance`).
     pub glass: Option<f64>,
+    /// The solar transmittance by angle of glazing whose construction gives none
+    /// (`--glass-curve`, as its text: `ANGLE:T,...`); an EnergyPlus model's only.
+    pub curve: Option<String>,
+    /// Globs over mesh node names: each matching node is a room (`--interior`); empty: the
+    /// EnergyPlus model's zones.
+    pub interior: Vec<String>,
+    /// Globs over mesh node names: each matching node is glass (`--glazing`).
+    pub glazing: Vec<String>,
     /// A study of the inside (`--study leed-ase` or `bre-nsl`), or none.
     pub study: Option<InsideStudy>,
 }
@@ -210,7 +220,7 @@ impl MapRequest {
                 format!("'{key}' is not a map option ({}, {}, {})", SITE_KEYS.join(", "), MAP_KEYS.join(", "), INSIDE_KEYS.join(", ")),
             ));
         }
-        let inside = inside_ask(all.remove("inside"), all.remove("workPlane"), all.remove("glassTransmittance"), all.remove("study"))?;
+        let inside = inside_ask(&mut all)?;
         let study = inside.as_ref().and_then(|i| i.study);
         let mut take = |key: &str| all.remove(key);
         let (grid, points, period, step, from, to, at, value) =
@@ -285,25 +295,61 @@ impl MapRequest {
     }
 }
 
-/// `inside`, `workPlane`, `glassTransmittance` and `study`: the inside asked, or none (the
-/// latter three need the first).
-fn inside_ask(inside: Option<Value>, work_plane: Option<Value>, glass: Option<Value>, study: Option<Value>) -> Result<Option<InsideAsk>> {
-    let inside = match inside {
+/// The inside keys ([`INSIDE_KEYS`]): the inside asked, or none (the others need `inside`).
+fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideAsk>> {
+    let inside = match all.remove("inside") {
         None | Some(Value::Bool(false)) => false,
         Some(Value::Bool(true)) => true,
         Some(other) => return Err(Error::argument("inside", format!("{other} is not true or false"))),
     };
-    let (work_plane, glass) = (number("workPlane", work_plane)?, number("glassTransmittance", glass)?);
-    let study = text_of("study", study)?.as_deref().map(InsideStudy::parse).transpose()?;
+    let (work_plane, glass) =
+        (number("workPlane", all.remove("workPlane"))?, number("glassTransmittance", all.remove("glassTransmittance"))?);
+    let curve = text_of("glassCurve", all.remove("glassCurve"))?;
+    let study = text_of("study", all.remove("study"))?.as_deref().map(InsideStudy::parse).transpose()?;
+    let (interior, glazing) = (globs_of("interior", all.remove("interior"))?, globs_of("glazing", all.remove("glazing"))?);
     if !inside {
-        let given = [("workPlane", work_plane.is_some()), ("glassTransmittance", glass.is_some()), ("study", study.is_some())];
+        let given = [
+            ("workPlane", work_plane.is_some()),
+            ("glassTransmittance", glass.is_some()),
+            ("glassCurve", curve.is_some()),
+            ("study", study.is_some()),
+            ("interior", !interior.is_empty()),
+            ("glazing", !glazing.is_empty()),
+        ];
         if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
             return Err(Error::argument(*name, "maps the inside of rooms: add inside: true"));
         }
         return Ok(None);
     }
+    if interior.is_empty() && !glazing.is_empty() {
+        return Err(Error::argument("glazing", "picks the panes of a mesh model's rooms: give the rooms too ('interior')"));
+    }
+    if let Some(text) = &curve {
+        if !interior.is_empty() {
+            return Err(Error::argument(
+                "glassCurve",
+                "is for an EnergyPlus model's glazing: a glTF pane's curve is its material's extras",
+            ));
+        }
+        TransmittanceCurve::parse(text).map_err(|why| Error::argument("glassCurve", why))?;
+    }
     let work_plane = work_plane.unwrap_or(study.map_or(0.0, |s| s.defaults().1));
-    Ok(Some(InsideAsk { work_plane, glass, study }))
+    Ok(Some(InsideAsk { work_plane, glass, curve, interior, glazing, study }))
+}
+
+/// Globs over node names, as a comma-separated text (as `loadFiles`' `receivers`) or an array
+/// of texts; empty when not given.
+fn globs_of(name: &str, value: Option<Value>) -> Result<Vec<String>> {
+    let texts: Vec<String> = match value {
+        None => return Ok(Vec::new()),
+        Some(Value::String(text)) => vec![text],
+        Some(Value::Array(items)) => items
+            .into_iter()
+            .map(|v| v.as_str().map(String::from).ok_or_else(|| Error::argument(name, format!("{v} is not a glob (text)"))))
+            .collect::<Result<_>>()?,
+        Some(other) => return Err(Error::argument(name, format!("{other} is not globs: give 'Room*, Hall*' or ['Room*']"))),
+    };
+    Ok(texts.iter().flat_map(|t| t.split(',')).map(str::trim).filter(|g| !g.is_empty()).map(String::from).collect())
 }
 
 /// A number option, if given.

@@ -36,3 +36,73 @@ export function goldenEpw() {
   });
   return `${lines.join('\n')}\n`;
 }
+
+/** The same room as a glTF model (tests/inside.rs's `room_glb`): node `Room`, its closed shell
+ * wound outwards with the window's opening left in the south wall, and node `Glass`, the pane in
+ * it. With `glass` (a material's `extras.sunlit`, e.g. a transmittance curve), the pane's mesh
+ * uses that material. Written as a .gltf with its buffer embedded (a data: URI), in glTF's axes
+ * (y up, −z north). */
+export function roomGltf(glass = null) {
+  const [w, d, h] = [4, 5, 3];
+  const [x0, x1, z0, z1] = [1, 3, 1, 2.5];
+  // A rectangle in the plane y = `y` (sunlit's axes), its normal along ±y as `out` says.
+  const rectY = (y, xa, xb, za, zb, out) => [[[xa, y, za], [xb, y, za], [xb, y, zb], [xa, y, zb]], [0, out, 0]];
+  const shell = [
+    rectY(0, 0, x0, 0, h, -1),
+    rectY(0, x1, w, 0, h, -1),
+    rectY(0, x0, x1, 0, z0, -1),
+    rectY(0, x0, x1, z1, h, -1),
+    rectY(d, 0, w, 0, h, 1),
+    [[[0, 0, 0], [0, d, 0], [0, d, h], [0, 0, h]], [-1, 0, 0]],
+    [[[w, 0, 0], [w, d, 0], [w, d, h], [w, 0, h]], [1, 0, 0]],
+    [[[0, 0, 0], [w, 0, 0], [w, d, 0], [0, d, 0]], [0, 0, -1]],
+    [[[0, 0, h], [w, 0, h], [w, d, h], [0, d, h]], [0, 0, 1]],
+  ];
+  const pane = [rectY(0, x0, x1, z0, z1, -1)];
+  const sub = (a, b) => a.map((v, i) => v - b[i]);
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const dot = (a, b) => a.reduce((s, v, i) => s + v * b[i], 0);
+  const meshes = [shell, pane].map((quads) => {
+    const positions = [];
+    const indices = [];
+    for (const [q, out] of quads) {
+      const flip = dot(cross(sub(q[1], q[0]), sub(q[2], q[0])), out) < 0;
+      const base = positions.length / 3;
+      // sunlit (x east, y north, z up) to glTF (x, z, −y): a rotation, so windings keep.
+      for (const [x, y, z] of q) positions.push(x, z, -y);
+      indices.push(...(flip ? [0, 2, 1, 0, 3, 2] : [0, 1, 2, 0, 2, 3]).map((i) => base + i));
+    }
+    return { positions: new Float32Array(positions), indices: new Uint32Array(indices) };
+  });
+  const chunks = [];
+  let offset = 0;
+  const views = [];
+  for (const m of meshes) {
+    for (const [array, target] of [[m.positions, 34962], [m.indices, 34963]]) {
+      views.push({ buffer: 0, byteOffset: offset, byteLength: array.byteLength, target });
+      chunks.push(Buffer.from(array.buffer));
+      offset += array.byteLength;
+    }
+  }
+  const accessors = meshes.flatMap((m, k) => {
+    const lo = [0, 1, 2].map((a) => Math.min(...m.positions.filter((_, i) => i % 3 === a)));
+    const hi = [0, 1, 2].map((a) => Math.max(...m.positions.filter((_, i) => i % 3 === a)));
+    return [
+      { bufferView: 2 * k, componentType: 5126, count: m.positions.length / 3, type: 'VEC3', min: lo, max: hi },
+      { bufferView: 2 * k + 1, componentType: 5125, count: m.indices.length, type: 'SCALAR' },
+    ];
+  });
+  const primitive = (k, material) => ({ attributes: { POSITION: 2 * k }, indices: 2 * k + 1, ...(material === undefined ? {} : { material }) });
+  const doc = {
+    asset: { version: '2.0' },
+    scene: 0,
+    scenes: [{ nodes: [0, 1] }],
+    nodes: [{ name: 'Room', mesh: 0 }, { name: 'Glass', mesh: 1 }],
+    meshes: [{ name: 'room', primitives: [primitive(0)] }, { name: 'glass', primitives: [primitive(1, glass ? 0 : undefined)] }],
+    ...(glass ? { materials: [{ name: 'Pane', extras: { sunlit: glass } }] } : {}),
+    accessors,
+    bufferViews: views,
+    buffers: [{ byteLength: offset, uri: `data:application/octet-stream;base64,${Buffer.concat(chunks).toString('base64')}` }],
+  };
+  return JSON.stringify(doc);
+}
