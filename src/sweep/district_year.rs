@@ -165,7 +165,7 @@ mod tests {
         }
         .resolve()
         .unwrap();
-        let weather = Weather::constant(settings.location, Hour { dni: 700.0, dhi: 120.0, ghi: 500.0, albedo: 0.2 });
+        let weather = Weather::constant(settings.location.clone(), Hour { dni: 700.0, dhi: 120.0, ghi: 500.0, albedo: 0.2 });
         let patches = SkyPatches::parse("tregenza").unwrap();
         let s = TileSettings {
             load: LoadOptions::default(),

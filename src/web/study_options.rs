@@ -83,8 +83,10 @@ pub struct StudyRequest {
     /// points are placed: [`Self::whole_window_of_each`]).
     pub gb: Option<Gb50180Rule>,
     /// `windowWidth: 'sill'`: each window's own sill line, measured from its geometry.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // read by the page's study (web only)
     pub sill_of_each: bool,
     /// `windowWidths`: each window's own sill width, by its name.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // read by the page's study (web only)
     pub window_widths: Option<GivenWidths>,
     /// EN 17037's rule, when en17037 is asked.
     pub en17037: Option<En17037Rule>,
@@ -194,6 +196,7 @@ impl StudyRequest {
     /// `rule` with each window's own 满窗 sill at `points` of `scene`, where asked: `windowWidths`'
     /// widths, or `windowWidth: 'sill'`'s sill lines (the points must be the windows' sills);
     /// checked.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))] // read by the page's study (web only)
     pub fn whole_window_of_each(&self, rule: &mut Gb50180Rule, scene: &Scene, points: &Points) -> Result<()> {
         rule.window_widths = match &self.window_widths {
             Some(GivenWidths::Csv(text)) => Some(sill_widths(scene, points, "windowWidths", text)?),

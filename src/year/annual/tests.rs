@@ -29,7 +29,7 @@ fn twin_days_share_views_with_the_same_sun() {
     for (latitude, at_least) in [(40.0, 0.45), (-33.9, 0.45), (75.0, 0.2)] {
         let location = Location::new(latitude, 10.0, 1.0).unwrap();
         let regimes = vec![Regime::year(plan, &taus, 1.0).unwrap()];
-        let views = sample_views(&scene, &location, &regimes, &taus);
+        let views = sample_views(&scene, 0..scene.receivers.len(), &location, &regimes, &taus);
         let per_piece = plan.days * taus.len();
         for &(request, _, cell) in &views.cells {
             let (id, rest) = (cell / (MAX_PIECES * per_piece), cell % (MAX_PIECES * per_piece));
