@@ -238,3 +238,16 @@ fn lit_bits(windows: &Windows, asks: &[Ask], progress: &mut dyn FnMut(usize, usi
     }
     LitSeries { words, instants: asks.len(), bits }
 }
+
+/// A scene of one receiver, the polygon `corners` (counter-clockwise seen from outside) fanned
+/// from its first corner: the window the sill and window-point tests measure.
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+pub(crate) fn test_window(corners: &[DVec3]) -> crate::scene::Scene {
+    use crate::scene::{SceneBuilder, SourceMesh};
+    let positions: Vec<[f32; 3]> = corners.iter().map(|c| c.as_vec3().to_array()).collect();
+    let indices: Vec<u32> = (1..corners.len() as u32 - 1).flat_map(|i| [0, i, i + 1]).collect();
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", SourceMesh { positions, indices }, true);
+    b.build().unwrap()
+}

@@ -122,17 +122,7 @@ fn chord(r: &Receiver, height: f64) -> Result<SillLine> {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
-    use crate::scene::{SceneBuilder, SourceMesh};
-
-    /// A scene of one receiver, the polygon `corners` (counter-clockwise seen from outside) fanned
-    /// from its first corner.
-    fn window(corners: &[DVec3]) -> Scene {
-        let positions: Vec<[f32; 3]> = corners.iter().map(|c| c.as_vec3().to_array()).collect();
-        let indices: Vec<u32> = (1..corners.len() as u32 - 1).flat_map(|i| [0, i, i + 1]).collect();
-        let mut b = SceneBuilder::new();
-        b.add_object("test", "WIN", SourceMesh { positions, indices }, true);
-        b.build().unwrap()
-    }
+    use crate::map::planning::test_window as window;
 
     fn close(a: DVec3, b: DVec3) -> bool {
         (a - b).length() < 1e-5

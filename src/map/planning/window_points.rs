@@ -170,17 +170,7 @@ pub fn lowest_edge(r: &Receiver) -> Result<(DVec3, DVec3)> {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
-    use crate::scene::{SceneBuilder, SourceMesh};
-
-    /// A scene of one receiver, the polygon `corners` (counter-clockwise seen from outside) fanned
-    /// from its first corner.
-    fn window(corners: &[DVec3]) -> Scene {
-        let positions: Vec<[f32; 3]> = corners.iter().map(|c| c.as_vec3().to_array()).collect();
-        let indices: Vec<u32> = (1..corners.len() as u32 - 1).flat_map(|i| [0, i, i + 1]).collect();
-        let mut b = SceneBuilder::new();
-        b.add_object("test", "WIN", SourceMesh { positions, indices }, true);
-        b.build().unwrap()
-    }
+    use crate::map::planning::test_window as window;
 
     #[test]
     fn a_rectangles_sill_is_its_lowest_edges_middle_and_its_centre_the_middle() {
