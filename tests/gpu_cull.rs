@@ -279,3 +279,25 @@ fn a_view_fitted_to_a_receivers_distinct_corners_is_the_view_of_all_its_corners(
         assert!(repeats > 0, "{name}: its receivers repeat corners");
     }
 }
+
+#[test]
+fn the_gpu_cullings_tile_draws_count_a_view_alike_in_every_slot() {
+    // blaas-louvres' 3×5 year at 64² counted forward and in reverse order, which puts the tiles
+    // in other atlas slots: the per-tile draws clip at the tile's own viewport, so a view's
+    // fraction may not move. The batch draw, one viewport for the atlas, clips at the atlas's
+    // edges on lavapipe; how many of its views move is printed (docs/benchmarks-gpu.md).
+    let (scene, requests) = louvres_3x5();
+    let reversed: Vec<ViewRequest> = requests.iter().rev().copied().collect();
+    let moved = |batch_draw: bool| {
+        let (forward, _) = by_draw(&scene, &requests, 64, batch_draw);
+        let (back, _) = by_draw(&scene, &reversed, 64, batch_draw);
+        let backward: Vec<Counted> = back.into_iter().rev().collect();
+        let rendered = forward.iter().filter(|c| c.side > 0 && c.visible < c.covered).count();
+        assert!(rendered >= 50, "{rendered} partly shaded views rendered");
+        (0..requests.len()).filter(|&i| forward[i].fraction.to_bits() != backward[i].fraction.to_bits()).collect::<Vec<_>>()
+    };
+    let by_tile = moved(false);
+    assert!(by_tile.is_empty(), "{} of {} views changed fraction with their slot: {by_tile:?}", by_tile.len(), requests.len());
+    let by_batch = moved(true);
+    println!("blaas-louvres 3x5 at 64², reversed: {} of {} views move with one draw a batch", by_batch.len(), requests.len());
+}
