@@ -56,9 +56,18 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # beside it (same binary, --cull cpu), blaas-trees-summer's every view both ways, and the host's
 # cost of each on noop. Each JSON line's `cull` says which path ran, and `shading_tested_on_cpu`
 # how many views the GPU's shading test (shaders/may_shade.wgsl) left to the host.
-# The cheapest host form first (--cull gpu-batch: the GPU's culling drawn with one draw a batch,
+# The compute kernel for many SMs first (binning a workgroup per 256 triangles, up to 1,024
+# views a submission, the node pool sized from the batch before; docs/benchmarks-gpu.md): never
+# measured on a GPU, and the H200's 2026-11-28 line (470 s, 5 batches counted twice) is the one
+# to set it beside. nyt-blocks' even spread of 20,040 views, then blaas-trees-summer's every view.
+run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" --check 30 "${gpu_flags[@]}"
+[ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" "${gpu_flags[@]}"
+run blaas-trees-summer-compute 40 bench blaas-trees-summer --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"
+# Then the cheapest host form (--cull gpu-batch: the GPU's culling drawn with one draw a batch,
 # src/count/gpu/batched.rs; the least host time a view on noop, docs/benchmarks-gpu.md), with its
 # answers checked, and its host cost on noop; then the per-tile form and the CPU's culling.
+# (On lavapipe the batch draw is a lit pixel from the per-tile form on some louvre views: lavapipe
+# clips at the tile's viewport; a GPU with a guard band should not. Compare the two --check lines.)
 run nyt-blocks-cull-gpu-batch 90 bench nyt-blocks --engine gpu --cull gpu-batch --views "${VIEWS:-20040}" --check 10 "${gpu_flags[@]}"
 run blaas-trees-summer-cull-gpu-batch 40 bench blaas-trees-summer --engine gpu --cull gpu-batch --check 20 "${views[@]}" "${gpu_flags[@]}"
 run nyt-blocks-noop-cull-gpu-batch 60 bench nyt-blocks --engine gpu --backend noop --cull gpu-batch --lanes 1 --views "${VIEWS:-20040}"
@@ -72,13 +81,10 @@ run nyt-blocks-gpu-cull 90 bench nyt-blocks --engine gpu --views "${VIEWS:-20040
 run nyt-blocks-noop-cull 90 bench nyt-blocks --engine gpu --backend noop --lanes 1 --views "${VIEWS:-20040}" --gpu-cull
 run blaas-trees-summer-gpu-cull 40 bench blaas-trees-summer --engine gpu --gpu-cull "${views[@]}" "${gpu_flags[@]}"
 if [ -z "${VIEWS:-}" ]; then
-  run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views 20040 --check 30 "${gpu_flags[@]}"
-  [ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views 20040 "${gpu_flags[@]}"
   run nyt-blocks-gpu-20040 60 bench nyt-blocks --engine gpu --views 20040 "${gpu_flags[@]}"
   run nyt-blocks-exact-20040 60 bench nyt-blocks --engine exact --views 20040
 fi
 run nyt-blocks-compute-all 150 bench nyt-blocks --engine compute --check 30 "${views[@]}" "${gpu_flags[@]}"
-run blaas-trees-summer-compute 40 bench blaas-trees-summer --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"
 run nyt-blocks-exact-all 150 bench nyt-blocks --engine exact "${views[@]}"
 run synthetic 40 bench --suns 64 "${gpu_flags[@]}"
 # The host's cost a view alone (wgpu's no-op backend), to set beside the real GPU's.

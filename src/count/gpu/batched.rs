@@ -12,11 +12,22 @@
 //! blaas-buildings and on placed see-through trees, but not everywhere: on blaas-louvres' 3×5
 //! year at 64², 55 of the 620 views count one pixel more or fewer lit (the covered counts
 //! equal), and 16 grazing views one form renders fully lit the other settles unrendered as
-//! unshaded (fraction 1 both); causes not isolated (tests/gpu_cull.rs). So it is not the default.
+//! unshaded (fraction 1 both). The cause is the tile's viewport, not depth: lavapipe clips x and
+//! y at the viewport (no guard band while a depth buffer is bound), so the per-tile draws cut
+//! every caster crossing the tile's edge with corners interpolated in the tile's clip
+//! coordinates, where this draw's viewport is the atlas; a re-snapped clipped edge moves a pixel
+//! centre lying within a rounding of it. Given the atlas as their viewport, the per-tile draws
+//! count exactly these pixels, but then a view's pixels depend on its atlas slot (clipped at the
+//! atlas's edges, as this draw is: counted in reverse order, 16 of those 620 views change
+//! fraction here and none with the per-tile draws). One draw cannot clip at each tile's edge, so
+//! the forms stay a lit pixel apart on lavapipe and this is not the default (tests/gpu_cull.rs;
+//! docs/benchmarks-gpu.md).
 //!
 //! The tile clip is a fragment discard on every adapter. `clip_distances` would spare the
-//! rasterizer the fragments outside the tile, but clipping there makes new corners on the tile's
-//! edges, whose rounding can move an edge pixel: not the same pixels, so not used.
+//! rasterizer the fragments outside the tile, but its new corners on the tile's edges would be
+//! interpolated in the atlas's clip coordinates, not the tile's as lavapipe's viewport clip does
+//! (so still not the same roundings), and an adapter with a guard band makes no such corners at
+//! all: not used (not tried either).
 //!
 //! One instanced draw and one indirect draw are core WebGPU: the same form natively and in the
 //! browser (multi-draw adds nothing where one draw already holds every pair). Where it is not
