@@ -80,6 +80,29 @@ pub(crate) fn seconds() -> f64 {
     }
 }
 
+/// This process's CPU seconds (user + system, every thread) since it started, so a stage's CPU
+/// against its wall time says how many cores its threads kept busy. On Unix `getrusage`; on the
+/// web, where the views run on one thread, the clock's [`seconds`] (a stage's CPU reads as its
+/// wall time); elsewhere the same stand-in.
+pub(crate) fn cpu_seconds() -> f64 {
+    #[cfg(all(unix, not(target_arch = "wasm32")))]
+    {
+        let mut usage = std::mem::MaybeUninit::<libc::rusage>::zeroed();
+        // SAFETY: getrusage fills the whole rusage it is pointed at, or fails and we read nothing.
+        if unsafe { libc::getrusage(libc::RUSAGE_SELF, usage.as_mut_ptr()) } != 0 {
+            return 0.0;
+        }
+        // SAFETY: zeroed, then written by getrusage above.
+        let usage = unsafe { usage.assume_init() };
+        let secs = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+        secs(usage.ru_utime) + secs(usage.ru_stime)
+    }
+    #[cfg(not(all(unix, not(target_arch = "wasm32"))))]
+    {
+        seconds()
+    }
+}
+
 /// The shortest interval [`seconds`] times well enough to route by: natively 0; on the web five
 /// ticks of Chrome's coarsened clock, so a probe repeats a light view until it has run this long
 /// (48 probed views then cost the first visit some 25 ms, not the probe's whole 0.15 s).
@@ -167,4 +190,41 @@ where
         out.push(job(item).await);
     }
     out
+}
+
+#[cfg(all(test, unix, not(target_arch = "wasm32")))]
+mod tests {
+    #![allow(clippy::unwrap_used)] // Tests may panic on the unexpected.
+    use super::*;
+
+    /// This process's CPU seconds as the kernel's own `/proc/self/stat` gives them (utime +
+    /// stime, in clock ticks of 10 ms).
+    fn proc_cpu_seconds() -> f64 {
+        let stat = std::fs::read_to_string("/proc/self/stat").unwrap();
+        // The command name may hold spaces: the fields counted after its closing parenthesis.
+        let fields: Vec<&str> = stat[stat.rfind(')').unwrap() + 2..].split(' ').collect();
+        let ticks = |i: usize| fields[i].parse::<f64>().unwrap();
+        // utime and stime are fields 14 and 15 of stat, 12 and 13 after the name and state.
+        (ticks(11) + ticks(12)) / 100.0
+    }
+
+    /// `cpu_seconds` is the process's CPU, not the clock: after some work, and again after a
+    /// sleep (which moves the clock, not the CPU), it reads what the kernel's `/proc/self/stat`
+    /// reads, to its 10 ms ticks plus what other test threads spend between the two reads.
+    #[test]
+    fn cpu_seconds_are_the_kernels_cpu_time_not_the_clock() {
+        let start = std::time::Instant::now();
+        let mut x = 1u64;
+        while proc_cpu_seconds() < 0.3 && start.elapsed().as_secs() < 60 {
+            for _ in 0..100_000 {
+                x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+            }
+        }
+        let (ours, kernels) = (cpu_seconds(), proc_cpu_seconds());
+        assert!(kernels >= 0.3, "spun for a minute without 0.3 s of CPU: {kernels}");
+        assert!((ours - kernels).abs() < 0.2, "cpu_seconds {ours} against /proc/self/stat's {kernels}");
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        let (ours, kernels) = (cpu_seconds(), proc_cpu_seconds());
+        assert!((ours - kernels).abs() < 0.2, "after a 1.5 s sleep: cpu_seconds {ours} against /proc/self/stat's {kernels}");
+    }
 }

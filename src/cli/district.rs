@@ -262,6 +262,10 @@ fn count_one(
             let seconds = start.elapsed().as_secs_f64();
             eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
             eprintln!("tile {k} stages: {}", stages.line());
+            let peak_mib = crate::bench_cli::peak_memory_mib();
+            if let Some(peak) = peak_mib {
+                eprintln!("tile {k}: peak resident memory {peak:.1} MiB");
+            }
             let written = Instant::now();
             // The PV files before the record: a finished tile has them.
             if let Some(pv) = &pv {
@@ -269,7 +273,10 @@ fn count_one(
             }
             let pv = pv.map(|p| p.sums);
             let stages = Some(stages);
-            district::write_tile(dir, &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, stages })?;
+            district::write_tile(
+                dir,
+                &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, stages, peak_mib },
+            )?;
             eprintln!("tile {k}: record written in {:.1} s", written.elapsed().as_secs_f64());
             Ok(())
         });

@@ -471,6 +471,10 @@ pub struct TileDone {
     /// Where its time went (absent in records written before it was kept).
     #[serde(default)]
     pub stages: Option<TileStages>,
+    /// The counting process's peak resident memory, MiB, where the OS reports it (a Slurm
+    /// without accounting storage has no other record of it).
+    #[serde(default)]
+    pub peak_mib: Option<f64>,
 }
 
 /// The record id of tile `k`.

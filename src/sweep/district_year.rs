@@ -21,7 +21,7 @@ use crate::count::hybrid::HybridEngine;
 use crate::error::Result;
 use crate::export::cadastre;
 use crate::export::irradiation::{SurfaceSummary, summarize_from};
-use crate::platform::seconds as now;
+use crate::platform::{cpu_seconds, seconds as now};
 use crate::scene::Scene;
 use crate::sky::views::sky_views;
 use crate::sweep::district::TileSettings;
@@ -34,13 +34,17 @@ use crate::year::annual::{Progress, YearStages, annual_receivers_with};
 pub const RECEIVER_BATCH: usize = 1024;
 
 /// Where a tile's time went, in seconds of wall time (the views are counted on every core), with
-/// the views each stage counted.
+/// the views each stage counted and the view stages' CPU seconds (every thread of the process:
+/// CPU / wall is the cores its threads kept busy; 0 in records written before they were kept).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct TileStages {
     /// Building the tile's scene from its part of the city, and the exact engine's index.
     pub scene: f64,
     /// Counting the year's sample views.
     pub sample_views: f64,
+    /// Their CPU seconds.
+    #[serde(default)]
+    pub sample_views_cpu: f64,
     /// How many.
     pub sample_view_count: usize,
     /// Fitting the splines and evaluating them at every timestep.
@@ -49,10 +53,16 @@ pub struct TileStages {
     pub certificates: f64,
     /// Counting the refined steps left.
     pub refinement: f64,
+    /// Its CPU seconds.
+    #[serde(default)]
+    pub refinement_cpu: f64,
     /// How many refined steps were counted.
     pub refined_view_count: usize,
     /// The sky pass: every receiver's view of each sky patch.
     pub sky: f64,
+    /// Its CPU seconds.
+    #[serde(default)]
+    pub sky_cpu: f64,
     /// Summing each receiver's year into its irradiation and sun hours.
     pub sums: f64,
     /// With a grid: the roofs' points, their year and sky.
@@ -64,27 +74,33 @@ pub struct TileStages {
 impl TileStages {
     fn add_year(&mut self, year: &YearStages) {
         self.sample_views += year.sampling;
+        self.sample_views_cpu += year.sampling_cpu;
         self.sample_view_count += year.sample_views;
         self.fitting += year.fitting;
         self.certificates += year.certifying;
         self.refinement += year.refining;
+        self.refinement_cpu += year.refining_cpu;
         self.refined_view_count += year.refined_views;
         self.batches += 1;
     }
 
-    /// One line for a log: each stage's seconds (and views).
+    /// One line for a log: each stage's seconds (and views; the view stages' CPU seconds).
     pub fn line(&self) -> String {
         format!(
-            "scene {:.1} s, sample views {:.1} s ({} views), fit and evaluation {:.1} s, certificates {:.1} s, \
-             refinement {:.1} s ({} views), sky pass {:.1} s, sums {:.1} s, roof points {:.1} s; {} batch(es) of receivers",
+            "scene {:.1} s, sample views {:.1} s ({:.1} s cpu, {} views), fit and evaluation {:.1} s, certificates {:.1} s, \
+             refinement {:.1} s ({:.1} s cpu, {} views), sky pass {:.1} s ({:.1} s cpu), sums {:.1} s, roof points {:.1} s; \
+             {} batch(es) of receivers",
             self.scene,
             self.sample_views,
+            self.sample_views_cpu,
             self.sample_view_count,
             self.fitting,
             self.certificates,
             self.refinement,
+            self.refinement_cpu,
             self.refined_view_count,
             self.sky,
+            self.sky_cpu,
             self.sums,
             self.points,
             self.batches
@@ -119,9 +135,10 @@ pub fn tile_year(
     let options = s.settings.options(None)?;
     let (location, calendar) = (&s.settings.location, &s.settings.calendar);
     // The sky first: each batch's sums read every receiver's sky views.
-    let start = now();
+    let (start, cpu) = (now(), cpu_seconds());
     let views = pollster::block_on(sky_views(engine, scene, s.patches, progress))?;
     stages.sky += now() - start;
+    stages.sky_cpu += cpu_seconds() - cpu;
     let mut out = TileYear { summaries: Vec::with_capacity(scene.receivers.len()), hours: Vec::with_capacity(scene.receivers.len()) };
     for receivers in batches(scene.receivers.len(), batch) {
         let first = receivers.start;
@@ -181,6 +198,9 @@ mod tests {
         let count = |batch: usize| count_tile_in_batches(&city, &tiling, 0, &s, batch, &mut |_| Ok(())).unwrap();
         let whole = count(usize::MAX);
         assert_eq!(whole.stages.batches, 1);
+        // The view stages' CPU is kept beside their wall time.
+        let st = &whole.stages;
+        assert!(st.sample_views_cpu > 0.0 && st.refinement_cpu > 0.0 && st.sky_cpu > 0.0, "{st:?}");
         assert!(whole.rows.len() > 10, "{} rows", whole.rows.len());
         let batched = count(5);
         assert!(batched.stages.batches > 2 && batched.stages.refined_view_count > 0, "{:?}", batched.stages);

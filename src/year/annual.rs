@@ -32,7 +32,7 @@ use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
 use crate::error::{Error, Result};
 use crate::export::Schedule;
-use crate::platform::seconds as now;
+use crate::platform::{cpu_seconds, seconds as now};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
@@ -592,7 +592,7 @@ async fn spline_year(
     year: &mut Columns,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<(Vec<FittedSurfaces>, RegimeOf)> {
-    let start = now();
+    let (start, cpu) = (now(), cpu_seconds());
     let taus = plan.taus();
     let (regimes, regime_of) = regimes(plan, &taus, calendar)?;
     let receivers = year.range();
@@ -602,6 +602,7 @@ async fn spline_year(
     let counted = views.count(&requests, &mut |p| progress(work.sampling(p))).await?;
     year.stages.sample_views += requests.len();
     year.stages.sampling += now() - start;
+    year.stages.sampling_cpu += cpu_seconds() - cpu;
     let start = now();
     // Each step below keeps only what the next reads, freed before the year is evaluated: a
     // city's views, counts and samples are a sixth of its peak memory (docs/district.md).
@@ -628,7 +629,7 @@ async fn spline_year(
         certified::certify_steps(scene, views.engine.index(), location, timesteps, rough, smooth, year)
     };
     year.stages.certifying += now() - start;
-    let start = now();
+    let (start, cpu) = (now(), cpu_seconds());
     // Certified timesteps are settled like interpolated ones: done, not counted.
     let rows_per_day = timesteps.rows() / timesteps.days() as usize;
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
@@ -643,6 +644,7 @@ async fn spline_year(
         year.set(r.row, r.column, as_energyplus(v));
     }
     year.stages.refining += now() - start;
+    year.stages.refining_cpu += cpu_seconds() - cpu;
     year.stages.refined_views += refined_views;
     let surfaces = regimes
         .iter()

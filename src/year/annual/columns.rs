@@ -42,11 +42,14 @@ impl Columns {
     }
 }
 
-/// Where a year's time went, in seconds of wall time, and the views each stage counted.
+/// Where a year's time went, in seconds of wall time, and the views each stage counted; the view
+/// stages' CPU seconds too (every thread of the process: CPU / wall is the cores kept busy).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct YearStages {
     /// Counting the sample views (a dense or periodic year: all its views).
     pub sampling: f64,
+    /// CPU seconds of the spline year's sample views.
+    pub sampling_cpu: f64,
     /// Sample views counted.
     pub sample_views: usize,
     /// Fitting the splines and evaluating them at every timestep.
@@ -55,6 +58,8 @@ pub struct YearStages {
     pub certifying: f64,
     /// Counting the refined steps left (by bisection in days, [`crate::year::refine`]).
     pub refining: f64,
+    /// CPU seconds of the spline year's refined steps.
+    pub refining_cpu: f64,
     /// Refined steps counted.
     pub refined_views: usize,
 }
@@ -63,10 +68,12 @@ impl YearStages {
     /// The two added, stage by stage.
     pub fn add(&mut self, other: &YearStages) {
         self.sampling += other.sampling;
+        self.sampling_cpu += other.sampling_cpu;
         self.sample_views += other.sample_views;
         self.fitting += other.fitting;
         self.certifying += other.certifying;
         self.refining += other.refining;
+        self.refining_cpu += other.refining_cpu;
         self.refined_views += other.refined_views;
     }
 }
