@@ -50,9 +50,9 @@ mod never_dark;
 
 use glam::{DVec2, DVec3};
 
+use composite::Composites;
 pub use cone::DirectionCone;
 pub use never_dark::MIN_LIT_SHARE;
-use composite::Composites;
 use never_dark::Outline;
 
 use crate::count::MIN_COS_INCIDENCE;
@@ -162,7 +162,7 @@ impl std::ops::Deref for Index<'_> {
 }
 
 /// A caster that may prove a receiver dark.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 enum Caster {
     /// One of the exact engine's convex objects.
     Object(u32),
@@ -175,7 +175,11 @@ pub struct Certifier<'a> {
     index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
+    /// Composite casters; none unless [`Self::with_many_casters`].
     composites: Composites,
+    /// Whether a dark proof may combine casters (composites, halves of a cell): off by default
+    /// until measured on the bench models (docs/energyplus-fidelity.md, "Certificates").
+    many_casters: bool,
 }
 
 impl Certifier<'static> {
@@ -205,9 +209,17 @@ impl<'a> Certifier<'a> {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        let composites = Composites::new(&index);
-        log::debug!("certificates: {} composite casters (coplanar panels)", composites.len());
-        Self { index, shapes, extent, composites }
+        Self { index, shapes, extent, composites: Composites::default(), many_casters: false }
+    }
+
+    /// Lets the dark proof combine casters: composite casters ([`composite`]) and halves of a
+    /// cell each covered by its own caster. Exact either way; off by default because its cost on
+    /// a city and on blaas-louvres is not yet measured.
+    pub fn with_many_casters(mut self) -> Self {
+        self.composites = Composites::new(&self.index);
+        log::debug!("certificates: {} composite casters (coplanar panels)", self.composites.len());
+        self.many_casters = true;
+        self
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
@@ -241,20 +253,33 @@ impl<'a> Certifier<'a> {
         if !wanted.dark {
             return None;
         }
+        let candidates = self.cover_candidates(shape, &cone);
         let mut set: Vec<usize> = (0..suns.len()).collect();
-        self.dark_in_parts(shape, suns, &mut set, &cone, DARK_HALVINGS).then_some(Certificate::Dark)
+        let halvings = if self.many_casters { DARK_HALVINGS } else { 0 };
+        self.dark_in_parts(shape, &candidates, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
     }
 
     /// Whether the receiver is dark at every sun of `set` (indices into `suns`, enclosed by
-    /// `cone`): one caster covers it over the whole cone, or, with `halvings` left, each half of
-    /// the set (split across its widest extent, [`never_dark::split_widest`]) is so proved over
-    /// its own cone. Each sun lies in a cone one caster covers, so it is dark: the cover may pass
-    /// from one caster to another between the suns (a nearer block to a farther one).
-    fn dark_in_parts(&self, shape: &Shape, suns: &[DVec3], set: &mut [usize], cone: &DirectionCone, halvings: usize) -> bool {
-        if self.one_caster_covers(shape, cone) {
+    /// `cone`): one of `candidates` covers it over the whole cone, or, with `halvings` left, each
+    /// half of the set (split across its widest extent, [`never_dark::split_widest`]) is so
+    /// proved over its own cone. Each sun lies in a cone one caster covers, so it is dark: the
+    /// cover may pass from one caster to another between the suns (a nearer block to a farther
+    /// one). The halves try the whole cell's candidates (a search per half cost more than the
+    /// proofs saved on a city): a caster that covers only a half and is not among them is
+    /// missed, never wrongly trusted.
+    fn dark_in_parts(
+        &self,
+        shape: &Shape,
+        candidates: &[Caster],
+        suns: &[DVec3],
+        set: &mut [usize],
+        cone: &DirectionCone,
+        halvings: usize,
+    ) -> bool {
+        if candidates.iter().any(|c| self.covers(shape, cone, *c)) {
             return true;
         }
-        if halvings == 0 || set.len() < 2 {
+        if halvings == 0 || set.len() < 2 || candidates.len() < 2 {
             return false;
         }
         never_dark::split_widest(suns, set);
@@ -262,15 +287,14 @@ impl<'a> Certifier<'a> {
         [first, second].into_iter().all(|half| {
             let part: Vec<DVec3> = half.iter().map(|&i| suns[i]).collect();
             // Inside the whole's cone, so in front of the receiver and above the horizon too.
-            DirectionCone::enclosing(&part).is_some_and(|c| self.dark_in_parts(shape, suns, half, &c, halvings - 1))
+            DirectionCone::enclosing(&part).is_some_and(|c| self.dark_in_parts(shape, candidates, suns, half, &c, halvings - 1))
         })
     }
 
-    /// Whether one opaque convex caster (an object or a composite) covers the receiver at every
-    /// direction of the cone.
-    fn one_caster_covers(&self, shape: &Shape, cone: &DirectionCone) -> bool {
-        // A caster that covers the receiver at every sun is hit by the ray from each receiver
-        // point along the cone's axis: it has a triangle in that one view's prism.
+    /// The opaque convex casters (objects and composites) that may cover the receiver over the
+    /// cone: a caster that covers it at every direction of the cone is hit by the ray from each
+    /// receiver point along the cone's axis, so it has a triangle in that one view's prism.
+    fn cover_candidates(&self, shape: &Shape, cone: &DirectionCone) -> Vec<Caster> {
         let mut candidates: Vec<Caster> = Vec::new();
         let view = view::fit(&shape.points, cone.axis(), self.index.bounds, self.index.origin, 64);
         self.index.culling.visit_triangles(&view.view_proj, |r| {
@@ -280,14 +304,22 @@ impl<'a> Certifier<'a> {
                 }
                 let object = self.opaque_convex(p).map(Caster::Object);
                 let composite = self.composites.of(p).map(Caster::Composite);
+                // An object's triangles come one after another: skip the repeats cheaply.
                 for c in [object, composite].into_iter().flatten() {
-                    if !candidates.contains(&c) {
+                    if candidates.last() != Some(&c) {
                         candidates.push(c);
                     }
                 }
             }
         });
-        candidates.into_iter().any(|c| self.covers(shape, cone, c))
+        candidates.sort_unstable();
+        candidates.dedup();
+        candidates
+    }
+
+    #[cfg(test)]
+    fn one_caster_covers(&self, shape: &Shape, cone: &DirectionCone) -> bool {
+        self.cover_candidates(shape, cone).into_iter().any(|c| self.covers(shape, cone, c))
     }
 
     /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;

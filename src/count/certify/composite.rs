@@ -346,7 +346,12 @@ mod tests {
     /// opposite ways do not.
     #[test]
     fn only_panels_tiling_a_convex_polygon_without_a_gap_combine() {
-        let tiled = [panel(0.0, 2.0, 0.0, 3.0, 0.0), panel(2.0, 5.0, 0.0, 3.0, 0.0), panel(0.0, 2.0, 3.0, 4.0, 0.0), panel(2.0, 5.0, 3.0, 4.0, 0.0)];
+        let tiled = [
+            panel(0.0, 2.0, 0.0, 3.0, 0.0),
+            panel(2.0, 5.0, 0.0, 3.0, 0.0),
+            panel(0.0, 2.0, 3.0, 4.0, 0.0),
+            panel(2.0, 5.0, 3.0, 4.0, 0.0),
+        ];
         assert_eq!(composites(&tiled), 1);
         let gap = [panel(0.0, 2.0, 0.0, 3.0, 0.0), panel(2.001, 5.0, 0.0, 3.0, 0.0)];
         assert_eq!(composites(&gap), 0);

@@ -267,7 +267,7 @@ fn two_blocks_built_flush_hand_the_cover_over_within_a_cell() {
     let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
 
     let flush = street(1.0);
-    let certifier = Certifier::new(&flush);
+    let certifier = Certifier::new(&flush).with_many_casters();
     assert_eq!(certifier.certify(0, &winter, both), Some(Certificate::Dark));
     assert!(ExactEngine::new(&flush).fractions(&requests).iter().all(|f| *f == 0.0));
     // Neither block alone covers the window at every sun of the cell.
@@ -280,7 +280,7 @@ fn two_blocks_built_flush_hand_the_cover_over_within_a_cell() {
     assert!(!objects.is_empty() && objects.iter().all(|o| !certifier.covers(shape, &cone, Caster::Object(*o))));
 
     let slot = street(1.3);
-    assert_eq!(Certifier::new(&slot).certify(0, &winter, both), None);
+    assert_eq!(Certifier::new(&slot).with_many_casters().certify(0, &winter, both), None);
     assert!(ExactEngine::new(&slot).fractions(&requests).iter().any(|f| *f > 0.0), "no sun passes the slot: the variant shows nothing");
 }
 
@@ -304,10 +304,10 @@ fn coplanar_panels_with_a_gap_do_not_prove_dark() {
     let both = Wanted { dark: true, lit: true };
     let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
     let joined = screen(1.0);
-    assert_eq!(Certifier::new(&joined).certify(0, &winter, both), Some(Certificate::Dark));
+    assert_eq!(Certifier::new(&joined).with_many_casters().certify(0, &winter, both), Some(Certificate::Dark));
     assert!(ExactEngine::new(&joined).fractions(&requests).iter().all(|f| *f == 0.0));
     let gap = screen(1.001);
-    assert_eq!(Certifier::new(&gap).certify(0, &winter, both), None);
+    assert_eq!(Certifier::new(&gap).with_many_casters().certify(0, &winter, both), None);
     assert!(ExactEngine::new(&gap).fractions(&requests).iter().any(|f| *f > 0.0), "no sun passes the gap: the test shows nothing");
 }
 
@@ -339,7 +339,7 @@ fn dark_certificates_over_flush_blocks_agree_with_the_exact_engine() {
             }
         }
         let scene = b.build().unwrap();
-        let certifier = Certifier::new(&scene);
+        let certifier = Certifier::new(&scene).with_many_casters();
         let exact = ExactEngine::new(&scene);
         let objects: Vec<u32> = (0..certifier.index.triangles.len()).filter_map(|p| certifier.opaque_convex(p)).collect();
         for _ in 0..80 {
@@ -400,10 +400,15 @@ fn facade(b: &mut SceneBuilder, skip: Option<usize>) {
 fn a_facade_of_walls_and_windows_proves_the_wall_at_its_inner_corner_dark() {
     let corner = |skip: Option<usize>| {
         let mut b = SceneBuilder::new();
-        b.add_object("test", "WALL", SourceMesh {
-            positions: vec![[15.0, -15.0, 4.0], [27.0, -15.0, 4.0], [27.0, -15.0, 8.0], [15.0, -15.0, 8.0]],
-            indices: vec![0, 1, 2, 0, 2, 3],
-        }, true);
+        b.add_object(
+            "test",
+            "WALL",
+            SourceMesh {
+                positions: vec![[15.0, -15.0, 4.0], [27.0, -15.0, 4.0], [27.0, -15.0, 8.0], [15.0, -15.0, 8.0]],
+                indices: vec![0, 1, 2, 0, 2, 3],
+            },
+            true,
+        );
         facade(&mut b, skip);
         b.build().unwrap()
     };
@@ -412,10 +417,10 @@ fn a_facade_of_walls_and_windows_proves_the_wall_at_its_inner_corner_dark() {
     let both = Wanted { dark: true, lit: true };
     let requests: Vec<ViewRequest> = afternoons.iter().map(|s| ViewRequest::new(0, *s)).collect();
     let whole = corner(None);
-    assert_eq!(Certifier::new(&whole).certify(0, &afternoons, both), Some(Certificate::Dark));
+    assert_eq!(Certifier::new(&whole).with_many_casters().certify(0, &afternoons, both), Some(Certificate::Dark));
     assert!(ExactEngine::new(&whole).fractions(&requests).iter().all(|f| *f == 0.0));
     let holed = corner(Some(3));
-    assert_eq!(Certifier::new(&holed).certify(0, &afternoons, both), None);
+    assert_eq!(Certifier::new(&holed).with_many_casters().certify(0, &afternoons, both), None);
     assert!(ExactEngine::new(&holed).fractions(&requests).iter().any(|f| *f > 0.0), "no sun passes the hole: the variant shows nothing");
 }
 
@@ -438,12 +443,15 @@ fn the_cover_passes_from_a_near_block_to_a_far_one_within_a_cell() {
     let both = Wanted { dark: true, lit: true };
     let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();
     let overlapping = street(-1.0);
-    let certifier = Certifier::new(&overlapping);
+    let certifier = Certifier::new(&overlapping).with_many_casters();
     assert_eq!(certifier.certify(0, &winter, both), Some(Certificate::Dark));
     assert!(ExactEngine::new(&overlapping).fractions(&requests).iter().all(|f| *f == 0.0));
     let cone = DirectionCone::enclosing(&winter).unwrap();
     assert!(!certifier.one_caster_covers(&certifier.shapes[0], &cone), "one block covers the whole cell: the test shows nothing");
     let apart = street(8.0);
-    assert_eq!(Certifier::new(&apart).certify(0, &winter, both), None);
-    assert!(ExactEngine::new(&apart).fractions(&requests).iter().any(|f| *f > 0.0), "no sun passes between the blocks: the variant shows nothing");
+    assert_eq!(Certifier::new(&apart).with_many_casters().certify(0, &winter, both), None);
+    assert!(
+        ExactEngine::new(&apart).fractions(&requests).iter().any(|f| *f > 0.0),
+        "no sun passes between the blocks: the variant shows nothing"
+    );
 }
