@@ -43,8 +43,6 @@ type Key = [u64; 3];
 pub(super) struct Composites {
     /// Per composite: its polygon's corners (world), collinear corners dropped.
     corners: Vec<Vec<DVec3>>,
-    /// Per composite: its plane.
-    planes: Vec<Plane>,
     /// Triangle position → composite, for the positions in one.
     of: HashMap<u32, u32>,
 }
@@ -73,7 +71,6 @@ impl Composites {
                 if let Some(corners) = convex_outline(index, plane, &component) {
                     let c = out.corners.len() as u32;
                     out.corners.push(corners);
-                    out.planes.push(plane);
                     out.of.extend(component.iter().map(|&p| (p, c)));
                 }
             }
@@ -89,28 +86,6 @@ impl Composites {
     /// Composite `c`'s polygon's corners (world).
     pub(super) fn corners(&self, c: u32) -> &[DVec3] {
         &self.corners[c as usize]
-    }
-
-    /// Whether `point` lies in composite `c`'s plane exactly (its coordinate along the plane's
-    /// axis equal bit for bit) and in its polygon, edges included: an exact test.
-    pub(super) fn holds(&self, c: u32, point: DVec3) -> bool {
-        let plane = self.planes[c as usize];
-        if point[usize::from(plane.axis)].to_bits() != plane.at {
-            return false;
-        }
-        let sign = if plane.positive { 1.0 } else { -1.0 };
-        let q = flat(point, plane.axis);
-        let corners = &self.corners[c as usize];
-        (0..corners.len()).all(|k| {
-            let (a, b) = (flat(corners[k], plane.axis), flat(corners[(k + 1) % corners.len()], plane.axis));
-            sign * (b - a).perp_dot(q - a) >= 0.0
-        })
-    }
-
-    /// Whether `point` lies in composite `c`'s plane exactly.
-    pub(super) fn in_plane(&self, c: u32, point: DVec3) -> bool {
-        let plane = self.planes[c as usize];
-        point[usize::from(plane.axis)].to_bits() == plane.at
     }
 
     /// How many composites were found.
@@ -332,12 +307,19 @@ mod tests {
         SourceMesh { positions: vec![[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], indices: vec![0, 1, 2, 0, 2, 3] }
     }
 
+    /// How many composites the panels form, each panel added as a receiver: a receiver keeps its
+    /// own mesh, so each panel is its own convex object, as nyt-blocks' walls and windows are.
+    /// (Added as plain casters, the builder bakes them into one mesh, where panels sharing
+    /// corners are one object, a convex one where they tile a rectangle: no composite needed.)
     fn composites(panels: &[SourceMesh]) -> usize {
         let mut b = SceneBuilder::new();
         for (k, m) in panels.iter().enumerate() {
-            b.add_object("test", &format!("P{k}"), m.clone(), false);
+            b.add_object("test", &format!("P{k}"), m.clone(), true);
         }
-        Composites::new(&ExactEngine::new(&b.build().unwrap())).len()
+        let index = ExactEngine::new(&b.build().unwrap());
+        let objects: std::collections::BTreeSet<Option<u32>> = (0..index.triangles.len()).map(|p| index.objects.of(p)).collect();
+        assert_eq!(objects.len(), panels.len(), "each panel must be its own object, or the composite rule is not exercised");
+        Composites::new(&index).len()
     }
 
     /// Four panels tiling a rectangle combine, and so do three meeting at a T-junction (two
