@@ -13,6 +13,10 @@
 //!   `O`'s projection by a margin. From a point outside a convex body the directions that hit it
 //!   form a convex cone, so a receiver point hit at every generator is hit at every direction
 //!   in between: the receiver is wholly shaded at every sun of the set. The fraction is 0.
+//!   Where no one caster does, the set's suns are halved (across their widest extent, up to
+//!   [`DARK_HALVINGS`] times) and each half proved so over its own cone: the cover may pass
+//!   from one caster to another between two suns of the set. The casters may be composites
+//!   ([`composite`]): coplanar panels that together form one convex polygon.
 //! - **Lit**: no triangle but the receiver's own lies in the volume its points sweep along the
 //!   cone's directions (`R + K`, convex, since the receiver's triangles and the cone are). A
 //!   triangle `T` misses it when it lies behind the receiver's plane (within the exact engine's
@@ -30,18 +34,23 @@
 //! Which casters qualify for *dark*: objects the exact engine finds convex ([`super::exact`]'s
 //! objects: a closed convex polyhedron or a flat convex polygon; up to 64 triangles any such,
 //! up to 65,536 if they lie in at most 64 planes and share corners bit for bit, as a panelled
-//! block does), opaque (no foliage, no transmittance). One with open caps (a block without a
+//! block does), opaque (no foliage, no transmittance); and *composite* casters ([`composite`]):
+//! opaque panels of any objects, receivers or not, in one axis-aligned plane whose union is
+//! proved to be one convex polygon with no gap (shared corners bit for bit, every inner edge
+//! used twice): a facade of per-floor walls and windows, the faces of blocks built flush. One with open caps (a block without a
 //! floor) qualifies only for a receiver strictly inside every cap's plane (above the ground),
 //! since a ray could otherwise pass through the openings. A caster that is not convex, open to
 //! the receiver, seen edge-on (its projection has no area) or see-through never proves a step
 //! dark; it only stops a step being proved lit.
 
 mod cells;
+mod composite;
 pub mod cone;
 mod never_dark;
 
 use glam::{DVec2, DVec3};
 
+use composite::Composites;
 pub use cone::DirectionCone;
 pub use never_dark::MIN_LIT_SHARE;
 use never_dark::Outline;
@@ -102,6 +111,10 @@ enum Sweep {
     TooMany,
 }
 
+/// Times a dark proof halves a cell's suns where no one caster covers the receiver over all of
+/// them (at most 2^(n+1) − 1 proofs a cell, fewer where a half fails).
+const DARK_HALVINGS: usize = 3;
+
 /// Sets of suns certified per thread hand-out.
 const CHUNK: usize = 8;
 
@@ -148,11 +161,25 @@ impl std::ops::Deref for Index<'_> {
     }
 }
 
+/// A caster that may prove a receiver dark.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Caster {
+    /// One of the exact engine's convex objects.
+    Object(u32),
+    /// Coplanar panels forming one flat convex polygon ([`composite`]).
+    Composite(u32),
+}
+
 /// The certificates of one scene. Build once, then ask [`Self::certify`].
 pub struct Certifier<'a> {
     index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
+    /// Composite casters; none unless [`Self::with_many_casters`].
+    composites: Composites,
+    /// Whether a dark proof may combine casters (composites, halves of a cell): off by default
+    /// until measured on the bench models (docs/energyplus-fidelity.md, "Certificates").
+    many_casters: bool,
 }
 
 impl Certifier<'static> {
@@ -182,7 +209,17 @@ impl<'a> Certifier<'a> {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index, shapes, extent }
+        Self { index, shapes, extent, composites: Composites::default(), many_casters: false }
+    }
+
+    /// Lets the dark proof combine casters: composite casters ([`composite`]) and halves of a
+    /// cell each covered by its own caster. Exact either way; off by default because its cost on
+    /// a city and on blaas-louvres is not yet measured.
+    pub fn with_many_casters(mut self) -> Self {
+        self.composites = Composites::new(&self.index);
+        log::debug!("certificates: {} composite casters (coplanar panels)", self.composites.len());
+        self.many_casters = true;
+        self
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
@@ -216,18 +253,73 @@ impl<'a> Certifier<'a> {
         if !wanted.dark {
             return None;
         }
-        // A caster that covers the receiver at every sun is hit by the ray from each receiver
-        // point along the cone's axis: it has a triangle in that one view's prism.
-        let mut candidates: Vec<u32> = Vec::new();
+        let candidates = self.cover_candidates(shape, &cone);
+        let mut set: Vec<usize> = (0..suns.len()).collect();
+        let halvings = if self.many_casters { DARK_HALVINGS } else { 0 };
+        self.dark_in_parts(shape, &candidates, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
+    }
+
+    /// Whether the receiver is dark at every sun of `set` (indices into `suns`, enclosed by
+    /// `cone`): one of `candidates` covers it over the whole cone, or, with `halvings` left, each
+    /// half of the set (split across its widest extent, [`never_dark::split_widest`]) is so
+    /// proved over its own cone. Each sun lies in a cone one caster covers, so it is dark: the
+    /// cover may pass from one caster to another between the suns (a nearer block to a farther
+    /// one). The halves try the whole cell's candidates (a search per half cost more than the
+    /// proofs saved on a city): a caster that covers only a half and is not among them is
+    /// missed, never wrongly trusted.
+    fn dark_in_parts(
+        &self,
+        shape: &Shape,
+        candidates: &[Caster],
+        suns: &[DVec3],
+        set: &mut [usize],
+        cone: &DirectionCone,
+        halvings: usize,
+    ) -> bool {
+        if candidates.iter().any(|c| self.covers(shape, cone, *c)) {
+            return true;
+        }
+        if halvings == 0 || set.len() < 2 || candidates.len() < 2 {
+            return false;
+        }
+        never_dark::split_widest(suns, set);
+        let (first, second) = set.split_at_mut(set.len() / 2);
+        [first, second].into_iter().all(|half| {
+            let part: Vec<DVec3> = half.iter().map(|&i| suns[i]).collect();
+            // Inside the whole's cone, so in front of the receiver and above the horizon too.
+            DirectionCone::enclosing(&part).is_some_and(|c| self.dark_in_parts(shape, candidates, suns, half, &c, halvings - 1))
+        })
+    }
+
+    /// The opaque convex casters (objects and composites) that may cover the receiver over the
+    /// cone: a caster that covers it at every direction of the cone is hit by the ray from each
+    /// receiver point along the cone's axis, so it has a triangle in that one view's prism.
+    fn cover_candidates(&self, shape: &Shape, cone: &DirectionCone) -> Vec<Caster> {
+        let mut candidates: Vec<Caster> = Vec::new();
         let view = view::fit(&shape.points, cone.axis(), self.index.bounds, self.index.origin, 64);
         self.index.culling.visit_triangles(&view.view_proj, |r| {
             for p in r {
-                if let Some(o) = self.opaque_convex(p).filter(|o| self.index.owner[p] != shape.gpu_id && !candidates.contains(o)) {
-                    candidates.push(o);
+                if self.index.owner[p] == shape.gpu_id {
+                    continue;
+                }
+                let object = self.opaque_convex(p).map(Caster::Object);
+                let composite = self.composites.of(p).map(Caster::Composite);
+                // An object's triangles come one after another: skip the repeats cheaply.
+                for c in [object, composite].into_iter().flatten() {
+                    if candidates.last() != Some(&c) {
+                        candidates.push(c);
+                    }
                 }
             }
         });
-        candidates.into_iter().any(|o| self.covers(shape, &cone, o)).then_some(Certificate::Dark)
+        candidates.sort_unstable();
+        candidates.dedup();
+        candidates
+    }
+
+    #[cfg(test)]
+    fn one_caster_covers(&self, shape: &Shape, cone: &DirectionCone) -> bool {
+        self.cover_candidates(shape, cone).into_iter().any(|c| self.covers(shape, cone, c))
     }
 
     /// Whether no triangle but the receiver's own lies in the volume it sweeps along the cone;
@@ -343,16 +435,29 @@ impl<'a> Certifier<'a> {
         })
     }
 
-    /// Whether object `o` shades the whole receiver at every generator of the cone (so at every
+    /// Whether `caster` shades the whole receiver at every generator of the cone (so at every
     /// direction of it): it lies in front of the receiver's plane, and at each generator every
     /// receiver vertex projects inside its projection, both by [`COVER_MARGIN`].
-    fn covers(&self, shape: &Shape, cone: &DirectionCone, o: u32) -> bool {
+    ///
+    /// A composite must stand clear of the plane by the margin too, as an object must. One that
+    /// touches it (a facade meeting the receiver's wall at an inner corner) would put the
+    /// shadow's edge on the receiver's own edge with no margin: rays and the reference engine
+    /// find such a wall dark, but the margin is what covers the GPU's rounding (its depth test
+    /// along the corner is not shown to side with the facade), so no such proof is given.
+    fn covers(&self, shape: &Shape, cone: &DirectionCone, caster: Caster) -> bool {
         let margin = COVER_MARGIN * (1.0 + self.extent);
-        let corners: Vec<DVec3> = self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect();
-        if corners.len() < 3 || corners.iter().any(|c| c.dot(shape.normal) <= margin) {
+        let corners: Vec<DVec3> = match caster {
+            Caster::Object(o) => self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect(),
+            Caster::Composite(c) => self.composites.corners(c).iter().map(|&p| p - shape.p0).collect(),
+        };
+        if corners.len() < 3 || !corners.iter().all(|c| c.dot(shape.normal) > margin) {
             return false;
         }
-        if self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin) {
+        let open_to_receiver = match caster {
+            Caster::Object(o) => self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin),
+            Caster::Composite(_) => false,
+        };
+        if open_to_receiver {
             return false;
         }
         cone.generators().iter().all(|g| {

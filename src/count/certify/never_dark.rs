@@ -538,7 +538,7 @@ fn capsule_interval(o: DVec2, d: DVec2, a: DVec2, b: DVec2, r: f64) -> Option<(f
 /// chart about their mean, so that each half spans about half the sky the set does that way: a
 /// cell's steps in order of rows split into its first and last days, which the sun's path
 /// across an hour or so of each day spans much more widely. Only the order of trying changes.
-fn split_widest(suns: &[DVec3], set: &mut [usize]) {
+pub(super) fn split_widest(suns: &[DVec3], set: &mut [usize]) {
     let Some(axis) = set.iter().map(|&i| suns[i]).sum::<DVec3>().try_normalize() else { return };
     let (u, v) = perpendicular_basis(axis);
     let chart = |i: usize| DVec2::new(suns[i].dot(u), suns[i].dot(v)) / suns[i].dot(axis);
