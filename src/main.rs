@@ -142,6 +142,11 @@ struct AnnualArgs {
     /// it otherwise: no shadow passing wholly between samples is lost (slower; off by default).
     #[arg(long)]
     prove_never_dark: bool,
+    /// With refinement on: let a dark proof combine casters (coplanar panels forming one convex
+    /// polygon, halves of a cell each covered by its own caster). Exact; off by default until
+    /// measured on every bench model.
+    #[arg(long)]
+    many_casters: bool,
     /// Output CSV, EnergyPlus's eplusshading.csv layout (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
@@ -228,6 +233,7 @@ impl AnnualArgs {
             samples_per_day: Some(self.samples_per_day),
             refine: Some(self.refine),
             prove_never_dark: Some(self.prove_never_dark),
+            many_casters: Some(self.many_casters),
             dense: Some(self.dense),
             evergreen: Some(self.evergreen),
             leaf_out: self.leaf_out.clone(),

@@ -26,7 +26,7 @@ fn golden() -> Location {
 fn year(scene: &Scene, method: Method, refine: f64, resolution: u32) -> Schedule {
     let counter = counter(resolution);
     let gpu = counter.upload(scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine, prove_never_dark: false };
+    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine, prove_never_dark: false, many_casters: false };
     pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| Ok(()))).unwrap()
 }
 
@@ -45,6 +45,7 @@ fn two_lanes_count_the_same_year_as_one() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
+        many_casters: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut reports = 0;
@@ -67,7 +68,13 @@ fn a_failing_progress_callback_cancels_the_year() {
     let scene = load_bytes(&[("office.glb".into(), office(6).to_glb())], &LoadOptions::default()).unwrap();
     let counter = counter(128);
     let gpu = counter.upload(&scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method: Method::Dense, refine: 1.0, prove_never_dark: false };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method: Method::Dense,
+        refine: 1.0,
+        prove_never_dark: false,
+        many_casters: false,
+    };
     let mut reports = Vec::new();
     let result = pollster::block_on(annual(&counter, &gpu, &scene, &golden(), &options, &mut |p| {
         reports.push(p);
@@ -225,7 +232,8 @@ fn cli_bad_annual_input() {
 /// The exact engine's year for `scene` at 4 timesteps an hour, and the views it counted;
 /// `prove_never_dark` as [`AnnualOptions::prove_never_dark`].
 fn exact_year(scene: &Scene, method: Method, prove_never_dark: bool) -> (Schedule, usize) {
-    let options = AnnualOptions { timesteps: Timesteps::new(4).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark };
+    let options =
+        AnnualOptions { timesteps: Timesteps::new(4).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark, many_casters: false };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut views = 0;
     let schedule = pollster::block_on(sunlit::year::annual::annual_with(
@@ -356,7 +364,13 @@ impl sunlit::count::Engine for Tally<'_> {
 /// Every progress report of the year for `scene` at `method` (hourly, evergreen), and the views
 /// the engine was asked for.
 fn reported_year(scene: &Scene, method: Method) -> (Vec<sunlit::year::annual::Progress>, usize) {
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark: false };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method,
+        refine: DEFAULT_REFINE,
+        prove_never_dark: false,
+        many_casters: false,
+    };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let engine = Tally::new(scene);
     let mut reports = Vec::new();
@@ -448,6 +462,7 @@ fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
+        many_casters: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut quiet = |_: sunlit::year::annual::Progress| -> sunlit::Result<()> { Ok(()) };

@@ -176,6 +176,8 @@ export interface AnnualSettings {
   refine?: number;
   /** Interpolate a timestep only where part of the surface is proved lit at its sun, else count it (slower; default false). */
   proveNeverDark?: boolean;
+  /** Let a dark proof combine casters (coplanar panels forming one convex polygon, halves of a cell), as `--many-casters`; exact, off by default. */
+  manyCasters?: boolean;
   /** Count every sun-up timestep instead of interpolating (slow). */
   dense?: boolean;
   /** Foliage keeps its leaves all year. */

@@ -15,6 +15,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("samples_per_day", "--samples-per-day"),
     ("refine", "--refine"),
     ("prove_never_dark", "--prove-never-dark"),
+    ("many_casters", "--many-casters"),
     ("resolution", "--resolution"),
     ("accuracy", "--accuracy"),
     ("hook", "--hook"),

@@ -170,11 +170,13 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
 
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
 /// the rest, to count, with the interpolated ones not proved never dark
-/// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one.
+/// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one;
+/// `many_casters`: [`super::annual::AnnualOptions::many_casters`].
 #[allow(clippy::too_many_arguments)] // The year's steps and where they go; grouping them would hide nothing.
 pub(super) fn certify_steps(
     scene: &Scene,
     index: Option<&ExactEngine>,
+    many_casters: bool,
     location: &Location,
     timesteps: Timesteps,
     rough: Vec<Rough>,
@@ -185,9 +187,7 @@ pub(super) fn certify_steps(
         Some(index) => Certifier::sharing(scene, index),
         None => Certifier::new(scene),
     };
-    // Off by default until shown to pay (docs/energyplus-fidelity.md, "Certificates"); the
-    // variable turns the many-caster dark proofs on for a measurement.
-    let certifier = if std::env::var_os("SUNLIT_MANY_CASTERS").is_some() { certifier.with_many_casters() } else { certifier };
+    let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
     let asked = rough.len();
     let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
     let interpolated = smooth.len();

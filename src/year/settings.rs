@@ -53,6 +53,8 @@ pub struct AnnualSettings {
     pub refine: Option<f64>,
     /// See [`AnnualOptions::prove_never_dark`] (default off).
     pub prove_never_dark: Option<bool>,
+    /// See [`AnnualOptions::many_casters`] (default off).
+    pub many_casters: Option<bool>,
     /// Count every timestep instead of the spline.
     pub dense: Option<bool>,
     /// Foliage keeps its leaves all year.
@@ -82,6 +84,8 @@ pub struct Resolved {
     pub refine: f64,
     /// Whether interpolated timesteps must be proved never dark ([`AnnualOptions::prove_never_dark`]).
     pub prove_never_dark: bool,
+    /// Whether dark proofs may combine casters ([`AnnualOptions::many_casters`]).
+    pub many_casters: bool,
     /// When foliage is in leaf.
     pub calendar: LeafCalendar,
     /// Timesteps per hour as asked (checked); `None`: the model's, else the default.
@@ -108,8 +112,8 @@ impl AnnualSettings {
         let calendar = self.calendar(&location)?;
         let timesteps_per_hour = self.timesteps_per_hour.map(Timesteps::new).transpose()?;
         let sky_model = self.sky_model()?;
-        let prove_never_dark = self.prove_never_dark.unwrap_or(false);
-        Ok(Resolved { location, method, refine, prove_never_dark, calendar, timesteps_per_hour, sky_model })
+        let (prove_never_dark, many_casters) = (self.prove_never_dark.unwrap_or(false), self.many_casters.unwrap_or(false));
+        Ok(Resolved { location, method, refine, prove_never_dark, many_casters, calendar, timesteps_per_hour, sky_model })
     }
 
     fn location(&self) -> Result<Location> {
@@ -161,6 +165,7 @@ impl Resolved {
             method: self.method,
             refine: self.refine,
             prove_never_dark: self.prove_never_dark,
+            many_casters: self.many_casters,
         })
     }
 
