@@ -6,7 +6,8 @@
 // clipping workers: the engine's thread alone), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto),
 // native-first (the same with an empty profile cache: it probes, as the page's first visit does;
-// SUNLIT_BIN names another binary than target/release/sunlit), page (the page itself: open it,
+// SUNLIT_BIN names another binary than target/release/sunlit), native-exact (the CLI with
+// --engine exact: the page's `exact` side like for like), page (the page itself: open it,
 // choose the model, Compute; from opening to "Done", as a new visitor waits). Each side
 // runs N times (default 1) in a fresh browser and prints one JSON line per run, then one summary
 // line per side with the median seconds; the browser's lines also carry the peak resident memory
@@ -319,7 +320,7 @@ async function pageRun() {
 }
 
 /** The CLI's year; `fresh`: with an empty profile cache, so `auto` probes as on a first run. */
-function nativeRun(fresh) {
+function nativeRun(fresh, engine = null) {
   const bin = process.env.SUNLIT_BIN ?? join(ROOT, 'target/release/sunlit');
   statSync(bin);
   const cache = fresh ? mkdtempSync(join(tmpdir(), 'sunlit-bench-cache-')) : undefined;
@@ -328,12 +329,12 @@ function nativeRun(fresh) {
   const t0 = performance.now();
   // /usr/bin/time for the CLI's CPU seconds (user + system), as Chromium's are read from /proc.
   execFileSync('/usr/bin/time', ['-f', '%U %S', '-o', times, bin, 'annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
-    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
+    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, ...(engine ? ['--engine', engine] : []), '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
   const total = (performance.now() - t0) / 1000;
   const cpu = readFileSync(times, 'utf8').trim().split(/\s+/).map(Number).reduce((a, b) => a + b, 0);
   rmSync(times, { force: true });
   if (cache) rmSync(cache, { recursive: true, force: true });
-  return { side: fresh ? 'native-first' : 'native', total_s: total, cpu_s: Number(cpu.toFixed(2)) };
+  return { side: engine ? `native-${engine}` : fresh ? 'native-first' : 'native', total_s: total, cpu_s: Number(cpu.toFixed(2)) };
 }
 
 const median = (xs) => {
@@ -356,7 +357,7 @@ for (const side of sides) {
 const rounds = Array.from({ length: runs }, (_, r) => r);
 const order = interleave ? rounds.flatMap((r) => sides.map((side) => [side, r])) : sides.flatMap((side) => rounds.map((r) => [side, r]));
 for (const [side, r] of order) {
-  const result = side.startsWith('native') ? nativeRun(side === 'native-first') : side === 'page' ? await pageRun() : await browserRun(side, r);
+  const result = side.startsWith('native') ? nativeRun(side === 'native-first', side === 'native-exact' ? 'exact' : null) : side === 'page' ? await pageRun() : await browserRun(side, r);
   bySide[side].times.push(result.total_s);
   bySide[side].visits.push(result.first_visit_s ?? result.total_s);
   console.log(JSON.stringify({ ...head, run: r + 1, ...result }));
