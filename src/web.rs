@@ -198,7 +198,7 @@ impl Engine {
     pub fn adapter(&self) -> String {
         let Some(gpu) = &self.gpu else {
             if self.kind == EngineKind::Exact {
-                return "none asked for (engine 'exact' clips every view)".into();
+                return "none (engine 'exact' clips every view, without a GPU)".into();
             }
             return "none (no WebGPU: views are clipped only)".into();
         };
