@@ -164,7 +164,9 @@ async function browserRun(side, run = 0) {
     // views done of all, and the peak memory so far.
     const started = Date.now();
     page.on('console', (m) => {
-      if (m.type() === 'error') console.error(m.text());
+      // The blank document's own 404 (and its favicon's) is no error of the run.
+      const blank = /\/(bench-blank|favicon\.ico)$/.test(m.location()?.url ?? '');
+      if (m.type() === 'error' && !blank) console.error(m.text());
       // The pool's sizing by its memory budget, and each instance's wasm once loaded.
       if (m.text().startsWith('sunlit: ') || m.text().startsWith('loaded ')) console.error(m.text());
       const at = /^progress (\d+) (\d+)$/.exec(m.text());
