@@ -6,7 +6,8 @@
 // clipping workers: the engine's thread alone), exact, gpu, exact-1 (one clipping
 // worker: the pool's speed-up is exact-1 over exact at 2+ cores), native (the CLI, auto),
 // native-first (the same with an empty profile cache: it probes, as the page's first visit does;
-// SUNLIT_BIN names another binary than target/release/sunlit), page (the page itself: open it,
+// SUNLIT_BIN names another binary than target/release/sunlit), native-exact (the CLI with
+// --engine exact: the page's `exact` side like for like), page (the page itself: open it,
 // choose the model, Compute; from opening to "Done", as a new visitor waits). Each side
 // runs N times (default 1) in a fresh browser and prints one JSON line per run, then one summary
 // line per side with the median seconds; the browser's lines also carry the peak resident memory
@@ -19,9 +20,9 @@
 // year does not wait for the workers to build their copies (--load-only does). The page's `auto` measures its profile in the first run (IndexedDB is fresh in
 // every browser), as a first visit does. Needs `scripts/build-web.sh` and a release build.
 import { execFileSync } from 'node:child_process';
-import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync } from 'node:fs';
+import { copyFileSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { basename, join } from 'node:path';
+import { basename, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { serve } from './serve.mjs';
 import { launch } from '../tests/browser/chromium.mjs';
@@ -45,6 +46,13 @@ if (!Number.isInteger(timesteps) || timesteps < 1 || timesteps > 60) {
 const loadOnly = args.includes('--load-only') && Boolean(args.splice(args.indexOf('--load-only'), 1));
 // --interleave: the sides take turns run by run, for paired ratios (below).
 const interleave = args.includes('--interleave') && Boolean(args.splice(args.indexOf('--interleave'), 1));
+// --cpu-profile PREFIX: V8's CPU profile of the page's thread (the engine's instance) over each
+// browser run, written to PREFIX-SIDE-RUN.cpuprofile (Chrome DevTools' format; a bundle built
+// without --remove-name-section names the wasm's functions): where the engine's thread goes.
+const cpuProfile = flag('--cpu-profile', null);
+// --www DIR: serve another build of the page (e.g. main's www/, pkg/ included) instead of this
+// checkout's, for A/B runs of the two bundles under scripts/paired.sh.
+const WWW = resolve(flag('--www', join(ROOT, 'www')));
 const sides = flag('--sides', 'default,exact,gpu,exact-1,native').split(',');
 const [model, samples = '27x19', resolution = '512'] = args;
 if (!model) {
@@ -142,9 +150,9 @@ function peakOf(a, b) {
 
 const mb = (bytes) => Math.round(bytes / 1e6);
 
-async function browserRun(side) {
-  copyFileSync(model, join(ROOT, `www/pkg/bench-model-${process.pid}.glb`));
-  const server = await serve(0);
+async function browserRun(side, run = 0) {
+  copyFileSync(model, join(WWW, `pkg/bench-model-${process.pid}.glb`));
+  const server = await serve(0, '127.0.0.1', WWW);
   const browser = await launch();
   let peak = {};
   const sampler = setInterval(() => {
@@ -156,7 +164,9 @@ async function browserRun(side) {
     // views done of all, and the peak memory so far.
     const started = Date.now();
     page.on('console', (m) => {
-      if (m.type() === 'error') console.error(m.text());
+      // The blank document's own 404 (and its favicon's) is no error of the run.
+      const blank = /\/(bench-blank|favicon\.ico)$/.test(m.location()?.url ?? '');
+      if (m.type() === 'error' && !blank) console.error(m.text());
       // The pool's sizing by its memory budget, and each instance's wasm once loaded.
       if (m.text().startsWith('sunlit: ') || m.text().startsWith('loaded ')) console.error(m.text());
       const at = /^progress (\d+) (\d+)$/.exec(m.text());
@@ -165,7 +175,16 @@ async function browserRun(side) {
         console.error(JSON.stringify({ side, elapsed_s: Math.round((Date.now() - started) / 1000), done: Number(at[1]), total: Number(at[2]), peak_rss_mb_by_process: so }));
       }
     });
-    await page.goto(`http://127.0.0.1:${server.address().port}/api-example.html`);
+    // A document of the site's origin that runs nothing of its own (a 404): api-example.html
+    // makes its own engine with its own workers and year as it loads, which ran beside every
+    // first visit timed here before (its adapter request, its index, its wasm compile shared).
+    await page.goto(`http://127.0.0.1:${server.address().port}/bench-blank`);
+    const profiler = cpuProfile ? await page.context().newCDPSession(page) : null;
+    if (profiler) {
+      await profiler.send('Profiler.enable');
+      await profiler.send('Profiler.setSamplingInterval', { interval: 200 });
+      await profiler.send('Profiler.start');
+    }
     const cpuBefore = treeCpu(process.pid);
     const threadsBefore = threadCpu(process.pid);
     const result = await page.evaluate(
@@ -255,12 +274,16 @@ async function browserRun(side) {
     const cpu = treeCpu(process.pid) - cpuBefore;
     const cpuByThread = cpuSpent(threadsBefore, threadCpu(process.pid));
     peak = peakOf(peak, treeRss(process.pid));
+    if (profiler) {
+      const { profile } = await profiler.send('Profiler.stop');
+      writeFileSync(`${cpuProfile}-${side}-${run + 1}.cpuprofile`, JSON.stringify(profile));
+    }
     return { side: `page-${side}`, ...result, cpu_s: Number(cpu.toFixed(2)), cpu_s_by_thread: cpuByThread, peak_rss_mb: mb(peak.total), peak_rss_mb_by_process: Object.fromEntries(Object.entries(peak).map(([k, v]) => [k, mb(v)])) };
   } finally {
     clearInterval(sampler);
     await browser.close();
     server.close();
-    rmSync(join(ROOT, `www/pkg/bench-model-${process.pid}.glb`), { force: true });
+    rmSync(join(WWW, `pkg/bench-model-${process.pid}.glb`), { force: true });
   }
 }
 
@@ -268,7 +291,7 @@ async function browserRun(side) {
  * input, press Compute as soon as it is loaded, with the form's settings set to the bench's.
  * `first_visit_s`: from opening the page to its "Done"; `compute_s`: from Compute to "Done". */
 async function pageRun() {
-  const server = await serve(0);
+  const server = await serve(0, '127.0.0.1', WWW);
   const browser = await launch();
   try {
     const page = await browser.newPage();
@@ -299,7 +322,7 @@ async function pageRun() {
 }
 
 /** The CLI's year; `fresh`: with an empty profile cache, so `auto` probes as on a first run. */
-function nativeRun(fresh) {
+function nativeRun(fresh, engine = null) {
   const bin = process.env.SUNLIT_BIN ?? join(ROOT, 'target/release/sunlit');
   statSync(bin);
   const cache = fresh ? mkdtempSync(join(tmpdir(), 'sunlit-bench-cache-')) : undefined;
@@ -308,12 +331,12 @@ function nativeRun(fresh) {
   const t0 = performance.now();
   // /usr/bin/time for the CLI's CPU seconds (user + system), as Chromium's are read from /proc.
   execFileSync('/usr/bin/time', ['-f', '%U %S', '-o', times, bin, 'annual', model, '--location', `${place.latitude},${place.longitude},${place.timeZone}`, '--timesteps-per-hour', String(timesteps),
-    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
+    '--days-per-year', String(days), '--samples-per-day', String(perDay), '--resolution', resolution, ...(engine ? ['--engine', engine] : []), '-o', '/tmp/sunlit-bench-web.csv'], { stdio: ['ignore', 'ignore', 'inherit'], env });
   const total = (performance.now() - t0) / 1000;
   const cpu = readFileSync(times, 'utf8').trim().split(/\s+/).map(Number).reduce((a, b) => a + b, 0);
   rmSync(times, { force: true });
   if (cache) rmSync(cache, { recursive: true, force: true });
-  return { side: fresh ? 'native-first' : 'native', total_s: total, cpu_s: Number(cpu.toFixed(2)) };
+  return { side: engine ? `native-${engine}` : fresh ? 'native-first' : 'native', total_s: total, cpu_s: Number(cpu.toFixed(2)) };
 }
 
 const median = (xs) => {
@@ -336,7 +359,7 @@ for (const side of sides) {
 const rounds = Array.from({ length: runs }, (_, r) => r);
 const order = interleave ? rounds.flatMap((r) => sides.map((side) => [side, r])) : sides.flatMap((side) => rounds.map((r) => [side, r]));
 for (const [side, r] of order) {
-  const result = side.startsWith('native') ? nativeRun(side === 'native-first') : side === 'page' ? await pageRun() : await browserRun(side);
+  const result = side.startsWith('native') ? nativeRun(side === 'native-first', side === 'native-exact' ? 'exact' : null) : side === 'page' ? await pageRun() : await browserRun(side, r);
   bySide[side].times.push(result.total_s);
   bySide[side].visits.push(result.first_visit_s ?? result.total_s);
   console.log(JSON.stringify({ ...head, run: r + 1, ...result }));

@@ -32,7 +32,9 @@ export const CSP = [
   "frame-ancestors 'none'",
 ].join('; ');
 
-export function serve(port = Number(process.env.PORT ?? 8080), host = '127.0.0.1') {
+/** Serves `root` (default www/; a folder holding another build of the page, for A/B runs). */
+export function serve(port = Number(process.env.PORT ?? 8080), host = '127.0.0.1', root = ROOT) {
+  const ROOT = root.endsWith(sep) ? root : root + sep;
   const server = createServer(async (req, res) => {
     const headers = { 'Content-Security-Policy': CSP, 'X-Content-Type-Options': 'nosniff', 'Cache-Control': 'no-store' };
     try {

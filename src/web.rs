@@ -93,6 +93,14 @@ pub fn js_option(param: &str) -> String {
     out
 }
 
+/// Exact engines (indexes of a model) this wasm instance has built so far
+/// ([`ExactEngine::indexes_built`]): the page's thread gives it as `engine.timings.indexesBuilt`,
+/// so a test can tell that the engine's thread indexes a model once for all it does with it.
+#[wasm_bindgen(js_name = exactIndexesBuilt)]
+pub fn exact_indexes_built() -> usize {
+    ExactEngine::indexes_built()
+}
+
 /// The page's WebGPU adapter, its device opened when a view is first routed to it ([`lazy`];
 /// none where the browser has no WebGPU: then views are clipped only).
 #[wasm_bindgen]
@@ -111,7 +119,7 @@ impl Engine {
     /// `resolution`, only where its shadow edges need it (default: every view at `resolution`);
     /// `engine`: `auto` (default), `gpu`, `exact` or `compute` ([`choice`]); `gpu: false` (no
     /// WebGPU in this browser) makes no device: views are clipped, and `gpu` and `compute` are
-    /// refused.
+    /// refused. `exact` asks for no adapter (it never draws).
     pub async fn create(
         resolution: Option<u32>,
         accuracy: Option<f64>,
@@ -127,7 +135,9 @@ impl Engine {
             kernel,
             ..Default::default()
         };
-        if gpu == Some(false) {
+        // `exact` never draws, so it asks for no adapter: on a fresh browser that request held
+        // `createEngine` back by up to 1.4 s (docs/page-speed.md, "The first visit").
+        if gpu == Some(false) || kind == EngineKind::Exact {
             if kind.gpu_only() {
                 return Err(js_error(Error::argument(
                     "engine",
@@ -186,7 +196,12 @@ impl Engine {
     /// The adapter's name and backend, for the page's status line.
     #[wasm_bindgen(getter)]
     pub fn adapter(&self) -> String {
-        let Some(gpu) = &self.gpu else { return "none (no WebGPU: views are clipped only)".into() };
+        let Some(gpu) = &self.gpu else {
+            if self.kind == EngineKind::Exact {
+                return "none (engine 'exact' clips every view, without a GPU)".into();
+            }
+            return "none (no WebGPU: views are clipped only)".into();
+        };
         // Browsers hide the adapter's name unless asked; say what is known.
         let info = gpu.info();
         if info.name.is_empty() { "the browser's WebGPU".into() } else { format!("{} ({:?})", info.name, info.backend) }
@@ -198,8 +213,9 @@ impl Engine {
         self.options.resolution
     }
 
-    /// Whether the browser offers a WebGPU adapter (false where it has no WebGPU); its device is
-    /// opened when a view is first routed to it.
+    /// Whether the engine holds a WebGPU adapter: false where the browser has no WebGPU, and with
+    /// engine `exact`, which never draws and asks for none; its device is opened when a view is
+    /// first routed to it.
     #[wasm_bindgen(getter, js_name = hasGpu)]
     pub fn has_gpu(&self) -> bool {
         self.gpu.is_some()

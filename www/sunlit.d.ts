@@ -206,13 +206,14 @@ export interface AnnualRunOptions {
 }
 
 export interface SunlitEngine {
-  /** The GPU adapter in use. */
+  /** The GPU adapter in use (with engine 'exact', which never draws, none is asked for). */
   readonly adapter: string;
   /** Pixels along a view's side. */
   readonly resolution: number;
   /** Which engine answers views (createEngine's `engine`). */
   readonly engine: 'auto' | 'gpu' | 'exact' | 'compute';
-  /** Whether a GPU device is in use (false without WebGPU: views are clipped). */
+  /** Whether the engine holds a WebGPU adapter: false without WebGPU (views are clipped) and with
+   * engine 'exact', which never draws and so asks for no adapter. */
   readonly hasGpu: boolean;
   /** Clipping workers in the pool (0: clipping runs in the engine's thread). */
   readonly workers: number;
@@ -245,7 +246,8 @@ export interface SunlitEngine {
    * (every worker built its copy), `yearStarted` (the last year routed: its model encoded, its
    * profile looked up, its counting begins), `yearCounted` (that year's schedule made, before its
    * profile is stored); `clipped`: views clipped so far in the engine's thread and by the
-   * workers. */
+   * workers; `indexesBuilt`: exact engines (indexes of a model) the engine's wasm instance has
+   * built so far, one a model however it is used. */
   readonly timings: {
     wasm?: number;
     engine?: number;
@@ -255,6 +257,7 @@ export interface SunlitEngine {
     yearStarted?: number;
     yearCounted?: number;
     clipped: { here: number; workers: number };
+    indexesBuilt: number;
   };
   /** Stops the pool's workers. */
   close(): void;

@@ -3,7 +3,7 @@
 //
 // Wraps the wasm-bindgen bindings (pkg/sunlit_wasm.js, built by scripts/build-web.sh) so that
 // callers get one init, plain-object settings, AbortSignal cancellation and sun angles.
-import init, { Engine, epwLocation as wasmEpwLocation } from './pkg/sunlit_wasm.js';
+import init, { Engine, epwLocation as wasmEpwLocation, exactIndexesBuilt } from './pkg/sunlit_wasm.js';
 import { onDevice } from './device.js';
 import { ClipPool, DEFAULT_MEMORY_BUDGET, defaultWorkers, wasmModule } from './pool.js';
 import { cachedProfile, storeProfile, warmProfiles } from './profiles.js';
@@ -202,7 +202,8 @@ class SunlitEngine {
     this.#asked = pool?.size ?? 0;
   }
 
-  /** Whether a GPU device is in use (false where the browser has no WebGPU: views are clipped). */
+  /** Whether the engine holds a WebGPU adapter: false where the browser has no WebGPU (views are
+   * clipped), and with engine 'exact', which never draws and asks for none. */
   get hasGpu() {
     return this.#engine.hasGpu;
   }
@@ -254,10 +255,12 @@ class SunlitEngine {
    * (every clipping worker started its instance), `encoded` (the first model encoded for the
    * workers), `workersHold` (every worker built its copy), `yearStarted` and `yearCounted` (the
    * last year's counting began, its model encoded and its profile looked up, and ended, before
-   * its profile is stored); and `clipped`: views clipped in this thread (`here`) and by the
-   * workers so far (docs/page-speed.md, "The first visit"). */
+   * its profile is stored); `clipped`: views clipped in this thread (`here`) and by the
+   * workers so far; and `indexesBuilt`: exact engines (indexes of a model) this thread's wasm
+   * instance has built, one a model however it is used (docs/page-speed.md, "The first
+   * visit"). */
   get timings() {
-    return { ...this.#timings, clipped: this.#pool?.clipped ?? { here: 0, workers: 0 } };
+    return { ...this.#timings, clipped: this.#pool?.clipped ?? { here: 0, workers: 0 }, indexesBuilt: exactIndexesBuilt() };
   }
 
   /** Stops the pool's workers; the engine then clips in this thread. */
@@ -331,7 +334,7 @@ class SunlitEngine {
     if (sky?.source === 'probe') await storeProfile(key.sky, sky.profile);
   }
 
-  /** The GPU adapter in use. */
+  /** The GPU adapter in use ('exact' asks for none). */
   get adapter() {
     return this.#engine.adapter;
   }

@@ -310,6 +310,13 @@ pub(super) fn store_key(
 }
 
 impl Engine for Chosen<'_> {
+    /// The model's exact engine, built once a page thread and shared: the year's certificates
+    /// use it (without it they built a second index of the model on the engine's thread, beside
+    /// the one that encodes the convex objects for the workers; docs/page-speed.md).
+    fn index(&self) -> Option<&ExactEngine> {
+        Some(self.exact())
+    }
+
     fn batch(&self) -> usize {
         // A GPU's atlas where views go to the GPU; else a batch every worker of a pool gets views
         // of. Each batch is a round trip to the pool, so `auto` clipping by the atlas's batch was

@@ -29,7 +29,7 @@
 //! and no allocation, and it stays within ~1e-9 of the reference.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 
 use glam::{DVec2, DVec3};
 
@@ -48,6 +48,8 @@ use crate::scene::{NO_RECEIVER, Scene, Veil, shifted_rank};
 const PRISM_SIDE: u32 = 512;
 /// Views a thread takes at a time.
 const CHUNK: usize = 16;
+/// Indexes built so far in this process (or wasm instance): see [`ExactEngine::indexes_built`].
+static INDEXES_BUILT: AtomicUsize = AtomicUsize::new(0);
 
 /// A receiver as the engine needs it, made once: its plane frame's axes and its 2D outline.
 struct Outline {
@@ -174,12 +176,20 @@ impl ExactEngine {
         self.objects.to_bytes()
     }
 
+    /// Exact engines built so far in this process (natively) or wasm instance (the page's
+    /// thread, a clipping worker): what a page's first visit pays per index of its model, so a
+    /// test can tell that one thread indexes a model once (docs/page-speed.md).
+    pub fn indexes_built() -> usize {
+        INDEXES_BUILT.load(Ordering::Relaxed)
+    }
+
     /// Indexes `scene`, its convex objects made by `objects` from each position's source and
     /// world triangle.
     fn build<E>(
         scene: &Scene,
         objects: impl FnOnce(&[(usize, u32)], &[[DVec3; 3]]) -> std::result::Result<PlacedObjects, E>,
     ) -> std::result::Result<Self, E> {
+        INDEXES_BUILT.fetch_add(1, Ordering::Relaxed);
         let culling = Culling::new(scene, CPU_LEAF_TRIANGLES);
         let sources = culling.triangle_sources();
         let extent = (scene.bounds.1 - scene.bounds.0).length();
