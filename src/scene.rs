@@ -17,7 +17,7 @@
 //! fraction exceeds it, so one upload serves every day; a node with transmittance t lets t of
 //! the beam through (a stochastic per-pixel threshold on the GPU). Receivers are always opaque.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 
 use glam::{DMat4, DVec3};
@@ -50,6 +50,10 @@ pub struct Mesh {
     pub indices: Vec<u32>,
     /// Per vertex: leaf rank and transmittance ([`Veil::OPAQUE`] for ordinary geometry).
     pub veils: Vec<Veil>,
+    /// Shading-only geometry laid out as receivers are ([`SceneBuilder::cast_by_parts`]): each
+    /// range (of triangles, numbered as in `indices` / 3, in order and disjoint) one planar part
+    /// of a node, which the exact engine groups into objects as it would the part received.
+    pub cast_parts: Vec<Range<u32>>,
 }
 
 /// How a caster's vertex lets the sun through: see the module doc.
@@ -277,6 +281,9 @@ pub struct SceneBuilder {
     veils: HashMap<usize, NodeVeil>,
     /// The static mesh's origin when set ([`SceneBuilder::set_origin`]).
     origin: Option<DVec3>,
+    /// Nodes cast by their planar parts when they do not receive: see
+    /// [`SceneBuilder::cast_by_parts`].
+    by_parts: HashSet<usize>,
 }
 
 impl SceneBuilder {
@@ -322,6 +329,19 @@ impl SceneBuilder {
         self.veils.insert(index, veil);
     }
 
+    /// Makes node `index` (in the order added), when it does not receive, cast its shadows as it
+    /// would if it received: its triangles laid out and grouped by the same planar parts
+    /// ([`Mesh::cast_parts`]). The exact engine merges a connected group of triangles into one
+    /// convex object's shadow; a receiver's parts are never merged with other geometry, so
+    /// without this a surface's shadow would be cast as its building's hull in one run and face
+    /// by face in another, the same region rounded differently, and a receiver's answer would
+    /// depend on which other surfaces receive beside it (a district tile's context against the
+    /// one-process run). For city surfaces, which receive in one run and are context in the
+    /// next. Foliage and see-through nodes (which never receive) are cast as they are.
+    pub fn cast_by_parts(&mut self, index: usize) {
+        self.by_parts.insert(index);
+    }
+
     /// Stores the static mesh relative to `origin` (world) instead of the input's centre: scenes
     /// cut from one larger model (a district's tiles) then round their f32 vertices alike, so a
     /// receiver's answers do not depend on which cut it was counted in.
@@ -365,7 +385,8 @@ impl SceneBuilder {
                 scene.see_through_triangles += source.indices.len() / 3;
             }
             if uses[node.mesh] == 1 {
-                bake_node(&mut scene, node, source, &veil, i as u32)?;
+                let by_parts = self.by_parts.contains(&i) && veil.is_opaque();
+                bake_node(&mut scene, node, source, &veil, i as u32, by_parts)?;
             } else {
                 let mesh_index = *shared.entry((node.mesh, veil.key())).or_insert_with(|| {
                     scene.meshes.push(shared_mesh(label, source, &veil, i as u32));
@@ -585,15 +606,36 @@ fn no_area_error(node: &SourceNode) -> Error {
     Error::object(file, object, "receiver has zero area (all its triangles are degenerate)")
 }
 
-/// Appends a single-use node to the static mesh, in world coordinates.
-fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh, veil: &NodeVeil, index: u32) -> Result<()> {
+/// Appends a single-use node to the static mesh, in world coordinates; `by_parts`: a node that
+/// does not receive is laid out by its planar parts ([`SceneBuilder::cast_by_parts`]).
+fn bake_node(scene: &mut Scene, node: &SourceNode, source: &SourceMesh, veil: &NodeVeil, index: u32, by_parts: bool) -> Result<()> {
     let tris = world_tris(node, source);
     let scene_origin = scene.origin;
     if !node.receiver {
         let veils = node_veils(source, veil, index);
+        let tri_veils = |i: usize| [0, 1, 2].map(|c| veils[source.indices[3 * i + c] as usize]);
+        // A node that would not split as a receiver (none, or too many parts) would be refused
+        // as one: it can only ever cast, so it is cast as it is.
+        let parts = if by_parts { planar_parts(&tris).filter(|p| !p.is_empty()) } else { None };
+        let Some(parts) = parts else {
+            for (i, t) in tris.iter().enumerate() {
+                push_tri(&mut scene.meshes[0], t, scene_origin, NO_RECEIVER, tri_veils(i));
+            }
+            return Ok(());
+        };
         let mesh = &mut scene.meshes[0];
-        for (t, tri) in tris.iter().zip(source.indices.chunks_exact(3)) {
-            push_tri(mesh, t, scene_origin, NO_RECEIVER, [0, 1, 2].map(|c| veils[tri[c] as usize]));
+        let mut in_part = vec![false; tris.len()];
+        for part in &parts {
+            let start = (mesh.indices.len() / 3) as u32;
+            for &i in &part.triangles {
+                push_tri(mesh, &tris[i], scene_origin, NO_RECEIVER, tri_veils(i));
+                in_part[i] = true;
+            }
+            mesh.cast_parts.push(start..(mesh.indices.len() / 3) as u32);
+        }
+        // Last, as a receiver's degenerate leftovers go.
+        for (i, t) in tris.iter().enumerate().filter(|(i, _)| !in_part[*i]) {
+            push_tri(mesh, t, scene_origin, NO_RECEIVER, tri_veils(i));
         }
         return Ok(());
     }
@@ -652,6 +694,7 @@ fn shared_mesh(label: &str, source: &SourceMesh, veil: &NodeVeil, node: u32) -> 
         surfaces: vec![NO_RECEIVER; source.positions.len()],
         indices: source.indices.clone(),
         veils: node_veils(source, veil, node),
+        cast_parts: Vec::new(),
     }
 }
 
@@ -729,157 +772,5 @@ fn bounds(scene: &Scene) -> (DVec3, DVec3) {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn quad(z: f32) -> SourceMesh {
-        SourceMesh { positions: vec![[0., 0., z], [1., 0., z], [1., 1., z], [0., 1., z]], indices: vec![0, 1, 2, 0, 2, 3] }
-    }
-
-    fn node(name: &str, mesh: usize, receiver: bool, t: DMat4) -> SourceNode {
-        SourceNode { name: name.into(), origin: format!("test.glb: node '{name}'"), mesh, transform: t, receiver }
-    }
-
-    #[test]
-    fn shared_mesh_is_instanced_not_copied() {
-        let mut b = SceneBuilder::new();
-        let m = b.add_mesh("quad", quad(0.0));
-        for i in 0..3 {
-            b.add_node(node(&format!("q{i}"), m, i == 1, DMat4::from_translation(DVec3::new(i as f64 * 2.0, 0.0, 0.0))));
-        }
-        let s = b.build().unwrap();
-        assert_eq!(s.meshes.len(), 2, "static mesh + one shared mesh");
-        assert_eq!(s.instances.len(), 4);
-        assert_eq!(s.receivers.len(), 1);
-        assert_eq!(s.receivers[0].name, "q1");
-        assert!((s.receivers[0].area - 1.0).abs() < 1e-9);
-        assert_eq!(s.triangle_count(), 6);
-        let ids: Vec<_> = s.world_triangles().map(|(_, id)| id).collect();
-        assert_eq!(ids.iter().filter(|i| i.is_some()).count(), 2);
-    }
-
-    #[test]
-    fn non_planar_receiver_is_split_into_named_parts() {
-        let mut b = SceneBuilder::new();
-        // Two faces of a box corner: z = 0 plane and x = 0 plane.
-        let m = b.add_mesh(
-            "corner",
-            SourceMesh {
-                positions: vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 0., 1.], [0., 1., 1.], [0., 1., 0.]],
-                indices: vec![0, 1, 2, 0, 4, 3, 0, 5, 4],
-            },
-        );
-        b.add_node(node("Box", m, true, DMat4::IDENTITY));
-        let s = b.build().unwrap();
-        let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
-        assert_eq!(names, ["Box#1", "Box#2"]);
-        assert!((s.receivers[1].area - 1.0).abs() < 1e-9);
-    }
-
-    #[test]
-    fn a_sliver_belongs_to_the_plane_its_vertices_lie_on() {
-        let mut b = SceneBuilder::new();
-        // A 3 m × 1 m wall in z = 0 and a sliver 2 µm wide along its bottom edge whose middle
-        // vertex is 1 µm off the plane: its own normal is far from the wall's (rounding decides
-        // it), but it is thinner than the coplanar distance, so it is part of the wall.
-        let m = b.add_mesh(
-            "wall",
-            SourceMesh {
-                positions: vec![[0., 0., 0.], [3., 0., 0.], [3., 1., 0.], [0., 1., 0.], [1.5, -2e-6, 1e-6]],
-                indices: vec![0, 1, 2, 0, 2, 3, 0, 4, 1],
-            },
-        );
-        b.add_node(node("Wall", m, true, DMat4::IDENTITY));
-        let s = b.build().unwrap();
-        let names: Vec<_> = s.receivers.iter().map(|r| r.name.as_str()).collect();
-        assert_eq!(names, ["Wall"]);
-        // A genuine second face (a 1 m² triangle at right angles) still splits.
-        let mut b = SceneBuilder::new();
-        let m = b.add_mesh(
-            "corner",
-            SourceMesh { positions: vec![[0., 0., 0.], [3., 0., 0.], [3., 1., 0.], [0., 0., 1.]], indices: vec![0, 1, 2, 0, 3, 1] },
-        );
-        b.add_node(node("Corner", m, true, DMat4::IDENTITY));
-        assert_eq!(b.build().unwrap().receivers.len(), 2);
-    }
-
-    #[test]
-    fn a_mirror_shares_geometry_and_faces_the_other_way() {
-        let mut b = SceneBuilder::new();
-        b.add_object("test", "LOUVER", quad(1.0), true);
-        b.add_mirror("LOUVER", "Mir-LOUVER");
-        let s = b.build().unwrap();
-        assert_eq!(s.receivers.len(), 2);
-        assert_eq!(s.receivers[1].gpu_id, 0);
-        assert_eq!(s.receivers[1].normal, -s.receivers[0].normal);
-        assert_eq!(s.triangle_count(), 2, "drawn once");
-    }
-
-    #[test]
-    fn leaves_are_connected_groups_and_each_placement_has_its_own() {
-        let mut b = SceneBuilder::new();
-        // Two separate quads: two leaves.
-        let mut two = quad(0.0);
-        two.positions.extend(quad(1.0).positions);
-        two.indices.extend([4, 5, 6, 4, 6, 7]);
-        let m = b.add_mesh("two leaves", two);
-        let foliage = NodeVeil { foliage: true, transmittance: 0.0 };
-        for i in 0..2 {
-            b.set_node_veil(b.node_count(), foliage);
-            b.add_node(node(&format!("tree{i}"), m, false, DMat4::from_translation(DVec3::new(5.0 * i as f64, 0.0, 0.0))));
-        }
-        // The same mesh placed opaque gets its own copy (veils live in the vertices).
-        b.add_node(node("statue", m, false, DMat4::IDENTITY));
-        b.add_object("test", "floor", quad(-1.0), true);
-        let s = b.build().unwrap();
-        assert_eq!(s.meshes.len(), 3, "static + foliage copy + opaque copy");
-        assert_eq!(s.veil_counts(), (4, 0));
-        let ranks: Vec<f32> = s.veiled_triangles().filter(|(_, _, v)| v.rank >= 0.0).map(|(_, _, v)| v.rank).collect();
-        assert_eq!(ranks.len(), 8);
-        assert!(ranks.iter().all(|r| (0.0..1.0).contains(r)));
-        let leaf = |k: usize| ranks[2 * k];
-        assert_eq!(ranks[0], ranks[1], "a quad's two triangles are one leaf");
-        assert!(leaf(0) != leaf(1) && leaf(0) != leaf(2) && leaf(1) != leaf(3), "{ranks:?}");
-        assert!(s.veiled_triangles().all(|(_, _, v)| v.present(0.0, 1.0)));
-        assert_eq!(s.veiled_triangles().filter(|(_, _, v)| !v.present(0.0, 0.0)).count(), 8, "no leaves at 0");
-    }
-
-    #[test]
-    fn see_through_receivers_and_bad_transmittance_are_refused() {
-        let mut b = SceneBuilder::new();
-        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 0.5 });
-        b.add_object("test.glb", "Screen", quad(0.0), true);
-        let e = b.build().unwrap_err().to_string();
-        assert!(e.contains("node 'Screen'") && e.contains("must be opaque"), "{e}");
-        let mut b = SceneBuilder::new();
-        b.set_node_veil(0, NodeVeil { foliage: false, transmittance: 1.0 });
-        b.add_object("test.glb", "Screen", quad(0.0), false);
-        let e = b.build().unwrap_err().to_string();
-        assert!(e.contains("node 'Screen'") && e.contains("outside [0, 1)"), "{e}");
-    }
-
-    #[test]
-    fn bad_inputs_are_named() {
-        let mut b = SceneBuilder::new();
-        let mut q = quad(0.0);
-        q.positions[2][1] = f32::NAN;
-        let m = b.add_mesh("quad", q);
-        b.add_node(node("Bad", m, false, DMat4::IDENTITY));
-        let e = b.build().unwrap_err().to_string();
-        assert!(e.contains("test.glb") && e.contains("node 'Bad'") && e.contains("non-finite"), "{e}");
-
-        let mut b = SceneBuilder::new();
-        let m = b.add_mesh("line", SourceMesh { positions: vec![[0., 0., 0.], [1., 0., 0.], [2., 0., 0.]], indices: vec![0, 1, 2] });
-        b.add_node(node("Flat", m, true, DMat4::IDENTITY));
-        let e = b.build().unwrap_err().to_string();
-        assert!(e.contains("node 'Flat'") && e.contains("zero area"), "{e}");
-
-        let mut b = SceneBuilder::new();
-        let m1 = b.add_mesh("a", quad(0.0));
-        let m2 = b.add_mesh("b", quad(1.0));
-        b.add_node(node("Same", m1, true, DMat4::IDENTITY));
-        b.add_node(node("Same", m2, true, DMat4::IDENTITY));
-        let e = b.build().unwrap_err().to_string();
-        assert!(e.contains("duplicate receiver name 'Same'"), "{e}");
-    }
-}
+#[path = "scene_tests.rs"]
+mod tests;

@@ -81,6 +81,10 @@ pub(super) struct DistrictArgs {
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
+    /// Receivers whose year a tile counts at once (default 1024): a tile's peak memory follows
+    /// it; the answers are the same bit for bit.
+    #[arg(long, value_name = "N")]
+    receiver_batch: Option<usize>,
     /// Submit a Slurm job array (a task per unfinished tile) and a merge job instead.
     #[arg(long, conflicts_with_all = ["index", "merge"])]
     slurm: bool,
@@ -131,6 +135,8 @@ impl DistrictArgs {
             ("--albedo", self.albedo.map(|a| a.to_string())),
             ("--grid", self.grid.map(|g| g.to_string())),
             ("--min-kwh-m2", self.min_kwh_m2.map(|m| m.to_string())),
+            // Not the result, but every tile and task is given it, as the rest.
+            ("--receiver-batch", self.receiver_batch.map(|b| b.to_string())),
         ];
         for (flag, value) in optional {
             if let Some(v) = value {
@@ -157,6 +163,9 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     let epw_path = std::path::absolute(&args.epw).map_err(|e| io(e, &args.epw))?;
     if args.jobs == 0 {
         return Err(Error::argument("jobs", "must be at least 1"));
+    }
+    if args.receiver_batch == Some(0) {
+        return Err(Error::argument("receiver-batch", "must be at least 1"));
     }
     // Everything that can be refused is refused before a tile is counted.
     let settings = AnnualSettings {
@@ -211,6 +220,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
             lanes: None,
             grid,
             pv: args.pv,
+            batch: args.receiver_batch.unwrap_or(district::RECEIVER_BATCH),
         };
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }

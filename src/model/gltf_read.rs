@@ -405,6 +405,10 @@ impl GltfModel {
             if !veil.is_opaque() {
                 builder.set_node_veil(builder.node_count(), veil);
             }
+            if node.city.is_some() {
+                // A city surface receives in one run and is a tile's context in another.
+                builder.cast_by_parts(builder.node_count());
+            }
             builder.add_node(SourceNode {
                 origin: node.origin(&file),
                 mesh: base[node.mesh],

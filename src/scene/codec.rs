@@ -23,7 +23,7 @@ use crate::error::{Error, Result, SceneBytesError};
 /// The first bytes of an encoded scene.
 pub const MAGIC: [u8; 8] = *b"SUNLITSC";
 /// The format's version; bytes of any other version are refused.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// How a mesh's indices are stored: each one, or only their count when they are 0, 1, 2, ….
 const INDICES_LISTED: u8 = 0;
@@ -91,6 +91,7 @@ fn write_mesh(w: &mut Writer, mesh: &Mesh) {
         w.f32(v.transmittance);
         w.u32(v.seed);
     });
+    w.u32s(&mesh.cast_parts.iter().flat_map(|r| [r.start, r.end]).collect::<Vec<_>>());
 }
 
 fn write_receiver(w: &mut Writer, r: &Receiver) {
@@ -211,7 +212,12 @@ fn read_mesh(r: &mut Reader, index: usize) -> Decoded<Mesh> {
     let veils = r.runs("mesh veils", 20, vertices, what, |r| {
         Ok(Veil { rank: r.f32("mesh veils")?, transmittance: r.f32("mesh veils")?, seed: r.u32("mesh veils")? })
     })?;
-    Ok(Mesh { label, positions, surfaces, indices, veils })
+    let ends = r.u32s("mesh cast parts")?;
+    if ends.len() % 2 == 1 {
+        return Err(invalid(what(), format!("{} cast part ends, an odd number", ends.len())));
+    }
+    let cast_parts = ends.chunks_exact(2).map(|e| e[0]..e[1]).collect();
+    Ok(Mesh { label, positions, surfaces, indices, veils, cast_parts })
 }
 
 fn read_instance(r: &mut Reader) -> Decoded<Instance> {
@@ -255,6 +261,9 @@ fn check(scene: &Scene) -> Decoded<()> {
         }
         if m.positions.iter().flatten().any(|x| !x.is_finite()) {
             return Err(invalid(what(), "a vertex that is not finite"));
+        }
+        if let Some(r) = m.cast_parts.iter().find(|r| !in_range(r, m.indices.len() / 3)) {
+            return Err(invalid(what(), format!("cast part {r:?} past its {} triangles", m.indices.len() / 3)));
         }
         top_surface.push(m.surfaces.iter().copied().filter(|&s| s != NO_RECEIVER).max());
     }

@@ -46,7 +46,8 @@ use crate::platform::seconds as now;
 use crate::scene::Scene;
 use crate::sky::patches::SkyPatches;
 use crate::sun::weather::Weather;
-use crate::sweep::district_year::{RECEIVER_BATCH, TileStages, TileYear, tile_year};
+pub use crate::sweep::district_year::RECEIVER_BATCH;
+use crate::sweep::district_year::{TileStages, TileYear, tile_year};
 use crate::year::annual::Progress;
 use crate::year::settings::Resolved;
 
@@ -345,6 +346,9 @@ pub struct TileSettings<'a> {
     pub grid: Option<RoofGrid>,
     /// With a grid: the points' PV tools' files too.
     pub pv: bool,
+    /// Receivers whose year is counted at once ([`RECEIVER_BATCH`] unless chosen): the peak
+    /// memory follows it, the answers do not ([`super::district_year`]).
+    pub batch: usize,
 }
 
 /// What a tile counted.
@@ -370,7 +374,7 @@ pub fn count_tile(
     s: &TileSettings,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
 ) -> Result<TileCount> {
-    count_tile_in_batches(city, tiling, k, s, RECEIVER_BATCH, progress)
+    count_tile_in_batches(city, tiling, k, s, s.batch, progress)
 }
 
 /// [`count_tile`], the year counted `batch` receivers at a time ([`super::district_year`]).

@@ -194,6 +194,7 @@ mod tests {
             lanes: None,
             grid: None,
             pv: false,
+            batch: RECEIVER_BATCH,
         };
         let count = |batch: usize| count_tile_in_batches(&city, &tiling, 0, &s, batch, &mut |_| Ok(())).unwrap();
         let whole = count(usize::MAX);

@@ -19,8 +19,8 @@ use glam::DVec3;
 
 use super::objects::{self, MeshObjects};
 use crate::error::SceneBytesError;
-use crate::scene::Scene;
 use crate::scene::codec::{Decoded, Reader, Writer, in_range, invalid};
+use crate::scene::{NO_RECEIVER, Scene};
 
 /// The first bytes of encoded objects.
 const MAGIC: [u8; 8] = *b"SUNLITOB";
@@ -197,21 +197,42 @@ fn slice<'a>(items: &'a [u32], range: &Range<u32>) -> &'a [u32] {
     &items[range.start as usize..range.end as usize]
 }
 
-/// Objects of one mesh: triangles grouped by shared positions, surface value and veil.
+/// Objects of one mesh: triangles grouped by shared positions, surface value and veil. A
+/// shading-only triangle of one of the mesh's cast parts ([`crate::scene::Mesh::cast_parts`])
+/// takes its part as its surface value, so a city surface is grouped alike whether it receives
+/// or not (parts count down from below `NO_RECEIVER`, receivers up from 0: they never meet).
 fn mesh_objects(mesh: &crate::scene::Mesh) -> MeshObjects {
     let tris: Vec<[[f32; 3]; 3]> = mesh.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| mesh.positions[t[k] as usize])).collect();
+    let part_of = cast_part_of_triangles(mesh);
     let keys: Vec<u64> = mesh
         .indices
         .chunks_exact(3)
-        .map(|t| {
+        .zip(&part_of)
+        .map(|(t, &part)| {
             let v = t[0] as usize;
             let veil = mesh.veils.get(v).copied().unwrap_or_default();
-            let surface = mesh.surfaces[v] as u64;
+            let surface = match mesh.surfaces[v] {
+                NO_RECEIVER => part,
+                receiver => receiver,
+            } as u64;
             // Surface, leaf rank and whether see-through: an object shares all three.
             (surface << 32) ^ (veil.rank.to_bits() as u64).rotate_left(7) ^ ((veil.transmittance > 0.0) as u64) << 63
         })
         .collect();
     objects::group(&tris, &keys)
+}
+
+/// Per triangle of `mesh`: `NO_RECEIVER - 1 - k` inside its cast part `k`, else `NO_RECEIVER`.
+fn cast_part_of_triangles(mesh: &crate::scene::Mesh) -> Vec<u32> {
+    let mut part_of = vec![NO_RECEIVER; mesh.indices.len() / 3];
+    for (k, range) in mesh.cast_parts.iter().enumerate() {
+        let part = NO_RECEIVER.saturating_sub(1).saturating_sub(k as u32);
+        // The builder keeps ranges within the mesh; a decoded scene is checked for it.
+        if let Some(slots) = part_of.get_mut(range.start as usize..range.end as usize) {
+            slots.fill(part);
+        }
+    }
+    part_of
 }
 
 /// Marks an object whose caps could not be placed (a cap corner's triangle is not indexed): it
