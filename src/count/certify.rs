@@ -44,13 +44,12 @@
 //! dark; it only stops a step being proved lit.
 
 mod cells;
-mod composite;
+pub(crate) mod composite;
 pub mod cone;
 mod never_dark;
 
 use glam::{DVec2, DVec3};
 
-use composite::Composites;
 pub use cone::DirectionCone;
 pub use never_dark::MIN_LIT_SHARE;
 use never_dark::Outline;
@@ -175,8 +174,6 @@ pub struct Certifier<'a> {
     index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
-    /// Composite casters; none unless [`Self::with_many_casters`].
-    composites: Composites,
     /// Whether a dark proof may combine casters (composites, halves of a cell): off by default
     /// until measured on the bench models (docs/energyplus-fidelity.md, "Certificates").
     many_casters: bool,
@@ -209,17 +206,22 @@ impl<'a> Certifier<'a> {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index, shapes, extent, composites: Composites::default(), many_casters: false }
+        Self { index, shapes, extent, many_casters: false }
     }
 
     /// Lets the dark proof combine casters: composite casters ([`composite`]) and halves of a
     /// cell each covered by its own caster. Exact either way; off by default because its cost on
     /// a city and on blaas-louvres is not yet measured.
     pub fn with_many_casters(mut self) -> Self {
-        self.composites = Composites::new(&self.index);
-        log::debug!("certificates: {} composite casters (coplanar panels)", self.composites.len());
+        // Found once per index: a city's batches of receivers share them, as they share it.
+        log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());
         self.many_casters = true;
         self
+    }
+
+    /// The scene's composite casters: its index's, found once however many certifiers share it.
+    fn composites(&self) -> &composite::Composites {
+        self.index.composites()
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
@@ -254,9 +256,12 @@ impl<'a> Certifier<'a> {
             return None;
         }
         let candidates = self.cover_candidates(shape, &cone);
+        // The halves are tried where the cell has two candidates or more, whether or not each
+        // may cover this receiver at all (as before they were made ready once a cell).
+        let halvings = if self.many_casters && candidates.len() >= 2 { DARK_HALVINGS } else { 0 };
+        let ready: Vec<Vec<DVec3>> = candidates.into_iter().filter_map(|c| self.ready(shape, c)).collect();
         let mut set: Vec<usize> = (0..suns.len()).collect();
-        let halvings = if self.many_casters { DARK_HALVINGS } else { 0 };
-        self.dark_in_parts(shape, &candidates, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
+        self.dark_in_parts(shape, &ready, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
     }
 
     /// Whether the receiver is dark at every sun of `set` (indices into `suns`, enclosed by
@@ -267,19 +272,22 @@ impl<'a> Certifier<'a> {
     /// one). The halves try the whole cell's candidates (a search per half cost more than the
     /// proofs saved on a city): a caster that covers only a half and is not among them is
     /// missed, never wrongly trusted.
+    ///
+    /// `candidates` are made ready for the receiver ([`Self::ready`]): what does not depend on
+    /// the cone is checked once a cell, not once a half.
     fn dark_in_parts(
         &self,
         shape: &Shape,
-        candidates: &[Caster],
+        candidates: &[Vec<DVec3>],
         suns: &[DVec3],
         set: &mut [usize],
         cone: &DirectionCone,
         halvings: usize,
     ) -> bool {
-        if candidates.iter().any(|c| self.covers(shape, cone, *c)) {
+        if candidates.iter().any(|c| self.covers_ready(shape, cone, c)) {
             return true;
         }
-        if halvings == 0 || set.len() < 2 || candidates.len() < 2 {
+        if halvings == 0 || set.len() < 2 {
             return false;
         }
         never_dark::split_widest(suns, set);
@@ -296,6 +304,7 @@ impl<'a> Certifier<'a> {
     /// receiver point along the cone's axis, so it has a triangle in that one view's prism.
     fn cover_candidates(&self, shape: &Shape, cone: &DirectionCone) -> Vec<Caster> {
         let mut candidates: Vec<Caster> = Vec::new();
+        let composites = self.many_casters.then(|| self.composites());
         let view = view::fit(&shape.points, cone.axis(), self.index.bounds, self.index.origin, 64);
         self.index.culling.visit_triangles(&view.view_proj, |r| {
             for p in r {
@@ -303,7 +312,7 @@ impl<'a> Certifier<'a> {
                     continue;
                 }
                 let object = self.opaque_convex(p).map(Caster::Object);
-                let composite = self.composites.of(p).map(Caster::Composite);
+                let composite = composites.and_then(|c| c.of(p)).map(Caster::Composite);
                 // An object's triangles come one after another: skip the repeats cheaply.
                 for c in [object, composite].into_iter().flatten() {
                     if candidates.last() != Some(&c) {
@@ -436,34 +445,58 @@ impl<'a> Certifier<'a> {
     }
 
     /// Whether `caster` shades the whole receiver at every generator of the cone (so at every
-    /// direction of it): it lies in front of the receiver's plane, and at each generator every
-    /// receiver vertex projects inside its projection, both by [`COVER_MARGIN`].
+    /// direction of it): [`Self::ready`], then [`Self::covers_ready`].
+    #[cfg(test)]
+    fn covers(&self, shape: &Shape, cone: &DirectionCone, caster: Caster) -> bool {
+        self.ready(shape, caster).is_some_and(|corners| self.covers_ready(shape, cone, &corners))
+    }
+
+    /// `caster`'s corners relative to the receiver's first vertex, where it may cover the
+    /// receiver at some direction: it lies in front of the receiver's plane by [`COVER_MARGIN`]
+    /// and is not open towards it. None otherwise. Nothing here depends on the sun, so a cell's
+    /// halves share it.
     ///
     /// A composite must stand clear of the plane by the margin too, as an object must. One that
     /// touches it (a facade meeting the receiver's wall at an inner corner) would put the
     /// shadow's edge on the receiver's own edge with no margin: rays and the reference engine
     /// find such a wall dark, but the margin is what covers the GPU's rounding (its depth test
     /// along the corner is not shown to side with the facade), so no such proof is given.
-    fn covers(&self, shape: &Shape, cone: &DirectionCone, caster: Caster) -> bool {
+    fn ready(&self, shape: &Shape, caster: Caster) -> Option<Vec<DVec3>> {
         let margin = COVER_MARGIN * (1.0 + self.extent);
         let corners: Vec<DVec3> = match caster {
             Caster::Object(o) => self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect(),
-            Caster::Composite(c) => self.composites.corners(c).iter().map(|&p| p - shape.p0).collect(),
+            Caster::Composite(c) => self.composites().corners(c).iter().map(|&p| p - shape.p0).collect(),
         };
         if corners.len() < 3 || !corners.iter().all(|c| c.dot(shape.normal) > margin) {
-            return false;
+            return None;
         }
         let open_to_receiver = match caster {
             Caster::Object(o) => self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin),
             Caster::Composite(_) => false,
         };
-        if open_to_receiver {
-            return false;
-        }
+        (!open_to_receiver).then_some(corners)
+    }
+
+    /// Whether a caster made ready ([`Self::ready`]: its `corners`, relative to the receiver's
+    /// first vertex) shades the whole receiver at every generator of the cone: at each, every
+    /// receiver vertex projects inside the caster's projection by [`COVER_MARGIN`]. A vertex
+    /// outside the projection's bounding box is outside the projection: that is looked at first,
+    /// without building the hull (most candidates of a cell fail so, and a panelled block has
+    /// hundreds of corners).
+    fn covers_ready(&self, shape: &Shape, cone: &DirectionCone, corners: &[DVec3]) -> bool {
+        let margin = COVER_MARGIN * (1.0 + self.extent);
+        let mut flat_corners: Vec<DVec2> = Vec::with_capacity(corners.len());
         cone.generators().iter().all(|g| {
             let (u, v) = perpendicular_basis(*g);
             let flat = |p: DVec3| DVec2::new(p.dot(u), p.dot(v));
-            let hull = convex_hull(&corners.iter().map(|c| flat(*c)).collect::<Vec<_>>());
+            flat_corners.clear();
+            flat_corners.extend(corners.iter().map(|c| flat(*c)));
+            let (lo, hi) = flat_corners.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), q| (lo.min(*q), hi.max(*q)));
+            let in_box = |q: DVec2| q.cmpge(lo).all() && q.cmple(hi).all();
+            if !shape.points.iter().all(|p| in_box(flat(*p - shape.p0))) {
+                return false;
+            }
+            let hull = convex_hull(&flat_corners);
             hull.len() >= 3
                 && shape.points.iter().all(|p| {
                     let q = flat(*p - shape.p0);

@@ -37,7 +37,7 @@ use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
 use crate::sun::position::{lit_intervals, sun_direction};
-use crate::year::certified::{self, Rough, Smooth};
+use crate::year::certified::{self, Rough, Rule, Smooth};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::refine;
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
@@ -45,6 +45,7 @@ use crate::year::season::{LeafCalendar, Phase};
 use crate::year::spline::{AnnualGrid, AnnualSpline};
 pub(super) use columns::Columns;
 pub use columns::YearStages;
+use fill::fill_dark;
 pub use sampling::sample_requests;
 use sampling::{SampleViews, sample_views};
 
@@ -81,8 +82,9 @@ pub struct AnnualOptions {
     /// With refinement on: a dark proof may combine casters, coplanar panels that together form
     /// one convex polygon and halves of a cell each covered by its own caster
     /// ([`crate::count::certify`]). Exact (the same CSV wherever measured, with 11 % fewer views
-    /// on nyt-blocks' floor 20); off by default until the whole suite has run with it on
-    /// (docs/energyplus-fidelity.md, "Certificates").
+    /// on nyt-blocks' floor 20 and 7 % fewer on canyon-slots); off by default until a paired
+    /// timing shows floor 20 and blaas-trees-summer no dearer (docs/energyplus-fidelity.md,
+    /// "Certificates").
     pub many_casters: bool,
 }
 
@@ -641,7 +643,7 @@ async fn spline_year(
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
-    let refined = refine::count_sparsely(views, &rough, rows_per_day, refine, &leaves, &mut |n, p| {
+    let refined = refine::count_sparsely(views, &rough, rows_per_day, &leaves, &mut |n, p| {
         refined_views = n;
         progress(work.refining(n, p))
     })
@@ -784,16 +786,17 @@ fn evaluate(
                     // guessed dark, since a slot of sun may light it between them.
                     if refine < 1.0 {
                         let at = regime.cells.at(grid_day, tau);
-                        rough.push(Rough { row, column, sun, day: day as f64, cell: (g, fit, at.0, at.1), corners: (0.0, 0.0) });
+                        let (day, cell) = (day as f64, (g, fit, at.0, at.1));
+                        rough.push(Rough { row, column, sun, day, cell, corners: (0.0, 0.0), rule: Rule::NoFit });
                     }
                     continue;
                 };
                 let value = piece.spline.eval(grid_day, tau);
                 year.schedule.set(row, local, as_energyplus(value));
                 let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
-                if cell.spread > refine || (refine < 1.0 && needs_count(&cell, value)) {
+                if let Some(rule) = counting_rule(&cell, value, refine) {
                     let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
-                    rough.push(Rough { row, column, sun, day, cell, corners });
+                    rough.push(Rough { row, column, sun, day, cell, corners, rule });
                 } else if refine < 1.0 && prove_never_dark {
                     smooth.push(Smooth::new(row, column, fit, g, cell.at));
                 }
@@ -803,16 +806,33 @@ fn evaluate(
     (rough, smooth)
 }
 
-/// With refinement on, whether a fitted `value` in `cell` is counted directly beyond the spread
-/// rule: near dark ([`NEAR_DARK`]), where the spline leaves the cell's bilinear interpolation
-/// ([`KINK`]), or where a sample day of the cell lacks the lit piece. That last is a piece of day
-/// that comes and goes with the season (a north wall's minutes after sunrise near the equinoxes):
-/// its samples on such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the
-/// fit there extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36,
-/// Chicago, Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
+/// The first rule that sends a fitted `value` in `cell` to counting, None where it is
+/// interpolated: the spread rule, then, with refinement on, a sample day of the cell lacking the
+/// lit piece, a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline leaving the
+/// cell's bilinear interpolation ([`KINK`]). The borrowed day is a piece of day that comes and
+/// goes with the season (a north wall's minutes after sunrise near the equinoxes): its samples on
+/// such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the fit there
+/// extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36, Chicago,
+/// Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
 /// appears, 0.14 with those cells counted, for 1.8 % more views.
-fn needs_count(cell: &Cell, value: f64) -> bool {
-    cell.borrowed || cell.lowest < NEAR_DARK || value < NEAR_DARK || (value - cell.bilinear).abs() > KINK
+fn counting_rule(cell: &Cell, value: f64, refine: f64) -> Option<Rule> {
+    Some(if cell.spread > refine {
+        Rule::Spread
+    } else if refine >= 1.0 {
+        return None;
+    } else if cell.borrowed {
+        Rule::Borrowed
+    } else if cell.highest < NEAR_DARK {
+        Rule::AllNearDark
+    } else if cell.lowest < NEAR_DARK {
+        Rule::SomeNearDark
+    } else if value < NEAR_DARK {
+        Rule::NearDarkFit
+    } else if (value - cell.bilinear).abs() > KINK {
+        Rule::Kink
+    } else {
+        return None;
+    })
 }
 
 /// Which of a regime's fits (by receiver and piece) serves receiver `column` at time `t`, given
@@ -838,43 +858,6 @@ fn piece_at(pieces: &[(f64, f64)], t: f64) -> Option<(usize, f64)> {
     Some((p, ((t - a) / (b - a).max(1e-9)).clamp(0.0, 1.0)))
 }
 
-/// Replaces unlit samples (None) with the nearest lit sample of the same day, then days with no
-/// lit sample with the nearest lit day (periodically). None if the surface is never lit.
-fn fill_dark(samples: &[Option<f64>], days: usize, per_day: usize) -> Option<Vec<f64>> {
-    let mut by_day: Vec<Option<Vec<f64>>> = samples.chunks(per_day).map(fill_day).collect();
-    let lit: Vec<usize> = (0..days).filter(|&d| by_day[d].is_some()).collect();
-    if lit.is_empty() {
-        return None;
-    }
-    for d in 0..days {
-        if by_day[d].is_none() {
-            let periodic = |a: usize| {
-                let diff = a.abs_diff(d);
-                diff.min(days - diff)
-            };
-            let nearest = lit.iter().copied().min_by_key(|&a| periodic(a))?;
-            by_day[d] = by_day[nearest].clone();
-        }
-    }
-    Some(by_day.into_iter().flatten().flatten().collect())
-}
-
-/// One day's samples with gaps filled from the nearest lit sample (earlier wins ties).
-fn fill_day(day: &[Option<f64>]) -> Option<Vec<f64>> {
-    let lit: Vec<usize> = (0..day.len()).filter(|&j| day[j].is_some()).collect();
-    if lit.is_empty() {
-        return None;
-    }
-    Some(
-        (0..day.len())
-            .map(|j| {
-                let nearest = lit.iter().copied().min_by_key(|&k| k.abs_diff(j)).unwrap_or(j);
-                day[nearest].unwrap_or(0.0)
-            })
-            .collect(),
-    )
-}
-
 /// Mean and max sunlit-fraction differences between two schedules over rows where either is lit.
 pub fn compare(a: &Schedule, b: &Schedule) -> Result<(f64, f64, f64)> {
     if a.names != b.names || a.values.len() != b.values.len() {
@@ -895,6 +878,7 @@ pub fn compare(a: &Schedule, b: &Schedule) -> Result<(f64, f64, f64)> {
 }
 
 mod columns;
+mod fill;
 mod sampling;
 #[cfg(test)]
 mod tests;

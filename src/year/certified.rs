@@ -19,6 +19,7 @@ use glam::DVec3;
 
 use crate::count::certify::{Certificate, Certifier, Wanted};
 use crate::count::exact::engine::ExactEngine;
+use crate::platform::{cpu_seconds, seconds};
 use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
@@ -36,6 +37,74 @@ pub(super) struct Rough {
     pub cell: (usize, usize, usize, usize),
     /// The lowest and highest of the cell's four samples.
     pub corners: (f64, f64),
+    /// The first rule that sent it to counting.
+    pub rule: Rule,
+}
+
+/// Which refinement rule sent a step to counting (the first that applies, in this order), for
+/// the year's tally of what each rule costs ([`tally`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Rule {
+    /// Its piece is dark at every sample of the year (no fit).
+    NoFit,
+    /// The cell's samples differ by more than the refinement threshold.
+    Spread,
+    /// A sample day of the cell lacks the lit piece (borrowed samples).
+    Borrowed,
+    /// All four of the cell's samples are under `NEAR_DARK`.
+    AllNearDark,
+    /// Some, not all, of the cell's samples are under `NEAR_DARK`.
+    SomeNearDark,
+    /// The fit is under `NEAR_DARK`.
+    NearDarkFit,
+    /// The fit leaves the cell's bilinear interpolation by more than `KINK`.
+    Kink,
+    /// Interpolated, but not proved never dark.
+    NotNeverDark,
+}
+
+impl Rule {
+    const ALL: [Rule; 8] = [
+        Rule::NoFit,
+        Rule::Spread,
+        Rule::Borrowed,
+        Rule::AllNearDark,
+        Rule::SomeNearDark,
+        Rule::NearDarkFit,
+        Rule::Kink,
+        Rule::NotNeverDark,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Rule::NoFit => "dark at every sample",
+            Rule::Spread => "spread",
+            Rule::Borrowed => "borrowed day",
+            Rule::AllNearDark => "all four samples near dark",
+            Rule::SomeNearDark => "some sample near dark",
+            Rule::NearDarkFit => "near-dark fit",
+            Rule::Kink => "KINK",
+            Rule::NotNeverDark => "not proved never dark",
+        }
+    }
+}
+
+/// Per rule, the steps of `steps` and how many of them `marked` holds, as a log line's text
+/// ("rule a / b, …", rules with no step left out).
+pub(super) fn tally<'a>(steps: impl Iterator<Item = (&'a Rough, bool)>) -> String {
+    let mut counts = [(0usize, 0usize); Rule::ALL.len()];
+    for (r, marked) in steps {
+        let k = Rule::ALL.iter().position(|x| *x == r.rule).unwrap_or(0);
+        counts[k].0 += 1;
+        counts[k].1 += usize::from(marked);
+    }
+    let parts: Vec<String> = Rule::ALL
+        .iter()
+        .zip(counts)
+        .filter(|(_, c)| c.0 > 0)
+        .map(|(rule, (all, marked))| format!("{} {all} / {marked}", rule.name()))
+        .collect();
+    parts.join(", ")
 }
 
 /// A timestep the spline interpolates, kept small (a city's year has millions): its row,
@@ -91,7 +160,7 @@ pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of:
                 let s = piece[k];
                 let (sun, day) = suns[k];
                 let key = (usize::from(s.regime), s.fit as usize, usize::from(s.at.0), usize::from(s.at.1));
-                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0) }
+                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0), rule: Rule::NotNeverDark }
             }));
         }
         start = end;
@@ -164,6 +233,10 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
             Certificate::Lit => lit += steps.len(),
         }
     }
+    // The tally walks every refined step again: only when someone reads it.
+    if log::log_enabled!(log::Level::Info) {
+        log::info!("certificates by rule (steps / proved): {}", tally(rough.iter().zip(settled.iter().copied())));
+    }
     let rest = rough.into_iter().zip(settled).filter(|(_, s)| !s).map(|(r, _)| r).collect();
     (rest, dark, lit)
 }
@@ -183,6 +256,7 @@ pub(super) fn certify_steps(
     smooth: Vec<Smooth>,
     schedule: &mut Columns,
 ) -> Vec<Rough> {
+    let (start, cpu) = (seconds(), cpu_seconds());
     let certifier = match index {
         Some(index) => Certifier::sharing(scene, index),
         None => Certifier::new(scene),
@@ -203,8 +277,11 @@ pub(super) fn certify_steps(
         format!("; of {interpolated} interpolated, {} not proved never dark", unproved.len())
     };
     log::info!(
-        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit{proof}; {} counted",
-        rest.len() + unproved.len()
+        "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit{proof}; {} counted \
+         (certificates {:.1} s, {:.1} s CPU)",
+        rest.len() + unproved.len(),
+        seconds() - start,
+        cpu_seconds() - cpu
     );
     rest.extend(unproved);
     rest

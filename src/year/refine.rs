@@ -28,7 +28,7 @@
 use crate::count::{Engine, ViewRequest};
 use crate::error::Result;
 use crate::year::annual::{NEAR_DARK, Progress, Views};
-use crate::year::certified::Rough;
+use crate::year::certified::{Rough, tally};
 
 /// How far, at most, a counted value may lie from the straight line between the counted days
 /// around it for the days between to be interpolated.
@@ -221,7 +221,6 @@ pub(super) async fn count_sparsely(
     views: &Views<'_, impl Engine>,
     rough: &[Rough],
     rows_per_day: usize,
-    refine: f64,
     leaves: &dyn Fn(&Rough) -> f32,
     report: &mut dyn FnMut(usize, Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
@@ -244,33 +243,9 @@ pub(super) async fn count_sparsely(
     log::info!("refinement: {} of {} steps counted, the rest interpolated between counted days", sparse.counted(), rough.len());
     // The tally walks every refined step again: only when someone reads it.
     if log::log_enabled!(log::Level::Info) {
-        log::info!("refinement by rule (steps / counted): {}", by_rule(rough, refine, &sparse.was_counted));
+        log::info!("refinement by rule (steps / counted): {}", tally(rough.iter().zip(sparse.was_counted.iter().copied())));
     }
     Ok(sparse.values())
-}
-
-/// The refined steps and those of them counted, by the first refinement rule that asked for
-/// them (as far as a step's cell tells): the spread rule, a near-dark corner, and the rest (a
-/// near-dark fit, `KINK`, a borrowed day).
-fn by_rule(rough: &[Rough], refine: f64, counted: &[bool]) -> String {
-    let mut tally = [(0usize, 0usize); 3];
-    for (r, &c) in rough.iter().zip(counted) {
-        let (lowest, highest) = r.corners;
-        let rule = if highest - lowest > refine {
-            0
-        } else if lowest < NEAR_DARK {
-            1
-        } else {
-            2
-        };
-        tally[rule].0 += 1;
-        tally[rule].1 += usize::from(c);
-    }
-    let [spread, dark, other] = tally;
-    format!(
-        "spread {} / {}, near-dark corner {} / {}, KINK or near-dark fit or borrowed day {} / {}",
-        spread.0, spread.1, dark.0, dark.1, other.0, other.1
-    )
 }
 
 #[cfg(test)]

@@ -203,6 +203,9 @@ mod tests {
         let south = AnnualSettings { latitude: Some(-33.9), ..golden() }.resolve().unwrap();
         assert_eq!(south.calendar, LeafCalendar::for_latitude(-33.9), "the southern calendar");
         assert_ne!(south.calendar, r.calendar);
+        assert!(!r.many_casters && !r.prove_never_dark, "the many-caster and never-dark proofs off");
+        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":true}"#).unwrap();
+        assert!(many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: true turns them on");
     }
 
     #[test]

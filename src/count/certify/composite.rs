@@ -40,7 +40,7 @@ type Key = [u64; 3];
 
 /// The composite casters of a scene.
 #[derive(Debug, Default)]
-pub(super) struct Composites {
+pub(crate) struct Composites {
     /// Per composite: its polygon's corners (world), collinear corners dropped.
     corners: Vec<Vec<DVec3>>,
     /// Triangle position → composite, for the positions in one.
@@ -49,7 +49,7 @@ pub(super) struct Composites {
 
 impl Composites {
     /// Finds the composites among `index`'s opaque triangles.
-    pub(super) fn new(index: &ExactEngine) -> Self {
+    pub(crate) fn new(index: &ExactEngine) -> Self {
         let mut panels: Vec<(Plane, u32)> = (0..index.triangles.len())
             .filter(|&p| {
                 let veil = index.veils[p];
@@ -89,7 +89,7 @@ impl Composites {
     }
 
     /// How many composites were found.
-    pub(super) fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.corners.len()
     }
 }

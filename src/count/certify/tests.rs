@@ -325,6 +325,32 @@ fn coplanar_panels_with_a_gap_do_not_prove_dark() {
     }
 }
 
+/// The composite casters are found once per scene, not once per certifier: a city's year builds
+/// a certifier per batch of receivers over one shared index, and finding them walks every
+/// triangle of the scene. Two certifiers over one index use the very same composites (the
+/// index's), and both prove the window behind the joined screen dark with them.
+#[test]
+fn certifiers_sharing_an_index_share_its_composites() {
+    let panel = |x0: f32, x1: f32| SourceMesh {
+        positions: vec![[x0, -3.0, 0.0], [x1, -3.0, 0.0], [x1, -3.0, 15.0], [x0, -3.0, 15.0]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+    b.add_object("test", "WEST", panel(-20.0, 1.0), true);
+    b.add_object("test", "EAST", panel(1.0, 20.0), true);
+    let scene = b.build().unwrap();
+    let index = ExactEngine::new(&scene);
+    let (first, second) = (Certifier::sharing(&scene, &index).with_many_casters(), Certifier::sharing(&scene, &index).with_many_casters());
+    assert_eq!(first.composites().len(), 1, "the two panels must form one composite, or sharing is not exercised");
+    assert!(std::ptr::eq(first.composites(), second.composites()), "each certifier found its own composites");
+    assert!(std::ptr::eq(first.composites(), index.composites()), "the composites are not the index's");
+    let winter = suns(1..14, (11.0, 13.0), -DVec3::Y);
+    let both = Wanted { dark: true, lit: true };
+    assert_eq!(first.certify(0, &winter, both), Some(Certificate::Dark));
+    assert_eq!(second.certify(0, &winter, both), Some(Certificate::Dark));
+}
+
 /// Brute force for composite casters: streets of blocks built flush (whole-metre widths, so
 /// neighbours share corners bit for bit), mostly of one height, some with 5 cm slots between them,
 /// and random south-facing windows across the street; every dark certificate of a random cell is

@@ -29,6 +29,7 @@
 //! and no allocation, and it stays within ~1e-9 of the reference.
 
 use std::ops::Range;
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 
 use glam::{DVec2, DVec3};
@@ -38,6 +39,7 @@ use super::objects;
 use super::placed::PlacedObjects;
 use super::reach::Reach;
 use super::{AREA_EPS, PLANE_EPS, PlaneFrame, Rect, WINDOW_MARGIN};
+use crate::count::certify::composite::Composites;
 use crate::count::cull::{CPU_LEAF_TRIANGLES, Culling};
 use crate::count::{ViewRequest, is_dark, view};
 use crate::error::{Error, Result};
@@ -93,6 +95,10 @@ pub struct ExactEngine {
     /// yet), cast first in its next views. Only how soon a covered view stops depends on it,
     /// never an answer, so threads share it without ordering.
     cover_hints: Vec<AtomicU32>,
+    /// The composite casters of the certificates' dark proofs, found on first use
+    /// ([`Self::composites`]) and kept with the index, so that every certifier sharing it (one
+    /// per year, one per batch of a city's receivers) shares them.
+    composites: OnceLock<Composites>,
 }
 
 /// No object has covered the receiver yet.
@@ -239,7 +245,13 @@ impl ExactEngine {
             origin: scene.origin,
             area_eps: AREA_EPS * scale * scale,
             cover_hints: scene.receivers.iter().map(|_| AtomicU32::new(NO_HINT)).collect(),
+            composites: OnceLock::new(),
         })
+    }
+
+    /// The scene's composite casters ([`Composites`]), found the first time they are asked for.
+    pub(crate) fn composites(&self) -> &Composites {
+        self.composites.get_or_init(|| Composites::new(self))
     }
 
     /// Fresh scratch memory for one thread.

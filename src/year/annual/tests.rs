@@ -73,7 +73,8 @@ fn a_year_by_batches_of_receivers_is_the_whole_year() {
         method: Method::Spline(SamplingPlan::new(13, 9).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: true,
-        many_casters: false,
+        // On: the batches share the index's composite casters.
+        many_casters: true,
     };
     let calendar = LeafCalendar::evergreen();
     let year = |receivers: Range<usize>| {

@@ -4,13 +4,22 @@
 use glam::DVec3;
 
 use super::*;
+use crate::year::certified::Rule;
 
 /// Rows a day in these tests (Timestep 4).
 const ROWS: usize = 96;
 
 /// A refined step of fitted piece `fit` at time of day `slot` on day `day` (0-based).
 fn step(fit: usize, slot: usize, day: usize) -> Rough {
-    Rough { row: day * ROWS + slot, column: fit, sun: DVec3::Z, day: day as f64 + 1.0, cell: (0, fit, 0, 0), corners: (0.0, 1.0) }
+    Rough {
+        row: day * ROWS + slot,
+        column: fit,
+        sun: DVec3::Z,
+        day: day as f64 + 1.0,
+        cell: (0, fit, 0, 0),
+        corners: (0.0, 1.0),
+        rule: Rule::Spread,
+    }
 }
 
 /// Runs the rounds of [`Sparse`] with `truth` answering every asked step: each step's value and
