@@ -81,7 +81,7 @@ pub(super) struct DistrictArgs {
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
-    /// Receivers whose year a tile counts at once (default 1024): a tile's peak memory follows
+    /// Receivers whose year a tile counts at once (default 128): a tile's peak memory follows
     /// it; the answers are the same bit for bit.
     #[arg(long, value_name = "N")]
     receiver_batch: Option<usize>,

@@ -29,9 +29,11 @@ use crate::year::annual::{Progress, YearStages, annual_receivers_with};
 
 /// Receivers whose year is counted at once. A receiver's year holds at most about 180 kB at
 /// its peak (its share of the whole-year table, refined steps, fits and samples; measured on
-/// the 120-building district, docs/district.md), so a batch about 180 MB; smaller batches add
-/// refinement rounds of fewer views each.
-pub const RECEIVER_BATCH: usize = 1024;
+/// the 120-building district, docs/district.md), so a batch of 128 about 23 MB. 128 rather
+/// than 1,024 so that a tile's peak is a small share of a whole city's (a 330 m tile holds about
+/// 1,000 receivers); on the 2,000-building district the smaller batch cost 1.4 % more CPU and
+/// no wall time (paired, docs/district.md).
+pub const RECEIVER_BATCH: usize = 128;
 
 /// Where a tile's time went, in seconds of wall time (the views are counted on every core), with
 /// the views each stage counted and the view stages' CPU seconds (every thread of the process:
