@@ -60,6 +60,9 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # views a submission, the node pool sized from the batch before; docs/benchmarks-gpu.md): never
 # measured on a GPU, and the H200's 2026-11-28 line (470 s, 5 batches counted twice) is the one
 # to set it beside. nyt-blocks' even spread of 20,040 views, then blaas-trees-summer's every view.
+# BEST="--engine …" (scripts/bench-gpu-lease.sh sets it from the spread's lines) times the
+# fastest kernel of the spread on every view of nyt-blocks, checked: the issue's first target.
+[ -n "${BEST:-}" ] && run nyt-blocks-best-all 150 bench nyt-blocks $BEST --check 30 "${views[@]}" "${gpu_flags[@]}"
 run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" --check 30 "${gpu_flags[@]}"
 [ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" "${gpu_flags[@]}"
 run blaas-trees-summer-compute 40 bench blaas-trees-summer --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"

@@ -10,8 +10,8 @@
 # --write`), ENGINES (default gpu; compute too where time allows), SAMPLES (27x19), RES (512),
 # TIMESTEPS (4), REFINE (unset: the CLI's and the API's default; 1: only the sample views, a quick try
 # on a CPU driver), BUDGET seconds after which the remaining runs are skipped (default 480), SUNLIT
-# (default target/release/sunlit), NODE (default node). Needs www/pkg (scripts/build-web.sh) and
-# node_modules/webgpu (npm ci).
+# (default target/release/sunlit), NODE (default node), RUN_TIMEOUT seconds a run (default 300).
+# Needs www/pkg (scripts/build-web.sh) and node_modules/webgpu (npm ci).
 #
 # On a GPU machine with no Node and no package registry (the H200 lent to some sessions): make the
 # carry folder here with scripts/stage-node-gpu.sh, carry `.node-gpu`, and run there
@@ -89,10 +89,10 @@ for m in ${MODELS:-blaas-trees-summer nyt-blocks}; do
   glb="$scratch/$m.glb"
   [ -f "$glb" ] || "$B" bench "$m" --write "$glb" 2>>"$OUT/stderr.txt" || { echo "cannot write $m" >> "$OUT/stderr.txt"; continue; }
   for e in ${ENGINES:-gpu}; do
-    timed "$m-$e-native" 300 "$B" annual "$glb" --engine "$e" --location 39.74,-105.18,-7 --timesteps-per-hour "$TIMESTEPS" \
+    timed "$m-$e-native" "${RUN_TIMEOUT:-300}" "$B" annual "$glb" --engine "$e" --location 39.74,-105.18,-7 --timesteps-per-hour "$TIMESTEPS" \
       --days-per-year "$days" --samples-per-day "$per_day" --resolution "$RES" "${refine[@]}" -o "$OUT/$m-$e-native.csv" || continue
     native_wall=$wall
-    timed "$m-$e-node" 300 "$NODE" scripts/bench-node-gpu.mjs "$glb" "$SAMPLES" "$RES" --engine "$e" --timesteps "$TIMESTEPS" \
+    timed "$m-$e-node" "${RUN_TIMEOUT:-300}" "$NODE" scripts/bench-node-gpu.mjs "$glb" "$SAMPLES" "$RES" --engine "$e" --timesteps "$TIMESTEPS" \
       "${refine[@]}" --csv "$OUT/$m-$e-node.csv" || continue
     compare "$m-$e-node-vs-native" "$OUT/$m-$e-native.csv" "$OUT/$m-$e-node.csv" "$native_wall" "$wall"
   done
