@@ -16,9 +16,17 @@
 //    the view go there: a tile then rejects at most ~3 boxes for each it draws. A pool too small for the batch still counts
 //    what it needed in heads[0] and drops the rest: the host reads that count and runs the batch
 //    again with a pool that large, so a list is never truncated.
-// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the tile's list and
-//    then the view's large list (skipping large triangles whose box misses the tile), taking
-//    every other triangle; each lane owns one row and steps across it. Per pixel an
+//    The view's members' own triangles (its receivers') go, whatever their size, into a third
+//    list of the view, with their boxes, so that a raster tile can draw them first.
+// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the view's member
+//    list, then its large list and then the tile's list (skipping boxes that miss the tile),
+//    taking every other triangle; each lane owns one row and steps across it. With every
+//    member drawn first, a tile stops walking as soon as no pixel of it shows a member: a tile no
+//    member covers, at once, and a tile a caster has shaded whole, after that caster's chunk of
+//    the walk (checked every WALK_CHUNK steps). What it has not drawn then could only lower
+//    casters' depths or cover pixels no member covers, which changes no count (atomicMin keeps
+//    a member's word only where it is the nearest). Tests that dump every pixel's class walk
+//    everything, so the dump stays the whole picture. Per pixel an
 //    atomicMin in workgroup memory on a word packing quantized depth (high 29 bits) and class
 //    (low 3 bits: member k of the view, or CASTER), so the nearest triangle wins and, at equal
 //    quantized depth, a member beats a caster. Members also set their bit of the pixel's
@@ -47,6 +55,12 @@ const JOB: u32 = 256u;
 // The fewest raster tiles a triangle's box may touch and go to its view's large list; the
 // library's compute::LARGE_TILES (see large_tiles).
 const LARGE_TILES: u32 = 8u;
+// Heads a view has after its raster tiles': the large list's, then the member list's.
+const LARGE_LIST: u32 = 0u;
+const MEMBER_LIST: u32 = 1u;
+// Steps of the walk (two triangles each, one per half of the workgroup) between two checks
+// whether any pixel of the tile still shows a member.
+const WALK_CHUNK: u32 = 16u;
 
 // Raster tiles a triangle's box may touch and be binned into each, in a view of `per_row`²
 // raster tiles: a quarter of them, at least LARGE_TILES (the library's compute::node_bound).
@@ -68,7 +82,7 @@ struct View {
     first_range: u32,
     range_count: u32,
     // Where the view's list heads start in heads (after heads[0], the pool count): one per
-    // raster tile, row by row, then its large list's.
+    // raster tile, row by row, then its large list's and its member list's.
     first_head: u32,
     triangles: u32,
     _pad1: u32,
@@ -266,15 +280,12 @@ fn bin(t: u32, view: View) {
     let t0 = clamp(lo / span, vec2<i32>(0), vec2<i32>(last));
     let t1 = clamp(hi / span, vec2<i32>(0), vec2<i32>(last));
     let box = t1 - t0 + vec2<i32>(1);
+    if class_of(t, view) != CASTER {
+        push_boxed(t, view, per_row * per_row + MEMBER_LIST, t0, t1);
+        return;
+    }
     if u32(box.x * box.y) > large_tiles(per_row) {
-        let n = atomicAdd(&heads[0], 2u);
-        if n + 1u >= params.capacity {
-            return;
-        }
-        let head = 1u + view.first_head + per_row * per_row;
-        let next = atomicExchange(&heads[head], n + 1u);
-        nodes[n] = vec2<u32>(t, next);
-        nodes[n + 1u] = vec2<u32>(u32(t0.x) | (u32(t0.y) << 16u), u32(t1.x) | (u32(t1.y) << 16u));
+        push_boxed(t, view, per_row * per_row + LARGE_LIST, t0, t1);
         return;
     }
     for (var ty = t0.y; ty <= t1.y; ty++) {
@@ -290,12 +301,41 @@ fn bin(t: u32, view: View) {
     }
 }
 
+// Appends triangle t with its box in raster tiles (t0 to t1) to the view's list `list` (a head
+// after its raster tiles'): two nodes, the triangle and the box.
+fn push_boxed(t: u32, view: View, list: u32, t0: vec2<i32>, t1: vec2<i32>) {
+    let n = atomicAdd(&heads[0], 2u);
+    if n + 1u >= params.capacity {
+        return;
+    }
+    let next = atomicExchange(&heads[1u + view.first_head + list], n + 1u);
+    nodes[n] = vec2<u32>(t, next);
+    nodes[n + 1u] = vec2<u32>(u32(t0.x) | (u32(t0.y) << 16u), u32(t1.x) | (u32(t1.y) << 16u));
+}
+
+// Member k of the view that triangle t belongs to, or CASTER.
+fn class_of(t: u32, view: View) -> u32 {
+    let id = attributes[t].x;
+    var kind = CASTER;
+    for (var k = 0u; k < view.member_count; k++) {
+        if id == members[view.first_member + k] {
+            kind = k;
+        }
+    }
+    return kind;
+}
+
 // ---- pass 2: rasterizing and counting a raster tile ----
 
 var<workgroup> depth: array<atomic<u32>, 1024>;
 var<workgroup> cover: array<atomic<u32>, 1024>;
 // Per member: visible, covered, edge pairs.
 var<workgroup> totals: array<atomic<u32>, 12>;
+// Each lane's vote after a chunk of the walk (SHOWS_MEMBER | MORE_TO_WALK), and their union.
+var<workgroup> votes: array<u32, 64>;
+var<workgroup> decision: u32;
+const SHOWS_MEMBER: u32 = 1u;
+const MORE_TO_WALK: u32 = 2u;
 
 // PCG hash (Jarzynski & Olano 2020), as sun_view.wgsl's.
 fn pcg(v: u32) -> u32 {
@@ -322,12 +362,7 @@ fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
     }
     let px0 = (i32(tile0.x) + first) * 256 + 128;
     let a = attributes[t];
-    var kind = CASTER;
-    for (var k = 0u; k < view.member_count; k++) {
-        if a.x == members[view.first_member + k] {
-            kind = k;
-        }
-    }
+    let kind = class_of(t, view);
     let transmittance = bitcast<f32>(a.z);
     // Edge functions at the row's first pixel centre and their step a pixel right; a pixel is
     // in when all three are >= 0 after a bias of -1 on edges that are neither top nor left.
@@ -371,6 +406,38 @@ fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
     }
 }
 
+// Where a half of the workgroup starts walking a list that starts at `head`: lanes 0..31 at its
+// first triangle, lanes 32..63 at its second (each half then takes every other triangle).
+fn first_of_half(head: u32, lane: u32) -> u32 {
+    if lane >= TILE {
+        return next_node(head);
+    }
+    return head;
+}
+
+// Draws this lane's row of the triangle at boxed node `node` (a member or large list's), if its
+// box holds raster tile `at` (the box is the next node: nodes[node], the triangle nodes[node - 1]).
+fn draw_boxed(node: u32, view: View, at: vec2<u32>, tile0: vec2<u32>, row: u32) {
+    let box = nodes[node];
+    if at.x >= (box.x & 0xffffu) && at.y >= (box.x >> 16u) && at.x <= (box.y & 0xffffu) && at.y <= (box.y >> 16u) {
+        let t = nodes[node - 1u].x;
+        let s = setup(t, view);
+        if s.live {
+            draw_row(t, view, s, tile0, row);
+        }
+    }
+}
+
+// Whether any of this lane's pixels of the tile shows a member (its nearest word is a member's).
+fn shows_member(lane: u32) -> bool {
+    var any = false;
+    for (var i = lane; i < TILE * TILE; i += 64u) {
+        let word = atomicLoad(&depth[i]);
+        any = any || (word != NONE && (word & 7u) != CASTER);
+    }
+    return any;
+}
+
 // The next node after n (0: the end).
 fn next_node(n: u32) -> u32 {
     if n == 0u {
@@ -396,35 +463,50 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     }
     workgroupBarrier();
     let row = lane % TILE;
-    var node = atomicLoad(&heads[1u + view.first_head + group.x]);
-    if lane >= TILE {
-        node = next_node(node);
-    }
+    let at = vec2<u32>(group.x % per_row, group.x / per_row);
+    let lists = 1u + view.first_head + per_row * per_row;
+    // The members first, whole (few triangles: a view's receivers).
+    var node = first_of_half(atomicLoad(&heads[lists + MEMBER_LIST]), lane);
     while node != 0u {
-        let t = nodes[node - 1u].x;
-        let s = setup(t, view);
-        if s.live {
-            draw_row(t, view, s, tile0, row);
-        }
+        draw_boxed(node, view, at, tile0, row);
         node = next_node(next_node(node));
     }
-    // The view's large triangles whose box holds this tile (the box is node `node`: the node
-    // after the triangle's, node - 1).
-    let at = vec2<u32>(group.x % per_row, group.x / per_row);
-    node = atomicLoad(&heads[1u + view.first_head + per_row * per_row]);
-    if lane >= TILE {
-        node = next_node(node);
-    }
-    while node != 0u {
-        let box = nodes[node];
-        if at.x >= (box.x & 0xffffu) && at.y >= (box.x >> 16u) && at.x <= (box.y & 0xffffu) && at.y <= (box.y >> 16u) {
-            let t = nodes[node - 1u].x;
-            let s = setup(t, view);
-            if s.live {
-                draw_row(t, view, s, tile0, row);
+    // Then the large list and the tile's list, a chunk at a time, until nothing of the tile
+    // shows a member or nothing is left.
+    var small = first_of_half(atomicLoad(&heads[1u + view.first_head + group.x]), lane);
+    var large = first_of_half(atomicLoad(&heads[lists + LARGE_LIST]), lane);
+    loop {
+        workgroupBarrier();
+        votes[lane] = select(0u, SHOWS_MEMBER, shows_member(lane)) | select(0u, MORE_TO_WALK, small != 0u || large != 0u);
+        workgroupBarrier();
+        if lane == 0u {
+            var all = 0u;
+            for (var i = 0u; i < 64u; i++) {
+                all |= votes[i];
+            }
+            decision = all;
+        }
+        let now = workgroupUniformLoad(&decision);
+        // A test's dump walks everything: the classes of pixels no member shows are kept too.
+        if (now & MORE_TO_WALK) == 0u || ((now & SHOWS_MEMBER) == 0u && params.dump == 0u) {
+            break;
+        }
+        // Large triangles first: they are the ones likely to shade a tile whole.
+        for (var step = 0u; step < WALK_CHUNK; step++) {
+            if large != 0u {
+                draw_boxed(large, view, at, tile0, row);
+                large = next_node(next_node(large));
+            } else if small != 0u {
+                let t = nodes[small - 1u].x;
+                let s = setup(t, view);
+                if s.live {
+                    draw_row(t, view, s, tile0, row);
+                }
+                small = next_node(next_node(small));
+            } else {
+                break;
             }
         }
-        node = next_node(next_node(node));
     }
     workgroupBarrier();
     if params.dump != 0u {

@@ -195,6 +195,46 @@ fn depth_ties_go_to_the_member_and_nearer_casters_win() {
     assert_eq!(gpu_counts[0][0], 2 * 256, "visible: the two tied squares");
 }
 
+#[test]
+fn tiles_that_stop_early_count_what_walking_every_triangle_counts() {
+    // A 96² view (3 × 3 raster tiles). Two members tile the left two columns; the right column
+    // has none, so its tiles stop at once. A caster in front covers the left column whole, so
+    // its tiles stop once that caster is drawn; hundreds of small casters (many chunks of the
+    // walk) lie over all three columns, in front of the members, behind them and tied with them,
+    // so a tile that stopped while a member still showed, or skipped a caster it needed, counts
+    // more visible pixels than the truth.
+    let counter = compute_counter(96);
+    let mut rng = SmallRng::seed_from_u64(29);
+    let members = [10u32, 11];
+    let side = 96;
+    let rect = |x0: f32, y0: f32, x1: f32, y1: f32, z: f32| [[[x0, y0, z], [x1, y0, z], [x1, y1, z]], [[x0, y0, z], [x1, y1, z], [x0, y1, z]]];
+    for round in 0..4 {
+        let (mut triangles, mut ids) = (Vec::new(), Vec::new());
+        for (k, x) in [0.0f32, 32.0].into_iter().enumerate() {
+            triangles.extend(rect(x + 0.25, 0.25, x + 32.25, 96.25, 0.75));
+            ids.extend([members[(k + round) % 2]; 2]);
+        }
+        triangles.extend(rect(-4.0, -4.0, 33.0, 100.0, 0.25));
+        ids.extend([NO_RECEIVER; 2]);
+        for _ in 0..400 {
+            let (x, y) = (grid(&mut rng, -8.0, 100.0), grid(&mut rng, -8.0, 100.0));
+            let z = [0.5, 0.75, 0.9][rng.random_range(0..3)];
+            let t = [0; 3].map(|_| [x + grid(&mut rng, -6.0, 6.0), y + grid(&mut rng, -6.0, 6.0), z]);
+            triangles.push(t);
+            ids.push(NO_RECEIVER);
+        }
+        let want = counts(&truth(&triangles, &ids, &members, side), members.len());
+        let early = pollster::block_on(counter.compute_counts(&triangles, &ids, &members, side)).unwrap();
+        let (whole, _) = pollster::block_on(counter.compute_pixels(&triangles, &ids, &members, side)).unwrap();
+        for k in 0..members.len() {
+            assert_eq!([early[k][0], early[k][1]], want[k], "round {round}, member {k}: (visible, covered), stopping early");
+            assert_eq!(early[k], whole[k], "round {round}, member {k}: stopping early against walking everything");
+        }
+        let visible: u32 = want.iter().map(|c| c[0]).sum();
+        assert!(visible > 500 && visible < 32 * 96, "some of the middle column shaded, some not: {want:?}");
+    }
+}
+
 /// Requests over a generated bench model: `suns` sun positions of its year at which `receiver`
 /// faces the sun.
 fn bench_scene(name: &str) -> (Scene, sunlit::sun::location::Location) {

@@ -15,6 +15,10 @@
 //! batch from the nodes a triangle took in the batch before ([`node_bound`] a triangle at most,
 //! the bound the first batch is sized by), so in steady state no batch is counted twice; a batch
 //! that still needed more is counted again with a pool that large (never truncated).
+//!
+//! Each view's members' own triangles are listed apart and drawn first by every raster tile, so
+//! a tile can stop as soon as none of its pixels shows a member (none covers it, or casters have
+//! shaded it whole): on a dense city most of a dark view's tiles stop after their first chunk.
 
 use std::ops::Range;
 use std::sync::Mutex;
@@ -49,6 +53,20 @@ pub const LARGE_TILES: u32 = 8;
 /// over a quarter of the view (a tile rejects at most ~3 boxes for each it draws).
 pub fn node_bound(side: u32) -> u32 {
     LARGE_TILES.max(side.div_ceil(RASTER_TILE).pow(2) / 4)
+}
+
+/// Lists a view has besides its raster tiles' (the shader's LARGE_LIST and MEMBER_LIST): its
+/// large triangles', and its members' own triangles', which every raster tile draws first.
+const VIEW_LISTS: u32 = 2;
+
+/// List heads a view of side `side` has: one a raster tile, row by row, then [`VIEW_LISTS`].
+fn heads_per_view(side: u32) -> u32 {
+    raster_tiles(side) + VIEW_LISTS
+}
+
+/// Raster tiles (workgroups of the raster pass) a view of side `side` has.
+fn raster_tiles(side: u32) -> u32 {
+    side.div_ceil(RASTER_TILE).pow(2)
 }
 /// The most views a batch counts: at 512² that is 262,144 raster workgroups, enough to keep a
 /// data-centre GPU's SMs busy, and the batch's own buffers stay small (the heads 1 MiB).
@@ -225,7 +243,7 @@ pub(super) struct ComputeBatch {
     members: Vec<u32>,
     /// Triangles in the views' lists.
     triangles: u64,
-    /// List heads a view has: its raster tiles' and its large list's.
+    /// List heads a view has ([`heads_per_view`]).
     heads_per_view: u32,
     side: u32,
 }
@@ -233,7 +251,7 @@ pub(super) struct ComputeBatch {
 impl ComputeBatch {
     /// Starts a batch of views of side `side`.
     fn new(side: u32) -> Self {
-        let heads_per_view = side.div_ceil(RASTER_TILE).pow(2) + 1;
+        let heads_per_view = heads_per_view(side);
         Self { views: Vec::new(), words: Vec::new(), members: Vec::new(), triangles: 0, heads_per_view, side }
     }
 
@@ -404,7 +422,7 @@ impl Counter {
         let limit = pool_limit(&self.device);
         let budget = POOL_BUDGET.min(limit) / 8;
         let per_triangle = (bins.per_triangle * POOL_MARGIN).min(node_bound(side) as f64);
-        let heads_per_view = side.div_ceil(RASTER_TILE).pow(2) as u64 + 1;
+        let heads_per_view = heads_per_view(side) as u64;
         let most = most.min(bins.max_views).min((limit / 4 / heads_per_view) as usize).max(1);
         let (mut n, mut triangles) = (0usize, 0u64);
         for &s in sizes.iter().take(most) {
@@ -519,7 +537,7 @@ impl Counter {
         let across = jobs.clamp(1, d.limits().max_compute_workgroups_per_dimension);
         pass.dispatch_workgroups(across, jobs.div_ceil(across).max(1), 1);
         pass.set_pipeline(&state.pipelines.raster);
-        pass.dispatch_workgroups(batch.heads_per_view - 1, views as u32, 1);
+        pass.dispatch_workgroups(raster_tiles(batch.side), views as u32, 1);
         drop(pass);
         encoder.copy_buffer_to_buffer(&bins.heads, 0, &bins.readback, 0, 4);
         if entry_bytes > 0 {
@@ -587,7 +605,7 @@ impl Counter {
         if self.compute.is_none() {
             return Ok(Vec::new());
         }
-        let heads_per_view = side.div_ceil(RASTER_TILE).pow(2) as u64 + 1;
+        let heads_per_view = heads_per_view(side) as u64;
         let first = 4 * (1 + views as u64 * heads_per_view);
         let bytes = 4 * views as u64 * side as u64 * side as u64;
         let target = buffer(&self.device, "dump readback", bytes, READBACK);
@@ -603,7 +621,8 @@ impl Counter {
     /// Runs the compute kernel on `triangles` given in the pixels of one view of side `side` (x
     /// right, y down, z the depth in [0, 1]), triangle k carrying receiver id `ids[k]`, counting
     /// `members`: per member (visible, covered, edge pairs), and the pixels as [`Self::read_dump`]
-    /// gives them. The pool grows and the view is counted again until its lists fit.
+    /// gives them. The pool grows and the view is counted again until its lists fit. A dump walks
+    /// every triangle of every tile, so the pixels are the whole picture.
     pub async fn compute_pixels(
         &self,
         triangles: &[[[f32; 3]; 3]],
@@ -611,6 +630,21 @@ impl Counter {
         members: &[u32],
         side: u32,
     ) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
+        self.dump_pixels(true);
+        let counts = self.count_pixels(triangles, ids, members, side).await;
+        let dump = self.read_dump(1, side).await;
+        self.dump_pixels(false);
+        Ok((counts?, dump?))
+    }
+
+    /// [`Self::compute_pixels`]' counts alone, as a count runs: each raster tile stops walking
+    /// once none of its pixels shows a member.
+    pub async fn compute_counts(&self, triangles: &[[[f32; 3]; 3]], ids: &[u32], members: &[u32], side: u32) -> Result<Vec<[u32; 3]>> {
+        self.dump_pixels(false);
+        self.count_pixels(triangles, ids, members, side).await
+    }
+
+    async fn count_pixels(&self, triangles: &[[[f32; 3]; 3]], ids: &[u32], members: &[u32], side: u32) -> Result<Vec<[u32; 3]>> {
         let positions: Vec<f32> = triangles.iter().flatten().flatten().copied().collect();
         let attributes: Vec<[u32; 4]> = ids.iter().map(|&id| [id, (-1.0f32).to_bits(), 0, 0]).collect();
         let scene = ComputeScene::new(&self.device, &positions, &attributes);
@@ -624,11 +658,7 @@ impl Counter {
         let mut batch = ComputeBatch::new(side);
         let all = 0..triangles.len() as u32;
         batch.push(view_proj, [0, 0], 1.0, members, std::slice::from_ref(&all));
-        self.dump_pixels(true);
         let counts = self.run_batch(&scene, &batch).await?.ok_or_else(|| GpuError::Readback("one view over the pool's limit".into()))?;
-        let counts = counts.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let dump = self.read_dump(1, side).await?;
-        self.dump_pixels(false);
-        Ok((counts, dump))
+        Ok(counts.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
     }
 }
