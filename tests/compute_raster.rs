@@ -207,7 +207,8 @@ fn tiles_that_stop_early_count_what_walking_every_triangle_counts() {
     let mut rng = SmallRng::seed_from_u64(29);
     let members = [10u32, 11];
     let side = 96;
-    let rect = |x0: f32, y0: f32, x1: f32, y1: f32, z: f32| [[[x0, y0, z], [x1, y0, z], [x1, y1, z]], [[x0, y0, z], [x1, y1, z], [x0, y1, z]]];
+    let rect =
+        |x0: f32, y0: f32, x1: f32, y1: f32, z: f32| [[[x0, y0, z], [x1, y0, z], [x1, y1, z]], [[x0, y0, z], [x1, y1, z], [x0, y1, z]]];
     for round in 0..4 {
         let (mut triangles, mut ids) = (Vec::new(), Vec::new());
         for (k, x) in [0.0f32, 32.0].into_iter().enumerate() {
