@@ -288,6 +288,20 @@ fn interzone_windows_are_skipped_by_name() {
     );
     assert_eq!(beam.balances.len(), 1);
     assert!(beam.balances[0].window != "Through");
+
+    // 4ZoneWithShading_Simple_1 writes its pair as `Window:Interzone` (in its wall's own
+    // coordinates): read, each is a hole in its wall, whose inside face then has EnergyPlus's net
+    // area (20 × 10 m less the 3 × 5 m window), and each is skipped by name.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/energyplus_testfiles/4ZoneWithShading_Simple_1.idf");
+    let ep = load(&std::fs::read_to_string(path).unwrap());
+    let four = sunlit::model::inside::rooms(&ep, None).unwrap();
+    let beam = interior_beam(&ep, &four, &weather, &weather.location, Timesteps::new(1).unwrap(), None).unwrap();
+    assert_eq!(beam.skipped, ["Zn003:Wall004:Win001", "Zn004:Wall004:Win001"]);
+    let scene = sunlit::model::inside::inside_scene(&ep).unwrap();
+    for wall in ["Zn003:Wall004:inside", "Zn004:Wall004:inside"] {
+        let area = scene.receiver(wall).unwrap().1.area;
+        assert!((area - 185.0).abs() < 1e-6, "{wall}: {area} m²");
+    }
 }
 
 /// What `--interior-beam` cannot do is refused by name before any counting, and nothing is
