@@ -61,6 +61,20 @@ fn room_idf(window: [f64; 4], overhang: bool, extra: &str) -> String {
     idf + extra
 }
 
+/// A window in the east wall's plane (x = 4), named on the south wall.
+const EAST_PLANE_WINDOW: &str = "4,1,2.5,4,1,1,4,3,1,4,3,2.5";
+/// The window turned 18° about its sill: its head 0.5 m out of the south wall.
+const TILTED_WINDOW: &str = "1,-0.5,2.5,1,0,1,3,0,1,3,-0.5,2.5";
+
+/// The box room with the window's four corners as written (`x,y,z` × 4, upper left first).
+fn room_idf_with_window(corners: &str, overhang: bool, extra: &str) -> String {
+    let [x0, x1, z0, z1] = WINDOW;
+    let written = format!("{x0},0,{z1},{x0},0,{z0},{x1},0,{z0},{x1},0,{z1};");
+    let idf = room_idf(WINDOW, overhang, extra);
+    assert!(idf.contains(&written));
+    idf.replace(&written, &format!("{corners};"))
+}
+
 fn load(idf: &str) -> sunlit::Result<(Scene, Rooms)> {
     let loaded = model::load_bytes_all(&[("room.idf".to_string(), idf.as_bytes().to_vec())], &LoadOptions::default())?;
     let ep = loaded.energyplus.unwrap();
@@ -195,6 +209,12 @@ fn bad_rooms_are_refused_naming_the_object() {
     // A window that sticks out of its wall.
     let err = load(&room_idf([3.0, 4.5, 1.0, 2.5], false, "")).unwrap_err().to_string();
     assert!(err.contains("Win") && err.contains("not within its base surface"), "{err}");
+    // A window drawn in the east wall's plane but named on the south wall: cast onto the south
+    // wall it is a line on the wall's edge, so it opens nothing there and the room would be dark.
+    let err = load(&room_idf_with_window(EAST_PLANE_WINDOW, false, "")).unwrap_err().to_string();
+    assert!(err.contains("Win") && err.contains("does not lie in its base surface 'South'") && err.contains("90.0°"), "{err}");
+    // Turned 18° out of its wall (its head 0.5 m out), its opening is still the hole in the wall.
+    load(&room_idf_with_window(TILTED_WINDOW, false, "")).unwrap();
     // A glazing transmittance outside 0..1.
     let idf = room_idf(WINDOW, false, "").replace("SimpleGlass,2.0,0.6,0.7", "SimpleGlass,2.0,0.6,1.3");
     let err = load(&idf).unwrap_err().to_string();
@@ -251,6 +271,32 @@ fn map_inside_cli_writes_lit_weights_patches_and_ase() {
     assert!(text.starts_with("receiver,x,y,z,nx,ny,nz,lit,solar_transmittance,visible_transmittance\n"), "{}", &text[..80]);
     assert!(text.lines().any(|l| l.starts_with("Floor:inside,") && l.contains(",1,")), "no lit floor point");
 
+    // LEED ASE through the CLI: `POINTS.study-leed-ase.json` has `areas` with the zone and a
+    // numeric `ase` (%), numpy's on the same 0.6 m work plane at 0.76 m and Golden's 3,650
+    // occupied hours within 1 point; the CSV is its map, each point's hours over 1,000 lux, and
+    // the share of points over 250 h is the room's `ase`.
+    let (ase_idf, ase_csv) = (tmp.join("ase.idf"), tmp.join("ase.csv"));
+    std::fs::write(&ase_idf, room_idf(WINDOW, true, "")).unwrap();
+    let epw = golden_epw();
+    let args = ["map", ase_idf.to_str().unwrap(), "--inside", "--epw", epw.to_str().unwrap(), "--study", "leed-ase"];
+    let out = sunlit(&[&args[..], &["-o", ase_csv.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(tmp.join("ase.study-leed-ase.json")).unwrap()).unwrap();
+    let areas = report["areas"].as_array().unwrap();
+    assert_eq!((areas.len(), areas[0]["zone"].as_str()), (1, Some("OFFICE")), "{report}");
+    let ase = areas[0]["ase"].as_f64().expect("a numeric ase");
+    let (mut scene, rooms) = load(&room_idf(WINDOW, true, "")).unwrap();
+    let (ours, theirs) = ase_against_numpy(&mut scene, &rooms, json!({"vt": VT, "angular": "E"}));
+    assert!((ase - theirs).abs() <= 1.0, "the CLI's ASE {ase} % against numpy's {theirs} %");
+    assert!((ase - ours.areas[0].ase).abs() < 1e-3 && areas[0]["points"] == ours.areas[0].points, "{report}");
+    assert!(report["occupied"].as_str().unwrap().contains("no daylight saving shift"), "{report}");
+    let text = std::fs::read_to_string(&ase_csv).unwrap();
+    assert!(text.lines().next().unwrap().ends_with(",hours_over_1000_lux"), "{}", &text[..80]);
+    let hours: Vec<f64> = text.lines().skip(1).map(|l| l.rsplit(',').next().unwrap().parse().unwrap()).collect();
+    assert_eq!(hours.len(), ours.areas[0].points);
+    let over = 100.0 * hours.iter().filter(|&&h| h > inside::ASE_HOURS).count() as f64 / hours.len() as f64;
+    assert!((over - ase).abs() < 1e-3, "{over} % of the map's points over 250 h against ASE {ase} %");
+
     // Refused before anything is written: a glass transmittance outside 0..1, a study without --inside.
     let bad = tmp.join("bad.csv");
     for args in [
@@ -263,6 +309,143 @@ fn map_inside_cli_writes_lit_weights_patches_and_ase() {
         assert!(!out.status.success());
         assert!(!bad.exists());
     }
+}
+
+/// Each bad input of the issue through the CLI, as a user meets it under `--study leed-ase`: an
+/// error naming the object (and why), and neither the points CSV nor the study's report written.
+#[test]
+fn map_inside_cli_refuses_each_bad_input_naming_it_and_writes_nothing() {
+    let tmp = Scratch::new("inside", "map_inside_cli_refuses_each_bad_input_naming_it_and_writes_nothing");
+    let epw = golden_epw();
+    let outside = tmp.join("outside.csv");
+    std::fs::write(&outside, "x,y,z,nx,ny,nz\n2,2,0.76,0,0,1\n9,2,0.76,0,0,1\n").unwrap();
+    let attic = surface("AtticRoof", "Roof", "Outdoors", &[[0.0, 0.0, 4.0], [4.0, 0.0, 4.0], [4.0, 5.0, 4.0], [0.0, 5.0, 4.0]])
+        .replace("Office", "Attic");
+    let good = room_idf(WINDOW, true, "");
+    let cases: Vec<(String, Vec<&str>, Vec<&str>)> = vec![
+        (room_idf([3.0, 4.5, 1.0, 2.5], true, ""), vec![], vec!["'Win'", "is not within its base surface 'South'"]),
+        (room_idf_with_window(EAST_PLANE_WINDOW, true, ""), vec![], vec!["'Win'", "does not lie in its base surface 'South'"]),
+        (good.replace("SimpleGlass,2.0,0.6,0.7", "SimpleGlass,2.0,0.6,1.3"), vec![], vec!["'SimpleGlass'", "Visible Transmittance 1.3"]),
+        (
+            good.replace("SimpleGlass,2.0,0.6,0.7", "SimpleGlass,2.0,1.6,0.7"),
+            vec![],
+            vec!["'SimpleGlass'", "Solar Heat Gain Coefficient 1.6"],
+        ),
+        (good.replace(",Glass,South,", ",Unread,South,"), vec!["--glass-transmittance", "-0.1"], vec!["glass_transmittance", "-0.1"]),
+        (good.clone(), vec!["--points", outside.to_str().unwrap()], vec!["outside.csv", "line 3", "lies in no zone"]),
+        (room_idf(WINDOW, true, &format!("Zone,Attic,0,0,0,0;\n{attic}")), vec![], vec!["'ATTIC'", "no floor"]),
+    ];
+    for (k, (idf, extra, needles)) in cases.into_iter().enumerate() {
+        let (model, csv) = (tmp.join(format!("bad{k}.idf")), tmp.join(format!("bad{k}.csv")));
+        std::fs::write(&model, idf).unwrap();
+        let args = ["map", model.to_str().unwrap(), "--inside", "--epw", epw.to_str().unwrap(), "--study", "leed-ase"];
+        let out = sunlit(&[&args[..], &extra[..], &["-o", csv.to_str().unwrap()]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && needles.iter().all(|n| err.contains(n)), "case {k}: {err}");
+        assert!(!csv.exists() && !tmp.join(format!("bad{k}.study-leed-ase.json")).exists(), "case {k} wrote output");
+    }
+}
+
+/// With two zones, a free point belongs to the zone it lies in, a point on an inside face (within
+/// 1 cm, facing its way) to that face, and a free point's normal says which way it looks: at
+/// (2, 2, 0.5) a sun from the south-south-east reaches it through the window (its ray leaves the
+/// south wall at z 2.0, inside the window's 1.0–2.5) when it faces south or up, and not when it
+/// faces north.
+#[test]
+fn free_points_belong_to_the_zone_they_lie_in_and_look_along_their_normal() {
+    // A second zone, a 4 × 5 × 3 m box 1 m north of the office, no window.
+    let store: String = room_idf(WINDOW, false, "")
+        .lines()
+        .filter(|l| l.starts_with("BuildingSurface:Detailed"))
+        .map(|l| {
+            let (head, tail) = l.split_once(",4,").unwrap();
+            let moved: Vec<String> = tail
+                .trim_end_matches(';')
+                .split(',')
+                .enumerate()
+                .map(|(i, v)| {
+                    let v: f64 = v.parse().unwrap();
+                    if i % 3 == 1 { format!("{}", v + 6.0) } else { format!("{v}") }
+                })
+                .collect();
+            format!("{},4,{};\n", head.replacen("Detailed,", "Detailed,Store", 1).replace(",Office,", ",Store,"), moved.join(","))
+        })
+        .collect();
+    let (mut scene, rooms) = load(&room_idf(WINDOW, false, &format!("Zone,Store,0,0,0,0;\n{store}"))).unwrap();
+    let zone = |name: &str| rooms.rooms.iter().position(|r| r.name == name).unwrap() as u32;
+    let text = "x,y,z,nx,ny,nz\n2,8,0.76,0,0,1\n2,2,0.5,0,-1,0\n2,2,0.5,0,1,0\n2,2,0.5,0,0,1\n2,2,0,0,0,1\n2,5.005,1.5,0,-1,0\n2,10.995,1.5,0,-1,0\n";
+    let at = inside::room_points_csv(&mut scene, &rooms, "p.csv", text).unwrap();
+    let (office, store) = (zone("OFFICE"), zone("STORE"));
+    assert_eq!(at.room, [store, office, office, office, office, office, store]);
+    let on = |i: usize| scene.receivers[at.points.receivers[i] as usize].name.clone();
+    assert_eq!((on(4).as_str(), on(5).as_str(), on(6).as_str()), ("Floor:inside", "North:inside", "StoreNorth:inside"));
+    assert!((0..4).all(|i| on(i).contains("free plane")), "{:?}", (0..4).map(on).collect::<Vec<_>>());
+    let err = inside::room_points_csv(&mut scene, &rooms, "p.csv", "x,y,z,nx,ny,nz\n2,5.5,1.5,0,0,1\n").unwrap_err().to_string();
+    assert!(err.contains("line 2") && err.contains("no zone"), "{err}");
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let sun = DVec3::new(0.2, -0.75, 0.5).normalize();
+    let lit = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0).lit;
+    assert_eq!(lit[1..4], [1.0, 0.0, 1.0], "facing south, north, up");
+    assert_eq!((lit[0], lit[6]), (0.0, 0.0), "the store has no window");
+}
+
+/// The box room and a back room north of it sharing its north wall, with an interzone window
+/// pair in it written as EnergyPlus's `Window:Interzone` (each zone its copy, placed in its base
+/// wall's own coordinates: both at x 1–3 m, z 0.5–2.5 m) of a construction sunlit cannot read.
+fn back_room_idf() -> String {
+    let [w, d, h] = ROOM;
+    let (y0, y1) = (d, 2.0 * d);
+    let back = |name: &str, kind: &str, boundary: &str, corners: &[[f64; 3]]| {
+        surface(name, kind, boundary, corners).replace(",Opaque,Office,", ",Opaque,Back,")
+    };
+    let mut idf = room_idf(WINDOW, false, "Zone,Back,0,0,0,0;\n").replace(
+        "BuildingSurface:Detailed,North,Wall,Opaque,Office,,Outdoors,,SunExposed,WindExposed,",
+        "BuildingSurface:Detailed,North,Wall,Opaque,Office,,Surface,BackSouth,NoSun,NoWind,",
+    );
+    idf += &back("BackSouth", "Wall", "Surface", &[[0.0, y0, h], [0.0, y0, 0.0], [w, y0, 0.0], [w, y0, h]])
+        .replace(",Surface,,NoSun", ",Surface,North,NoSun");
+    idf += &back("BackNorth", "Wall", "Outdoors", &[[w, y1, h], [w, y1, 0.0], [0.0, y1, 0.0], [0.0, y1, h]]);
+    idf += &back("BackEast", "Wall", "Outdoors", &[[w, y0, h], [w, y0, 0.0], [w, y1, 0.0], [w, y1, h]]);
+    idf += &back("BackWest", "Wall", "Outdoors", &[[0.0, y1, h], [0.0, y1, 0.0], [0.0, y0, 0.0], [0.0, y0, h]]);
+    idf += &back("BackFloor", "Floor", "Ground", &[[w, y0, 0.0], [0.0, y0, 0.0], [0.0, y1, 0.0], [w, y1, 0.0]]);
+    idf += &back("BackRoof", "Roof", "Outdoors", &[[0.0, y0, h], [w, y0, h], [w, y1, h], [0.0, y1, h]]);
+    idf + "Window:Interzone,IzA,Pane,North,IzB,1,1,0.5,2,2;\nWindow:Interzone,IzB,Pane,BackSouth,IzA,1,1,0.5,2,2;\n"
+}
+
+/// A beam that reaches the back room through the office's window and the interzone pane is
+/// weighted by both: on every lit point of the back room's floor, the office glass's weight at
+/// its incidence (curve E) × the pane's 0.5, the pane's two copies counted once; on the office's
+/// floor the office glass alone. The sun (0.1, −1, 0.3) reaches the back floor 6.7–8.3 m from the
+/// south wall through both openings, by hand.
+#[test]
+fn a_beam_through_an_interzone_window_is_weighted_by_every_pane_it_crosses() {
+    let loaded = model::load_bytes_all(&[("back.idf".to_string(), back_room_idf().into_bytes())], &LoadOptions::default()).unwrap();
+    let ep = loaded.energyplus.unwrap();
+    let (mut scene, rooms) = (inside_scene(&ep).unwrap(), rooms(&ep, Some(0.5)).unwrap());
+    let glazing: Vec<(&str, bool)> = rooms.glazing.iter().map(|g| (g.name.as_str(), g.interzone)).collect();
+    assert_eq!(glazing, [("Win", false), ("IzA", true), ("IzB", true)]);
+    assert_eq!((rooms.twin_of(1).map(|t| t.1), rooms.twin_of(2).map(|t| t.1), rooms.twin_of(0)), (Some(2), Some(1), None));
+    let at = inside::floor_grid(&mut scene, &rooms, 0.25, 0.0).unwrap();
+    let mapper = Mapper::new(&scene, &at.points).unwrap();
+    let sun = DVec3::new(0.1, -1.0, 0.3).normalize();
+    let ours = inside::instant(InsideMap { mapper: &mapper, rooms: &rooms, at: &at }, sun, 1.0);
+    let (win, back) = (&rooms.glazing[0], rooms.rooms.iter().position(|r| r.name == "BACK").unwrap() as u32);
+    let cos = win.plane.normal.dot(sun).abs();
+    let (mut in_back, mut in_office) = (0, 0);
+    for i in (0..at.points.len()).filter(|&i| ours.lit[i] == 1.0) {
+        let pane = if at.room[i] == back { 0.5 } else { 1.0 };
+        *(if at.room[i] == back { &mut in_back } else { &mut in_office }) += 1;
+        let (s, v) = (ours.solar_transmittance[i], ours.visible_transmittance[i]);
+        let p = at.points.position(i);
+        assert!((p.y - 7.5).abs() < 0.9 || at.room[i] != back, "back point {p} lit outside the strip drawn by hand");
+        assert!(
+            (s - win.solar_at(cos) * pane).abs() < 1e-12 && (v - win.visible_at(cos) * pane).abs() < 1e-12,
+            "point {p}: weights {s} {v}, expected the window's {} {} × {pane}",
+            win.solar_at(cos),
+            win.visible_at(cos)
+        );
+    }
+    assert!(in_back > 20 && in_office > 20, "{in_back} back and {in_office} office points lit");
 }
 
 #[test]

@@ -182,14 +182,32 @@ pub struct InsideMap<'a> {
 
 /// Per point, the glass between it and the sun: the product of the transmittances (solar,
 /// visible) of its room's openings its ray to the sun crosses, each at the ray's incidence on
-/// it ([`crate::model::inside::Glazing::solar_at`], the same curves as the interior beam).
+/// it ([`crate::model::inside::Glazing::solar_at`], the same curves as the interior beam). A ray
+/// that leaves by an interzone window goes on through the next room, whose openings it crosses
+/// weight it too (its copy of that window, the same pane, once): a beam that came in through
+/// another room's window and an interzone pane has crossed both.
 pub fn through_glass(rooms: &Rooms, room: u32, p: DVec3, sun: DVec3) -> (f64, f64) {
-    let Some(room) = rooms.rooms.get(room as usize) else { return (1.0, 1.0) };
-    room.glazing.iter().map(|&g| &rooms.glazing[g]).filter(|g| g.crossed_by(p, sun)).fold((1.0, 1.0), |(s, v), g| {
-        // Either side's normal: the beam crosses the glass one way or the other.
-        let cos = g.plane.normal.dot(sun).abs();
-        (s * g.solar_at(cos), v * g.visible_at(cos))
-    })
+    let (mut weights, mut here, mut entered_by) = ((1.0, 1.0), room as usize, None);
+    // Each room once at most: a straight ray cannot come back through a pane it crossed.
+    for _ in 0..rooms.rooms.len() {
+        let Some(at) = rooms.rooms.get(here) else { break };
+        let mut next = None;
+        for &k in at.glazing.iter().filter(|&&k| Some(k) != entered_by) {
+            let g = &rooms.glazing[k];
+            if !g.crossed_by(p, sun) {
+                continue;
+            }
+            // Either side's normal: the beam crosses the glass one way or the other.
+            let cos = g.plane.normal.dot(sun).abs();
+            weights = (weights.0 * g.solar_at(cos), weights.1 * g.visible_at(cos));
+            if g.interzone {
+                next = rooms.twin_of(k);
+            }
+        }
+        let Some((room, twin)) = next else { break };
+        (here, entered_by) = (room, Some(twin));
+    }
+    weights
 }
 
 /// One instant inside: per point its geometric visibility (`lit`: 1 lit, also through glass; 0

@@ -486,9 +486,18 @@ impl<'a> Reader<'a> {
             return self.push_subsurface(object, kind, base, world);
         }
         let shading_control = usize::from(self.layout.shading_control);
-        for (class, kind, first) in
-            [("Window", "Window", 5 + shading_control), ("GlazedDoor", "GlassDoor", 5 + shading_control), ("Door", "Door", 4)]
-        {
+        // The interzone forms (Name, Construction, Building Surface Name, Outside Boundary
+        // Condition Object, Multiplier, then the placement) are read too: each is a hole in its
+        // interzone wall, so a zone's inside faces have EnergyPlus's net areas and the interior
+        // beam can name the window it skips. Facing another zone, none is a receiver.
+        for (class, kind, first) in [
+            ("Window", "Window", 5 + shading_control),
+            ("GlazedDoor", "GlassDoor", 5 + shading_control),
+            ("Door", "Door", 4),
+            ("Window:Interzone", "Window", 5),
+            ("GlazedDoor:Interzone", "GlassDoor", 5),
+            ("Door:Interzone", "Door", 5),
+        ] {
             if self.handles(object, &[class]) {
                 let (base, _) = self.base_of(object, 2)?;
                 let frame = SurfaceFrame::of(&self.surfaces[base].vertices);

@@ -191,6 +191,17 @@ const RECT_DOOR: &[(&str, Kind)] = &[
     ("height", Number),
 ];
 
+const RECT_INTERZONE_SUB: &[(&str, Kind)] = &[
+    ("construction_name", Text),
+    ("building_surface_name", Text),
+    ("outside_boundary_condition_object", Text),
+    ("multiplier", Number),
+    ("starting_x_coordinate", Number),
+    ("starting_z_coordinate", Number),
+    ("length", Number),
+    ("height", Number),
+];
+
 const OVERHANG: &[(&str, Kind)] = &[
     ("window_or_door_name", Text),
     ("height_above_window_or_door", Number),
@@ -438,6 +449,9 @@ const CLASSES: &[ClassSpec] = &[
     spec("Window", true, RECT_GLAZED, false),
     spec("GlazedDoor", true, RECT_GLAZED, false),
     spec("Door", true, RECT_DOOR, false),
+    spec("Window:Interzone", true, RECT_INTERZONE_SUB, false),
+    spec("GlazedDoor:Interzone", true, RECT_INTERZONE_SUB, false),
+    spec("Door:Interzone", true, RECT_INTERZONE_SUB, false),
     spec("Shading:Site", true, RECT_DETACHED, false),
     spec("Shading:Building", true, RECT_DETACHED, false),
     spec("Shading:Overhang", true, OVERHANG, false),

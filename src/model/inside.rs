@@ -246,6 +246,28 @@ pub fn rooms_with(input: &EnergyPlusInput, glass: &UnreadGlass) -> Result<Rooms>
     Ok(Rooms { rooms, glazing })
 }
 
+/// How close (m) the centres of an interzone window's two copies lie: EnergyPlus asks each
+/// zone for its own copy of the pane, the same outline wound the other way.
+const TWIN_DISTANCE: f64 = 0.01;
+
+impl Rooms {
+    /// The other copy of interzone window `k` (the same pane as the next zone sees it): that
+    /// zone's index into [`Rooms::rooms`] and the copy's into [`Rooms::glazing`]. None where
+    /// the model gives it no copy (its beam then stops at the pane, as the map's geometry has it).
+    pub fn twin_of(&self, k: usize) -> Option<(usize, usize)> {
+        let this = self.glazing.get(k).filter(|g| g.interzone)?;
+        let centre = |g: &Glazing| g.vertices.iter().sum::<DVec3>() / g.vertices.len().max(1) as f64;
+        let twin = |j: usize| {
+            let g = &self.glazing[j];
+            j != k
+                && g.interzone
+                && g.plane.normal.dot(this.plane.normal).abs() > 1.0 - 1e-6
+                && centre(g).distance(centre(this)) < TWIN_DISTANCE
+        };
+        self.rooms.iter().enumerate().find_map(|(r, room)| room.glazing.iter().find(|&&j| twin(j)).map(|&j| (r, j)))
+    }
+}
+
 /// A polygon's triangles (ear clipping in its plane).
 fn fan(vertices: &[DVec3]) -> Vec<[DVec3; 3]> {
     let plane = Plane::of_polygon(vertices);

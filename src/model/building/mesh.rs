@@ -20,6 +20,30 @@ pub(super) fn hole_problem(base: &EpSurface, hole: &EpSurface) -> Option<String>
     None
 }
 
+/// How far (degrees) an opening's plane may turn from its wall's and still be the hole the inside
+/// cuts: EnergyPlus's own limit before it warns (`checkSubSurfAzTiltNorm` in SurfaceGeometry.cc,
+/// "Outward facing angle of subsurface differs more than 30.0 degrees from base surface").
+const OPENING_TURN_DEG: f64 = 30.0;
+
+/// Why a subsurface is no opening of its wall for the inside, if it is not: beyond
+/// [`hole_problem`], its plane must lie along the wall's (within [`OPENING_TURN_DEG`], either
+/// facing), since the beam enters through its outline cast straight onto the wall. A window drawn
+/// in another plane (a side wall's, the floor's) would cast a sliver there, and the room would be
+/// dark without a word.
+fn opening_problem(base: &EpSurface, hole: &EpSurface) -> Option<String> {
+    if let Some(why) = hole_problem(base, hole) {
+        return Some(why);
+    }
+    let (wall, opening) = (newell(&base.vertices).normalize_or_zero(), newell(&hole.vertices).normalize_or_zero());
+    let turn = wall.dot(opening).abs().clamp(0.0, 1.0).acos().to_degrees();
+    (turn > OPENING_TURN_DEG).then(|| {
+        format!(
+            "does not lie in its base surface '{}': its plane is turned {turn:.1}° from the wall's (more than {OPENING_TURN_DEG}°), so it opens no hole the beam can pass",
+            base.name
+        )
+    })
+}
+
 /// Why EnergyPlus's own clipping does not shade a set-back window as the window is shaded, if it
 /// does not: `SHDRVL` (SolarShading.cc) builds a four-sided window's reveal opening by moving its
 /// vertices 1 and 2 as the left edge, 3 and 4 as the right, 1 and 4 as the top and 2 and 3 as the
@@ -112,7 +136,7 @@ impl Building {
             .filter(|s| s.is_fenestration())
             .filter_map(|hole| {
                 let base = hole.base.as_deref().and_then(|b| self.surface(b))?;
-                hole_problem(base, hole).map(|why| (hole, why))
+                opening_problem(base, hole).map(|why| (hole, why))
             })
             .collect()
     }
