@@ -75,7 +75,7 @@ fn obj_groups_are_names_globs_select() {
 #[test]
 fn bad_city_input_is_refused_with_nothing_written() {
     let dir = scratch("bad-city");
-    let cases: [(&str, String, &str); 5] = [
+    let cases: [(&str, String, &str); 7] = [
         (
             // Found by the 10-minute mutation run: it was refused without the file's name.
             "empty.city.json",
@@ -96,6 +96,16 @@ fn bad_city_input_is_refused_with_nothing_written() {
             "integers.city.json",
             r#"{"type":"CityJSON","version":"1.1","CityObjects":{},"vertices":[[0,0,0]]}"#.into(),
             "integers.city.json: no \"transform\", yet the vertices are integers",
+        ),
+        (
+            "semantics.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{"b":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,2]]],"semantics":{"surfaces":[{"type":"RoofSurface"}],"values":[3]}}]}},"vertices":[[0,0,0],[1,0,0],[0,1,0]]}"#.into(),
+            "semantics.city.json: CityObject 'b': geometry 0: surface 0: semantic value 3 points nowhere (1 semantic surfaces)",
+        ),
+        (
+            "ring.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{"b":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,0,1]]]}]}},"vertices":[[0,0,0],[1,0,0],[0,1,0]]}"#.into(),
+            "ring.city.json: CityObject 'b': geometry 0: surface 0, ring 0: has 2 distinct vertices; a ring needs at least 3",
         ),
         ("faces.obj", "v 0 0 0\nv 1 0 0\no shed\nf 1 2 9\n".into(), "faces.obj: 'shed' (line 4): vertex index 9 is missing (2 vertices read so far)"),
     ];
@@ -530,6 +540,14 @@ fn a_non_planar_city_roof_is_split_into_planar_parts_and_merged_back_into_one_ro
     let out = dir.join("out");
     let run = district(&city, &epw, &out, &["--tile", "100", "--context", "100", "--receivers", "RoofSurface"]);
     assert!(run.status.success(), "{}", stderr(&run));
+    // Exactly one cadastre, its CSV and its roofs (no tile writes one of its own).
+    let mut files: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    files.sort();
+    assert_eq!(files, ["cadastre-roofs.geojson", "cadastre.city.json", "cadastre.csv"]);
     let csv = std::fs::read_to_string(out.join("cadastre.csv")).unwrap();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.iter().map(|r| r[0]).collect::<Vec<_>>(), ["A/RoofSurface/1", "B/RoofSurface/1"], "{csv}");
