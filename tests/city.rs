@@ -75,7 +75,7 @@ fn obj_groups_are_names_globs_select() {
 #[test]
 fn bad_city_input_is_refused_with_nothing_written() {
     let dir = scratch("bad-city");
-    let cases: [(&str, String, &str); 5] = [
+    let cases: [(&str, String, &str); 7] = [
         (
             // Found by the 10-minute mutation run: it was refused without the file's name.
             "empty.city.json",
@@ -96,6 +96,16 @@ fn bad_city_input_is_refused_with_nothing_written() {
             "integers.city.json",
             r#"{"type":"CityJSON","version":"1.1","CityObjects":{},"vertices":[[0,0,0]]}"#.into(),
             "integers.city.json: no \"transform\", yet the vertices are integers",
+        ),
+        (
+            "semantics.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{"b":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,2]]],"semantics":{"surfaces":[{"type":"RoofSurface"}],"values":[3]}}]}},"vertices":[[0,0,0],[1,0,0],[0,1,0]]}"#.into(),
+            "semantics.city.json: CityObject 'b': geometry 0: surface 0: semantic value 3 points nowhere (1 semantic surfaces)",
+        ),
+        (
+            "ring.city.json",
+            r#"{"type":"CityJSON","version":"2.0","transform":{"scale":[1,1,1],"translate":[0,0,0]},"CityObjects":{"b":{"type":"Building","geometry":[{"type":"MultiSurface","lod":"2","boundaries":[[[0,1,0,1]]]}]}},"vertices":[[0,0,0],[1,0,0],[0,1,0]]}"#.into(),
+            "ring.city.json: CityObject 'b': geometry 0: surface 0, ring 0: has 2 distinct vertices; a ring needs at least 3",
         ),
         ("faces.obj", "v 0 0 0\nv 1 0 0\no shed\nf 1 2 9\n".into(), "faces.obj: 'shed' (line 4): vertex index 9 is missing (2 vertices read so far)"),
     ];
@@ -449,4 +459,181 @@ fn district_pv_merges_more_tiles_than_the_open_file_limit() {
     assert_eq!(header.len(), 1 + 4 * HOUSES, "a column a point (4 a roof): {header:?}");
     assert!(names.iter().all(|n| header.contains(&format!("{n}/RoofSurface/0/p3").as_str())), "{header:?}");
     assert_eq!(merged.lines().count(), 1 + 8760);
+}
+
+/// `--buildings` takes a `Building`'s id or a `BuildingPart`'s, in `district` as in `info`; an id
+/// that is neither is refused with the file, the id and the reason, and nothing is written. A
+/// tile once narrowed its receivers to its buildings' root ids, so a part's id gave an empty
+/// cadastre, and an unknown id was dropped without a word (an empty cadastre, exit 0).
+#[test]
+fn buildings_take_a_building_or_its_part_and_an_unknown_id_is_refused() {
+    let dir = scratch("district-buildings");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let rows = |out: &Path| -> Vec<String> {
+        let csv = std::fs::read_to_string(out.join("cadastre.csv")).unwrap();
+        csv.lines().skip(1).map(|l| l.split(',').next().unwrap().to_string()).collect()
+    };
+    for (id, n) in [("NL.B.house.part", 6), ("NL.B.house", 6), ("NL.B.courtyard,NL.B.house.part", 15)] {
+        let out = dir.join(id);
+        let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--buildings", id]);
+        assert!(run.status.success(), "{id}: {}", stderr(&run));
+        let names = rows(&out);
+        assert_eq!(names.len(), n, "{id}: {names:?}");
+        assert_eq!(names.iter().filter(|s| s.starts_with("NL.B.house.part/")).count(), 6, "{id}: {names:?}");
+    }
+    let why = "invalid --buildings: 'NL.B.nope' is no Building or BuildingPart with geometry in ";
+    let out = dir.join("unknown");
+    let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--buildings", "NL.B.house,NL.B.nope"]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert!(stderr(&run).contains(why) && stderr(&run).contains("block.city.json"), "{}", stderr(&run));
+    assert!(!out.exists(), "nothing written");
+    // The tree is a CityObject, not a building: it never receives, so it cannot be asked for.
+    for args in [["--buildings", "NL.B.house,NL.B.nope"], ["--buildings", "tree-1"]] {
+        let info = sunlit(&[&["info", BLOCK][..], &args].concat());
+        assert_eq!(info.status.code(), Some(1), "{args:?}: {}", String::from_utf8_lossy(&info.stdout));
+        assert!(
+            stderr(&info).contains("is no Building or BuildingPart with geometry in") && stderr(&info).contains("block.city.json"),
+            "{}",
+            stderr(&info)
+        );
+    }
+}
+
+/// A CityJSON roof whose ring is not planar (one corner 1 m up) is triangulated and split into
+/// planar receivers `NAME#1`, `NAME#2` at the scene's tolerance (0.5°, 1 mm); one 0.5 mm off its
+/// plane stays one. The cadastre has one row per city surface, its parts combined by area, and
+/// the values on that surface in the CityJSON, which `cjval` still passes.
+#[test]
+fn a_non_planar_city_roof_is_split_into_planar_parts_and_merged_back_into_one_row() {
+    let dir = scratch("district-non-planar");
+    let quad = |x: f64, z: [f64; 4]| [[x, 0.0, z[0]], [x + 10.0, 0.0, z[1]], [x + 10.0, 10.0, z[2]], [x, 10.0, z[3]]];
+    // Integers of 0.1 mm.
+    let mm = |p: [f64; 3]| p.map(|v| (v * 10_000.0).round() as i64);
+    let mut vertices = Vec::new();
+    let mut objects = serde_json::Map::new();
+    for (id, x, roof) in [("A", 0.0, [5.0, 5.0, 6.0, 5.0]), ("B", 20.0, [5.0, 5.0, 5.0005, 5.0])] {
+        let base = vertices.len();
+        vertices.extend(quad(x, [0.0; 4]).into_iter().chain(quad(x, roof)).map(mm));
+        let (g, r) = ([base + 3, base + 2, base + 1, base], [base + 4, base + 5, base + 6, base + 7]);
+        let wall = |a: usize, b: usize| [base + a, base + b, base + b + 4, base + a + 4];
+        let boundaries = serde_json::json!([[g], [r], [wall(0, 1)], [wall(1, 2)], [wall(2, 3)], [wall(3, 0)]]);
+        let semantics = serde_json::json!({"surfaces": [{"type": "GroundSurface"}, {"type": "RoofSurface"}, {"type": "WallSurface"}], "values": [0, 1, 2, 2, 2, 2]});
+        let geometry = serde_json::json!([{"type": "MultiSurface", "lod": "2.2", "boundaries": boundaries, "semantics": semantics}]);
+        objects.insert(id.into(), serde_json::json!({"type": "Building", "geometry": geometry}));
+    }
+    let doc = serde_json::json!({"type": "CityJSON", "version": "2.0", "transform": {"scale": [0.0001, 0.0001, 0.0001], "translate": [85000.0, 446000.0, 0.0]},
+        "metadata": {"referenceSystem": "https://www.opengis.net/def/crs/EPSG/0/7415"}, "CityObjects": objects, "vertices": vertices});
+    let city = dir.join("twisted.city.json");
+    std::fs::write(&city, doc.to_string()).unwrap();
+    assert_valid_cityjson(&city);
+    let v = info(&[city.to_str().unwrap(), "--receivers", "RoofSurface"]);
+    let parts: Vec<(String, f64)> =
+        v["receivers"].as_array().unwrap().iter().map(|r| (r["name"].as_str().unwrap().to_string(), r["area"].as_f64().unwrap())).collect();
+    let names: Vec<&str> = parts.iter().map(|p| p.0.as_str()).collect();
+    assert_eq!(names, ["A/RoofSurface/1#1", "A/RoofSurface/1#2", "B/RoofSurface/1"]);
+    let twisted: f64 = parts[..2].iter().map(|p| p.1).sum();
+    // Two triangles of a 10 m square with one corner 1 m up: 100.4975 or 100.4988 m² by the diagonal.
+    assert!((100.49..100.50).contains(&twisted), "{parts:?}");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let out = dir.join("out");
+    let run = district(&city, &epw, &out, &["--tile", "100", "--context", "100", "--receivers", "RoofSurface"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    // Exactly one cadastre, its CSV and its roofs (no tile writes one of its own).
+    let mut files: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    files.sort();
+    assert_eq!(files, ["cadastre-roofs.geojson", "cadastre.city.json", "cadastre.csv"]);
+    let csv = std::fs::read_to_string(out.join("cadastre.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.iter().map(|r| r[0]).collect::<Vec<_>>(), ["A/RoofSurface/1", "B/RoofSurface/1"], "{csv}");
+    assert!((rows[0][2].parse::<f64>().unwrap() - twisted).abs() < 1e-3, "the parts' areas summed: {csv}");
+    assert!(rows.iter().all(|r| r[6].parse::<f64>().unwrap() > 100.0), "both roofs get the sun: {csv}");
+    let cadastre = out.join("cadastre.city.json");
+    assert_valid_cityjson(&cadastre);
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
+    let geometry = &doc["CityObjects"]["A"]["geometry"][0]["semantics"];
+    let roof = &geometry["surfaces"][geometry["values"][1].as_u64().unwrap() as usize];
+    assert_eq!(roof["type"], "RoofSurface");
+    let total: f64 = rows[0][6].parse().unwrap();
+    assert!((roof["total_kwh_m2"].as_f64().unwrap() - total).abs() < 1e-3, "{roof} against the CSV's {total}");
+}
+
+/// Geometry nested a level deeper: a building as a `CompositeSolid` of two boxes (x 0–10 m, 6 m
+/// high; x 10–20 m, 9 m high) beside one as a `Solid`. Every roof and wall is a receiver named by
+/// its place among the geometry's surfaces (solids and shells flattened in file order), and the
+/// cadastre puts its values on the semantic surface that place points at, three levels down in a
+/// `CompositeSolid`'s `values`, which `cjval` passes. (`MultiSolid`, which the reader takes too,
+/// is no geometry a CityJSON 2.0 `Building` may have: `cjval` refuses it.)
+#[test]
+fn composite_solids_receive_and_get_their_values_back_in_place() {
+    let dir = scratch("district-solids");
+    let mut vertices: Vec<[i64; 3]> = Vec::new();
+    // A box's six faces (ground, roof, four walls), outward, and their semantic values.
+    let mut cube = |lo: [i64; 3], hi: [i64; 3]| {
+        let base = vertices.len();
+        for k in 0..8 {
+            vertices.push([
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            ]);
+        }
+        let f = |q: [usize; 4]| serde_json::json!([q.map(|i| base + i)]);
+        let faces = [f([0, 2, 3, 1]), f([4, 5, 7, 6]), f([0, 1, 5, 4]), f([1, 3, 7, 5]), f([3, 2, 6, 7]), f([2, 0, 4, 6])];
+        (serde_json::json!([faces]), serde_json::json!([[0, 1, 2, 2, 2, 2]]))
+    };
+    let (a, a_values) = cube([0, 0, 0], [10_000, 10_000, 6_000]);
+    let (b, b_values) = cube([10_000, 0, 0], [20_000, 10_000, 9_000]);
+    let (c, c_values) = cube([40_000, 0, 0], [50_000, 10_000, 12_000]);
+    let surfaces = serde_json::json!([{"type": "GroundSurface"}, {"type": "RoofSurface"}, {"type": "WallSurface"}]);
+    let solid = |kind: &str, boundaries: Vec<serde_json::Value>, values: Vec<serde_json::Value>| serde_json::json!({"type": "Building", "geometry": [{"type": kind, "lod": "2", "boundaries": boundaries, "semantics": {"surfaces": surfaces, "values": values}}]});
+    let doc = serde_json::json!({"type": "CityJSON", "version": "2.0", "transform": {"scale": [0.001, 0.001, 0.001], "translate": [85000.0, 446000.0, 0.0]},
+        "metadata": {"referenceSystem": "https://www.opengis.net/def/crs/EPSG/0/7415"},
+        "CityObjects": {"twin": solid("CompositeSolid", vec![a, b], vec![a_values, b_values]), "lone": solid("Solid", c.as_array().unwrap().clone(), c_values.as_array().unwrap().clone())},
+        "vertices": vertices});
+    let city = dir.join("solids.city.json");
+    std::fs::write(&city, doc.to_string()).unwrap();
+    assert_valid_cityjson(&city);
+    let mut names = receiver_names(&info(&[city.to_str().unwrap()]));
+    names.sort();
+    let mut expected: Vec<String> = ["twin", "lone"]
+        .iter()
+        .flat_map(|id| {
+            let solids = if *id == "twin" { 2 } else { 1 };
+            (0..solids).flat_map(move |s| {
+                (1..6).map(move |k| format!("{id}/{}/{}", if k == 1 { "RoofSurface" } else { "WallSurface" }, 6 * s + k))
+            })
+        })
+        .collect();
+    expected.sort();
+    assert_eq!(names, expected);
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let out = dir.join("out");
+    let run = district(&city, &epw, &out, &["--tile", "100", "--context", "100"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let rows = tile_rows(&out);
+    assert_eq!(rows.keys().cloned().collect::<std::collections::BTreeSet<_>>(), expected.iter().cloned().collect());
+    let cadastre = out.join("cadastre.city.json");
+    assert_valid_cityjson(&cadastre);
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&cadastre).unwrap()).unwrap();
+    for name in &expected {
+        let mut parts = name.split('/');
+        let (id, kind, index) = (parts.next().unwrap(), parts.next().unwrap(), parts.next().unwrap().parse::<usize>().unwrap());
+        let semantics = &doc["CityObjects"][id]["geometry"][0]["semantics"];
+        let value = if id == "twin" { &semantics["values"][index / 6][0][index % 6] } else { &semantics["values"][0][index] };
+        let value = value.as_u64().unwrap_or_else(|| panic!("{name}: {semantics}"));
+        let surface = &semantics["surfaces"][value as usize];
+        assert_eq!(surface["type"], kind, "{name}: {surface}");
+        let total = surface["total_kwh_m2"].as_f64().unwrap_or_else(|| panic!("{name}: {surface}"));
+        assert!((total - rows[name][4]).abs() < 1e-3, "{name}: {total} in the CityJSON, {} in its tile", rows[name][4]);
+    }
+    // The roofs differ in height and the walls in facing, so a value in the wrong place shows.
+    let totals: std::collections::BTreeSet<u64> = rows.values().map(|v| (v[4] * 1000.0) as u64).collect();
+    assert!(totals.len() > 6, "{rows:?}");
 }

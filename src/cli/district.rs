@@ -193,6 +193,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     let source = CitySource::parse(&name, &bytes)?;
     let plan = district::CityPlan::of_source(&name, &source, lod, args.north)?;
     let tiling = district::tiles_of(&plan, args.tile, args.context)?;
+    plan.check_buildings(&args.load().buildings)?;
     let tile_city = args.index.map(|k| district::read_tile_city(&name, &source, lod, &plan, &tiling, k)).transpose()?;
     drop(plan);
     let defining = args.defining(&city_path, &epw_path);

@@ -314,6 +314,7 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
         _ => Selection::new(&models, options)?,
     };
     let veils = Veils::new(options)?;
+    check_buildings(&models, &options.buildings)?;
     let mut builder = SceneBuilder::new();
     if let Some(origin) = options.origin {
         builder.set_origin(origin);
@@ -362,6 +363,33 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
         notes.push(note);
     }
     Ok((scene, notes))
+}
+
+/// The error for an id of the `buildings` parameter that names no building of `file`.
+pub fn unknown_building(id: &str, file: &str) -> Error {
+    Error::argument("buildings", format!("'{id}' is no Building or BuildingPart with geometry in {file} (at the level of detail read)"))
+}
+
+/// Refuses an id of `buildings` that no city surface of `models` has as its building or its
+/// CityObject, as a misspelt foliage pattern is refused: it would leave a building out unsaid.
+fn check_buildings(models: &[GltfModel], buildings: &[String]) -> Result<()> {
+    let known = |id: &str| {
+        models
+            .iter()
+            .flat_map(|m| &m.nodes)
+            .filter_map(|n| n.city.as_ref())
+            .any(|t| t.building.is_some() && (t.object == id || t.building.as_deref() == Some(id)))
+    };
+    match buildings.iter().find(|id| !known(id)) {
+        None => Ok(()),
+        Some(id) => {
+            let cities: Vec<&str> = models.iter().filter(|m| m.nodes.iter().any(|n| n.city.is_some())).map(|m| m.file.as_str()).collect();
+            Err(unknown_building(
+                id,
+                &if cities.is_empty() { "the models (no city model among them)".to_string() } else { cities.join(", ") },
+            ))
+        }
+    }
 }
 
 /// Whether a node may receive under the `buildings` option: a city surface of a building (or

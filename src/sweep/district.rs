@@ -238,6 +238,19 @@ impl CityPlan {
         }
     }
 
+    /// Refuses an id in `buildings` that is no `Building` or `BuildingPart` with geometry (at the
+    /// level of detail read), naming it and the file, before anything is counted or written: a
+    /// misspelt id would otherwise leave its building out of the cadastre without a word.
+    pub fn check_buildings(&self, buildings: &[String]) -> Result<()> {
+        // A building may hold no geometry of its own, only its parts': it is a key of
+        // `buildings` then, not of `objects`.
+        let known = |id: &str| self.buildings.contains_key(id) || self.objects.get(id).is_some_and(|(building, _)| building.is_some());
+        match buildings.iter().find(|id| !known(id)) {
+            Some(id) => Err(crate::model::unknown_building(id, &self.head.file)),
+            None => Ok(()),
+        }
+    }
+
     /// Whether tile `tile` of `tiling` is counted with CityObject `id`: one of its own buildings',
     /// or one whose box comes within the context ([`tile_city`]'s surfaces all lie in such
     /// objects).
@@ -390,10 +403,7 @@ pub fn count_tile_in_batches(
     let mut stages = TileStages::default();
     let tile = tile_of(tiling, k)?;
     let part = tile_city(city, tiling, tile);
-    let buildings: Vec<String> = match s.load.buildings.as_slice() {
-        [] => tile.buildings.clone(),
-        asked => tile.buildings.iter().filter(|b| asked.contains(b)).cloned().collect(),
-    };
+    let buildings = tile_buildings(&part, tile, &s.load.buildings);
     let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, casters: part.surfaces.len(), stages };
     if buildings.is_empty() {
         return Ok(empty);
@@ -416,6 +426,24 @@ pub fn count_tile_in_batches(
     };
     stages.points = now() - start;
     Ok(TileCount { rows, points, pv, casters: part.surfaces.len(), stages })
+}
+
+/// The ids a tile's scene narrows its receivers to: the tile's own buildings, or of those asked
+/// for (`asked`: ids of `Building`s or `BuildingPart`s) the ones whose building is the tile's. A
+/// part is matched by its own id, as [`crate::model::load_city`] matches it, not by its building's
+/// (which would give every part of that building, or none when only the part was asked for).
+fn tile_buildings(part: &City, tile: &Tile, asked: &[String]) -> Vec<String> {
+    if asked.is_empty() {
+        return tile.buildings.clone();
+    }
+    let own: HashSet<&str> = tile.buildings.iter().map(String::as_str).collect();
+    let ids: HashSet<&str> = part
+        .surfaces
+        .iter()
+        .filter_map(|s| s.building.as_deref().filter(|b| own.contains(b)).map(|b| [b, s.object.as_str()]))
+        .flatten()
+        .collect();
+    asked.iter().filter(|id| ids.contains(id.as_str())).cloned().collect()
 }
 
 /// The grid on the scene's roofs, each point's year counted directly (never interpolated: the
