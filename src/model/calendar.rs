@@ -110,13 +110,15 @@ impl DateRule {
     ///
     /// In a leap year EnergyPlus 25.2 places an nth (or last) weekday of a month after February
     /// as if the year had no Feb 29, one day after the weekday itself: "2nd Sunday in March" is
-    /// 9 March 2020 (a Monday), "Last Sunday in October" 26 October 2020 (its eio's
-    /// `Environment:Daylight Saving` and `Environment:Special Days` dates, and the schedule values
-    /// of tests/energyplus_schedules.rs). sunlit places them where EnergyPlus does.
+    /// 9 March 2020 (a Monday), "Last Sunday in October" 26 October 2020, while February's own
+    /// are right ("5th Saturday in February" 29 February 2020): its eio's `Environment:Daylight
+    /// Saving` and `Environment:Special Days` dates, and the schedule values of
+    /// tests/energyplus_schedules.rs. sunlit places them where EnergyPlus does.
     pub fn day(self, leap: bool, first_weekday: usize) -> Option<u32> {
-        if let (DateRule::Nth(..), true) = (self, leap) {
-            let plain = self.day(false, first_weekday)?;
-            return Some(if plain >= 60 { plain + 1 } else { plain });
+        if let (DateRule::Nth(_, _, month), true) = (self, leap)
+            && month > 2
+        {
+            return Some(self.day(false, first_weekday)? + 1);
         }
         let lengths = |m: usize| if m == 2 && !leap { 28 } else { MONTH_DAYS[m - 1] };
         let before = |m: usize| (1..m).map(lengths).sum::<u32>();

@@ -120,6 +120,7 @@ fn daylight_saving_dates_in_every_form() {
     // 2020 (1 January a Wednesday): EnergyPlus 25.2 puts an nth weekday after February a day late.
     let leap_day = |text: &str| DateRule::parse(text).unwrap().day(true, 3).unwrap();
     assert_eq!(leap_day("1st Tuesday in February"), 35, "4 February 2020, before Feb 29: as it is");
+    assert_eq!(leap_day("5th Saturday in February"), 60, "29 February 2020: February's own are right");
     assert_eq!(leap_day("2nd Sunday in March"), 69, "9 March 2020, EnergyPlus's date, not 8 March");
     assert_eq!(leap_day("Last Sunday in October"), 300, "26 October 2020, not 25 October");
     for bad in ["", "13/1", "2/30", "6th Sunday in March", "Sunday in March", "Funday 1"] {
