@@ -574,8 +574,8 @@ impl Compact {
             }
         }
         if upper.contains("ALLOTHERDAY") {
-            for t in 0..DAY_TYPES {
-                chosen[t] |= self.types[t].is_none();
+            for (on, given) in chosen.iter_mut().zip(&self.types) {
+                *on |= given.is_none();
             }
             valid = true;
         }
