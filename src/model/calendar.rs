@@ -107,7 +107,19 @@ impl DateRule {
     /// of 1 January; None for an nth weekday the month does not have that year (a 5th Monday
     /// in a month with four), on which EnergyPlus stops ("not enough Nths" in WeatherManager's
     /// `SetSpecialDayDates` and `SetDSTDateRanges`, a fatal error).
+    ///
+    /// In a leap year EnergyPlus 25.2 places an nth (or last) weekday of a month after February
+    /// as if the year had no Feb 29, one day after the weekday itself: "2nd Sunday in March" is
+    /// 9 March 2020 (a Monday), "Last Sunday in October" 26 October 2020, while February's own
+    /// are right ("5th Saturday in February" 29 February 2020): its eio's `Environment:Daylight
+    /// Saving` and `Environment:Special Days` dates, and the schedule values of
+    /// tests/energyplus_schedules.rs. sunlit places them where EnergyPlus does.
     pub fn day(self, leap: bool, first_weekday: usize) -> Option<u32> {
+        if let (DateRule::Nth(_, _, month), true) = (self, leap)
+            && month > 2
+        {
+            return Some(self.day(false, first_weekday)? + 1);
+        }
         let lengths = |m: usize| if m == 2 && !leap { 28 } else { MONTH_DAYS[m - 1] };
         let before = |m: usize| (1..m).map(lengths).sum::<u32>();
         match self {

@@ -20,7 +20,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use super::calendar::{DAY_TYPE_NAMES, DAY_TYPES, MONTH_DAYS, ModelCalendar, WeatherDays, month_day};
+use super::calendar::{DAY_TYPE_NAMES, DAY_TYPES, DateRule, MONTH_DAYS, ModelCalendar, WeatherDays, month_day};
 use super::idf::IdfObject;
 use crate::error::{Error, Result};
 
@@ -35,7 +35,7 @@ enum Interpolate {
     No,
     /// The mean over the timestep.
     Average,
-    /// The mean over the timestep of values ramped between `Until` times.
+    /// Values ramped minute by minute between `Until` times, taken at the timestep's end.
     Linear,
 }
 
@@ -64,18 +64,22 @@ impl Day {
         (0..24 * per_hour)
             .map(|ts| {
                 let minutes = &self.minutes[ts * step..(ts + 1) * step];
+                // EnergyPlus 25.2 takes a Linear ramp's value at the step's end, as for No (its
+                // reported `Schedule Value`, tests/energyplus_schedules.rs), not the step's mean.
                 match self.interpolate {
-                    Interpolate::No => minutes[step - 1],
-                    Interpolate::Average | Interpolate::Linear => minutes.iter().sum::<f64>() / step as f64,
+                    Interpolate::No | Interpolate::Linear => minutes[step - 1],
+                    Interpolate::Average => minutes.iter().sum::<f64>() / step as f64,
                 }
             })
             .collect()
     }
 
     /// Values that hold until given minutes of the day (each after the previous; the last 1440).
+    /// A Linear day ramps each period from the previous `Until` value to its own; the first
+    /// period has none before it and is flat, as in EnergyPlus.
     fn from_untils(untils: &[(usize, f64)], interpolate: Interpolate) -> Self {
         let mut minutes = Vec::with_capacity(DAY_MINUTES);
-        let mut previous = untils.last().map_or(0.0, |u| u.1);
+        let mut previous = untils.first().map_or(0.0, |u| u.1);
         for &(until, value) in untils {
             let start = minutes.len();
             let length = (until - start).max(1) as f64;
@@ -98,7 +102,50 @@ enum Source {
     /// per day type.
     Calendar { days: Vec<Day>, periods: Vec<(u32, [Option<usize>; DAY_TYPES])> },
     /// A column of a file, one value per item of `minutes` minutes from 1 January 00:00.
-    File { values: Vec<f64>, minutes: usize, interpolate: Interpolate },
+    File(FileColumn),
+}
+
+/// A `Schedule:File`'s column as EnergyPlus lays it over the year.
+#[derive(Debug, Clone, PartialEq)]
+struct FileColumn {
+    values: Vec<f64>,
+    minutes: usize,
+    interpolate: Interpolate,
+    /// Whether the file holds a leap year (8,784 hours of items): its days are then the
+    /// leap-numbered days of the year, Feb 29 skipped in a plain run; a plain file's Feb 29, in a
+    /// leap run, is its Feb 28 again (EnergyPlus's `ProcessScheduleInput`).
+    leap: bool,
+    /// `Adjust Schedule for Daylight Savings` (default Yes): No keeps the file in standard time.
+    daylight_saving: bool,
+}
+
+impl FileColumn {
+    /// The file's day (0-based) that holds the run's day `day` (0-based).
+    fn file_day(&self, day: usize, leap_run: bool) -> usize {
+        // Feb 29 is day 59 (0-based) of the leap numbering every schedule uses.
+        let leap_day = if leap_run || day < 59 { day } else { day + 1 };
+        match leap_day {
+            d if self.leap || d < 59 => d,
+            59 => 58,
+            d => d - 1,
+        }
+    }
+
+    /// The value of every timestep of a run of `days` days, `per_hour` timesteps an hour.
+    fn timestep_values(&self, days: usize, per_hour: usize, leap_run: bool) -> Vec<f64> {
+        let step = 60 / per_hour;
+        let per_day = 24 * per_hour;
+        (0..days * per_day)
+            .map(|ts| {
+                let first = self.file_day(ts / per_day, leap_run) * DAY_MINUTES + (ts % per_day) * step;
+                let item = |minute: usize| self.values.get(minute / self.minutes).copied().unwrap_or(0.0);
+                match self.interpolate {
+                    Interpolate::Average => (first..first + step).map(item).sum::<f64>() / step as f64,
+                    Interpolate::No | Interpolate::Linear => item(first + step - 1),
+                }
+            })
+            .collect()
+    }
 }
 
 /// A schedule as EnergyPlus would run it: see the module doc.
@@ -140,6 +187,9 @@ impl Schedule {
     /// ([`ModelCalendar::day_types`]).
     pub fn values(&self, calendar: RunCalendar<'_>) -> Result<Vec<f64>> {
         let standard = self.standard_values(calendar)?;
+        if matches!(&self.source, Source::File(f) if !f.daylight_saving) {
+            return Ok(standard);
+        }
         let saving = self.calendar.saving_days(calendar.leap, calendar.weather)?;
         let per_hour = calendar.per_hour as usize;
         let per_day = 24 * per_hour;
@@ -169,18 +219,7 @@ impl Schedule {
                 }
                 out
             }
-            Source::File { values, minutes, interpolate } => {
-                let step = 60 / n;
-                (0..days * 24 * n)
-                    .map(|ts| {
-                        let item = |minute: usize| values.get(minute / minutes).copied().unwrap_or(0.0);
-                        match interpolate {
-                            Interpolate::No => item((ts + 1) * step - 1),
-                            _ => (ts * step..(ts + 1) * step).map(item).sum::<f64>() / step as f64,
-                        }
-                    })
-                    .collect()
-            }
+            Source::File(column) => column.timestep_values(days, n, calendar.leap),
         })
     }
 
@@ -189,7 +228,7 @@ impl Schedule {
         match &self.source {
             Source::Constant(v) => vec![*v],
             Source::Calendar { days, .. } => days.iter().flat_map(|d| d.minutes.iter().copied()).collect(),
-            Source::File { values, .. } => values.clone(),
+            Source::File(column) => column.values.clone(),
         }
     }
 }
@@ -270,7 +309,8 @@ impl<'a> Schedules<'a> {
     }
 
     /// `ScheduleTypeLimits`: the named limits must exist, and every value lie within them (and be
-    /// whole for a Discrete type), as EnergyPlus checks.
+    /// whole for a Discrete or Integer type), as EnergyPlus checks. Like EnergyPlus, a limits
+    /// object with either bound blank limits nothing.
     fn check_limits(&self, object: &IdfObject, schedule: &Schedule) -> Result<()> {
         let name = object.field(1).trim();
         if name.is_empty() {
@@ -280,8 +320,12 @@ impl<'a> Schedules<'a> {
             return Err(self.bad(object, format!("field 'Schedule Type Limits Name': '{name}' names no ScheduleTypeLimits in the model")));
         };
         let bound = |i: usize| limits.field(i).trim().parse::<f64>().ok();
-        let (lower, upper) = (bound(1), bound(2));
-        let discrete = limits.field(3).trim().eq_ignore_ascii_case("Discrete");
+        let (lower, upper) = match (bound(1), bound(2)) {
+            (Some(l), Some(u)) => (Some(l), Some(u)),
+            _ => return Ok(()),
+        };
+        let numeric = limits.field(3).trim();
+        let discrete = numeric.eq_ignore_ascii_case("Discrete") || numeric.eq_ignore_ascii_case("Integer");
         for v in schedule.all_values() {
             let outside = lower.is_some_and(|l| v < l) || upper.is_some_and(|u| v > u);
             if outside || (discrete && v.fract() != 0.0) {
@@ -303,12 +347,14 @@ impl<'a> Schedules<'a> {
         let mut i = 2;
         while i < object.fields.len() {
             let field = object.field(i).trim();
-            let (key, rest) = field.split_once(':').map_or((field, ""), |(k, r)| (k.trim(), r.trim()));
+            let (key, rest) = keyword(field);
             let at = i + 1;
             let bad = |why: String| self.bad(object, format!("field {at} '{field}' {why}"));
-            match key.to_ascii_lowercase().as_str() {
+            match key.as_str() {
                 "" => {}
-                "through" => parser.through(month_day(rest).ok_or_else(|| bad("is not Through: MM/DD".into()))?).map_err(bad)?,
+                "through" => parser
+                    .through(through_day(rest).ok_or_else(|| bad("is not Through: a date (MM/DD, or a month name and a day)".into()))?)
+                    .map_err(bad)?,
                 "for" => parser.day_types(rest).map_err(bad)?,
                 "interpolate" => {
                     let how = Interpolate::parse(rest).ok_or_else(|| bad("is not Interpolate: No, Average or Linear".into()))?;
@@ -327,33 +373,56 @@ impl<'a> Schedules<'a> {
         parser.finish().map_err(|why| self.bad(object, why))
     }
 
-    /// `Schedule:Year`: week schedules over date ranges that cover the year.
+    /// `Schedule:Year`: week schedules over date ranges that cover the year, in any order; a range
+    /// may run over New Year, and Feb 29 left out takes Feb 28's week (as EnergyPlus does).
     fn year(&self, object: &IdfObject) -> Result<Source> {
         let mut days: Vec<Day> = Vec::new();
-        let mut periods = Vec::new();
-        let mut expected = 1;
+        // Per week schedule used: its name and its day index per day type.
+        let mut weeks: Vec<(String, [Option<usize>; DAY_TYPES])> = Vec::new();
+        // The week (index into `weeks`) of every leap-numbered day.
+        let mut week_of: Vec<Option<usize>> = vec![None; 366];
         for (k, group) in object.fields.get(2..).unwrap_or(&[]).chunks(5).enumerate() {
             let at = |j: usize| group.get(j).map_or("", |s| s.trim());
             let date = |m: usize| month_day(&format!("{}/{}", at(m), at(m + 1)));
             let (Some(first), Some(last)) = (date(1), date(3)) else {
                 return Err(self.bad(object, format!("week {}: its start and end dates are not months and days", k + 1)));
             };
-            if first != expected || last < first {
-                return Err(self.bad(object, format!("week {} ('{}') does not start the day after the previous one ends", k + 1, at(0))));
-            }
-            let Some(week) = self.find(&[WEEK], at(0)) else {
-                return Err(self.bad(object, format!("Schedule Week Name '{}' names no Schedule:Week:Daily in the model", at(0))));
+            let index = match weeks.iter().position(|w| w.0.eq_ignore_ascii_case(at(0))) {
+                Some(index) => index,
+                None => {
+                    let Some(week) = self.find(&[WEEK], at(0)) else {
+                        return Err(self.bad(object, format!("Schedule Week Name '{}' names no Schedule:Week:Daily in the model", at(0))));
+                    };
+                    let mut types = [None; DAY_TYPES];
+                    for (t, slot) in types.iter_mut().enumerate() {
+                        *slot = Some(days.len());
+                        days.push(self.day(week, week.field(t + 1), DAY_TYPE_NAMES[t])?);
+                    }
+                    weeks.push((at(0).to_string(), types));
+                    weeks.len() - 1
+                }
             };
-            let mut types = [None; DAY_TYPES];
-            for (t, slot) in types.iter_mut().enumerate() {
-                *slot = Some(days.len());
-                days.push(self.day(week, week.field(t + 1), DAY_TYPE_NAMES[t])?);
+            let range: Vec<u32> = if first <= last { (first..=last).collect() } else { (first..=366).chain(1..=last).collect() };
+            for day in range {
+                let slot = &mut week_of[day as usize - 1];
+                if slot.is_some() {
+                    return Err(self.bad(object, format!("week {} ('{}') covers {} again", k + 1, at(0), date_text(day))));
+                }
+                *slot = Some(index);
             }
-            periods.push((last, types));
-            expected = last + 1;
         }
-        if expected <= 366 {
-            return Err(self.bad(object, format!("its weeks end on {}, not on 12/31", date_text(expected - 1))));
+        if week_of[59].is_none() {
+            week_of[59] = week_of[58];
+        }
+        let mut periods: Vec<(u32, [Option<usize>; DAY_TYPES])> = Vec::new();
+        for (day, week) in (1..=366).zip(&week_of) {
+            let Some(week) = *week else {
+                return Err(self.bad(object, format!("its weeks leave {} without a week schedule", date_text(day))));
+            };
+            match periods.last_mut() {
+                Some((last, types)) if *types == weeks[week].1 => *last = day,
+                _ => periods.push((day, weeks[week].1)),
+            }
         }
         Ok(Source::Calendar { days, periods })
     }
@@ -392,6 +461,9 @@ impl<'a> Schedules<'a> {
             "" => 8760,
             _ => self.whole(object, 5, "Number of Hours of Data", 8760)?,
         };
+        if hours != 8760 && hours != 8784 {
+            return Err(self.bad(object, format!("field 'Number of Hours of Data': {hours} is neither 8760 nor 8784 (a leap year)")));
+        }
         let separator = match object.field(6).trim().to_ascii_lowercase().as_str() {
             "" | "comma" => ',',
             "tab" => '\t',
@@ -408,6 +480,7 @@ impl<'a> Schedules<'a> {
         if minutes == 0 || 60 % minutes != 0 {
             return Err(self.bad(object, format!("field 'Minutes per Item': {minutes} does not divide an hour")));
         }
+        let daylight_saving = !object.field(9).trim().eq_ignore_ascii_case("no");
         let path = match &self.dir {
             Some(dir) => dir.join(name),
             None => PathBuf::from(name),
@@ -415,13 +488,22 @@ impl<'a> Schedules<'a> {
         let text = std::fs::read_to_string(&path)
             .map_err(|e| self.bad(object, format!("field 'File Name': '{}' cannot be read ({e})", path.display())))?;
         let wanted = hours * 60 / minutes;
-        let mut values = Vec::with_capacity(wanted);
-        for (row, line) in text.lines().enumerate().skip(skip).take(wanted) {
+        // A file may hold a leap year whatever its Number of Hours says: EnergyPlus counts the
+        // rows it finds, so rows past the hours asked for are read while they hold numbers.
+        let leap_items = 8784 * 60 / minutes;
+        let mut values = Vec::with_capacity(leap_items);
+        for (row, line) in text.lines().enumerate().skip(skip).take(leap_items) {
             let cell = line.split(separator).map(str::trim).filter(|c| separator != ' ' || !c.is_empty()).nth(column - 1).unwrap_or("");
-            let value = cell.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                self.bad(object, format!("'{}' line {}: column {column} '{cell}' is not a number", path.display(), row + 1))
-            })?;
-            values.push(value);
+            match cell.parse::<f64>().ok().filter(|v| v.is_finite()) {
+                Some(value) => values.push(value),
+                None if values.len() >= wanted => break,
+                None => {
+                    return Err(self.bad(
+                        object,
+                        format!("field 'File Name': '{}' line {}: column {column} '{cell}' is not a number", path.display(), row + 1),
+                    ));
+                }
+            }
         }
         if values.len() < wanted {
             return Err(self.bad(
@@ -429,7 +511,8 @@ impl<'a> Schedules<'a> {
                 format!("field 'File Name': '{}' is too short: {} values after {skip} skipped rows, {wanted} needed ({hours} hours of {minutes}-minute items)", path.display(), values.len()),
             ));
         }
-        Ok(Source::File { values, minutes, interpolate })
+        let leap = values.len() == leap_items;
+        Ok(Source::File(FileColumn { values, minutes, interpolate, leap, daylight_saving }))
     }
 
     fn whole(&self, object: &IdfObject, i: usize, field: &str, min: usize) -> Result<usize> {
@@ -468,29 +551,36 @@ impl Compact {
         Ok(())
     }
 
+    /// A `For:` field's day types, found as EnergyPlus's `ProcessForDayTypes` finds them: by the
+    /// words its text contains (`Weekday` or `Weekdays`, `AllOtherDay`, `SummerDesignDay`, …);
+    /// a day type an earlier `For:` of the period already has is refused, as EnergyPlus does.
     fn day_types(&mut self, text: &str) -> std::result::Result<(), String> {
         self.close_day()?;
         if self.through.is_none() {
-            return Err("comes before any Through:".into());
+            return Err("comes before any For:".into());
         }
+        let upper = text.to_ascii_uppercase();
         let mut chosen = [false; DAY_TYPES];
-        for word in text.split_whitespace() {
-            let word = word.to_ascii_lowercase();
-            let pick: Vec<usize> = match word.as_str() {
-                "alldays" => (0..DAY_TYPES).collect(),
-                "weekdays" => (1..6).collect(),
-                "weekends" => vec![0, 6],
-                "holiday" | "holidays" => vec![7],
-                "alldesigndays" => vec![8, 9],
-                "allotherdays" => (0..DAY_TYPES).filter(|&t| self.types[t].is_none()).collect(),
-                _ => match DAY_TYPE_NAMES.iter().position(|n| n.eq_ignore_ascii_case(&word)) {
-                    Some(t) => vec![t],
-                    None => return Err(format!("'{word}' is not a day type")),
-                },
-            };
-            for t in pick {
-                chosen[t] = true;
+        let mut valid = false;
+        for (word, types) in FOR_WORDS {
+            if upper.contains(word) {
+                for &t in types {
+                    if chosen[t] || self.types[t].is_some() {
+                        return Err(format!("gives {} a second time in this Through:", DAY_TYPE_NAMES[t]));
+                    }
+                    chosen[t] = true;
+                }
+                valid = true;
             }
+        }
+        if upper.contains("ALLOTHERDAY") {
+            for (on, given) in chosen.iter_mut().zip(&self.types) {
+                *on |= given.is_none();
+            }
+            valid = true;
+        }
+        if !valid {
+            return Err(format!("'{text}' names no day type"));
         }
         self.open = Some((chosen, Vec::new()));
         self.interpolate = Interpolate::No;
@@ -512,7 +602,7 @@ impl Compact {
             let index = self.days.len();
             self.days.push(Day::from_untils(&untils, self.interpolate));
             for (t, on) in chosen.iter().enumerate() {
-                // A day type given twice in one period keeps its first For (EnergyPlus warns).
+                // `day_types` refused a day type given twice in one period.
                 if *on && self.types[t].is_none() {
                     self.types[t] = Some(index);
                 }
@@ -536,6 +626,46 @@ impl Compact {
             Some((last, _)) => Err(format!("field 'Through': its dates end on {}, not on 12/31", date_text(*last))),
             None => Err("field 'Through': there is none, so no date reaches 12/31".into()),
         }
+    }
+}
+
+/// The words a `For:` field's day types are found by, with the day types ([`DAY_TYPE_NAMES`]
+/// indices) each gives, in EnergyPlus's order; `AllOtherDays` is read after them.
+const FOR_WORDS: [(&str, &[usize]); 15] = [
+    ("WEEKDAY", &[1, 2, 3, 4, 5]),
+    ("MONDAY", &[1]),
+    ("TUESDAY", &[2]),
+    ("WEDNESDAY", &[3]),
+    ("THURSDAY", &[4]),
+    ("FRIDAY", &[5]),
+    ("WEEKEND", &[0, 6]),
+    ("SATURDAY", &[6]),
+    ("SUNDAY", &[0]),
+    ("CUSTOMDAY1", &[10]),
+    ("CUSTOMDAY2", &[11]),
+    ("ALLDAY", &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]),
+    ("HOLIDAY", &[7]),
+    ("SUMMER", &[8]),
+    ("WINTER", &[9]),
+];
+
+/// A `Schedule:Compact` field as its keyword (lower case: `through`, `for`, `interpolate`,
+/// `until`; empty for a blank field) and the text after it, the colon being optional as in
+/// EnergyPlus (`Through: 12/31` or `Through 12/31`).
+fn keyword(field: &str) -> (String, &str) {
+    let end = field.find(|c: char| !c.is_ascii_alphabetic()).unwrap_or(field.len());
+    let (key, rest) = field.split_at(end);
+    let rest = rest.trim_start();
+    (key.to_ascii_lowercase(), rest.strip_prefix(':').unwrap_or(rest).trim())
+}
+
+/// A `Through:` date as a leap-numbered day of the year: `12/31` or a month name and a day
+/// (`Dec 31`, `31 December`), as EnergyPlus's `ProcessDateString` reads it; an nth weekday of a
+/// month, which EnergyPlus refuses here, is not a date.
+fn through_day(text: &str) -> Option<u32> {
+    match DateRule::parse(text)? {
+        rule @ DateRule::Fixed(..) => rule.day(true, 0),
+        DateRule::Nth(..) => None,
     }
 }
 

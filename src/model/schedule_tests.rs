@@ -64,7 +64,7 @@ fn year_week_and_day_schedules() {
         "Schedule:Year, Y, , W1, 1, 1, 6, 30;\nSchedule:Week:Daily, W1, D,D,D,D,D,D,D,D,D,D,D,D;\nSchedule:Day:Hourly, D, , {hours};"
     );
     let e = schedule(&half, "Y").unwrap_err().to_string();
-    assert!(e.contains("Schedule:Year 'Y'") && e.contains("its weeks end on 06/30, not on 12/31"), "{e}");
+    assert!(e.contains("Schedule:Year 'Y'") && e.contains("its weeks leave 07/01 without a week schedule"), "{e}");
     let e = schedule(&half.replace(&hours, "0"), "Y").unwrap_err().to_string();
     assert!(e.contains("Schedule:Day:Hourly 'D'") && e.contains("field 'Hour 2': '' is not a number"), "{e}");
 }
@@ -117,6 +117,12 @@ fn daylight_saving_dates_in_every_form() {
     assert_eq!(day("April 1"), 91);
     assert_eq!(day("1 Apr"), 91);
     assert_eq!(DateRule::parse("3/1").unwrap().day(true, 0), Some(61), "a leap run counts Feb 29");
+    // 2020 (1 January a Wednesday): EnergyPlus 25.2 puts an nth weekday after February a day late.
+    let leap_day = |text: &str| DateRule::parse(text).unwrap().day(true, 3).unwrap();
+    assert_eq!(leap_day("1st Tuesday in February"), 35, "4 February 2020, before Feb 29: as it is");
+    assert_eq!(leap_day("5th Saturday in February"), 60, "29 February 2020: February's own are right");
+    assert_eq!(leap_day("2nd Sunday in March"), 69, "9 March 2020, EnergyPlus's date, not 8 March");
+    assert_eq!(leap_day("Last Sunday in October"), 300, "26 October 2020, not 25 October");
     for bad in ["", "13/1", "2/30", "6th Sunday in March", "Sunday in March", "Funday 1"] {
         assert_eq!(DateRule::parse(bad), None, "{bad}");
     }
@@ -137,4 +143,92 @@ fn daylight_saving_shifts_values_by_an_hour() {
     let bad = text.replace("4/1", "Easter");
     let err = schedule(&bad, "S").unwrap_err().to_string();
     assert!(err.contains("RunPeriodControl:DaylightSavingTime") && err.contains("field 'Start Date': 'Easter' is not a date"), "{err}");
+}
+
+/// `Schedule:Compact` as EnergyPlus reads it: `Through:` dates with month names, keywords
+/// without their colon, day types found by the words a `For:` contains; a day type given twice
+/// in one period, and an nth weekday as a `Through:` date, refused as EnergyPlus refuses them.
+#[test]
+fn compact_reads_every_through_for_and_until_form() {
+    let text = "Schedule:Compact, S, , Through: Mar 31, For: AllDays, Until: 24:00, 0.1,\n\
+                Through 15 July, For Weekday, Until 12:00, 0.3, Until 24:00, 0.6, For AllOtherDay, Until 24:00, 0.5,\n\
+                Through: December 31, For: Weekends Holidays, Until: 24:00, 0.9, For: AllOtherDays, Until: 24:00, 0.7;\n\
+                RunPeriod, R, 1, 1, 2017, 12, 31, 2017;";
+    let v = schedule(text, "S").unwrap().values(N4).unwrap();
+    assert_eq!((v[row(90, 12, 0)], v[row(91, 12, 0)]), (0.1, 0.5), "31 March, then Saturday 1 April 2017");
+    assert_eq!((v[row(93, 12, 0)], v[row(93, 12, 15)]), (0.3, 0.6), "Monday 3 April: Weekday");
+    assert_eq!((v[row(196, 12, 0)], v[row(197, 12, 0)]), (0.5, 0.9), "Saturday 15 July, then Sunday 16 July in the third period");
+    let twice = "Schedule:Compact, S, , Through: 12/31, For: Weekdays, Until: 24:00, 0.1, For: Monday, Until: 24:00, 0.2;";
+    let e = schedule(twice, "S").unwrap_err().to_string();
+    assert!(e.contains("field 7 'For: Monday' gives Monday a second time"), "{e}");
+    let nth = "Schedule:Compact, S, , Through: Last Sunday in December, For: AllDays, Until: 24:00, 0.1;";
+    let e = schedule(nth, "S").unwrap_err().to_string();
+    assert!(e.contains("field 3 'Through: Last Sunday in December' is not Through: a date"), "{e}");
+    let none = "Schedule:Compact, S, , Through: 12/31, For: Someday, Until: 24:00, 0.1;";
+    assert!(schedule(none, "S").unwrap_err().to_string().contains("'Someday' names no day type"));
+}
+
+/// `Interpolate: Linear` ramps from one `Until` value to the next and takes the value at each
+/// timestep's end (EnergyPlus 25.2's reported values); the first period is flat.
+#[test]
+fn linear_takes_the_ramp_at_the_steps_end_and_starts_flat() {
+    let text = "Schedule:Compact, S, , Through: 12/31, For: AllDays, Interpolate: Linear, Until: 06:00, 0.2, Until: 12:00, 0.8, Until: 24:00, 0.4;";
+    let v = schedule(text, "S").unwrap().values(N4).unwrap();
+    assert_eq!(v[row(1, 0, 15)], 0.2, "the first period does not ramp from the day's last value");
+    assert!((v[row(1, 6, 15)] - 0.225).abs() < 1e-12, "{}", v[row(1, 6, 15)]);
+    let text = "Schedule:Year, Y, , W, 1, 1, 12, 31;\nSchedule:Week:Daily, W, D,D,D,D,D,D,D,D,D,D,D,D;\n\
+                Schedule:Day:Interval, D, , Linear, 06:00, 0.2, 12:00, 0.8, 24:00, 0.4;";
+    let v = schedule(text, "Y").unwrap().values(N4).unwrap();
+    assert!((v[row(1, 6, 15)] - 0.225).abs() < 1e-12, "{}", v[row(1, 6, 15)]);
+}
+
+/// `Schedule:Year`'s weeks in any order, one running over New Year, Feb 29 taking Feb 28's week;
+/// a day covered twice or not at all refused naming the date.
+#[test]
+fn year_weeks_in_any_order_and_feb_29() {
+    let days = "Schedule:Week:Daily, A, DA,DA,DA,DA,DA,DA,DA,DA,DA,DA,DA,DA;\nSchedule:Week:Daily, B, DB,DB,DB,DB,DB,DB,DB,DB,DB,DB,DB,DB;\n\
+                Schedule:Day:Interval, DA, , No, 24:00, 0.25;\nSchedule:Day:Interval, DB, , No, 24:00, 0.75;\n";
+    let year = |weeks: &str| schedule(&format!("Schedule:Year, Y, , {weeks};\n{days}"), "Y");
+    let leap = RunCalendar { per_hour: 4, leap: true, weather: None };
+    let v = year("B, 11, 1, 2, 28, A, 3, 1, 10, 31").unwrap().values(leap).unwrap();
+    assert_eq!((v[row(59, 12, 0)], v[row(60, 12, 0)], v[row(61, 12, 0)]), (0.75, 0.75, 0.25), "Feb 28, 29 and Mar 1");
+    assert_eq!((v[row(305, 12, 0)], v[row(306, 12, 0)]), (0.25, 0.75), "31 October, 1 November (leap)");
+    let e = year("A, 1, 1, 6, 30, B, 6, 30, 12, 31").unwrap_err().to_string();
+    assert!(e.contains("week 2 ('B') covers 06/30 again"), "{e}");
+    let e = year("A, 1, 1, 6, 29, B, 7, 1, 12, 31").unwrap_err().to_string();
+    assert!(e.contains("its weeks leave 06/30 without a week schedule"), "{e}");
+}
+
+/// A leap (8,784-hour) `Schedule:File` skips its Feb 29 in a plain year; a plain file gives a
+/// leap year's Feb 29 its Feb 28; `Adjust Schedule for Daylight Savings` No keeps standard time.
+#[test]
+fn schedule_file_days_in_plain_and_leap_years_and_daylight_saving() {
+    let dir = std::env::temp_dir().join(format!("sunlit-schedule-leap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let day_numbers = |hours: usize| (0..hours).map(|h| format!("{}", (h / 24 + 1) as f64 / 1000.0)).collect::<Vec<_>>().join("\n");
+    std::fs::write(dir.join("leap.csv"), day_numbers(8784)).unwrap();
+    std::fs::write(dir.join("plain.csv"), day_numbers(8760)).unwrap();
+    let text = "Schedule:File, L, , leap.csv, 1, 0, 8784;\nSchedule:File, P, , plain.csv, 1, 0;\n\
+                Schedule:File, S, , plain.csv, 1, 0, 8760, Comma, No, 60, No;\nSchedule:File, H, , plain.csv, 1, 0, 9000;\n\
+                RunPeriodControl:DaylightSavingTime, 4/1, 10/31;";
+    let objects = parse_idf("m.idf", text).unwrap();
+    let schedules = Schedules::new("m.idf", &objects, Some(&dir));
+    let at = |name: &str, leap: bool, day: usize| {
+        let v = schedules.resolve(name, "x", "y").unwrap().values(RunCalendar { per_hour: 4, leap, weather: None }).unwrap();
+        v[row(day, 12, 0)]
+    };
+    assert_eq!((at("L", false, 59), at("L", false, 60)), (0.059, 0.061), "a plain year skips the file's Feb 29");
+    assert_eq!((at("L", true, 60), at("L", true, 366)), (0.060, 0.366));
+    assert_eq!((at("P", true, 59), at("P", true, 60), at("P", true, 61)), (0.059, 0.059, 0.060), "Feb 29 is Feb 28 again");
+    assert_eq!(at("P", false, 365), 0.365);
+    let hours =
+        |name: &str| schedules.resolve(name, "x", "y").unwrap().values(RunCalendar { per_hour: 1, leap: false, weather: None }).unwrap();
+    assert_eq!(
+        (hours("P")[100 * 24 + 23], hours("S")[100 * 24 + 23]),
+        (0.102, 0.101),
+        "11 April, the last hour: a day later in daylight time"
+    );
+    let e = schedules.resolve("H", "x", "y").unwrap_err().to_string();
+    assert!(e.contains("Schedule:File 'H'") && e.contains("field 'Number of Hours of Data': 9000 is neither 8760 nor 8784"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
