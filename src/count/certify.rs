@@ -16,7 +16,10 @@
 //!   Where no one caster does, the set's suns are halved (across their widest extent, up to
 //!   [`DARK_HALVINGS`] times) and each half proved so over its own cone: the cover may pass
 //!   from one caster to another between two suns of the set. The casters may be composites
-//!   ([`composite`]): coplanar panels that together form one convex polygon.
+//!   ([`composite`]): coplanar panels that together form one convex polygon. With those
+//!   many-caster proofs, a caster that comes nearer the receiver's plane than the margin (a
+//!   facade meeting it at an inner corner) takes part by its convex part twice the margin in
+//!   front ([`clipped_in_front`]), so its shadows are still cast the margin in front.
 //! - **Lit**: no triangle but the receiver's own lies in the volume its points sweep along the
 //!   cone's directions (`R + K`, convex, since the receiver's triangles and the cone are). A
 //!   triangle `T` misses it when it lies behind the receiver's plane (within the exact engine's
@@ -209,9 +212,10 @@ impl<'a> Certifier<'a> {
         Self { index, shapes, extent, many_casters: false }
     }
 
-    /// Lets the dark proof combine casters: composite casters ([`composite`]) and halves of a
-    /// cell each covered by its own caster. Exact either way; off by default because its cost on
-    /// a city and on blaas-louvres is not yet measured.
+    /// Lets the dark proof combine casters: composite casters ([`composite`]), halves of a
+    /// cell each covered by its own caster, and casters meeting the receiver's plane by their
+    /// part clear of it ([`clipped_in_front`]). Exact either way; off by default until a paired
+    /// timing shows it no dearer (docs/energyplus-fidelity.md, "Certificates").
     pub fn with_many_casters(mut self) -> Self {
         // Found once per index: a city's batches of receivers share them, as they share it.
         log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());
@@ -456,20 +460,29 @@ impl<'a> Certifier<'a> {
     /// and is not open towards it. None otherwise. Nothing here depends on the sun, so a cell's
     /// halves share it.
     ///
-    /// A composite must stand clear of the plane by the margin too, as an object must. One that
-    /// touches it (a facade meeting the receiver's wall at an inner corner) would put the
-    /// shadow's edge on the receiver's own edge with no margin: rays and the reference engine
-    /// find such a wall dark, but the margin is what covers the GPU's rounding (its depth test
-    /// along the corner is not shown to side with the facade), so no such proof is given.
+    /// A caster that comes nearer the plane than the margin (a facade meeting the receiver's
+    /// wall at an inner corner, a block built against it) is given no proof, except with the
+    /// many-caster proofs: then only its part at least twice the margin in front is kept
+    /// ([`clipped_in_front`]), itself convex, so every shadow it proves is cast at least the
+    /// margin in front of the plane, as a caster standing clear casts it. A receiver reaching
+    /// into the corner is still not proved: its edge there lies in the clipped-off band, outside
+    /// the kept part's shadow.
     fn ready(&self, shape: &Shape, caster: Caster) -> Option<Vec<DVec3>> {
         let margin = COVER_MARGIN * (1.0 + self.extent);
         let corners: Vec<DVec3> = match caster {
             Caster::Object(o) => self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect(),
             Caster::Composite(c) => self.composites().corners(c).iter().map(|&p| p - shape.p0).collect(),
         };
-        if corners.len() < 3 || !corners.iter().all(|c| c.dot(shape.normal) > margin) {
+        if corners.len() < 3 {
             return None;
         }
+        let corners = if corners.iter().all(|c| c.dot(shape.normal) > margin) {
+            corners
+        } else if self.many_casters {
+            clipped_in_front(&corners, shape.normal, 2.0 * margin)?
+        } else {
+            return None;
+        };
         let open_to_receiver = match caster {
             Caster::Object(o) => self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin),
             Caster::Composite(_) => false,
@@ -507,6 +520,35 @@ impl<'a> Certifier<'a> {
                 })
         })
     }
+}
+
+/// Pairs of corners a clipped caster may be made from, at most: a panelled block meeting the
+/// receiver's plane would otherwise cost more than the views it saves.
+const MAX_CLIPPED_PAIRS: usize = 4_096;
+
+/// The corners of the part of the convex hull of `corners` (relative to a point of the plane
+/// with normal `normal`) at least `height` in front of that plane: the corners that high, and
+/// where the segment between a corner below and a corner above crosses the height. Every point
+/// of the part is a convex combination of these (a vertex of a convex polytope cut by a plane
+/// is a corner or lies on an edge, and every edge is such a segment), and every one of these
+/// lies in the hull, so their hull is the part, exactly. None where fewer than three remain, or
+/// more than [`MAX_CLIPPED_PAIRS`] pairs would be crossed.
+fn clipped_in_front(corners: &[DVec3], normal: DVec3, height: f64) -> Option<Vec<DVec3>> {
+    let (above, below): (Vec<DVec3>, Vec<DVec3>) = corners.iter().partition(|c| c.dot(normal) >= height);
+    if above.is_empty() || above.len() * below.len() > MAX_CLIPPED_PAIRS {
+        return None;
+    }
+    let mut out = above.clone();
+    for b in &below {
+        let hb = b.dot(normal);
+        for a in &above {
+            let ha = a.dot(normal);
+            // Rounding leaves the crossing within a hair of `height`, which is twice the margin
+            // the proof needs: at least the margin in front either way.
+            out.push(*b + (*a - *b) * ((height - hb) / (ha - hb)));
+        }
+    }
+    (out.len() >= 3).then_some(out)
 }
 
 #[cfg(test)]

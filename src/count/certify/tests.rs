@@ -556,3 +556,61 @@ fn the_cover_passes_from_a_near_block_to_a_far_one_within_a_cell() {
         "no sun passes between the blocks: the variant shows nothing"
     );
 }
+
+/// The wall of [`a_facade_proves_a_wall_clear_of_it_dark_but_not_one_it_touches`] 1 m east of
+/// the inner corner where the facade meets its plane (the facade reaching y = −15, the wall from
+/// x = 16), through the summer afternoons when the facade shades it. The facade comes nearer the
+/// wall's plane than the margin, so without the many-caster proofs nothing is proved; with them
+/// its part twice the margin in front (clipped, [`clipped_in_front`]) covers the wall: proved
+/// dark, and at every sun the reference engine and rays from a grid of the wall's points find it
+/// dark. (That a facade with a hole proves nothing is
+/// [`a_facade_proves_a_wall_clear_of_it_dark_but_not_one_it_touches`]'s: a facade with a hole
+/// is no composite, clipped or not.)
+#[test]
+fn a_facade_meeting_the_walls_plane_at_an_inner_corner_proves_the_wall_beside_it_dark() {
+    let corner_suns = suns(160..174, (15.0, 16.0), -DVec3::Y);
+    assert!(corner_suns.len() > 40);
+    let both = Wanted { dark: true, lit: true };
+    let apart = wall_and_facade(16.0, None, 12.0);
+    assert_eq!(Certifier::new(&apart).certify(0, &corner_suns, both), None);
+    let certifier = Certifier::new(&apart).with_many_casters();
+    assert_eq!(certifier.certify(0, &corner_suns, both), Some(Certificate::Dark));
+    let requests: Vec<ViewRequest> = corner_suns.iter().map(|s| ViewRequest::new(0, *s)).collect();
+    for (f, s) in ExactEngine::new(&apart).fractions(&requests).into_iter().zip(&corner_suns) {
+        assert!(f < 1e-9, "proved dark at {s}: the exact engine says {f}");
+        let reference = crate::count::exact::sunlit_fraction(&apart, ViewRequest::new(0, *s));
+        assert!(reference == 0.0, "proved dark at {s}: the reference engine says {reference}");
+        assert_eq!(lit_grid_points(&apart, 0, *s), 0, "proved dark at {s}: a ray escapes");
+    }
+}
+
+/// A box crossing the plane z = 1 (normal +z), tilted or not: the clipped corners lie in the box
+/// and at least the height in front, and span exactly the box's part above it (their bounds are
+/// the part's bounds); a box wholly below gives none, and one with too many pairs none.
+#[test]
+fn a_caster_clipped_in_front_is_its_part_above_the_height() {
+    let corners = |lo: DVec3, hi: DVec3| -> Vec<DVec3> {
+        (0..8).map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2])).collect()
+    };
+    let (lo, hi) = (DVec3::new(-1.0, 2.0, -3.0), DVec3::new(4.0, 5.0, 6.0));
+    let part = clipped_in_front(&corners(lo, hi), DVec3::Z, 1.0).unwrap();
+    let (plo, phi) = part.iter().fold((DVec3::MAX, DVec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
+    assert!((plo - DVec3::new(-1.0, 2.0, 1.0)).abs().max_element() < 1e-12, "{plo}");
+    assert!((phi - hi).abs().max_element() < 1e-12, "{phi}");
+    // Tilted: a box turned about x and y, cut at height 1; every clipped corner lies on or above
+    // the height and inside the turned box, and the highest and lowest reach what the box does.
+    let turn = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -0.5, 0.2);
+    let box_corners: Vec<DVec3> = corners(lo, hi).into_iter().map(|c| turn * c).collect();
+    let part = clipped_in_front(&box_corners, DVec3::Z, 1.0).unwrap();
+    for p in &part {
+        assert!(p.z >= 1.0 - 1e-12, "{p} below the height");
+        let local = turn.inverse() * *p;
+        assert!(local.cmpge(lo - 1e-9).all() && local.cmple(hi + 1e-9).all(), "{p} outside the box");
+    }
+    let top = box_corners.iter().map(|c| c.z).fold(f64::MIN, f64::max);
+    assert!((part.iter().map(|p| p.z).fold(f64::MIN, f64::max) - top).abs() < 1e-12);
+    assert!((part.iter().map(|p| p.z).fold(f64::MAX, f64::min) - 1.0).abs() < 1e-12);
+    assert!(clipped_in_front(&corners(lo, DVec3::new(4.0, 5.0, 0.5)), DVec3::Z, 1.0).is_none());
+    let many: Vec<DVec3> = (0..200).map(|i| DVec3::new(f64::from(i), 0.0, f64::from(i % 2) * 4.0 - 1.0)).collect();
+    assert!(clipped_in_front(&many, DVec3::Z, 1.0).is_none());
+}
