@@ -500,6 +500,33 @@ fn buildings_take_a_building_or_its_part_and_an_unknown_id_is_refused() {
     }
 }
 
+/// `district --receivers` that no surface of the city matches is refused as `annual` and `info`
+/// refuse it, before anything is written (it once wrote an empty cadastre with exit 0); so are
+/// patterns that match only surfaces outside the buildings asked for. A pattern matching a
+/// semantic type still runs.
+#[test]
+fn receivers_no_city_surface_matches_are_refused_before_anything_is_written() {
+    let dir = scratch("district-receivers");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let tiles = ["--tile", "50", "--context", "50"];
+    for (extra, why) in [
+        (&["--receivers", "NoSuchSurface*"][..], "no node name matches --receivers NoSuchSurface*"),
+        (&["--receivers", "NL.B.courtyard/*", "--buildings", "NL.B.house"][..], "no node name matches --receivers NL.B.courtyard/*"),
+    ] {
+        let out = dir.join("none");
+        let run = district(Path::new(BLOCK), &epw, &out, &[&tiles[..], extra].concat());
+        assert_eq!(run.status.code(), Some(1), "{extra:?}: {}", stderr(&run));
+        assert!(stderr(&run).contains(why), "{extra:?}: {}", stderr(&run));
+        assert!(!out.exists(), "{extra:?}: nothing written");
+    }
+    let out = dir.join("roofs");
+    let run = district(Path::new(BLOCK), &epw, &out, &[&tiles[..], &["--receivers", "roofsurface"]].concat());
+    assert!(run.status.success(), "{}", stderr(&run));
+    let csv = std::fs::read_to_string(out.join("cadastre.csv")).unwrap();
+    assert!(csv.lines().skip(1).count() > 0 && csv.lines().skip(1).all(|l| l.contains("/RoofSurface/")), "{csv}");
+}
+
 /// A CityJSON roof whose ring is not planar (one corner 1 m up) is triangulated and split into
 /// planar receivers `NAME#1`, `NAME#2` at the scene's tolerance (0.5°, 1 mm); one 0.5 mm off its
 /// plane stays one. The cadastre has one row per city surface, its parts combined by area, and

@@ -191,9 +191,12 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
     // The file is parsed once (a CityJSONSeq's feature lines as each pass reads them): the plan
     // pass holds no surfaces, a tile then builds only its part, the merge only what it writes.
     let source = CitySource::parse(&name, &bytes)?;
-    let plan = district::CityPlan::of_source(&name, &source, lod, args.north)?;
+    let load = args.load();
+    let mut receivers = model::CityReceivers::new(&load)?;
+    let plan = district::CityPlan::of_source_seeing(&name, &source, lod, args.north, &mut |s| receivers.see(s))?;
     let tiling = district::tiles_of(&plan, args.tile, args.context)?;
-    plan.check_buildings(&args.load().buildings)?;
+    plan.check_buildings(&load.buildings)?;
+    receivers.check()?;
     let tile_city = args.index.map(|k| district::read_tile_city(&name, &source, lod, &plan, &tiling, k)).transpose()?;
     drop(plan);
     let defining = args.defining(&city_path, &epw_path);

@@ -397,10 +397,62 @@ fn check_buildings(models: &[GltfModel], buildings: &[String]) -> Result<()> {
 fn in_buildings(node: &GltfNode, buildings: &[String]) -> bool {
     match &node.city {
         None => true,
-        Some(tags) => match &tags.building {
-            None => false,
-            Some(b) => buildings.is_empty() || buildings.iter().any(|id| id == b || *id == tags.object),
-        },
+        Some(tags) => in_buildings_of(tags.building.as_deref(), &tags.object, buildings),
+    }
+}
+
+/// [`in_buildings`] for a city surface of `object`, whose building is `building`.
+fn in_buildings_of(building: Option<&str>, object: &str, buildings: &[String]) -> bool {
+    match building {
+        None => false,
+        Some(b) => buildings.is_empty() || buildings.iter().any(|id| id == b || id == object),
+    }
+}
+
+/// A city's receivers under the receiver rule of some load options, seen a surface at a time by
+/// a reader that never holds the whole city (a district's first pass), so that a rule no surface
+/// of the file meets is refused before anything is counted or written, as a whole load refuses
+/// it. It follows the load's rule (the `receivers` patterns over a surface's name or semantic
+/// type, else the roofs and walls, else every surface; only the `buildings` asked for) but not
+/// its see-through surfaces, so it refuses only a city where nothing can receive at all.
+pub struct CityReceivers {
+    rule: Option<Selection>,
+    buildings: Vec<String>,
+    /// Surfaces the patterns match, or without them the roofs and walls.
+    marked: usize,
+    /// Without patterns, every surface of the buildings asked for.
+    named: usize,
+}
+
+impl CityReceivers {
+    /// The rule of `options` (its `receivers` patterns, else the default), nothing seen yet.
+    pub fn new(options: &LoadOptions) -> Result<Self> {
+        let rule = if options.receivers.is_empty() { None } else { Some(Selection::globs(&options.receivers)?) };
+        Ok(Self { rule, buildings: options.buildings.clone(), marked: 0, named: 0 })
+    }
+
+    /// Counts surface `s` if the rule would let it receive.
+    pub fn see(&mut self, s: &cityjson::CitySurface) {
+        if !in_buildings_of(s.building.as_deref(), &s.object, &self.buildings) {
+            return;
+        }
+        match &self.rule {
+            Some(Selection::Globs(set, _)) => {
+                self.marked += (set.is_match(&s.name) || s.kind.as_deref().is_some_and(|k| set.is_match(k))) as usize;
+            }
+            _ => {
+                self.named += 1;
+                self.marked += cityjson::default_receiver(s) as usize;
+            }
+        }
+    }
+
+    /// The load's own error where no surface seen can receive.
+    pub fn check(&self) -> Result<()> {
+        if self.marked + self.named > 0 {
+            return Ok(());
+        }
+        Err(Error::NoReceivers(self.rule.as_ref().unwrap_or(&Selection::Named).explain()))
     }
 }
 
@@ -492,19 +544,24 @@ enum Selection {
 impl Selection {
     fn new(models: &[GltfModel], options: &LoadOptions) -> Result<Self> {
         if !options.receivers.is_empty() {
-            let mut set = globset::GlobSetBuilder::new();
-            for pattern in &options.receivers {
-                let glob = globset::GlobBuilder::new(pattern)
-                    .case_insensitive(true)
-                    .build()
-                    .map_err(|e| Error::argument("receivers", format!("'{pattern}': {e}")))?;
-                set.add(glob);
-            }
-            let set = set.build().map_err(|e| Error::argument("receivers", e.to_string()))?;
-            return Ok(Selection::Globs(set, options.receivers.clone()));
+            return Self::globs(&options.receivers);
         }
         let any_marked = models.iter().any(|m| m.nodes.iter().any(|n| n.marked));
         Ok(if any_marked { Selection::Marked } else { Selection::Named })
+    }
+
+    /// The rule of the `receivers` patterns (case-insensitive globs over names and types).
+    fn globs(patterns: &[String]) -> Result<Self> {
+        let mut set = globset::GlobSetBuilder::new();
+        for pattern in patterns {
+            let glob = globset::GlobBuilder::new(pattern)
+                .case_insensitive(true)
+                .build()
+                .map_err(|e| Error::argument("receivers", format!("'{pattern}': {e}")))?;
+            set.add(glob);
+        }
+        let set = set.build().map_err(|e| Error::argument("receivers", e.to_string()))?;
+        Ok(Selection::Globs(set, patterns.to_vec()))
     }
 
     fn is_receiver(&self, node: &GltfNode) -> bool {

@@ -202,11 +202,26 @@ impl CityPlan {
     /// [`Self::read`] of a file already parsed (which later passes read again without parsing a
     /// document twice).
     pub fn of_source(file: &str, source: &CitySource, lod: Option<&str>, north: f64) -> Result<Self> {
+        Self::of_source_seeing(file, source, lod, north, &mut |_| {})
+    }
+
+    /// [`Self::of_source`], showing `see` each surface as it passes (the one pass over the file
+    /// that sees every surface, so checks of the whole city ride on it).
+    pub fn of_source_seeing(
+        file: &str,
+        source: &CitySource,
+        lod: Option<&str>,
+        north: f64,
+        see: &mut dyn FnMut(&CitySurface),
+    ) -> Result<Self> {
         let mut plan = Self::empty(
             City { file: file.to_string(), version: String::new(), reference_system: None, offset: DVec3::ZERO, surfaces: Vec::new() },
             north,
         );
-        let head = crate::model::cityjson::read_city_from(file, source, lod, None, &mut |s| plan.add(s))?;
+        let head = crate::model::cityjson::read_city_from(file, source, lod, None, &mut |s| {
+            see(&s);
+            plan.add(s)
+        })?;
         plan.head = head;
         Ok(plan)
     }
