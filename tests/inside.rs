@@ -7,7 +7,6 @@ mod common;
 use common::Scratch;
 use common::inside::{golden_epw, numpy_reference};
 
-use std::path::Path;
 use std::process::Command;
 
 use glam::DVec3;
