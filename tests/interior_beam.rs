@@ -195,7 +195,8 @@ fn l_shaped_zone_beam_per_face_agrees_with_numpy_rays() {
 
 /// The hooked L runs to completion in EnergyPlus 25.2 (which reports CHKBKS as severe errors for
 /// its own distribution in this zone, in both runs, and carries on), and the balance takes back
-/// exactly the beam the faces got.
+/// at least the beam the faces got (all the beam its windows let in: what lands on the back of
+/// another of its windows too).
 #[test]
 fn l_shaped_zone_hooked_run_completes() {
     let dir = Scratch::new("interior-beam", "l-shaped");
@@ -213,7 +214,8 @@ fn l_shaped_zone_hooked_run_completes() {
     let text = std::fs::read_to_string(&hooked).unwrap();
     assert_eq!(text.matches("SurfaceProperty:SolarIncidentInside,").count(), 9, "8 faces and the balance");
 
-    // The balance column is minus the faces' beam (W) over the window's area, row by row.
+    // The balance column is minus the beam the windows let in (W) over the window's area, row by
+    // row: never less than what the faces got.
     let beam_csv = std::fs::read_to_string(dir.join("l.interior-beam.csv")).unwrap();
     let header: Vec<&str> = beam_csv.lines().next().unwrap().split(',').collect();
     assert_eq!(header.last(), Some(&"WinS"));
@@ -229,7 +231,7 @@ fn l_shaped_zone_hooked_run_completes() {
         let faces: f64 = header[1..header.len() - 1].iter().zip(&v).map(|(n, w)| w * area(n)).sum();
         let balance = v[v.len() - 1] * polygon_area(&ep.building.surface("WinS").unwrap().vertices);
         // The CSV rounds to 1 mW/m²: about 0.1 W over the faces' 200 m².
-        assert!((faces + balance).abs() <= 0.2 + 1e-3 * faces, "{line}");
+        assert!(-balance >= faces - 0.2 - 1e-3 * faces, "{line}");
         lit_rows += usize::from(faces > 0.0);
     }
     assert!(lit_rows > 40, "{lit_rows} rows with beam");
@@ -338,7 +340,13 @@ fn interior_beam_refusals_name_the_flag_and_write_nothing() {
 /// (before EnergyPlus's interpolation was followed) the walls' sums were off by 4–9 % and single
 /// timesteps by up to 11 W/m². The two walls holding the `Window:Interzone` pair are held too:
 /// before that class was read (30 Nov 2026) sunlit's walls had no hole where the pane is, and
-/// these two were left out by name, 3–4 % above EnergyPlus a year.
+/// these two were left out by name, 3–4 % above EnergyPlus a year. Each zone's balance (minus the
+/// beam its exterior windows let in) is EnergyPlus's own `Enclosure Exterior Windows Total
+/// Transmitted Beam Solar Radiation Rate` at every timestep within 1 W + 1 %, and what it takes
+/// beyond the faces' beam is the beam EnergyPlus lands on the backs of the zone's windows (its
+/// incident beam on them, exterior windows and the interzone pane) within 2 % over the fortnight:
+/// before 30 Nov 2026 (session 13) the balance took back the faces' beam only, and the beam on the
+/// windows' backs stayed in the zone as diffuse, 0.078 points of site energy a year.
 #[test]
 fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
     let dir = Scratch::new("interior-beam", "four-zone");
@@ -360,7 +368,8 @@ fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
         idf = idf.replacen(old, new, 1);
     }
     idf += "ShadowCalculation,PolygonClipping,Timestep,1,15000,SutherlandHodgman,512,SimpleSkyDiffuseModeling,Yes;\n\
-            Output:Variable,*,Surface Inside Face Exterior Windows Incident Beam Solar Radiation Rate per Area,Timestep;\n";
+            Output:Variable,*,Surface Inside Face Exterior Windows Incident Beam Solar Radiation Rate per Area,Timestep;\n\
+            Output:Variable,*,Enclosure Exterior Windows Total Transmitted Beam Solar Radiation Rate,Timestep;\n";
     let (model, run) = (dir.join("four-zone.idf"), dir.join("four-zone-own"));
     std::fs::write(&model, &idf).unwrap();
     let epw = common::energyplus::energyplus().parent().unwrap().join("WeatherData/USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw");
@@ -406,6 +415,45 @@ fn four_zone_interior_beam_matches_energyplus_per_face_and_timestep() {
     let walls =
         beam.faces.iter().filter(|f| f.surface.eq_ignore_ascii_case("Zn003:Wall004") || f.surface.eq_ignore_ascii_case("Zn004:Wall004"));
     assert_eq!(walls.count(), 2, "the interzone pair's walls are compared");
+
+    // Each zone's balance: the beam its exterior windows let in, and beyond its faces' the beam on
+    // its windows' backs.
+    let incident = |surface: &str| {
+        let key = format!(
+            "{}:SURFACE INSIDE FACE EXTERIOR WINDOWS INCIDENT BEAM SOLAR RADIATION RATE PER AREA [W/M2](TIMESTEP)",
+            surface.to_uppercase()
+        );
+        theirs.get(&key).map_or(0.0, |v| v.iter().sum::<f64>()) * polygon_area(&ep.building.surface(surface).unwrap().vertices)
+    };
+    let mut beyond_faces = 0.0;
+    for b in &beam.balances {
+        let area = polygon_area(&ep.building.surface(&b.window).unwrap().vertices);
+        let key = format!("{}:ENCLOSURE EXTERIOR WINDOWS TOTAL TRANSMITTED BEAM SOLAR RADIATION RATE [W](TIMESTEP)", b.zone.to_uppercase());
+        let reported = &theirs[&key];
+        let ours: Vec<f64> = b.watts_m2[rows.clone()].iter().map(|w| -w * area).collect();
+        for (k, (s, e)) in ours.iter().zip(reported).enumerate() {
+            assert!((s - e).abs() <= 1.0 + 0.01 * e, "{} at step {k}: sunlit lets in {s} W, EnergyPlus {e} W", b.zone);
+        }
+        let faces: f64 =
+            beam.faces.iter().filter(|f| f.zone == b.zone).map(|f| f.watts_m2[rows.clone()].iter().sum::<f64>() * f.area).sum();
+        let windows: f64 = ep
+            .building
+            .surfaces
+            .iter()
+            .filter(|w| ["Window", "GlassDoor"].iter().any(|k| w.kind.eq_ignore_ascii_case(k)))
+            .filter(|w| w.zone.as_deref().is_some_and(|z| z.eq_ignore_ascii_case(&b.zone)))
+            .map(|w| incident(&w.name))
+            .sum();
+        let taken = ours.iter().sum::<f64>() - faces;
+        eprintln!(
+            "{}: lets in {:.0}, faces {faces:.0}, beyond them {taken:.0}, EnergyPlus's on the windows' backs {windows:.0} (Σ W)",
+            b.zone,
+            ours.iter().sum::<f64>()
+        );
+        assert!((taken - windows).abs() <= 0.02 * windows + 50.0, "{}: {taken} beyond the faces against {windows} on the windows", b.zone);
+        beyond_faces += windows;
+    }
+    assert!(beyond_faces > 1000.0, "the beam lands on windows' backs over the fortnight ({beyond_faces} Σ W)");
 }
 
 /// The solar transmittance `--glass-curve`'s pairs give at incidence `cos` (the curve's rule,

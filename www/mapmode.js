@@ -3,8 +3,8 @@
 // a day/time slider that maps the instant as it moves; the points CSV and the map glb to
 // download (the library's own writers, as `sunlit map` writes them), written by the worker only
 // when a download is clicked: a slider's move asks for nothing the view does not draw.
-import { areaSummary, insideOptions, insideStudy, patchSummary, wireInside } from './insidemode.js';
-import { MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
+import { areaSummary, drawnPatches, insideOptions, insideStudy, patchSummary, wireInside } from './insidemode.js';
+import { LIT, MAP_VALUES, mapCells, mapColours, mapRange } from './map.js';
 
 const MONTH_DAYS = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
 
@@ -53,7 +53,7 @@ export function mapMode(page) {
     const o = { ...(await page.location()), grid: Number($('mapgrid').value) };
     if (page.skyModel()) o.skyModel = page.skyModel();
     if (insideStudy($)) return { ...o, ...insideOptions($) };
-    if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit', ...insideOptions($) };
+    if (instant()) return { ...o, at: `${monthDay(Number($('mapday').value))} ${clock(Number($('maptime').value))}`, value: 'lit', ...insideOptions($, true) };
     Object.assign(o, { value: $('mapvalue').value, ...insideOptions($) });
     const period = $('mapperiod').value;
     if (period === 'range') o.period = `${$('mapstart').value.trim()}..${$('mapend').value.trim()}`;
@@ -108,6 +108,7 @@ export function mapMode(page) {
     view.dataset.lit = lit === null ? '' : String(lit);
     view.dataset.at = map.value === 'lit' ? `${tag.day},${tag.time}` : '';
     view.dataset.patches = map.patches ? JSON.stringify(map.patches) : '';
+    showDrawn();
     view.dataset.areas = map.areas ? JSON.stringify(map.areas) : '';
     state.id = id;
     $('downloadmap').disabled = false;
@@ -118,6 +119,17 @@ export function mapMode(page) {
         ? `${info.title} from ${map.min.toFixed(2)} to ${map.max.toFixed(2)}${info.unit ? ` ${info.unit}` : ''} over ${map.instants.toLocaleString()} instants${areaSummary(map.areas)}`
         : `${lit.toLocaleString()} in the sun${patchSummary(map.patches)}`;
     page.status(`Map in ${seconds.toFixed(1)} s (${tag.kind}): ${map.values.length.toLocaleString()} points on ${receivers} receivers; ${summary}.`);
+  }
+
+  /** An inside instant's sun patch as drawn, per face (m² of the lit cells in the view's own
+   * overlay, the cut's collapsed ones counting nothing): `data-drawn-patches` on the view, for a
+   * person's check and the browser test. */
+  function showDrawn() {
+    const map = state.map;
+    const overlay = page.viewer()?.overlay;
+    const drawn = map?.patches && map.value === 'lit' && overlay;
+    const stride = drawn ? overlay.length / (6 * map.values.length) : 0;
+    $('view').dataset.drawnPatches = drawn ? JSON.stringify(drawnPatches(overlay, stride, map.receivers, map.receiverNames, LIT)) : '';
   }
 
   function legendOf(map, range, tag) {
@@ -156,6 +168,8 @@ export function mapMode(page) {
     $('downloadmap').addEventListener('click', () => ask('csv'));
     $('downloadglb').addEventListener('click', () => ask('glb'));
     wireInside(page);
+    // After the view's own cut (wireInside's listener runs first): what it now draws.
+    $('mapcut').addEventListener('change', showDrawn);
     showFields();
   }
 

@@ -472,6 +472,10 @@ export interface MapOptions {
   /** With `interior`: globs over node names, each matching node glass in an opening
    * (`--glazing`), its material's extras giving its curve, else `glassTransmittance`. */
   glazing?: string | string[];
+  /** With `inside` and `grid`: the grid on every inside face of the rooms too (walls, roofs,
+   * ceilings, at the same spacing), not only on the floors or work plane (`--faces`), so that an
+   * instant's sun patch is mapped on each face it falls on. Refused with `points` or a `study`. */
+  faces?: boolean;
 }
 
 /** One room's share in an inside study (`inside: true, study`), as the study's report's `areas`. */

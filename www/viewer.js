@@ -74,6 +74,10 @@ export class Viewer {
   setCut(cut) {
     this.cut = cut;
     if (this.colourOfReceiver) this.setColours(this.colourOfReceiver);
+    // A map's cells on the faces cut away go with them: the overlay is written again.
+    const [cells, colours] = [this.overlayCells, this.overlayColours];
+    this.overlayCells = null;
+    if (cells) this.setOverlay(cells, colours);
   }
 
   /** Colours per receiver (RGB 0..1); shading geometry stays grey. */
@@ -110,9 +114,12 @@ export class Viewer {
     const data = this.overlay;
     for (let v = 0; v < n; v++) {
       const at = v * FLOATS_PER_VERTEX;
+      // A cut triangle's three corners all at its first: it keeps its place (a recolour writes
+      // in place) and draws nothing.
+      const from = this.cut && isCut(this.cut, cells.positions, 9 * Math.floor(v / 3)) ? 9 * Math.floor(v / 3) : 3 * v;
       for (let k = 0; k < 3; k++) {
         if (!recolour) {
-          data[at + k] = cells.positions[3 * v + k];
+          data[at + k] = cells.positions[from + k];
           data[at + 3 + k] = cells.normals[3 * v + k];
         }
         data[at + 6 + k] = colours[3 * v + k];

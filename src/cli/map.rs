@@ -124,6 +124,11 @@ pub(super) struct MapArgs {
     /// floors; 0.76 with --study leed-ase).
     #[arg(long, value_name = "METRES", allow_hyphen_values = true)]
     work_plane: Option<f64>,
+    /// With --inside and a grid: put it on every inside face of the rooms (walls, roofs and
+    /// ceilings at the grid's spacing besides the floors or work plane), so a sun patch at an
+    /// instant is mapped on each face it falls on.
+    #[arg(long, requires = "inside", conflicts_with = "points")]
+    faces: bool,
     /// Print a JSON summary.
     #[arg(long)]
     json: bool,

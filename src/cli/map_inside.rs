@@ -44,6 +44,9 @@ fn ask(args: &MapArgs) -> Result<Ask> {
             "the inside is mapped by the exact engine's rays only (free planes are no geometry to draw)",
         ));
     }
+    if args.faces && !args.study.is_empty() {
+        return Err(Error::argument("faces", "a study's share is of the work plane alone: drop --faces"));
+    }
     if args.study.iter().any(|s| s == "bre-nsl") {
         if args.period.is_some() || args.at.is_some() {
             return Err(Error::argument("study", "bre-nsl is geometry (which points see sky); drop --period and --at"));
@@ -144,14 +147,17 @@ pub(super) fn map_inside(args: MapArgs) -> Result<()> {
 }
 
 /// The rooms' points: `--points`, else a grid (`--grid`, `--work-plane`, else `defaults`:
-/// spacing and height) on their floors.
+/// spacing and height) on their floors, and with `--faces` on every other inside face too.
 fn room_points(args: &MapArgs, scene: &mut Scene, rooms: &Rooms, defaults: (f64, f64)) -> Result<RoomPoints> {
     match &args.points {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|source| Error::Io { path: path.clone(), source })?;
             rooms_map::room_points_csv(scene, rooms, &path.display().to_string(), &text)
         }
-        None => rooms_map::floor_grid(scene, rooms, args.grid.unwrap_or(defaults.0), args.work_plane.unwrap_or(defaults.1)),
+        None => {
+            let grid = if args.faces { rooms_map::face_grid } else { rooms_map::floor_grid };
+            grid(scene, rooms, args.grid.unwrap_or(defaults.0), args.work_plane.unwrap_or(defaults.1))
+        }
     }
 }
 

@@ -48,8 +48,9 @@ pub fn interior_beam_csv(beam: &InteriorBeam, timesteps: Timesteps) -> String {
 ///   method with `FullInteriorAndExterior` all of it becomes diffuse (no back surfaces), so the
 ///   beam would count twice. The zone's balance column takes it back: on one exterior window
 ///   (whose inside absorptance EnergyPlus takes as 0, so all of it goes to the zone's diffuse) it
-///   is minus the beam the faces got, in W/m² of that window. The zone then keeps EnergyPlus's
-///   own transmitted beam, distributed as sunlit found it.
+///   is minus all the beam the zone's exterior windows let in, in W/m² of that window. The zone
+///   then keeps EnergyPlus's own transmitted beam where sunlit found it landing on its faces; what
+///   lands on the back of a window leaves, as FullInterior books it.
 pub fn interior_beam_objects(csv: &str, beam: &InteriorBeam, timesteps: Timesteps) -> String {
     let minutes = (60 / timesteps.per_hour()).to_string();
     let hours = (24 * timesteps.days()).to_string();

@@ -96,6 +96,23 @@ pub fn floor_grid(scene: &mut Scene, rooms: &Rooms, spacing: f64, height: f64) -
     Ok(out)
 }
 
+/// [`floor_grid`]'s points, then a grid at the same `spacing` on every other inside face of each
+/// room (walls, roofs, ceilings: the faces a sun patch can reach besides the floors), so that an
+/// instant's patch is drawn on each face it lies on. The cells are the floors', and each point
+/// stands for `spacing²` of its face, as on the floors.
+pub fn face_grid(scene: &mut Scene, rooms: &Rooms, spacing: f64, height: f64) -> Result<RoomPoints> {
+    let mut out = floor_grid(scene, rooms, spacing, height)?;
+    for (k, room) in rooms.rooms.iter().enumerate() {
+        for face in room.inside.iter().filter(|f| !room.floors.contains(f)) {
+            let (id, _) = scene.receiver(face).ok_or_else(|| Error::argument("rooms", format!("'{face}' is not a receiver")))?;
+            let mut points = grid(scene, spacing, &[id])?;
+            out.room.extend(std::iter::repeat_n(k as u32, points.len()));
+            append(&mut out.points, &mut points);
+        }
+    }
+    Ok(out)
+}
+
 /// Points from a CSV (`x,y,z,nx,ny,nz`, as [`super::from_csv`] reads): a point on a room's
 /// inside face (within [`super::points::ON_SURFACE_TOLERANCE`], facing its way) belongs to that
 /// face, any other to the room it lies in, on a plane of its own shared with the room's other

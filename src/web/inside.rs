@@ -115,7 +115,9 @@ fn build(model: &ModelInner, key: &InsideKey) -> Result<InsideScene> {
         (None, false) => mesh_rooms(model, ask)?,
     };
     let at = match &key.place {
+        Where::Grid(spacing) if ask.faces => rooms_map::face_grid(&mut scene, &rooms, *spacing, ask.work_plane)?,
         Where::Grid(spacing) => rooms_map::floor_grid(&mut scene, &rooms, *spacing, ask.work_plane)?,
+        Where::Given(_) if ask.faces => return Err(Error::argument("faces", "puts a grid on the faces: give 'grid', not 'points'")),
         Where::Given(numbers) => rooms_map::room_points_csv(&mut scene, &rooms, "points", &given_points(numbers)?)?,
     };
     let mapper = Mapper::new(&scene, &at.points)?;

@@ -27,7 +27,7 @@ pub const DEFAULT_DAY_STEP: u32 = 10;
 pub const MAP_KEYS: [&str; 8] = ["grid", "points", "period", "step", "from", "to", "at", "value"];
 
 /// The keys that map the inside of an EnergyPlus model's zones instead of its outside.
-pub const INSIDE_KEYS: [&str; 7] = ["inside", "workPlane", "glassTransmittance", "glassCurve", "study", "interior", "glazing"];
+pub const INSIDE_KEYS: [&str; 8] = ["inside", "workPlane", "glassTransmittance", "glassCurve", "study", "interior", "glazing", "faces"];
 
 /// The annual settings' keys a map also takes: the site, the foliage's calendar and the sky model
 /// ([`AnnualSettings`], resolved as an annual run resolves them).
@@ -146,6 +146,9 @@ pub struct InsideAsk {
     pub glazing: Vec<String>,
     /// A study of the inside (`--study leed-ase` or `bre-nsl`), or none.
     pub study: Option<InsideStudy>,
+    /// The grid on every inside face of the rooms besides the floors (`--faces`), so that a sun
+    /// patch is mapped on each face it falls on.
+    pub faces: bool,
 }
 
 /// A study of the inside, as `sunlit map --inside --study` names it.
@@ -307,6 +310,11 @@ fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideA
     let curve = text_of("glassCurve", all.remove("glassCurve"))?;
     let study = text_of("study", all.remove("study"))?.as_deref().map(InsideStudy::parse).transpose()?;
     let (interior, glazing) = (globs_of("interior", all.remove("interior"))?, globs_of("glazing", all.remove("glazing"))?);
+    let faces = match all.remove("faces") {
+        None | Some(Value::Bool(false)) => false,
+        Some(Value::Bool(true)) => true,
+        Some(other) => return Err(Error::argument("faces", format!("{other} is not true or false"))),
+    };
     if !inside {
         let given = [
             ("workPlane", work_plane.is_some()),
@@ -315,6 +323,7 @@ fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideA
             ("study", study.is_some()),
             ("interior", !interior.is_empty()),
             ("glazing", !glazing.is_empty()),
+            ("faces", faces),
         ];
         if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
             return Err(Error::argument(*name, "maps the inside of rooms: add inside: true"));
@@ -333,8 +342,11 @@ fn inside_ask(all: &mut serde_json::Map<String, Value>) -> Result<Option<InsideA
         }
         TransmittanceCurve::parse(text).map_err(|why| Error::argument("glassCurve", why))?;
     }
+    if faces && study.is_some() {
+        return Err(Error::argument("faces", "a study's share is of the work plane alone: leave faces out"));
+    }
     let work_plane = work_plane.unwrap_or(study.map_or(0.0, |s| s.defaults().1));
-    Ok(Some(InsideAsk { work_plane, glass, curve, interior, glazing, study }))
+    Ok(Some(InsideAsk { work_plane, glass, curve, interior, glazing, study, faces }))
 }
 
 /// Globs over node names, as a comma-separated text (as `loadFiles`' `receivers`) or an array

@@ -23,6 +23,13 @@
 //! Interzone windows are no source of interior beam: their beam is what another zone's exterior
 //! window let in, which EnergyPlus passes on as diffuse. They are skipped by name.
 //!
+//! Each zone's balance takes back all the beam its exterior windows let in (each glass's sunlit
+//! share seen from outside × DNI · τ · cos θ · area: EnergyPlus's `BTOTZone`), not only what its
+//! faces got: EnergyPlus's FullInterior books the beam landing on the back of a window (another
+//! exterior window, an interzone pane) as leaving the zone (`BABSZone += BOverlap *
+//! (AbsBeamTotWin + TransBeamWin)`), and left in the zone's diffuse it put 0.078 points of site
+//! energy a year on 4ZoneWithShading_Simple_1 (docs/energyplus-fidelity.md).
+//!
 //! The DNI is the one EnergyPlus's heat balance sees at the timestep
 //! ([`Weather::dni_as_energyplus`]: interpolated between hour middles), not the hour's: held
 //! over the hour, it missed the morning's first beam (the hour ending 08:00 at 0 where
@@ -65,7 +72,12 @@ pub struct InsideFace {
     pub watts_m2: Vec<f64>,
 }
 
-/// A zone's balance: the beam put on its faces, taken back out of the zone's diffuse.
+/// A zone's balance: the beam its exterior windows let in, taken back out of the zone's diffuse.
+/// EnergyPlus's own FullInterior takes it all out (`DBZone = BTOTZone − BABSZone`): what lands on
+/// an opaque face is that face's (the face schedules put it back), and what lands on the back of
+/// another window leaves the zone (through an exterior window, into its glass, or through an
+/// interzone pane into the next zone), so none of the beam stays in the zone as diffuse but the
+/// faces' reflected share.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ZoneBalance {
     /// The zone.
@@ -74,7 +86,8 @@ pub struct ZoneBalance {
     pub window: String,
     /// The window's construction.
     pub construction: String,
-    /// Per timestep (W/m² of the window, ≤ 0): minus the faces' beam (W) over the window's area.
+    /// Per timestep (W/m² of the window, ≤ 0): minus the beam through the zone's exterior windows
+    /// (W) over the window's area.
     pub watts_m2: Vec<f64>,
 }
 
@@ -132,31 +145,42 @@ pub fn interior_beam(
         }
         for window in &windows {
             views.through_window(&scene, window, &suns, start, &out.faces[start..]);
+            views.entering_zone(&scene, window, &suns, zones.len());
         }
-        zones.push((room, *first, start..out.faces.len()));
+        zones.push((room, *first));
     }
     out.views = views.requests.len();
     let fractions = ExactEngine::new(&scene).fractions_through(&views.requests, &views.open);
-    for ((k, row, scale), f) in views.targets.into_iter().zip(fractions) {
-        out.faces[k].watts_m2[row] += scale * f;
+    let mut entering = vec![vec![0.0; rows]; zones.len()];
+    for ((to, row, scale), f) in views.targets.into_iter().zip(fractions) {
+        match to {
+            Target::Face(k) => out.faces[k].watts_m2[row] += scale * f,
+            Target::Zone(z) => entering[z][row] += scale * f,
+        }
     }
-    for (room, first, faces) in zones {
-        let faces = &out.faces[faces];
+    for ((room, first), entering) in zones.into_iter().zip(entering) {
         let area = newell(&first.vertices).length();
-        let balance = (0..rows).map(|r| -faces.iter().map(|f| f.watts_m2[r] * f.area).sum::<f64>() / area).collect();
+        let balance = entering.iter().map(|w| -w / area).collect();
         let construction = input.building.surface(&first.name).and_then(|s| construction_of(input, s)).unwrap_or_default();
         out.balances.push(ZoneBalance { zone: room.name.clone(), window: first.name.clone(), construction, watts_m2: balance });
     }
     Ok(out)
 }
 
-/// The views asked of the exact engine: per view the glass it sees through, and the face, row
-/// and scale (W/m² per unit lit share) its fraction goes to.
+/// Where a view's lit share goes: a face's beam (W/m² per unit share), or the beam a zone's
+/// window lets in (W per unit share).
+enum Target {
+    Face(usize),
+    Zone(usize),
+}
+
+/// The views asked of the exact engine: per view the glass it sees through, and where, at which
+/// row and scaled by what its fraction goes.
 #[derive(Default)]
 struct Views {
     requests: Vec<ViewRequest>,
     open: Vec<Option<u32>>,
-    targets: Vec<(usize, usize, f64)>,
+    targets: Vec<(Target, usize, f64)>,
 }
 
 impl Views {
@@ -184,8 +208,27 @@ impl Views {
                 }
                 self.requests.push(ViewRequest { receiver, sun, leaves: 1.0 });
                 self.open.push(open);
-                self.targets.push((first + k, row, dni * window.solar_at(outward.dot(sun)) * cos));
+                self.targets.push((Target::Face(first + k), row, dni * window.solar_at(outward.dot(sun)) * cos));
             }
+        }
+    }
+
+    /// Asks for the beam `window` lets into zone `zone` (W) at every row with a sun: its glass's
+    /// sunlit share from outside (the view of its own receiver, its glass left out so that only
+    /// what lies outside shades it) × DNI · τ · cos θ · area, as EnergyPlus's `BTOTZone` counts it.
+    fn entering_zone(&mut self, scene: &Scene, window: &Glazing, suns: &[Option<(DVec3, f64)>], zone: usize) {
+        let Some((receiver, glass)) = scene.receiver(&window.name) else { return };
+        let outward = newell(&window.vertices).normalize_or_zero();
+        let area = newell(&window.vertices).length();
+        for (row, sun) in suns.iter().enumerate() {
+            let Some((sun, dni)) = *sun else { continue };
+            let cos = outward.dot(sun);
+            if cos < MIN_COS_INCIDENCE {
+                continue;
+            }
+            self.requests.push(ViewRequest { receiver, sun, leaves: 1.0 });
+            self.open.push(Some(glass.gpu_id));
+            self.targets.push((Target::Zone(zone), row, dni * window.solar_at(cos) * cos * area));
         }
     }
 }

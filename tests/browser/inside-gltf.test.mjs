@@ -104,14 +104,16 @@ test('a glTF room in the page: at an instant, over a day and for LEED ASE its CS
   await setMapSliders(page, 355, 13);
   await page.fill('#mapworkplane', '0');
   const done = await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 240_000);
-  assert.match(done, /^Map in .*: 320 points on 1 receivers; \d+ in the sun; sun patches: .*Room#\d+:inside \d/);
-  const at = native(['--at', '12-21', '13:00', '--location', `${LOCATION.latitude},${LOCATION.longitude},${LOCATION.timezone}`]);
+  // At an instant the grid covers every inside face (--faces): the floor's 320 points and the
+  // other five faces'.
+  assert.match(done, /^Map in .*: 1,456 points on 6 receivers; \d+ in the sun; sun patches: .*Room#\d+:inside \d/);
+  const at = native(['--at', '12-21', '13:00', '--faces', '--location', `${LOCATION.latitude},${LOCATION.longitude},${LOCATION.timezone}`]);
   const web = await downloadText(page, '#downloadmap', join(WORK, 'web-at.csv'));
   assert.equal(web.text, at.csv, 'the page\'s points CSV is the CLI\'s, byte for byte');
   const rows = at.csv.trim().split('\n').slice(1).map((l) => l.split(','));
   const lit = rows.filter((r) => r.at(-3) === '1');
   assert.equal(Number(await page.getAttribute('#view', 'data-lit')), at.summary.lit_points);
-  assert.ok(lit.length > 20 && lit.length < 300, `the beam lights part of the floor: ${lit.length} of 320 points`);
+  assert.ok(lit.length > 20 && lit.length < 300, `the beam lights part of the room: ${lit.length} of 1,456 points`);
   // The pane's material gives the glass: a lit point's weight is the curve's at the beam's angle.
   const solar = new Set(lit.map((r) => r.at(-2)));
   assert.equal(solar.size, 1, 'one pane, one angle');
@@ -176,7 +178,7 @@ test('an inside period cancelled after its first progress leaves nothing, and th
   await page.selectOption('#mapperiod', 'instant');
   await setMapSliders(page, 355, 13);
   const next = await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 240_000);
-  assert.match(next, /^Map in .*: 8,000 points on 1 receivers; [\d,]+ in the sun/);
+  assert.match(next, /^Map in .*: 36,400 points on 6 receivers; [\d,]+ in the sun/);
   assert.deepEqual(pageErrors, []);
 });
 

@@ -1,9 +1,11 @@
 // The page's interior view (headless Chromium, driven by Playwright) against the native library
 // through the CLI: on a box room (an EnergyPlus model: one zone, one south window), Map mode at
-// an instant with "Inside rooms" maps a grid on the floor; its points CSV equals `sunlit map
-// --inside --at` byte for byte, its lit count and each inside face's sun patch equal the CLI's
-// JSON summary; cutting away the roof or the south wall takes exactly those faces out of the 3D
-// view. The view is saved to target/artifacts/inside.png for a person to look at. Over a period
+// an instant with "Inside rooms" maps a grid on every inside face; its points CSV equals `sunlit
+// map --inside --faces --at` byte for byte, its lit count and each inside face's sun patch equal
+// the CLI's JSON summary; the patch the view draws on each face (its lit cells) matches the CLI's
+// exact patch area within half a cell along the drawn patch's outline, at 13:00 (floor, east and
+// north walls) and 15:00 (the east wall); cutting away the roof or the south wall takes exactly
+// those faces out of the 3D view, and cutting the east wall its cells. The view is saved to target/artifacts/inside.png for a person to look at. Over a period
 // (the beam through the glass under an EPW) and for LEED ASE (`study: 'leed-ase'`), the page's
 // CSV equals `sunlit map --inside --period` and `--study leed-ase` byte for byte, and each room's
 // ASE the CLI's.
@@ -39,11 +41,11 @@ before(async () => {
 
 after(() => closePage(served, WORK));
 
-/** `sunlit map --inside --at` on the room: its JSON summary and its points CSV. */
-function nativeInside() {
+/** `sunlit map --inside --faces --at` on the room at `hour`: its JSON summary and its points CSV. */
+function nativeInside(hour = HOUR) {
   const csv = join(WORK, 'native.csv');
-  const at = `${HOUR}:00`.padStart(5, '0');
-  const args = ['map', model, '--inside', '--at', '12-21', at, '--grid', GRID, '--json', '-o', csv];
+  const at = `${hour}:00`.padStart(5, '0');
+  const args = ['map', model, '--inside', '--faces', '--at', '12-21', at, '--grid', GRID, '--json', '-o', csv];
   args.push('--location', `${LOCATION.latitude},${LOCATION.longitude},${LOCATION.timezone}`);
   const summary = JSON.parse(execFileSync(join(ROOT, 'target/debug/sunlit'), args, { cwd: ROOT, env: { ...process.env, XDG_RUNTIME_DIR: WORK } }));
   return { summary, csv: execFileSync('cat', [csv], { encoding: 'utf8' }) };
@@ -61,7 +63,8 @@ test('the interior view: the floor\'s sun patch at an instant equals `sunlit map
   await page.check('#mapinside');
   await page.fill('#mapworkplane', '0');
   const done = await statusAfter(page, () => page.click('#compute'), /^Map in|^Could not/, 240_000);
-  assert.match(done, /^Map in .*: 320 points on 1 receivers; \d+ in the sun; sun patches: .*Floor:inside \d/);
+  // The floor's 320 points and the other five faces' (the south wall's around its window).
+  assert.match(done, /^Map in .*: 1,456 points on 6 receivers; \d+ in the sun; sun patches: .*Floor:inside \d/);
 
   const native = nativeInside();
   const web = await downloadText(page, '#downloadmap', join(WORK, 'web.csv'));
@@ -69,7 +72,7 @@ test('the interior view: the floor\'s sun patch at an instant equals `sunlit map
   assert.match(native.csv.split('\n')[0], /,lit,solar_transmittance,visible_transmittance$/);
   const lit = Number(await page.getAttribute('#view', 'data-lit'));
   assert.equal(lit, native.summary.lit_points);
-  assert.ok(lit > 20 && lit < 300, `the beam lights part of the floor: ${lit} of 320 points`);
+  assert.ok(lit > 20 && lit < 300, `the beam lights part of the room: ${lit} of 1,456 points`);
   const patches = JSON.parse(await page.getAttribute('#view', 'data-patches'));
   assert.deepEqual(patches.map((p) => [p.surface, p.zone]), native.summary.sun_patches.map((p) => [p.surface, p.zone]));
   patches.forEach((p, i) => {
@@ -88,6 +91,69 @@ test('the interior view: the floor\'s sun patch at an instant equals `sunlit map
   assert.ok(south >= 4, `the south wall with its window's hole and the window go: ${south} triangles`);
   await page.selectOption('#mapcut', 'roof');
   await page.locator('#view').screenshot({ path: join(ROOT, 'target/artifacts/inside.png') });
+  assert.deepEqual(pageErrors, []);
+});
+
+/** Per face, the lit cells' edges that border no lit cell of the same face (a neighbour unlit,
+ * or off the face): the drawn patch's outline, in cells, from the points CSV. */
+function outlineEdges(csv, spacing) {
+  const lit = csv.trim().split('\n').slice(1).map((l) => l.split(',')).filter((r) => r[7] === '1');
+  const out = {};
+  for (const r of lit) {
+    const p = r.slice(1, 4).map(Number);
+    const neighbours = lit.filter((q) => q[0] === r[0] && Math.abs(Math.hypot(...q.slice(1, 4).map((v, k) => Number(v) - p[k])) - spacing) < 1e-3).length;
+    out[r[0]] = (out[r[0]] ?? 0) + 4 - neighbours;
+  }
+  return out;
+}
+
+/** The view's drawn sun patch on each face against the CLI's exact one (`sun_patches`): within
+ * half a cell along the drawn outline (edges × s² / 2); a face the CLI lights but the view draws
+ * nothing on only for a patch under two cells (a sliver between cell centres). */
+function assertDrawnMatches(drawn, native, spacing) {
+  const edges = outlineEdges(native.csv, spacing);
+  const exact = Object.fromEntries(native.summary.sun_patches.map((p) => [p.surface, p.area_m2]));
+  for (const face of new Set([...Object.keys(drawn), ...Object.keys(exact)])) {
+    const [d, x] = [drawn[face] ?? 0, exact[face] ?? 0];
+    if (d === 0) {
+      assert.ok(x < 2 * spacing * spacing, `${face}: the CLI's patch ${x} m² is drawn nowhere`);
+      continue;
+    }
+    const tolerance = ((edges[face] ?? 0) * spacing * spacing) / 2;
+    assert.ok(Math.abs(d - x) <= tolerance + 1e-4, `${face}: drawn ${d.toFixed(4)} m² against the CLI's ${x} m² (± ${tolerance} m²)`);
+  }
+}
+
+test('the sun patch drawn on each inside face: its area the CLI\'s `map --inside --at` per face, the east wall lit at 15:00 and cut away with its wall', { timeout: 300_000 }, async () => {
+  // The first test's map at 13:00 stands; its cut goes.
+  await page.selectOption('#mapcut', '');
+  const spacing = Number(GRID);
+  const drawnNow = async () => JSON.parse(await page.getAttribute('#view', 'data-drawn-patches'));
+  const noon = nativeInside();
+  const drawn13 = await drawnNow();
+  assert.ok(drawn13['East:inside'] > 0.25 && drawn13['Floor:inside'] > 4, `the floor and the east wall drawn lit at 13:00: ${JSON.stringify(drawn13)}`);
+  assertDrawnMatches(drawn13, noon, spacing);
+
+  // The slider to 15:00: the low sun through the window lands on the east wall.
+  const moved = await statusAfter(page, () => setMapSliders(page, DAY, 15), /^Map in|^Could not/, 240_000);
+  assert.match(moved, /sun patches: .*East:inside \d/);
+  const evening = nativeInside(15);
+  const web = await downloadText(page, '#downloadmap', join(WORK, 'web-15.csv'));
+  assert.equal(web.text, evening.csv, 'the page\'s points CSV at 15:00 is the CLI\'s, byte for byte');
+  const drawn15 = await drawnNow();
+  const east = evening.summary.sun_patches.find((p) => p.surface === 'East:inside');
+  assert.ok(east.area_m2 > 2, `the CLI puts the patch on the east wall: ${east.area_m2} m²`);
+  assertDrawnMatches(drawn15, evening, spacing);
+
+  // Cutting away the east wall takes its cells too; the other faces' patches stay as drawn.
+  await page.selectOption('#mapcut', 'east');
+  const cut = await drawnNow();
+  assert.equal(cut['East:inside'], undefined, 'the east wall\'s cells go with it');
+  for (const [face, area] of Object.entries(drawn15)) if (face !== 'East:inside') assert.equal(cut[face], area, face);
+  // The roof cut away instead: the east wall's patch seen from above (for a person to look at).
+  await page.selectOption('#mapcut', 'roof');
+  await page.locator('#view').screenshot({ path: join(ROOT, 'target/artifacts/inside-east.png') });
+  await page.selectOption('#mapcut', '');
   assert.deepEqual(pageErrors, []);
 });
 
