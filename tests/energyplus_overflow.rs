@@ -11,7 +11,7 @@
 //!
 //! The 100-zone file (`scripts/eplus-100zones.py`) overflows the default 15,000 figures;
 //! EnergyPlus takes about 20 min on it here, so its comparison is run on demand:
-//! `cargo test --release --test energyplus_overflow hundred_zones -- --ignored --nocapture`
+//! `cargo test --test energyplus_overflow hundred_zones -- --ignored --nocapture`
 //! (`SUNLIT_100ZONES_RUN=DIR` reuses an EnergyPlus run of `scripts/eplus-100zones.py`'s model,
 //! its eplusout.csv and eplusout.err, instead of running it).
 
