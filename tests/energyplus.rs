@@ -12,7 +12,7 @@ use sunlit::model::office_idf::{Shading, office_idf};
 
 mod common;
 use common::Scratch;
-use common::energyplus::{columns, energyplus};
+use common::energyplus::{columns, energyplus, leap_weather};
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_CO_Golden-NREL.724666_TMY3.epw")
@@ -262,48 +262,13 @@ fn hooked_model_finds_its_csv_from_any_folder() {
     assert!(used.iter().any(|v| *v > 0.0 && *v < 0.99) && worst < 1e-4, "EnergyPlus did not use the CSV (max |Δ| {worst})");
 }
 
-/// An actual-year weather file of a leap year: the Golden TMY3 with every year set to 2020 and a
-/// Feb 29 (a copy of Feb 28) inserted, its header saying a leap year is observed. Every data
-/// row's date is checked, so a wrong edit fails here rather than in EnergyPlus.
-fn leap_weather(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(weather()).unwrap();
-    let mut out = String::new();
-    let mut feb28 = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if i < 8 {
-            let line = if line.starts_with("HOLIDAYS/DAYLIGHT SAVINGS,No,") { line.replacen(",No,", ",Yes,", 1) } else { line.to_string() };
-            out.push_str(&line);
-            out.push('\n');
-            continue;
-        }
-        let (_, rest) = line.split_once(',').unwrap();
-        let row = format!("2020,{rest}");
-        if rest.starts_with("2,28,") {
-            feb28.push(format!("2020,2,29,{}", rest.splitn(3, ',').nth(2).unwrap()));
-        }
-        if rest.starts_with("3,1,1,") {
-            assert_eq!(feb28.len(), 24);
-            for r in feb28.drain(..) {
-                out.push_str(&r);
-                out.push('\n');
-            }
-        }
-        out.push_str(&row);
-        out.push('\n');
-    }
-    assert_eq!(out.lines().count(), 8 + 8784);
-    let path = dir.join("leap2020.epw");
-    std::fs::write(&path, out).unwrap();
-    path
-}
-
 /// A leap year: a RunPeriod in 2020 with an actual-year 2020 weather file. sunlit writes
 /// 8784 × 4 rows and hooks them as 8784 hours; EnergyPlus runs 366 days without a severe error
 /// and uses the CSV's fractions on every lit timestep, Feb 29 and Dec 31 included.
 #[test]
 fn leap_year_runs_366_days_in_energyplus() {
     let dir = scratch("leap");
-    let epw = leap_weather(&dir);
+    let epw = leap_weather(&weather(), &dir);
     let office = office_idf(2, false, Shading::None);
     let year = "RunPeriod, YEAR, 1, 1, 2020, 12, 31, 2020, , No, No, No, Yes, Yes, No;";
     let text = office.replacen("RunPeriod, YEAR, 1, 1, , 12, 31, , , No, No, No, Yes, Yes, No;", year, 1);

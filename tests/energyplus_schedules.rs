@@ -6,7 +6,9 @@
 //! keywords with and without their colon, `For:` day types in EnergyPlus's spellings (`Weekday`,
 //! `Weekends`, `AllOtherDays`, …), and `Interpolate:` No, Average and Linear; `Schedule:Year`
 //! with its weeks in any order or leaving out Feb 29, `Schedule:Week:Daily`,
-//! `Schedule:Day:Hourly` and `Schedule:Day:Interval` (No, Average, Linear); and `Schedule:File`
+//! `Schedule:Day:Hourly` and `Schedule:Day:Interval` (No, Average, Linear); `Schedule:Week:Compact`
+//! (`For:` words, `AllOtherDays`) and `Schedule:Day:List` (items of 5 to 60 minutes, No, Average,
+//! Linear and blank); and `Schedule:File`
 //! with hourly and 10-minute items, with and without averaging, a leap (8,784-hour) and a plain
 //! (8,760-hour) file, and with `Adjust Schedule for Daylight Savings` Yes and No. The model has
 //! daylight saving and special days given as nth weekdays (which EnergyPlus places a day late
@@ -28,41 +30,13 @@ use std::process::Command;
 
 mod common;
 use common::Scratch;
-use common::energyplus::{columns, energyplus};
+use common::energyplus::{columns, energyplus, leap_weather};
 use sunlit::model::calendar::WeatherDays;
 use sunlit::model::idf::parse_idf;
 use sunlit::model::schedule::{RunCalendar, Schedules};
 
 fn weather() -> PathBuf {
     energyplus().parent().unwrap().join("WeatherData/USA_IL_Chicago-OHare.Intl.AP.725300_TMY3.epw")
-}
-
-/// The Chicago TMY3 file as an actual 2020 weather file: every record dated 2020 and a Feb 29
-/// (a copy of Feb 28) inserted, so that EnergyPlus runs 366 days.
-fn leap_weather(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(weather()).unwrap();
-    let mut out = String::new();
-    let mut feb28 = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if i < 8 {
-            let _ = writeln!(out, "{}", line.replacen("HOLIDAYS/DAYLIGHT SAVINGS,No,", "HOLIDAYS/DAYLIGHT SAVINGS,Yes,", 1));
-            continue;
-        }
-        let dated = format!("2020,{}", line.split_once(',').unwrap().1);
-        let date: Vec<&str> = dated.splitn(4, ',').collect();
-        if date[1] == "2" && date[2] == "28" {
-            feb28.push(dated.replacen("2020,2,28,", "2020,2,29,", 1));
-        }
-        if date[1] == "3" && date[2] == "1" {
-            for l in feb28.drain(..) {
-                let _ = writeln!(out, "{l}");
-            }
-        }
-        let _ = writeln!(out, "{dated}");
-    }
-    let path = dir.join("chicago_2020.epw");
-    std::fs::write(&path, out).unwrap();
-    path
 }
 
 /// The schedules compared, each written as EnergyPlus 25.2 runs it without a warning.
@@ -102,8 +76,35 @@ Schedule:File, F_TEN_AVERAGE, Fraction, ten.csv, 1, 0, 8760, Semicolon, Yes, 10;
 Schedule:File, F_TEN_NO, Fraction, ten.csv, 1, 0, 8760, Semicolon, No, 10;
 ";
 
-/// Every schedule [`SCHEDULES`] defines (the week and day schedules through the years).
-const NAMES: [&str; 14] = [
+/// `Schedule:Week:Compact` and `Schedule:Day:List`, their values generated ([`list_schedules`]).
+const LIST_SCHEDULES: &str = "Schedule:Year, Y_WEEK_COMPACT, Fraction, W_COMPACT, 1, 1, 6, 30, W_COMPACT_ALL, 7, 1, 12, 31;
+Schedule:Week:Compact, W_COMPACT, For: Weekdays, D_LIST_HOURS, For: Weekends Holiday, D_LIST_AVERAGE,
+  For: AllOtherDays, D_LIST_LINEAR;
+Schedule:Week:Compact, W_COMPACT_ALL, AllDays, D_LIST_QUARTERS;
+Schedule:Year, Y_DAILY_LIST, Fraction, W_DAILY_LIST, 1, 1, 12, 31;
+Schedule:Week:Daily, W_DAILY_LIST, D_LIST_AVERAGE, D_LIST_HOURS, D_LIST_HOURS, D_LIST_HOURS, D_LIST_HOURS, D_LIST_HOURS,
+  D_LIST_AVERAGE, D_LIST_LINEAR, D_LIST_LINEAR, D_LIST_LINEAR, D_LIST_QUARTERS, D_LIST_QUARTERS;
+";
+
+/// The `Schedule:Day:List`s [`LIST_SCHEDULES`] names: hourly items (No), 10-minute items
+/// (Average), 5-minute items (Linear) and 15-minute items (Interpolate blank), each value unlike
+/// its neighbours so that a misplaced item shows.
+fn list_schedules() -> String {
+    let list = |name: &str, how: &str, minutes: usize, value: &dyn Fn(usize) -> f64| {
+        let values: Vec<String> = (0..1440 / minutes).map(|k| format!("{:.4}", value(k))).collect();
+        format!("Schedule:Day:List, {name}, Fraction, {how}, {minutes}, {};\n", values.join(", "))
+    };
+    let mut out = LIST_SCHEDULES.to_string();
+    out += &list("D_LIST_HOURS", "No", 60, &|k| ((k * 7) % 20) as f64 / 20.0);
+    out += &list("D_LIST_AVERAGE", "Average", 10, &|k| ((k * 13) % 21) as f64 / 20.0);
+    out += &list("D_LIST_LINEAR", "Linear", 5, &|k| ((k * 7) % 23) as f64 / 22.0);
+    out += &list("D_LIST_QUARTERS", "", 15, &|k| ((k * 3) % 17) as f64 / 16.0);
+    out
+}
+
+/// Every schedule [`SCHEDULES`] and [`LIST_SCHEDULES`] define (the week and day schedules through
+/// the years).
+const NAMES: [&str; 16] = [
     "CONSTANT",
     "C_SEASONS",
     "C_SPECIAL_DAYS",
@@ -118,6 +119,8 @@ const NAMES: [&str; 14] = [
     "F_NO_DST",
     "F_TEN_AVERAGE",
     "F_TEN_NO",
+    "Y_WEEK_COMPACT",
+    "Y_DAILY_LIST",
 ];
 
 /// The model: a bare box (EnergyPlus needs surfaces to run), Timestep 4, daylight saving, the
@@ -133,7 +136,8 @@ fn model(year: &str) -> String {
          RunPeriodControl:SpecialDays, LAST_SUNDAY, Last Sunday in October, 1, CustomDay1;\n\
          RunPeriodControl:SpecialDays, FIRST_TUESDAY, 1st Tuesday in February, 1, CustomDay2;\n\
          Material:NoMass, INSULATION, MediumRough, 3.0, 0.9, 0.6, 0.6;\nConstruction, OPAQUE, INSULATION;\nZone, BOX;\n\
-         Output:Variable, *, Schedule Value, Timestep;\n{SCHEDULES}"
+         Output:Variable, *, Schedule Value, Timestep;\n{SCHEDULES}{}",
+        list_schedules()
     );
     let faces: [(&str, &str, &str, &str); 6] = [
         ("S", "Wall", "Outdoors", "0,0,3, 0,0,0, 6,0,0, 6,0,3"),
@@ -217,7 +221,7 @@ fn compare(dir: &Path, idf: &Path, epw: &Path, leap: bool) -> Vec<String> {
 fn every_schedule_form_matches_energyplus_step_by_step() {
     let dir = Scratch::new("epschedules", "forms");
     write_files(&dir);
-    let leap_epw = leap_weather(&dir);
+    let leap_epw = leap_weather(&weather(), &dir);
     let mut differ = Vec::new();
     for (label, year, epw, leap) in [("plain year", "", weather(), false), ("leap year 2020", "2020", leap_epw, true)] {
         let idf = dir.join("schedules.idf");

@@ -24,7 +24,7 @@ use std::process::Command;
 
 mod common;
 use common::Scratch;
-use common::energyplus::{DarkLit, columns, dark_lit, energyplus, energyplus_glitch, print_glitches, stamp, sunlit_annual};
+use common::energyplus::{DarkLit, columns, dark_lit, energyplus, energyplus_glitch, leap_weather, print_glitches, stamp, sunlit_annual};
 
 const CURRENT: &str = "4ZoneWithShading_Simple_1.idf";
 const OLD: &str = "4ZoneWithShading_Simple_1_V8-4.idf";
@@ -511,41 +511,6 @@ fn configured(text: &str, n: u32, run_period: Option<[(u32, u32, Option<i32>); 2
     text.replacen(old, &new, 1)
 }
 
-/// The Chicago TMY3 file as an actual 2020 weather file: every record dated 2020, a Feb 29 (a copy
-/// of Feb 28) inserted and the leap year declared, so that EnergyPlus runs 366 days.
-fn leap_weather(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(weather()).unwrap();
-    let mut out = String::new();
-    let mut feb28 = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if i < 8 {
-            out.push_str(&line.replacen("HOLIDAYS/DAYLIGHT SAVINGS,No,", "HOLIDAYS/DAYLIGHT SAVINGS,Yes,", 1));
-            out.push('\n');
-            continue;
-        }
-        let fields: Vec<&str> = line.splitn(2, ',').collect();
-        let dated = format!("2020,{}", fields[1]);
-        let (month, day) = {
-            let f: Vec<&str> = dated.split(',').collect();
-            (f[1].trim().to_string(), f[2].trim().to_string())
-        };
-        if month == "2" && day == "28" {
-            feb28.push(dated.replacen("2020,2,28,", "2020,2,29,", 1));
-        }
-        if month == "3" && day == "1" && !feb28.is_empty() {
-            for l in feb28.drain(..) {
-                out.push_str(&l);
-                out.push('\n');
-            }
-        }
-        out.push_str(&dated);
-        out.push('\n');
-    }
-    let path = dir.join("chicago_2020.epw");
-    std::fs::write(&path, out).unwrap();
-    path
-}
-
 /// Per surface: name, steps dark in one and lit in the other against the clipping run and
 /// against the hooked run (EnergyPlus's own one-step glitches apart), mean |Δ| over lit steps
 /// against the clipping run.
@@ -630,7 +595,7 @@ fn sun_and_dark_steps_match_energyplus_reported_fractions() {
         SunCase {
             label: "4zone-ts1-leap",
             text: configured(&four, 1, Some([(1, 1, Some(2020)), (12, 31, Some(2020))])),
-            weather: leap_weather(&scratch_dir),
+            weather: leap_weather(&weather(), &scratch_dir),
             n: 1,
             first_day: 1,
             leap: true,

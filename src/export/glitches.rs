@@ -46,6 +46,7 @@ const NAMED: usize = 3;
 pub fn known_glitches(ep: &EnergyPlusInput, columns: &[String], hook: Hook) -> Vec<KnownGlitch> {
     [
         lone_full_sun(ep, columns),
+        figure_overflow(ep, columns),
         non_convex_casters(ep),
         transmittance_ignored(ep),
         shading_export_a_day_late(ep),
@@ -84,6 +85,41 @@ fn lone_full_sun(ep: &EnergyPlusInput, columns: &[String]) -> Option<KnownGlitch
 fn in_front(caster: &[DVec3], receiver: &[DVec3]) -> bool {
     let plane = Plane::of_polygon(receiver);
     caster.iter().any(|p| plane.height(*p) > IN_FRONT)
+}
+
+/// EnergyPlus's default `Maximum Figures in Shadow Overlap Calculations`.
+const MAX_FIGURES: u64 = 15_000;
+
+/// The figure overflow: EnergyPlus's clipping keeps every shadow on a surface, and every overlap
+/// of shadows, as one figure of an array of `Maximum Figures in Shadow Overlap Calculations`; past
+/// its end SolarShading.cc gives up (`Too many figures` in the err file) and reports the surface's
+/// windows 0. k casters whose shadows all overlap make 2^k figures on a surface and up to as many
+/// again on a window of it, so a hooked surface with k shading surfaces in front of its plane can
+/// overflow when 2^(k+1) passes the maximum (measured on 25.2: seven slats overflow 200 figures,
+/// six do not; the 100-zone test file's west windows, under 200 overhangs, overflow 15,000).
+fn figure_overflow(ep: &EnergyPlusInput, columns: &[String]) -> Option<KnownGlitch> {
+    let limit = shadow_calculation_field(ep, 3).parse::<f64>().ok().filter(|v| *v >= 1.0).map_or(MAX_FIGURES, |v| v as u64);
+    let shades: Vec<&EpSurface> = ep.building.surfaces.iter().filter(|s| s.kind == "Shading").collect();
+    let crowded: Vec<&str> = columns
+        .iter()
+        .filter_map(|c| ep.building.surface(c))
+        .filter(|r| {
+            let casters = shades.iter().filter(|s| in_front(&s.vertices, &r.vertices)).count() as u32;
+            1u64.checked_shl(casters + 1).is_none_or(|figures| figures > limit)
+        })
+        .map(|r| r.name.as_str())
+        .collect();
+    (!crowded.is_empty()).then(|| KnownGlitch {
+        name: "figure-overflow",
+        what: "EnergyPlus's clipping can run out of figures for overlapping shadows (`Too many figures` in its err file, \
+               no surface or time given) and then reports the surface's windows 0, leaving their lit area on the wall \
+               (seen on the 100-zone test file's west and east windows at the noon crossing, May to July)",
+        applies: format!("{} with enough shading surfaces in front of their plane to pass {limit} figures", surfaces(&crowded, "surface")),
+        sunlit: "counted those steps itself (the geometry's fraction); the hooked model takes sunlit's fractions, so \
+                 EnergyPlus's heat balance never sees the overflow's 0 (its sky-diffuse pass still clips, and may still \
+                 warn)"
+            .into(),
+    })
 }
 
 /// Non-convex casters: EnergyPlus's polygon clipping takes convex casters only and calls another
@@ -244,6 +280,28 @@ mod tests {
         let behind = "Shading:Site:Detailed, BEHIND, , 4, 1,9,2.8, 2,9,2.8, 2,1,2.8, 1,1,2.8;\n";
         assert!(names(&model(behind), Hook::Scheduled).is_empty());
         assert!(known_glitches(&ep, &["WALL_W".into()], Hook::Scheduled).is_empty(), "the window is not hooked");
+    }
+
+    /// The figure overflow is named for a hooked surface with enough shades in front of its plane
+    /// to pass the model's maximum figures (2^(k+1) > maximum), and not below it.
+    #[test]
+    fn the_figure_overflow_needs_more_shades_in_front_than_the_figures_allow() {
+        let slats = |k: usize| -> String {
+            (0..k)
+                .map(|i| {
+                    format!("Shading:Site:Detailed, SLAT_{i}, , 4, 0,6,{z}, -0.5,6,{z}, -0.5,2,{z}, 0,2,{z};\n", z = 2.6 + 0.1 * i as f64)
+                })
+                .collect()
+        };
+        let at = |figures: u32| format!("ShadowCalculation, PolygonClipping, Timestep, 1, {figures};\n");
+        let named = |extra: String| names(&model(&extra), Hook::Scheduled).contains(&"figure-overflow");
+        assert!(named(format!("{}{}", at(200), slats(7))), "7 slats, 2^8 = 256 > 200 figures");
+        assert!(!named(format!("{}{}", at(200), slats(6))), "6 slats, 2^7 = 128 ≤ 200 figures");
+        assert!(!named(slats(7)), "the default 15,000 figures");
+        assert!(named(slats(13)), "13 slats, 2^14 > 15,000 figures");
+        let found = known_glitches(&model(&format!("{}{}", at(200), slats(7))), &["WALL_W".into(), "WIN_W".into()], Hook::Scheduled);
+        let line = found.iter().find(|g| g.name == "figure-overflow").unwrap().line();
+        assert!(line.contains("2 surfaces (WALL_W, WIN_W)") && line.contains("pass 200 figures"), "{line}");
     }
 
     /// Each of the others is named exactly when the model has what it needs.

@@ -336,12 +336,19 @@ const SCHEDULE_CLASSES: &[ClassSpec] = &[
         &[("schedule_week_name", Text), ("start_month", Number), ("start_day", Number), ("end_month", Number), ("end_day", Number)],
     ),
     spec("Schedule:Week:Daily", true, WEEK_DAILY, false),
+    listed("Schedule:Week:Compact", &[], "data", &[("daytype_list", Text), ("schedule_day_name", Text)]),
     spec("Schedule:Day:Hourly", true, HOURS, false),
     listed(
         "Schedule:Day:Interval",
         &[("schedule_type_limits_name", Text), ("interpolate_to_timestep", Text)],
         "data",
         &[("time", Text), ("value_until_time", Number)],
+    ),
+    listed(
+        "Schedule:Day:List",
+        &[("schedule_type_limits_name", Text), ("interpolate_to_timestep", Text), ("minutes_per_item", Number)],
+        "extensions",
+        &[("value", Number)],
     ),
     spec("Schedule:File", true, SCHEDULE_FILE, false),
 ];
@@ -357,6 +364,8 @@ const CLASSES: &[ClassSpec] = &[
             ("shading_calculation_method", Text),
             ("shading_calculation_update_frequency_method", Text),
             ("shading_calculation_update_frequency", Number),
+            // Read by `export::glitches` (the figure overflow).
+            ("maximum_figures_in_shadow_overlap_calculations", Number),
         ],
         false,
     ),

@@ -2,13 +2,15 @@
 //! every timestep of a weather-file run.
 //!
 //! Owns the meaning of `Schedule:Constant`, `Schedule:Compact`, `Schedule:Year` with
-//! `Schedule:Week:Daily`, `Schedule:Day:Hourly` and `Schedule:Day:Interval`, `Schedule:File`, and
-//! `ScheduleTypeLimits`, as EnergyPlus's ScheduleManager resolves them for a weather-file run:
+//! `Schedule:Week:Daily` or `Schedule:Week:Compact`, `Schedule:Day:Hourly`, `Schedule:Day:Interval`
+//! and `Schedule:Day:List`, `Schedule:File`, and `ScheduleTypeLimits`, as EnergyPlus's
+//! ScheduleManager resolves them for a weather-file run:
 //! - a day's values are kept per minute (an `Until: HH:MM` value fills the minutes before HH:MM,
-//!   an hourly value its hour, a file's item its `Minutes per Item`), and a timestep of N per hour
-//!   takes, with `Interpolate` No, the value of its last minute (the one holding at its end, the
-//!   instant EnergyPlus stamps it with); with Average the mean of its minutes; with Linear the
-//!   mean of minutes ramped linearly from the previous `Until` value to this one;
+//!   an hourly value its hour, a list's or a file's item its `Minutes per Item`), and a timestep of
+//!   N per hour takes, with `Interpolate` No, the value of its last minute (the one holding at its
+//!   end, the instant EnergyPlus stamps it with); with Average the mean of its minutes; with Linear
+//!   the value at its end of minutes ramped linearly from the previous `Until` value to this one (a
+//!   list's items are not ramped: EnergyPlus 25.2 reads a `Schedule:Day:List` at Linear as at No);
 //! - a day's type (its weekday, or a holiday, design day or custom day) and whether it is in
 //!   daylight saving are the run's calendar's ([`super::calendar`]: the model's special days and
 //!   daylight saving, and the weather file's when the RunPeriod uses them); `AllOtherDays` fills
@@ -248,15 +250,16 @@ pub struct Schedules<'a> {
 /// Classes a shade's `Transmittance Schedule Name` may name.
 const YEAR_CLASSES: [&str; 4] = ["Schedule:Constant", "Schedule:Compact", "Schedule:Year", "Schedule:File"];
 /// Classes a week's day type may name.
-const DAY_CLASSES: [&str; 2] = ["Schedule:Day:Hourly", "Schedule:Day:Interval"];
+const DAY_CLASSES: [&str; 3] = ["Schedule:Day:Hourly", "Schedule:Day:Interval", "Schedule:Day:List"];
 const LIMITS: &str = "ScheduleTypeLimits";
-const WEEK: &str = "Schedule:Week:Daily";
+/// Classes a `Schedule:Year` may name for its weeks.
+const WEEK_CLASSES: [&str; 2] = ["Schedule:Week:Daily", "Schedule:Week:Compact"];
 
 impl<'a> Schedules<'a> {
     /// The schedules of `objects` (from `file`, whose folder is `dir`).
     pub fn new(file: &'a str, objects: &'a [IdfObject], dir: Option<&Path>) -> Self {
         let mut by_name: HashMap<String, Vec<&IdfObject>> = HashMap::new();
-        let classes = YEAR_CLASSES.iter().chain(&DAY_CLASSES).chain(&[LIMITS, WEEK]);
+        let classes = YEAR_CLASSES.iter().chain(&DAY_CLASSES).chain(&WEEK_CLASSES).chain(&[LIMITS]);
         for o in objects.iter().filter(|o| classes.clone().any(|c| o.is(c))) {
             if let Some(n) = o.name() {
                 by_name.entry(n.to_ascii_lowercase()).or_default().push(o);
@@ -390,14 +393,17 @@ impl<'a> Schedules<'a> {
             let index = match weeks.iter().position(|w| w.0.eq_ignore_ascii_case(at(0))) {
                 Some(index) => index,
                 None => {
-                    let Some(week) = self.find(&[WEEK], at(0)) else {
-                        return Err(self.bad(object, format!("Schedule Week Name '{}' names no Schedule:Week:Daily in the model", at(0))));
+                    let Some(week) = self.find(&WEEK_CLASSES, at(0)) else {
+                        return Err(self.bad(
+                            object,
+                            format!("Schedule Week Name '{}' names no Schedule:Week:Daily or Schedule:Week:Compact in the model", at(0)),
+                        ));
                     };
-                    let mut types = [None; DAY_TYPES];
-                    for (t, slot) in types.iter_mut().enumerate() {
-                        *slot = Some(days.len());
-                        days.push(self.day(week, week.field(t + 1), DAY_TYPE_NAMES[t])?);
-                    }
+                    let types = if week.is("Schedule:Week:Daily") {
+                        self.week_daily(week, &mut days)?
+                    } else {
+                        self.week_compact(week, &mut days)?
+                    };
                     weeks.push((at(0).to_string(), types));
                     weeks.len() - 1
                 }
@@ -427,11 +433,56 @@ impl<'a> Schedules<'a> {
         Ok(Source::Calendar { days, periods })
     }
 
-    /// A week's day schedule for one day type: `Schedule:Day:Hourly` or `Schedule:Day:Interval`.
-    fn day(&self, week: &IdfObject, name: &str, day_type: &str) -> Result<Day> {
+    /// `Schedule:Week:Daily`: a day schedule per day type, in [`DAY_TYPE_NAMES`] order; pushes
+    /// them to `days` and returns each type's index there.
+    fn week_daily(&self, week: &IdfObject, days: &mut Vec<Day>) -> Result<[Option<usize>; DAY_TYPES]> {
+        let mut types = [None; DAY_TYPES];
+        for (t, slot) in types.iter_mut().enumerate() {
+            *slot = Some(days.len());
+            let field = format!("field '{} Schedule:Day Name'", DAY_TYPE_NAMES[t]);
+            days.push(self.day(week, week.field(t + 1), &field)?);
+        }
+        Ok(types)
+    }
+
+    /// `Schedule:Week:Compact`: pairs of a `DayType List` (`For:` words, as in `Schedule:Compact`)
+    /// and a day schedule; every day type must be given once, as EnergyPlus requires ("Missing
+    /// some day assignments" and a duplicate are severe errors there). Pushes the days to `days`
+    /// and returns each type's index there.
+    fn week_compact(&self, week: &IdfObject, days: &mut Vec<Day>) -> Result<[Option<usize>; DAY_TYPES]> {
+        let mut types = [None; DAY_TYPES];
+        for (k, pair) in week.fields.get(1..).unwrap_or(&[]).chunks(2).enumerate() {
+            let (list, name) = (pair[0].trim(), pair.get(1).map_or("", |n| n.trim()));
+            if list.is_empty() && name.is_empty() {
+                continue;
+            }
+            let at = 2 * k + 2;
+            let given = types.map(|t| t.is_some());
+            let chosen = for_day_types(list, &given, "in this week")
+                .map_err(|why| self.bad(week, format!("field {at} 'DayType List {}' {why}", k + 1)))?;
+            let index = days.len();
+            days.push(self.day(week, name, &format!("field {} 'Schedule:Day Name {}'", at + 1, k + 1))?);
+            for (slot, on) in types.iter_mut().zip(chosen) {
+                if on {
+                    *slot = Some(index);
+                }
+            }
+        }
+        if let Some(t) = types.iter().position(Option::is_none) {
+            return Err(self.bad(week, format!("its DayType Lists give {} no day schedule (use AllOtherDays)", DAY_TYPE_NAMES[t])));
+        }
+        Ok(types)
+    }
+
+    /// A week's day schedule, named in `week`'s `field`: `Schedule:Day:Hourly`, `:Interval` or
+    /// `:List`.
+    fn day(&self, week: &IdfObject, name: &str, field: &str) -> Result<Day> {
         let Some(day) = self.find(&DAY_CLASSES, name) else {
-            return Err(self.bad(week, format!("field '{day_type} Schedule:Day Name': '{name}' names no Schedule:Day:Hourly or :Interval")));
+            return Err(self.bad(week, format!("{field}: '{name}' names no Schedule:Day:Hourly, :Interval or :List")));
         };
+        if day.is("Schedule:Day:List") {
+            return self.day_list(day);
+        }
         if day.is("Schedule:Day:Hourly") {
             let untils =
                 (0..24).map(|h| Ok(((h + 1) * 60, self.number(day, h + 2, &format!("Hour {}", h + 1))?))).collect::<Result<Vec<_>>>()?;
@@ -450,6 +501,25 @@ impl<'a> Schedules<'a> {
         }
         check_untils(&untils).map_err(|why| self.bad(day, why))?;
         Ok(Day::from_untils(&untils, interpolate))
+    }
+
+    /// `Schedule:Day:List`: a value per `Minutes per Item` minutes from midnight, exactly as many as
+    /// fill the day (EnergyPlus refuses fewer or more, and minutes that do not divide an hour).
+    fn day_list(&self, day: &IdfObject) -> Result<Day> {
+        let interpolate = Interpolate::parse(day.field(2))
+            .ok_or_else(|| self.bad(day, "field 'Interpolate to Timestep' is not No, Average or Linear"))?;
+        let minutes = self.whole(day, 3, "Minutes per Item", 1)?;
+        if minutes > 60 || 60 % minutes != 0 {
+            return Err(self.bad(day, format!("field 'Minutes per Item': {minutes} does not divide an hour")));
+        }
+        let given = day.fields.len().saturating_sub(4);
+        let wanted = DAY_MINUTES / minutes;
+        if given != wanted {
+            return Err(self.bad(day, format!("it has {given} values, and {minutes}-minute items need {wanted} to fill the day")));
+        }
+        let values = (0..wanted).map(|k| self.number(day, 4 + k, &format!("Value {}", k + 1))).collect::<Result<Vec<_>>>()?;
+        let minutes = (0..DAY_MINUTES).map(|m| values[m / minutes]).collect();
+        Ok(Day { minutes, interpolate })
     }
 
     /// `Schedule:File`: one column of a text file, `Minutes per Item` each, from 1 January 00:00.
@@ -559,29 +629,7 @@ impl Compact {
         if self.through.is_none() {
             return Err("comes before any For:".into());
         }
-        let upper = text.to_ascii_uppercase();
-        let mut chosen = [false; DAY_TYPES];
-        let mut valid = false;
-        for (word, types) in FOR_WORDS {
-            if upper.contains(word) {
-                for &t in types {
-                    if chosen[t] || self.types[t].is_some() {
-                        return Err(format!("gives {} a second time in this Through:", DAY_TYPE_NAMES[t]));
-                    }
-                    chosen[t] = true;
-                }
-                valid = true;
-            }
-        }
-        if upper.contains("ALLOTHERDAY") {
-            for (on, given) in chosen.iter_mut().zip(&self.types) {
-                *on |= given.is_none();
-            }
-            valid = true;
-        }
-        if !valid {
-            return Err(format!("'{text}' names no day type"));
-        }
+        let chosen = for_day_types(text, &self.types.map(|t| t.is_some()), "in this Through:")?;
         self.open = Some((chosen, Vec::new()));
         self.interpolate = Interpolate::No;
         Ok(())
@@ -627,6 +675,38 @@ impl Compact {
             None => Err("field 'Through': there is none, so no date reaches 12/31".into()),
         }
     }
+}
+
+/// The day types a `For:` field (or a week's `DayType List`) names, found as EnergyPlus's
+/// `ProcessForDayTypes` finds them: by the words its text contains ([`FOR_WORDS`]: `Weekday` or
+/// `Weekdays`, `SummerDesignDay`, …), then `AllOtherDay(s)` for every type not yet `given`. A day
+/// type given twice (in this field or before it, `scope` saying where) is refused, as EnergyPlus
+/// does.
+fn for_day_types(text: &str, given: &[bool; DAY_TYPES], scope: &str) -> std::result::Result<[bool; DAY_TYPES], String> {
+    let upper = text.to_ascii_uppercase();
+    let mut chosen = [false; DAY_TYPES];
+    let mut valid = false;
+    for (word, types) in FOR_WORDS {
+        if upper.contains(word) {
+            for &t in types {
+                if chosen[t] || given[t] {
+                    return Err(format!("gives {} a second time {scope}", DAY_TYPE_NAMES[t]));
+                }
+                chosen[t] = true;
+            }
+            valid = true;
+        }
+    }
+    if upper.contains("ALLOTHERDAY") {
+        for (on, given) in chosen.iter_mut().zip(given) {
+            *on |= !given;
+        }
+        valid = true;
+    }
+    if !valid {
+        return Err(format!("'{text}' names no day type"));
+    }
+    Ok(chosen)
 }
 
 /// The words a `For:` field's day types are found by, with the day types ([`DAY_TYPE_NAMES`]

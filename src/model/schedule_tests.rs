@@ -232,3 +232,60 @@ fn schedule_file_days_in_plain_and_leap_years_and_daylight_saving() {
     assert!(e.contains("Schedule:File 'H'") && e.contains("field 'Number of Hours of Data': 9000 is neither 8760 nor 8784"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `Schedule:Week:Compact` gives day schedules by `For:` words (the prefix optional,
+/// `AllOtherDays` for the rest); `Schedule:Day:List` holds a value per `Minutes per Item`, read at
+/// each timestep's end (No, and Linear as EnergyPlus 25.2 reads it) or averaged over it.
+#[test]
+fn week_compact_and_day_list_read_as_energyplus_does() {
+    let hours: Vec<String> = (0..24).map(|h| format!("{}", h as f64 / 100.0)).collect();
+    let tens: Vec<String> = (0..144).map(|k| format!("{}", (k % 3) as f64 / 2.0)).collect();
+    let text = format!(
+        "Schedule:Year, Y, , W, 1, 1, 12, 31;\n\
+         Schedule:Week:Compact, W, For: Weekdays, HOURS, Weekends Holiday, TENS, For: AllOtherDays, LINEAR;\n\
+         Schedule:Day:List, HOURS, , No, 60, {};\nSchedule:Day:List, TENS, , Average, 10, {};\n\
+         Schedule:Day:List, LINEAR, , Linear, 10, {};\nRunPeriod, R, 1, 1, 2017, 12, 31, 2017;",
+        hours.join(", "),
+        tens.join(", "),
+        tens.join(", ")
+    );
+    let v = schedule(&text, "Y").unwrap().values(N4).unwrap();
+    // 2017 starts on a Sunday: 1 January takes TENS, 2 January (Monday) HOURS.
+    assert_eq!((v[row(2, 12, 0)], v[row(2, 12, 15)]), (0.11, 0.12), "hour 12 is 11:00–12:00");
+    // 10-minute items 0, 0.5, 1, 0, …: the step 00:00–00:15 averages 10 minutes of 0 and 5 of 0.5.
+    assert!((v[row(1, 0, 15)] - 0.5 / 3.0).abs() < 1e-12, "{}", v[row(1, 0, 15)]);
+    let list = schedule(&text.replace("For: Weekdays, HOURS, Weekends Holiday, TENS, For: AllOtherDays, LINEAR", "AllDays, LINEAR"), "Y");
+    let v = list.unwrap().values(N4).unwrap();
+    assert_eq!((v[row(1, 0, 15)], v[row(1, 0, 30)]), (0.5, 1.0), "Linear: the item holding at the step's end, not ramped");
+}
+
+/// A week that leaves a day type without a day schedule or gives one twice, a day type it cannot
+/// read, a day schedule that does not exist, and a list of the wrong length, with items that do
+/// not divide an hour or a value that is not a number: each refused naming object, field and reason.
+#[test]
+fn week_compact_and_day_list_refusals_name_object_field_and_reason() {
+    let day = "Schedule:Day:List, D, , No, 60, 0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0.5;\n";
+    let week = |pairs: &str| schedule(&format!("Schedule:Year, Y, , W, 1, 1, 12, 31;\nSchedule:Week:Compact, W, {pairs};\n{day}"), "Y");
+    let e = week("For: Weekdays, D, For: Weekends, D").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Week:Compact 'W' (line 2): its DayType Lists give Holiday no day schedule"), "{e}");
+    let e = week("For: Weekdays, D, For: Monday Holiday, D, AllOtherDays, D").unwrap_err().to_string();
+    assert!(
+        e.contains("Schedule:Week:Compact 'W'") && e.contains("field 4 'DayType List 2' gives Monday a second time in this week"),
+        "{e}"
+    );
+    let e = week("For: Someday, D").unwrap_err().to_string();
+    assert!(e.contains("field 2 'DayType List 1' 'For: Someday' names no day type"), "{e}");
+    let e = week("AllDays, NOPE").unwrap_err().to_string();
+    assert!(e.contains("field 3 'Schedule:Day Name 1': 'NOPE' names no Schedule:Day:Hourly, :Interval or :List"), "{e}");
+    let list = |body: &str| schedule(&format!("Schedule:Year, Y, , W, 1, 1, 12, 31;\nSchedule:Week:Compact, W, AllDays, D;\n{body}"), "Y");
+    let e = list("Schedule:Day:List, D, , No, 60, 0,0,0;").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Day:List 'D' (line 3): it has 3 values, and 60-minute items need 24 to fill the day"), "{e}");
+    let e = list("Schedule:Day:List, D, , No, 7, 0;").unwrap_err().to_string();
+    assert!(e.contains("Schedule:Day:List 'D'") && e.contains("field 'Minutes per Item': 7 does not divide an hour"), "{e}");
+    let e = list(&day.replace("0.5;", "x;")).unwrap_err().to_string();
+    assert!(e.contains("Schedule:Day:List 'D'") && e.contains("field 'Value 24': 'x' is not a number"), "{e}");
+    let e = list(&day.replace("No, 60", "Sometimes, 60")).unwrap_err().to_string();
+    assert!(e.contains("field 'Interpolate to Timestep' is not No, Average or Linear"), "{e}");
+    let e = schedule("Schedule:Year, Y, , W, 1, 1, 12, 31;", "Y").unwrap_err().to_string();
+    assert!(e.contains("'W' names no Schedule:Week:Daily or Schedule:Week:Compact"), "{e}");
+}

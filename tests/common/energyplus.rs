@@ -1,7 +1,7 @@
 //! Where the round-trip tests find EnergyPlus 25.2, and how they tell EnergyPlus's own one-step
-//! glitches from disagreements ([`energyplus_glitch`]).
+//! glitches ([`energyplus_glitch`]) and figure overflows ([`super::overflow`]) from disagreements.
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 /// The EnergyPlus binary: `ENERGYPLUS`, else the one `npm test` installs into .venv-ep. Panics
@@ -45,19 +45,26 @@ pub struct Glitch {
 }
 
 /// Timesteps where sunlit (`ours`) and EnergyPlus (`theirs`) disagree on dark against lit, split
-/// into EnergyPlus's own one-step glitches, named, and the rest.
+/// into EnergyPlus's own one-step glitches and figure overflows, named, and the rest.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct DarkLit {
-    /// Disagreements that are not glitches: these count against sunlit.
+    /// Disagreements that are neither: these count against sunlit.
     pub disagreements: usize,
     /// EnergyPlus's own one-step glitches ([`energyplus_glitch`]), in step order.
     pub glitches: Vec<Glitch>,
+    /// Steps where EnergyPlus's clipping ran out of figures ([`super::overflow`]), in step order.
+    pub overflows: Vec<Glitch>,
 }
 
 impl DarkLit {
-    /// `N EnergyPlus glitches named, M disagreements`, the line every comparison prints.
+    /// `N EnergyPlus glitches named, M disagreements` (with `, K figure overflows named` before the
+    /// disagreements when there are any), the line every comparison prints.
     pub fn summary(&self) -> String {
-        format!("{} EnergyPlus glitches named, {} disagreements", self.glitches.len(), self.disagreements)
+        let overflows = match self.overflows.len() {
+            0 => String::new(),
+            k => format!(", {k} figure overflows named"),
+        };
+        format!("{} EnergyPlus glitches named{overflows}, {} disagreements", self.glitches.len(), self.disagreements)
     }
 }
 
@@ -90,13 +97,22 @@ pub fn energyplus_glitch(ours: &[f64], theirs: &[f64], i: usize) -> bool {
 /// Classifies the dark/lit disagreements of two columns of one run's timesteps (see [`DarkLit`]).
 #[allow(dead_code)] // Not every test file that uses `common` compares columns.
 pub fn dark_lit(ours: &[f64], theirs: &[f64]) -> DarkLit {
+    dark_lit_with(ours, theirs, &BTreeSet::new())
+}
+
+/// [`dark_lit`], with the steps `overflows` (the surface's steps that carry EnergyPlus's figure
+/// overflow, [`super::overflow::figure_overflows`]) named apart when the two disagree there.
+#[allow(dead_code)] // Not every test file that uses `common` compares columns.
+pub fn dark_lit_with(ours: &[f64], theirs: &[f64], overflows: &BTreeSet<usize>) -> DarkLit {
     let lit = |v: f64| v > 0.0;
     let mut out = DarkLit::default();
     for i in 0..ours.len().min(theirs.len()) {
         if lit(ours[i]) == lit(theirs[i]) {
             continue;
         }
-        if energyplus_glitch(ours, theirs, i) {
+        if overflows.contains(&i) {
+            out.overflows.push(Glitch { step: i, energyplus: theirs[i], sunlit: ours[i] });
+        } else if energyplus_glitch(ours, theirs, i) {
             out.glitches.push(Glitch { step: i, energyplus: theirs[i], sunlit: ours[i] });
         } else {
             out.disagreements += 1;
@@ -132,6 +148,44 @@ pub fn stamp(step: usize, per_hour: usize, first_day: usize, leap: bool) -> Stri
         day -= len;
     }
     format!("{:02}/{:02} {:02}:{:02}", month + 1, day + 1, minutes / 60, minutes % 60)
+}
+
+/// A weather file as an actual leap year's, for EnergyPlus to run 366 days: `source` (a TMY file)
+/// with every record dated 2020, a Feb 29 (a copy of Feb 28's 24 hours) inserted before 1 March,
+/// and its header saying a leap year is observed; written into `dir` as `STEM_2020.epw`. Every
+/// row is counted, so a wrong edit fails here rather than in EnergyPlus.
+#[allow(dead_code)] // Not every test file that uses `common` runs a leap year.
+pub fn leap_weather(source: &Path, dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(source).unwrap_or_else(|e| panic!("{}: {e}", source.display()));
+    let mut out = String::new();
+    let mut feb28 = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if i < 8 {
+            out.push_str(&line.replacen("HOLIDAYS/DAYLIGHT SAVINGS,No,", "HOLIDAYS/DAYLIGHT SAVINGS,Yes,", 1));
+            out.push('\n');
+            continue;
+        }
+        let rest = line.split_once(',').map_or("", |(_, rest)| rest);
+        if let Some(hour) = rest.strip_prefix("2,28,") {
+            feb28.push(format!("2020,2,29,{hour}"));
+        }
+        if rest.starts_with("3,1,1,") {
+            assert_eq!(feb28.len(), 24, "{}: Feb 28 has {} hours", source.display(), feb28.len());
+            for row in feb28.drain(..) {
+                out.push_str(&row);
+                out.push('\n');
+            }
+        }
+        out.push_str("2020,");
+        out.push_str(rest);
+        out.push('\n');
+    }
+    assert_eq!(out.lines().count(), 8 + 8784, "{}: not 8,760 hourly records", source.display());
+    let stem = source.file_stem().map_or("weather".into(), |s| s.to_string_lossy().into_owned());
+    let path = dir.join(format!("{stem}_2020.epw"));
+    #[allow(clippy::unwrap_used)] // A test helper: a scratch folder that cannot be written fails the test.
+    std::fs::write(&path, out).unwrap();
+    path
 }
 
 /// `sunlit annual MODEL --epw WEATHER --engine exact -o CSV EXTRA…`: the command's output (the

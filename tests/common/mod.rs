@@ -3,6 +3,7 @@
 
 pub mod energyplus;
 pub mod inside;
+pub mod overflow;
 
 use std::path::{Path, PathBuf};
 
