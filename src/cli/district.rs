@@ -38,6 +38,12 @@ pub(super) struct DistrictArgs {
     /// Only these buildings' surfaces receive (ids, comma-separated).
     #[arg(long, value_name = "ID,...")]
     buildings: Option<String>,
+    /// Receivers by attribute, KEY=VALUE (also !=, <, <=, >, >=): the surface's semantic
+    /// surface's attributes, else its CityObject's, else its parents'. Numbers compare as numbers
+    /// (storeysAboveGround>=3); text as a case-insensitive glob (function=resid*). Repeatable: a
+    /// receiver meets every rule, beside --receivers and --buildings.
+    #[arg(long = "where", value_name = "KEY=VALUE")]
+    where_rules: Vec<String>,
     /// Level of detail read (2.2, or 2 for any 2.x); default: each object's highest.
     #[arg(long, value_name = "LOD")]
     lod: Option<String>,
@@ -129,6 +135,9 @@ impl DistrictArgs {
         for r in &self.receivers {
             words.extend(["--receivers".into(), r.clone()]);
         }
+        for w in &self.where_rules {
+            words.extend(["--where".into(), w.clone()]);
+        }
         let optional = [
             ("--buildings", self.buildings.clone()),
             ("--lod", self.lod.clone()),
@@ -152,7 +161,14 @@ impl DistrictArgs {
     fn load(&self) -> LoadOptions {
         let buildings =
             self.buildings.as_deref().unwrap_or("").split(',').map(str::trim).filter(|b| !b.is_empty()).map(String::from).collect();
-        LoadOptions { receivers: self.receivers.clone(), north: self.north, buildings, lod: self.lod.clone(), ..Default::default() }
+        LoadOptions {
+            receivers: self.receivers.clone(),
+            north: self.north,
+            buildings,
+            lod: self.lod.clone(),
+            attribute_rules: self.where_rules.clone(),
+            ..Default::default()
+        }
     }
 }
 

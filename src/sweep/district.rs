@@ -675,6 +675,7 @@ mod tests {
             geometry: 0,
             index: 0,
             rings: vec![ring.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()],
+            attributes: Default::default(),
         }
     }
 
