@@ -686,34 +686,10 @@ fn receivers_by_attribute_alike_in_info_annual_and_district() {
     assert_eq!(names(&["--where", "function!=office", "--where", "storeysAboveGround>1"]), house, "rules together");
     let steep = names(&["--receivers", "RoofSurface", "--where", "slope>30"]);
     assert_eq!(steep, ["NL.B.house.part/RoofSurface/5", "NL.B.house.part/RoofSurface/6"]);
-    // Refused, naming the rule and its attribute: in info, annual (no CSV) and district (no folder).
+    // The same rule in annual and district gives the same receivers; the cadastre stays valid.
     let dir = scratch("city-where");
     let epw = dir.join("site.epw");
     std::fs::write(&epw, varying_epw()).unwrap();
-    for (rule, why) in [
-        ("function=shop", "--where function=shop: of the 15 surfaces chosen, 15 have the attribute 'function', and none meets the rule"),
-        ("usage=x", "--where usage=x: no surface of the 15 chosen has the attribute 'usage'"),
-        ("storeysAboveGround<two", "invalid --where: 'storeysAboveGround<two': < compares numbers, and 'two' is not one"),
-    ] {
-        let info = sunlit(&["info", BLOCK, "--where", rule]);
-        assert_eq!(info.status.code(), Some(1), "{rule}");
-        assert!(stderr(&info).contains(why), "{rule}: {}", stderr(&info));
-        let csv = dir.join("none.csv");
-        let annual = sunlit(&["annual", BLOCK, "--location", "52,5,1", "-o", csv.to_str().unwrap(), "--where", rule]);
-        assert_eq!(annual.status.code(), Some(1), "{rule}");
-        assert!(stderr(&annual).contains(why) && !csv.exists(), "{rule}: {}", stderr(&annual));
-        let out = dir.join("none");
-        let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--where", rule]);
-        assert_eq!(run.status.code(), Some(1), "{rule}");
-        assert!(stderr(&run).contains(why) && !out.exists(), "{rule}: {}", stderr(&run));
-    }
-    let out = dir.join("none");
-    let flat = ["--tile", "50", "--context", "50", "--receivers", "RoofSurface", "--where", "slope<30"];
-    let run = district(Path::new(BLOCK), &epw, &out, &flat);
-    assert_eq!(run.status.code(), Some(1));
-    assert!(stderr(&run).contains("of the 3 surfaces chosen, 2 have the attribute 'slope', and none meets the rule"), "{}", stderr(&run));
-    assert!(!out.exists());
-    // The same rule in annual and district gives the same receivers; the cadastre stays valid.
     let csv = dir.join("house.csv");
     let annual = sunlit(&[
         "annual",
@@ -742,6 +718,39 @@ fn receivers_by_attribute_alike_in_info_annual_and_district() {
     sorted.sort();
     assert_eq!(rows, sorted);
     assert_valid_cityjson(&out.join("cadastre.city.json"));
+}
+
+/// A `--where` rule that leaves no surface is refused naming the rule and its attribute, in
+/// `info`, `annual` (no CSV) and `district` (no folder: its first pass puts the rules to every
+/// surface, as the load does, before anything is written); so is a malformed rule.
+#[test]
+fn a_where_rule_leaving_no_surface_is_refused_before_anything_is_written() {
+    let dir = scratch("city-where-none");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    for (rule, why) in [
+        ("function=shop", "--where function=shop: of the 15 surfaces chosen, 15 have the attribute 'function', and none meets the rule"),
+        ("usage=x", "--where usage=x: no surface of the 15 chosen has the attribute 'usage'"),
+        ("storeysAboveGround<two", "invalid --where: 'storeysAboveGround<two': < compares numbers, and 'two' is not one"),
+    ] {
+        let info = sunlit(&["info", BLOCK, "--where", rule]);
+        assert_eq!(info.status.code(), Some(1), "{rule}");
+        assert!(stderr(&info).contains(why), "{rule}: {}", stderr(&info));
+        let csv = dir.join("none.csv");
+        let annual = sunlit(&["annual", BLOCK, "--location", "52,5,1", "-o", csv.to_str().unwrap(), "--where", rule]);
+        assert_eq!(annual.status.code(), Some(1), "{rule}");
+        assert!(stderr(&annual).contains(why) && !csv.exists(), "{rule}: {}", stderr(&annual));
+        let out = dir.join("none");
+        let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--where", rule]);
+        assert_eq!(run.status.code(), Some(1), "{rule}");
+        assert!(stderr(&run).contains(why) && !out.exists(), "{rule}: {}", stderr(&run));
+    }
+    let out = dir.join("none");
+    let flat = ["--tile", "50", "--context", "50", "--receivers", "RoofSurface", "--where", "slope<30"];
+    let run = district(Path::new(BLOCK), &epw, &out, &flat);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(stderr(&run).contains("of the 3 surfaces chosen, 2 have the attribute 'slope', and none meets the rule"), "{}", stderr(&run));
+    assert!(!out.exists());
 }
 
 /// `MultiSolid` geometry is read: CityJSON 2.0 gives it to no `Building`, so here it is an
@@ -792,4 +801,67 @@ fn a_multisolid_is_read_and_shades_a_roof_as_its_analytic_shadow() {
         let got = pollster::block_on(Exact { scene: &scene }.answer(&requests)).unwrap()[0].fraction;
         assert!((got - want).abs() < 1e-4, "sun at {altitude}°: sunlit {got}, the analytic shadow {want}");
     }
+}
+
+/// `district --year-table` writes every receiver's whole-year table, `cadastre-year.csv`, and it
+/// is the CSV `sunlit annual` writes of the city for the same receivers: the same header (the
+/// same columns in the same order) and the same stamps, each value within 1e-9, with
+/// `--engine exact` and a context reaching across the city (the radius that holds every shadow);
+/// here from tiles of 30 m counted by two child processes a few receivers a batch, each batch's
+/// table a part file of its tile. A second run counts nothing and writes the same table.
+#[test]
+fn district_year_tables_are_annuals_csv_of_the_same_receivers() {
+    let dir = scratch("district-year-table");
+    let city = dir.join("district.city.json");
+    std::fs::write(&city, sunlit::model::city_write::district_cityjson(3, 3, 7)).unwrap();
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let annual_csv = dir.join("annual.csv");
+    let (c, e, a) = (city.to_str().unwrap(), epw.to_str().unwrap(), annual_csv.to_str().unwrap());
+    #[rustfmt::skip]
+    let annual = sunlit(&[
+        "annual", c, "--epw", e, "-o", a, "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5",
+        "--timesteps-per-hour", "1",
+    ]);
+    assert!(annual.status.success(), "{}", stderr(&annual));
+    let out = dir.join("tiled");
+    let args = ["--tile", "30", "--context", "1000", "--jobs", "2", "--receiver-batch", "7", "--year-table"];
+    let run = district(&city, &epw, &out, &args);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let parts = std::fs::read_dir(out.join("year")).unwrap().count();
+    let tiles = std::fs::read_dir(out.join(".done")).unwrap().count();
+    assert!(tiles >= 4 && parts > tiles, "{parts} parts of {tiles} tiles");
+    let table = std::fs::read_to_string(out.join("cadastre-year.csv")).unwrap();
+    let whole = std::fs::read_to_string(&annual_csv).unwrap();
+    let (mut t, mut w) = (table.lines(), whole.lines());
+    let header = w.next().unwrap();
+    assert_eq!(t.next().unwrap(), header);
+    assert!(header.split(',').count() > 40, "{header}");
+    let mut rows = 0;
+    let mut differ = 0;
+    for (x, y) in t.by_ref().zip(w.by_ref()) {
+        let (xs, ys): (Vec<&str>, Vec<&str>) = (x.split(',').collect(), y.split(',').collect());
+        assert_eq!((xs[0], xs.len()), (ys[0], ys.len()), "row {rows}");
+        for (a, b) in xs[1..xs.len() - 1].iter().zip(&ys[1..]) {
+            let (a, b): (f64, f64) = (a.parse().unwrap(), b.parse().unwrap());
+            assert!((a - b).abs() <= 1e-9, "row {rows}: {a} tiled, {b} by annual");
+        }
+        differ += (x != y) as usize;
+        rows += 1;
+    }
+    assert_eq!((rows, t.next(), w.next()), (8760, None, None));
+    assert!(
+        whole
+            .lines()
+            .skip(1)
+            .any(|l| l.split(',').skip(1).any(|v| !v.is_empty() && v.parse::<f64>().unwrap() > 0.0 && v.parse::<f64>().unwrap() < 1.0)),
+        "some partial shade"
+    );
+    // The same origin and the same views: the same bytes, too.
+    assert_eq!(differ, 0, "rows that differ as text");
+    // The cadastre written with the option passes cjval; a second run counts nothing, same table.
+    assert_valid_cityjson(&out.join("cadastre.city.json"));
+    let again = district(&city, &epw, &out, &args);
+    assert!(again.status.success() && stderr(&again).contains("0 to count"), "{}", stderr(&again));
+    assert!(std::fs::read_to_string(out.join("cadastre-year.csv")).unwrap() == table);
 }

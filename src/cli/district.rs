@@ -84,6 +84,11 @@ pub(super) struct DistrictArgs {
     /// point's in cadastre-points-pvlib.csv (pvlib) and cadastre-points-sam.json (SAM pvsamv1).
     #[arg(long, requires = "grid")]
     pv: bool,
+    /// Also each receiver's whole-year table of sunlit fractions, the CSV `sunlit annual CITY -o
+    /// FILE.csv` writes for the same receivers: cadastre-year.csv (each tile's in year/). Without
+    /// it a tile keeps annual sums only.
+    #[arg(long)]
+    year_table: bool,
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
@@ -154,6 +159,9 @@ impl DistrictArgs {
         }
         if self.pv {
             words.push("--pv".into());
+        }
+        if self.year_table {
+            words.push("--year-table".into());
         }
         words
     }
@@ -241,6 +249,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
             grid,
             pv: args.pv,
             batch: args.receiver_batch.unwrap_or(district::RECEIVER_BATCH),
+            year_table: args.year_table.then(|| dir.clone()),
         };
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }
@@ -288,7 +297,7 @@ fn count_one(
     let start = Instant::now();
     let log = record::log_path(dir, &district::tile_id(k));
     let counted =
-        district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, casters, stages }| {
+        district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, year, casters, stages }| {
             let seconds = start.elapsed().as_secs_f64();
             eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
             eprintln!("tile {k} stages: {}", stages.line());
@@ -305,7 +314,7 @@ fn count_one(
             let stages = Some(stages);
             district::write_tile(
                 dir,
-                &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, stages, peak_mib },
+                &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, year, stages, peak_mib },
             )?;
             eprintln!("tile {k}: record written in {:.1} s", written.elapsed().as_secs_f64());
             Ok(())
