@@ -107,7 +107,11 @@ impl AttributeRule {
             (Value::String(s), _) => self.glob.is_match(s),
             (Value::Array(items), _) => items.iter().any(|i| self.equal(i)),
             (Value::Null, _) => false,
-            (other, _) => self.glob.is_match(other.to_string()) || other.to_string() == self.value,
+            (other, _) => {
+                // A boolean (or an object) as its JSON text: `true`, `false`.
+                let text = other.to_string();
+                self.glob.is_match(&text) || text == self.value
+            }
         }
     }
 }
