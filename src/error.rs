@@ -148,6 +148,13 @@ pub enum NoReceivers {
     Unnamed,
     /// Any other reason, in words that name no parameter.
     Other(String),
+    /// The `where` rules (receivers by attribute) left no surface of those otherwise chosen.
+    Where {
+        /// The rule (or rules, comma-separated) that left none, as given.
+        rule: String,
+        /// Why, naming the attribute.
+        reason: String,
+    },
 }
 
 /// What went wrong on the GPU (a lost device is [`Error::DeviceLost`]).
@@ -214,6 +221,7 @@ impl Error {
         match self {
             Error::Argument { what, .. } | Error::Unmatched { what, .. } => Some(what),
             Error::NoReceivers(NoReceivers::Unmatched(_)) => Some("receivers"),
+            Error::NoReceivers(NoReceivers::Where { .. }) => Some("where"),
             Error::TimestepMismatch { .. } => Some("timesteps_per_hour"),
             _ => None,
         }
@@ -293,6 +301,7 @@ impl NoReceivers {
                 format!("the models have no named node with a mesh (name nodes, mark them in extras, or use {})", name("receivers"))
             }
             NoReceivers::Other(reason) => reason.clone(),
+            NoReceivers::Where { rule, reason } => format!("{} {rule}: {reason}", name("where")),
         }
     }
 }

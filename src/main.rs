@@ -273,6 +273,12 @@ struct ModelArgs {
     /// CityJSON: only these buildings' surfaces receive (Building or BuildingPart ids, comma-separated).
     #[arg(long, value_name = "ID,...")]
     buildings: Option<String>,
+    /// CityJSON: receivers by attribute, KEY=VALUE (also !=, <, <=, >, >=): the surface's semantic
+    /// surface's attributes, else its CityObject's, else its parents'. Numbers compare as numbers
+    /// (storeysAboveGround>=3); text as a case-insensitive glob (function=resid*). Repeatable: a
+    /// receiver meets every rule, beside --receivers and --buildings.
+    #[arg(long = "where", value_name = "KEY=VALUE")]
+    where_rules: Vec<String>,
     /// CityJSON: the level of detail read (2.2, or 2 for any 2.x); default: each object's highest.
     #[arg(long, value_name = "LOD")]
     lod: Option<String>,
@@ -301,6 +307,7 @@ impl ModelArgs {
                 .map(String::from)
                 .collect(),
             lod: self.lod.clone(),
+            attribute_rules: self.where_rules.clone(),
             up: self.up.as_deref().map(ObjUp::parse).transpose().unwrap_or_default().unwrap_or_default(),
             unit: self.unit.as_deref().map(ObjUnit::parse).transpose().unwrap_or_default().unwrap_or_default(),
             ..Default::default()

@@ -664,3 +664,204 @@ fn composite_solids_receive_and_get_their_values_back_in_place() {
     let totals: std::collections::BTreeSet<u64> = rows.values().map(|v| (v[4] * 1000.0) as u64).collect();
     assert!(totals.len() > 6, "{rows:?}");
 }
+
+/// Receivers by attribute (`--where`), one rule for `info`, `annual` and `district`: the block's
+/// house part takes its `Building`'s `function` (a part sees its parents' attributes), the
+/// courtyard's `measuredHeight` 10.0 meets `=10` (numbers compare as numbers, not as the text
+/// `10.0`), the roofs' semantic surfaces' own `slope` selects them with `--receivers`, and a rule
+/// that leaves no surface is refused naming its attribute, before anything is written.
+#[test]
+fn receivers_by_attribute_alike_in_info_annual_and_district() {
+    assert_valid_cityjson(Path::new(BLOCK));
+    let names = |args: &[&str]| receiver_names(&info(&[&[BLOCK][..], args].concat()));
+    let house = names(&["--where", "function=residential"]);
+    assert_eq!(house.len(), 6, "{house:?}");
+    assert!(house.iter().all(|n| n.starts_with("NL.B.house.part/")), "{house:?}");
+    assert_eq!(names(&["--where", "function = RESID*"]), house, "text is a case-insensitive glob");
+    let courtyard = names(&["--where", "measuredHeight=10"]);
+    assert_eq!(courtyard.len(), 9, "{courtyard:?}");
+    assert!(courtyard.iter().all(|n| n.starts_with("NL.B.courtyard/")), "{courtyard:?}");
+    assert_eq!(names(&["--where", "storeysAboveGround>=3"]), courtyard);
+    assert_eq!(names(&["--where", "storeysAboveGround<3"]), house);
+    assert_eq!(names(&["--where", "function!=office", "--where", "storeysAboveGround>1"]), house, "rules together");
+    let steep = names(&["--receivers", "RoofSurface", "--where", "slope>30"]);
+    assert_eq!(steep, ["NL.B.house.part/RoofSurface/5", "NL.B.house.part/RoofSurface/6"]);
+    // The same rule in annual and district gives the same receivers; the cadastre stays valid.
+    let dir = scratch("city-where");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let csv = dir.join("house.csv");
+    let annual = sunlit(&[
+        "annual",
+        BLOCK,
+        "--epw",
+        epw.to_str().unwrap(),
+        "-o",
+        csv.to_str().unwrap(),
+        "--where",
+        "function=residential",
+        "--engine",
+        "exact",
+        "--days-per-year",
+        "4",
+        "--samples-per-day",
+        "5",
+    ]);
+    assert!(annual.status.success(), "{}", stderr(&annual));
+    let header = std::fs::read_to_string(&csv).unwrap().lines().next().unwrap().to_string();
+    assert_eq!(header, format!("Surface Name,{},", house.join(",")));
+    let out = dir.join("house");
+    let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--where", "function=residential"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let rows: Vec<String> = tile_rows(&out).keys().cloned().collect();
+    let mut sorted = house.clone();
+    sorted.sort();
+    assert_eq!(rows, sorted);
+    assert_valid_cityjson(&out.join("cadastre.city.json"));
+}
+
+/// A `--where` rule that leaves no surface is refused naming the rule and its attribute, in
+/// `info`, `annual` (no CSV) and `district` (no folder: its first pass puts the rules to every
+/// surface, as the load does, before anything is written); so is a malformed rule.
+#[test]
+fn a_where_rule_leaving_no_surface_is_refused_before_anything_is_written() {
+    let dir = scratch("city-where-none");
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    for (rule, why) in [
+        ("function=shop", "--where function=shop: of the 15 surfaces chosen, 15 have the attribute 'function', and none meets the rule"),
+        ("usage=x", "--where usage=x: no surface of the 15 chosen has the attribute 'usage'"),
+        ("storeysAboveGround<two", "invalid --where: 'storeysAboveGround<two': < compares numbers, and 'two' is not one"),
+    ] {
+        let info = sunlit(&["info", BLOCK, "--where", rule]);
+        assert_eq!(info.status.code(), Some(1), "{rule}");
+        assert!(stderr(&info).contains(why), "{rule}: {}", stderr(&info));
+        let csv = dir.join("none.csv");
+        let annual = sunlit(&["annual", BLOCK, "--location", "52,5,1", "-o", csv.to_str().unwrap(), "--where", rule]);
+        assert_eq!(annual.status.code(), Some(1), "{rule}");
+        assert!(stderr(&annual).contains(why) && !csv.exists(), "{rule}: {}", stderr(&annual));
+        let out = dir.join("none");
+        let run = district(Path::new(BLOCK), &epw, &out, &["--tile", "50", "--context", "50", "--where", rule]);
+        assert_eq!(run.status.code(), Some(1), "{rule}");
+        assert!(stderr(&run).contains(why) && !out.exists(), "{rule}: {}", stderr(&run));
+    }
+    let out = dir.join("none");
+    let flat = ["--tile", "50", "--context", "50", "--receivers", "RoofSurface", "--where", "slope<30"];
+    let run = district(Path::new(BLOCK), &epw, &out, &flat);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(stderr(&run).contains("of the 3 surfaces chosen, 2 have the attribute 'slope', and none meets the rule"), "{}", stderr(&run));
+    assert!(!out.exists());
+}
+
+/// `MultiSolid` geometry is read: CityJSON 2.0 gives it to no `Building`, so here it is an
+/// `OtherConstruction`, two 9 m pillars 2 m × 2 m standing 1 m south of a 10 m × 10 m flat roof
+/// 3 m high, with semantics nested a solid, a shell and a surface deep. Its 12 surfaces are
+/// read with their types, and it shades the roof as the analytic shadow says: for the sun due
+/// south at altitude a, each pillar darkens a 2 m wide strip of the roof min(10, 6 / tan a − 1) m
+/// long.
+#[test]
+fn a_multisolid_is_read_and_shades_a_roof_as_its_analytic_shadow() {
+    let dir = scratch("city-multisolid");
+    let mut vertices: Vec<[i64; 3]> = Vec::new();
+    let mut cube = |lo: [i64; 3], hi: [i64; 3]| {
+        let base = vertices.len();
+        for k in 0..8 {
+            vertices.push([0, 1, 2].map(|a| if k >> a & 1 == 1 { hi[a] } else { lo[a] }));
+        }
+        // Roof, ground, then four walls; corners by bits (x, y, z), counter-clockwise from outside.
+        let faces = [[4, 5, 7, 6], [0, 2, 3, 1], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        serde_json::json!([faces.map(|f| [f.map(|i| base + i)])])
+    };
+    let house = cube([0, 0, 0], [10_000, 10_000, 3_000]);
+    let pillars = [cube([2_000, -3_000, 0], [4_000, -1_000, 9_000]), cube([6_000, -3_000, 0], [8_000, -1_000, 9_000])];
+    let surfaces = serde_json::json!([{"type": "RoofSurface"}, {"type": "GroundSurface"}, {"type": "WallSurface"}]);
+    let values = serde_json::json!([[0, 1, 2, 2, 2, 2]]);
+    let doc = serde_json::json!({"type": "CityJSON", "version": "2.0", "transform": {"scale": [0.001, 0.001, 0.001], "translate": [85000.0, 446000.0, 0.0]},
+        "CityObjects": {
+            "H": {"type": "Building", "geometry": [{"type": "Solid", "lod": "2.2", "boundaries": house, "semantics": {"surfaces": surfaces, "values": values}}]},
+            "P": {"type": "OtherConstruction", "geometry": [{"type": "MultiSolid", "lod": "2", "boundaries": pillars,
+                "semantics": {"surfaces": surfaces, "values": [values, values]}}]}},
+        "vertices": vertices});
+    let city = dir.join("pillars.city.json");
+    std::fs::write(&city, doc.to_string()).unwrap();
+    assert_valid_cityjson(&city);
+    let bytes = std::fs::read(&city).unwrap();
+    let read = sunlit::model::cityjson::read_city("pillars.city.json", &bytes, None).unwrap();
+    let pillar: Vec<&str> = read.surfaces.iter().filter(|s| s.object == "P").map(|s| s.name.as_str()).collect();
+    assert_eq!(pillar.len(), 12, "{pillar:?}");
+    assert_eq!((pillar[0], pillar[6], pillar[11]), ("P/RoofSurface/0", "P/RoofSurface/6", "P/WallSurface/11"));
+    assert!(read.surfaces.iter().filter(|s| s.object == "P").all(|s| s.building.is_none()), "a pillar only casts");
+    let options = sunlit::model::LoadOptions { receivers: vec!["RoofSurface".into()], ..Default::default() };
+    let scene = sunlit::model::load_bytes(&[("pillars.city.json".into(), bytes)], &options).unwrap();
+    assert_eq!(scene.receivers.iter().map(|r| r.name.as_str()).collect::<Vec<_>>(), ["H/RoofSurface/0"]);
+    for altitude in [30.0_f64, 45.0, 60.0] {
+        let strip = (6.0 / altitude.to_radians().tan() - 1.0).clamp(0.0, 10.0);
+        let want = 1.0 - 2.0 * 2.0 * strip / 100.0;
+        let requests = [ViewRequest::new(0, common::sun(180.0, altitude))];
+        let got = pollster::block_on(Exact { scene: &scene }.answer(&requests)).unwrap()[0].fraction;
+        assert!((got - want).abs() < 1e-4, "sun at {altitude}°: sunlit {got}, the analytic shadow {want}");
+    }
+}
+
+/// `district --year-table` writes every receiver's whole-year table, `cadastre-year.csv`, and it
+/// is the CSV `sunlit annual` writes of the city for the same receivers: the same header (the
+/// same columns in the same order) and the same stamps, each value within 1e-9, with
+/// `--engine exact` and a context reaching across the city (the radius that holds every shadow);
+/// here from tiles of 30 m counted by two child processes a few receivers a batch, each batch's
+/// table a part file of its tile. A second run counts nothing and writes the same table.
+#[test]
+fn district_year_tables_are_annuals_csv_of_the_same_receivers() {
+    let dir = scratch("district-year-table");
+    let city = dir.join("district.city.json");
+    std::fs::write(&city, sunlit::model::city_write::district_cityjson(3, 3, 7)).unwrap();
+    let epw = dir.join("site.epw");
+    std::fs::write(&epw, varying_epw()).unwrap();
+    let annual_csv = dir.join("annual.csv");
+    let (c, e, a) = (city.to_str().unwrap(), epw.to_str().unwrap(), annual_csv.to_str().unwrap());
+    #[rustfmt::skip]
+    let annual = sunlit(&[
+        "annual", c, "--epw", e, "-o", a, "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5",
+        "--timesteps-per-hour", "1",
+    ]);
+    assert!(annual.status.success(), "{}", stderr(&annual));
+    let out = dir.join("tiled");
+    let args = ["--tile", "30", "--context", "1000", "--jobs", "2", "--receiver-batch", "7", "--year-table"];
+    let run = district(&city, &epw, &out, &args);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let parts = std::fs::read_dir(out.join("year")).unwrap().count();
+    let tiles = std::fs::read_dir(out.join(".done")).unwrap().count();
+    assert!(tiles >= 4 && parts > tiles, "{parts} parts of {tiles} tiles");
+    let table = std::fs::read_to_string(out.join("cadastre-year.csv")).unwrap();
+    let whole = std::fs::read_to_string(&annual_csv).unwrap();
+    let (mut t, mut w) = (table.lines(), whole.lines());
+    let header = w.next().unwrap();
+    assert_eq!(t.next().unwrap(), header);
+    assert!(header.split(',').count() > 40, "{header}");
+    let mut rows = 0;
+    let mut differ = 0;
+    for (x, y) in t.by_ref().zip(w.by_ref()) {
+        let (xs, ys): (Vec<&str>, Vec<&str>) = (x.split(',').collect(), y.split(',').collect());
+        assert_eq!((xs[0], xs.len()), (ys[0], ys.len()), "row {rows}");
+        for (a, b) in xs[1..xs.len() - 1].iter().zip(&ys[1..]) {
+            let (a, b): (f64, f64) = (a.parse().unwrap(), b.parse().unwrap());
+            assert!((a - b).abs() <= 1e-9, "row {rows}: {a} tiled, {b} by annual");
+        }
+        differ += (x != y) as usize;
+        rows += 1;
+    }
+    assert_eq!((rows, t.next(), w.next()), (8760, None, None));
+    assert!(
+        whole
+            .lines()
+            .skip(1)
+            .any(|l| l.split(',').skip(1).any(|v| !v.is_empty() && v.parse::<f64>().unwrap() > 0.0 && v.parse::<f64>().unwrap() < 1.0)),
+        "some partial shade"
+    );
+    // The same origin and the same views: the same bytes, too.
+    assert_eq!(differ, 0, "rows that differ as text");
+    // The cadastre written with the option passes cjval; a second run counts nothing, same table.
+    assert_valid_cityjson(&out.join("cadastre.city.json"));
+    let again = district(&city, &epw, &out, &args);
+    assert!(again.status.success() && stderr(&again).contains("0 to count"), "{}", stderr(&again));
+    assert!(std::fs::read_to_string(out.join("cadastre-year.csv")).unwrap() == table);
+}

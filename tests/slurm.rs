@@ -260,7 +260,8 @@ fn slurm_array_equals_the_local_sweep_and_a_cancelled_task_is_all_a_resubmission
 
 /// `sunlit district --slurm`: an array task a tile and a merge job; its cadastre equals the
 /// one-process run's (one tile holding the whole district) within 1e-9, with the exact engine and
-/// a context reaching across the district.
+/// a context reaching across the district, and so does its `--year-table` (byte for byte: the
+/// tasks write their parts, the merge job merges them).
 #[test]
 fn slurm_district_tiles_equal_the_one_process_run() {
     let _one = ONE_CLUSTER.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
@@ -273,7 +274,7 @@ fn slurm_district_tiles_equal_the_one_process_run() {
     let (one, tiled) = (dir.join("one"), dir.join("tiled"));
     let args = |out: &Path, tile: &str| -> Vec<String> {
         let words = ["district", city.to_str().unwrap(), "--epw", epw.to_str().unwrap(), "-o", out.to_str().unwrap(), "--tile", tile];
-        let small = ["--context", "1000", "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5"];
+        let small = ["--context", "1000", "--engine", "exact", "--days-per-year", "4", "--samples-per-day", "5", "--year-table"];
         words.iter().chain(&small).map(|w| w.to_string()).collect()
     };
     let run = Command::new(env!("CARGO_BIN_EXE_sunlit")).args(args(&one, "1000")).output().unwrap();
@@ -296,5 +297,9 @@ fn slurm_district_tiles_equal_the_one_process_run() {
         assert!(x.iter().zip(y).all(|(x, y)| (x - y).abs() <= 1e-9), "{name}: {x:?} against {y:?}");
     }
     assert!(std::fs::read_dir(tiled.join(".done")).unwrap().count() >= 4, "several tiles");
+    let table = |out: &Path| std::fs::read_to_string(out.join("cadastre-year.csv")).unwrap();
+    let (whole, tasks) = (table(&one), table(&tiled));
+    assert_eq!(whole.lines().count(), 8761);
+    assert!(whole == tasks, "the year tables differ");
     drop(cluster);
 }

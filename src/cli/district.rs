@@ -38,6 +38,12 @@ pub(super) struct DistrictArgs {
     /// Only these buildings' surfaces receive (ids, comma-separated).
     #[arg(long, value_name = "ID,...")]
     buildings: Option<String>,
+    /// Receivers by attribute, KEY=VALUE (also !=, <, <=, >, >=): the surface's semantic
+    /// surface's attributes, else its CityObject's, else its parents'. Numbers compare as numbers
+    /// (storeysAboveGround>=3); text as a case-insensitive glob (function=resid*). Repeatable: a
+    /// receiver meets every rule, beside --receivers and --buildings.
+    #[arg(long = "where", value_name = "KEY=VALUE")]
+    where_rules: Vec<String>,
     /// Level of detail read (2.2, or 2 for any 2.x); default: each object's highest.
     #[arg(long, value_name = "LOD")]
     lod: Option<String>,
@@ -78,6 +84,11 @@ pub(super) struct DistrictArgs {
     /// point's in cadastre-points-pvlib.csv (pvlib) and cadastre-points-sam.json (SAM pvsamv1).
     #[arg(long, requires = "grid")]
     pv: bool,
+    /// Also each receiver's whole-year table of sunlit fractions, the CSV `sunlit annual CITY -o
+    /// FILE.csv` writes for the same receivers: cadastre-year.csv (each tile's in year/). Without
+    /// it a tile keeps annual sums only.
+    #[arg(long)]
+    year_table: bool,
     /// Tiles counted side by side, each a child process.
     #[arg(long, value_name = "N", default_value_t = 1)]
     jobs: usize,
@@ -129,6 +140,9 @@ impl DistrictArgs {
         for r in &self.receivers {
             words.extend(["--receivers".into(), r.clone()]);
         }
+        for w in &self.where_rules {
+            words.extend(["--where".into(), w.clone()]);
+        }
         let optional = [
             ("--buildings", self.buildings.clone()),
             ("--lod", self.lod.clone()),
@@ -146,13 +160,23 @@ impl DistrictArgs {
         if self.pv {
             words.push("--pv".into());
         }
+        if self.year_table {
+            words.push("--year-table".into());
+        }
         words
     }
 
     fn load(&self) -> LoadOptions {
         let buildings =
             self.buildings.as_deref().unwrap_or("").split(',').map(str::trim).filter(|b| !b.is_empty()).map(String::from).collect();
-        LoadOptions { receivers: self.receivers.clone(), north: self.north, buildings, lod: self.lod.clone(), ..Default::default() }
+        LoadOptions {
+            receivers: self.receivers.clone(),
+            north: self.north,
+            buildings,
+            lod: self.lod.clone(),
+            attribute_rules: self.where_rules.clone(),
+            ..Default::default()
+        }
     }
 }
 
@@ -225,6 +249,7 @@ pub(super) fn district(args: DistrictArgs) -> Result<()> {
             grid,
             pv: args.pv,
             batch: args.receiver_batch.unwrap_or(district::RECEIVER_BATCH),
+            year_table: args.year_table.then(|| dir.clone()),
         };
         return count_one(&dir, &city, &tiling, k, &tile, &fingerprint);
     }
@@ -272,7 +297,7 @@ fn count_one(
     let start = Instant::now();
     let log = record::log_path(dir, &district::tile_id(k));
     let counted =
-        district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, casters, stages }| {
+        district::count_tile(city, tiling, k, tile, &mut |_| Ok(())).and_then(|TileCount { rows, points, pv, year, casters, stages }| {
             let seconds = start.elapsed().as_secs_f64();
             eprintln!("tile {k}: {} surfaces, {} points against {casters} in {seconds:.1} s", rows.len(), points.len());
             eprintln!("tile {k} stages: {}", stages.line());
@@ -289,7 +314,7 @@ fn count_one(
             let stages = Some(stages);
             district::write_tile(
                 dir,
-                &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, stages, peak_mib },
+                &TileDone { tile: k, fingerprint: fingerprint.clone(), seconds, casters, rows, points, pv, year, stages, peak_mib },
             )?;
             eprintln!("tile {k}: record written in {:.1} s", written.elapsed().as_secs_f64());
             Ok(())

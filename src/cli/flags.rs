@@ -55,6 +55,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("context", "--context"),
     ("min_kwh_m2", "--min-kwh-m2"),
     ("buildings", "--buildings"),
+    ("where", "--where"),
     ("lod", "--lod"),
     ("up", "--up"),
     ("unit", "--unit"),

@@ -13,6 +13,8 @@
 //!   (so no surface is counted twice);
 //! - names `OBJECT_ID/TYPE/INDEX`: TYPE the semantic type (`Surface` without one), INDEX the
 //!   surface's position in its geometry (shells and solids flattened in file order);
+//! - attributes ([`SurfaceAttributes`]): a surface's semantic surface's own, its CityObject's,
+//!   then its parents', which receiver rules by attribute read ([`crate::model::city_where`]);
 //! - buildings: a `BuildingPart` (or any child) belongs to its root `Building` for
 //!   [`CitySurface::building`]; only `Building` and `BuildingPart` surfaces may receive, the rest
 //!   (terrain, vegetation, roads) only cast shadows;
@@ -23,6 +25,7 @@
 //! tolerance (0.5°, 1 mm: [`crate::scene`]).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
 use serde_json::Value;
@@ -70,6 +73,37 @@ pub struct CitySurface {
     pub index: usize,
     /// Rings in local coordinates (real − offset): the exterior, then holes.
     pub rings: Vec<Vec<DVec3>>,
+    /// The attributes a receiver rule may ask of it ([`crate::model::city_where`]).
+    pub attributes: SurfaceAttributes,
+}
+
+/// One attribute map of a CityJSON file, shared by the surfaces that see it.
+pub type AttributeMap = Arc<serde_json::Map<String, Value>>;
+
+/// A surface's attributes, where a rule looks for a key in turn: its semantic surface's own
+/// (every member but `type`, `parent` and `children`), then its CityObject's `attributes`, then
+/// each parent's up to the root (a `BuildingPart` sees its `Building`'s). The first holding the
+/// key answers.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SurfaceAttributes {
+    layers: Vec<AttributeMap>,
+}
+
+impl SurfaceAttributes {
+    /// Layers nearest first (the semantic surface's, the object's, its parents').
+    pub fn of(layers: Vec<AttributeMap>) -> Self {
+        Self { layers }
+    }
+
+    /// The value of `key`, from the first layer that has it.
+    pub fn get(&self, key: &str) -> Option<&Value> {
+        self.layers.iter().find_map(|m| m.get(key))
+    }
+
+    /// Whether any layer has `key` (null or not).
+    pub fn has(&self, key: &str) -> bool {
+        self.get(key).is_some()
+    }
 }
 
 /// Whether a file name is a CityJSON model: `.city.json`, `.city.jsonl`, `.jsonl`, or a `.json`
@@ -369,12 +403,14 @@ impl<'a> Reader<'a> {
         for (id, object) in objects.iter().filter(|(id, _)| keep.is_none_or(|keep| keep(id))) {
             let kind = object.get("type").and_then(Value::as_str).unwrap_or("");
             let building = BUILDING_TYPES.contains(&kind).then(|| root_of(id, &parents).to_string());
+            let inherited = object_attributes(id, objects, &parents);
             let geometries = object.get("geometry").and_then(Value::as_array).map(Vec::as_slice).unwrap_or(&[]);
             let Some(g) = self.choose(geometries) else { continue };
             let err = |reason: String| Error::object(&file, format!("CityObject '{id}'"), format!("geometry {g}: {reason}"));
             let mut found = self.surfaces(&geometries[g], &vertices).map_err(err)?;
-            for (index, (kind, rings)) in found.drain(..).enumerate() {
+            for (index, Surface { kind, own, rings }) in found.drain(..).enumerate() {
                 let type_name = kind.clone().unwrap_or_else(|| "Surface".into());
+                let layers = own.into_iter().chain(inherited.iter().cloned()).collect();
                 out(CitySurface {
                     name: format!("{id}/{type_name}/{index}"),
                     object: id.clone(),
@@ -383,6 +419,7 @@ impl<'a> Reader<'a> {
                     geometry: g,
                     index,
                     rings,
+                    attributes: SurfaceAttributes { layers },
                 });
             }
         }
@@ -479,8 +516,43 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// A surface as read: its semantic type and rings.
-type Surface = (Option<String>, Vec<Vec<DVec3>>);
+/// A surface as read.
+struct Surface {
+    /// Its semantic type.
+    kind: Option<String>,
+    /// Its semantic surface's own attributes, if it has any.
+    own: Option<AttributeMap>,
+    /// Its rings.
+    rings: Vec<Vec<DVec3>>,
+}
+
+/// The `attributes` of object `id` and of each of its parents up to the root, nearest first
+/// (those without attributes left out); a cycle stops at the start.
+fn object_attributes(id: &str, objects: &serde_json::Map<String, Value>, parents: &HashMap<&str, &str>) -> Vec<AttributeMap> {
+    let mut chain = Vec::new();
+    let mut at = id;
+    for _ in 0..=parents.len() {
+        if let Some(map) = objects.get(at).and_then(|o| o.get("attributes")).and_then(Value::as_object) {
+            chain.push(Arc::new(map.clone()));
+        }
+        match parents.get(at) {
+            Some(&p) if p != id => at = p,
+            _ => break,
+        }
+    }
+    chain
+}
+
+/// A semantic surface's own attributes: every member but those CityJSON gives a meaning.
+fn semantic_attributes(semantic: &Value) -> Option<AttributeMap> {
+    let own: serde_json::Map<String, Value> = semantic
+        .as_object()?
+        .iter()
+        .filter(|(k, _)| !matches!(k.as_str(), "type" | "parent" | "children"))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    (!own.is_empty()).then(|| Arc::new(own))
+}
 
 /// Three finite numbers.
 fn point(v: &Value) -> Option<DVec3> {
@@ -523,18 +595,20 @@ fn flatten(g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, S
     if let Some(v) = g.pointer("/semantics/values") {
         collect(v, depth, &mut values).map_err(|_| format!("semantics.values are not nested as a {kind}'s boundaries"))?;
     }
+    // One map a semantic surface, shared by every surface pointing at it.
+    let owns: Vec<Option<AttributeMap>> = semantic_surfaces.iter().map(semantic_attributes).collect();
     surfaces
         .iter()
         .enumerate()
         .map(|(s, surface)| {
-            let semantic = match values.get(s).copied() {
-                None | Some(Value::Null) => None,
+            let (semantic, own) = match values.get(s).copied() {
+                None | Some(Value::Null) => (None, None),
                 Some(v) => {
                     let k = v.as_u64().ok_or_else(|| format!("surface {s}: semantic value {v} is not an index"))? as usize;
                     let obj = semantic_surfaces.get(k).ok_or_else(|| {
                         format!("surface {s}: semantic value {k} points nowhere ({} semantic surfaces)", semantic_surfaces.len())
                     })?;
-                    Some(obj.get("type").and_then(Value::as_str).unwrap_or("Surface").to_string())
+                    (Some(obj.get("type").and_then(Value::as_str).unwrap_or("Surface").to_string()), owns.get(k).cloned().flatten())
                 }
             };
             let rings = surface.as_array().ok_or_else(|| format!("surface {s} is not a list of rings"))?;
@@ -543,7 +617,7 @@ fn flatten(g: &Value, vertices: &[DVec3]) -> std::result::Result<Vec<Surface>, S
             }
             let rings =
                 rings.iter().enumerate().map(|(r, ring)| read_ring(ring, vertices).map_err(|e| format!("surface {s}, ring {r}: {e}")));
-            Ok((semantic, rings.collect::<std::result::Result<Vec<_>, String>>()?))
+            Ok(Surface { kind: semantic, own, rings: rings.collect::<std::result::Result<Vec<_>, String>>()? })
         })
         .collect()
 }
@@ -612,7 +686,12 @@ pub fn city_model(city: &City, north_deg: f64) -> Result<GltfModel> {
             veil: NodeVeil::default(),
             mesh: meshes.len(),
             transform: turn,
-            city: Some(CityTags { building: s.building.clone(), object: s.object.clone(), kind: s.kind.clone() }),
+            city: Some(CityTags {
+                building: s.building.clone(),
+                object: s.object.clone(),
+                kind: s.kind.clone(),
+                attributes: s.attributes.clone(),
+            }),
         });
         meshes.push(mesh);
     }

@@ -58,6 +58,8 @@ pub struct CityTags {
     pub object: String,
     /// Semantic type (`RoofSurface`, …).
     pub kind: Option<String>,
+    /// Its attributes, which `where` rules select by.
+    pub attributes: super::cityjson::SurfaceAttributes,
 }
 
 impl GltfNode {

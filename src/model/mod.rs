@@ -13,11 +13,13 @@
 //!
 //! City models (CityJSON, [`cityjson`]) and OBJ ([`obj`]) are read into the same node list as
 //! glTF. A CityJSON surface is a node `OBJECT_ID/TYPE/INDEX`; `receivers` globs match its name or
-//! its semantic type (`RoofSurface`), `buildings` limits receivers to the named buildings, and by
-//! default its roofs and walls are marked as receivers. Only buildings' surfaces ever receive.
+//! its semantic type (`RoofSurface`), `buildings` limits receivers to the named buildings,
+//! `attribute_rules` to the surfaces whose attributes meet them ([`city_where`]), and by default
+//! its roofs and walls are marked as receivers. Only buildings' surfaces ever receive.
 pub mod arrays;
 pub mod building;
 pub mod calendar;
+pub mod city_where;
 #[cfg(feature = "fixtures")]
 pub mod city_write;
 pub mod cityjson;
@@ -75,6 +77,10 @@ pub struct LoadOptions {
     /// City models: only these buildings' surfaces receive (ids of `Building`s or their parts);
     /// empty: every building's.
     pub buildings: Vec<String>,
+    /// City models: `where` rules over attributes (`function=residential`, `storeysAboveGround>=3`;
+    /// [`city_where`]): a receiver meets them all, beside `receivers` and `buildings`; empty:
+    /// no rule.
+    pub attribute_rules: Vec<String>,
     /// City models: the level of detail read (`2.2`, or `2` for any 2.x); `None`: each
     /// object's highest.
     pub lod: Option<String>,
@@ -314,6 +320,7 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
         _ => Selection::new(&models, options)?,
     };
     let veils = Veils::new(options)?;
+    let mut rules = city_where::WhereRules::new(&options.attribute_rules)?;
     check_buildings(&models, &options.buildings)?;
     let mut builder = SceneBuilder::new();
     if let Some(origin) = options.origin {
@@ -344,7 +351,10 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
             &mut builder,
             |n| {
                 let explicit = matches!(select, Selection::Globs(..));
-                let hit = select.is_receiver(n) && in_buildings(n, &options.buildings) && (explicit || veils.of(n).is_opaque());
+                let hit = select.is_receiver(n)
+                    && in_buildings(n, &options.buildings)
+                    && rules.admit(n.city.as_ref().map(|c| &c.attributes))
+                    && (explicit || veils.of(n).is_opaque());
                 matched += hit as usize;
                 hit
             },
@@ -353,7 +363,7 @@ fn build(models: Vec<GltfModel>, energyplus: Option<&EnergyPlusInput>, options: 
     }
     veils.check_used()?;
     if matched == 0 {
-        return Err(Error::NoReceivers(select.explain()));
+        return Err(Error::NoReceivers(rules.refusal().unwrap_or_else(|| select.explain())));
     }
     let scene = builder.build()?;
     let mut notes = Vec::new();
@@ -413,46 +423,61 @@ fn in_buildings_of(building: Option<&str>, object: &str, buildings: &[String]) -
 /// a reader that never holds the whole city (a district's first pass), so that a rule no surface
 /// of the file meets is refused before anything is counted or written, as a whole load refuses
 /// it. It follows the load's rule (the `receivers` patterns over a surface's name or semantic
-/// type, else the roofs and walls, else every surface; only the `buildings` asked for) but not
+/// type, else the roofs and walls, else every surface; only the `buildings` asked for; the `where`
+/// rules over attributes) but not
 /// its see-through surfaces, so it refuses only a city where nothing can receive at all.
 pub struct CityReceivers {
     rule: Option<Selection>,
     buildings: Vec<String>,
-    /// Surfaces the patterns match, or without them the roofs and walls.
+    /// Surfaces the patterns match, or without them the roofs and walls (before the `where` rules).
     marked: usize,
-    /// Without patterns, every surface of the buildings asked for.
+    /// Without patterns, every surface of the buildings asked for (before the `where` rules).
     named: usize,
+    /// The `where` rules put to the marked surfaces, and (without patterns) to every surface: the
+    /// load's default falls back to every surface where none is a roof or wall.
+    rules_marked: city_where::WhereRules,
+    rules_named: city_where::WhereRules,
 }
 
 impl CityReceivers {
-    /// The rule of `options` (its `receivers` patterns, else the default), nothing seen yet.
+    /// The rule of `options` (its `receivers` patterns, else the default, and its `where`
+    /// rules), nothing seen yet.
     pub fn new(options: &LoadOptions) -> Result<Self> {
         let rule = if options.receivers.is_empty() { None } else { Some(Selection::globs(&options.receivers)?) };
-        Ok(Self { rule, buildings: options.buildings.clone(), marked: 0, named: 0 })
+        let rules = city_where::WhereRules::new(&options.attribute_rules)?;
+        Ok(Self { rule, buildings: options.buildings.clone(), marked: 0, named: 0, rules_marked: rules.clone(), rules_named: rules })
     }
 
-    /// Counts surface `s` if the rule would let it receive.
+    /// Counts surface `s` if the rule would put it to the `where` rules, and puts it to them.
     pub fn see(&mut self, s: &cityjson::CitySurface) {
         if !in_buildings_of(s.building.as_deref(), &s.object, &self.buildings) {
             return;
         }
-        match &self.rule {
-            Some(Selection::Globs(set, _)) => {
-                self.marked += (set.is_match(&s.name) || s.kind.as_deref().is_some_and(|k| set.is_match(k))) as usize;
-            }
+        let marked = match &self.rule {
+            Some(Selection::Globs(set, _)) => set.is_match(&s.name) || s.kind.as_deref().is_some_and(|k| set.is_match(k)),
             _ => {
                 self.named += 1;
-                self.marked += cityjson::default_receiver(s) as usize;
+                self.rules_named.admit(Some(&s.attributes));
+                cityjson::default_receiver(s)
             }
+        };
+        if marked {
+            self.marked += 1;
+            self.rules_marked.admit(Some(&s.attributes));
         }
     }
 
-    /// The load's own error where no surface seen can receive.
+    /// The load's own error where no surface seen can receive: none chosen, or none of those
+    /// meeting the `where` rules (naming the rule and its attribute).
     pub fn check(&self) -> Result<()> {
-        if self.marked + self.named > 0 {
-            return Ok(());
+        let (chosen, rules) = if self.marked > 0 { (self.marked, &self.rules_marked) } else { (self.named, &self.rules_named) };
+        if chosen == 0 {
+            return Err(Error::NoReceivers(self.rule.as_ref().unwrap_or(&Selection::Named).explain()));
         }
-        Err(Error::NoReceivers(self.rule.as_ref().unwrap_or(&Selection::Named).explain()))
+        match rules.refusal() {
+            Some(why) => Err(Error::NoReceivers(why)),
+            None => Ok(()),
+        }
     }
 }
 

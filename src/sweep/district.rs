@@ -18,7 +18,8 @@
 //! - records: `.done/tile-K.json` per finished tile (the inputs' fingerprint and its rows,
 //!   written atomically after counting), `.failed/tile-K.json` per failed one; the merge writes
 //!   `cadastre.city.json`, `cadastre.csv` and `cadastre-roofs.geojson` (with a grid, also the
-//!   roofs' points) when every tile is done, and `failed.csv` listing the rest;
+//!   roofs' points; with year tables, `cadastre-year.csv`, [`super::district_table`]) when every
+//!   tile is done, and `failed.csv` listing the rest;
 //! - per-point maps on roofs ([`RoofGrid`]): a tile's roofs gridded and each point's year counted
 //!   with the map's exact rays ([`crate::map`]), each roof's usable area from its points; with
 //!   `pv`, their PV tools' files ([`super::district_pv`]).
@@ -30,6 +31,7 @@ use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::district_pv::{self, TilePv};
+use super::district_table::{self, YearPart};
 use super::record::{self, Failed, Fingerprint};
 use crate::count::gpu::CounterOptions;
 use crate::count::hybrid::{EngineKind, HybridEngine, ProfileSource};
@@ -234,7 +236,8 @@ impl CityPlan {
     }
 
     fn add(&mut self, s: CitySurface) {
-        let turn = glam::DMat3::from_rotation_z(-self.north.to_radians());
+        // As the city's model turns it (`cityjson::city_model`), so the box is the scene's.
+        let turn = glam::DMat4::from_rotation_z(-self.north.to_radians());
         let grow = |b: &mut (DVec2, DVec2), p: DVec2| *b = (b.0.min(p), b.1.max(p));
         let blank = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         let object = self.objects.entry(s.object.clone()).or_insert_with(|| (s.building.clone(), blank));
@@ -245,7 +248,10 @@ impl CityPlan {
             if let Some((_, b)) = building.as_mut() {
                 grow(b, p.truncate());
             }
-            let w = turn * *p;
+            // The scene builder centres a whole load on its f32 vertices turned; so does the
+            // box here, bit for bit, so a district's origin is a whole load's (`sunlit annual`'s)
+            // and its tiles' answers are that load's, not a rounding apart.
+            let w = turn.transform_point3(p.as_vec3().as_dvec3());
             self.turned = (self.turned.0.min(w), self.turned.1.max(w));
         }
         if let Some((grounds, _)) = building.filter(|_| is_ground(&s)) {
@@ -377,6 +383,9 @@ pub struct TileSettings<'a> {
     /// Receivers whose year is counted at once ([`RECEIVER_BATCH`] unless chosen): the peak
     /// memory follows it, the answers do not ([`super::district_year`]).
     pub batch: usize,
+    /// The output folder, when the receivers' whole-year tables are asked for: each batch's is
+    /// written there as the tile counts ([`super::district_table`]).
+    pub year_table: Option<PathBuf>,
 }
 
 /// What a tile counted.
@@ -387,6 +396,8 @@ pub struct TileCount {
     pub points: Vec<PointRow>,
     /// With a grid and `pv` (and points): their PV files' contents.
     pub pv: Option<TilePv>,
+    /// With year tables: the parts it wrote.
+    pub year: Vec<YearPart>,
     /// Surfaces it was counted with.
     pub casters: usize,
     /// Where its time went.
@@ -419,7 +430,7 @@ pub fn count_tile_in_batches(
     let tile = tile_of(tiling, k)?;
     let part = tile_city(city, tiling, tile);
     let buildings = tile_buildings(&part, tile, &s.load.buildings);
-    let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, casters: part.surfaces.len(), stages };
+    let empty = TileCount { rows: Vec::new(), points: Vec::new(), pv: None, year: Vec::new(), casters: part.surfaces.len(), stages };
     if buildings.is_empty() {
         return Ok(empty);
     }
@@ -432,7 +443,7 @@ pub fn count_tile_in_batches(
     };
     let engine = HybridEngine::new(&scene, s.engine, s.counter, s.lanes, ProfileSource::Cache)?;
     stages.scene = now() - start;
-    let TileYear { summaries, hours } = tile_year(&engine, &scene, s, batch, &mut stages, progress)?;
+    let TileYear { summaries, hours, parts } = tile_year(&engine, &scene, s, k, batch, &mut stages, progress)?;
     let mut rows = cadastre::rows(&part, &scene, &summaries, &hours)?;
     let start = now();
     let (points, pv) = match s.grid {
@@ -440,7 +451,7 @@ pub fn count_tile_in_batches(
         None => (Vec::new(), None),
     };
     stages.points = now() - start;
-    Ok(TileCount { rows, points, pv, casters: part.surfaces.len(), stages })
+    Ok(TileCount { rows, points, pv, year: parts, casters: part.surfaces.len(), stages })
 }
 
 /// The ids a tile's scene narrows its receivers to: the tile's own buildings, or of those asked
@@ -515,6 +526,9 @@ pub struct TileDone {
     /// With a grid and PV files: its points' SAM sums (its pvlib CSV is in `pv/`).
     #[serde(default)]
     pub pv: Option<SamSums>,
+    /// With year tables: its parts (in `year/`).
+    #[serde(default)]
+    pub year: Vec<YearPart>,
     /// Where its time went (absent in records written before it was kept).
     #[serde(default)]
     pub stages: Option<TileStages>,
@@ -588,6 +602,7 @@ pub fn merge(
     let mut rows: Vec<CadastreRow> = Vec::new();
     let mut points: Vec<PointRow> = Vec::new();
     let mut pv: Vec<(usize, SamSums)> = Vec::new();
+    let mut year: Vec<YearPart> = Vec::new();
     let mut unfinished = Vec::new();
     for t in &tiling.tiles {
         match finished(dir, t.index, fingerprint) {
@@ -595,6 +610,7 @@ pub fn merge(
                 rows.extend(done.rows);
                 points.extend(done.points);
                 pv.extend(done.pv.map(|sums| (t.index, sums)));
+                year.extend(done.year);
             }
             None => {
                 let id = tile_id(t.index);
@@ -634,10 +650,11 @@ pub fn merge(
     }
     // The PV files first: their CSV, streamed from the tiles' files, is what a bad tile file fails.
     let pv_files = district_pv::write_merged(dir, &pv, &position)?;
+    let year_file = district_table::write_merged(dir, &year, &position)?;
     for (path, bytes) in &files {
         write_atomic(path, bytes)?;
     }
-    let written = files.into_iter().map(|(p, _)| p).chain(pv_files).collect();
+    let written = files.into_iter().map(|(p, _)| p).chain(pv_files).chain(year_file).collect();
     Ok(DistrictMerged { written, surfaces: rows.len(), unfinished })
 }
 
@@ -675,6 +692,7 @@ mod tests {
             geometry: 0,
             index: 0,
             rings: vec![ring.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()],
+            attributes: Default::default(),
         }
     }
 

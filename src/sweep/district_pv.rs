@@ -194,23 +194,24 @@ fn merge_in_blocks(
     Ok(())
 }
 
-/// One tile's pvlib CSV read a block of lines at a time, opened for each block and closed after.
-struct TileLines {
-    path: PathBuf,
+/// One tile's pvlib CSV (or a table of [`super::district_table`]) read a block of lines at a
+/// time, opened for each block and closed after; its header line skipped.
+pub(super) struct TileLines {
+    pub(super) path: PathBuf,
     /// Where the next block starts; `None` before the header is skipped (the names come from the
     /// records).
     offset: Option<u64>,
     /// The block's lines, without their line ends.
-    lines: Vec<String>,
+    pub(super) lines: Vec<String>,
 }
 
 impl TileLines {
-    fn new(path: PathBuf) -> Self {
+    pub(super) fn new(path: PathBuf) -> Self {
         Self { path, offset: None, lines: Vec::new() }
     }
 
     /// Reads rows `first..first + n` (of `rows`) into `lines`.
-    fn read_block(&mut self, first: usize, n: usize, rows: usize) -> Result<()> {
+    pub(super) fn read_block(&mut self, first: usize, n: usize, rows: usize) -> Result<()> {
         let io = |source: std::io::Error| Error::Io { path: self.path.clone(), source };
         let mut file = std::fs::File::open(&self.path).map_err(io)?;
         file.seek(SeekFrom::Start(self.offset.unwrap_or(0))).map_err(io)?;

@@ -25,6 +25,7 @@ use crate::platform::{cpu_seconds, seconds as now};
 use crate::scene::Scene;
 use crate::sky::views::sky_views;
 use crate::sweep::district::TileSettings;
+use crate::sweep::district_table::{self, YearPart};
 use crate::year::annual::{Progress, YearStages, annual_receivers_with};
 
 /// Receivers whose year is counted at once. A receiver's year holds at most about 180 kB at
@@ -116,6 +117,8 @@ pub struct TileYear {
     pub summaries: Vec<SurfaceSummary>,
     /// Sun hours, one a receiver.
     pub hours: Vec<f64>,
+    /// With [`TileSettings::year_table`]: each batch's whole-year table, as written.
+    pub parts: Vec<YearPart>,
 }
 
 /// The ranges of `receivers` receivers, `batch` at a time (at least one each).
@@ -124,12 +127,14 @@ pub fn batches(receivers: usize, batch: usize) -> impl Iterator<Item = Range<usi
     (0..receivers.div_ceil(batch)).map(move |k| k * batch..((k + 1) * batch).min(receivers))
 }
 
-/// The sky pass, then the year of `scene`'s receivers `batch` at a time, each batch summed and
-/// dropped; the time of each stage added to `stages`.
+/// The sky pass, then the year of `scene`'s receivers `batch` at a time, each batch summed (and
+/// with [`TileSettings::year_table`], its table written as part of tile `k`'s) and dropped; the
+/// time of each stage added to `stages`.
 pub fn tile_year(
     engine: &HybridEngine,
     scene: &Scene,
     s: &TileSettings,
+    k: usize,
     batch: usize,
     stages: &mut TileStages,
     progress: &mut dyn FnMut(Progress) -> Result<()>,
@@ -141,14 +146,18 @@ pub fn tile_year(
     let views = pollster::block_on(sky_views(engine, scene, s.patches, progress))?;
     stages.sky += now() - start;
     stages.sky_cpu += cpu_seconds() - cpu;
-    let mut out = TileYear { summaries: Vec::with_capacity(scene.receivers.len()), hours: Vec::with_capacity(scene.receivers.len()) };
-    for receivers in batches(scene.receivers.len(), batch) {
+    let n = scene.receivers.len();
+    let mut out = TileYear { summaries: Vec::with_capacity(n), hours: Vec::with_capacity(n), parts: Vec::new() };
+    for (b, receivers) in batches(n, batch).enumerate() {
         let first = receivers.start;
         let (schedule, year) = pollster::block_on(annual_receivers_with(engine, scene, receivers, location, &options, calendar, progress))?;
         stages.add_year(&year);
         let start = now();
         out.summaries.extend(summarize_from(scene, first, &schedule, location, Some((&views, calendar)), Some(s.weather), &[])?);
         out.hours.extend(cadastre::sun_hours(&schedule, location));
+        if let Some(dir) = &s.year_table {
+            out.parts.push(district_table::write_part(dir, k, b, &schedule)?);
+        }
         stages.sums += now() - start;
     }
     Ok(out)
@@ -197,6 +206,7 @@ mod tests {
             grid: None,
             pv: false,
             batch: RECEIVER_BATCH,
+            year_table: None,
         };
         let count = |batch: usize| count_tile_in_batches(&city, &tiling, 0, &s, batch, &mut |_| Ok(())).unwrap();
         let whole = count(usize::MAX);

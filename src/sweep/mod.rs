@@ -8,12 +8,14 @@
 //! - [`slurm`]: the job array, its scripts and the merge job;
 //! - [`district`]: a city model's tiles with their context, their records and the merged cadastre;
 //! - [`district_year`]: a tile's year counted a batch of receivers at a time, and its stages;
-//! - [`district_pv`]: with `--grid --pv`, what PV tools read for the roofs' points, per tile and merged.
+//! - [`district_pv`]: with `--grid --pv`, what PV tools read for the roofs' points, per tile and merged;
+//! - [`district_table`]: with `--year-table`, the receivers' whole-year tables, per tile and merged.
 //!
 //! Native only: it runs processes and writes files.
 
 pub mod district;
 pub mod district_pv;
+pub mod district_table;
 pub mod district_year;
 pub mod manifest;
 pub mod record;
