@@ -180,8 +180,8 @@ pub struct Certifier<'a> {
     index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
-    /// Whether a dark proof may combine casters (composites, halves of a cell): off by default
-    /// until measured on the bench models (docs/energyplus-fidelity.md, "Certificates").
+    /// Whether a dark proof may combine casters (composites, halves of a cell); the year asks
+    /// for it by default (docs/energyplus-fidelity.md, "certs13").
     many_casters: bool,
     /// With `many_casters`: whether a receiver's corners lying on a composite that meets its
     /// plane count as covered by it ([`Self::with_inner_corners`]).
@@ -239,8 +239,8 @@ impl<'a> Certifier<'a> {
 
     /// Lets the dark proof combine casters: composite casters ([`composite`]), halves of a
     /// cell each covered by its own caster, and casters meeting the receiver's plane by their
-    /// part clear of it ([`clipped_in_front`]). Exact either way; off by default until a paired
-    /// timing shows it no dearer (docs/energyplus-fidelity.md, "Certificates").
+    /// part clear of it ([`clipped_in_front`]). Exact either way; the year's default since
+    /// certs13's paired gates (docs/energyplus-fidelity.md, "certs13").
     pub fn with_many_casters(mut self) -> Self {
         // Found once per index: a city's batches of receivers share them, as they share it.
         log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());

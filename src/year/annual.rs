@@ -83,9 +83,8 @@ pub struct AnnualOptions {
     /// one convex polygon, halves of a cell each covered by its own caster, and casters that
     /// meet the receiver's plane by their part clear of it ([`crate::count::certify`]). Exact
     /// (the same CSV wherever measured, with 27 % fewer views on nyt-blocks' floor 20 and 7 %
-    /// fewer on canyon-slots); off by default until a paired
-    /// timing shows floor 20 and blaas-trees-summer no dearer (docs/energyplus-fidelity.md,
-    /// "Certificates").
+    /// fewer on canyon-slots); on by default since certs13's paired gates
+    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`], docs/energyplus-fidelity.md, "certs13").
     pub many_casters: bool,
     /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
     /// corner (a tower's other arm) may be proved dark by that facade, its corners there covered
