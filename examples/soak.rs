@@ -28,6 +28,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         refine: 1.0,
         prove_never_dark: false,
         many_casters: false,
+        inner_corners: false,
     };
     let counter = pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))?;
     let gpu = counter.upload(&scene)?;

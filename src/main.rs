@@ -143,10 +143,15 @@ struct AnnualArgs {
     #[arg(long)]
     prove_never_dark: bool,
     /// With refinement on: let a dark proof combine casters (coplanar panels forming one convex
-    /// polygon, halves of a cell each covered by its own caster). Exact; off by default until
-    /// measured on every bench model.
-    #[arg(long)]
+    /// polygon, halves of a cell each covered by its own caster, a facade clipped where it meets
+    /// the surface's plane). Exact (the same CSV); on by default, --many-casters=false turns it off.
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_value_t = sunlit::year::settings::DEFAULT_MANY_CASTERS, default_missing_value = "true", action = clap::ArgAction::Set)]
     many_casters: bool,
+    /// With --many-casters: let a facade meeting a surface's plane at an inner corner prove it
+    /// dark along their shared edge (no margin there). Exact with the exact engine; off by
+    /// default until shown for the GPU engine.
+    #[arg(long)]
+    inner_corners: bool,
     /// Output CSV, EnergyPlus's eplusshading.csv layout (written atomically).
     #[arg(short = 'o', long = "output", value_name = "FILE.csv")]
     output: PathBuf,
@@ -234,6 +239,7 @@ impl AnnualArgs {
             refine: Some(self.refine),
             prove_never_dark: Some(self.prove_never_dark),
             many_casters: Some(self.many_casters),
+            inner_corners: Some(self.inner_corners),
             dense: Some(self.dense),
             evergreen: Some(self.evergreen),
             leaf_out: self.leaf_out.clone(),

@@ -18,6 +18,7 @@ use sunlit::sun::location::Location;
 use sunlit::sun::position::sun_direction;
 use sunlit::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual, annual_on, compare};
 use sunlit::year::samples::{SamplingPlan, Timesteps};
+use sunlit::year::settings::DEFAULT_MANY_CASTERS;
 
 fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
@@ -26,7 +27,14 @@ fn golden() -> Location {
 fn year(scene: &Scene, method: Method, refine: f64, resolution: u32) -> Schedule {
     let counter = counter(resolution);
     let gpu = counter.upload(scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine, prove_never_dark: false, many_casters: false };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method,
+        refine,
+        prove_never_dark: false,
+        many_casters: false,
+        inner_corners: false,
+    };
     pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| Ok(()))).unwrap()
 }
 
@@ -46,6 +54,7 @@ fn two_lanes_count_the_same_year_as_one() {
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
         many_casters: false,
+        inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut reports = 0;
@@ -74,6 +83,7 @@ fn a_failing_progress_callback_cancels_the_year() {
         refine: 1.0,
         prove_never_dark: false,
         many_casters: false,
+        inner_corners: false,
     };
     let mut reports = Vec::new();
     let result = pollster::block_on(annual(&counter, &gpu, &scene, &golden(), &options, &mut |p| {
@@ -232,8 +242,14 @@ fn cli_bad_annual_input() {
 /// The exact engine's year for `scene` at 4 timesteps an hour, and the views it counted;
 /// `prove_never_dark` as [`AnnualOptions::prove_never_dark`].
 fn exact_year(scene: &Scene, method: Method, prove_never_dark: bool) -> (Schedule, usize) {
-    let options =
-        AnnualOptions { timesteps: Timesteps::new(4).unwrap(), method, refine: DEFAULT_REFINE, prove_never_dark, many_casters: false };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(4).unwrap(),
+        method,
+        refine: DEFAULT_REFINE,
+        prove_never_dark,
+        many_casters: DEFAULT_MANY_CASTERS,
+        inner_corners: false,
+    };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut views = 0;
     let schedule = pollster::block_on(sunlit::year::annual::annual_with(
@@ -370,6 +386,7 @@ fn reported_year(scene: &Scene, method: Method) -> (Vec<sunlit::year::annual::Pr
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
         many_casters: false,
+        inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let engine = Tally::new(scene);
@@ -462,7 +479,8 @@ fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: DEFAULT_MANY_CASTERS,
+        inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
     let mut quiet = |_: sunlit::year::annual::Progress| -> sunlit::Result<()> { Ok(()) };

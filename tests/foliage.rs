@@ -123,7 +123,14 @@ fn golden() -> Location {
 fn year(scene: &Scene, method: Method, refine: f64) -> (Schedule, usize) {
     let counter = counter(256);
     let gpu = counter.upload(scene).unwrap();
-    let options = AnnualOptions { timesteps: Timesteps::new(1).unwrap(), method, refine, prove_never_dark: false, many_casters: false };
+    let options = AnnualOptions {
+        timesteps: Timesteps::new(1).unwrap(),
+        method,
+        refine,
+        prove_never_dark: false,
+        many_casters: false,
+        inner_corners: false,
+    };
     let mut views = 0;
     let schedule = pollster::block_on(annual_with_leaves(&counter, &gpu, scene, &golden(), &options, &NORTHERN, &mut |p| {
         views = p.counted();

@@ -27,6 +27,7 @@ fn options() -> AnnualOptions {
         refine: 1.0,
         prove_never_dark: false,
         many_casters: false,
+        inner_corners: false,
     }
 }
 

@@ -16,6 +16,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("refine", "--refine"),
     ("prove_never_dark", "--prove-never-dark"),
     ("many_casters", "--many-casters"),
+    ("inner_corners", "--inner-corners"),
     ("resolution", "--resolution"),
     ("accuracy", "--accuracy"),
     ("hook", "--hook"),

@@ -19,7 +19,10 @@
 //!   ([`composite`]): coplanar panels that together form one convex polygon. With those
 //!   many-caster proofs, a caster that comes nearer the receiver's plane than the margin (a
 //!   facade meeting it at an inner corner) takes part by its convex part twice the margin in
-//!   front ([`clipped_in_front`]), so its shadows are still cast the margin in front.
+//!   front ([`clipped_in_front`]), so its shadows are still cast the margin in front. With
+//!   [`Certifier::with_inner_corners`] as well (off by default), a receiver's corners lying on
+//!   such a composite (its edge along the inner corner) are covered with no margin, since every
+//!   ray from them starts on the caster.
 //! - **Lit**: no triangle but the receiver's own lies in the volume its points sweep along the
 //!   cone's directions (`R + K`, convex, since the receiver's triangles and the cone are). A
 //!   triangle `T` misses it when it lies behind the receiver's plane (within the exact engine's
@@ -177,9 +180,31 @@ pub struct Certifier<'a> {
     index: Index<'a>,
     shapes: Vec<Shape>,
     extent: f64,
-    /// Whether a dark proof may combine casters (composites, halves of a cell): off by default
-    /// until measured on the bench models (docs/energyplus-fidelity.md, "Certificates").
+    /// Whether a dark proof may combine casters (composites, halves of a cell); the year asks
+    /// for it by default (docs/energyplus-fidelity.md, "certs13").
     many_casters: bool,
+    /// With `many_casters`: whether a receiver's corners lying on a composite that meets its
+    /// plane count as covered by it ([`Self::with_inner_corners`]).
+    inner_corners: bool,
+}
+
+/// A caster made ready for one receiver ([`Certifier::ready`]): what a cell's halves share.
+#[derive(Debug)]
+struct Ready {
+    /// Its corners (clipped where it meets the receiver's plane), relative to the receiver's
+    /// first vertex.
+    corners: Vec<DVec3>,
+    /// Per receiver point: whether it lies on the caster itself (an inner corner's contact,
+    /// [`Certifier::with_inner_corners`]), so that every ray from it meets the caster at its
+    /// start, whatever the sun. Empty where none does.
+    on_caster: Vec<bool>,
+}
+
+impl Ready {
+    /// Whether receiver point `k` lies on the caster.
+    fn on_caster(&self, k: usize) -> bool {
+        self.on_caster.get(k).copied().unwrap_or(false)
+    }
 }
 
 impl Certifier<'static> {
@@ -209,17 +234,30 @@ impl<'a> Certifier<'a> {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index, shapes, extent, many_casters: false }
+        Self { index, shapes, extent, many_casters: false, inner_corners: false }
     }
 
     /// Lets the dark proof combine casters: composite casters ([`composite`]), halves of a
     /// cell each covered by its own caster, and casters meeting the receiver's plane by their
-    /// part clear of it ([`clipped_in_front`]). Exact either way; off by default until a paired
-    /// timing shows it no dearer (docs/energyplus-fidelity.md, "Certificates").
+    /// part clear of it ([`clipped_in_front`]). Exact either way; the year's default since
+    /// certs13's paired gates (docs/energyplus-fidelity.md, "certs13").
     pub fn with_many_casters(mut self) -> Self {
         // Found once per index: a city's batches of receivers share them, as they share it.
         log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());
         self.many_casters = true;
+        self
+    }
+
+    /// With the many-caster proofs ([`Self::with_many_casters`]): a receiver's corner that lies
+    /// on a composite meeting the receiver's plane (the facade of a tower's other arm, at the
+    /// inner corner: [`composite::Composites::holds`], exact, no tolerance) is covered by it at
+    /// every sun, with no margin, and the receiver's other corners as before (inside the clipped
+    /// part's shadow by the margin). The shadow of the composite's part in front of the plane is
+    /// convex and holds both, so it holds the receiver: its lit area is 0. Off by default: the
+    /// exact engines agree (the CSV unchanged), but the GPU's rounding along a shadow edge that
+    /// is the receiver's own edge is not shown (docs/energyplus-fidelity.md, "certs13").
+    pub fn with_inner_corners(mut self) -> Self {
+        self.inner_corners = true;
         self
     }
 
@@ -263,7 +301,7 @@ impl<'a> Certifier<'a> {
         // The halves are tried where the cell has two candidates or more, whether or not each
         // may cover this receiver at all (as before they were made ready once a cell).
         let halvings = if self.many_casters && candidates.len() >= 2 { DARK_HALVINGS } else { 0 };
-        let ready: Vec<Vec<DVec3>> = candidates.into_iter().filter_map(|c| self.ready(shape, c)).collect();
+        let ready: Vec<Ready> = candidates.into_iter().filter_map(|c| self.ready(shape, c)).collect();
         let mut set: Vec<usize> = (0..suns.len()).collect();
         self.dark_in_parts(shape, &ready, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
     }
@@ -282,7 +320,7 @@ impl<'a> Certifier<'a> {
     fn dark_in_parts(
         &self,
         shape: &Shape,
-        candidates: &[Vec<DVec3>],
+        candidates: &[Ready],
         suns: &[DVec3],
         set: &mut [usize],
         cone: &DirectionCone,
@@ -452,7 +490,7 @@ impl<'a> Certifier<'a> {
     /// direction of it): [`Self::ready`], then [`Self::covers_ready`].
     #[cfg(test)]
     fn covers(&self, shape: &Shape, cone: &DirectionCone, caster: Caster) -> bool {
-        self.ready(shape, caster).is_some_and(|corners| self.covers_ready(shape, cone, &corners))
+        self.ready(shape, caster).is_some_and(|ready| self.covers_ready(shape, cone, &ready))
     }
 
     /// `caster`'s corners relative to the receiver's first vertex, where it may cover the
@@ -466,8 +504,9 @@ impl<'a> Certifier<'a> {
     /// ([`clipped_in_front`]), itself convex, so every shadow it proves is cast at least the
     /// margin in front of the plane, as a caster standing clear casts it. A receiver reaching
     /// into the corner is still not proved: its edge there lies in the clipped-off band, outside
-    /// the kept part's shadow.
-    fn ready(&self, shape: &Shape, caster: Caster) -> Option<Vec<DVec3>> {
+    /// the kept part's shadow; unless, with [`Self::with_inner_corners`], the caster is a
+    /// composite and the receiver's corners in that band lie on it.
+    fn ready(&self, shape: &Shape, caster: Caster) -> Option<Ready> {
         let margin = COVER_MARGIN * (1.0 + self.extent);
         let corners: Vec<DVec3> = match caster {
             Caster::Object(o) => self.index.objects.corners(o).iter().map(|&c| self.index.corner(c) - shape.p0).collect(),
@@ -476,10 +515,11 @@ impl<'a> Certifier<'a> {
         if corners.len() < 3 {
             return None;
         }
-        let corners = if corners.iter().all(|c| c.dot(shape.normal) > margin) {
-            corners
+        let (corners, on_caster) = if corners.iter().all(|c| c.dot(shape.normal) > margin) {
+            (corners, Vec::new())
         } else if self.many_casters {
-            clipped_in_front(&corners, shape.normal, 2.0 * margin)?
+            let clipped = clipped_in_front(&corners, shape.normal, 2.0 * margin)?;
+            (clipped, self.contact(shape, caster, margin))
         } else {
             return None;
         };
@@ -487,7 +527,20 @@ impl<'a> Certifier<'a> {
             Caster::Object(o) => self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin),
             Caster::Composite(_) => false,
         };
-        (!open_to_receiver).then_some(corners)
+        (!open_to_receiver).then_some(Ready { corners, on_caster })
+    }
+
+    /// Per receiver point, whether it lies on `caster` ([`Self::with_inner_corners`]; only a
+    /// composite's polygon is tested, exactly): empty where the option is off, the caster is an
+    /// object, or no point does. Never every point: a receiver lying wholly on its caster has
+    /// no area in front of it to prove.
+    fn contact(&self, shape: &Shape, caster: Caster, margin: f64) -> Vec<bool> {
+        let Caster::Composite(c) = caster else { return Vec::new() };
+        if !self.inner_corners {
+            return Vec::new();
+        }
+        let on: Vec<bool> = shape.points.iter().map(|p| self.composites().holds(c, *p, margin)).collect();
+        if on.iter().all(|&x| x) || !on.iter().any(|&x| x) { Vec::new() } else { on }
     }
 
     /// Whether a caster made ready ([`Self::ready`]: its `corners`, relative to the receiver's
@@ -496,8 +549,13 @@ impl<'a> Certifier<'a> {
     /// outside the projection's bounding box is outside the projection: that is looked at first,
     /// without building the hull (most candidates of a cell fail so, and a panelled block has
     /// hundreds of corners).
-    fn covers_ready(&self, shape: &Shape, cone: &DirectionCone, corners: &[DVec3]) -> bool {
+    ///
+    /// A receiver point lying on the caster ([`Ready::on_caster`]) is covered at every sun and
+    /// not tested.
+    fn covers_ready(&self, shape: &Shape, cone: &DirectionCone, ready: &Ready) -> bool {
         let margin = COVER_MARGIN * (1.0 + self.extent);
+        let corners = &ready.corners;
+        let tested = || shape.points.iter().enumerate().filter(|(k, _)| !ready.on_caster(*k)).map(|(_, p)| p);
         let mut flat_corners: Vec<DVec2> = Vec::with_capacity(corners.len());
         cone.generators().iter().all(|g| {
             let (u, v) = perpendicular_basis(*g);
@@ -506,12 +564,12 @@ impl<'a> Certifier<'a> {
             flat_corners.extend(corners.iter().map(|c| flat(*c)));
             let (lo, hi) = flat_corners.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), q| (lo.min(*q), hi.max(*q)));
             let in_box = |q: DVec2| q.cmpge(lo).all() && q.cmple(hi).all();
-            if !shape.points.iter().all(|p| in_box(flat(*p - shape.p0))) {
+            if !tested().all(|p| in_box(flat(*p - shape.p0))) {
                 return false;
             }
             let hull = convex_hull(&flat_corners);
             hull.len() >= 3
-                && shape.points.iter().all(|p| {
+                && tested().all(|p| {
                     let q = flat(*p - shape.p0);
                     (0..hull.len()).all(|k| {
                         let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);

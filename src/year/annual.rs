@@ -83,10 +83,15 @@ pub struct AnnualOptions {
     /// one convex polygon, halves of a cell each covered by its own caster, and casters that
     /// meet the receiver's plane by their part clear of it ([`crate::count::certify`]). Exact
     /// (the same CSV wherever measured, with 27 % fewer views on nyt-blocks' floor 20 and 7 %
-    /// fewer on canyon-slots); off by default until a paired
-    /// timing shows floor 20 and blaas-trees-summer no dearer (docs/energyplus-fidelity.md,
-    /// "Certificates").
+    /// fewer on canyon-slots); on by default since certs13's paired gates
+    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`], docs/energyplus-fidelity.md, "certs13").
     pub many_casters: bool,
+    /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
+    /// corner (a tower's other arm) may be proved dark by that facade, its corners there covered
+    /// with no margin ([`crate::count::certify::Certifier::with_inner_corners`]). Exact for the
+    /// exact engines; off by default until the GPU engine's rounding along that edge is shown to
+    /// agree (docs/energyplus-fidelity.md, "certs13").
+    pub inner_corners: bool,
 }
 
 /// With refinement on, a timestep whose sample cell has a corner under this lit fraction (a
@@ -635,7 +640,8 @@ async fn spline_year(
     let rough = if rough.is_empty() && smooth.is_empty() {
         rough
     } else {
-        certified::certify_steps(scene, views.engine.index(), options.many_casters, location, timesteps, rough, smooth, year)
+        let proofs = (options.many_casters, options.inner_corners);
+        certified::certify_steps(scene, views.engine.index(), proofs, location, timesteps, rough, smooth, year)
     };
     year.stages.certifying += now() - start;
     let (start, cpu) = (now(), cpu_seconds());

@@ -244,12 +244,13 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
 /// the rest, to count, with the interpolated ones not proved never dark
 /// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one;
-/// `many_casters`: [`super::annual::AnnualOptions::many_casters`].
+/// `proofs`: [`super::annual::AnnualOptions::many_casters`] and
+/// [`super::annual::AnnualOptions::inner_corners`].
 #[allow(clippy::too_many_arguments)] // The year's steps and where they go; grouping them would hide nothing.
 pub(super) fn certify_steps(
     scene: &Scene,
     index: Option<&ExactEngine>,
-    many_casters: bool,
+    (many_casters, inner_corners): (bool, bool),
     location: &Location,
     timesteps: Timesteps,
     rough: Vec<Rough>,
@@ -262,6 +263,7 @@ pub(super) fn certify_steps(
         None => Certifier::new(scene),
     };
     let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
+    let certifier = if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier };
     let asked = rough.len();
     let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
     let interpolated = smooth.len();

@@ -142,6 +142,7 @@ mod tests {
             refine,
             prove_never_dark: false,
             many_casters: false,
+            inner_corners: false,
         };
         let calendar = LeafCalendar::for_latitude(location.latitude);
         let (schedule, fitted) =

@@ -25,6 +25,11 @@ use crate::sun::periods::ShadingPeriods;
 /// EnergyPlus's own default Timestep (rows per hour) where neither the caller nor the model says.
 pub const DEFAULT_TIMESTEPS_PER_HOUR: u32 = 4;
 
+/// Whether dark proofs combine casters unless asked otherwise ([`AnnualOptions::many_casters`]):
+/// on since certs13's gates (the same CSVs, no dearer paired on nyt-blocks' floor 20,
+/// blaas-louvres and blaas-trees-summer; docs/energyplus-fidelity.md, "certs13").
+pub const DEFAULT_MANY_CASTERS: bool = true;
+
 /// An annual run's settings as a caller gives them: every field optional. Serialised names are
 /// the JS API's (`timestepsPerHour`); the library's parameter names are the snake_case ones.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
@@ -53,8 +58,10 @@ pub struct AnnualSettings {
     pub refine: Option<f64>,
     /// See [`AnnualOptions::prove_never_dark`] (default off).
     pub prove_never_dark: Option<bool>,
-    /// See [`AnnualOptions::many_casters`] (default off).
+    /// See [`AnnualOptions::many_casters`] (default on, [`DEFAULT_MANY_CASTERS`]).
     pub many_casters: Option<bool>,
+    /// See [`AnnualOptions::inner_corners`] (default off).
+    pub inner_corners: Option<bool>,
     /// Count every timestep instead of the spline.
     pub dense: Option<bool>,
     /// Foliage keeps its leaves all year.
@@ -86,6 +93,8 @@ pub struct Resolved {
     pub prove_never_dark: bool,
     /// Whether dark proofs may combine casters ([`AnnualOptions::many_casters`]).
     pub many_casters: bool,
+    /// Whether they may trust a facade at an inner corner ([`AnnualOptions::inner_corners`]).
+    pub inner_corners: bool,
     /// When foliage is in leaf.
     pub calendar: LeafCalendar,
     /// Timesteps per hour as asked (checked); `None`: the model's, else the default.
@@ -112,8 +121,9 @@ impl AnnualSettings {
         let calendar = self.calendar(&location)?;
         let timesteps_per_hour = self.timesteps_per_hour.map(Timesteps::new).transpose()?;
         let sky_model = self.sky_model()?;
-        let (prove_never_dark, many_casters) = (self.prove_never_dark.unwrap_or(false), self.many_casters.unwrap_or(false));
-        Ok(Resolved { location, method, refine, prove_never_dark, many_casters, calendar, timesteps_per_hour, sky_model })
+        let prove_never_dark = self.prove_never_dark.unwrap_or(false);
+        let (many_casters, inner_corners) = (self.many_casters.unwrap_or(DEFAULT_MANY_CASTERS), self.inner_corners.unwrap_or(false));
+        Ok(Resolved { location, method, refine, prove_never_dark, many_casters, inner_corners, calendar, timesteps_per_hour, sky_model })
     }
 
     fn location(&self) -> Result<Location> {
@@ -166,6 +176,7 @@ impl Resolved {
             refine: self.refine,
             prove_never_dark: self.prove_never_dark,
             many_casters: self.many_casters,
+            inner_corners: self.inner_corners,
         })
     }
 
@@ -203,9 +214,12 @@ mod tests {
         let south = AnnualSettings { latitude: Some(-33.9), ..golden() }.resolve().unwrap();
         assert_eq!(south.calendar, LeafCalendar::for_latitude(-33.9), "the southern calendar");
         assert_ne!(south.calendar, r.calendar);
-        assert!(!r.many_casters && !r.prove_never_dark, "the many-caster and never-dark proofs off");
-        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":true}"#).unwrap();
-        assert!(many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: true turns them on");
+        assert!(r.many_casters, "the many-caster proofs on");
+        assert!(!r.prove_never_dark && !r.inner_corners, "the never-dark and inner-corner proofs off");
+        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":false}"#).unwrap();
+        assert!(!many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: false turns them off");
+        let corners: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"innerCorners":true}"#).unwrap();
+        assert!(corners.resolve().unwrap().options(None).unwrap().inner_corners, "innerCorners: true turns them on");
     }
 
     #[test]

@@ -92,6 +92,37 @@ impl Composites {
     pub(crate) fn len(&self) -> usize {
         self.corners.len()
     }
+
+    /// Whether `p` lies in composite `c`'s closed polygon, exactly: on its plane bit for bit, and
+    /// on the inner side of, or on, each of its edges. Only an edge running along a coordinate
+    /// axis of the plane (its two corners share that coordinate bit for bit, as a facade's
+    /// rectangle's do) may hold `p` on it, since comparing one coordinate is exact; across any
+    /// other edge `p` must lie `margin` inside. So a point this accepts is a point of the panels
+    /// (a boundary edge is a union of the panels' own edges, [`convex_outline`]): a receiver's
+    /// corner lying on a facade that meets its plane at an inner corner.
+    pub(super) fn holds(&self, c: u32, p: DVec3, margin: f64) -> bool {
+        let corners = self.corners(c);
+        let Some(axis) = (0..3).find(|&a| corners.iter().all(|q| q[a].to_bits() == corners[0][a].to_bits())) else { return false };
+        if corners.len() < 3 || p[axis].to_bits() != corners[0][axis].to_bits() {
+            return false;
+        }
+        let q: Vec<DVec2> = corners.iter().map(|c| flat(*c, axis as u8)).collect();
+        let at = flat(p, axis as u8);
+        let n = q.len();
+        // Twice the polygon's signed area: which side of each edge is inside.
+        let turn = (0..n).map(|k| q[k].perp_dot(q[(k + 1) % n])).sum::<f64>().signum();
+        (0..n).all(|k| {
+            let (a, b) = (q[k], q[(k + 1) % n]);
+            if a.x.to_bits() == b.x.to_bits() {
+                // Inside lies on the side of x = a.x that the edge's direction turns towards.
+                turn * (b.y - a.y).signum() * (a.x - at.x) >= 0.0
+            } else if a.y.to_bits() == b.y.to_bits() {
+                turn * (b.x - a.x).signum() * (at.y - a.y) >= 0.0
+            } else {
+                turn * (b - a).perp_dot(at - a) >= margin * (b - a).length()
+            }
+        })
+    }
 }
 
 /// An axis-aligned plane a triangle lies in exactly, with the side its front faces.

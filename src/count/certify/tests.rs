@@ -614,3 +614,71 @@ fn a_caster_clipped_in_front_is_its_part_above_the_height() {
     let many: Vec<DVec3> = (0..200).map(|i| DVec3::new(f64::from(i), 0.0, f64::from(i % 2) * 4.0 - 1.0)).collect();
     assert!(clipped_in_front(&many, DVec3::Z, 1.0).is_none());
 }
+
+/// A wall facing south at y = −15 from the inner corner (x = 15) to x = 27, z over `wall_z`
+/// (receiver 0), and [`facade`] of `width` meeting its plane at the corner.
+fn inner_corner(wall_z: (f32, f32), width: f32) -> Scene {
+    let mut b = SceneBuilder::new();
+    let (z0, z1) = wall_z;
+    let wall = SourceMesh {
+        positions: vec![[15.0, -15.0, z0], [27.0, -15.0, z0], [27.0, -15.0, z1], [15.0, -15.0, z1]],
+        indices: vec![0, 1, 2, 0, 2, 3],
+    };
+    b.add_object("test", "WALL", wall, true);
+    facade(&mut b, None, width);
+    b.build().unwrap()
+}
+
+/// Whether a ray towards `sun` from a point of receiver 0 (at y = −15) at most 1e-5 m from the
+/// inner corner (x = 15) at height `z` meets no other triangle: light along the corner, which a
+/// grid of the wall's points would not reach.
+fn escapes_at_the_corner(scene: &Scene, z: f64, sun: DVec3) -> bool {
+    let own = Some(scene.receivers[0].gpu_id);
+    let triangles: Vec<[DVec3; 3]> = scene.world_triangles().filter(|(_, id)| *id != own).map(|(t, _)| t).collect();
+    [1e-7, 1e-6, 1e-5].iter().any(|d| {
+        let p = DVec3::new(15.0 + d, -15.0, z);
+        !triangles.iter().any(|t| ray_hits(p, sun, t))
+    })
+}
+
+/// The inner corner of [`a_facade_meeting_the_walls_plane_at_an_inner_corner_proves_the_wall_beside_it_dark`]
+/// with the wall reaching into it (from x = 15, where the facade of the tower's other arm meets
+/// its plane), as nyt-blocks' wall strips do, over the summer afternoons when the facade shades
+/// it:
+/// - the many-caster proofs alone cannot prove it (the wall's edge lies in the facade's clipped
+///   band); with [`Certifier::with_inner_corners`], its two corners on the facade are covered
+///   with no margin and it is proved dark. At every sun the reference engine finds it dark, the
+///   fast exact engine below 1e-9, and no ray escapes, from a grid of its points nor from points
+///   within 1e-5 m of the corner;
+/// - the facade stopping one f32 step short of the wall's plane (y = −15.000001): a ray along
+///   the corner escapes through the gap at some sun, and nothing is proved (a proof trusting a
+///   facade within any tolerance of the corner would prove it);
+/// - the wall reaching above the facade's top (z up to 42 against 40): its upper corner is on
+///   the corner's line but not on the facade, light passes over the top, and nothing is proved.
+#[test]
+fn an_inner_corner_is_proved_dark_only_where_the_wall_s_corners_lie_on_the_facade() {
+    let corner_suns = suns(160..174, (15.0, 16.0), -DVec3::Y);
+    assert!(corner_suns.len() > 40);
+    let both = Wanted { dark: true, lit: true };
+    let requests: Vec<ViewRequest> = corner_suns.iter().map(|s| ViewRequest::new(0, *s)).collect();
+    let proved = |scene: &Scene| Certifier::new(scene).with_many_casters().with_inner_corners().certify(0, &corner_suns, both);
+
+    let touching = inner_corner((4.0, 8.0), 12.0);
+    assert_eq!(Certifier::new(&touching).with_many_casters().certify(0, &corner_suns, both), None, "proved without the option");
+    assert_eq!(proved(&touching), Some(Certificate::Dark));
+    for (f, s) in ExactEngine::new(&touching).fractions(&requests).into_iter().zip(&corner_suns) {
+        assert!(f < 1e-9, "proved dark at {s}: the exact engine says {f}");
+        let reference = crate::count::exact::sunlit_fraction(&touching, ViewRequest::new(0, *s));
+        assert!(reference == 0.0, "proved dark at {s}: the reference engine says {reference}");
+        assert_eq!(lit_grid_points(&touching, 0, *s), 0, "proved dark at {s}: a ray escapes");
+        assert!(!escapes_at_the_corner(&touching, 6.0, *s), "proved dark at {s}: a ray escapes along the corner");
+    }
+
+    let short = inner_corner((4.0, 8.0), f32::from_bits(12.0f32.to_bits() - 1));
+    assert_eq!(proved(&short), None, "proved across a gap of one f32 step");
+    assert!(corner_suns.iter().any(|s| escapes_at_the_corner(&short, 6.0, *s)), "no ray passes the gap: the variant shows nothing");
+
+    let above = inner_corner((38.0, 42.0), 12.0);
+    assert_eq!(proved(&above), None, "proved above the facade's top");
+    assert!(corner_suns.iter().any(|s| lit_grid_points(&above, 0, *s) > 0), "no ray passes over the top: the variant shows nothing");
+}

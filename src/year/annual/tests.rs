@@ -75,6 +75,7 @@ fn a_year_by_batches_of_receivers_is_the_whole_year() {
         prove_never_dark: true,
         // On: the batches share the index's composite casters.
         many_casters: true,
+        inner_corners: false,
     };
     let calendar = LeafCalendar::evergreen();
     let year = |receivers: Range<usize>| {
