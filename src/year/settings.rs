@@ -28,7 +28,7 @@ pub const DEFAULT_TIMESTEPS_PER_HOUR: u32 = 4;
 /// Whether dark proofs combine casters unless asked otherwise ([`AnnualOptions::many_casters`]):
 /// on since certs13's gates (the same CSVs, no dearer paired on nyt-blocks' floor 20,
 /// blaas-louvres and blaas-trees-summer; docs/energyplus-fidelity.md, "certs13").
-pub const DEFAULT_MANY_CASTERS: bool = true;
+pub const DEFAULT_MANY_CASTERS: bool = false;
 
 /// An annual run's settings as a caller gives them: every field optional. Serialised names are
 /// the JS API's (`timestepsPerHour`); the library's parameter names are the snake_case ones.
@@ -58,7 +58,7 @@ pub struct AnnualSettings {
     pub refine: Option<f64>,
     /// See [`AnnualOptions::prove_never_dark`] (default off).
     pub prove_never_dark: Option<bool>,
-    /// See [`AnnualOptions::many_casters`] (default on, [`DEFAULT_MANY_CASTERS`]).
+    /// See [`AnnualOptions::many_casters`] (default off, [`DEFAULT_MANY_CASTERS`]).
     pub many_casters: Option<bool>,
     /// See [`AnnualOptions::inner_corners`] (default off).
     pub inner_corners: Option<bool>,
@@ -214,10 +214,10 @@ mod tests {
         let south = AnnualSettings { latitude: Some(-33.9), ..golden() }.resolve().unwrap();
         assert_eq!(south.calendar, LeafCalendar::for_latitude(-33.9), "the southern calendar");
         assert_ne!(south.calendar, r.calendar);
-        assert!(r.many_casters, "the many-caster proofs on");
+        assert!(!r.many_casters, "the many-caster proofs off");
         assert!(!r.prove_never_dark && !r.inner_corners, "the never-dark and inner-corner proofs off");
-        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":false}"#).unwrap();
-        assert!(!many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: false turns them off");
+        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":true}"#).unwrap();
+        assert!(many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: true turns them on");
         let corners: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"innerCorners":true}"#).unwrap();
         assert!(corners.resolve().unwrap().options(None).unwrap().inner_corners, "innerCorners: true turns them on");
     }
