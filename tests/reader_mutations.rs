@@ -170,7 +170,12 @@ fn mutate_tree(doc: &mut Value, rng: &mut Rng) {
 
 /// The mutations the issue names, aimed at CityJSON's own members.
 fn mutate_city(doc: &mut Value, rng: &mut Rng) {
-    let ids: Vec<String> = doc["CityObjects"].as_object().map(|m| m.keys().cloned().collect()).unwrap_or_default();
+    // Only the objects still objects: an earlier mutation of the same document may have made one
+    // a number, which cannot take `parents`.
+    let ids: Vec<String> = doc["CityObjects"]
+        .as_object()
+        .map(|m| m.iter().filter(|(_, v)| v.is_object()).map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
     match rng.below(8) {
         0 => {
             doc.as_object_mut().unwrap().remove("transform");
