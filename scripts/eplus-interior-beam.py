@@ -17,6 +17,9 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eplus_hooked import columns, own_fractions, site  # noqa: E402
+
 sunlit, energyplus, epw, out = sys.argv[1:5]
 here = os.path.dirname(os.path.abspath(__file__))
 os.makedirs(out, exist_ok=True)
@@ -58,34 +61,6 @@ def run(idf, d):
     subprocess.run([energyplus, "-r", "-w", epw, "-d", d, idf], check=True, capture_output=True)
 
 
-def columns(path):
-    rows = list(csv.reader(open(path)))
-    head = [h.strip().upper() for h in rows[0]]
-    return {head[i]: [float(r[i]) for r in rows[1:] if i < len(r) and r[i].strip()] for i in range(1, len(head))}
-
-
-def site(d):
-    for line in open(os.path.join(d, "eplustbl.csv"), errors="replace"):
-        f = line.split(",")
-        if len(f) > 2 and f[1] == "Total Site Energy":
-            return float(f[2])
-
-
-def own_fractions(shading, hooked, clip, name):
-    """The hooked copy re-pointed at EnergyPlus's reported fractions in sunlit's CSV layout."""
-    theirs = columns(os.path.join(clip, "eplusout.csv"))
-    lines = open(shading).read().splitlines()
-    names = [n.upper() for n in lines[0].split(",")[1:] if n]
-    cols = [theirs[n + ":SURFACE OUTSIDE FACE SUNLIT FRACTION [](TIMESTEP)"] for n in names]
-    text = [lines[0]] + [line.split(",")[0] + "".join(",%.8f" % c[r] for c in cols) for r, line in enumerate(lines[1:])]
-    own = os.path.join(out, name + "-own.csv")
-    open(own, "w").write("\n".join(text) + "\n")
-    idf = open(hooked).read().replace(os.path.realpath(shading), os.path.realpath(own))
-    path = os.path.join(out, name + "-own.idf")
-    open(path, "w").write(idf)
-    return path
-
-
 clip_idf = os.path.join(out, "clipping.idf")
 open(clip_idf, "w").write(model())
 clip = os.path.join(out, "clipping")
@@ -95,7 +70,7 @@ for name, extra in (("scheduled", []), ("interior-beam", ["--interior-beam"])):
     shading, hooked = os.path.join(out, name + ".csv"), os.path.join(out, name + ".idf")
     subprocess.run([sunlit, "annual", clip_idf, "--epw", epw, "--engine", "exact", "-o", shading, "--idf-out", hooked] + extra,
                    check=True, capture_output=True)
-    run(own_fractions(shading, hooked, clip, name), os.path.join(out, name))
+    run(own_fractions(shading, hooked, clip, name, out), os.path.join(out, name))
     gaps[name] = 100 * (site(os.path.join(out, name)) - site(clip)) / site(clip)
     print(f"{name}: site energy {site(os.path.join(out, name))} GJ against the clipping run's {site(clip)} GJ: {gaps[name]:+.3f} %")
 theirs = columns(os.path.join(clip, "eplusout.csv"))

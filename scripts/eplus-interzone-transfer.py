@@ -29,6 +29,9 @@ import re
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eplus_hooked import columns, own_fractions, site  # noqa: E402
+
 sunlit, energyplus, epw, out = sys.argv[1:5]
 VAR = "Enclosure Interior Windows Total Transmitted Beam Solar Radiation Rate"
 # The one interzone pair of the model: what enters one zone through it leaves the other.
@@ -42,27 +45,6 @@ def run(idf, d):
     subprocess.run([energyplus, "-r", "-w", epw, "-d", d, idf], check=True, capture_output=True)
 
 
-def columns(path):
-    rows = list(csv.reader(open(path)))
-    head = [h.strip().upper() for h in rows[0]]
-    return {head[i]: [float(r[i]) for r in rows[1:] if i < len(r) and r[i].strip()] for i in range(1, len(head))}
-
-
-def own_fractions(shading, hooked, clip, name):
-    """The hooked copy re-pointed at EnergyPlus's reported fractions in sunlit's CSV layout."""
-    theirs = columns(os.path.join(clip, "eplusout.csv"))
-    lines = open(shading).read().splitlines()
-    names = [n.upper() for n in lines[0].split(",")[1:] if n]
-    cols = [theirs[n + ":SURFACE OUTSIDE FACE SUNLIT FRACTION [](TIMESTEP)"] for n in names]
-    text = [lines[0]] + [line.split(",")[0] + "".join(",%.8f" % c[r] for c in cols) for r, line in enumerate(lines[1:])]
-    own = os.path.join(out, name + "-own.csv")
-    open(own, "w").write("\n".join(text) + "\n")
-    idf = open(hooked).read().replace(os.path.realpath(shading), os.path.realpath(own))
-    path = os.path.join(out, name + "-own.idf")
-    open(path, "w").write(idf)
-    return path
-
-
 def loads(d):
     """Per zone, the year's ideal loads heating + cooling (GJ), from the RunPeriod row."""
     rows = list(csv.reader(open(os.path.join(d, "eplusout.csv"))))
@@ -72,13 +54,6 @@ def loads(d):
             zone = h.split(" IDEAL LOADS")[0].strip().upper()
             out[zone] = out.get(zone, 0.0) + float(rows[-1][i]) / 1e9
     return out
-
-
-def site(d):
-    for line in open(os.path.join(d, "eplustbl.csv"), errors="replace"):
-        f = line.split(",")
-        if len(f) > 2 and f[1] == "Total Site Energy":
-            return float(f[2])
 
 
 clip_idf = os.path.join(out, "clipping-transfer.idf")
@@ -172,7 +147,7 @@ open(fe_idf, "w").write(text.replace("FullInteriorAndExterior,", "FullExterior,"
 run(fe_idf, os.path.join(out, "clipping-fe"))
 shading, hooked_fe = os.path.join(out, "scheduled-fe.csv"), os.path.join(out, "scheduled-fe.idf")
 subprocess.run([sunlit, "annual", fe_idf, "--epw", epw, "--engine", "exact", "-o", shading, "--idf-out", hooked_fe], check=True, capture_output=True)
-run(own_fractions(shading, hooked_fe, os.path.join(out, "clipping-fe"), "scheduled-fe"), os.path.join(out, "scheduled-fe"))
+run(own_fractions(shading, hooked_fe, os.path.join(out, "clipping-fe"), "scheduled-fe", out), os.path.join(out, "scheduled-fe"))
 fe = site(os.path.join(out, "clipping-fe"))
 print(f"FullExterior scheduled: {site(os.path.join(out, 'scheduled-fe'))} GJ against its clipping run's {fe} GJ: "
       f"{100 * (site(os.path.join(out, 'scheduled-fe')) - fe) / fe:+.3f} %")
