@@ -279,3 +279,33 @@ fn objects_that_do_not_fit_the_scene_are_refused_by_their_reason() {
     let louvres = ExactEngine::new(&louvred_wall()).objects_bytes();
     assert!(why(&louvres).contains("triangles, where the scene has"), "{}", why(&louvres));
 }
+
+/// The hint's search finds what a scan of every (triangle, range) pair finds: the lowest of an
+/// object's triangles that the walk reached, or none, over overlapping, empty, unsorted ranges
+/// and triangles at both ends of ranges.
+#[test]
+fn first_reached_is_the_lowest_reached_triangle_as_a_scan_finds_it() {
+    let scan =
+        |sorted: &[u32], reached: &[Range<usize>]| sorted.iter().copied().find(|&p| reached.iter().any(|r| r.contains(&(p as usize))));
+    let mut seed = 7u64;
+    let mut next = |n: u64| {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 33) % n
+    };
+    let mut found = 0;
+    for _ in 0..2000 {
+        let mut sorted: Vec<u32> = (0..next(12)).map(|_| next(60) as u32).collect();
+        sorted.sort_unstable();
+        sorted.dedup();
+        let reached: Vec<Range<usize>> = (0..next(6))
+            .map(|_| {
+                let a = next(64) as usize;
+                a..a + next(8) as usize
+            })
+            .collect();
+        assert_eq!(first_reached(&sorted, &reached), scan(&sorted, &reached), "{sorted:?} {reached:?}");
+        found += usize::from(scan(&sorted, &reached).is_some());
+    }
+    // Both answers are exercised.
+    assert!(found > 200 && found < 1800, "{found}");
+}
