@@ -54,6 +54,9 @@ pub(crate) mod composite;
 pub mod cone;
 mod never_dark;
 
+use std::collections::HashMap;
+use std::rc::Rc;
+
 use glam::{DVec2, DVec3};
 
 pub use cone::DirectionCone;
@@ -167,7 +170,7 @@ impl std::ops::Deref for Index<'_> {
 }
 
 /// A caster that may prove a receiver dark.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 enum Caster {
     /// One of the exact engine's convex objects.
     Object(u32),
@@ -186,6 +189,27 @@ pub struct Certifier<'a> {
     /// With `many_casters`: whether a receiver's corners lying on a composite that meets its
     /// plane count as covered by it ([`Self::with_inner_corners`]).
     inner_corners: bool,
+}
+
+/// Casters made ready ([`Certifier::ready`]) for the receiver whose sets one thread is
+/// certifying: its cells share most candidates, and making a panelled block ready (gathering its
+/// corners, testing its caps) was nearly half of a city's certificate stage.
+#[derive(Debug, Default)]
+struct ReadyCache {
+    receiver: Option<usize>,
+    casters: HashMap<Caster, Option<Rc<Ready>>>,
+}
+
+impl ReadyCache {
+    /// `caster` made ready for `receiver`, by `make` unless this cache holds it already; the
+    /// cache is emptied when the receiver changes.
+    fn ready(&mut self, receiver: usize, caster: Caster, make: impl FnOnce() -> Option<Ready>) -> Option<Rc<Ready>> {
+        if self.receiver != Some(receiver) {
+            self.receiver = Some(receiver);
+            self.casters.clear();
+        }
+        self.casters.entry(caster).or_insert_with(|| make().map(Rc::new)).clone()
+    }
 }
 
 /// A caster made ready for one receiver ([`Certifier::ready`]): what a cell's halves share.
@@ -267,10 +291,13 @@ impl<'a> Certifier<'a> {
     }
 
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
-    /// natively over every core.
+    /// natively over every core. A receiver's sets should come together: each thread keeps the
+    /// casters it made ready for the last receiver it saw ([`ReadyCache`]).
     pub fn certify_all(&self, sets: &[(usize, &[DVec3], Wanted)]) -> Vec<Option<Certificate>> {
         let threads = worker_threads().min(sets.len().div_ceil(CHUNK)).max(1);
-        parallel_chunks(sets.len(), threads, CHUNK, || (), |i, _| self.certify(sets[i].0, sets[i].1, sets[i].2))
+        parallel_chunks(sets.len(), threads, CHUNK, ReadyCache::default, |i, cache| {
+            self.certify_with(sets[i].0, sets[i].1, sets[i].2, cache)
+        })
     }
 
     /// The receiver's shape and a cone holding `suns`, where a proof may be looked for: every
@@ -287,6 +314,12 @@ impl<'a> Certifier<'a> {
     /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
     /// can be proved (count those views). Every sun must be up and in front of the receiver.
     pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
+        self.certify_with(receiver, suns, wanted, &mut ReadyCache::default())
+    }
+
+    /// [`Self::certify`], taking the casters made ready for `receiver` from `cache` where an
+    /// earlier set of the same receiver made them ([`Self::ready`] does not depend on the suns).
+    fn certify_with(&self, receiver: usize, suns: &[DVec3], wanted: Wanted, cache: &mut ReadyCache) -> Option<Certificate> {
         if !(wanted.dark || wanted.lit) {
             return None;
         }
@@ -301,7 +334,7 @@ impl<'a> Certifier<'a> {
         // The halves are tried where the cell has two candidates or more, whether or not each
         // may cover this receiver at all (as before they were made ready once a cell).
         let halvings = if self.many_casters && candidates.len() >= 2 { DARK_HALVINGS } else { 0 };
-        let ready: Vec<Ready> = candidates.into_iter().filter_map(|c| self.ready(shape, c)).collect();
+        let ready: Vec<Rc<Ready>> = candidates.into_iter().filter_map(|c| cache.ready(receiver, c, || self.ready(shape, c))).collect();
         let mut set: Vec<usize> = (0..suns.len()).collect();
         self.dark_in_parts(shape, &ready, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
     }
@@ -320,7 +353,7 @@ impl<'a> Certifier<'a> {
     fn dark_in_parts(
         &self,
         shape: &Shape,
-        candidates: &[Ready],
+        candidates: &[Rc<Ready>],
         suns: &[DVec3],
         set: &mut [usize],
         cone: &DirectionCone,
