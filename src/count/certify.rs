@@ -54,7 +54,6 @@ pub(crate) mod composite;
 pub mod cone;
 mod never_dark;
 
-use std::collections::HashMap;
 use std::rc::Rc;
 
 use glam::{DVec2, DVec3};
@@ -75,6 +74,20 @@ pub enum Certificate {
     Dark,
     /// Nothing can shade it: fraction 1.
     Lit,
+}
+
+/// A certificate and how it was found: `alone` where the single-caster proofs would find it too
+/// (a lit proof, or one convex object standing wholly in front of the receiver's plane covering
+/// it over the whole cell), false where it needed the many-caster proofs
+/// ([`Certifier::with_many_casters`]). The year keeps its refinement's pattern to what the
+/// single-caster proofs settle, so the many-caster ones save views without moving a value
+/// (docs/energyplus-fidelity.md, "Proofs that move no value").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Proof {
+    /// What is proved.
+    pub certificate: Certificate,
+    /// Whether the single-caster proofs find it too.
+    pub alone: bool,
 }
 
 /// Which certificates to look for (each costs a search; a caller skips one that its samples
@@ -170,7 +183,7 @@ impl std::ops::Deref for Index<'_> {
 }
 
 /// A caster that may prove a receiver dark.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 enum Caster {
     /// One of the exact engine's convex objects.
     Object(u32),
@@ -191,24 +204,34 @@ pub struct Certifier<'a> {
     inner_corners: bool,
 }
 
-/// Casters made ready ([`Certifier::ready`]) for the receiver whose sets one thread is
-/// certifying: its cells share most candidates, and making a panelled block ready (gathering its
-/// corners, testing its caps) was nearly half of a city's certificate stage.
+/// The candidates of the last set one thread certified, made ready ([`Certifier::ready`]) for
+/// its receiver: the next set of the same receiver (the next cell of its year) shares most of
+/// them, and making a panelled block ready (gathering its corners, testing its caps) was nearly
+/// half of a city's certificate stage. Both lists are sorted, so they are matched by one walk;
+/// a hash map of every caster a receiver ever met cost more than it saved on blaas-trees-summer.
 #[derive(Debug, Default)]
 struct ReadyCache {
     receiver: Option<usize>,
-    casters: HashMap<Caster, Option<Rc<Ready>>>,
+    casters: Vec<(Caster, Option<Rc<Ready>>)>,
 }
 
 impl ReadyCache {
-    /// `caster` made ready for `receiver`, by `make` unless this cache holds it already; the
-    /// cache is emptied when the receiver changes.
-    fn ready(&mut self, receiver: usize, caster: Caster, make: impl FnOnce() -> Option<Ready>) -> Option<Rc<Ready>> {
-        if self.receiver != Some(receiver) {
-            self.receiver = Some(receiver);
-            self.casters.clear();
+    /// `candidates` (sorted, distinct) made ready for `receiver` by `make`, those the last set of
+    /// the same receiver had taken from it; it then holds these.
+    fn ready(&mut self, receiver: usize, candidates: &[Caster], make: impl Fn(Caster) -> Option<Ready>) -> Vec<Rc<Ready>> {
+        let last = std::mem::take(&mut self.casters);
+        let last = if self.receiver == Some(receiver) { last } else { Vec::new() };
+        self.receiver = Some(receiver);
+        let mut old = last.into_iter().peekable();
+        for &c in candidates {
+            while old.next_if(|(o, _)| *o < c).is_some() {}
+            let ready = match old.next_if(|(o, _)| *o == c) {
+                Some((_, ready)) => ready,
+                None => make(c).map(Rc::new),
+            };
+            self.casters.push((c, ready));
         }
-        self.casters.entry(caster).or_insert_with(|| make().map(Rc::new)).clone()
+        self.casters.iter().filter_map(|(_, r)| r.clone()).collect()
     }
 }
 
@@ -222,6 +245,9 @@ struct Ready {
     /// [`Certifier::with_inner_corners`]), so that every ray from it meets the caster at its
     /// start, whatever the sun. Empty where none does.
     on_caster: Vec<bool>,
+    /// Whether the single-caster proofs would take it as it is: a convex object wholly in front
+    /// of the receiver's plane by the margin, not clipped and not a composite.
+    alone: bool,
 }
 
 impl Ready {
@@ -293,7 +319,7 @@ impl<'a> Certifier<'a> {
     /// Certificates for many sets at once (receiver, its suns, what to look for), in order;
     /// natively over every core. A receiver's sets should come together: each thread keeps the
     /// casters it made ready for the last receiver it saw ([`ReadyCache`]).
-    pub fn certify_all(&self, sets: &[(usize, &[DVec3], Wanted)]) -> Vec<Option<Certificate>> {
+    pub fn certify_all(&self, sets: &[(usize, &[DVec3], Wanted)]) -> Vec<Option<Proof>> {
         let threads = worker_threads().min(sets.len().div_ceil(CHUNK)).max(1);
         parallel_chunks(sets.len(), threads, CHUNK, ReadyCache::default, |i, cache| {
             self.certify_with(sets[i].0, sets[i].1, sets[i].2, cache)
@@ -314,18 +340,18 @@ impl<'a> Certifier<'a> {
     /// A certificate that `receiver` is dark, or lit, at every one of `suns`; None where neither
     /// can be proved (count those views). Every sun must be up and in front of the receiver.
     pub fn certify(&self, receiver: usize, suns: &[DVec3], wanted: Wanted) -> Option<Certificate> {
-        self.certify_with(receiver, suns, wanted, &mut ReadyCache::default())
+        self.certify_with(receiver, suns, wanted, &mut ReadyCache::default()).map(|p| p.certificate)
     }
 
     /// [`Self::certify`], taking the casters made ready for `receiver` from `cache` where an
     /// earlier set of the same receiver made them ([`Self::ready`] does not depend on the suns).
-    fn certify_with(&self, receiver: usize, suns: &[DVec3], wanted: Wanted, cache: &mut ReadyCache) -> Option<Certificate> {
+    fn certify_with(&self, receiver: usize, suns: &[DVec3], wanted: Wanted, cache: &mut ReadyCache) -> Option<Proof> {
         if !(wanted.dark || wanted.lit) {
             return None;
         }
         let (shape, cone) = self.cone_of(receiver, suns)?;
         if wanted.lit && self.swept_is_empty(shape, &cone) {
-            return Some(Certificate::Lit);
+            return Some(Proof { certificate: Certificate::Lit, alone: true });
         }
         if !wanted.dark {
             return None;
@@ -334,9 +360,21 @@ impl<'a> Certifier<'a> {
         // The halves are tried where the cell has two candidates or more, whether or not each
         // may cover this receiver at all (as before they were made ready once a cell).
         let halvings = if self.many_casters && candidates.len() >= 2 { DARK_HALVINGS } else { 0 };
-        let ready: Vec<Rc<Ready>> = candidates.into_iter().filter_map(|c| cache.ready(receiver, c, || self.ready(shape, c))).collect();
+        let ready = cache.ready(receiver, &candidates, |c| self.ready(shape, c));
+        let dark = |alone| Some(Proof { certificate: Certificate::Dark, alone });
+        // The single-caster proof first, so a certificate it finds says so.
+        if ready.iter().any(|c| c.alone && self.covers_ready(shape, &cone, c)) {
+            return dark(true);
+        }
+        // The rest (clipped casters, composites, then halves of the cell) only with the
+        // many-caster proofs; the casters tried above are not tried over the whole cell again.
+        if !self.many_casters {
+            return None;
+        }
         let mut set: Vec<usize> = (0..suns.len()).collect();
-        self.dark_in_parts(shape, &ready, suns, &mut set, &cone, halvings).then_some(Certificate::Dark)
+        let together = ready.iter().any(|c| !c.alone && self.covers_ready(shape, &cone, c))
+            || self.halves_dark(shape, &ready, suns, &mut set, halvings);
+        if together { dark(false) } else { None }
     }
 
     /// Whether the receiver is dark at every sun of `set` (indices into `suns`, enclosed by
@@ -359,9 +397,12 @@ impl<'a> Certifier<'a> {
         cone: &DirectionCone,
         halvings: usize,
     ) -> bool {
-        if candidates.iter().any(|c| self.covers_ready(shape, cone, c)) {
-            return true;
-        }
+        candidates.iter().any(|c| self.covers_ready(shape, cone, c)) || self.halves_dark(shape, candidates, suns, set, halvings)
+    }
+
+    /// With `halvings` left, whether each half of `set` is dark ([`Self::dark_in_parts`] over
+    /// its own cone); false where none are left or the set has one sun.
+    fn halves_dark(&self, shape: &Shape, candidates: &[Rc<Ready>], suns: &[DVec3], set: &mut [usize], halvings: usize) -> bool {
         if halvings == 0 || set.len() < 2 {
             return false;
         }
@@ -548,7 +589,8 @@ impl<'a> Certifier<'a> {
         if corners.len() < 3 {
             return None;
         }
-        let (corners, on_caster) = if corners.iter().all(|c| c.dot(shape.normal) > margin) {
+        let whole = corners.iter().all(|c| c.dot(shape.normal) > margin);
+        let (corners, on_caster) = if whole {
             (corners, Vec::new())
         } else if self.many_casters {
             let clipped = clipped_in_front(&corners, shape.normal, 2.0 * margin)?;
@@ -560,7 +602,8 @@ impl<'a> Certifier<'a> {
             Caster::Object(o) => self.index.objects.has_caps(o) && !self.caps_face_away(shape, o, margin),
             Caster::Composite(_) => false,
         };
-        (!open_to_receiver).then_some(Ready { corners, on_caster })
+        let alone = whole && matches!(caster, Caster::Object(_));
+        (!open_to_receiver).then_some(Ready { corners, on_caster, alone })
     }
 
     /// Per receiver point, whether it lies on `caster` ([`Self::with_inner_corners`]; only a

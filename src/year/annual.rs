@@ -640,7 +640,7 @@ async fn spline_year(
     year.stages.fitting += now() - start;
     let start = now();
     let rough = if rough.is_empty() && smooth.is_empty() {
-        rough
+        certified::ToCount { dark: vec![false; rough.len()], steps: rough }
     } else {
         let proofs = (options.many_casters, options.inner_corners);
         certified::certify_steps(scene, views.engine.index(), proofs, location, timesteps, rough, smooth, year)
@@ -652,12 +652,12 @@ async fn spline_year(
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
-    let refined = refine::count_sparsely(views, &rough, rows_per_day, &leaves, &mut |n, p| {
+    let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, &mut |n, p| {
         refined_views = n;
         progress(work.refining(n, p))
     })
     .await?;
-    for (r, v) in rough.into_iter().zip(refined) {
+    for (r, v) in rough.steps.into_iter().zip(refined) {
         year.set(r.row, r.column, as_energyplus(v));
     }
     year.stages.refining += now() - start;

@@ -17,7 +17,7 @@
 
 use glam::DVec3;
 
-use crate::count::certify::{Certificate, Certifier, Wanted};
+use crate::count::certify::{Certificate, Certifier, Proof, Wanted};
 use crate::count::exact::engine::ExactEngine;
 use crate::platform::{cpu_seconds, seconds};
 use crate::scene::Scene;
@@ -206,9 +206,19 @@ fn wanted((lowest, highest): (f64, f64)) -> Wanted {
     Wanted { dark: highest < 0.5, lit: lowest > 0.5 }
 }
 
-/// Writes the steps of `rough` that a certificate settles into `schedule` and returns the rest
-/// (to count), in their order, with the numbers of steps proved dark and lit.
-pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Columns) -> (Vec<Rough>, usize, usize) {
+/// The refined steps left to the refinement ([`super::refine`]) and, per step, whether the
+/// many-caster proofs showed it dark: such a step is not counted, but it keeps its place, so the
+/// refinement counts and interpolates the others as it would without those proofs (the CSV does
+/// not move with them; docs/energyplus-fidelity.md, "Proofs that move no value").
+pub(super) struct ToCount {
+    pub steps: Vec<Rough>,
+    pub dark: Vec<bool>,
+}
+
+/// Writes the steps of `rough` that a single-caster certificate settles into `schedule` and
+/// returns the rest ([`ToCount`], in their order, those the many-caster proofs showed dark
+/// marked), with the numbers of steps proved dark and lit.
+pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Columns) -> (ToCount, usize, usize) {
     let mut order: Vec<usize> = (0..rough.len()).collect();
     order.sort_by_key(|&i| rough[i].cell);
     let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
@@ -221,12 +231,17 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     let sets: Vec<(usize, &[DVec3], Wanted)> =
         asked.iter().zip(&suns).map(|((steps, w), s)| (rough[steps[0]].column, s.as_slice(), *w)).collect();
     let mut settled = vec![false; rough.len()];
+    let mut together = vec![false; rough.len()];
     let (mut dark, mut lit) = (0, 0);
-    for ((steps, _), certificate) in asked.iter().zip(certifier.certify_all(&sets)) {
-        let Some(certificate) = certificate else { continue };
+    for ((steps, _), proof) in asked.iter().zip(certifier.certify_all(&sets)) {
+        let Some(Proof { certificate, alone }) = proof else { continue };
         for &i in *steps {
-            schedule.set(rough[i].row, rough[i].column, fraction(certificate));
-            settled[i] = true;
+            if alone {
+                schedule.set(rough[i].row, rough[i].column, fraction(certificate));
+                settled[i] = true;
+            } else {
+                together[i] = true;
+            }
         }
         match certificate {
             Certificate::Dark => dark += steps.len(),
@@ -235,10 +250,11 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     }
     // The tally walks every refined step again: only when someone reads it.
     if log::log_enabled!(log::Level::Info) {
-        log::info!("certificates by rule (steps / proved): {}", tally(rough.iter().zip(settled.iter().copied())));
+        let proved = settled.iter().zip(&together).map(|(a, b)| *a || *b);
+        log::info!("certificates by rule (steps / proved): {}", tally(rough.iter().zip(proved)));
     }
-    let rest = rough.into_iter().zip(settled).filter(|(_, s)| !s).map(|(r, _)| r).collect();
-    (rest, dark, lit)
+    let (steps, dark_marks) = rough.into_iter().zip(settled).zip(together).filter(|((_, s), _)| !s).map(|((r, _), t)| (r, t)).unzip();
+    (ToCount { steps, dark: dark_marks }, dark, lit)
 }
 
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
@@ -256,7 +272,7 @@ pub(super) fn certify_steps(
     rough: Vec<Rough>,
     smooth: Vec<Smooth>,
     schedule: &mut Columns,
-) -> Vec<Rough> {
+) -> ToCount {
     let (start, cpu) = (seconds(), cpu_seconds());
     let certifier = match index {
         Some(index) => Certifier::sharing(scene, index),
@@ -281,11 +297,12 @@ pub(super) fn certify_steps(
     log::info!(
         "refinement: {asked} timesteps to count, {dark} proved dark and {lit} proved lit{proof}; {} counted \
          (certificates {:.1} s, {:.1} s CPU)",
-        rest.len() + unproved.len(),
+        rest.dark.iter().filter(|d| !**d).count() + unproved.len(),
         seconds() - start,
         cpu_seconds() - cpu
     );
-    rest.extend(unproved);
+    rest.dark.extend(std::iter::repeat_n(false, unproved.len()));
+    rest.steps.extend(unproved);
     rest
 }
 

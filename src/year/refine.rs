@@ -22,6 +22,10 @@
 //!   between its ends, is of the same kind, and no counted day is more than [`MAX_GAP`] days
 //!   from the next; else each half is taken the same way.
 //!
+//! A step the many-caster proofs showed dark ([`super::certified::ToCount`]) is known before
+//! any round: it is never counted, but it is read where the rules read a counted one, so the
+//! steps counted and interpolated around it are those counting it would give.
+//!
 //! So the views only go down: every refined step is counted at most once. Measured against
 //! counting every timestep in docs/energyplus-fidelity.md ("Refined steps counted sparsely").
 
@@ -82,8 +86,9 @@ pub(super) struct Sparse {
 }
 
 impl Sparse {
-    /// Groups `rough` (the steps to count, `rows_per_day` rows a day) into runs.
-    pub(super) fn new(rough: &[Rough], rows_per_day: usize) -> Self {
+    /// Groups `rough` (the steps to count, `rows_per_day` rows a day) into runs; the steps
+    /// `known_dark` marks are known to be 0 and never asked.
+    pub(super) fn new(rough: &[Rough], known_dark: &[bool], rows_per_day: usize) -> Self {
         let key = |i: usize| {
             let r = &rough[i];
             (r.cell.0, r.cell.1, r.row % rows_per_day, r.row / rows_per_day)
@@ -99,7 +104,7 @@ impl Sparse {
             runs.push(start..start + run.len());
         }
         Sparse {
-            values: vec![None; rough.len()],
+            values: (0..rough.len()).map(|i| known_dark.get(i).copied().unwrap_or(false).then_some(0.0)).collect(),
             order,
             runs,
             spans: Vec::new(),
@@ -120,8 +125,21 @@ impl Sparse {
         self.counted
     }
 
-    /// The steps to count next (indices into the refined steps); empty once every step has a value.
+    /// Whether every step has its value: no span is open and no middle awaits its answer.
+    pub(super) fn done(&self) -> bool {
+        self.started && self.spans.is_empty() && self.asked_middles.is_empty()
+    }
+
+    /// The steps to count next (indices into the refined steps), those already known left out:
+    /// may be empty while [`Self::done`] is not (every middle asked was known); answer it then.
     pub(super) fn next_round(&mut self) -> Vec<usize> {
+        let mut asked = self.asked();
+        asked.retain(|&i| self.values[i].is_none());
+        asked
+    }
+
+    /// The steps the rules ask for next, known or not.
+    fn asked(&mut self) -> Vec<usize> {
         if !self.started {
             self.started = true;
             return self.first_round();
@@ -190,7 +208,10 @@ impl Sparse {
         let (va, vb) = (self.value(self.run(run)[a]), self.value(self.run(run)[b]));
         for p in a + 1..b {
             let step = self.run(run)[p];
-            self.values[step] = Some(va + (vb - va) * (p - a) as f64 / (b - a) as f64);
+            // A step proved dark keeps its 0 (counting it would not: it would be interpolated).
+            if self.values[step].is_none() {
+                self.values[step] = Some(va + (vb - va) * (p - a) as f64 / (b - a) as f64);
+            }
         }
     }
 
@@ -215,21 +236,26 @@ fn interpolable(a: f64, b: f64) -> bool {
 }
 
 /// Counts the refined steps `rough` sparsely ([`Sparse`]) and returns every step's fraction, in
-/// order. `leaves` gives a step's leaf fraction; `report` gets, with each progress report, the
+/// order; the steps `known_dark` marks are 0 and not counted. `leaves` gives a step's leaf fraction; `report` gets, with each progress report, the
 /// most refined steps that may in all be counted (those counted so far and those still open).
 pub(super) async fn count_sparsely(
     views: &Views<'_, impl Engine>,
     rough: &[Rough],
+    known_dark: &[bool],
     rows_per_day: usize,
     leaves: &dyn Fn(&Rough) -> f32,
     report: &mut dyn FnMut(usize, Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
-    let mut sparse = Sparse::new(rough, rows_per_day);
+    let mut sparse = Sparse::new(rough, known_dark, rows_per_day);
     loop {
         let to_count = sparse.counted() + sparse.unsettled();
         let asked = sparse.next_round();
         if asked.is_empty() {
-            break;
+            if sparse.done() {
+                break;
+            }
+            sparse.answer(&[], &[]);
+            continue;
         }
         let requests: Vec<ViewRequest> =
             asked.iter().map(|&i| ViewRequest::new(rough[i].column as u32, rough[i].sun).with_leaves(leaves(&rough[i]))).collect();

@@ -25,13 +25,24 @@ fn step(fit: usize, slot: usize, day: usize) -> Rough {
 /// Runs the rounds of [`Sparse`] with `truth` answering every asked step: each step's value and
 /// how many were counted.
 fn sparse(rough: &[Rough], truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
-    let mut s = Sparse::new(rough, ROWS);
+    sparse_knowing(rough, &[], truth)
+}
+
+/// [`sparse`] with the steps `known_dark` marks known to be 0 before any round: they must never
+/// be asked.
+fn sparse_knowing(rough: &[Rough], known_dark: &[bool], truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
+    let mut s = Sparse::new(rough, known_dark, ROWS);
     let mut asked_ever = vec![false; rough.len()];
     loop {
         let asked = s.next_round();
         if asked.is_empty() {
-            break;
+            if s.done() {
+                break;
+            }
+            s.answer(&[], &[]);
+            continue;
         }
+        assert!(asked.iter().all(|&i| !known_dark.get(i).copied().unwrap_or(false)), "a known step was asked");
         for &i in &asked {
             assert!(!asked_ever[i], "step {i} asked twice");
             asked_ever[i] = true;
@@ -126,7 +137,7 @@ fn runs_break_at_gaps_times_of_day_and_pieces() {
         rough.push(step(0, 41, d));
         rough.push(step(1, 40, d));
     }
-    let s = Sparse::new(&rough, ROWS);
+    let s = Sparse::new(&rough, &[], ROWS);
     let mut lengths: Vec<usize> = s.runs.iter().map(|r| r.len()).collect();
     lengths.sort_unstable();
     assert_eq!(lengths, vec![8, 8, 8, 10, 10, 10]);
@@ -161,8 +172,38 @@ fn runs_as_ranges_are_the_lists_they_replace() {
         })
         .map(<[usize]>::to_vec)
         .collect();
-    let s = Sparse::new(&rough, ROWS);
+    let s = Sparse::new(&rough, &[], ROWS);
     let ranges: Vec<Vec<usize>> = (0..s.runs.len()).map(|k| s.run(k).to_vec()).collect();
     assert!(lists.len() > 20, "{} runs", lists.len());
     assert_eq!(ranges, lists);
+}
+
+/// Steps known dark (the many-caster proofs) are never counted, and the rest come out as they do
+/// when those steps are counted: a run lit at its ends with a dark spell, a run whose first
+/// days are dark, and a lit run with one dark day inside a span that counting would interpolate
+/// (known, it keeps its 0). Failed with the known steps asked (counted as before) and with
+/// `interpolate` overwriting them.
+#[test]
+fn steps_known_dark_are_not_counted_and_move_no_other_value() {
+    let spell = |d: usize| if (26..34).contains(&d) { 0.0 } else { 0.5 + 0.001 * d as f64 };
+    let early = |d: usize| if d < 12 { 0.0 } else { 0.3 + 0.002 * d as f64 };
+    for f in [&spell as &dyn Fn(usize) -> f64, &early] {
+        let rough: Vec<Rough> = (0..40).map(|d| step(0, 40, d)).collect();
+        let truth = |r: &Rough| f(r.row / ROWS);
+        let known: Vec<bool> = rough.iter().map(|r| truth(r) == 0.0).collect();
+        let (counting, counted) = sparse(&rough, truth);
+        let (knowing, counted_knowing) = sparse_knowing(&rough, &known, truth);
+        assert_eq!(knowing, counting);
+        let dark = known.iter().filter(|k| **k).count();
+        assert!(dark > 0 && counted_knowing + dark <= counted, "{counted_knowing} + {dark} against {counted}");
+    }
+    // Day 5 dark inside a lit, straight run: counting interpolates across it, knowing keeps it.
+    let lit = |d: usize| if d == 5 { 0.0 } else { 0.6 };
+    let rough: Vec<Rough> = (0..9).map(|d| step(0, 40, d)).collect();
+    let known: Vec<bool> = (0..9).map(|d| d == 5).collect();
+    let (counting, _) = sparse(&rough, |r| lit(r.row / ROWS));
+    let (knowing, _) = sparse_knowing(&rough, &known, |r| lit(r.row / ROWS));
+    assert_eq!(counting[5], 0.6);
+    assert_eq!(knowing[5], 0.0);
+    assert_eq!(knowing.iter().enumerate().filter(|(d, _)| *d != 5).map(|(_, v)| *v).collect::<Vec<_>>(), vec![0.6; 8]);
 }
