@@ -82,11 +82,10 @@ pub struct AnnualOptions {
     /// With refinement on: a dark proof may combine casters, coplanar panels that together form
     /// one convex polygon, halves of a cell each covered by its own caster, and casters that
     /// meet the receiver's plane by their part clear of it ([`crate::count::certify`]). Exact
-    /// (no step proved dark is lit; 27 % fewer views on nyt-blocks' floor 20, the same CSV, and 7 %
-    /// fewer on canyon-slots), but on blaas-trees-summer the sparse refinement then interpolates
-    /// two windows differently (mean |Δ| against the dense year 7e-6 worse) and its first-floor south
-    /// windows cost 1.05× the CPU, so it is off by default
-    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`], docs/energyplus-fidelity.md, "certs13").
+    /// (no step proved dark is lit), and the steps only they prove stay in the sparse refinement
+    /// as known zeros ([`crate::count::certify::Proof::alone`]), so the CSV is the one without
+    /// them; on by default ([`crate::year::settings::DEFAULT_MANY_CASTERS`],
+    /// docs/energyplus-fidelity.md, "Proofs that move no value").
     pub many_casters: bool,
     /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
     /// corner (a tower's other arm) may be proved dark by that facade, its corners there covered

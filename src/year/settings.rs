@@ -26,9 +26,10 @@ use crate::sun::periods::ShadingPeriods;
 pub const DEFAULT_TIMESTEPS_PER_HOUR: u32 = 4;
 
 /// Whether dark proofs combine casters unless asked otherwise ([`AnnualOptions::many_casters`]):
-/// on since certs13's gates (the same CSVs, no dearer paired on nyt-blocks' floor 20,
-/// blaas-louvres and blaas-trees-summer; docs/energyplus-fidelity.md, "certs13").
-pub const DEFAULT_MANY_CASTERS: bool = false;
+/// on since the steps they alone prove keep their place in the sparse refinement as known zeros,
+/// so they save views without moving a value (docs/energyplus-fidelity.md, "Proofs that move no
+/// value").
+pub const DEFAULT_MANY_CASTERS: bool = true;
 
 /// An annual run's settings as a caller gives them: every field optional. Serialised names are
 /// the JS API's (`timestepsPerHour`); the library's parameter names are the snake_case ones.
@@ -58,7 +59,7 @@ pub struct AnnualSettings {
     pub refine: Option<f64>,
     /// See [`AnnualOptions::prove_never_dark`] (default off).
     pub prove_never_dark: Option<bool>,
-    /// See [`AnnualOptions::many_casters`] (default off, [`DEFAULT_MANY_CASTERS`]).
+    /// See [`AnnualOptions::many_casters`] (default on, [`DEFAULT_MANY_CASTERS`]).
     pub many_casters: Option<bool>,
     /// See [`AnnualOptions::inner_corners`] (default off).
     pub inner_corners: Option<bool>,
