@@ -215,10 +215,10 @@ mod tests {
         let south = AnnualSettings { latitude: Some(-33.9), ..golden() }.resolve().unwrap();
         assert_eq!(south.calendar, LeafCalendar::for_latitude(-33.9), "the southern calendar");
         assert_ne!(south.calendar, r.calendar);
-        assert!(!r.many_casters, "the many-caster proofs off");
+        assert!(r.many_casters, "the many-caster proofs on");
         assert!(!r.prove_never_dark && !r.inner_corners, "the never-dark and inner-corner proofs off");
-        let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":true}"#).unwrap();
-        assert!(many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: true turns them on");
+        let few: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":false}"#).unwrap();
+        assert!(!few.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: false turns them off");
         let corners: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"innerCorners":true}"#).unwrap();
         assert!(corners.resolve().unwrap().options(None).unwrap().inner_corners, "innerCorners: true turns them on");
     }
