@@ -214,6 +214,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// left as it was. For outputs too large to build in memory first.
 pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
     let io = |source: std::io::Error, p: &Path| Error::Io { path: p.to_path_buf(), source };
+    if is_special(path) {
+        return write_through(path, write);
+    }
     let tmp = temporary_sibling(path);
     partials().push(tmp.clone());
     let written = (|| {
@@ -230,6 +233,21 @@ pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> Resu
     }
     list.retain(|p| *p != tmp);
     result
+}
+
+/// Whether `path` exists and is not a regular file (`/dev/null`, `/dev/stdout`, a named pipe):
+/// a rename onto it would replace the device with a file (seen: `-o /dev/null` left a regular
+/// file there, and every later `> /dev/null` of the machine wrote into it).
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
+/// Writes straight into a device or pipe: there is no file to leave half-written.
+fn write_through(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    let file = std::fs::OpenOptions::new().write(true).open(path).map_err(|source| Error::Io { path: path.to_path_buf(), source })?;
+    let mut buffered = std::io::BufWriter::with_capacity(1 << 16, file);
+    write(&mut buffered)?;
+    buffered.flush().map_err(|source| Error::Io { path: path.to_path_buf(), source })
 }
 
 /// Removes the temporary files of writes in progress (from a Ctrl-C handler: the process is
@@ -369,6 +387,26 @@ mod tests {
             .collect();
         assert!(leftovers.is_empty());
         assert!(partials().iter().all(|p| !p.starts_with(&dir)), "finished writes are unregistered");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A named pipe given as the output stays a pipe and gets the bytes, as `/dev/null` must
+    /// stay a device (a rename onto it replaced it with a file). Failed with the rename kept.
+    #[cfg(unix)]
+    #[test]
+    fn writing_to_a_pipe_or_device_writes_through_it() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = std::env::temp_dir().join(format!("sunlit-fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("out.csv");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let reader = {
+            let fifo = fifo.clone();
+            std::thread::spawn(move || std::fs::read(fifo).unwrap())
+        };
+        write_atomic(&fifo, b"through").unwrap();
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo(), "the pipe was replaced");
+        assert_eq!(reader.join().unwrap(), b"through");
         let _ = std::fs::remove_dir_all(&dir);
     }
 
