@@ -4,7 +4,8 @@
 //! `Schedule:File:Shading` reads): a header `Surface Name,NAME1,NAME2,…,` then one row per
 //! timestep ` MM/DD HH:MM,v1,v2,…,` with 8 decimals and a trailing comma, exactly 8760·N rows.
 //! A schedule is checked before anything is written (row count, names, values in [0, 1]), and
-//! files are written to a temporary sibling and renamed, so a failure never leaves a partial file.
+//! files are written to a temporary sibling and renamed, so a failure never leaves a partial file
+//! (a device or pipe given as the output is written through instead: a rename would replace it).
 //! Beside it, [`hook`] patches an EnergyPlus model to read the CSV, and [`interior_beam`] writes
 //! the beam onto inside faces that a hooked model reads too.
 
