@@ -145,7 +145,7 @@ struct AnnualArgs {
     /// With refinement on: let a dark proof combine casters (coplanar panels forming one convex
     /// polygon, halves of a cell each covered by its own caster, a facade clipped where it meets
     /// the surface's plane). Exact (no step proved dark is lit), and the values are those without
-    /// it: only views go. On by default; `--many-casters=false` turns it off.
+    /// it: only views go. Off by default (on blaas-louvres it costs CPU and saves no view).
     #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_value_t = sunlit::year::settings::DEFAULT_MANY_CASTERS, default_missing_value = "true", action = clap::ArgAction::Set)]
     many_casters: bool,
     /// With --many-casters: let a facade meeting a surface's plane at an inner corner prove it

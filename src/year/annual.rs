@@ -84,7 +84,8 @@ pub struct AnnualOptions {
     /// meet the receiver's plane by their part clear of it ([`crate::count::certify`]). Exact
     /// (no step proved dark is lit), and the steps only they prove stay in the sparse refinement
     /// as known zeros ([`crate::count::certify::Proof::alone`]), so the CSV is the one without
-    /// them; on by default ([`crate::year::settings::DEFAULT_MANY_CASTERS`],
+    /// them; off by default, since on blaas-louvres they cost CPU and save no view
+    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`],
     /// docs/energyplus-fidelity.md, "Proofs that move no value").
     pub many_casters: bool,
     /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
