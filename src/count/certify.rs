@@ -686,4 +686,4 @@ fn clipped_in_front(corners: &[DVec3], normal: DVec3, height: f64) -> Option<Vec
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

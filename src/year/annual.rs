@@ -27,6 +27,7 @@ use std::ops::Range;
 
 use glam::DVec3;
 
+use crate::count::exact::engine::ExactEngine;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
@@ -639,11 +640,16 @@ async fn spline_year(
     let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, year);
     year.stages.fitting += now() - start;
     let start = now();
-    let rough = if rough.is_empty() && smooth.is_empty() {
-        certified::ToCount { dark: vec![false; rough.len()], steps: rough }
-    } else {
-        let proofs = (options.many_casters, options.inner_corners);
-        certified::certify_steps(scene, views.engine.index(), proofs, location, timesteps, rough, smooth, year)
+    // Built only where a step is left to settle; without the engine's index, one of their own.
+    let settling = !(rough.is_empty() && smooth.is_empty());
+    let own_index = (settling && views.engine.index().is_none()).then(|| ExactEngine::new(scene));
+    let certifiers = settling
+        .then(|| views.engine.index().or(own_index.as_ref()))
+        .flatten()
+        .map(|index| certified::Certifiers::new(scene, index, (options.many_casters, options.inner_corners)));
+    let rough = match &certifiers {
+        Some(c) => certified::certify_steps(&c.cells, location, timesteps, rough, smooth, year),
+        None => certified::ToCount { dark: vec![false; rough.len()], steps: rough },
     };
     year.stages.certifying += now() - start;
     let (start, cpu) = (now(), cpu_seconds());
@@ -652,7 +658,9 @@ async fn spline_year(
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
-    let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, &mut |n, p| {
+    let span_proofs = certifiers.as_ref().map(|c| certified::SpanProofs::new(&c.spans, &rough.steps));
+    let prover = span_proofs.as_ref().map_or(&refine::NoProofs as &dyn refine::SpanProver, |p| p);
+    let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, prover, &mut |n, p| {
         refined_views = n;
         progress(work.refining(n, p))
     })

@@ -8,6 +8,10 @@
 //! them. Exact either way: a certificate holds at every sun of its steps, so the schedule is what
 //! counting them would give, and a step no certificate settles is counted as before.
 //!
+//! The refinement's spans counted step by step are proved here too ([`SpanProofs`]): a span is
+//! one receiver's steps at one time of day on consecutive days, whose suns lie along a short
+//! arc, so a caster covers it where none covered the whole cell.
+//!
 //! The steps the spline interpolates are handed over too ([`Smooth`], [`never_dark`]): a sliver
 //! of shadow between the samples may take a lit cell's receiver wholly dark for a step (a tall
 //! block passing the sun in a street canyon), which no rule on the samples can see. A step is
@@ -24,6 +28,7 @@ use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 use crate::year::annual::{Columns, shading_sun_day};
+use crate::year::refine;
 use crate::year::samples::Timesteps;
 
 /// A timestep the refinement counts directly unless a certificate settles it.
@@ -257,16 +262,37 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     (ToCount { steps, dark: dark_marks }, dark, lit)
 }
 
+/// The year's two certifiers over one index of the scene (the counting engine's own where it
+/// has one): the sample cells' ([`certify_steps`]) with the proofs the options ask for
+/// ([`super::annual::AnnualOptions::many_casters`] and
+/// [`super::annual::AnnualOptions::inner_corners`]), and the refinement's spans'
+/// ([`SpanProofs`]) with the many-caster proofs always.
+///
+/// Why the spans always: a span's steps are counted one by one unless proved, so every proof
+/// there saves views, and the search runs only where they would be counted. Over a whole cell
+/// the many-caster search runs wherever the single-caster proof fails, also on steps the
+/// refinement then interpolates or counts sparsely: on blaas-louvres it saved no view and cost
+/// 1.166× the CPU (docs/energyplus-fidelity.md, "Proofs that move no value").
+pub(super) struct Certifiers<'a> {
+    pub cells: Certifier<'a>,
+    pub spans: Certifier<'a>,
+}
+
+impl<'a> Certifiers<'a> {
+    pub(super) fn new(scene: &Scene, index: &'a ExactEngine, (many_casters, inner_corners): (bool, bool)) -> Self {
+        let with_proofs = |many_casters: bool| {
+            let certifier = Certifier::sharing(scene, index);
+            let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
+            if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier }
+        };
+        Certifiers { cells: with_proofs(many_casters), spans: with_proofs(true) }
+    }
+}
+
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
-/// the rest, to count, with the interpolated ones not proved never dark
-/// ([`never_dark`]). `index`: the counting engine's own index of `scene`, shared where it has one;
-/// `proofs`: [`super::annual::AnnualOptions::many_casters`] and
-/// [`super::annual::AnnualOptions::inner_corners`].
-#[allow(clippy::too_many_arguments)] // The year's steps and where they go; grouping them would hide nothing.
+/// the rest, to count, with the interpolated ones not proved never dark ([`never_dark`]).
 pub(super) fn certify_steps(
-    scene: &Scene,
-    index: Option<&ExactEngine>,
-    (many_casters, inner_corners): (bool, bool),
+    certifier: &Certifier,
     location: &Location,
     timesteps: Timesteps,
     rough: Vec<Rough>,
@@ -274,20 +300,14 @@ pub(super) fn certify_steps(
     schedule: &mut Columns,
 ) -> ToCount {
     let (start, cpu) = (seconds(), cpu_seconds());
-    let certifier = match index {
-        Some(index) => Certifier::sharing(scene, index),
-        None => Certifier::new(scene),
-    };
-    let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
-    let certifier = if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier };
     let asked = rough.len();
-    let (mut rest, dark, lit) = settle(&certifier, rough, schedule);
+    let (mut rest, dark, lit) = settle(certifier, rough, schedule);
     let interpolated = smooth.len();
     let sun_of = |row: usize| {
         let instant = timesteps.instant(row);
         (sun_direction(location, shading_sun_day(instant.day), instant.hour), f64::from(instant.day))
     };
-    let unproved = never_dark(&certifier, smooth, &sun_of);
+    let unproved = never_dark(certifier, smooth, &sun_of);
     // Without the never-dark proof no interpolated step is handed over: say nothing of them then.
     let proof = if interpolated == 0 {
         String::new()
@@ -306,9 +326,166 @@ pub(super) fn certify_steps(
     rest
 }
 
+/// Times a span's steps are halved where no certificate holds over all of them: each half's
+/// suns span half the arc, so a caster that covers the receiver over one half only still
+/// proves it (at most 2^(n+1) − 1 proofs a span).
+const SPAN_HALVINGS: usize = 3;
+
+/// Spans of fewer steps than this are not halved: their halves would cost about what counting does.
+const MIN_HALVED_SPAN: usize = 4;
+
+/// Spans proved per batch, between which the proofs' yield is checked.
+const SPAN_BATCH: usize = 32;
+
+/// Proofs tried before their yield is judged.
+const WARM_UP: usize = 256;
+
+/// The fewest steps proved per proof tried for the proofs to go on: a proof costs about what a
+/// view does (on blaas-louvres, 2,508 proofs of spans proved none; on nyt-blocks' floor 5,
+/// 17,934 proved 32,111 steps).
+const MIN_YIELD: f64 = 0.25;
+
+/// The refinement's span proofs ([`refine::SpanProver`]): the certifier's proofs over a span's
+/// suns, the span halved where they fail. Exact like every certificate, so a proved step is
+/// what counting it would give, and the refinement counts and interpolates the rest as before.
+///
+/// Where they do not pay (fewer than [`MIN_YIELD`] steps proved per proof after [`WARM_UP`]
+/// proofs: a scene whose dark steps are dark only behind many small casters, like louvres),
+/// they stop for the rest of the year; the values are the same either way.
+pub(super) struct SpanProofs<'a> {
+    certifier: &'a Certifier<'a>,
+    rough: &'a [Rough],
+    /// Proofs tried and steps proved so far.
+    ledger: std::cell::Cell<(usize, usize)>,
+}
+
+impl<'a> SpanProofs<'a> {
+    pub(super) fn new(certifier: &'a Certifier<'a>, rough: &'a [Rough]) -> Self {
+        SpanProofs { certifier, rough, ledger: std::cell::Cell::new((0, 0)) }
+    }
+
+    /// Whether the proofs have paid so far (or are still warming up).
+    fn paying(&self) -> bool {
+        let (tried, proved) = self.ledger.get();
+        tried < WARM_UP || proved as f64 >= MIN_YIELD * tried as f64
+    }
+
+    /// The steps of `spans` proved, each span halved up to [`SPAN_HALVINGS`] times where a proof
+    /// over it fails, with their values.
+    fn prove_batch(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
+        let mut proved = Vec::new();
+        let mut level: Vec<(&[usize], Wanted)> = spans.iter().map(|(s, w)| (s.as_slice(), *w)).collect();
+        for halvings_left in (0..=SPAN_HALVINGS).rev() {
+            if level.is_empty() {
+                break;
+            }
+            let suns: Vec<Vec<DVec3>> = level.iter().map(|(steps, _)| steps.iter().map(|&i| self.rough[i].sun).collect()).collect();
+            let sets: Vec<(usize, &[DVec3], Wanted)> =
+                level.iter().zip(&suns).map(|((steps, w), s)| (self.rough[steps[0]].column, s.as_slice(), *w)).collect();
+            let mut next = Vec::new();
+            for ((steps, wanted), proof) in level.iter().zip(self.certifier.certify_all(&sets)) {
+                match proof {
+                    Some(p) => proved.extend(steps.iter().map(|&i| (i, f64::from(fraction(p.certificate))))),
+                    None if halvings_left > 0 && steps.len() >= MIN_HALVED_SPAN => {
+                        let (first, second) = steps.split_at(steps.len() / 2);
+                        next.extend([(first, *wanted), (second, *wanted)]);
+                    }
+                    None => {}
+                }
+            }
+            let (tried, settled) = self.ledger.get();
+            self.ledger.set((tried + sets.len(), settled));
+            level = next;
+        }
+        let (tried, settled) = self.ledger.get();
+        self.ledger.set((tried, settled + proved.len()));
+        proved
+    }
+}
+
+impl refine::SpanProver for SpanProofs<'_> {
+    fn ledger(&self) -> (usize, usize) {
+        self.ledger.get()
+    }
+
+    fn prove(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
+        let mut proved = Vec::new();
+        for batch in spans.chunks(SPAN_BATCH) {
+            if !self.paying() {
+                break;
+            }
+            proved.extend(self.prove_batch(batch));
+        }
+        proved
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::count::ViewRequest;
+    use crate::count::certify::tests::{block, window};
+    use crate::scene::SceneBuilder;
+    use crate::year::refine::SpanProver;
+
+    /// A window behind a 0.1 m slot between two 12 m blocks across a 6 m street (as in
+    /// tests/annual.rs' canyon of blocks): each day at one time of day, 14 days a span, the
+    /// refinement's span proofs. Every step they prove dark is dark for the exact engine at
+    /// its sun; they prove most dark steps; and a span through which the slot's sun passes is
+    /// proved in part (its halves), its lit steps left to count.
+    #[test]
+    fn span_proofs_prove_a_canyon_s_dark_days_and_leave_the_slot_s_sun_to_count() {
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "LOW", window(2.8, 3.1, 0.0, 1.0, 0.0), true);
+        b.add_object("test", "BLOCK_W", block([-40.0, -16.0, 0.0], [2.95, -6.0, 12.0]), false);
+        b.add_object("test", "BLOCK_E", block([3.05, -16.0, 0.0], [40.0, -6.0, 12.0]), false);
+        let scene = b.build().unwrap();
+        let location = Location::new(39.74, -105.18, -7.0).unwrap();
+        let index = ExactEngine::new(&scene);
+        let certifiers = Certifiers::new(&scene, &index, (false, false));
+        let mut rough = Vec::new();
+        let mut spans = Vec::new();
+        for slot in 36..60 {
+            let hour = f64::from(slot) * 0.25;
+            let mut run: Vec<usize> = Vec::new();
+            for day in 1..=365u32 {
+                let sun = sun_direction(&location, f64::from(day), hour);
+                let facing = sun.z > 0.05 && -sun.y > 0.05;
+                if facing {
+                    rough.push(Rough {
+                        row: day as usize * 96 + slot as usize,
+                        column: 0,
+                        sun,
+                        day: f64::from(day),
+                        cell: (0, 0, 0, 0),
+                        corners: (0.0, 0.0),
+                        rule: Rule::AllNearDark,
+                    });
+                    run.push(rough.len() - 1);
+                }
+                if !facing || run.len() == 14 || day == 365 {
+                    if run.len() >= 2 {
+                        spans.push((std::mem::take(&mut run), Wanted { dark: true, lit: false }));
+                    }
+                    run.clear();
+                }
+            }
+        }
+        let proofs = SpanProofs::new(&certifiers.spans, &rough);
+        let proved = proofs.prove(&spans);
+        let truth = index.fractions(&rough.iter().map(|r| ViewRequest::new(0, r.sun)).collect::<Vec<_>>());
+        let mut is_proved = vec![false; rough.len()];
+        for &(i, v) in &proved {
+            assert_eq!(v, 0.0, "only dark was asked for");
+            assert_eq!(truth[i], 0.0, "step {i} (day {}, row {}) proved dark is lit", rough[i].day, rough[i].row);
+            is_proved[i] = true;
+        }
+        let asked: Vec<usize> = spans.iter().flat_map(|(s, _)| s.iter().copied()).collect();
+        let dark = asked.iter().filter(|&&i| truth[i] == 0.0).count();
+        assert!(proved.len() * 4 >= dark * 3, "{} of {dark} dark steps proved", proved.len());
+        let split = spans.iter().filter(|(s, _)| s.iter().any(|&i| truth[i] > 0.0) && s.iter().any(|&i| is_proved[i])).count();
+        assert!(split > 0, "no span through the slot's sun was proved in part");
+    }
 
     /// The cheap interleaving is the bits' own: every day and τ index a grid can have (below
     /// 2¹⁶) against a loop over the bits, at all indices below 600 and the largest ones.

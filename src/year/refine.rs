@@ -16,7 +16,9 @@
 //! - a span between counted days whose ends are not both lit (≥ [`NEAR_DARK`]) and of the same
 //!   kind (both partly lit, or both wholly lit) is counted step by step, as before: a dark/lit
 //!   edge, a sliver of sun in a dark canyon or a shadow entering a wholly lit surface is never
-//!   interpolated;
+//!   interpolated. Such a span is first handed to a [`SpanProver`] (the year's certificates over
+//!   the span's suns, [`super::certified::SpanProofs`]): the steps it proves dark or lit take the
+//!   value counting them would give, exactly, and are not counted;
 //! - otherwise its middle day is counted, and the span is interpolated (piecewise linearly
 //!   through the middle) only if the middle lies within [`TOLERANCE`] of the straight line
 //!   between its ends, is of the same kind, and no counted day is more than [`MAX_GAP`] days
@@ -29,6 +31,7 @@
 //! So the views only go down: every refined step is counted at most once. Measured against
 //! counting every timestep in docs/energyplus-fidelity.md ("Refined steps counted sparsely").
 
+use crate::count::certify::Wanted;
 use crate::count::{Engine, ViewRequest};
 use crate::error::Result;
 use crate::year::annual::{NEAR_DARK, Progress, Views};
@@ -79,6 +82,8 @@ pub(super) struct Sparse {
     asked_middles: Vec<(usize, usize, usize)>,
     /// Steps counted so far.
     counted: usize,
+    /// Steps a span proof settled ([`SpanProver`]).
+    proved: usize,
     /// Per step: whether it was counted (not interpolated).
     was_counted: Vec<bool>,
     /// Whether the first round (every run's ends) was asked.
@@ -110,6 +115,7 @@ impl Sparse {
             spans: Vec::new(),
             asked_middles: Vec::new(),
             counted: 0,
+            proved: 0,
             was_counted: vec![false; rough.len()],
             started: false,
         }
@@ -125,6 +131,11 @@ impl Sparse {
         self.counted
     }
 
+    /// Steps a span proof settled so far.
+    pub(super) fn proved(&self) -> usize {
+        self.proved
+    }
+
     /// Whether every step has its value: no span is open and no middle awaits its answer.
     pub(super) fn done(&self) -> bool {
         self.started && self.spans.is_empty() && self.asked_middles.is_empty()
@@ -132,19 +143,35 @@ impl Sparse {
 
     /// The steps to count next (indices into the refined steps), those already known left out:
     /// may be empty while [`Self::done`] is not (every middle asked was known); answer it then.
-    pub(super) fn next_round(&mut self) -> Vec<usize> {
-        let mut asked = self.asked();
+    /// The spans this round counts step by step are first handed to `prover`, and the steps it
+    /// settles are not counted.
+    pub(super) fn next_round(&mut self, prover: &dyn SpanProver) -> Vec<usize> {
+        let (mut asked, whole) = self.asked();
+        let whole: Vec<(Vec<usize>, Wanted)> = whole
+            .into_iter()
+            .map(|(steps, wanted)| (steps.into_iter().filter(|&i| self.values[i].is_none()).collect::<Vec<_>>(), wanted))
+            .filter(|(steps, _)| steps.len() >= MIN_PROVED_SPAN)
+            .collect();
+        if !whole.is_empty() {
+            for (i, v) in prover.prove(&whole) {
+                if self.values[i].is_none() {
+                    self.values[i] = Some(v);
+                    self.proved += 1;
+                }
+            }
+        }
         asked.retain(|&i| self.values[i].is_none());
         asked
     }
 
-    /// The steps the rules ask for next, known or not.
-    fn asked(&mut self) -> Vec<usize> {
+    /// The steps the rules ask for next, known or not, and the spans among them counted step by
+    /// step, with the certificates their ends make worth looking for.
+    fn asked(&mut self) -> (Vec<usize>, Vec<(Vec<usize>, Wanted)>) {
         if !self.started {
             self.started = true;
-            return self.first_round();
+            return (self.first_round(), Vec::new());
         }
-        let mut asked = Vec::new();
+        let (mut asked, mut whole) = (Vec::new(), Vec::new());
         for (run, a, b) in std::mem::take(&mut self.spans) {
             let steps = self.run(run);
             let (va, vb) = (self.value(steps[a]), self.value(steps[b]));
@@ -152,10 +179,12 @@ impl Sparse {
                 asked.push(steps[(a + b) / 2]);
                 self.asked_middles.push((run, a, b));
             } else {
-                asked.extend(steps[a + 1..b].iter().copied());
+                let inner = &steps[a + 1..b];
+                asked.extend(inner.iter().copied());
+                whole.push((inner.to_vec(), span_wanted(va, vb)));
             }
         }
-        asked
+        (asked, whole)
     }
 
     /// Every run's first and last day, and the whole of runs of one or two days.
@@ -230,6 +259,39 @@ impl Sparse {
     }
 }
 
+/// Which certificate a span counted step by step whose ends count `a` and `b` may hold: dark
+/// beside a dark end (a canyon's dark days, a sliver of sun among them counted), lit beside a
+/// wholly lit one (the days before a shadow enters).
+fn span_wanted(a: f64, b: f64) -> Wanted {
+    Wanted { dark: kind(a) == Kind::Dark || kind(b) == Kind::Dark, lit: kind(a) == Kind::Wholly || kind(b) == Kind::Wholly }
+}
+
+/// Spans with fewer unknown steps than this are counted without looking for a proof: one view
+/// costs about what a proof does.
+const MIN_PROVED_SPAN: usize = 2;
+
+/// Proves steps of spans the refinement would count step by step dark or lit instead: the
+/// steps of one receiver at one time of day on consecutive days, whose suns lie along a short
+/// arc, so a certificate over them is much likelier than over a whole sample cell.
+pub(super) trait SpanProver {
+    /// For spans (steps and what to look for), the steps proved and their exact values (0 or 1).
+    fn prove(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)>;
+
+    /// Proofs tried and steps proved so far, for the year's log.
+    fn ledger(&self) -> (usize, usize) {
+        (0, 0)
+    }
+}
+
+/// A prover that proves nothing: every span is counted step by step.
+pub(super) struct NoProofs;
+
+impl SpanProver for NoProofs {
+    fn prove(&self, _: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
+        Vec::new()
+    }
+}
+
 /// Whether a span whose ends count `a` and `b` may be interpolated at all: both lit, of one kind.
 fn interpolable(a: f64, b: f64) -> bool {
     kind(a) != Kind::Dark && kind(a) == kind(b)
@@ -244,12 +306,13 @@ pub(super) async fn count_sparsely(
     known_dark: &[bool],
     rows_per_day: usize,
     leaves: &dyn Fn(&Rough) -> f32,
+    prover: &dyn SpanProver,
     report: &mut dyn FnMut(usize, Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
     let mut sparse = Sparse::new(rough, known_dark, rows_per_day);
     loop {
         let to_count = sparse.counted() + sparse.unsettled();
-        let asked = sparse.next_round();
+        let asked = sparse.next_round(prover);
         if asked.is_empty() {
             if sparse.done() {
                 break;
@@ -266,7 +329,14 @@ pub(super) async fn count_sparsely(
     // The last round's interpolated steps are settled too: the year ends at its total.
     let counted = sparse.counted();
     report(counted, Progress::counting(counted, counted))?;
-    log::info!("refinement: {} of {} steps counted, the rest interpolated between counted days", sparse.counted(), rough.len());
+    let (tried, _) = prover.ledger();
+    log::info!(
+        "refinement: {} of {} steps counted, {} proved in spans ({tried} span proofs tried), the rest interpolated \
+         between counted days",
+        sparse.counted(),
+        rough.len(),
+        sparse.proved()
+    );
     // The tally walks every refined step again: only when someone reads it.
     if log::log_enabled!(log::Level::Info) {
         log::info!("refinement by rule (steps / counted): {}", tally(rough.iter().zip(sparse.was_counted.iter().copied())));

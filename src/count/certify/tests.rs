@@ -5,14 +5,14 @@ use crate::sun::location::Location;
 use crate::sun::position::sun_direction;
 
 /// A closed box [lo, hi], 12 triangles wound outward.
-pub(super) fn block(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
+pub(crate) fn block(lo: [f32; 3], hi: [f32; 3]) -> SourceMesh {
     let c = |i: u32| [[lo[0], hi[0]][(i & 1) as usize], [lo[1], hi[1]][(i >> 1 & 1) as usize], [lo[2], hi[2]][(i >> 2) as usize]];
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     SourceMesh { positions: (0..8).map(c).collect(), indices: quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect() }
 }
 
 /// A south-facing window (normal −y) at y = `y`, x in [x0, x1], z in [z0, z1].
-pub(super) fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
+pub(crate) fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
     SourceMesh { positions: vec![[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], indices: vec![0, 1, 2, 0, 2, 3] }
 }
 

@@ -31,10 +31,15 @@ fn sparse(rough: &[Rough], truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
 /// [`sparse`] with the steps `known_dark` marks known to be 0 before any round: they must never
 /// be asked.
 fn sparse_knowing(rough: &[Rough], known_dark: &[bool], truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
+    sparse_proving(rough, known_dark, &NoProofs, truth)
+}
+
+/// [`sparse_knowing`] with `prover` settling spans counted step by step.
+fn sparse_proving(rough: &[Rough], known_dark: &[bool], prover: &dyn SpanProver, truth: impl Fn(&Rough) -> f64) -> (Vec<f64>, usize) {
     let mut s = Sparse::new(rough, known_dark, ROWS);
     let mut asked_ever = vec![false; rough.len()];
     loop {
-        let asked = s.next_round();
+        let asked = s.next_round(prover);
         if asked.is_empty() {
             if s.done() {
                 break;
@@ -206,4 +211,72 @@ fn steps_known_dark_are_not_counted_and_move_no_other_value() {
     assert_eq!(counting[5], 0.6);
     assert_eq!(knowing[5], 0.0);
     assert_eq!(knowing.iter().enumerate().filter(|(d, _)| *d != 5).map(|(_, v)| *v).collect::<Vec<_>>(), vec![0.6; 8]);
+}
+
+/// A prover that knows the truth: it proves a span's step dark where it is 0 and lit where it
+/// is 1 and the span's ends ask for it, as an exact certificate would; it records what it was
+/// handed.
+struct Oracle<'a> {
+    rough: &'a [Rough],
+    truth: &'a dyn Fn(&Rough) -> f64,
+    handed: std::cell::RefCell<Vec<usize>>,
+}
+
+impl SpanProver for Oracle<'_> {
+    fn prove(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
+        let mut proved = Vec::new();
+        for (steps, wanted) in spans {
+            self.handed.borrow_mut().extend(steps);
+            for &i in steps {
+                let v = (self.truth)(&self.rough[i]);
+                if (wanted.dark && v == 0.0) || (wanted.lit && v == 1.0) {
+                    proved.push((i, v));
+                }
+            }
+        }
+        proved
+    }
+}
+
+/// Spans the refinement counts step by step are handed to the prover first, and what it proves
+/// is not counted and moves no value: a dark spell with a sliver of sun in it, a dark start, a
+/// wholly lit start before a shadow enters. Only spans that would be counted whole are handed
+/// over (never a middle the rules interpolate around).
+#[test]
+fn steps_proved_in_spans_are_not_counted_and_move_no_value() {
+    let spell = |d: usize| {
+        if d == 30 {
+            0.2
+        } else if (20..40).contains(&d) {
+            0.0
+        } else {
+            0.5 + 0.001 * d as f64
+        }
+    };
+    let early = |d: usize| if d < 12 { 0.0 } else { 0.3 + 0.002 * d as f64 };
+    let shadow = |d: usize| if d < 15 { 1.0 } else { 0.9 - 0.01 * d as f64 };
+    for (k, f) in [&spell as &dyn Fn(usize) -> f64, &early, &shadow].into_iter().enumerate() {
+        let rough: Vec<Rough> = (0..50).map(|d| step(0, 40, d)).collect();
+        let truth = |r: &Rough| f(r.row / ROWS);
+        let (counting, counted) = sparse(&rough, truth);
+        let oracle = Oracle { rough: &rough, truth: &truth, handed: Default::default() };
+        let (proving, counted_proving) = sparse_proving(&rough, &[], &oracle, truth);
+        assert_eq!(proving, counting, "case {k}");
+        let handed = oracle.handed.borrow();
+        let settled = handed.iter().filter(|&&i| [0.0, 1.0].contains(&truth(&rough[i]))).count();
+        assert!(settled > 0 && counted_proving + settled <= counted, "case {k}: {counted_proving} + {settled} against {counted}");
+        // Handed over only where counting would count each step: with no proofs, those were counted.
+        let mut s = Sparse::new(&rough, &[], ROWS);
+        let mut counted_steps = Vec::new();
+        loop {
+            let asked = s.next_round(&NoProofs);
+            if asked.is_empty() && s.done() {
+                break;
+            }
+            let values: Vec<f64> = asked.iter().map(|&i| truth(&rough[i])).collect();
+            counted_steps.extend(&asked);
+            s.answer(&asked, &values);
+        }
+        assert!(handed.iter().all(|i| counted_steps.contains(i)), "case {k}: a step counting interpolates was handed over");
+    }
 }
