@@ -262,31 +262,14 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     (ToCount { steps, dark: dark_marks }, dark, lit)
 }
 
-/// The year's two certifiers over one index of the scene (the counting engine's own where it
-/// has one): the sample cells' ([`certify_steps`]) with the proofs the options ask for
+/// The year's certifier over `index` (the counting engine's own index of `scene` where it has
+/// one), with the proofs `(many_casters, inner_corners)` asks for
 /// ([`super::annual::AnnualOptions::many_casters`] and
-/// [`super::annual::AnnualOptions::inner_corners`]), and the refinement's spans'
-/// ([`SpanProofs`]) with the many-caster proofs always.
-///
-/// Why the spans always: a span's steps are counted one by one unless proved, so every proof
-/// there saves views, and the search runs only where they would be counted. Over a whole cell
-/// the many-caster search runs wherever the single-caster proof fails, also on steps the
-/// refinement then interpolates or counts sparsely: on blaas-louvres it saved no view and cost
-/// 1.166× the CPU (docs/energyplus-fidelity.md, "Proofs that move no value").
-pub(super) struct Certifiers<'a> {
-    pub cells: Certifier<'a>,
-    pub spans: Certifier<'a>,
-}
-
-impl<'a> Certifiers<'a> {
-    pub(super) fn new(scene: &Scene, index: &'a ExactEngine, (many_casters, inner_corners): (bool, bool)) -> Self {
-        let with_proofs = |many_casters: bool| {
-            let certifier = Certifier::sharing(scene, index);
-            let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
-            if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier }
-        };
-        Certifiers { cells: with_proofs(many_casters), spans: with_proofs(true) }
-    }
+/// [`super::annual::AnnualOptions::inner_corners`]).
+pub(super) fn certifier<'a>(scene: &Scene, index: &'a ExactEngine, (many_casters, inner_corners): (bool, bool)) -> Certifier<'a> {
+    let certifier = Certifier::sharing(scene, index);
+    let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
+    if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier }
 }
 
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
@@ -331,90 +314,111 @@ pub(super) fn certify_steps(
 /// proves it (at most 2^(n+1) − 1 proofs a span).
 const SPAN_HALVINGS: usize = 3;
 
-/// Spans of fewer steps than this are not halved: their halves would cost about what counting does.
-const MIN_HALVED_SPAN: usize = 4;
+/// Sets of fewer steps than this are not proved (nor halved into): on nyt-blocks' floor 5 a
+/// proof over 4–7 steps saved 0.58 views, over 2–3 steps 0.20, and a proof costs about a view.
+const MIN_SPAN_PROOF: usize = 8;
 
-/// Spans proved per batch, between which the proofs' yield is checked.
+/// Spans proved per batch, between which the proofs' cost is weighed.
 const SPAN_BATCH: usize = 32;
 
-/// Proofs tried before their yield is judged.
-const WARM_UP: usize = 256;
+/// Proofs tried for a receiver before their yield there is judged.
+const WARM_UP: usize = 16;
 
-/// The fewest steps proved per proof tried for the proofs to go on: a proof costs about what a
-/// view does (on blaas-louvres, 2,508 proofs of spans proved none; on nyt-blocks' floor 5,
-/// 17,934 proved 32,111 steps).
-const MIN_YIELD: f64 = 0.25;
+/// The fewest steps proved per proof tried, at a receiver, for the proofs to go on there: a
+/// proof costs about what a view does, under a canopy more.
+const MIN_YIELD: f64 = 2.0;
 
 /// The refinement's span proofs ([`refine::SpanProver`]): the certifier's proofs over a span's
 /// suns, the span halved where they fail. Exact like every certificate, so a proved step is
 /// what counting it would give, and the refinement counts and interpolates the rest as before.
 ///
-/// Where they do not pay (fewer than [`MIN_YIELD`] steps proved per proof after [`WARM_UP`]
-/// proofs: a scene whose dark steps are dark only behind many small casters, like louvres),
-/// they stop for the rest of the year; the values are the same either way.
+/// Whether they go on is decided receiver by receiver, by their yield: after [`WARM_UP`] proofs
+/// for a receiver, only while they have proved at least [`MIN_YIELD`] steps per proof tried
+/// there. Whether a proof pays is the receiver's surroundings': behind louvres a dark step is
+/// dark behind several slats at once, which no proof here takes; under a canopy a proof walks
+/// thousands of leaves for a few steps; in a street of blocks one block covers a window for
+/// weeks. The values are the same however soon they stop, and the rule counts proofs, not
+/// seconds, so the views counted are the same from run to run too.
 pub(super) struct SpanProofs<'a> {
     certifier: &'a Certifier<'a>,
     rough: &'a [Rough],
-    /// Proofs tried and steps proved so far.
-    ledger: std::cell::Cell<(usize, usize)>,
+    /// Per receiver: proofs tried and steps proved there.
+    receivers: std::cell::RefCell<std::collections::HashMap<usize, (usize, usize)>>,
+    /// Over all receivers: proofs tried and steps proved.
+    totals: std::cell::Cell<(usize, usize)>,
 }
 
 impl<'a> SpanProofs<'a> {
     pub(super) fn new(certifier: &'a Certifier<'a>, rough: &'a [Rough]) -> Self {
-        SpanProofs { certifier, rough, ledger: std::cell::Cell::new((0, 0)) }
+        SpanProofs { certifier, rough, receivers: Default::default(), totals: std::cell::Cell::new((0, 0)) }
     }
 
-    /// Whether the proofs have paid so far (or are still warming up).
-    fn paying(&self) -> bool {
-        let (tried, proved) = self.ledger.get();
+    /// Whether the proofs have paid for `receiver` so far (or are still warming up there).
+    fn paying(&self, receiver: usize) -> bool {
+        let (tried, proved) = self.receivers.borrow().get(&receiver).copied().unwrap_or_default();
         tried < WARM_UP || proved as f64 >= MIN_YIELD * tried as f64
     }
 
     /// The steps of `spans` proved, each span halved up to [`SPAN_HALVINGS`] times where a proof
-    /// over it fails, with their values.
-    fn prove_batch(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
+    /// over it fails (halves of at least [`MIN_SPAN_PROOF`] steps), with their values.
+    fn prove_batch(&self, spans: &[(&[usize], Wanted)]) -> Vec<(usize, f64)> {
         let mut proved = Vec::new();
-        let mut level: Vec<(&[usize], Wanted)> = spans.iter().map(|(s, w)| (s.as_slice(), *w)).collect();
+        let mut level = spans.to_vec();
+        let mut receivers = self.receivers.borrow_mut();
         for halvings_left in (0..=SPAN_HALVINGS).rev() {
             if level.is_empty() {
                 break;
             }
+            let receiver = |steps: &[usize]| self.rough[steps[0]].column;
             let suns: Vec<Vec<DVec3>> = level.iter().map(|(steps, _)| steps.iter().map(|&i| self.rough[i].sun).collect()).collect();
             let sets: Vec<(usize, &[DVec3], Wanted)> =
-                level.iter().zip(&suns).map(|((steps, w), s)| (self.rough[steps[0]].column, s.as_slice(), *w)).collect();
+                level.iter().zip(&suns).map(|((steps, w), s)| (receiver(steps), s.as_slice(), *w)).collect();
             let mut next = Vec::new();
-            for ((steps, wanted), proof) in level.iter().zip(self.certifier.certify_all(&sets)) {
+            for (&(steps, wanted), proof) in level.iter().zip(self.certifier.certify_all(&sets)) {
+                let ledger = receivers.entry(receiver(steps)).or_default();
+                ledger.0 += 1;
                 match proof {
-                    Some(p) => proved.extend(steps.iter().map(|&i| (i, f64::from(fraction(p.certificate))))),
-                    None if halvings_left > 0 && steps.len() >= MIN_HALVED_SPAN => {
+                    Some(p) => {
+                        ledger.1 += steps.len();
+                        proved.extend(steps.iter().map(|&i| (i, f64::from(fraction(p.certificate)))));
+                    }
+                    None if halvings_left > 0 && steps.len() >= 2 * MIN_SPAN_PROOF => {
                         let (first, second) = steps.split_at(steps.len() / 2);
-                        next.extend([(first, *wanted), (second, *wanted)]);
+                        next.extend([(first, wanted), (second, wanted)]);
                     }
                     None => {}
                 }
             }
-            let (tried, settled) = self.ledger.get();
-            self.ledger.set((tried + sets.len(), settled));
+            let (tried, settled) = self.totals.get();
+            self.totals.set((tried + sets.len(), settled));
             level = next;
         }
-        let (tried, settled) = self.ledger.get();
-        self.ledger.set((tried, settled + proved.len()));
+        let (tried, settled) = self.totals.get();
+        self.totals.set((tried, settled + proved.len()));
         proved
     }
 }
 
 impl refine::SpanProver for SpanProofs<'_> {
     fn ledger(&self) -> (usize, usize) {
-        self.ledger.get()
+        self.totals.get()
     }
 
     fn prove(&self, spans: &[(Vec<usize>, Wanted)]) -> Vec<(usize, f64)> {
         let mut proved = Vec::new();
-        for batch in spans.chunks(SPAN_BATCH) {
-            if !self.paying() {
-                break;
-            }
-            proved.extend(self.prove_batch(batch));
+        let mut batch = Vec::with_capacity(SPAN_BATCH);
+        let mut spans = spans.iter().filter(|(steps, _)| steps.len() >= MIN_SPAN_PROOF).peekable();
+        while spans.peek().is_some() {
+            // The ledgers move only between batches: a batch's spans are judged together.
+            batch.clear();
+            batch.extend(
+                spans
+                    .by_ref()
+                    .filter(|(steps, _)| self.paying(self.rough[steps[0]].column))
+                    .take(SPAN_BATCH)
+                    .map(|(s, w)| (s.as_slice(), *w)),
+            );
+            proved.extend(self.prove_batch(&batch));
         }
         proved
     }
@@ -429,7 +433,7 @@ mod tests {
     use crate::year::refine::SpanProver;
 
     /// A window behind a 0.1 m slot between two 12 m blocks across a 6 m street (as in
-    /// tests/annual.rs' canyon of blocks): each day at one time of day, 14 days a span, the
+    /// tests/annual.rs' canyon of blocks): each day at one time of day, 32 days a span, the
     /// refinement's span proofs. Every step they prove dark is dark for the exact engine at
     /// its sun; they prove most dark steps; and a span through which the slot's sun passes is
     /// proved in part (its halves), its lit steps left to count.
@@ -442,7 +446,7 @@ mod tests {
         let scene = b.build().unwrap();
         let location = Location::new(39.74, -105.18, -7.0).unwrap();
         let index = ExactEngine::new(&scene);
-        let certifiers = Certifiers::new(&scene, &index, (false, false));
+        let certifier = certifier(&scene, &index, (true, false));
         let mut rough = Vec::new();
         let mut spans = Vec::new();
         for slot in 36..60 {
@@ -463,7 +467,7 @@ mod tests {
                     });
                     run.push(rough.len() - 1);
                 }
-                if !facing || run.len() == 14 || day == 365 {
+                if !facing || run.len() == 32 || day == 365 {
                     if run.len() >= 2 {
                         spans.push((std::mem::take(&mut run), Wanted { dark: true, lit: false }));
                     }
@@ -471,7 +475,7 @@ mod tests {
                 }
             }
         }
-        let proofs = SpanProofs::new(&certifiers.spans, &rough);
+        let proofs = SpanProofs::new(&certifier, &rough);
         let proved = proofs.prove(&spans);
         let truth = index.fractions(&rough.iter().map(|r| ViewRequest::new(0, r.sun)).collect::<Vec<_>>());
         let mut is_proved = vec![false; rough.len()];
