@@ -27,7 +27,6 @@ use std::ops::Range;
 
 use glam::DVec3;
 
-use crate::count::exact::engine::ExactEngine;
 use crate::count::gpu::{Counter, GpuScene};
 use crate::count::lanes::{Lane, Lanes};
 use crate::count::{Engine, MIN_COS_INCIDENCE, ViewRequest, is_dark};
@@ -85,12 +84,9 @@ pub struct AnnualOptions {
     /// meet the receiver's plane by their part clear of it ([`crate::count::certify`]). Exact
     /// (no step proved dark is lit), and the steps only they prove stay in the sparse refinement
     /// as known zeros ([`crate::count::certify::Proof::alone`]), so the CSV is the one without
-    /// them. With them, the spans the sparse refinement counts step by step are proved first
-    /// too ([`crate::year::certified`]'s `SpanProofs`), the same CSV again. Off by default,
-    /// since on blaas-louvres the cells' search costs CPU and saves no view, and under
-    /// blaas-trees-summer's canopy the spans' costs more than it saves
-    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`],
-    /// docs/energyplus-fidelity.md, "Proofs that move no value", "Spans proved before they are counted").
+    /// them; with them the refinement's step-by-step spans are proved first too (`SpanProofs`).
+    /// Off by default: they cost blaas-louvres and blaas-trees-summer CPU
+    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`], docs/energyplus-fidelity.md).
     pub many_casters: bool,
     /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
     /// corner (a tower's other arm) may be proved dark by that facade, its corners there covered
@@ -643,12 +639,9 @@ async fn spline_year(
     let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, year);
     year.stages.fitting += now() - start;
     let start = now();
-    // Built only where a step is left to settle; without the engine's index, one of their own.
-    let settling = !(rough.is_empty() && smooth.is_empty());
-    let own_index = (settling && views.engine.index().is_none()).then(|| ExactEngine::new(scene));
+    // Built only where a step is left to settle (without the engine's index it builds its own).
     let proofs = (options.many_casters, options.inner_corners);
-    let certifier =
-        settling.then(|| views.engine.index().or(own_index.as_ref())).flatten().map(|index| certified::certifier(scene, index, proofs));
+    let certifier = (!(rough.is_empty() && smooth.is_empty())).then(|| certified::certifier(scene, views.engine.index(), proofs));
     let rough = match &certifier {
         Some(c) => certified::certify_steps(c, location, timesteps, rough, smooth, year),
         None => certified::ToCount { dark: vec![false; rough.len()], steps: rough },
@@ -660,8 +653,7 @@ async fn spline_year(
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
-    // The spans' proofs come with the many-caster ones (docs/energyplus-fidelity.md, "Spans proved
-    // before they are counted": on by default they cost blaas-trees-summer's windows 1.07×).
+    // The spans' proofs come with the many-caster ones: alone they cost the trees 1.07× (docs).
     let span_proofs = certifier.as_ref().filter(|_| options.many_casters).map(|c| certified::SpanProofs::new(c, &rough.steps));
     let prover = span_proofs.as_ref().map_or(&refine::NoProofs as &dyn refine::SpanProver, |p| p);
     let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, prover, &mut |n, p| {

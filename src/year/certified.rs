@@ -262,12 +262,15 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     (ToCount { steps, dark: dark_marks }, dark, lit)
 }
 
-/// The year's certifier over `index` (the counting engine's own index of `scene` where it has
-/// one), with the proofs `(many_casters, inner_corners)` asks for
+/// The year's certifier over the counting engine's own index of `scene` where it has one
+/// (`index`; else it builds its own), with the proofs `(many_casters, inner_corners)` asks for
 /// ([`super::annual::AnnualOptions::many_casters`] and
 /// [`super::annual::AnnualOptions::inner_corners`]).
-pub(super) fn certifier<'a>(scene: &Scene, index: &'a ExactEngine, (many_casters, inner_corners): (bool, bool)) -> Certifier<'a> {
-    let certifier = Certifier::sharing(scene, index);
+pub(super) fn certifier<'a>(scene: &Scene, index: Option<&'a ExactEngine>, (many_casters, inner_corners): (bool, bool)) -> Certifier<'a> {
+    let certifier = match index {
+        Some(index) => Certifier::sharing(scene, index),
+        None => Certifier::new(scene),
+    };
     let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
     if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier }
 }
@@ -446,7 +449,7 @@ mod tests {
         let scene = b.build().unwrap();
         let location = Location::new(39.74, -105.18, -7.0).unwrap();
         let index = ExactEngine::new(&scene);
-        let certifier = certifier(&scene, &index, (true, false));
+        let certifier = certifier(&scene, Some(&index), (true, false));
         let mut rough = Vec::new();
         let mut spans = Vec::new();
         for slot in 36..60 {
