@@ -27,7 +27,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         method: Method::Spline(SamplingPlan::new(6, 7)?),
         refine: 1.0,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     let counter = pollster::block_on(Counter::new(CounterOptions { resolution, ..Default::default() }))?;

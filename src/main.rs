@@ -145,9 +145,10 @@ struct AnnualArgs {
     /// With refinement on: let a dark proof combine casters (coplanar panels forming one convex
     /// polygon, halves of a cell each covered by its own caster, a facade clipped where it meets
     /// the surface's plane). Exact (no step proved dark is lit), and the values are those without
-    /// it: only views go. Off by default (on blaas-louvres it costs CPU and saves no view).
-    #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_value_t = sunlit::year::settings::DEFAULT_MANY_CASTERS, default_missing_value = "true", action = clap::ArgAction::Set)]
-    many_casters: bool,
+    /// it: only views go. Without the flag the year tries them on one cell in 16 and keeps them
+    /// where they settle at least 4 steps a cell tried there (on a city; not on blaas-louvres).
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, require_equals = true, default_missing_value = "true", action = clap::ArgAction::Set)]
+    many_casters: Option<bool>,
     /// With --many-casters: let a facade meeting a surface's plane at an inner corner prove it
     /// dark along their shared edge (no margin there). Exact with the exact engine; off by
     /// default until shown for the GPU engine.
@@ -239,7 +240,7 @@ impl AnnualArgs {
             samples_per_day: Some(self.samples_per_day),
             refine: Some(self.refine),
             prove_never_dark: Some(self.prove_never_dark),
-            many_casters: Some(self.many_casters),
+            many_casters: self.many_casters,
             inner_corners: Some(self.inner_corners),
             dense: Some(self.dense),
             evergreen: Some(self.evergreen),

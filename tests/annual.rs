@@ -18,7 +18,6 @@ use sunlit::sun::location::Location;
 use sunlit::sun::position::sun_direction;
 use sunlit::year::annual::{AnnualOptions, DEFAULT_REFINE, Method, annual, annual_on, compare};
 use sunlit::year::samples::{SamplingPlan, Timesteps};
-use sunlit::year::settings::DEFAULT_MANY_CASTERS;
 
 fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
@@ -32,7 +31,7 @@ fn year(scene: &Scene, method: Method, refine: f64, resolution: u32) -> Schedule
         method,
         refine,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     pollster::block_on(annual(&counter, &gpu, scene, &golden(), &options, &mut |_| Ok(()))).unwrap()
@@ -53,7 +52,7 @@ fn two_lanes_count_the_same_year_as_one() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
@@ -82,7 +81,7 @@ fn a_failing_progress_callback_cancels_the_year() {
         method: Method::Dense,
         refine: 1.0,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     let mut reports = Vec::new();
@@ -247,7 +246,7 @@ fn exact_year(scene: &Scene, method: Method, prove_never_dark: bool) -> (Schedul
         method,
         refine: DEFAULT_REFINE,
         prove_never_dark,
-        many_casters: DEFAULT_MANY_CASTERS,
+        many_casters: None,
         inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
@@ -385,7 +384,7 @@ fn reported_year(scene: &Scene, method: Method) -> (Vec<sunlit::year::annual::Pr
         method,
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();
@@ -479,7 +478,7 @@ fn cli_progress_goes_to_a_log_and_counts_only_counted_views() {
         method: Method::Spline(SamplingPlan::new(9, 7).unwrap()),
         refine: DEFAULT_REFINE,
         prove_never_dark: false,
-        many_casters: DEFAULT_MANY_CASTERS,
+        many_casters: None,
         inner_corners: false,
     };
     let calendar = sunlit::year::season::LeafCalendar::evergreen();

@@ -128,7 +128,7 @@ fn year(scene: &Scene, method: Method, refine: f64) -> (Schedule, usize) {
         method,
         refine,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     };
     let mut views = 0;

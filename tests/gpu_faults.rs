@@ -26,7 +26,7 @@ fn options() -> AnnualOptions {
         method: Method::Spline(SamplingPlan::new(6, 7).unwrap()),
         refine: 1.0,
         prove_never_dark: false,
-        many_casters: false,
+        many_casters: Some(false),
         inner_corners: false,
     }
 }

@@ -176,7 +176,7 @@ export interface AnnualSettings {
   refine?: number;
   /** Interpolate a timestep only where part of the surface is proved lit at its sun, else count it (slower; default false). */
   proveNeverDark?: boolean;
-  /** Let a dark proof combine casters (coplanar panels forming one convex polygon, halves of a cell, a facade clipped where it meets the surface's plane), as `--many-casters`; exact (no step proved dark is lit) and moving no value, only views; default false. */
+  /** Let a dark proof combine casters (coplanar panels forming one convex polygon, halves of a cell, a facade clipped where it meets the surface's plane), as `--many-casters`; exact (no step proved dark is lit) and moving no value, only views. Left out, the year tries them on one cell in 16 and keeps them where they settle at least 4 steps a cell tried (on a city they do; on an office behind louvres they do not). */
   manyCasters?: boolean;
   /** With manyCasters: let a facade meeting the surface's plane at an inner corner prove it dark along that shared edge, as `--inner-corners`; exact for the exact engine, default false (not yet shown for the GPU engine). */
   innerCorners?: boolean;

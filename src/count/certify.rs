@@ -55,6 +55,7 @@ pub mod cone;
 mod never_dark;
 
 use std::rc::Rc;
+use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
@@ -194,7 +195,8 @@ enum Caster {
 /// The certificates of one scene. Build once, then ask [`Self::certify`].
 pub struct Certifier<'a> {
     index: Index<'a>,
-    shapes: Vec<Shape>,
+    /// The receivers' shapes, shared with the single-caster view ([`Self::single_casters`]).
+    shapes: Arc<Vec<Shape>>,
     extent: f64,
     /// Whether a dark proof may combine casters (composites, halves of a cell); the year asks
     /// for it by default (docs/energyplus-fidelity.md, "certs13").
@@ -284,7 +286,7 @@ impl<'a> Certifier<'a> {
                 Shape { p0: points.first().copied().unwrap_or_default(), points, normal: r.normal, lowest, gpu_id: r.gpu_id, outline }
             })
             .collect();
-        Self { index, shapes, extent, many_casters: false, inner_corners: false }
+        Self { index, shapes: Arc::new(shapes), extent, many_casters: false, inner_corners: false }
     }
 
     /// Lets the dark proof combine casters: composite casters ([`composite`]), halves of a
@@ -296,6 +298,19 @@ impl<'a> Certifier<'a> {
         log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());
         self.many_casters = true;
         self
+    }
+
+    /// This certifier without the many-caster proofs (over the same index and shapes, built
+    /// again for nothing): what it proves is what [`Proof::alone`] marks. The year tries the
+    /// many-caster proofs on a sample of its cells and keeps them only where they pay there.
+    pub fn single_casters(&self) -> Certifier<'_> {
+        let index = Index::Shared(&self.index);
+        Certifier { index, shapes: Arc::clone(&self.shapes), extent: self.extent, many_casters: false, inner_corners: false }
+    }
+
+    /// Whether the many-caster proofs are on ([`Self::with_many_casters`]).
+    pub fn has_many_casters(&self) -> bool {
+        self.many_casters
     }
 
     /// With the many-caster proofs ([`Self::with_many_casters`]): a receiver's corner that lies

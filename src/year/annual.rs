@@ -85,9 +85,9 @@ pub struct AnnualOptions {
     /// (no step proved dark is lit), and the steps only they prove stay in the sparse refinement
     /// as known zeros ([`crate::count::certify::Proof::alone`]), so the CSV is the one without
     /// them; with them the refinement's step-by-step spans are proved first too (`SpanProofs`).
-    /// Off by default: they cost blaas-louvres and blaas-trees-summer CPU
-    /// ([`crate::year::settings::DEFAULT_MANY_CASTERS`], docs/energyplus-fidelity.md).
-    pub many_casters: bool,
+    /// `None` (the default): a pilot of one cell in 16 decides them (`certified::prove_cells`;
+    /// on a city they pay, on blaas-louvres they save nothing; docs/energyplus-fidelity.md).
+    pub many_casters: Option<bool>,
     /// With `many_casters`: a receiver whose edge lies on a facade meeting its plane at an inner
     /// corner (a tower's other arm) may be proved dark by that facade, its corners there covered
     /// with no margin ([`crate::count::certify::Certifier::with_inner_corners`]). Exact for the
@@ -643,8 +643,8 @@ async fn spline_year(
     let proofs = (options.many_casters, options.inner_corners);
     let certifier = (!(rough.is_empty() && smooth.is_empty())).then(|| certified::certifier(scene, views.engine.index(), proofs));
     let rough = match &certifier {
-        Some(c) => certified::certify_steps(c, location, timesteps, rough, smooth, year),
-        None => certified::ToCount { dark: vec![false; rough.len()], steps: rough },
+        Some(c) => certified::certify_steps(c, options.many_casters, location, timesteps, rough, smooth, year),
+        None => certified::ToCount { dark: vec![false; rough.len()], steps: rough, many_casters: false },
     };
     year.stages.certifying += now() - start;
     let (start, cpu) = (now(), cpu_seconds());
@@ -653,8 +653,8 @@ async fn spline_year(
     let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
-    // The spans' proofs come with the many-caster ones: alone they cost the trees 1.07× (docs).
-    let span_proofs = certifier.as_ref().filter(|_| options.many_casters).map(|c| certified::SpanProofs::new(c, &rough.steps));
+    // The spans' proofs come with the many-caster ones (asked for, or kept by the pilot).
+    let span_proofs = certifier.as_ref().filter(|_| rough.many_casters).map(|c| certified::SpanProofs::new(c, &rough.steps));
     let prover = span_proofs.as_ref().map_or(&refine::NoProofs as &dyn refine::SpanProver, |p| p);
     let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, prover, &mut |n, p| {
         refined_views = n;

@@ -218,12 +218,100 @@ fn wanted((lowest, highest): (f64, f64)) -> Wanted {
 pub(super) struct ToCount {
     pub steps: Vec<Rough>,
     pub dark: Vec<bool>,
+    /// Whether the many-caster proofs were used (asked for, or paid in the pilot): the
+    /// refinement's span proofs come with them.
+    pub many_casters: bool,
+}
+
+/// Where the caller leaves the many-caster proofs to the year, one cell in this many (every
+/// `PILOT_STRIDE`-th in the cells' order, so every part of the model has its share) is proved
+/// with them first, and their yield there decides them for the rest.
+const PILOT_STRIDE: usize = 16;
+
+/// The fewest steps the many-caster proofs must settle, per cell they are tried on in the
+/// pilot, to be used for the rest. A try walks the cell's candidates over up to 15 cones (the
+/// halvings), about what a view or two cost, and a step it settles saves at most a view; the
+/// span proofs that come with them cost more where they settle less. Measured (pilot's yield,
+/// then the year with them against without, paired): nyt-blocks' floors 5, 20 and 45 5.05,
+/// 5.81 and 8.08 a cell (floor 5 0.935× the CPU); canyon-slots 11.5; blaas-trees-summer's south
+/// windows 2.60 (1.055×: kept off), the whole model 0.46; blaas-louvres 0.
+const MIN_PILOT_YIELD: f64 = 4.0;
+
+/// What the many-caster proofs did in a pilot: cells they were tried on (a dark proof wanted,
+/// the single-caster proofs found none) and steps they alone settled.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Pilot {
+    tried: usize,
+    settled: usize,
+}
+
+impl Pilot {
+    /// The pilot's record of `proofs` over `asked` (the same order), proved with the
+    /// many-caster proofs.
+    fn of(asked: &[(&[usize], Wanted)], proofs: &[Option<Proof>]) -> Self {
+        let mut pilot = Pilot::default();
+        for ((steps, wanted), proof) in asked.iter().zip(proofs) {
+            if !wanted.dark || proof.is_some_and(|p| p.alone) {
+                continue;
+            }
+            pilot.tried += 1;
+            if proof.is_some() {
+                pilot.settled += steps.len();
+            }
+        }
+        pilot
+    }
+
+    /// Whether the many-caster proofs paid in the pilot (where they were never tried, nothing
+    /// says they would pay: the span proofs that come with them are then left off too).
+    fn pays(self) -> bool {
+        self.tried > 0 && self.settled as f64 >= MIN_PILOT_YIELD * self.tried as f64
+    }
+}
+
+/// Proofs for every set of `sets` (in order): with `certifier`'s own proofs where `many` says
+/// whether to combine casters, else (`None`) with the many-caster proofs on a pilot of the sets
+/// first ([`PILOT_STRIDE`]) and on the rest only where they paid there ([`Pilot::pays`]). The
+/// proofs are exact either way, so the choice moves views, never values. Returns the proofs and
+/// whether the many-caster proofs were used.
+fn prove_cells(
+    certifier: &Certifier,
+    many: Option<bool>,
+    asked: &[(&[usize], Wanted)],
+    sets: &[(usize, &[DVec3], Wanted)],
+) -> (Vec<Option<Proof>>, bool) {
+    let single = certifier.single_casters();
+    let chosen = |together: bool| if together && certifier.has_many_casters() { certifier } else { &single };
+    if let Some(together) = many {
+        return (chosen(together).certify_all(sets), together && certifier.has_many_casters());
+    }
+    let pilot: Vec<usize> = (0..sets.len()).step_by(PILOT_STRIDE).collect();
+    let picked = |k: &[usize]| -> Vec<(usize, &[DVec3], Wanted)> { k.iter().map(|&i| sets[i]).collect() };
+    let pilot_proofs = certifier.certify_all(&picked(&pilot));
+    let pilot_asked: Vec<(&[usize], Wanted)> = pilot.iter().map(|&i| asked[i]).collect();
+    let record = Pilot::of(&pilot_asked, &pilot_proofs);
+    let together = certifier.has_many_casters() && record.pays();
+    log::info!(
+        "many-caster proofs: in a pilot of {} cells they settled {} steps in {} cells tried ({:.2} a cell): {} for the rest",
+        pilot.len(),
+        record.settled,
+        record.tried,
+        record.settled as f64 / record.tried.max(1) as f64,
+        if together { "on" } else { "off" }
+    );
+    let rest: Vec<usize> = (0..sets.len()).filter(|i| i % PILOT_STRIDE != 0).collect();
+    let rest_proofs = chosen(together).certify_all(&picked(&rest));
+    let mut proofs = vec![None; sets.len()];
+    for (i, p) in pilot.into_iter().zip(pilot_proofs).chain(rest.into_iter().zip(rest_proofs)) {
+        proofs[i] = p;
+    }
+    (proofs, together)
 }
 
 /// Writes the steps of `rough` that a single-caster certificate settles into `schedule` and
 /// returns the rest ([`ToCount`], in their order, those the many-caster proofs showed dark
-/// marked), with the numbers of steps proved dark and lit.
-pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Columns) -> (ToCount, usize, usize) {
+/// marked), with the numbers of steps proved dark and lit. `many` as for [`prove_cells`].
+pub(super) fn settle(certifier: &Certifier, many: Option<bool>, rough: Vec<Rough>, schedule: &mut Columns) -> (ToCount, usize, usize) {
     let mut order: Vec<usize> = (0..rough.len()).collect();
     order.sort_by_key(|&i| rough[i].cell);
     let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
@@ -235,10 +323,11 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
     let suns: Vec<Vec<DVec3>> = asked.iter().map(|(steps, _)| steps.iter().map(|&i| rough[i].sun).collect()).collect();
     let sets: Vec<(usize, &[DVec3], Wanted)> =
         asked.iter().zip(&suns).map(|((steps, w), s)| (rough[steps[0]].column, s.as_slice(), *w)).collect();
+    let (proofs, many_casters) = prove_cells(certifier, many, &asked, &sets);
     let mut settled = vec![false; rough.len()];
     let mut together = vec![false; rough.len()];
     let (mut dark, mut lit) = (0, 0);
-    for ((steps, _), proof) in asked.iter().zip(certifier.certify_all(&sets)) {
+    for ((steps, _), proof) in asked.iter().zip(proofs) {
         let Some(Proof { certificate, alone }) = proof else { continue };
         for &i in *steps {
             if alone {
@@ -259,26 +348,34 @@ pub(super) fn settle(certifier: &Certifier, rough: Vec<Rough>, schedule: &mut Co
         log::info!("certificates by rule (steps / proved): {}", tally(rough.iter().zip(proved)));
     }
     let (steps, dark_marks) = rough.into_iter().zip(settled).zip(together).filter(|((_, s), _)| !s).map(|((r, _), t)| (r, t)).unzip();
-    (ToCount { steps, dark: dark_marks }, dark, lit)
+    (ToCount { steps, dark: dark_marks, many_casters }, dark, lit)
 }
 
 /// The year's certifier over the counting engine's own index of `scene` where it has one
 /// (`index`; else it builds its own), with the proofs `(many_casters, inner_corners)` asks for
 /// ([`super::annual::AnnualOptions::many_casters`] and
-/// [`super::annual::AnnualOptions::inner_corners`]).
-pub(super) fn certifier<'a>(scene: &Scene, index: Option<&'a ExactEngine>, (many_casters, inner_corners): (bool, bool)) -> Certifier<'a> {
+/// [`super::annual::AnnualOptions::inner_corners`]): the many-caster proofs unless they are
+/// turned off (left to the year, its pilot decides them, [`prove_cells`]).
+pub(super) fn certifier<'a>(
+    scene: &Scene,
+    index: Option<&'a ExactEngine>,
+    (many_casters, inner_corners): (Option<bool>, bool),
+) -> Certifier<'a> {
     let certifier = match index {
         Some(index) => Certifier::sharing(scene, index),
         None => Certifier::new(scene),
     };
+    let many_casters = many_casters != Some(false);
     let certifier = if many_casters { certifier.with_many_casters() } else { certifier };
     if many_casters && inner_corners { certifier.with_inner_corners() } else { certifier }
 }
 
 /// Sets the refined timesteps that a certificate proves dark or lit (this module) and returns
-/// the rest, to count, with the interpolated ones not proved never dark ([`never_dark`]).
+/// the rest, to count, with the interpolated ones not proved never dark ([`never_dark`]). `many`
+/// says whether to combine casters, or (`None`) leaves it to a pilot ([`prove_cells`]).
 pub(super) fn certify_steps(
     certifier: &Certifier,
+    many: Option<bool>,
     location: &Location,
     timesteps: Timesteps,
     rough: Vec<Rough>,
@@ -287,7 +384,7 @@ pub(super) fn certify_steps(
 ) -> ToCount {
     let (start, cpu) = (seconds(), cpu_seconds());
     let asked = rough.len();
-    let (mut rest, dark, lit) = settle(certifier, rough, schedule);
+    let (mut rest, dark, lit) = settle(certifier, many, rough, schedule);
     let interpolated = smooth.len();
     let sun_of = |row: usize| {
         let instant = timesteps.instant(row);
@@ -449,7 +546,7 @@ mod tests {
         let scene = b.build().unwrap();
         let location = Location::new(39.74, -105.18, -7.0).unwrap();
         let index = ExactEngine::new(&scene);
-        let certifier = certifier(&scene, Some(&index), (true, false));
+        let certifier = certifier(&scene, Some(&index), (Some(true), false));
         let mut rough = Vec::new();
         let mut spans = Vec::new();
         for slot in 36..60 {
@@ -492,6 +589,59 @@ mod tests {
         assert!(proved.len() * 4 >= dark * 3, "{} of {dark} dark steps proved", proved.len());
         let split = spans.iter().filter(|(s, _)| s.iter().any(|&i| truth[i] > 0.0) && s.iter().any(|&i| is_proved[i])).count();
         assert!(split > 0, "no span through the slot's sun was proved in part");
+    }
+
+    /// A street of two 30 m blocks 10 m south of a window, built flush (their faces meet at
+    /// x = 1, behind the window's middle) or with a 0.3 m slot there. The sample cells are a
+    /// year of one-hour blocks of 14 days around noon, dark wanted. Flush, the many-caster
+    /// proofs settle the cells where neither block alone covers the window (the cover handed
+    /// over, or the faces as one composite), so the pilot keeps them; with the slot the sun
+    /// passes it in those cells and they settle nothing, so the pilot drops them. Either way
+    /// each cell's proof is what the chosen proofs give on their own.
+    #[test]
+    fn the_pilot_keeps_the_many_caster_proofs_where_they_pay_and_drops_them_where_they_do_not() {
+        let location = Location::new(39.74, -105.18, -7.0).unwrap();
+        let mut cells: Vec<Vec<DVec3>> = Vec::new();
+        for first in (1..365).step_by(14) {
+            for hour in [10.0, 11.0, 12.0, 13.0] {
+                let suns: Vec<DVec3> = (first..(first + 14).min(366))
+                    .flat_map(|day| (0..4).map(move |q| (day, hour + 0.25 * f64::from(q))))
+                    .map(|(day, h)| sun_direction(&location, f64::from(day), h))
+                    .filter(|s| s.z > 0.05 && -s.y > 0.05)
+                    .collect();
+                if suns.len() >= 2 {
+                    cells.push(suns);
+                }
+            }
+        }
+        let dark = Wanted { dark: true, lit: false };
+        let steps: Vec<Vec<usize>> = cells.iter().map(|c| (0..c.len()).collect()).collect();
+        let asked: Vec<(&[usize], Wanted)> = steps.iter().map(|s| (s.as_slice(), dark)).collect();
+        let sets: Vec<(usize, &[DVec3], Wanted)> = cells.iter().map(|c| (0, c.as_slice(), dark)).collect();
+        assert!(sets.len() >= 4 * PILOT_STRIDE, "{} cells: too few for a pilot", sets.len());
+        let street = |east_from: f32| {
+            let mut b = SceneBuilder::new();
+            b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+            b.add_object("test", "WEST", block([-30.0, -14.0, 0.0], [1.0, -10.0, 30.0]), false);
+            b.add_object("test", "EAST", block([east_from, -14.0, 0.0], [30.0, -10.0, 30.0]), false);
+            b.build().unwrap()
+        };
+        for (east_from, pays) in [(1.0, true), (1.3, false)] {
+            let scene = street(east_from);
+            let index = ExactEngine::new(&scene);
+            let certifier = certifier(&scene, Some(&index), (None, false));
+            let (proofs, kept) = prove_cells(&certifier, None, &asked, &sets);
+            assert_eq!(kept, pays, "street with its east block from x = {east_from}");
+
+            assert_eq!(proofs, prove_cells(&certifier, Some(pays), &asked, &sets).0, "x = {east_from}");
+            let pilot: Vec<usize> = (0..sets.len()).step_by(PILOT_STRIDE).collect();
+            let together = prove_cells(&certifier, Some(true), &asked, &sets).0;
+            let record =
+                Pilot::of(&pilot.iter().map(|&i| asked[i]).collect::<Vec<_>>(), &pilot.iter().map(|&i| together[i]).collect::<Vec<_>>());
+            assert!(record.tried > 0, "x = {east_from}: the pilot tried no cell, so it shows nothing");
+            let settled = together.iter().filter(|p| p.is_some_and(|p| !p.alone)).count();
+            assert_eq!(settled > 0, pays, "x = {east_from}: {settled} cells settled only by the many-caster proofs");
+        }
     }
 
     /// The cheap interleaving is the bits' own: every day and τ index a grid can have (below

@@ -141,7 +141,7 @@ mod tests {
             method: Method::Spline(SamplingPlan::new(14, 9).unwrap()),
             refine,
             prove_never_dark: false,
-            many_casters: false,
+            many_casters: Some(false),
             inner_corners: false,
         };
         let calendar = LeafCalendar::for_latitude(location.latitude);

@@ -25,12 +25,6 @@ use crate::sun::periods::ShadingPeriods;
 /// EnergyPlus's own default Timestep (rows per hour) where neither the caller nor the model says.
 pub const DEFAULT_TIMESTEPS_PER_HOUR: u32 = 4;
 
-/// Whether dark proofs combine casters unless asked otherwise ([`AnnualOptions::many_casters`]):
-/// off. They move no value since the steps they alone prove keep their place in the sparse
-/// refinement as known zeros, but on blaas-louvres they save no view and cost 1.17× the CPU
-/// (paired, quiet; docs/energyplus-fidelity.md, "Proofs that move no value").
-pub const DEFAULT_MANY_CASTERS: bool = false;
-
 /// An annual run's settings as a caller gives them: every field optional. Serialised names are
 /// the JS API's (`timestepsPerHour`); the library's parameter names are the snake_case ones.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
@@ -59,7 +53,7 @@ pub struct AnnualSettings {
     pub refine: Option<f64>,
     /// See [`AnnualOptions::prove_never_dark`] (default off).
     pub prove_never_dark: Option<bool>,
-    /// See [`AnnualOptions::many_casters`] (default off, [`DEFAULT_MANY_CASTERS`]).
+    /// See [`AnnualOptions::many_casters`] (default: the year's pilot decides).
     pub many_casters: Option<bool>,
     /// See [`AnnualOptions::inner_corners`] (default off).
     pub inner_corners: Option<bool>,
@@ -92,8 +86,9 @@ pub struct Resolved {
     pub refine: f64,
     /// Whether interpolated timesteps must be proved never dark ([`AnnualOptions::prove_never_dark`]).
     pub prove_never_dark: bool,
-    /// Whether dark proofs may combine casters ([`AnnualOptions::many_casters`]).
-    pub many_casters: bool,
+    /// Whether dark proofs may combine casters, `None` for the year's pilot to decide
+    /// ([`AnnualOptions::many_casters`]).
+    pub many_casters: Option<bool>,
     /// Whether they may trust a facade at an inner corner ([`AnnualOptions::inner_corners`]).
     pub inner_corners: bool,
     /// When foliage is in leaf.
@@ -123,7 +118,7 @@ impl AnnualSettings {
         let timesteps_per_hour = self.timesteps_per_hour.map(Timesteps::new).transpose()?;
         let sky_model = self.sky_model()?;
         let prove_never_dark = self.prove_never_dark.unwrap_or(false);
-        let (many_casters, inner_corners) = (self.many_casters.unwrap_or(DEFAULT_MANY_CASTERS), self.inner_corners.unwrap_or(false));
+        let (many_casters, inner_corners) = (self.many_casters, self.inner_corners.unwrap_or(false));
         Ok(Resolved { location, method, refine, prove_never_dark, many_casters, inner_corners, calendar, timesteps_per_hour, sky_model })
     }
 
@@ -215,10 +210,12 @@ mod tests {
         let south = AnnualSettings { latitude: Some(-33.9), ..golden() }.resolve().unwrap();
         assert_eq!(south.calendar, LeafCalendar::for_latitude(-33.9), "the southern calendar");
         assert_ne!(south.calendar, r.calendar);
-        assert!(!r.many_casters, "the many-caster proofs off");
+        assert_eq!(r.many_casters, None, "the many-caster proofs left to the year's pilot");
         assert!(!r.prove_never_dark && !r.inner_corners, "the never-dark and inner-corner proofs off");
         let many: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":true}"#).unwrap();
-        assert!(many.resolve().unwrap().options(None).unwrap().many_casters, "manyCasters: true turns them on");
+        assert_eq!(many.resolve().unwrap().options(None).unwrap().many_casters, Some(true), "manyCasters: true turns them on");
+        let none: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"manyCasters":false}"#).unwrap();
+        assert_eq!(none.resolve().unwrap().options(None).unwrap().many_casters, Some(false), "manyCasters: false turns them off");
         let corners: AnnualSettings = serde_json::from_str(r#"{"latitude":1,"longitude":2,"timeZone":3,"innerCorners":true}"#).unwrap();
         assert!(corners.resolve().unwrap().options(None).unwrap().inner_corners, "innerCorners: true turns them on");
     }

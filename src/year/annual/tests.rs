@@ -74,7 +74,7 @@ fn a_year_by_batches_of_receivers_is_the_whole_year() {
         refine: DEFAULT_REFINE,
         prove_never_dark: true,
         // On: the batches share the index's composite casters.
-        many_casters: true,
+        many_casters: Some(true),
         inner_corners: false,
     };
     let calendar = LeafCalendar::evergreen();
