@@ -294,8 +294,8 @@ impl<'a> Certifier<'a> {
     /// part clear of it ([`clipped_in_front`]). Exact either way; the year's default since
     /// certs13's paired gates (docs/energyplus-fidelity.md, "certs13").
     pub fn with_many_casters(mut self) -> Self {
-        // Found once per index: a city's batches of receivers share them, as they share it.
-        log::debug!("certificates: {} composite casters (coplanar panels)", self.composites().len());
+        // The composites are found once per index, when a proof first asks for them (not here:
+        // the year's pilot may drop these proofs before any does).
         self.many_casters = true;
         self
     }

@@ -233,8 +233,8 @@ const PILOT_STRIDE: usize = 16;
 /// halvings), about what a view or two cost, and a step it settles saves at most a view; the
 /// span proofs that come with them cost more where they settle less. Measured (pilot's yield,
 /// then the year with them against without, paired): nyt-blocks' floors 5, 20 and 45 5.05,
-/// 5.81 and 8.08 a cell (floor 5 0.935× the CPU); canyon-slots 11.5; blaas-trees-summer's south
-/// windows 2.60 (1.055×: kept off), the whole model 0.46; blaas-louvres 0.
+/// 5.81 and 8.08 a cell (floor 5 0.807× main's CPU, quiet); canyon-slots 11.5; blaas-trees-summer's
+/// south windows 2.60 (kept on there, they cost 1.055×), the whole model 0.46; blaas-louvres 0.
 const MIN_PILOT_YIELD: f64 = 4.0;
 
 /// What the many-caster proofs did in a pilot: cells they were tried on (a dark proof wanted,
@@ -528,7 +528,7 @@ impl refine::SpanProver for SpanProofs<'_> {
 mod tests {
     use super::*;
     use crate::count::ViewRequest;
-    use crate::count::certify::tests::{block, window};
+    use crate::count::certify::tests::{block, street, window};
     use crate::scene::SceneBuilder;
     use crate::year::refine::SpanProver;
 
@@ -619,13 +619,6 @@ mod tests {
         let asked: Vec<(&[usize], Wanted)> = steps.iter().map(|s| (s.as_slice(), dark)).collect();
         let sets: Vec<(usize, &[DVec3], Wanted)> = cells.iter().map(|c| (0, c.as_slice(), dark)).collect();
         assert!(sets.len() >= 4 * PILOT_STRIDE, "{} cells: too few for a pilot", sets.len());
-        let street = |east_from: f32| {
-            let mut b = SceneBuilder::new();
-            b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
-            b.add_object("test", "WEST", block([-30.0, -14.0, 0.0], [1.0, -10.0, 30.0]), false);
-            b.add_object("test", "EAST", block([east_from, -14.0, 0.0], [30.0, -10.0, 30.0]), false);
-            b.build().unwrap()
-        };
         for (east_from, pays) in [(1.0, true), (1.3, false)] {
             let scene = street(east_from);
             let index = ExactEngine::new(&scene);

@@ -16,6 +16,16 @@ pub(crate) fn window(x0: f32, x1: f32, z0: f32, z1: f32, y: f32) -> SourceMesh {
     SourceMesh { positions: vec![[x0, y, z0], [x1, y, z0], [x1, y, z1], [x0, y, z1]], indices: vec![0, 1, 2, 0, 2, 3] }
 }
 
+/// A south-facing window 2 m wide, 10 m north of two 30 m blocks whose faces meet at x = 1
+/// (behind the window's middle) where `east_from` is 1, or leave a slot from 1 to `east_from`.
+pub(crate) fn street(east_from: f32) -> Scene {
+    let mut b = SceneBuilder::new();
+    b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
+    b.add_object("test", "WEST", block([-30.0, -14.0, 0.0], [1.0, -10.0, 30.0]), false);
+    b.add_object("test", "EAST", block([east_from, -14.0, 0.0], [30.0, -10.0, 30.0]), false);
+    b.build().unwrap()
+}
+
 pub(super) fn golden() -> Location {
     Location::new(39.74, -105.18, -7.0).unwrap()
 }
@@ -255,13 +265,6 @@ fn a_scrim_leaves_a_window_proved_lit_between_its_rods_however_the_window_is_cut
 /// combine, sun passes the slot at some step, and nothing is proved.
 #[test]
 fn two_blocks_built_flush_hand_the_cover_over_within_a_cell() {
-    let street = |east_from: f32| {
-        let mut b = SceneBuilder::new();
-        b.add_object("test", "WIN", window(0.0, 2.0, 1.0, 2.5, 0.0), true);
-        b.add_object("test", "WEST", block([-30.0, -14.0, 0.0], [1.0, -10.0, 30.0]), false);
-        b.add_object("test", "EAST", block([east_from, -14.0, 0.0], [30.0, -10.0, 30.0]), false);
-        b.build().unwrap()
-    };
     let winter = suns(1..14, (11.0, 13.0), -DVec3::Y);
     let both = Wanted { dark: true, lit: true };
     let requests: Vec<ViewRequest> = winter.iter().map(|s| ViewRequest::new(0, *s)).collect();

@@ -267,7 +267,11 @@ impl ExactEngine {
 
     /// The scene's composite casters ([`Composites`]), found the first time they are asked for.
     pub(crate) fn composites(&self) -> &Composites {
-        self.composites.get_or_init(|| Composites::new(self))
+        self.composites.get_or_init(|| {
+            let found = Composites::new(self);
+            log::debug!("certificates: {} composite casters (coplanar panels)", found.len());
+            found
+        })
     }
 
     /// Fresh scratch memory for one thread.
