@@ -353,6 +353,30 @@ fn a_post_passing_the_sun_between_samples_darkens_the_window() {
     assert!(unproved > 0, "without the proof no step is lost here, so the test proves nothing");
 }
 
+/// An east window 1 m square with a fin 0.3 mm deep and 10 m tall along its south edge: the
+/// fin's shadow covers the window only in the last 0.02° of azimuth before the sun passes behind
+/// it at noon, between the day's last sample and the end of its lit piece, where the fit
+/// extrapolates the window lit. A step falls there once in this year (as the equation of time
+/// moves noon across the clock); it is counted (`year::certified::Rule::BeyondSamples`), so the
+/// year tells dark from lit as counting every timestep does. Without that rule the fit keeps it
+/// lit at 0.94 (tried: 1 disagreement); a fin 0.5–1.5 mm deep darkens the window early enough
+/// that the last sample sees it.
+#[test]
+fn the_last_minute_before_the_sun_passes_behind_a_window_is_counted() {
+    let mut s = TestScene::new();
+    let east =
+        |y0: f64, y1: f64| vec![DVec3::new(0.0, y0, 0.0), DVec3::new(0.0, y1, 0.0), DVec3::new(0.0, y1, 1.0), DVec3::new(0.0, y0, 1.0)];
+    s.polygon("WIN", &east(0.0, 1.0), true);
+    s.cuboid("FIN", DVec3::new(0.0, -0.01, 0.0), DVec3::new(0.0003, 0.0, 10.0));
+    let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "fin", false);
+    // Every step the sun is in front of the window is counted densely: those not lit are the
+    // fin's, or the test would ask nothing of the rule.
+    assert!(lit > 8_000 && lit < dense_views, "the window is lit at {lit} of {dense_views} steps in front of the sun");
+    assert_eq!(disagree, 0, "steps dark in one and lit in the other");
+    assert!(mean <= 0.005, "mean |Δ| {mean}");
+    assert!(spline_views < dense_views, "{spline_views} views against {dense_views} dense");
+}
+
 /// The exact reference, tallying the views it is asked to count.
 struct Tally<'a> {
     exact: sunlit::count::exact::Exact<'a>,

@@ -727,6 +727,8 @@ struct Cell {
     bilinear: f64,
     /// Whether either of its sample days lacks the piece, its samples borrowed from another day.
     borrowed: bool,
+    /// Whether τ lies outside the outermost sample times, between one and its piece's end.
+    beyond: bool,
 }
 
 impl SampleCells {
@@ -750,7 +752,8 @@ impl SampleCells {
         let (lo, hi) = corners.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
         let v = if j1 > j0 { ((tau - self.taus[j0]) / (self.taus[j1] - self.taus[j0])).clamp(0.0, 1.0) } else { 0.0 };
         let bilinear = (1.0 - u) * ((1.0 - v) * corners[0] + v * corners[1]) + u * ((1.0 - v) * corners[2] + v * corners[3]);
-        Cell { spread: hi - lo, lowest: lo, highest: hi, bilinear, at: (k0, j0), borrowed: borrowed[k0] || borrowed[k1] }
+        let beyond = self.taus.first().is_some_and(|&t| tau < t) || self.taus.last().is_some_and(|&t| tau > t);
+        Cell { spread: hi - lo, lowest: lo, highest: hi, bilinear, at: (k0, j0), borrowed: borrowed[k0] || borrowed[k1], beyond }
     }
 }
 
@@ -821,13 +824,20 @@ fn evaluate(
 
 /// The first rule that sends a fitted `value` in `cell` to counting, None where it is
 /// interpolated: the spread rule, then, with refinement on, a sample day of the cell lacking the
-/// lit piece, a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline leaving the
+/// lit piece, a time beyond the day's outermost samples, a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline leaving the
 /// cell's bilinear interpolation ([`KINK`]). The borrowed day is a piece of day that comes and
 /// goes with the season (a north wall's minutes after sunrise near the equinoxes): its samples on
 /// such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the fit there
 /// extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36, Chicago,
 /// Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
 /// appears, 0.14 with those cells counted, for 1.8 % more views.
+///
+/// Beyond the outermost samples (the first and last 0.17 % of a lit piece at 19 a day) the fit
+/// extrapolates towards the piece's end, where the sun grazes the surface and anything standing
+/// a little proud of its plane shades all of it: nyt-blocks' east window `F5_WIN_3` (sun at 38.6°)
+/// is 0.93 lit 1° of azimuth before the sun passes behind it, 0.54 at 0.1°, 0 at 0.01°, after
+/// the last sample, and the fit kept a step there lit at 0.76 that is dark. A timestep falls
+/// there on few days, so counting them costs little.
 fn counting_rule(cell: &Cell, value: f64, refine: f64) -> Option<Rule> {
     Some(if cell.spread > refine {
         Rule::Spread
@@ -835,6 +845,8 @@ fn counting_rule(cell: &Cell, value: f64, refine: f64) -> Option<Rule> {
         return None;
     } else if cell.borrowed {
         Rule::Borrowed
+    } else if cell.beyond {
+        Rule::BeyondSamples
     } else if cell.highest < NEAR_DARK {
         Rule::AllNearDark
     } else if cell.lowest < NEAR_DARK {

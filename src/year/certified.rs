@@ -56,6 +56,8 @@ pub(super) enum Rule {
     Spread,
     /// A sample day of the cell lacks the lit piece (borrowed samples).
     Borrowed,
+    /// Its time lies beyond the day's outermost samples, where the fit extrapolates.
+    BeyondSamples,
     /// All four of the cell's samples are under `NEAR_DARK`.
     AllNearDark,
     /// Some, not all, of the cell's samples are under `NEAR_DARK`.
@@ -69,10 +71,11 @@ pub(super) enum Rule {
 }
 
 impl Rule {
-    const ALL: [Rule; 8] = [
+    const ALL: [Rule; 9] = [
         Rule::NoFit,
         Rule::Spread,
         Rule::Borrowed,
+        Rule::BeyondSamples,
         Rule::AllNearDark,
         Rule::SomeNearDark,
         Rule::NearDarkFit,
@@ -85,6 +88,7 @@ impl Rule {
             Rule::NoFit => "dark at every sample",
             Rule::Spread => "spread",
             Rule::Borrowed => "borrowed day",
+            Rule::BeyondSamples => "beyond the outermost samples",
             Rule::AllNearDark => "all four samples near dark",
             Rule::SomeNearDark => "some sample near dark",
             Rule::NearDarkFit => "near-dark fit",
