@@ -824,20 +824,14 @@ fn evaluate(
 
 /// The first rule that sends a fitted `value` in `cell` to counting, None where it is
 /// interpolated: the spread rule, then, with refinement on, a sample day of the cell lacking the
-/// lit piece, a time beyond the day's outermost samples, a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline leaving the
-/// cell's bilinear interpolation ([`KINK`]). The borrowed day is a piece of day that comes and
-/// goes with the season (a north wall's minutes after sunrise near the equinoxes): its samples on
-/// such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the fit there
-/// extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36, Chicago,
-/// Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
+/// lit piece, a time beyond the day's outermost samples, where the fit extrapolates
+/// ([`Rule::BeyondSamples`]), a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline
+/// leaving the cell's bilinear interpolation ([`KINK`]). The borrowed day is a piece of day that
+/// comes and goes with the season (a north wall's minutes after sunrise near the equinoxes): its
+/// samples on such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the fit
+/// there extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36,
+/// Chicago, Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
 /// appears, 0.14 with those cells counted, for 1.8 % more views.
-///
-/// Beyond the outermost samples (the first and last 0.17 % of a lit piece at 19 a day) the fit
-/// extrapolates towards the piece's end, where the sun grazes the surface and anything standing
-/// a little proud of its plane shades all of it: nyt-blocks' east window `F5_WIN_3` (sun at 38.6°)
-/// is 0.93 lit 1° of azimuth before the sun passes behind it, 0.54 at 0.1°, 0 at 0.01°, after
-/// the last sample, and the fit kept a step there lit at 0.76 that is dark. A timestep falls
-/// there on few days, so counting them costs little.
 fn counting_rule(cell: &Cell, value: f64, refine: f64) -> Option<Rule> {
     Some(if cell.spread > refine {
         Rule::Spread
