@@ -364,9 +364,8 @@ fn a_post_passing_the_sun_between_samples_darkens_the_window() {
 #[test]
 fn the_last_minute_before_the_sun_passes_behind_a_window_is_counted() {
     let mut s = TestScene::new();
-    let east =
-        |y0: f64, y1: f64| vec![DVec3::new(0.0, y0, 0.0), DVec3::new(0.0, y1, 0.0), DVec3::new(0.0, y1, 1.0), DVec3::new(0.0, y0, 1.0)];
-    s.polygon("WIN", &east(0.0, 1.0), true);
+    let east_window = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.0, 1.0, 1.0), DVec3::new(0.0, 0.0, 1.0)];
+    s.polygon("WIN", &east_window, true);
     s.cuboid("FIN", DVec3::new(0.0, -0.01, 0.0), DVec3::new(0.0003, 0.0, 10.0));
     let (spline_views, dense_views, lit, disagree, mean) = against_dense(&s.build(), "fin", false);
     // Every step the sun is in front of the window is counted densely: those not lit are the

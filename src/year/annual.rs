@@ -824,14 +824,9 @@ fn evaluate(
 
 /// The first rule that sends a fitted `value` in `cell` to counting, None where it is
 /// interpolated: the spread rule, then, with refinement on, a sample day of the cell lacking the
-/// lit piece, a time beyond the day's outermost samples, where the fit extrapolates
-/// ([`Rule::BeyondSamples`]), a near-dark corner ([`NEAR_DARK`]), a near-dark fit, or the spline
-/// leaving the cell's bilinear interpolation ([`KINK`]). The borrowed day is a piece of day that
-/// comes and goes with the season (a north wall's minutes after sunrise near the equinoxes): its
-/// samples on such a day are borrowed from the nearest day that has it ([`fill_dark`]), so the fit
-/// there extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36,
-/// Chicago, Timestep 6, against counting every timestep): off by up to 0.51 on the days the piece
-/// appears, 0.14 with those cells counted, for 1.8 % more views.
+/// lit piece, a time beyond the day's outermost samples, a near-dark corner ([`NEAR_DARK`]), a
+/// near-dark fit, or the spline leaving the cell's bilinear interpolation ([`KINK`]). Why each
+/// is counted is on its [`Rule`].
 fn counting_rule(cell: &Cell, value: f64, refine: f64) -> Option<Rule> {
     Some(if cell.spread > refine {
         Rule::Spread

@@ -54,7 +54,12 @@ pub(super) enum Rule {
     NoFit,
     /// The cell's samples differ by more than the refinement threshold.
     Spread,
-    /// A sample day of the cell lacks the lit piece (borrowed samples).
+    /// A sample day of the cell lacks the lit piece: a piece of day that comes and goes with the
+    /// season (a north wall's minutes after sunrise near the equinoxes), whose samples on such a
+    /// day are borrowed from the nearest day that has it (`annual::fill_dark`), so the fit there
+    /// extrapolates. Measured on the north windows of NREL's 100-zone test file (issue 36,
+    /// Chicago, Timestep 6, against counting every timestep): off by up to 0.51 on the days the
+    /// piece appears, 0.14 with those cells counted, for 1.8 % more views.
     Borrowed,
     /// Its time lies beyond the day's outermost samples (the first and last 0.17 % of a lit piece
     /// at 19 a day), where the fit extrapolates towards the piece's end. There the sun grazes the
