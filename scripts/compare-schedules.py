@@ -26,7 +26,10 @@ def against(a, b, ncol):
 args = sys.argv[1:]
 before = None
 if '--before' in args:
-    i = args.index('--before'); before = args[i + 1]; del args[i:i + 2]
+    i = args.index('--before')
+    if i + 1 >= len(args): sys.exit("compare-schedules.py: --before needs the earlier CSV after it")
+    before = args[i + 1]; del args[i:i + 2]
+if len(args) < 2: sys.exit("usage: compare-schedules.py A.csv B.csv [N] [--before OLD.csv]")
 na, a = load(args[0]); nb, b = load(args[1])
 assert na == nb
 ncol = len(na)
