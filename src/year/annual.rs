@@ -37,7 +37,7 @@ use crate::scene::Scene;
 use crate::sun::location::Location;
 use crate::sun::periods::ShadingPeriods;
 use crate::sun::position::{lit_intervals, sun_direction};
-use crate::year::certified::{self, Rough, Rule, Smooth};
+use crate::year::certified::{self, Rough, RowSuns, Rule, Smooth};
 use crate::year::fitted::{FittedSurfaces, FittedYear};
 use crate::year::refine;
 use crate::year::samples::{DAYS, SamplingPlan, SeasonAxis, Timesteps};
@@ -641,28 +641,29 @@ async fn spline_year(
     let start = now();
     // Built only where a step is left to settle (without the engine's index it builds its own).
     let proofs = (options.many_casters, options.inner_corners);
+    let suns = RowSuns::new(location, timesteps);
     let certifier = (!(rough.is_empty() && smooth.is_empty())).then(|| certified::certifier(scene, views.engine.index(), proofs));
     let rough = match &certifier {
-        Some(c) => certified::certify_steps(c, options.many_casters, location, timesteps, rough, smooth, year),
+        Some(c) => certified::certify_steps(c, options.many_casters, &suns, rough, smooth, year),
         None => certified::ToCount { dark: vec![false; rough.len()], steps: rough, many_casters: false },
     };
     year.stages.certifying += now() - start;
     let (start, cpu) = (now(), cpu_seconds());
     // Certified timesteps are settled like interpolated ones: done, not counted.
     let rows_per_day = timesteps.rows() / timesteps.days() as usize;
-    let leaves = |r: &Rough| calendar.fraction(r.day) as f32;
+    let request = |r: &Rough| ViewRequest::new(r.column, suns.sun(r.row)).with_leaves(calendar.fraction(suns.day(r.row)) as f32);
     // The last report says how many refined steps were counted in all.
     let mut refined_views = 0;
     // The spans' proofs come with the many-caster ones (asked for, or kept by the pilot).
-    let span_proofs = certifier.as_ref().filter(|_| rough.many_casters).map(|c| certified::SpanProofs::new(c, &rough.steps));
+    let span_proofs = certifier.as_ref().filter(|_| rough.many_casters).map(|c| certified::SpanProofs::new(c, &rough.steps, &suns));
     let prover = span_proofs.as_ref().map_or(&refine::NoProofs as &dyn refine::SpanProver, |p| p);
-    let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &leaves, prover, &mut |n, p| {
+    let refined = refine::count_sparsely(views, &rough.steps, &rough.dark, rows_per_day, &request, prover, &mut |n, p| {
         refined_views = n;
         progress(work.refining(n, p))
     })
     .await?;
     for (r, v) in rough.steps.into_iter().zip(refined) {
-        year.set(r.row, r.column, as_energyplus(v));
+        year.set(r.row as usize, r.column as usize, as_energyplus(v));
     }
     year.stages.refining += now() - start;
     year.stages.refining_cpu += cpu_seconds() - cpu;
@@ -802,8 +803,7 @@ fn evaluate(
                     // guessed dark, since a slot of sun may light it between them.
                     if refine < 1.0 {
                         let at = regime.cells.at(grid_day, tau);
-                        let (day, cell) = (day as f64, (g, fit, at.0, at.1));
-                        rough.push(Rough { row, column, sun, day, cell, corners: (0.0, 0.0), rule: Rule::NoFit });
+                        rough.push(Rough::new(row, column, (g, fit, at.0, at.1), (0.0, 0.0), Rule::NoFit));
                     }
                     continue;
                 };
@@ -811,8 +811,7 @@ fn evaluate(
                 year.schedule.set(row, local, as_energyplus(value));
                 let cell = regime.cells.cell(&piece.samples, &piece.borrowed, grid_day, tau);
                 if let Some(rule) = counting_rule(&cell, value, refine) {
-                    let (day, cell, corners) = (day as f64, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest));
-                    rough.push(Rough { row, column, sun, day, cell, corners, rule });
+                    rough.push(Rough::new(row, column, (g, fit, cell.at.0, cell.at.1), (cell.lowest, cell.highest), rule));
                 } else if refine < 1.0 && prove_never_dark {
                     smooth.push(Smooth::new(row, column, fit, g, cell.at));
                 }

@@ -31,19 +31,59 @@ use crate::year::annual::{Columns, shading_sun_day};
 use crate::year::refine;
 use crate::year::samples::Timesteps;
 
-/// A timestep the refinement counts directly unless a certificate settles it.
+/// A timestep the refinement counts directly unless a certificate settles it, kept small (a
+/// city's year has millions: nyt-blocks' Timestep 4 year 6.4 M, which at 80 bytes in wasm32, with
+/// its sun and day and the cell's samples as f64, took the page's engine 1.3 GB between the fit
+/// and the refinement). Its sun and day follow from its row ([`RowSuns`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Rough {
-    pub row: usize,
-    pub column: usize,
-    pub sun: DVec3,
-    pub day: f64,
+    pub row: u32,
+    pub column: u32,
     /// Its sample cell: regime, fitted piece (receiver and lit piece), cell's first day and τ.
-    pub cell: (usize, usize, usize, usize),
-    /// The lowest and highest of the cell's four samples.
-    pub corners: (f64, f64),
+    pub cell: (u16, u32, u16, u16),
+    /// The certificate its cell's four samples make worth looking for ([`wanted`]).
+    pub wanted: Wanted,
     /// The first rule that sent it to counting.
     pub rule: Rule,
+}
+
+impl Rough {
+    /// Step `row` of receiver `column` in regime `regime`'s fitted piece `fit` and its sample
+    /// cell `(k, j)`, whose samples lie between `corners` (lowest, highest), sent to counting
+    /// by `rule`.
+    pub(super) fn new(row: usize, column: usize, (regime, fit, k, j): (usize, usize, usize, usize), corners: (f64, f64), rule: Rule) -> Self {
+        let small = |x: usize| u16::try_from(x).unwrap_or(u16::MAX);
+        let cell = (small(regime), fit as u32, small(k), small(j));
+        Rough { row: row as u32, column: column as u32, cell, wanted: wanted(corners), rule }
+    }
+}
+
+/// The sun and the calendar day of every row of a year, so a step need not carry them: a
+/// year's rows are few (35,040 at Timestep 4), its refined steps many.
+pub(super) struct RowSuns {
+    suns: Vec<DVec3>,
+    rows_per_day: usize,
+}
+
+impl RowSuns {
+    /// Every row's sun at `location` (each calendar day's own, [`shading_sun_day`]).
+    pub(super) fn new(location: &Location, timesteps: Timesteps) -> Self {
+        let suns = (0..timesteps.rows())
+            .map(|row| timesteps.instant(row))
+            .map(|at| sun_direction(location, shading_sun_day(at.day), at.hour))
+            .collect();
+        RowSuns { suns, rows_per_day: timesteps.rows() / timesteps.days() as usize }
+    }
+
+    /// The sun at `row`.
+    pub(super) fn sun(&self, row: u32) -> DVec3 {
+        self.suns[row as usize]
+    }
+
+    /// The calendar day (1-based) of `row`.
+    pub(super) fn day(&self, row: u32) -> f64 {
+        (row as usize / self.rows_per_day + 1) as f64
+    }
 }
 
 /// Which refinement rule sent a step to counting (the first that applies, in this order), for
@@ -146,43 +186,33 @@ impl Smooth {
     }
 }
 
-/// Interpolated steps proved per batch: bounds the suns held at once.
-const SMOOTH_BATCH: usize = 1 << 18;
+/// Steps proved per batch: bounds the suns held at once.
+const SUNS_BATCH: usize = 1 << 18;
 
 /// The interpolated steps of `smooth` whose receiver is not proved partly lit at their sun
-/// (`sun_of` gives a row's sun and calendar day), as steps to count. The steps of one receiver
+/// (`suns` gives a row's sun), as steps to count. The steps of one receiver
 /// and fitted piece are proved together, cell by cell in [`block_order`]: runs of neighbouring
 /// cells at once (a half of a run is a block of days by times of day), then single cells, then
 /// halves of a cell ([`Certifier::unproved_lit_in_cells`]).
-pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, sun_of: &dyn Fn(usize) -> (DVec3, f64)) -> Vec<Rough> {
+pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, suns: &RowSuns) -> Vec<Rough> {
     smooth.sort_unstable_by_key(|s| (s.regime, s.fit, block_order(s.at), s.row));
     let pieces: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit) == (b.regime, b.fit)).collect();
     let mut out = Vec::new();
-    let mut start = 0;
-    while start < pieces.len() {
-        // Whole pieces per batch, up to about SMOOTH_BATCH steps.
-        let mut end = start;
-        let mut steps = 0;
-        while end < pieces.len() && (end == start || steps + pieces[end].len() <= SMOOTH_BATCH) {
-            steps += pieces[end].len();
-            end += 1;
-        }
-        let batch = &pieces[start..end];
-        let suns: Vec<Vec<(DVec3, f64)>> = batch.iter().map(|p| p.iter().map(|s| sun_of(s.row as usize)).collect()).collect();
-        let directions: Vec<Vec<DVec3>> = suns.iter().map(|p| p.iter().map(|s| s.0).collect()).collect();
+    // Whole pieces per batch, up to about SUNS_BATCH steps.
+    for batch in weighted_chunks(&pieces, |p| p.len()) {
+        let directions: Vec<Vec<DVec3>> = batch.iter().map(|p| p.iter().map(|s| suns.sun(s.row)).collect()).collect();
         // Where each cell starts among its piece's steps.
         let starts: Vec<Vec<usize>> = batch.iter().map(|p| (0..p.len()).filter(|&i| i == 0 || p[i].at != p[i - 1].at).collect()).collect();
         let sets: Vec<(usize, &[DVec3], &[usize])> =
             batch.iter().zip(&directions).zip(&starts).map(|((p, d), c)| (p[0].column as usize, d.as_slice(), c.as_slice())).collect();
-        for ((piece, suns), unproved) in batch.iter().zip(&suns).zip(certifier.unproved_lit_in_cells(&sets)) {
+        for (piece, unproved) in batch.iter().zip(certifier.unproved_lit_in_cells(&sets)) {
             out.extend(unproved.into_iter().map(|k| {
                 let s = piece[k];
-                let (sun, day) = suns[k];
-                let key = (usize::from(s.regime), s.fit as usize, usize::from(s.at.0), usize::from(s.at.1));
-                Rough { row: s.row as usize, column: s.column as usize, sun, day, cell: key, corners: (1.0, 1.0), rule: Rule::NotNeverDark }
+                // An interpolated step's cell is lit at all four samples.
+                let (cell, wanted) = ((s.regime, s.fit, s.at.0, s.at.1), Wanted { dark: false, lit: true });
+                Rough { row: s.row, column: s.column, cell, wanted, rule: Rule::NotNeverDark }
             }));
         }
-        start = end;
     }
     out
 }
@@ -283,25 +313,27 @@ impl Pilot {
     }
 }
 
-/// Proofs for every set of `sets` (in order): with `certifier`'s own proofs where `many` says
-/// whether to combine casters, else (`None`) with the many-caster proofs on a pilot of the sets
-/// first ([`PILOT_STRIDE`]) and on the rest only where they paid there ([`Pilot::pays`]). The
-/// proofs are exact either way, so the choice moves views, never values. Returns the proofs and
+/// Proofs for every cell of `asked` (in order; `set_of` gives a cell's receiver, suns and
+/// wanted certificate): with `certifier`'s own proofs where `many` says whether to combine
+/// casters, else (`None`) with the many-caster proofs on a pilot of the cells first
+/// ([`PILOT_STRIDE`]) and on the rest only where they paid there ([`Pilot::pays`]). The proofs
+/// are exact either way, so the choice moves views, never values. Returns the proofs and
 /// whether the many-caster proofs were used.
 fn prove_cells(
     certifier: &Certifier,
     many: Option<bool>,
     asked: &[(&[usize], Wanted)],
-    sets: &[(usize, &[DVec3], Wanted)],
+    set_of: &dyn Fn(usize) -> Set,
 ) -> (Vec<Option<Proof>>, bool) {
     let single = certifier.single_casters();
     let chosen = |together: bool| if together && certifier.has_many_casters() { certifier } else { &single };
+    let prove = |prover: &Certifier, cells: &[usize]| certify_in_batches(prover, cells, &|i| asked[i].0.len(), set_of);
     if let Some(together) = many {
-        return (chosen(together).certify_all(sets), together && certifier.has_many_casters());
+        let all: Vec<usize> = (0..asked.len()).collect();
+        return (prove(chosen(together), &all), together && certifier.has_many_casters());
     }
-    let pilot: Vec<usize> = (0..sets.len()).step_by(PILOT_STRIDE).collect();
-    let picked = |k: &[usize]| -> Vec<(usize, &[DVec3], Wanted)> { k.iter().map(|&i| sets[i]).collect() };
-    let pilot_proofs = certifier.certify_all(&picked(&pilot));
+    let pilot: Vec<usize> = (0..asked.len()).step_by(PILOT_STRIDE).collect();
+    let pilot_proofs = prove(certifier, &pilot);
     let pilot_asked: Vec<(&[usize], Wanted)> = pilot.iter().map(|&i| asked[i]).collect();
     let record = Pilot::of(&pilot_asked, &pilot_proofs);
     let together = certifier.has_many_casters() && record.pays();
@@ -313,31 +345,72 @@ fn prove_cells(
         record.settled as f64 / record.tried.max(1) as f64,
         if together { "on" } else { "off" }
     );
-    let rest: Vec<usize> = (0..sets.len()).filter(|i| i % PILOT_STRIDE != 0).collect();
-    let rest_proofs = chosen(together).certify_all(&picked(&rest));
-    let mut proofs = vec![None; sets.len()];
+    let rest: Vec<usize> = (0..asked.len()).filter(|i| i % PILOT_STRIDE != 0).collect();
+    let rest_proofs = prove(chosen(together), &rest);
+    let mut proofs = vec![None; asked.len()];
     for (i, p) in pilot.into_iter().zip(pilot_proofs).chain(rest.into_iter().zip(rest_proofs)) {
         proofs[i] = p;
     }
     (proofs, together)
 }
 
+/// A set of steps to prove: its receiver, its suns and the certificate wanted.
+type Set = (usize, Vec<DVec3>, Wanted);
+
+/// `prover`'s proofs of the sets `cells` names (`set_of` builds one, `steps` says how many
+/// suns it holds), in order, built and proved about [`SUNS_BATCH`] suns at a time: a city's
+/// refined steps' suns are never all held at once (nyt-blocks' 6.4 M, 150 MB in wasm32).
+fn certify_in_batches(prover: &Certifier, cells: &[usize], steps: &dyn Fn(usize) -> usize, set_of: &dyn Fn(usize) -> Set) -> Vec<Option<Proof>> {
+    let mut proofs = Vec::with_capacity(cells.len());
+    for batch in weighted_chunks(cells, |&i| steps(i)) {
+        let owned: Vec<Set> = batch.iter().map(|&i| set_of(i)).collect();
+        let sets: Vec<(usize, &[DVec3], Wanted)> = owned.iter().map(|(r, s, w)| (*r, s.as_slice(), *w)).collect();
+        proofs.extend(prover.certify_all(&sets));
+    }
+    proofs
+}
+
+/// `items` cut, in order, into runs of at most [`SUNS_BATCH`] in all by `weight` (a heavier item
+/// alone).
+fn weighted_chunks<T>(items: &[T], weight: impl Fn(&T) -> usize) -> Vec<&[T]> {
+    let mut chunks = Vec::new();
+    let mut start = 0;
+    while start < items.len() {
+        let (mut end, mut sum) = (start, 0);
+        while end < items.len() && (end == start || sum + weight(&items[end]) <= SUNS_BATCH) {
+            sum += weight(&items[end]);
+            end += 1;
+        }
+        chunks.push(&items[start..end]);
+        start = end;
+    }
+    chunks
+}
+
 /// Writes the steps of `rough` that a single-caster certificate settles into `schedule` and
 /// returns the rest ([`ToCount`], in their order, those the many-caster proofs showed dark
-/// marked), with the numbers of steps proved dark and lit. `many` as for [`prove_cells`].
-pub(super) fn settle(certifier: &Certifier, many: Option<bool>, rough: Vec<Rough>, schedule: &mut Columns) -> (ToCount, usize, usize) {
+/// marked), with the numbers of steps proved dark and lit. `suns` gives a step's sun; `many` as
+/// for [`prove_cells`].
+pub(super) fn settle(
+    certifier: &Certifier,
+    many: Option<bool>,
+    mut rough: Vec<Rough>,
+    suns: &RowSuns,
+    schedule: &mut Columns,
+) -> (ToCount, usize, usize) {
     let mut order: Vec<usize> = (0..rough.len()).collect();
     order.sort_by_key(|&i| rough[i].cell);
     let cells: Vec<&[usize]> = order.chunk_by(|a, b| rough[*a].cell == rough[*b].cell).collect();
     let asked: Vec<(&[usize], Wanted)> = cells
         .into_iter()
-        .map(|steps| (steps, wanted(rough[steps[0]].corners)))
+        .map(|steps| (steps, rough[steps[0]].wanted))
         .filter(|(steps, w)| steps.len() >= MIN_STEPS && (w.dark || w.lit))
         .collect();
-    let suns: Vec<Vec<DVec3>> = asked.iter().map(|(steps, _)| steps.iter().map(|&i| rough[i].sun).collect()).collect();
-    let sets: Vec<(usize, &[DVec3], Wanted)> =
-        asked.iter().zip(&suns).map(|((steps, w), s)| (rough[steps[0]].column, s.as_slice(), *w)).collect();
-    let (proofs, many_casters) = prove_cells(certifier, many, &asked, &sets);
+    let set_of = |i: usize| {
+        let (steps, wanted) = asked[i];
+        (rough[steps[0]].column as usize, steps.iter().map(|&k| suns.sun(rough[k].row)).collect(), wanted)
+    };
+    let (proofs, many_casters) = prove_cells(certifier, many, &asked, &set_of);
     let mut settled = vec![false; rough.len()];
     let mut together = vec![false; rough.len()];
     let (mut dark, mut lit) = (0, 0);
@@ -345,7 +418,7 @@ pub(super) fn settle(certifier: &Certifier, many: Option<bool>, rough: Vec<Rough
         let Some(Proof { certificate, alone }) = proof else { continue };
         for &i in *steps {
             if alone {
-                schedule.set(rough[i].row, rough[i].column, fraction(certificate));
+                schedule.set(rough[i].row as usize, rough[i].column as usize, fraction(certificate));
                 settled[i] = true;
             } else {
                 together[i] = true;
@@ -361,8 +434,11 @@ pub(super) fn settle(certifier: &Certifier, many: Option<bool>, rough: Vec<Rough
         let proved = settled.iter().zip(&together).map(|(a, b)| *a || *b);
         log::info!("certificates by rule (steps / proved): {}", tally(rough.iter().zip(proved)));
     }
-    let (steps, dark_marks) = rough.into_iter().zip(settled).zip(together).filter(|((_, s), _)| !s).map(|((r, _), t)| (r, t)).unzip();
-    (ToCount { steps, dark: dark_marks, many_casters }, dark, lit)
+    // Kept in place, not copied: a city's refined steps are its largest allocation here.
+    let mut is_settled = settled.iter();
+    rough.retain(|_| !is_settled.next().copied().unwrap_or(false));
+    let dark_marks = settled.iter().zip(together).filter(|(s, _)| !**s).map(|(_, t)| t).collect();
+    (ToCount { steps: rough, dark: dark_marks, many_casters }, dark, lit)
 }
 
 /// The year's certifier over the counting engine's own index of `scene` where it has one
@@ -390,21 +466,16 @@ pub(super) fn certifier<'a>(
 pub(super) fn certify_steps(
     certifier: &Certifier,
     many: Option<bool>,
-    location: &Location,
-    timesteps: Timesteps,
+    suns: &RowSuns,
     rough: Vec<Rough>,
     smooth: Vec<Smooth>,
     schedule: &mut Columns,
 ) -> ToCount {
     let (start, cpu) = (seconds(), cpu_seconds());
     let asked = rough.len();
-    let (mut rest, dark, lit) = settle(certifier, many, rough, schedule);
+    let (mut rest, dark, lit) = settle(certifier, many, rough, suns, schedule);
     let interpolated = smooth.len();
-    let sun_of = |row: usize| {
-        let instant = timesteps.instant(row);
-        (sun_direction(location, shading_sun_day(instant.day), instant.hour), f64::from(instant.day))
-    };
-    let unproved = never_dark(certifier, smooth, &sun_of);
+    let unproved = never_dark(certifier, smooth, suns);
     // Without the never-dark proof no interpolated step is handed over: say nothing of them then.
     let proof = if interpolated == 0 {
         String::new()
@@ -456,6 +527,7 @@ const MIN_YIELD: f64 = 2.0;
 pub(super) struct SpanProofs<'a> {
     certifier: &'a Certifier<'a>,
     rough: &'a [Rough],
+    suns: &'a RowSuns,
     /// Per receiver: proofs tried and steps proved there.
     receivers: std::cell::RefCell<std::collections::HashMap<usize, (usize, usize)>>,
     /// Over all receivers: proofs tried and steps proved.
@@ -463,8 +535,8 @@ pub(super) struct SpanProofs<'a> {
 }
 
 impl<'a> SpanProofs<'a> {
-    pub(super) fn new(certifier: &'a Certifier<'a>, rough: &'a [Rough]) -> Self {
-        SpanProofs { certifier, rough, receivers: Default::default(), totals: std::cell::Cell::new((0, 0)) }
+    pub(super) fn new(certifier: &'a Certifier<'a>, rough: &'a [Rough], suns: &'a RowSuns) -> Self {
+        SpanProofs { certifier, rough, suns, receivers: Default::default(), totals: std::cell::Cell::new((0, 0)) }
     }
 
     /// Whether the proofs have paid for `receiver` so far (or are still warming up there).
@@ -483,8 +555,9 @@ impl<'a> SpanProofs<'a> {
             if level.is_empty() {
                 break;
             }
-            let receiver = |steps: &[usize]| self.rough[steps[0]].column;
-            let suns: Vec<Vec<DVec3>> = level.iter().map(|(steps, _)| steps.iter().map(|&i| self.rough[i].sun).collect()).collect();
+            let receiver = |steps: &[usize]| self.rough[steps[0]].column as usize;
+            let suns: Vec<Vec<DVec3>> =
+                level.iter().map(|(steps, _)| steps.iter().map(|&i| self.suns.sun(self.rough[i].row)).collect()).collect();
             let sets: Vec<(usize, &[DVec3], Wanted)> =
                 level.iter().zip(&suns).map(|((steps, w), s)| (receiver(steps), s.as_slice(), *w)).collect();
             let mut next = Vec::new();
@@ -528,7 +601,7 @@ impl refine::SpanProver for SpanProofs<'_> {
             batch.extend(
                 spans
                     .by_ref()
-                    .filter(|(steps, _)| self.paying(self.rough[steps[0]].column))
+                    .filter(|(steps, _)| self.paying(self.rough[steps[0]].column as usize))
                     .take(SPAN_BATCH)
                     .map(|(s, w)| (s.as_slice(), *w)),
             );
@@ -561,24 +634,17 @@ mod tests {
         let location = Location::new(39.74, -105.18, -7.0).unwrap();
         let index = ExactEngine::new(&scene);
         let certifier = certifier(&scene, Some(&index), (Some(true), false));
+        let suns = RowSuns::new(&location, Timesteps::new(4).unwrap());
         let mut rough = Vec::new();
         let mut spans = Vec::new();
         for slot in 36..60 {
-            let hour = f64::from(slot) * 0.25;
             let mut run: Vec<usize> = Vec::new();
             for day in 1..=365u32 {
-                let sun = sun_direction(&location, f64::from(day), hour);
+                let row = (day - 1) * 96 + slot;
+                let sun = suns.sun(row);
                 let facing = sun.z > 0.05 && -sun.y > 0.05;
                 if facing {
-                    rough.push(Rough {
-                        row: day as usize * 96 + slot as usize,
-                        column: 0,
-                        sun,
-                        day: f64::from(day),
-                        cell: (0, 0, 0, 0),
-                        corners: (0.0, 0.0),
-                        rule: Rule::AllNearDark,
-                    });
+                    rough.push(Rough::new(row as usize, 0, (0, 0, 0, 0), (0.0, 0.0), Rule::AllNearDark));
                     run.push(rough.len() - 1);
                 }
                 if !facing || run.len() == 32 || day == 365 {
@@ -589,13 +655,13 @@ mod tests {
                 }
             }
         }
-        let proofs = SpanProofs::new(&certifier, &rough);
+        let proofs = SpanProofs::new(&certifier, &rough, &suns);
         let proved = proofs.prove(&spans);
-        let truth = index.fractions(&rough.iter().map(|r| ViewRequest::new(0, r.sun)).collect::<Vec<_>>());
+        let truth = index.fractions(&rough.iter().map(|r| ViewRequest::new(0, suns.sun(r.row))).collect::<Vec<_>>());
         let mut is_proved = vec![false; rough.len()];
         for &(i, v) in &proved {
             assert_eq!(v, 0.0, "only dark was asked for");
-            assert_eq!(truth[i], 0.0, "step {i} (day {}, row {}) proved dark is lit", rough[i].day, rough[i].row);
+            assert_eq!(truth[i], 0.0, "step {i} (day {}, row {}) proved dark is lit", suns.day(rough[i].row), rough[i].row);
             is_proved[i] = true;
         }
         let asked: Vec<usize> = spans.iter().flat_map(|(s, _)| s.iter().copied()).collect();
@@ -631,18 +697,18 @@ mod tests {
         let dark = Wanted { dark: true, lit: false };
         let steps: Vec<Vec<usize>> = cells.iter().map(|c| (0..c.len()).collect()).collect();
         let asked: Vec<(&[usize], Wanted)> = steps.iter().map(|s| (s.as_slice(), dark)).collect();
-        let sets: Vec<(usize, &[DVec3], Wanted)> = cells.iter().map(|c| (0, c.as_slice(), dark)).collect();
-        assert!(sets.len() >= 4 * PILOT_STRIDE, "{} cells: too few for a pilot", sets.len());
+        let set_of = |i: usize| (0, cells[i].clone(), dark);
+        assert!(cells.len() >= 4 * PILOT_STRIDE, "{} cells: too few for a pilot", cells.len());
         for (east_from, pays) in [(1.0, true), (1.3, false)] {
             let scene = street(east_from);
             let index = ExactEngine::new(&scene);
             let certifier = certifier(&scene, Some(&index), (None, false));
-            let (proofs, kept) = prove_cells(&certifier, None, &asked, &sets);
+            let (proofs, kept) = prove_cells(&certifier, None, &asked, &set_of);
             assert_eq!(kept, pays, "street with its east block from x = {east_from}");
 
-            assert_eq!(proofs, prove_cells(&certifier, Some(pays), &asked, &sets).0, "x = {east_from}");
-            let pilot: Vec<usize> = (0..sets.len()).step_by(PILOT_STRIDE).collect();
-            let together = prove_cells(&certifier, Some(true), &asked, &sets).0;
+            assert_eq!(proofs, prove_cells(&certifier, Some(pays), &asked, &set_of).0, "x = {east_from}");
+            let pilot: Vec<usize> = (0..cells.len()).step_by(PILOT_STRIDE).collect();
+            let together = prove_cells(&certifier, Some(true), &asked, &set_of).0;
             let record =
                 Pilot::of(&pilot.iter().map(|&i| asked[i]).collect::<Vec<_>>(), &pilot.iter().map(|&i| together[i]).collect::<Vec<_>>());
             assert!(record.tried > 0, "x = {east_from}: the pilot tried no cell, so it shows nothing");

@@ -95,8 +95,8 @@ impl Sparse {
     /// `known_dark` marks are known to be 0 and never asked.
     pub(super) fn new(rough: &[Rough], known_dark: &[bool], rows_per_day: usize) -> Self {
         let key = |i: usize| {
-            let r = &rough[i];
-            (r.cell.0, r.cell.1, r.row % rows_per_day, r.row / rows_per_day)
+            let (r, row) = (&rough[i], rough[i].row as usize);
+            (r.cell.0, r.cell.1, row % rows_per_day, row / rows_per_day)
         };
         let mut order: Vec<usize> = (0..rough.len()).collect();
         order.sort_by_key(|&i| key(i));
@@ -298,14 +298,15 @@ fn interpolable(a: f64, b: f64) -> bool {
 }
 
 /// Counts the refined steps `rough` sparsely ([`Sparse`]) and returns every step's fraction, in
-/// order; the steps `known_dark` marks are 0 and not counted. `leaves` gives a step's leaf fraction; `report` gets, with each progress report, the
-/// most refined steps that may in all be counted (those counted so far and those still open).
+/// order; the steps `known_dark` marks are 0 and not counted. `request` gives a step's view;
+/// `report` gets, with each progress report, the most refined steps that may in all be counted
+/// (those counted so far and those still open).
 pub(super) async fn count_sparsely(
     views: &Views<'_, impl Engine>,
     rough: &[Rough],
     known_dark: &[bool],
     rows_per_day: usize,
-    leaves: &dyn Fn(&Rough) -> f32,
+    request: &dyn Fn(&Rough) -> ViewRequest,
     prover: &dyn SpanProver,
     report: &mut dyn FnMut(usize, Progress) -> Result<()>,
 ) -> Result<Vec<f64>> {
@@ -320,8 +321,7 @@ pub(super) async fn count_sparsely(
             sparse.answer(&[], &[]);
             continue;
         }
-        let requests: Vec<ViewRequest> =
-            asked.iter().map(|&i| ViewRequest::new(rough[i].column as u32, rough[i].sun).with_leaves(leaves(&rough[i]))).collect();
+        let requests: Vec<ViewRequest> = asked.iter().map(|&i| request(&rough[i])).collect();
         let before = sparse.counted();
         let values = views.count(&requests, &mut |p| report(to_count, Progress::counting(before + p.done, to_count))).await?;
         sparse.answer(&asked, &values);

@@ -1,7 +1,6 @@
 //! Sparse counting of refined steps against counting every one of them, on fractions given as
 //! functions of the day (one receiver, one time of day).
 
-use glam::DVec3;
 
 use super::*;
 use crate::year::certified::Rule;
@@ -11,15 +10,8 @@ const ROWS: usize = 96;
 
 /// A refined step of fitted piece `fit` at time of day `slot` on day `day` (0-based).
 fn step(fit: usize, slot: usize, day: usize) -> Rough {
-    Rough {
-        row: day * ROWS + slot,
-        column: fit,
-        sun: DVec3::Z,
-        day: day as f64 + 1.0,
-        cell: (0, fit, 0, 0),
-        corners: (0.0, 1.0),
-        rule: Rule::Spread,
-    }
+    // Samples from 0 to 1: neither certificate is worth looking for.
+    Rough::new(day * ROWS + slot, fit, (0, fit, 0, 0), (0.0, 1.0), Rule::Spread)
 }
 
 /// Runs the rounds of [`Sparse`] with `truth` answering every asked step: each step's value and
@@ -63,7 +55,7 @@ fn sparse_proving(rough: &[Rough], known_dark: &[bool], prover: &dyn SpanProver,
 /// One run of `days` consecutive days at one time of day, with `f(day)` its fraction.
 fn run(days: usize, f: impl Fn(usize) -> f64) -> (Vec<f64>, Vec<f64>, usize) {
     let rough: Vec<Rough> = (0..days).map(|d| step(0, 40, d)).collect();
-    let (values, counted) = sparse(&rough, |r| f(r.row / ROWS));
+    let (values, counted) = sparse(&rough, |r| f(r.row as usize / ROWS));
     ((0..days).map(f).collect(), values, counted)
 }
 
@@ -147,7 +139,7 @@ fn runs_break_at_gaps_times_of_day_and_pieces() {
     lengths.sort_unstable();
     assert_eq!(lengths, vec![8, 8, 8, 10, 10, 10]);
     for k in 0..s.runs.len() {
-        assert!(s.run(k).windows(2).all(|w| rough[w[1]].row == rough[w[0]].row + ROWS), "consecutive days");
+        assert!(s.run(k).windows(2).all(|w| rough[w[1]].row as usize == rough[w[0]].row as usize + ROWS), "consecutive days");
     }
 }
 
@@ -167,7 +159,7 @@ fn runs_as_ranges_are_the_lists_they_replace() {
     rough = (0..n).map(|i| rough[(i * 37) % n]).collect();
     // The lists as they were made: the steps sorted by piece, time of day and day, cut where a
     // day is missing.
-    let key = |i: usize| (rough[i].cell.0, rough[i].cell.1, rough[i].row % ROWS, rough[i].row / ROWS);
+    let key = |i: usize| (rough[i].cell.0, rough[i].cell.1, rough[i].row as usize % ROWS, rough[i].row as usize / ROWS);
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_by_key(|&i| key(i));
     let lists: Vec<Vec<usize>> = order
@@ -194,7 +186,7 @@ fn steps_known_dark_are_not_counted_and_move_no_other_value() {
     let early = |d: usize| if d < 12 { 0.0 } else { 0.3 + 0.002 * d as f64 };
     for f in [&spell as &dyn Fn(usize) -> f64, &early] {
         let rough: Vec<Rough> = (0..40).map(|d| step(0, 40, d)).collect();
-        let truth = |r: &Rough| f(r.row / ROWS);
+        let truth = |r: &Rough| f(r.row as usize / ROWS);
         let known: Vec<bool> = rough.iter().map(|r| truth(r) == 0.0).collect();
         let (counting, counted) = sparse(&rough, truth);
         let (knowing, counted_knowing) = sparse_knowing(&rough, &known, truth);
@@ -206,8 +198,8 @@ fn steps_known_dark_are_not_counted_and_move_no_other_value() {
     let lit = |d: usize| if d == 5 { 0.0 } else { 0.6 };
     let rough: Vec<Rough> = (0..9).map(|d| step(0, 40, d)).collect();
     let known: Vec<bool> = (0..9).map(|d| d == 5).collect();
-    let (counting, _) = sparse(&rough, |r| lit(r.row / ROWS));
-    let (knowing, _) = sparse_knowing(&rough, &known, |r| lit(r.row / ROWS));
+    let (counting, _) = sparse(&rough, |r| lit(r.row as usize / ROWS));
+    let (knowing, _) = sparse_knowing(&rough, &known, |r| lit(r.row as usize / ROWS));
     assert_eq!(counting[5], 0.6);
     assert_eq!(knowing[5], 0.0);
     assert_eq!(knowing.iter().enumerate().filter(|(d, _)| *d != 5).map(|(_, v)| *v).collect::<Vec<_>>(), vec![0.6; 8]);
@@ -257,7 +249,7 @@ fn steps_proved_in_spans_are_not_counted_and_move_no_value() {
     let shadow = |d: usize| if d < 15 { 1.0 } else { 0.9 - 0.01 * d as f64 };
     for (k, f) in [&spell as &dyn Fn(usize) -> f64, &early, &shadow].into_iter().enumerate() {
         let rough: Vec<Rough> = (0..50).map(|d| step(0, 40, d)).collect();
-        let truth = |r: &Rough| f(r.row / ROWS);
+        let truth = |r: &Rough| f(r.row as usize / ROWS);
         let (counting, counted) = sparse(&rough, truth);
         let oracle = Oracle { rough: &rough, truth: &truth, handed: Default::default() };
         let (proving, counted_proving) = sparse_proving(&rough, &[], &oracle, truth);
