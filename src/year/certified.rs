@@ -51,7 +51,13 @@ impl Rough {
     /// Step `row` of receiver `column` in regime `regime`'s fitted piece `fit` and its sample
     /// cell `(k, j)`, whose samples lie between `corners` (lowest, highest), sent to counting
     /// by `rule`.
-    pub(super) fn new(row: usize, column: usize, (regime, fit, k, j): (usize, usize, usize, usize), corners: (f64, f64), rule: Rule) -> Self {
+    pub(super) fn new(
+        row: usize,
+        column: usize,
+        (regime, fit, k, j): (usize, usize, usize, usize),
+        corners: (f64, f64),
+        rule: Rule,
+    ) -> Self {
         let small = |x: usize| u16::try_from(x).unwrap_or(u16::MAX);
         let cell = (small(regime), fit as u32, small(k), small(j));
         Rough { row: row as u32, column: column as u32, cell, wanted: wanted(corners), rule }
@@ -360,7 +366,12 @@ type Set = (usize, Vec<DVec3>, Wanted);
 /// `prover`'s proofs of the sets `cells` names (`set_of` builds one, `steps` says how many
 /// suns it holds), in order, built and proved about [`SUNS_BATCH`] suns at a time: a city's
 /// refined steps' suns are never all held at once (nyt-blocks' 6.4 M, 150 MB in wasm32).
-fn certify_in_batches(prover: &Certifier, cells: &[usize], steps: &dyn Fn(usize) -> usize, set_of: &dyn Fn(usize) -> Set) -> Vec<Option<Proof>> {
+fn certify_in_batches(
+    prover: &Certifier,
+    cells: &[usize],
+    steps: &dyn Fn(usize) -> usize,
+    set_of: &dyn Fn(usize) -> Set,
+) -> Vec<Option<Proof>> {
     let mut proofs = Vec::with_capacity(cells.len());
     for batch in weighted_chunks(cells, |&i| steps(i)) {
         let owned: Vec<Set> = batch.iter().map(|&i| set_of(i)).collect();

@@ -1,7 +1,6 @@
 //! Sparse counting of refined steps against counting every one of them, on fractions given as
 //! functions of the day (one receiver, one time of day).
 
-
 use super::*;
 use crate::year::certified::Rule;
 
