@@ -205,7 +205,7 @@ pub(super) fn never_dark(certifier: &Certifier, mut smooth: Vec<Smooth>, suns: &
     let pieces: Vec<&[Smooth]> = smooth.chunk_by(|a, b| (a.regime, a.fit) == (b.regime, b.fit)).collect();
     let mut out = Vec::new();
     // Whole pieces per batch, up to about SUNS_BATCH steps.
-    for batch in weighted_chunks(&pieces, |p| p.len()) {
+    for batch in weighted_chunks(&pieces, |p| p.len(), SUNS_BATCH) {
         let directions: Vec<Vec<DVec3>> = batch.iter().map(|p| p.iter().map(|s| suns.sun(s.row)).collect()).collect();
         // Where each cell starts among its piece's steps.
         let starts: Vec<Vec<usize>> = batch.iter().map(|p| (0..p.len()).filter(|&i| i == 0 || p[i].at != p[i - 1].at).collect()).collect();
@@ -373,7 +373,7 @@ fn certify_in_batches(
     set_of: &dyn Fn(usize) -> Set,
 ) -> Vec<Option<Proof>> {
     let mut proofs = Vec::with_capacity(cells.len());
-    for batch in weighted_chunks(cells, |&i| steps(i)) {
+    for batch in weighted_chunks(cells, |&i| steps(i), SUNS_BATCH) {
         let owned: Vec<Set> = batch.iter().map(|&i| set_of(i)).collect();
         let sets: Vec<(usize, &[DVec3], Wanted)> = owned.iter().map(|(r, s, w)| (*r, s.as_slice(), *w)).collect();
         proofs.extend(prover.certify_all(&sets));
@@ -381,14 +381,13 @@ fn certify_in_batches(
     proofs
 }
 
-/// `items` cut, in order, into runs of at most [`SUNS_BATCH`] in all by `weight` (a heavier item
-/// alone).
-fn weighted_chunks<T>(items: &[T], weight: impl Fn(&T) -> usize) -> Vec<&[T]> {
+/// `items` cut, in order, into runs of at most `limit` in all by `weight` (a heavier item alone).
+fn weighted_chunks<T>(items: &[T], weight: impl Fn(&T) -> usize, limit: usize) -> Vec<&[T]> {
     let mut chunks = Vec::new();
     let mut start = 0;
     while start < items.len() {
         let (mut end, mut sum) = (start, 0);
-        while end < items.len() && (end == start || sum + weight(&items[end]) <= SUNS_BATCH) {
+        while end < items.len() && (end == start || sum + weight(&items[end]) <= limit) {
             sum += weight(&items[end]);
             end += 1;
         }
@@ -726,6 +725,40 @@ mod tests {
             let settled = together.iter().filter(|p| p.is_some_and(|p| !p.alone)).count();
             assert_eq!(settled > 0, pays, "x = {east_from}: {settled} cells settled only by the many-caster proofs");
         }
+    }
+
+    /// A refined step stays small: a city's year holds millions of them at once (nyt-blocks'
+    /// Timestep 4 year 6.4 M; at 80 bytes in wasm32 they and their copy grew the page's engine by
+    /// 1.3 GB).
+    #[test]
+    fn a_refined_step_is_24_bytes() {
+        assert!(std::mem::size_of::<Rough>() <= 24, "{} bytes", std::mem::size_of::<Rough>());
+    }
+
+    /// A row's sun and day are the ones the year evaluates that row at: the calendar day's own
+    /// sun at the row's time, on every row of a Timestep 4 year and a leap year's Timestep 1.
+    #[test]
+    fn a_row_s_sun_is_its_calendar_day_s_at_its_time() {
+        let location = Location::new(39.74, -105.18, -7.0).unwrap();
+        for timesteps in [Timesteps::new(4).unwrap(), Timesteps::new(1).unwrap().leap_year(true)] {
+            let suns = RowSuns::new(&location, timesteps);
+            for row in 0..timesteps.rows() {
+                let at = timesteps.instant(row);
+                assert_eq!(suns.sun(row as u32), sun_direction(&location, shading_sun_day(at.day), at.hour), "row {row}");
+                assert_eq!(suns.day(row as u32), f64::from(at.day), "row {row}");
+            }
+        }
+    }
+
+    /// Batches keep their items' order, hold at most the limit unless one item alone is
+    /// heavier, and are never cut short of it: every item once.
+    #[test]
+    fn weighted_chunks_cut_in_order_up_to_the_limit() {
+        let items = [3, 4, 1, 9, 2, 2, 2, 7, 1];
+        let chunks = weighted_chunks(&items, |&w| w, 7);
+        assert_eq!(chunks, vec![&[3, 4][..], &[1], &[9], &[2, 2, 2], &[7], &[1]]);
+        assert_eq!(chunks.concat(), items);
+        assert!(weighted_chunks(&[] as &[usize], |&w| w, 7).is_empty());
     }
 
     /// The cheap interleaving is the bits' own: every day and τ index a grid can have (below
