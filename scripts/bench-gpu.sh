@@ -12,8 +12,8 @@
 # beside the H200's 2026-11-28 figure (1,335 µs a nyt-blocks view, 5 batches counted twice, 16
 # views a submission): its JSON has bin_pool_reruns, bin_pool_nodes and
 # compute_views_per_submission (the batches are no longer the atlas's 16 views).
-# BEFORE=path/to/an/older/sunlit adds that binary's compute run on the same spread right after,
-# for a before/after on the same lease.
+# BEFORE=path/to/an/older/sunlit adds that binary's compute runs right after the new one's (the
+# spread, blaas-trees-summer's and blaas-louvres' every view), for a before/after on one lease.
 # ONLY=REGEX runs only the runs whose label matches (e.g. ONLY=cull for the GPU culling pass).
 # TIMEOUT_SCALE=N multiplies every run's timeout (sized for the lease's 16 cores): the lavapipe
 # form on a loaded 2-core machine needs about 6 (generating nyt-blocks alone took 47-68 s there).
@@ -66,6 +66,8 @@ profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 run nyt-blocks-compute-20040 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" --check 30 "${gpu_flags[@]}"
 [ -n "${BEFORE:-}" ] && B="$BEFORE" run nyt-blocks-compute-20040-before 60 bench nyt-blocks --engine compute --views "${VIEWS:-20040}" "${gpu_flags[@]}"
 run blaas-trees-summer-compute 40 bench blaas-trees-summer --engine compute --check 50 "${views[@]}" "${gpu_flags[@]}"
+[ -n "${BEFORE:-}" ] && B="$BEFORE" run blaas-trees-summer-compute-before 40 bench blaas-trees-summer --engine compute "${views[@]}" "${gpu_flags[@]}"
+[ -n "${BEFORE:-}" ] && B="$BEFORE" run blaas-louvres-compute-before 40 bench blaas-louvres --engine compute "${views[@]}" "${gpu_flags[@]}"
 # Then the cheapest host form (--cull gpu-batch: the GPU's culling drawn with one draw a batch,
 # src/count/gpu/batched.rs; the least host time a view on noop, docs/benchmarks-gpu.md), with its
 # answers checked, and its host cost on noop; then the per-tile form and the CPU's culling.
