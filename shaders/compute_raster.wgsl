@@ -352,8 +352,9 @@ var<workgroup> depth: array<atomic<u32>, 1024>;
 var<workgroup> cover: array<atomic<u32>, 1024>;
 // Per member: visible, covered, edge pairs.
 var<workgroup> totals: array<atomic<u32>, 12>;
-// Each lane's vote before a round (SHOWS_MEMBER | MORE_TO_WALK), and their union.
-var<workgroup> votes: array<u32, 64>;
+// The lanes' votes before a round (SHOWS_MEMBER | MORE_TO_WALK), or'ed together, and their
+// union as lane 0 read it (which every lane then loads as one uniform value).
+var<workgroup> votes: atomic<u32>;
 var<workgroup> decision: u32;
 const SHOWS_MEMBER: u32 = 1u;
 const MORE_TO_WALK: u32 = 2u;
@@ -515,8 +516,10 @@ fn gather_members_left(lane: u32) {
     }
 }
 
-// Sums rows_to in place (inclusive prefix sums over the round's slots; a barrier a step).
+// Sums rows_to in place (inclusive prefix sums over the round's slots; a barrier a step, and
+// one first: every lane's own count must be written before any lane reads its neighbour's).
 fn scan_rows(lane: u32) {
+    workgroupBarrier();
     for (var d = 1u; d < ROUND; d *= 2u) {
         var add = 0u;
         if lane >= d {
@@ -558,6 +561,9 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     if lane < 12u {
         atomicStore(&totals[lane], 0u);
     }
+    if lane == 0u {
+        atomicStore(&votes, 0u);
+    }
     let at = vec2<u32>(group.x % per_row, group.x / per_row);
     let tiles = per_row * per_row;
     // Lane w < SUBLISTS walks chain w of the member list, then of the large list; lane HALF + w
@@ -586,14 +592,14 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
         if members_drawn {
             workgroupBarrier();
             let more = large_cursor != 0u || small_cursor != 0u;
-            votes[lane] = select(0u, SHOWS_MEMBER, shows_member(lane)) | select(0u, MORE_TO_WALK, more);
+            let vote = select(0u, SHOWS_MEMBER, shows_member(lane)) | select(0u, MORE_TO_WALK, more);
+            if vote != 0u {
+                atomicOr(&votes, vote);
+            }
             workgroupBarrier();
             if lane == 0u {
-                var all = 0u;
-                for (var i = 0u; i < 64u; i++) {
-                    all |= votes[i];
-                }
-                decision = all;
+                // Cleared for the next round's votes, which come after two more barriers.
+                decision = atomicExchange(&votes, 0u);
             }
             let now = workgroupUniformLoad(&decision);
             if (now & MORE_TO_WALK) == 0u || ((now & SHOWS_MEMBER) == 0u && params.dump == 0u) {
