@@ -18,12 +18,12 @@
 //    again with a pool that large, so a list is never truncated.
 //    The view's members' own triangles (its receivers') go, whatever their size, into a third
 //    list of the view, with their boxes, so that a raster tile can draw them first.
-// 2. raster_main, a workgroup per raster tile: the view's member list first, then its large list
-//    (skipping boxes that miss the tile) and the tile's own list, in rounds of 64 triangles, each
-//    set up once by one lane into workgroup memory and drawn a (triangle, row) pair a lane (see
-//    the pass's own note below). With every member drawn first, a tile stops walking as soon as
-//    no pixel of it shows a member: a tile no member covers, at once, and a tile a caster has
-//    shaded whole, after that caster's round. What it has not drawn then could only lower
+// 2. raster_main, a workgroup per raster tile: lanes 0..31 and 32..63 walk the view's member
+//    list, then its large list and then the tile's list (skipping boxes that miss the tile),
+//    taking every other triangle; each lane owns one row and steps across it. With every
+//    member drawn first, a tile stops walking as soon as no pixel of it shows a member: a tile no
+//    member covers, at once, and a tile a caster has shaded whole, after that caster's chunk of
+//    the walk (checked every WALK_CHUNK steps). What it has not drawn then could only lower
 //    casters' depths or cover pixels no member covers, which changes no count (atomicMin keeps
 //    a member's word only where it is the nearest). Tests that dump every pixel's class walk
 //    everything, so the dump stays the whole picture. Per pixel an
@@ -55,13 +55,12 @@ const JOB: u32 = 256u;
 // The fewest raster tiles a triangle's box may touch and go to its view's large list; the
 // library's compute::LARGE_TILES (see large_tiles).
 const LARGE_TILES: u32 = 8u;
-// Lists a view has after its raster tiles': the large list, then the member list.
+// Heads a view has after its raster tiles': the large list's, then the member list's.
 const LARGE_LIST: u32 = 0u;
 const MEMBER_LIST: u32 = 1u;
-// Chains a list is kept in (a triangle t goes to chain t % SUBLISTS; the library's
-// compute::SUBLISTS): walking a chain is one dependent load a triangle, so a raster tile walks
-// its lists with SUBLISTS lanes at once.
-const SUBLISTS: u32 = 8u;
+// Steps of the walk (two triangles each, one per half of the workgroup) between two checks
+// whether any pixel of the tile still shows a member.
+const WALK_CHUNK: u32 = 16u;
 
 // Raster tiles a triangle's box may touch and be binned into each, in a view of `per_row`²
 // raster tiles: a quarter of them, at least LARGE_TILES (the library's compute::node_bound).
@@ -82,8 +81,8 @@ struct View {
     // the view's triangles in the ranges before it), `triangles` in all.
     first_range: u32,
     range_count: u32,
-    // Where the view's list heads start in heads (after heads[0], the pool count): SUBLISTS per
-    // list, the raster tiles' lists row by row, then its large list's and its member list's.
+    // Where the view's list heads start in heads (after heads[0], the pool count): one per
+    // raster tile, row by row, then its large list's and its member list's.
     first_head: u32,
     triangles: u32,
     _pad1: u32,
@@ -117,8 +116,8 @@ struct Params {
 @group(0) @binding(4) var<storage, read> members: array<u32>;
 // counts[3m], counts[3m + 1], counts[3m + 2]: visible, covered, edge pairs of member entry m.
 @group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
-// heads[0]: pool nodes asked for; heads[sublist_head(view, list, chain)] (lists numbered raster
-// tile by raster tile, then the large list and the member list): 1 + its first node, 0 if none.
+// heads[0]: pool nodes asked for; heads[1 + first_head + raster tile] (the large list after the
+// view's raster tiles): 1 + its first node, 0 if none.
 @group(0) @binding(6) var<storage, read_write> heads: array<atomic<u32>>;
 // Node n: (triangle, 1 + next node or 0); a large triangle's node n + 1: its box in raster tiles,
 // (x0 | y0 << 16, x1 | y1 << 16).
@@ -229,12 +228,6 @@ fn setup(t: u32, view: View) -> Setup {
 
 // ---- pass 1: binning ----
 
-// Where chain `chain` of the view's list `list` starts (list: a raster tile, row by row, then
-// per_row² + LARGE_LIST or MEMBER_LIST).
-fn sublist_head(view: View, list: u32, chain: u32) -> u32 {
-    return 1u + view.first_head + list * SUBLISTS + chain;
-}
-
 // Triangle k of a view's culled list: the last range starting at or before k (binary search).
 fn triangle_at(view: View, k: u32) -> u32 {
     var lo = view.first_range;
@@ -295,19 +288,15 @@ fn bin(t: u32, view: View) {
         push_boxed(t, view, per_row * per_row + LARGE_LIST, t0, t1);
         return;
     }
-    // Its nodes in one go: every node of a batch comes from the one counter, heads[0], so an
-    // atomicAdd a node would queue every lane of the GPU on one word.
-    let needed = u32(box.x * box.y);
-    var n = atomicAdd(&heads[0], needed);
-    if n + needed > params.capacity {
-        return;
-    }
     for (var ty = t0.y; ty <= t1.y; ty++) {
         for (var tx = t0.x; tx <= t1.x; tx++) {
-            let head = sublist_head(view, u32(ty) * per_row + u32(tx), t % SUBLISTS);
+            let n = atomicAdd(&heads[0], 1u);
+            if n >= params.capacity {
+                continue;
+            }
+            let head = 1u + view.first_head + u32(ty) * per_row + u32(tx);
             let next = atomicExchange(&heads[head], n + 1u);
             nodes[n] = vec2<u32>(t, next);
-            n++;
         }
     }
 }
@@ -319,7 +308,7 @@ fn push_boxed(t: u32, view: View, list: u32, t0: vec2<i32>, t1: vec2<i32>) {
     if n + 1u >= params.capacity {
         return;
     }
-    let next = atomicExchange(&heads[sublist_head(view, list, t % SUBLISTS)], n + 1u);
+    let next = atomicExchange(&heads[1u + view.first_head + list], n + 1u);
     nodes[n] = vec2<u32>(t, next);
     nodes[n + 1u] = vec2<u32>(u32(t0.x) | (u32(t0.y) << 16u), u32(t1.x) | (u32(t1.y) << 16u));
 }
@@ -337,54 +326,16 @@ fn class_of(t: u32, view: View) -> u32 {
 }
 
 // ---- pass 2: rasterizing and counting a raster tile ----
-//
-// The walk goes in rounds of up to ROUND triangles. Lanes 0 .. SUBLISTS each fetch up to
-// PER_WALKER from their chain of the view's member list (while it has any, so that every member
-// is drawn before the first check whether the tile may stop) or else of its large list; lanes
-// HALF .. HALF + SUBLISTS as many from their chain of the tile's own list, all at once (a chain
-// is one dependent load a triangle: 16 walkers wait for 4 loads a round, not 64). Each lane then sets
-// up one fetched triangle (transform, snap, its rows and columns in the tile) into workgroup
-// memory, once; and the round's (triangle, row) pairs are drawn one a lane, stepping across the
-// row. A triangle is set up once a tile, not once a lane, and a lane draws a row only where the
-// triangle has one, so small triangles (most of a city's) no longer leave most lanes idle.
 
 var<workgroup> depth: array<atomic<u32>, 1024>;
 var<workgroup> cover: array<atomic<u32>, 1024>;
 // Per member: visible, covered, edge pairs.
 var<workgroup> totals: array<atomic<u32>, 12>;
-// The lanes' votes before a round (SHOWS_MEMBER | MORE_TO_WALK), or'ed together, and their
-// union as lane 0 read it (which every lane then loads as one uniform value).
-var<workgroup> votes: atomic<u32>;
+// Each lane's vote after a chunk of the walk (SHOWS_MEMBER | MORE_TO_WALK), and their union.
+var<workgroup> votes: array<u32, 64>;
 var<workgroup> decision: u32;
 const SHOWS_MEMBER: u32 = 1u;
 const MORE_TO_WALK: u32 = 2u;
-
-const ROUND: u32 = 64u;
-const HALF: u32 = 32u;
-// Triangles a walker fetches a round: the walkers of each half fill its HALF slots.
-const PER_WALKER: u32 = HALF / SUBLISTS;
-// A fetched triangle: (triangle, its boxed node or 0 for a tile list's triangle).
-var<workgroup> fetched: array<vec2<u32>, 64>;
-// Triangles each walker fetched this round (the first half's walkers, then the second's).
-var<workgroup> taken: array<u32, 16>;
-// Each member walker's cursor, and non-zero while any of them has triangles not yet fetched.
-var<workgroup> pending: array<u32, 8>;
-var<workgroup> members_left: u32;
-// A set-up triangle of the round, as draw_item reads it.
-struct Ready {
-    x: vec3<i32>,
-    y: vec3<i32>,
-    z0: f32,
-    dzdx: f32,
-    dzdy: f32,
-    // Its first and last column and first row in the tile, and its class: c0 | c1 << 8 | r0 << 16 | class << 24.
-    span: u32,
-    transmittance: f32,
-    seed: u32,
-}
-var<workgroup> ready: array<Ready, 64>;
-// Rows each slot's triangle has in the tile, then (scanned) the rows of the slots up to it.
-var<workgroup> rows_to: array<u32, 64>;
 
 // PCG hash (Jarzynski & Olano 2020), as sun_view.wgsl's.
 fn pcg(v: u32) -> u32 {
@@ -393,48 +344,26 @@ fn pcg(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-// Sets up fetched triangle `entry` for raster tile `at` (pixel tile0) into ready[slot]; returns
-// the rows it has in the tile, 0 where it draws nothing there (its box misses the tile, or it is
-// dropped, or no pixel centre of the tile lies in its bounding box).
-fn prepare(entry: vec2<u32>, view: View, at: vec2<u32>, tile0: vec2<u32>, slot: u32) -> u32 {
-    if entry.y != 0u {
-        let box = nodes[entry.y];
-        if at.x < (box.x & 0xffffu) || at.y < (box.x >> 16u) || at.x > (box.y & 0xffffu) || at.y > (box.y >> 16u) {
-            return 0u;
-        }
-    }
-    let t = entry.x;
-    let s = setup(t, view);
-    if !s.live {
-        return 0u;
-    }
-    // The pixel centres (at 128 + 256·k subpixels) within the bounding box, within the tile and
-    // the view: ceilings and floors of divisions by 256 as arithmetic shifts.
-    let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
-    let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
-    let first = max(-((vec2<i32>(128) - lo) >> vec2<u32>(8u)) - vec2<i32>(tile0), vec2<i32>(0));
-    let last = min(((hi - vec2<i32>(128)) >> vec2<u32>(8u)) - vec2<i32>(tile0), vec2<i32>(min(vec2<u32>(TILE), vec2<u32>(view.side) - tile0)) - vec2<i32>(1));
-    if first.x > last.x || first.y > last.y {
-        return 0u;
-    }
-    let a = attributes[t];
-    let span = u32(first.x) | (u32(last.x) << 8u) | (u32(first.y) << 16u) | (class_of(t, view) << 24u);
-    ready[slot] = Ready(s.x, s.y, s.z0, s.dzdx, s.dzdy, span, bitcast<f32>(a.z), a.w);
-    return u32(last.y - first.y + 1);
-}
-
-// Draws row `r` (counted from its first) of the round's triangle in slot `slot` in the tile at
-// pixel tile0: each pixel centre of the row inside the triangle by the fill rule, within depth
-// [0, 1] and not dithered away, takes atomicMin on its word; a member's also sets its cover bit.
-fn draw_item(slot: u32, r: u32, view: View, tile0: vec2<u32>) {
-    let s = ready[slot];
-    let first = s.span & 0xffu;
-    let last = (s.span >> 8u) & 0xffu;
-    let row = ((s.span >> 16u) & 0xffu) + r;
-    let kind = s.span >> 24u;
+// Draws triangle t's pixels in one row of a raster tile: row `row` of tile (tx, ty).
+fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
     let y = tile0.y + row;
     let py = i32(y * 256u + 128u);
-    let px0 = i32((tile0.x + first) * 256u + 128u);
+    // Only the pixel centres within the triangle's bounding box: the row, and its first and last
+    // columns (floor and ceiling divisions by 256 as arithmetic shifts).
+    let lo = vec2<i32>(min(s.x.x, min(s.x.y, s.x.z)), min(s.y.x, min(s.y.y, s.y.z)));
+    let hi = vec2<i32>(max(s.x.x, max(s.x.y, s.x.z)), max(s.y.x, max(s.y.y, s.y.z)));
+    if py < lo.y || py > hi.y || y >= view.side {
+        return;
+    }
+    let first = max(-((128 - lo.x) >> 8u) - i32(tile0.x), 0);
+    let last = min(((hi.x - 128) >> 8u) - i32(tile0.x), i32(min(TILE, view.side - tile0.x)) - 1);
+    if first > last {
+        return;
+    }
+    let px0 = (i32(tile0.x) + first) * 256 + 128;
+    let a = attributes[t];
+    let kind = class_of(t, view);
+    let transmittance = bitcast<f32>(a.z);
     // Edge functions at the row's first pixel centre and their step a pixel right; a pixel is
     // in when all three are >= 0 after a bias of -1 on edges that are neither top nor left.
     var e: array<vec2<u32>, 3>;
@@ -450,7 +379,7 @@ fn draw_item(slot: u32, r: u32, view: View, tile0: vec2<u32>) {
         }
         step[k] = neg64(mul64(dy, 256));
     }
-    for (var x = first; x <= last; x++) {
+    for (var x = u32(first); x <= u32(last); x++) {
         let inside = !negative64(e[0]) && !negative64(e[1]) && !negative64(e[2]);
         let lx = tile0.x + x;
         if inside {
@@ -458,9 +387,9 @@ fn draw_item(slot: u32, r: u32, view: View, tile0: vec2<u32>) {
             let cy = f32(y) + 0.5 - f32(s.y.x) / 256.0;
             let z = s.z0 + s.dzdx * cx + s.dzdy * cy;
             var kept = z >= 0.0 && z <= 1.0;
-            if kept && s.transmittance > 0.0 {
-                let h = pcg((view.tile.x + lx) ^ pcg((view.tile.y + y) ^ pcg(s.seed)));
-                kept = f32(h >> 8u) * (1.0 / 16777216.0) >= s.transmittance;
+            if kept && transmittance > 0.0 {
+                let h = pcg((view.tile.x + lx) ^ pcg((view.tile.y + y) ^ pcg(a.w)));
+                kept = f32(h >> 8u) * (1.0 / 16777216.0) >= transmittance;
             }
             if kept {
                 let q = min(u32(z * 536870912.0), 0x1fffffffu);
@@ -477,6 +406,28 @@ fn draw_item(slot: u32, r: u32, view: View, tile0: vec2<u32>) {
     }
 }
 
+// Where a half of the workgroup starts walking a list that starts at `head`: lanes 0..31 at its
+// first triangle, lanes 32..63 at its second (each half then takes every other triangle).
+fn first_of_half(head: u32, lane: u32) -> u32 {
+    if lane >= TILE {
+        return next_node(head);
+    }
+    return head;
+}
+
+// Draws this lane's row of the triangle at boxed node `node` (a member or large list's), if its
+// box holds raster tile `at` (the box is the next node: nodes[node], the triangle nodes[node - 1]).
+fn draw_boxed(node: u32, view: View, at: vec2<u32>, tile0: vec2<u32>, row: u32) {
+    let box = nodes[node];
+    if at.x >= (box.x & 0xffffu) && at.y >= (box.x >> 16u) && at.x <= (box.y & 0xffffu) && at.y <= (box.y >> 16u) {
+        let t = nodes[node - 1u].x;
+        let s = setup(t, view);
+        if s.live {
+            draw_row(t, view, s, tile0, row);
+        }
+    }
+}
+
 // Whether any of this lane's pixels of the tile shows a member (its nearest word is a member's).
 fn shows_member(lane: u32) -> bool {
     var any = false;
@@ -487,63 +438,12 @@ fn shows_member(lane: u32) -> bool {
     return any;
 }
 
-// Walker `walker` (0 .. 2 SUBLISTS: the first half's, then the second's) fetches up to
-// PER_WALKER triangles into its slots from the chain whose next node is `cursor` (boxed: a member
-// or large list's, whose entries are two nodes); returns the cursor after them and leaves the
-// count in taken[walker].
-fn fetch(cursor: u32, walker: u32, boxed: bool) -> u32 {
-    let first = walker * PER_WALKER;
-    var node = cursor;
-    var n = 0u;
-    while n < PER_WALKER && node != 0u {
-        let entry = nodes[node - 1u];
-        fetched[first + n] = vec2<u32>(entry.x, select(0u, node, boxed));
-        n++;
-        node = entry.y;
+// The next node after n (0: the end).
+fn next_node(n: u32) -> u32 {
+    if n == 0u {
+        return 0u;
     }
-    taken[walker] = n;
-    return node;
-}
-
-// Lane 0 sums the member walkers' cursors into members_left (after a barrier).
-fn gather_members_left(lane: u32) {
-    if lane == 0u {
-        var any = 0u;
-        for (var w = 0u; w < SUBLISTS; w++) {
-            any |= pending[w];
-        }
-        members_left = any;
-    }
-}
-
-// Sums rows_to in place (inclusive prefix sums over the round's slots; a barrier a step, and
-// one first: every lane's own count must be written before any lane reads its neighbour's).
-fn scan_rows(lane: u32) {
-    workgroupBarrier();
-    for (var d = 1u; d < ROUND; d *= 2u) {
-        var add = 0u;
-        if lane >= d {
-            add = rows_to[lane - d];
-        }
-        workgroupBarrier();
-        rows_to[lane] += add;
-        workgroupBarrier();
-    }
-}
-
-// The slot whose scanned rows first pass `item` (binary search over rows_to).
-fn slot_of(item: u32) -> u32 {
-    var lo = 0u;
-    var hi = ROUND - 1u;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if rows_to[mid] > item {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
-    }
-    return lo;
+    return nodes[n - 1u].y;
 }
 
 @compute @workgroup_size(64)
@@ -561,83 +461,52 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     if lane < 12u {
         atomicStore(&totals[lane], 0u);
     }
-    if lane == 0u {
-        atomicStore(&votes, 0u);
-    }
-    let at = vec2<u32>(group.x % per_row, group.x / per_row);
-    let tiles = per_row * per_row;
-    // Lane w < SUBLISTS walks chain w of the member list, then of the large list; lane HALF + w
-    // chain w of the tile's list. Walker w of a half fills slots w·PER_WALKER of that half.
-    let chain = lane % HALF;
-    let walker = (lane / HALF) * SUBLISTS + chain;
-    var member_cursor = 0u;
-    var large_cursor = 0u;
-    var small_cursor = 0u;
-    if chain < SUBLISTS {
-        if lane < HALF {
-            member_cursor = atomicLoad(&heads[sublist_head(view, tiles + MEMBER_LIST, chain)]);
-            large_cursor = atomicLoad(&heads[sublist_head(view, tiles + LARGE_LIST, chain)]);
-            pending[chain] = member_cursor;
-        } else {
-            small_cursor = atomicLoad(&heads[sublist_head(view, group.x, chain)]);
-        }
-    }
     workgroupBarrier();
-    gather_members_left(lane);
-    var members_drawn = workgroupUniformLoad(&members_left) == 0u;
+    let row = lane % TILE;
+    let at = vec2<u32>(group.x % per_row, group.x / per_row);
+    let lists = 1u + view.first_head + per_row * per_row;
+    // The members first, whole (few triangles: a view's receivers).
+    var node = first_of_half(atomicLoad(&heads[lists + MEMBER_LIST]), lane);
+    while node != 0u {
+        draw_boxed(node, view, at, tile0, row);
+        node = next_node(next_node(node));
+    }
+    // Then the large list and the tile's list, a chunk at a time, until nothing of the tile
+    // shows a member or nothing is left.
+    var small = first_of_half(atomicLoad(&heads[1u + view.first_head + group.x]), lane);
+    var large = first_of_half(atomicLoad(&heads[lists + LARGE_LIST]), lane);
     loop {
-        // Once every member is drawn: stop when nothing of the tile shows a member (a tile no
-        // member covers, at once), or nothing is left. What is left undrawn then could only
-        // lower casters' depths or cover pixels no member covers. A test's dump walks everything.
-        if members_drawn {
-            workgroupBarrier();
-            let more = large_cursor != 0u || small_cursor != 0u;
-            let vote = select(0u, SHOWS_MEMBER, shows_member(lane)) | select(0u, MORE_TO_WALK, more);
-            if vote != 0u {
-                atomicOr(&votes, vote);
+        workgroupBarrier();
+        votes[lane] = select(0u, SHOWS_MEMBER, shows_member(lane)) | select(0u, MORE_TO_WALK, small != 0u || large != 0u);
+        workgroupBarrier();
+        if lane == 0u {
+            var all = 0u;
+            for (var i = 0u; i < 64u; i++) {
+                all |= votes[i];
             }
-            workgroupBarrier();
-            if lane == 0u {
-                // Cleared for the next round's votes, which come after two more barriers.
-                decision = atomicExchange(&votes, 0u);
-            }
-            let now = workgroupUniformLoad(&decision);
-            if (now & MORE_TO_WALK) == 0u || ((now & SHOWS_MEMBER) == 0u && params.dump == 0u) {
+            decision = all;
+        }
+        let now = workgroupUniformLoad(&decision);
+        // A test's dump walks everything: the classes of pixels no member shows are kept too.
+        if (now & MORE_TO_WALK) == 0u || ((now & SHOWS_MEMBER) == 0u && params.dump == 0u) {
+            break;
+        }
+        // Large triangles first: they are the ones likely to shade a tile whole.
+        for (var step = 0u; step < WALK_CHUNK; step++) {
+            if large != 0u {
+                draw_boxed(large, view, at, tile0, row);
+                large = next_node(next_node(large));
+            } else if small != 0u {
+                let t = nodes[small - 1u].x;
+                let s = setup(t, view);
+                if s.live {
+                    draw_row(t, view, s, tile0, row);
+                }
+                small = next_node(next_node(small));
+            } else {
                 break;
             }
         }
-        workgroupBarrier();
-        if chain < SUBLISTS {
-            if lane < HALF {
-                if member_cursor != 0u {
-                    member_cursor = fetch(member_cursor, walker, true);
-                } else {
-                    large_cursor = fetch(large_cursor, walker, true);
-                }
-                pending[chain] = member_cursor;
-            } else if members_drawn {
-                small_cursor = fetch(small_cursor, walker, false);
-            } else {
-                // The tile's own triangles wait until every member is drawn, so a tile no
-                // member covers draws none of them.
-                taken[walker] = 0u;
-            }
-        }
-        workgroupBarrier();
-        gather_members_left(lane);
-        var rows = 0u;
-        if lane % PER_WALKER < taken[lane / PER_WALKER] {
-            rows = prepare(fetched[lane], view, at, tile0, lane);
-        }
-        rows_to[lane] = rows;
-        scan_rows(lane);
-        let items = rows_to[ROUND - 1u];
-        for (var item = lane; item < items; item += 64u) {
-            let slot = slot_of(item);
-            let before = select(0u, rows_to[max(slot, 1u) - 1u], slot > 0u);
-            draw_item(slot, item - before, view, tile0);
-        }
-        members_drawn = workgroupUniformLoad(&members_left) == 0u;
     }
     workgroupBarrier();
     if params.dump != 0u {

@@ -59,14 +59,9 @@ pub fn node_bound(side: u32) -> u32 {
 /// large triangles', and its members' own triangles', which every raster tile draws first.
 const VIEW_LISTS: u32 = 2;
 
-/// Chains each list is kept in (the shader's SUBLISTS): a raster tile walks that many chains at
-/// once, each a dependent load a triangle, so a round of 64 triangles waits for 4 loads, not 64.
-const SUBLISTS: u32 = 8;
-
-/// List heads a view of side `side` has: [`SUBLISTS`] a list, one list a raster tile, row by
-/// row, then [`VIEW_LISTS`].
+/// List heads a view of side `side` has: one a raster tile, row by row, then [`VIEW_LISTS`].
 fn heads_per_view(side: u32) -> u32 {
-    (raster_tiles(side) + VIEW_LISTS) * SUBLISTS
+    raster_tiles(side) + VIEW_LISTS
 }
 
 /// Raster tiles (workgroups of the raster pass) a view of side `side` has.
@@ -74,7 +69,7 @@ fn raster_tiles(side: u32) -> u32 {
     side.div_ceil(RASTER_TILE).pow(2)
 }
 /// The most views a batch counts: at 512² that is 262,144 raster workgroups, enough to keep a
-/// data-centre GPU's SMs busy, and the batch's own buffers stay small (the heads 8.5 MB).
+/// data-centre GPU's SMs busy, and the batch's own buffers stay small (the heads 1 MiB).
 pub const MAX_BATCH_VIEWS: usize = 1024;
 /// The most bytes the pool is planned at (a view that needs more still gets them, up to the
 /// device's binding limit): 32 M nodes, ~1,500 views of 10,000 triangles at the nodes a triangle
