@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Several builds of sunlit side by side on one lent GPU, in turns, for a kernel change's A/B on
+# the same machine (docs/benchmarks-gpu.md, 2026-11-30). Here, first: each build stripped and
+# gzipped into the carry folder under its name, with the Vulkan loader's packages,
+#   mkdir -p .gpu-carry/gl && (cd .gpu-carry/gl && apt-get download libvulkan1 libegl1 libglvnd0 \
+#     libopengl0 libgl1 libglx0 libgles2)
+#   strip -o .gpu-carry/old path/to/old/sunlit && gzip .gpu-carry/old     # and so on for each
+# (.gpu-carry in .git/info/exclude); then on the GPU machine, carrying .gpu-carry:
+#   VARIANTS="new old" scripts/bench-gpu-variants.sh
+# Runs, each variant in turn: nyt-blocks' even spread of 20,040 views (the first variant's
+# checked against exact on 30 views), blaas-trees-summer's and blaas-louvres' every view
+# (checked on 50), then the spread and blaas-trees-summer again. One JSON line a run into
+# OUT/bench.jsonl (the run's label, exit code, wall time and bench output), a summary line a
+# run on stdout; runs that would start after BUDGET seconds (default 150) are skipped.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+C=${CARRY:-.gpu-carry}; R=${OUT:-target/bench-gpu-variants}; mkdir -p "$R"; T0=$(date +%s)
+read -r -a variants <<< "${VARIANTS:?VARIANTS: the names of the gzipped builds in $C}"
+if [ -d "$C/gl" ] && ! ldconfig -p | grep -q 'libvulkan.so.1 '; then
+  for f in "$C"/gl/*.deb; do dpkg -x "$f" /; done; ldconfig
+fi
+icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+egl=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+[ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$icd" ] && export VK_DRIVER_FILES=$icd
+[ -z "${__EGL_VENDOR_LIBRARY_FILENAMES:-}" ] && [ -f "$egl" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl
+bin=/tmp/sunlit-variants; mkdir -p "$bin"
+for v in "${variants[@]}"; do gunzip -c "$C/$v.gz" > "$bin/$v" && chmod +x "$bin/$v" || exit 1; done
+{ nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv; nproc; } > "$R/machine.txt" 2>&1
+
+run() { # label timeout variant args...
+  local label=$1 t=$2 v=$3; shift 3
+  if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-150}" ]; then echo "skip $label" >> "$R/stderr.txt"; return; fi
+  echo "== $label: $*" >> "$R/stderr.txt"
+  local s e rc; s=$(date +%s.%N)
+  timeout "$t" "$bin/$v" "$@" > "$R/last.json" 2>>"$R/stderr.txt"; rc=$?
+  e=$(date +%s.%N)
+  python3 - "$label" "$v" "$rc" "$s" "$e" "$R/last.json" "$R/bench.jsonl" <<'PY'
+import json, sys
+label, variant, rc, s, e, path, log = sys.argv[1:]
+text = open(path).read()
+with open(log, "a") as f:
+    f.write(json.dumps({"label": label, "variant": variant, "rc": int(rc), "wall": round(float(e) - float(s), 3), "out": text}) + "\n")
+try:
+    o = json.loads(text)
+except ValueError:
+    o = {}
+print(label, rc, o.get("estimated_seconds_all_views"), o.get("views_rendered"), o.get("max_abs_error"), flush=True)
+PY
+}
+first=${variants[0]}
+for v in "${variants[@]}"; do
+  check=(); [ "$v" = "$first" ] && check=(--check 30)
+  run "nyt-20040-$v" 60 "$v" bench nyt-blocks --engine compute --views 20040 "${check[@]}"
+done
+for v in "${variants[@]}"; do run "trees-$v" 40 "$v" bench blaas-trees-summer --engine compute --check 50; done
+for v in "${variants[@]}"; do run "louvres-$v" 40 "$v" bench blaas-louvres --engine compute --check 50; done
+for v in "${variants[@]}"; do run "nyt-20040-$v-again" 60 "$v" bench nyt-blocks --engine compute --views 20040; done
+for v in "${variants[@]}"; do run "trees-$v-again" 40 "$v" bench blaas-trees-summer --engine compute; done
+echo "done in $(( $(date +%s) - T0 )) s: $R/bench.jsonl"
