@@ -58,6 +58,13 @@ const LARGE_TILES: u32 = 8u;
 // Heads a view has after its raster tiles': the large list's, then the member list's.
 const LARGE_LIST: u32 = 0u;
 const MEMBER_LIST: u32 = 1u;
+// The raster pass's walk, counted with params.walk (the library's compute::WalkStats), each as
+// 64 bits (low, high words): tiles walked, list entries visited and triangles set up (a half of
+// the workgroup's each), rows drawn (a lane's each), pixel centres tested.
+const WALK_COUNTERS: u32 = 5u;
+const WALK_WORDS: u32 = 10u;
+// Where the views' list heads start in heads: after the pool's count and the walk's counters.
+const FIRST_HEAD: u32 = 11u;
 // Steps of the walk (two triangles each, one per half of the workgroup) between two checks
 // whether any pixel of the tile still shows a member. 4, not 16: a tile a caster shades whole
 // stops 24 triangles sooner, and the check is cheap (docs/benchmarks-gpu.md: blaas-trees-summer
@@ -102,7 +109,8 @@ struct Params {
     // The batch's jobs: ranges[first_job ..][.. jobs], (view, the first of its triangles) each.
     first_job: u32,
     jobs: u32,
-    _pad1: u32,
+    // Non-zero (benchmarks): count the raster pass's walk into heads[1 ..][.. WALK_WORDS].
+    walk: u32,
     _pad2: u32,
     _pad3: u32,
 }
@@ -118,8 +126,9 @@ struct Params {
 @group(0) @binding(4) var<storage, read> members: array<u32>;
 // counts[3m], counts[3m + 1], counts[3m + 2]: visible, covered, edge pairs of member entry m.
 @group(0) @binding(5) var<storage, read_write> counts: array<atomic<u32>>;
-// heads[0]: pool nodes asked for; heads[1 + first_head + raster tile] (the large list after the
-// view's raster tiles): 1 + its first node, 0 if none.
+// heads[0]: pool nodes asked for; heads[1 ..][.. WALK_WORDS]: the walk's counters (with
+// params.walk); heads[FIRST_HEAD + first_head + raster tile] (the large list after the view's
+// raster tiles): 1 + its first node, 0 if none.
 @group(0) @binding(6) var<storage, read_write> heads: array<atomic<u32>>;
 // Node n: (triangle, 1 + next node or 0); a large triangle's node n + 1: its box in raster tiles,
 // (x0 | y0 << 16, x1 | y1 << 16).
@@ -296,7 +305,7 @@ fn bin(t: u32, view: View) {
             if n >= params.capacity {
                 continue;
             }
-            let head = 1u + view.first_head + u32(ty) * per_row + u32(tx);
+            let head = FIRST_HEAD + view.first_head + u32(ty) * per_row + u32(tx);
             let next = atomicExchange(&heads[head], n + 1u);
             nodes[n] = vec2<u32>(t, next);
         }
@@ -310,7 +319,7 @@ fn push_boxed(t: u32, view: View, list: u32, t0: vec2<i32>, t1: vec2<i32>) {
     if n + 1u >= params.capacity {
         return;
     }
-    let next = atomicExchange(&heads[1u + view.first_head + list], n + 1u);
+    let next = atomicExchange(&heads[FIRST_HEAD + view.first_head + list], n + 1u);
     nodes[n] = vec2<u32>(t, next);
     nodes[n + 1u] = vec2<u32>(u32(t0.x) | (u32(t0.y) << 16u), u32(t1.x) | (u32(t1.y) << 16u));
 }
@@ -339,6 +348,11 @@ var<workgroup> decision: u32;
 const SHOWS_MEMBER: u32 = 1u;
 const MORE_TO_WALK: u32 = 2u;
 
+// This lane's share of the walk's counters (params.walk): list entries visited, triangles set
+// up, rows drawn, pixel centres tested; summed into walk_sums at the end of the tile.
+var<private> walked: array<u32, 4>;
+var<workgroup> walk_sums: array<atomic<u32>, 5>;
+
 // PCG hash (Jarzynski & Olano 2020), as sun_view.wgsl's.
 fn pcg(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
@@ -362,6 +376,8 @@ fn draw_row(t: u32, view: View, s: Setup, tile0: vec2<u32>, row: u32) {
     if first > last {
         return;
     }
+    walked[2] += 1u;
+    walked[3] += u32(last - first + 1);
     let px0 = (i32(tile0.x) + first) * 256 + 128;
     let a = attributes[t];
     let kind = class_of(t, view);
@@ -421,8 +437,10 @@ fn first_of_half(head: u32, lane: u32) -> u32 {
 // box holds raster tile `at` (the box is the next node: nodes[node], the triangle nodes[node - 1]).
 fn draw_boxed(node: u32, view: View, at: vec2<u32>, tile0: vec2<u32>, row: u32) {
     let box = nodes[node];
+    walked[0] += 1u;
     if at.x >= (box.x & 0xffffu) && at.y >= (box.x >> 16u) && at.x <= (box.y & 0xffffu) && at.y <= (box.y >> 16u) {
         let t = nodes[node - 1u].x;
+        walked[1] += 1u;
         let s = setup(t, view);
         if s.live {
             draw_row(t, view, s, tile0, row);
@@ -463,10 +481,13 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     if lane < 12u {
         atomicStore(&totals[lane], 0u);
     }
+    if lane < WALK_COUNTERS {
+        atomicStore(&walk_sums[lane], 0u);
+    }
     workgroupBarrier();
     let row = lane % TILE;
     let at = vec2<u32>(group.x % per_row, group.x / per_row);
-    let lists = 1u + view.first_head + per_row * per_row;
+    let lists = FIRST_HEAD + view.first_head + per_row * per_row;
     // The members first, whole (few triangles: a view's receivers).
     var node = first_of_half(atomicLoad(&heads[lists + MEMBER_LIST]), lane);
     while node != 0u {
@@ -475,7 +496,7 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     }
     // Then the large list and the tile's list, a chunk at a time, until nothing of the tile
     // shows a member or nothing is left.
-    var small = first_of_half(atomicLoad(&heads[1u + view.first_head + group.x]), lane);
+    var small = first_of_half(atomicLoad(&heads[FIRST_HEAD + view.first_head + group.x]), lane);
     var large = first_of_half(atomicLoad(&heads[lists + LARGE_LIST]), lane);
     loop {
         workgroupBarrier();
@@ -500,6 +521,8 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
                 large = next_node(next_node(large));
             } else if small != 0u {
                 let t = nodes[small - 1u].x;
+                walked[0] += 1u;
+                walked[1] += 1u;
                 let s = setup(t, view);
                 if s.live {
                     draw_row(t, view, s, tile0, row);
@@ -514,7 +537,36 @@ fn raster_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     if params.dump != 0u {
         dump_tile(view, tile0, lane, group.y);
     }
+    if params.walk != 0u {
+        count_walk(lane);
+    }
     count_tile(view, tile0, lane);
+}
+
+// Adds this tile's walk to the counters in heads (params.walk): every lane's rows and pixels, the
+// entries and set-ups of one lane a half (its 32 lanes walk the same triangles), and the tile.
+fn count_walk(lane: u32) {
+    if lane % TILE == 0u {
+        atomicAdd(&walk_sums[1], walked[0]);
+        atomicAdd(&walk_sums[2], walked[1]);
+    }
+    atomicAdd(&walk_sums[3], walked[2]);
+    atomicAdd(&walk_sums[4], walked[3]);
+    workgroupBarrier();
+    if lane == 0u {
+        atomicStore(&walk_sums[0], 1u);
+        for (var k = 0u; k < WALK_COUNTERS; k++) {
+            add_walk(k, atomicLoad(&walk_sums[k]));
+        }
+    }
+}
+
+// Adds v to walk counter k, 64 bits as two words of heads (low, then high).
+fn add_walk(k: u32, v: u32) {
+    let old = atomicAdd(&heads[1u + 2u * k], v);
+    if old + v < old {
+        atomicAdd(&heads[2u + 2u * k], 1u);
+    }
 }
 
 // Counts the tile's pixels per member into totals, then adds them to the view's counts.

@@ -459,3 +459,26 @@ fn an_overflowing_pair_list_is_run_again_never_truncated() {
     assert_eq!(sorted(&tight.pairs), sorted(&roomy.pairs));
     assert_eq!(tight.draw, roomy.draw);
 }
+
+#[test]
+fn the_walk_counts_each_tiles_entries_rows_and_pixels() {
+    // A 64² view (2 × 2 raster tiles) covered by one member's square (two triangles whose boxes
+    // hold every pixel centre of every tile) and one small caster in the first tile whose box
+    // holds 8 × 8 pixel centres. Each tile sets up the square's two triangles (one a half of the
+    // workgroup), 32 rows of 32 pixel centres each; the first tile also walks the caster (one
+    // half), 8 rows of 8; then every tile has nothing left to walk.
+    let options = CounterOptions { resolution: 64, kernel: Kernel::Compute, walk_stats: true, ..Default::default() };
+    let counter = pollster::block_on(Counter::new(options)).expect("a GPU adapter");
+    let (a, b, c, d) = ([-1.0, -1.0, 0.5], [65.0, -1.0, 0.5], [65.0, 65.0, 0.5], [-1.0, 65.0, 0.5]);
+    let triangles = vec![[a, b, c], [a, c, d], [[2.0, 2.0, 0.25], [10.0, 2.0, 0.25], [2.0, 10.0, 0.25]]];
+    let ids = [10, 10, NO_RECEIVER];
+    let counts = pollster::block_on(counter.compute_counts(&triangles, &ids, &[10], 64)).unwrap();
+    let walk = counter.walk_stats();
+    assert_eq!([walk.tiles, walk.entries, walk.set_up], [4, 9, 9], "{walk:?}");
+    assert_eq!([walk.rows, walk.pixels], [4 * 64 + 8, 4 * 2048 + 64], "{walk:?}");
+    // Counting the walk changes no count.
+    let plain = pollster::block_on(compute_counter(64).compute_counts(&triangles, &ids, &[10], 64)).unwrap();
+    assert_eq!(counts, plain);
+    assert_eq!(counts[0][1], 64 * 64, "the square covers the view");
+    assert_eq!(compute_counter(64).walk_stats(), Default::default(), "nothing counted unless asked for");
+}

@@ -70,6 +70,11 @@ pub(super) struct BenchArgs {
     /// Only with --engine gpu. The JSON line's `cull` says which ran.
     #[arg(long, value_name = "cpu|gpu|gpu-batch", default_value = "cpu")]
     cull: String,
+    /// Count what the compute kernel's raster tiles walk (tiles, list entries, triangles set up,
+    /// rows, pixel centres tested) into the JSON line's `compute_walk`. Only with --engine
+    /// compute; its atomics cost a little, so time without it.
+    #[arg(long)]
+    walk_stats: bool,
     /// Time each model's sky pass instead: every receiver's sky views over the given patch
     /// scheme (`tregenza` or `reinhart:N`), once, on the chosen engine.
     #[arg(long, value_name = "SCHEME")]
@@ -174,7 +179,12 @@ fn counter_options(args: &BenchArgs) -> Result<CounterOptions> {
         "gpu" | "gpu-batch" => return Err(Error::argument("--cull", "gpu culls for the raster kernel: use it with --engine gpu")),
         other => return Err(Error::argument("--cull", format!("'{other}' is not cpu, gpu or gpu-batch"))),
     };
-    let options = CounterOptions { max_atlas: args.atlas, backend, limits, kernel, gpu_cull, batch_draw, ..args.pixels.options() };
+    if args.walk_stats && kernel != Kernel::Compute {
+        return Err(Error::argument("--walk-stats", "counts the compute kernel's walk: use it with --engine compute"));
+    }
+    let walk_stats = args.walk_stats;
+    let options =
+        CounterOptions { max_atlas: args.atlas, backend, limits, kernel, gpu_cull, batch_draw, walk_stats, ..args.pixels.options() };
     if backend == Backend::Noop {
         if args.check > 0 {
             return Err(Error::argument("--check", "the noop backend counts nothing to check: drop --check or use --backend platform"));
@@ -254,6 +264,8 @@ fn bench_models(args: &BenchArgs, counter: &Counter, startup: f64, now: impl Fn(
             // count again by overflowing.
             "bin_pool_nodes": counters.iter().map(|c| c.bin_pool().0).max(),
             "bin_pool_reruns": counters.iter().map(|c| c.bin_pool().1).sum::<u64>(),
+            // With --walk-stats: what the compute kernel's raster tiles walked, summed.
+            "compute_walk": args.walk_stats.then(|| walk_totals(&counters)),
             // GPU-culled views whose shading the host tested (the GPU's test undecided, and the
             // render not fully lit), since the counters were made.
             "shading_tested_on_cpu": counters.iter().map(|c| c.shading_tested_on_cpu()).sum::<u64>(),
@@ -426,4 +438,24 @@ pub(crate) fn peak_memory_mib() -> Option<f64> {
 fn compute_views_per_submission(counters: &[&Counter]) -> Option<f64> {
     let (batches, views) = counters.iter().map(|c| c.compute_batches()).fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     (batches > 0).then(|| views as f64 / batches as f64)
+}
+
+/// The compute kernel's raster walk over `counters`, summed, with the means a tile.
+fn walk_totals(counters: &[&Counter]) -> serde_json::Value {
+    let mut sum = sunlit::count::gpu::compute::WalkStats::default();
+    for walk in counters.iter().map(|c| c.walk_stats()) {
+        sum.tiles += walk.tiles;
+        sum.entries += walk.entries;
+        sum.set_up += walk.set_up;
+        sum.rows += walk.rows;
+        sum.pixels += walk.pixels;
+    }
+    let per_tile = |n: u64| n as f64 / sum.tiles.max(1) as f64;
+    json!({
+        "totals": sum,
+        "entries_per_tile": per_tile(sum.entries),
+        "set_up_per_tile": per_tile(sum.set_up),
+        "rows_per_tile": per_tile(sum.rows),
+        "pixels_per_tile": per_tile(sum.pixels),
+    })
 }

@@ -64,6 +64,40 @@ fn heads_per_view(side: u32) -> u32 {
     raster_tiles(side) + VIEW_LISTS
 }
 
+/// Words of heads before the views' list heads (the shader's FIRST_HEAD): the pool's count, then
+/// the walk's counters, five of 64 bits.
+const FIRST_HEAD: u64 = 11;
+
+/// What the raster pass's tiles did (benchmarks, with [`super::CounterOptions::walk_stats`]): a
+/// tile's cost is mostly its walk over the casters binned to it (docs/benchmarks-gpu.md).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct WalkStats {
+    /// Raster tiles counted.
+    pub tiles: u64,
+    /// List entries the tiles visited (members', large and their own), each once a half of the
+    /// workgroup (a half's 32 lanes walk the same entries).
+    pub entries: u64,
+    /// Of those, triangles set up (a large or member entry whose box holds the tile, every entry
+    /// of the tile's own list).
+    pub set_up: u64,
+    /// Rows drawn: a lane's row inside a set-up triangle's bounding box.
+    pub rows: u64,
+    /// Pixel centres tested against a triangle's edges.
+    pub pixels: u64,
+}
+
+impl WalkStats {
+    /// Adds one batch's counters: five (low, high) word pairs.
+    fn add(&mut self, words: &[u32]) {
+        let at = |k: usize| words.get(2 * k).map_or(0, |&lo| u64::from(lo) | u64::from(words.get(2 * k + 1).copied().unwrap_or(0)) << 32);
+        self.tiles += at(0);
+        self.entries += at(1);
+        self.set_up += at(2);
+        self.rows += at(3);
+        self.pixels += at(4);
+    }
+}
+
 /// Raster tiles (workgroups of the raster pass) a view of side `side` has.
 fn raster_tiles(side: u32) -> u32 {
     side.div_ceil(RASTER_TILE).pow(2)
@@ -105,7 +139,8 @@ struct ComputeParams {
     dump: u32,
     first_job: u32,
     jobs: u32,
-    _pad: [u32; 3],
+    walk: u32,
+    _pad: [u32; 2],
 }
 
 /// The two passes and their bindings.
@@ -176,6 +211,8 @@ pub(super) struct ComputeBins {
     views_counted: u64,
     /// Tests: write each pixel's class and coverage into `heads` too.
     dump: bool,
+    /// The raster pass's walk, summed over the batches counted (with `walk_stats`).
+    walk: WalkStats,
     /// Tests: the most views a batch takes (else [`MAX_BATCH_VIEWS`]).
     max_views: usize,
 }
@@ -206,6 +243,7 @@ impl ComputeBins {
             batches: 0,
             views_counted: 0,
             dump: false,
+            walk: WalkStats::default(),
             max_views: MAX_BATCH_VIEWS,
         }
     }
@@ -295,7 +333,7 @@ impl ComputeBatch {
 
     /// Words of the heads buffer: the pool's count and every view's heads.
     fn head_words(&self) -> u64 {
-        1 + self.views.len() as u64 * self.heads_per_view as u64
+        FIRST_HEAD + self.views.len() as u64 * self.heads_per_view as u64
     }
 }
 
@@ -474,7 +512,8 @@ impl Counter {
             }
             bins.batches += 1;
             bins.views_counted += batch.views.len() as u64;
-            words.remove(0);
+            bins.walk.add(&words[1..FIRST_HEAD as usize]);
+            words.drain(..FIRST_HEAD as usize);
             return Ok(Some(words));
         }
     }
@@ -498,14 +537,15 @@ impl Counter {
         fit(d, &mut bins.members, size_of_val(&batch.members[..]) as u64, "compute members", STORAGE);
         fit(d, &mut bins.counts, entry_bytes, "compute counts", COUNTS);
         fit(d, &mut bins.heads, head_bytes, "compute heads", COUNTS);
-        fit(d, &mut bins.readback, 4 + entry_bytes, "compute readback", READBACK);
+        fit(d, &mut bins.readback, 4 * FIRST_HEAD + entry_bytes, "compute readback", READBACK);
         let params = ComputeParams {
             capacity: bins.capacity,
             count_edges: self.options.accuracy.is_some() as u32,
             dump: dump as u32,
             first_job,
             jobs,
-            _pad: [0; 3],
+            walk: self.options.walk_stats as u32,
+            _pad: [0; 2],
         };
         self.queue.write_buffer(&bins.views, 0, bytemuck::cast_slice(&batch.views));
         self.queue.write_buffer(&bins.ranges, 0, bytemuck::cast_slice(&words));
@@ -539,9 +579,9 @@ impl Counter {
         pass.set_pipeline(&state.pipelines.raster);
         pass.dispatch_workgroups(raster_tiles(batch.side), views as u32, 1);
         drop(pass);
-        encoder.copy_buffer_to_buffer(&bins.heads, 0, &bins.readback, 0, 4);
+        encoder.copy_buffer_to_buffer(&bins.heads, 0, &bins.readback, 0, 4 * FIRST_HEAD);
         if entry_bytes > 0 {
-            encoder.copy_buffer_to_buffer(&bins.counts, 0, &bins.readback, 4, entry_bytes);
+            encoder.copy_buffer_to_buffer(&bins.counts, 0, &bins.readback, 4 * FIRST_HEAD, entry_bytes);
         }
         let commands = encoder.finish();
         self.stages.recording.fetch_add(recording.nanos(), Ordering::Relaxed);
@@ -549,7 +589,13 @@ impl Counter {
         let submitting = Stopwatch::start();
         self.queue.submit([commands]);
         self.stages.submitting.fetch_add(submitting.nanos(), Ordering::Relaxed);
-        Ok((bins.readback.clone(), 4 + entry_bytes))
+        Ok((bins.readback.clone(), 4 * FIRST_HEAD + entry_bytes))
+    }
+
+    /// The compute kernel's raster walk summed over the batches counted since the counter was
+    /// made (zeros unless [`super::CounterOptions::walk_stats`], and for the raster kernel).
+    pub fn walk_stats(&self) -> WalkStats {
+        self.bins().map_or(WalkStats::default(), |b| b.walk)
     }
 
     /// Nodes the compute kernel's pool holds now, and how many batches were counted again
@@ -606,7 +652,7 @@ impl Counter {
             return Ok(Vec::new());
         }
         let heads_per_view = heads_per_view(side) as u64;
-        let first = 4 * (1 + views as u64 * heads_per_view);
+        let first = 4 * (FIRST_HEAD + views as u64 * heads_per_view);
         let bytes = 4 * views as u64 * side as u64 * side as u64;
         let target = buffer(&self.device, "dump readback", bytes, READBACK);
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("read dump") });

@@ -173,6 +173,9 @@ pub struct CounterOptions {
     /// one draw a tile. Off by default: on lavapipe its counts equal the per-tile draws' on the
     /// bench models but for one pixel on some louvre views (see `batched`).
     pub batch_draw: bool,
+    /// The compute kernel counts its raster tiles' walk ([`compute::WalkStats`], benchmarks):
+    /// atomics a tile that cost a little, so off unless asked for.
+    pub walk_stats: bool,
 }
 
 impl Default for CounterOptions {
@@ -186,6 +189,7 @@ impl Default for CounterOptions {
             kernel: Kernel::Raster,
             gpu_cull: false,
             batch_draw: false,
+            walk_stats: false,
         }
     }
 }
