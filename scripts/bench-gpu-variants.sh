@@ -2,9 +2,7 @@
 # Several builds of sunlit side by side on one lent GPU, in turns, for a kernel change's A/B on
 # the same machine (docs/benchmarks-gpu.md, 2026-11-30). Here, first: each build stripped and
 # gzipped into the carry folder under its name, with the Vulkan loader's packages,
-#   mkdir -p .gpu-carry/gl && (cd .gpu-carry/gl && apt-get download libvulkan1 libegl1 libglvnd0 \
-#     libopengl0 libgl1 libglx0 libgles2)
-#   strip -o .gpu-carry/old path/to/old/sunlit && gzip .gpu-carry/old     # and so on for each
+#   scripts/stage-gpu-variants.sh new=path/to/new/sunlit old=path/to/old/sunlit
 # (.gpu-carry in .git/info/exclude); then on the GPU machine, carrying .gpu-carry:
 #   VARIANTS="new old" scripts/bench-gpu-variants.sh
 # Runs, each variant in turn: nyt-blocks' even spread of 20,040 views (the first variant's
