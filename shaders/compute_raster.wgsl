@@ -64,7 +64,7 @@ const MEMBER_LIST: u32 = 1u;
 const WALK_COUNTERS: u32 = 5u;
 const WALK_WORDS: u32 = 10u;
 // Where the views' list heads start in heads: after the pool's count and the walk's counters.
-const FIRST_HEAD: u32 = 11u;
+const FIRST_HEAD: u32 = 1u + WALK_WORDS;
 // Steps of the walk (two triangles each, one per half of the workgroup) between two checks
 // whether any pixel of the tile still shows a member. 4, not 16: a tile a caster shades whole
 // stops 24 triangles sooner, and the check is cheap (docs/benchmarks-gpu.md: blaas-trees-summer

@@ -443,12 +443,8 @@ fn compute_views_per_submission(counters: &[&Counter]) -> Option<f64> {
 /// The compute kernel's raster walk over `counters`, summed, with the means a tile.
 fn walk_totals(counters: &[&Counter]) -> serde_json::Value {
     let mut sum = sunlit::count::gpu::compute::WalkStats::default();
-    for walk in counters.iter().map(|c| c.walk_stats()) {
-        sum.tiles += walk.tiles;
-        sum.entries += walk.entries;
-        sum.set_up += walk.set_up;
-        sum.rows += walk.rows;
-        sum.pixels += walk.pixels;
+    for counter in counters {
+        sum += counter.walk_stats();
     }
     let per_tile = |n: u64| n as f64 / sum.tiles.max(1) as f64;
     json!({

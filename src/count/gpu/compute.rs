@@ -87,14 +87,21 @@ pub struct WalkStats {
 }
 
 impl WalkStats {
-    /// Adds one batch's counters: five (low, high) word pairs.
-    fn add(&mut self, words: &[u32]) {
-        let at = |k: usize| words.get(2 * k).map_or(0, |&lo| u64::from(lo) | u64::from(words.get(2 * k + 1).copied().unwrap_or(0)) << 32);
-        self.tiles += at(0);
-        self.entries += at(1);
-        self.set_up += at(2);
-        self.rows += at(3);
-        self.pixels += at(4);
+    /// One batch's counters, as the shader leaves them: five (low, high) word pairs.
+    fn from_words(words: &[u32]) -> Self {
+        let mut at = words.chunks_exact(2).map(|pair| u64::from(pair[0]) | u64::from(pair[1]) << 32);
+        let mut next = || at.next().unwrap_or(0);
+        Self { tiles: next(), entries: next(), set_up: next(), rows: next(), pixels: next() }
+    }
+}
+
+impl std::ops::AddAssign for WalkStats {
+    fn add_assign(&mut self, other: Self) {
+        self.tiles += other.tiles;
+        self.entries += other.entries;
+        self.set_up += other.set_up;
+        self.rows += other.rows;
+        self.pixels += other.pixels;
     }
 }
 
@@ -512,7 +519,14 @@ impl Counter {
             }
             bins.batches += 1;
             bins.views_counted += batch.views.len() as u64;
-            bins.walk.add(&words[1..FIRST_HEAD as usize]);
+            let Some(walk) = words.get(1..FIRST_HEAD as usize) else {
+                return Err(GpuError::Readback(format!(
+                    "the compute kernel's readback has {} words, fewer than {FIRST_HEAD}",
+                    words.len()
+                ))
+                .into());
+            };
+            bins.walk += WalkStats::from_words(walk);
             words.drain(..FIRST_HEAD as usize);
             return Ok(Some(words));
         }
