@@ -309,3 +309,76 @@ fn first_reached_is_the_lowest_reached_triangle_as_a_scan_finds_it() {
     // Both answers are exercised.
     assert!(found > 200 && found < 1800, "{found}");
 }
+
+/// A box [lo, hi] with each face cut into `n` × `n` panels (welded corners, as a block's
+/// panelled facade): one convex object of `6 · 2n²` triangles and many corners on its faces.
+fn panelled_cuboid(lo: [f32; 3], hi: [f32; 3], n: u32) -> SourceMesh {
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut indices = Vec::new();
+    let at = |k: u32, a: usize| lo[a] + (hi[a] - lo[a]) * k as f32 / n as f32;
+    // Each face: the fixed axis and side, and the two axes along it, wound outward.
+    for (fixed, side, u, v) in [(2, 0, 1, 0), (2, 1, 0, 1), (1, 0, 0, 2), (1, 1, 2, 0), (0, 0, 2, 1), (0, 1, 1, 2)] {
+        let base = positions.len() as u32;
+        for i in 0..=n {
+            for j in 0..=n {
+                let mut p = [0.0f32; 3];
+                p[fixed] = if side == 0 { lo[fixed] } else { hi[fixed] };
+                (p[u], p[v]) = (at(i, u), at(j, v));
+                positions.push(p);
+            }
+        }
+        let corner = |i: u32, j: u32| base + i * (n + 1) + j;
+        for i in 0..n {
+            for j in 0..n {
+                let q = [corner(i, j), corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1)];
+                indices.extend([q[0], q[1], q[2], q[0], q[2], q[3]]);
+            }
+        }
+    }
+    SourceMesh { positions, indices }
+}
+
+/// A panelled block keeps only its eight vertices among its corners (the rest lie on the lines
+/// between them), and casts what the reference casts and what the same block in one panel a
+/// face casts, at every sun; turned about a slanted axis (no corner then shares two coordinates
+/// with another), it keeps every corner and agrees as well.
+#[test]
+fn a_panelled_block_is_its_eight_vertices_and_casts_what_the_reference_does() {
+    let block = |b: &mut SceneBuilder, mesh: SourceMesh, transform: DMat4| {
+        let m = b.add_mesh("block", mesh);
+        b.add_node(SourceNode { origin: "BLOCK".into(), name: "BLOCK".into(), mesh: m, transform, receiver: false });
+    };
+    let scene = |mesh: SourceMesh, transform: DMat4| {
+        let mut b = SceneBuilder::new();
+        b.add_object("test", "WALL", wall(), true);
+        block(&mut b, mesh, transform);
+        b.build().unwrap()
+    };
+    // About its centre, about a slanted axis (a turn about the vertical alone would keep the
+    // vertical lines of corners).
+    let centre = DVec3::new(2.25, -2.0, 1.5);
+    let turned = DMat4::from_translation(centre)
+        * DMat4::from_axis_angle(DVec3::new(1.0, 0.5, 2.0).normalize(), 0.3)
+        * DMat4::from_translation(-centre);
+    let (lo, hi) = ([1.0, -3.0, 0.5], [3.5, -1.0, 2.5]);
+    let panelled = scene(panelled_cuboid(lo, hi, 4), DMat4::IDENTITY);
+    let plain = scene(cuboid(lo, hi), DMat4::IDENTITY);
+    let panelled_turned = scene(panelled_cuboid(lo, hi, 4), turned);
+    let corners = |engine: &ExactEngine| (0..engine.objects.len() as u32).map(|o| engine.objects.corners(o).len()).max();
+    let mut partly = 0;
+    for (scene, expected_corners) in [(&panelled, 8), (&panelled_turned, 98)] {
+        let engine = ExactEngine::new(scene);
+        assert_eq!(engine.convex_objects(), 2, "the wall and the block, each one object");
+        assert_eq!(corners(&engine), Some(expected_corners));
+        let requests = all_views(scene);
+        let fast = engine.fractions(&requests);
+        let reference = super::super::sunlit_fractions(scene, &requests);
+        for ((f, r), q) in fast.iter().zip(&reference).zip(&requests) {
+            assert!((f - r).abs() < 1e-6, "{q:?}: fast {f}, reference {r}");
+            partly += usize::from(*r > 0.01 && *r < 0.99);
+        }
+    }
+    let requests = all_views(&panelled);
+    assert_eq!(ExactEngine::new(&panelled).fractions(&requests), ExactEngine::new(&plain).fractions(&requests), "bit for bit");
+    assert!(partly >= 10, "only {partly} views partly shaded");
+}

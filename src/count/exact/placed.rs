@@ -294,11 +294,48 @@ fn distinct_corners(objects: &[Range<u32>], object_triangles: &[u32], triangles:
         }
         keyed.sort_unstable();
         keyed.dedup_by_key(|(bits, _)| *bits);
+        if keyed.len() > FEW_CORNERS {
+            drop_inner_corners(&mut keyed);
+        }
         let start = corners.len() as u32;
         corners.extend(keyed.iter().map(|(_, c)| *c));
         ranges.push(start..corners.len() as u32);
     }
     (ranges, corners)
+}
+
+/// Objects with more distinct corners than this are thinned ([`drop_inner_corners`]): a box or
+/// a rod has fewer, and none between two others.
+const FEW_CORNERS: usize = 16;
+
+/// Leaves out of a convex object's corners (keyed by their bits, as [`distinct_corners`] has
+/// them) each one lying strictly between two others on a line along a coordinate axis: its
+/// other two coordinates equal theirs bit for bit, its third between theirs. Such a corner is
+/// exactly a convex combination of the two, so never a vertex of the object's hull, and every
+/// vertex of the hull is kept: the hull, and so every shadow, footprint and bound taken from
+/// the corners, is the same set. A panelled block of nyt-blocks has up to 4,096 corners on its
+/// faces' grid lines and 8 vertices; every view that reaches it projected and sorted them all.
+/// Corners off such lines (a rotated block) stay; so do all where one is not finite.
+fn drop_inner_corners(keyed: &mut Vec<([u64; 3], u32)>) {
+    if keyed.iter().any(|(bits, _)| bits.iter().any(|b| !f64::from_bits(*b).is_finite())) {
+        return;
+    }
+    let mut inner = vec![false; keyed.len()];
+    let mut order: Vec<usize> = (0..keyed.len()).collect();
+    for axis in 0..3 {
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        let line = |i: usize| (keyed[i].0[a], keyed[i].0[b]);
+        let along = |i: usize| f64::from_bits(keyed[i].0[axis]);
+        order.sort_unstable_by(|&i, &j| line(i).cmp(&line(j)).then(along(i).total_cmp(&along(j))));
+        // Within each run of one line, all but its first and last lie between them.
+        for run in order.chunk_by(|&i, &j| line(i) == line(j)) {
+            if let [_, middle @ .., _] = run {
+                middle.iter().for_each(|&i| inner[i] = true);
+            }
+        }
+    }
+    let mut flags = inner.iter();
+    keyed.retain(|_| !flags.next().copied().unwrap_or(false));
 }
 
 /// Numbers the objects in the order their first triangles come by position, as a view's walk
@@ -341,4 +378,47 @@ fn group_positions(object: &[u32], objects: usize) -> (Vec<Range<u32>>, Vec<u32>
         next[o as usize] += 1;
     }
     (ranges, out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn keyed(points: &[[f64; 3]]) -> Vec<([u64; 3], u32)> {
+        let mut k: Vec<([u64; 3], u32)> = points.iter().enumerate().map(|(i, p)| (p.map(f64::to_bits), i as u32)).collect();
+        k.sort_unstable();
+        k
+    }
+
+    #[test]
+    fn only_corners_between_two_others_along_an_axis_go() {
+        // A square's corners, a point on each edge, one inside: the four corners stay.
+        let mut square = keyed(&[
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [0.0, 2.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [1.0, 2.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ]);
+        drop_inner_corners(&mut square);
+        assert_eq!(square.iter().map(|k| k.1).collect::<Vec<_>>().len(), 4);
+        assert!(square.iter().all(|k| k.1 < 4), "{square:?}");
+        // A point on a diagonal (no two coordinates shared) stays, though it is inside.
+        let mut diagonal = keyed(&[[0.0, 0.0, 0.0], [2.0, 2.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0]]);
+        drop_inner_corners(&mut diagonal);
+        assert_eq!(diagonal.len(), 4);
+        // Coordinates one ulp apart are not one line: nothing goes.
+        let off = f64::from_bits(1.0f64.to_bits() + 1);
+        let mut apart = keyed(&[[0.0, 1.0, 0.0], [1.0, off, 0.0], [2.0, 1.0, 0.0]]);
+        drop_inner_corners(&mut apart);
+        assert_eq!(apart.len(), 3);
+        // A corner not finite: nothing goes.
+        let mut broken = keyed(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [f64::NAN, 5.0, 0.0]]);
+        drop_inner_corners(&mut broken);
+        assert_eq!(broken.len(), 4);
+    }
 }
