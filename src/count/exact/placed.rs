@@ -1,7 +1,8 @@
 //! The convex objects of a whole scene, for the fast exact engine: every placement's objects
 //! ([`super::objects`], found once per mesh) indexed by triangle *position* (the culling's
 //! order, in which the engine keeps its world triangles), with each object's triangles, its
-//! distinct corners and its open caps.
+//! distinct corners (less those between two others along an axis: never its hull's vertices)
+//! and its open caps.
 //!
 //! Owns the numbering: objects are numbered in the order of their first triangle's position (the
 //! order a view's walk meets them); a corner is `3 · position + k`, corner `k` of the triangle at
