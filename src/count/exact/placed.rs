@@ -314,7 +314,9 @@ const FEW_CORNERS: usize = 16;
 /// other two coordinates equal theirs bit for bit, its third between theirs. Such a corner is
 /// exactly a convex combination of the two, so never a vertex of the object's hull, and every
 /// vertex of the hull is kept: the hull, and so every shadow, footprint and bound taken from
-/// the corners, is the same set. A panelled block of nyt-blocks has up to 4,096 corners on its
+/// the corners, is the same set (up to rounding: a projected corner on an edge can land a hair
+/// off it, where a hull of every corner may keep it; on nyt-blocks' floor 20 two values of
+/// 840,960 moved by 3e-8). A panelled block of nyt-blocks has up to 4,096 corners on its
 /// faces' grid lines and 8 vertices; every view that reaches it projected and sorted them all.
 /// Corners off such lines (a rotated block) stay; so do all where one is not finite.
 fn drop_inner_corners(keyed: &mut Vec<([u64; 3], u32)>) {
@@ -406,7 +408,7 @@ mod tests {
             [1.0, 1.0, 0.0],
         ]);
         drop_inner_corners(&mut square);
-        assert_eq!(square.iter().map(|k| k.1).collect::<Vec<_>>().len(), 4);
+        assert_eq!(square.len(), 4);
         assert!(square.iter().all(|k| k.1 < 4), "{square:?}");
         // A point on a diagonal (no two coordinates shared) stays, though it is inside.
         let mut diagonal = keyed(&[[0.0, 0.0, 0.0], [2.0, 2.0, 0.0], [1.0, 1.0, 0.0], [2.0, 0.0, 0.0]]);
