@@ -292,8 +292,8 @@ test('the memory budget keeps only the workers whose copies fit beside the engin
         eval(scene);
         const { createEngine } = await import('/sunlit.js');
         const engine = await createEngine({ resolution: 128, engine: 'exact', workers, memoryBudget });
-        // 2,000 small crates in a yard to the north make each worker's copy some MB, far above
-        // the few hundred kB by which the engine's instance differs between pages.
+        // 2,000 small crates in a yard to the north make each worker's copy some MB, well above
+        // the steps by which the engine's instance may differ between pages.
         const block = louvredBlock();
         for (let k = 0; k < 2000; k++) {
           const [x, y] = [-20 + (k % 50), 40 + Math.floor(k / 50)];
@@ -322,9 +322,14 @@ test('the memory budget keeps only the workers whose copies fit beside the engin
   assert.equal(all.pool, 2, JSON.stringify(s));
   assert.ok(s.workerBytes > 0 && s.engineBytes > 0, JSON.stringify(s));
   assert.deepEqual(all.said.filter((t) => t.includes('clipping workers')), [], 'nothing dropped, nothing said');
-  // Room for one and a half copies beside the engine: one worker.
+  // Room for one and a half copies beside the engine: one worker. The second page's engine may
+  // hold a few MB more than the first's (CI once saw 2.5 MiB more, never seen here in 16 pages;
+  // wasm memory grows in 64 KiB pages as the allocator asks), so what this case needs is checked
+  // on its own figures: room for at least one copy and fewer than two.
   const one = await run(2, s.engineBytes + 1.5 * s.workerBytes);
-  assert.ok(Math.abs(one.sizing.engineBytes - s.engineBytes) < 0.25 * s.workerBytes, `the engines differ by less than a copy: ${JSON.stringify([s, one.sizing])}`);
+  const room = (one.sizing.budgetBytes - one.sizing.engineBytes) / one.sizing.workerBytes;
+  assert.ok(room >= 1 && room < 2, `room for one copy, not two, beside this engine: ${JSON.stringify([s, one.sizing])}`);
+  assert.equal(one.sizing.workerBytes, s.workerBytes, 'the same model, the same estimate');
   assert.deepEqual([one.pool, one.sizing.workers, one.sizing.asked, one.memory], [1, 1, 2, 1], JSON.stringify(one.sizing));
   assert.ok(one.said.some((t) => t.startsWith('sunlit: 1 of 2 clipping workers')), one.said.join('\n'));
   assert.equal(one.csv, all.csv, 'one worker kept by the budget = two workers');
