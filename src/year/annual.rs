@@ -635,13 +635,13 @@ async fn spline_year(
     }
     drop(samples);
     let fitted: Vec<FittedRegime> = regimes.iter().zip(&fits).map(|(g, f)| FittedRegime { fits: f, cells: &g.cells, map: g.map }).collect();
-    let (refine, prove) = (options.refine, options.prove_never_dark);
-    let (rough, smooth) = evaluate(scene, location, &fitted, &|day| regime_of(calendar.phase(day)), refine, prove, year);
+    // Every row's sun once: the schedule's rows read it here, the refined steps' views below.
+    let suns = RowSuns::new(location, timesteps);
+    let (rough, smooth) = evaluate(scene, location, &suns, &fitted, &|day| regime_of(calendar.phase(day)), &options, year);
     year.stages.fitting += now() - start;
     let start = now();
     // Built only where a step is left to settle (without the engine's index it builds its own).
     let proofs = (options.many_casters, options.inner_corners);
-    let suns = RowSuns::new(location, timesteps);
     let certifier = (!(rough.is_empty() && smooth.is_empty())).then(|| certified::certifier(scene, views.engine.index(), proofs));
     let rough = match &certifier {
         Some(c) => certified::certify_steps(c, options.many_casters, &suns, rough, smooth, year),
@@ -759,20 +759,22 @@ impl SampleCells {
 }
 
 /// Fills every timestep of `schedule` from the fitted pieces of each day's regime (exact zeros
-/// where dark) and returns the timesteps to count directly: those whose sample cell spreads
-/// more than `refine`, and (refinement on) those near dark ([`NEAR_DARK`]), where the spline
-/// leaves its cell's bilinear interpolation ([`KINK`]), or dark at every sample of the year;
-/// and (refinement and `prove_never_dark` on) the interpolated ones, which are kept only where
+/// where dark; each row's sun from `suns`, as the refined steps' views take it) and returns the
+/// timesteps to count directly: those whose sample cell spreads more than `options.refine`, and
+/// (refinement on) those near dark ([`NEAR_DARK`]), where the spline leaves its cell's bilinear
+/// interpolation ([`KINK`]), or dark at every sample of the year; and (refinement and
+/// `options.prove_never_dark` on) the interpolated ones, which are kept only where
 /// proved never dark ([`certified::never_dark`]).
 fn evaluate(
     scene: &Scene,
     location: &Location,
+    suns: &RowSuns,
     regimes: &[FittedRegime],
     regime_of: &dyn Fn(f64) -> usize,
-    refine: f64,
-    prove_never_dark: bool,
+    options: &AnnualOptions,
     year: &mut Columns,
 ) -> (Vec<Rough>, Vec<Smooth>) {
+    let (refine, prove_never_dark) = (options.refine, options.prove_never_dark);
     let (mut rough, mut smooth) = (Vec::new(), Vec::new());
     // The fits and the schedule's columns are numbered from the range's first receiver, the
     // steps by the scene's receiver (what their views and certificates name).
@@ -788,7 +790,7 @@ fn evaluate(
         let grid_day = regime.map.grid_day(day as f64);
         for row in (day as usize - 1) * rows_per_day..day as usize * rows_per_day {
             let instant = timesteps.instant(row);
-            let sun = sun_direction(location, shading_sun_day(day), instant.hour);
+            let sun = suns.sun(row as u32);
             if !sun_is_up(sun) {
                 continue;
             }
