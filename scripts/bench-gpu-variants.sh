@@ -25,21 +25,16 @@ bin=/tmp/sunlit-variants; mkdir -p "$bin"
 for v in "${variants[@]}"; do gunzip -c "$C/$v.gz" > "$bin/$v" && chmod +x "$bin/$v" || exit 1; done
 { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv; nproc; } > "$R/machine.txt" 2>&1
 
+. scripts/timed-run.sh
 run() { # label timeout variant args...
   local label=$1 t=$2 v=$3; shift 3
   if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-150}" ]; then echo "skip $label" >> "$R/stderr.txt"; return; fi
-  echo "== $label: $*" >> "$R/stderr.txt"
-  local s e rc; s=$(date +%s.%N)
-  timeout "$t" "$bin/$v" "$@" > "$R/last.json" 2>>"$R/stderr.txt"; rc=$?
-  e=$(date +%s.%N)
-  python3 - "$label" "$v" "$rc" "$s" "$e" "$R/last.json" "$R/bench.jsonl" <<'PY'
+  local rc; timed_run "$R" "$label" "$t" "$v" "$bin/$v" "$@"; rc=$?
+  python3 - "$label" "$rc" "$R/last.json" <<'PY'
 import json, sys
-label, variant, rc, s, e, path, log = sys.argv[1:]
-text = open(path).read()
-with open(log, "a") as f:
-    f.write(json.dumps({"label": label, "variant": variant, "rc": int(rc), "wall": round(float(e) - float(s), 3), "out": text}) + "\n")
+label, rc, path = sys.argv[1:]
 try:
-    o = json.loads(text)
+    o = json.loads(open(path).read())
 except ValueError:
     o = {}
 print(label, rc, o.get("estimated_seconds_all_views"), o.get("views_rendered"), o.get("max_abs_error"), flush=True)

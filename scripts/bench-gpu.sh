@@ -29,21 +29,14 @@ OUT=${OUT:-target/bench-gpu}; mkdir -p "$OUT"
 T0=$(date +%s)
 gpu_flags=(); [ -n "${ATLAS:-}" ] && gpu_flags+=(--atlas "$ATLAS"); [ -n "${LANES:-}" ] && gpu_flags+=(--lanes "$LANES")
 views=(); [ -n "${VIEWS:-}" ] && views=(--views "$VIEWS")
+. scripts/timed-run.sh
 run() { # label timeout args...
   local label=$1 t=$(( $2 * ${TIMEOUT_SCALE:-1} )); shift 2
   if [ -n "${ONLY:-}" ] && ! [[ $label =~ $ONLY ]]; then return; fi
   if [ $(( $(date +%s) - T0 )) -gt "${BUDGET:-480}" ]; then echo "skip $label" >> "$OUT/stderr.txt"; return; fi
   # SKIP_EXACT=1: a second lease on the same machine need not time the CPU again.
   if [ -n "${SKIP_EXACT:-}" ] && [[ $label == *exact* || $label == *noop* ]]; then return; fi
-  echo "== $label: $*" >> "$OUT/stderr.txt"
-  local s e rc; s=$(date +%s.%N)
-  timeout "$t" "$B" "$@" > "$OUT/last.json" 2>>"$OUT/stderr.txt"; rc=$?
-  e=$(date +%s.%N)
-  python3 - "$label" "$rc" "$s" "$e" "$OUT/last.json" <<'PY' >> "$OUT/bench.jsonl"
-import json, sys
-label, rc, s, e, path = sys.argv[1:]
-print(json.dumps({"label": label, "rc": int(rc), "wall": round(float(e) - float(s), 3), "out": open(path).read()}))
-PY
+  timed_run "$OUT" "$label" "$t" "" "$B" "$@"
 }
 profiles=$(mktemp -d); trap 'rm -rf "$profiles"' EXIT
 # The machine first, so every figure below has its GPU and driver beside it.
