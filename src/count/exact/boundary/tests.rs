@@ -311,3 +311,43 @@ fn a_dense_canopy_off_the_lattice_agrees() {
         assert!(got > 0.0 && got < 0.5, "case {case}: {got}");
     }
 }
+
+#[test]
+fn shadows_apart_from_every_receiver_go_and_the_area_is_the_same_to_the_bit() {
+    // A wall with a window's hole (10 m²) and a stripe of shadow across its foot (1 m²).
+    let w = holed_wall();
+    let across = square(-1., 0.5, 5., 0.75);
+    let (alone, kept) = area_and_kept(&w, std::slice::from_ref(&across));
+    assert_eq!((alone, kept), (9.0, 9));
+    // Shadows in the hole and beyond the wall's side, before and after the stripe: their boxes
+    // meet no receiver triangle's, so they go, and the area is the stripe's alone, bit for bit.
+    let hole = [square(1.25, 1.25, 2.75, 1.75), tri([[1.5, 1.1], [2.5, 1.1], [2., 1.9]])];
+    let mut shadows = hole.to_vec();
+    shadows.extend([across.clone(), square(4.25, 0., 6., 3.)]);
+    assert_eq!(area_and_kept(&w, &shadows), (alone, kept));
+    // One filling the hole exactly touches the ring's boxes: kept, and it still shades nothing.
+    assert_eq!(area_and_kept(&w, &[square(1., 1., 3., 2.), across.clone()]), (9.0, 10));
+
+    // Many: 20 × 16 quarter squares over and around the wall (buckets), a third of them in the
+    // hole or off the wall. Those wholly inside the hole or beyond the wall are left out of a
+    // second run: the same area to the bit, and the reference's.
+    let leaves: Vec<Vec<DVec2>> = (0..320)
+        .filter(|k| k % 3 != 1)
+        .map(|k| {
+            let (x, y) = (-0.75 + 0.25 * (k % 22) as f64, -0.5 + 0.25 * (k / 22) as f64);
+            square(x, y, x + 0.125, y + 0.125)
+        })
+        .collect();
+    let apart = |p: &Vec<DVec2>| {
+        let (lo, hi) = p.iter().fold((DVec2::MAX, DVec2::MIN), |(lo, hi), q| (lo.min(*q), hi.max(*q)));
+        let in_hole = lo.x > 1. && hi.x < 3. && lo.y > 1. && hi.y < 2.;
+        let off = hi.x < 0. || lo.x > 4. || hi.y < 0. || lo.y > 3.;
+        in_hole || off
+    };
+    let near: Vec<Vec<DVec2>> = leaves.iter().filter(|p| !apart(p)).cloned().collect();
+    assert!(leaves.len() - near.len() > 60 && near.len() > 48, "{} leaves, {} near", leaves.len(), near.len());
+    let (all, kept_all) = area_and_kept(&w, &leaves);
+    let (some, kept_some) = area_and_kept(&w, &near);
+    assert_eq!((all, kept_all), (some, kept_some));
+    assert_agrees(&w, &leaves, "leaves over a holed wall");
+}
