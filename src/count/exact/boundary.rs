@@ -383,8 +383,8 @@ impl Boundary {
     }
 
     /// Drops every shadow whose box lies apart from every receiver polygon's box (on a wall
-    /// around a window, the shadows that fall in the window's hole: a sixth of a city floor's
-    /// shadows), leaving the area the same to the bit. Such a shadow meets no receiver, so it
+    /// around a window, the shadows that fall in the window's hole, and any in the margin the
+    /// shadows are clipped to: a sixth of a city floor's), leaving the area the same to the bit. Such a shadow meets no receiver, so it
     /// takes no area away and its own edges add 0 (no receiver beside them); where it covers
     /// another polygon's edge no receiver lies within a grid unit, so its ends there only split
     /// pieces of that edge that add 0, and its covers only end early an edge whose pieces add 0.
