@@ -36,10 +36,10 @@
 //! lie across a receiver triangle end to end), so most edges sort only their leaf neighbours'
 //! crossings. A shadow whose box meets no receiver polygon's (on a wall around a window, those in
 //! the window's hole) is dropped first, then a polygon inside one shadow (most leaves of a
-//! crowded canopy): neither can change the area. Polygons inside the union of several others are not looked for: on
-//! `blaas-trees-summer`'s heaviest sky views (34,000 leaf shadows, none inside one other) a grid
-//! of cells each inside one shadow (exact corner tests) found no polygon whose cells were all
-//! covered, at cells of 1/3 to 1/16 of a leaf, and cost 16% more instructions: the canopy's
+//! crowded canopy): neither can change the area. Polygons inside the union of several others
+//! are not looked for: on `blaas-trees-summer`'s heaviest sky views (34,000 leaf shadows, none
+//! inside one other) a grid of cells each inside one shadow (exact corner tests) found no
+//! polygon whose cells were all covered, at cells of 1/3 to 1/16 of a leaf, and cost 16% more instructions: the canopy's
 //! gaps put nearly every leaf on the union's boundary (docs/sky.md, "Benchmarks").
 
 use glam::DVec2;
@@ -384,11 +384,12 @@ impl Boundary {
 
     /// Drops every shadow whose box lies apart from every receiver polygon's box (on a wall
     /// around a window, the shadows that fall in the window's hole, and any in the margin the
-    /// shadows are clipped to: a sixth of a city floor's), leaving the area the same to the bit. Such a shadow meets no receiver, so it
-    /// takes no area away and its own edges add 0 (no receiver beside them); where it covers
-    /// another polygon's edge no receiver lies within a grid unit, so its ends there only split
-    /// pieces of that edge that add 0, and its covers only end early an edge whose pieces add 0.
-    /// A shadow inside one of these is apart too: none is left for [`Self::drop_covered`] to find.
+    /// shadows are clipped to: a sixth of a city floor's), leaving the area the same to the bit.
+    /// Such a shadow meets no receiver, so it takes no area away and its own edges add 0 (no
+    /// receiver beside them); where it covers another polygon's edge no receiver lies within a
+    /// grid unit, so its ends there only split pieces of that edge that add 0, and its covers
+    /// only end early an edge whose pieces add 0. A shadow inside one of these is apart too, so
+    /// [`Self::drop_covered`] loses no container it would have used.
     fn drop_apart(&mut self) {
         let mut boxes = std::mem::take(&mut self.receiver_boxes);
         boxes.clear();
