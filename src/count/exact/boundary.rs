@@ -395,9 +395,7 @@ impl Boundary {
         boxes.clear();
         boxes.extend(self.polys.iter().filter(|p| p.receiver).map(|p| (p.lo, p.hi)));
         let near = |p: &Poly| p.receiver || boxes.iter().any(|&(lo, hi)| boxes_overlap(p.lo, p.hi, lo, hi));
-        if !self.polys.iter().all(near) {
-            self.polys.retain(near);
-        }
+        self.polys.retain(near);
         self.receiver_boxes = boxes;
     }
 
