@@ -29,6 +29,16 @@ pub struct SunView {
 /// Fits the view. `points` are the receiver's vertices and `bounds` the scene's, both in world
 /// coordinates; `sun` points towards the sun (unit); `resolution` is the tile size in pixels.
 pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, resolution: u32) -> SunView {
+    fit_to(points, sun, bounds, origin, resolution, false)
+}
+
+/// [`fit`] with its depth ending at the farthest of `points` towards the sun, not at the
+/// scene's bound: a box about the points alone (one slab of a volume swept towards the sun).
+pub fn fit_slab(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, resolution: u32) -> SunView {
+    fit_to(points, sun, bounds, origin, resolution, true)
+}
+
+fn fit_to(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, resolution: u32, slab: bool) -> SunView {
     let (u0, v0) = perpendicular_basis(sun);
     // One buffer a view, not three: this runs once a tile, and on the GPU's culling it is most of
     // the host's work a view.
@@ -52,7 +62,8 @@ pub fn fit(points: &[DVec3], sun: DVec3, bounds: (DVec3, DVec3), origin: DVec3, 
     let row_x = ((a.0 * gc - b.0 * gs) * k).extend((a.1 * gc - b.1 * gs) * k);
     let row_y = ((a.0 * gs + b.0 * gc) * k).extend((a.1 * gs + b.1 * gc) * k);
 
-    let near = corners(bounds).iter().map(|p| (*p - origin).dot(sun)).fold(f64::NEG_INFINITY, f64::max);
+    let ends: &[DVec3] = if slab { points } else { &corners(bounds) };
+    let near = ends.iter().map(|p| (*p - origin).dot(sun)).fold(f64::NEG_INFINITY, f64::max);
     let far = points.iter().map(|p| (*p - origin).dot(sun)).fold(f64::INFINITY, f64::min);
     // Pads keep the scene's nearest point and the receiver's farthest point strictly inside [0, 1].
     let pad = extent * 1e-4;

@@ -42,11 +42,17 @@ impl Certifier<'_> {
                 if let Some(shape) = self.shapes.get(receiver) {
                     self.prove_run(receiver, shape, suns, &starts, &mut hints, &mut out);
                 }
-                (out, [hints.proofs, hints.runs_proved + hints.runs_failed, hints.runs_proved])
+                (out, [hints.proofs, hints.runs_proved + hints.runs_failed, hints.runs_proved, hints.apertures_proved])
             },
         );
-        let counts = answers.iter().fold([0; 3], |s, (_, c)| [s[0] + c[0], s[1] + c[1], s[2] + c[2]]);
-        log::debug!("never dark: {} proofs looked for, {} of them over runs of cells, {} runs proved", counts[0], counts[1], counts[2]);
+        let counts = answers.iter().fold([0; 4], |s, (_, c)| [s[0] + c[0], s[1] + c[1], s[2] + c[2], s[3] + c[3]]);
+        log::debug!(
+            "never dark: {} proofs looked for, {} of them over runs of cells, {} runs proved, {} proofs held through an aperture",
+            counts[0],
+            counts[1],
+            counts[2],
+            counts[3]
+        );
         answers.into_iter().map(|(out, _)| out).collect()
     }
 

@@ -35,6 +35,7 @@ use super::{CHUNK, COVER_MARGIN, Certifier, DirectionCone, MAX_SWEPT, NEAR_REACH
 use crate::count::exact::engine::{parallel_chunks, worker_threads};
 use crate::count::view::{self, convex_hull, perpendicular_basis};
 use crate::scene::NO_RECEIVER;
+use aperture::Aperture;
 
 /// Least share of the receiver's area the lit disc holds: ten times EnergyPlus's 1e-5 (a
 /// fraction under it is written as 0), so a proved step is lit in the schedule with room for an
@@ -56,6 +57,10 @@ const SLACK_SHARE: f64 = 0.25;
 /// Discs proved lit that a receiver's next proofs try before a search: proofs over a block of
 /// cells (see [`super::cells`]) come back to places its earlier blocks' discs proved.
 const RECENT_DISCS: usize = 4;
+
+/// Where the swept volume is cut along the cone, as shares of its reach, when one box about it
+/// holds too many triangles ([`Certifier::reached`]).
+const SECTIONS: [f64; 6] = [0.0, 1.0 / 256.0, 1.0 / 64.0, 1.0 / 16.0, 1.0 / 4.0, 1.0];
 
 /// Most times a candidate disc is checked against its whole swept volume and, blocked there,
 /// the search run again with what blocked it.
@@ -91,12 +96,15 @@ struct Footprint {
 }
 
 /// A cone's directions scaled to rise one unit off the receiver's plane: a point that high
-/// moves by minus such a vector onto the plane.
+/// moves by minus such a vector onto the plane; a point at height `hp` moves by `−(hp − height)`
+/// of one onto the plane of the disc ([`Aperture`]), `height` in front of the receiver's.
 struct Onto {
     axis: DVec3,
     generators: Vec<DVec3>,
     /// How far the farthest generator lies from the axis.
     spread: f64,
+    /// Where the disc is looked for: 0 on the receiver's plane.
+    height: f64,
 }
 
 /// The casters a never-dark search has taken (or passed over as never near).
@@ -155,6 +163,12 @@ pub(super) struct Hints {
     pub(super) runs_failed: usize,
     /// Proofs looked for (for the log).
     pub(super) proofs: usize,
+    /// The aperture's height where one proved the last set ([`aperture`]): tried first.
+    aperture: Option<f64>,
+    /// Apertures' discs proved lit, as `discs`.
+    aperture_discs: Vec<DVec2>,
+    /// Aperture proofs that held (for the log).
+    pub(super) apertures_proved: usize,
 }
 
 /// A bit-exact key of a point, for matching edges.
@@ -216,12 +230,18 @@ impl Outline {
     }
 
     /// The cone's directions scaled onto the receiver's plane, once per cone.
+    #[cfg(test)]
     fn onto(&self, cone: &DirectionCone) -> Onto {
+        self.onto_at(cone, 0.0)
+    }
+
+    /// The cone's directions scaled onto the plane `height` in front of the receiver's.
+    fn onto_at(&self, cone: &DirectionCone, height: f64) -> Onto {
         let onto = |g: DVec3| g / g.dot(self.normal);
         let axis = onto(cone.axis());
         let generators: Vec<DVec3> = cone.generators().iter().map(|g| onto(*g)).collect();
         let spread = generators.iter().map(|g| (*g - axis).length()).fold(0.0, f64::max);
-        Onto { axis, generators, spread }
+        Onto { axis, generators, spread, height }
     }
 
     /// The footprint of triangle `t` over the cone (`onto`, whose generators all face the
@@ -299,9 +319,12 @@ impl Outline {
         // cone would take it (the scaled directions are convex combinations of the scaled
         // generators). So a footprint whose corners moved along the axis stay `slack + r` off
         // the polygon's bounds is not near any disc: rejected before the generators are tried.
-        let highest = front.iter().map(|(_, hp)| *hp).fold(0.0, f64::max);
+        // Heights above the disc's plane: a point below it (between it and the receiver's)
+        // moves forward onto it, along the ray it would block on its way to the disc.
+        let rise = |hp: f64| hp - onto.height;
+        let highest = front.iter().map(|(_, hp)| rise(*hp).abs()).fold(0.0, f64::max);
         let slack = highest * onto.spread;
-        let along_axis: Vec<DVec2> = front.iter().map(|(p, hp)| self.flat(*p - onto.axis * *hp)).collect();
+        let along_axis: Vec<DVec2> = front.iter().map(|(p, hp)| self.flat(*p - onto.axis * rise(*hp))).collect();
         let (lo, hi) = bounds(&along_axis);
         if !(lo.is_finite() && hi.is_finite()) || apart(near, lo, hi, r + slack) {
             return None;
@@ -311,7 +334,8 @@ impl Outline {
         if slack <= SLACK_SHARE * self.radius {
             return Some(Footprint::new(along_axis, lo, hi, slack));
         }
-        let moved: Vec<DVec2> = onto.generators.iter().flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - *g * *hp))).collect();
+        let moved: Vec<DVec2> =
+            onto.generators.iter().flat_map(|g| front.iter().map(move |(p, hp)| self.flat(*p - *g * rise(*hp)))).collect();
         // The hull's bounds are the moved corners' bounds.
         let (lo, hi) = bounds(&moved);
         (!apart(near, lo, hi, r)).then(|| Footprint::new(moved, lo, hi, 0.0))
@@ -329,33 +353,33 @@ impl Outline {
             == 1
     }
 
-    /// Whether a disc of radius `r` at `q` lies inside the polygon and clear of every footprint.
-    fn clear(&self, q: DVec2, r: f64, footprints: &[Footprint]) -> bool {
-        self.contains(q)
-            && self.edges.iter().all(|(a, b)| segment_distance(q, *a, *b) >= r)
-            && footprints.iter().all(|f| f.distance_at_least(q, r))
+    /// Whether a disc of radius `r` at `q` on the aperture's plane lies, moved onto the
+    /// receiver's, inside the polygon, and is clear of every footprint.
+    fn clear(&self, q: DVec2, r: f64, footprints: &[Footprint], at: &Aperture) -> bool {
+        self.contains(q - at.shift) && at.inside(self, q, r) && footprints.iter().all(|f| f.distance_at_least(q, r))
     }
 
     /// A point where a disc of radius `r` is inside the polygon and clear of every footprint,
     /// looked for at the centroid, then at the middle of the widest clear stretch of each line
     /// searched in turn; None where none is found.
-    fn find(&self, footprints: &[Footprint], r: f64) -> Option<DVec2> {
-        if self.clear(self.centroid, r, footprints) {
-            return Some(self.centroid);
+    fn find(&self, footprints: &[Footprint], r: f64, at: &Aperture) -> Option<DVec2> {
+        let centroid = self.centroid + at.shift;
+        if self.clear(centroid, r, footprints, at) {
+            return Some(centroid);
         }
         // A few points of a grid across the bounds, each checked without a hull where the
         // footprints allow ([`separated`]): a wide clear patch is found before any line.
         let grid = (1..GRID).flat_map(|i| (1..GRID).map(move |j| (i, j)));
-        let at = |(i, j): (usize, usize)| self.lo + (self.hi - self.lo) * DVec2::new(i as f64, j as f64) / GRID as f64;
-        if let Some(q) = grid.map(at).find(|q| self.clear(*q, r, footprints)) {
+        let point = |(i, j): (usize, usize)| self.lo + at.shift + (self.hi - self.lo) * DVec2::new(i as f64, j as f64) / GRID as f64;
+        if let Some(q) = grid.map(point).find(|q| self.clear(*q, r, footprints, at)) {
             return Some(q);
         }
         // Line by line (the centroid's first), the widest clear stretch first.
-        self.lines().into_iter().find_map(|(o, d)| {
+        self.lines().into_iter().map(|(o, d)| (o + at.shift, d)).find_map(|(o, d)| {
             let mut stretches: Vec<(f64, DVec2)> =
-                self.clear_stretches(o, d, r, footprints).into_iter().map(|(t0, t1)| (t1 - t0, o + d * (0.5 * (t0 + t1)))).collect();
+                self.clear_stretches(o, d, r, footprints, at).into_iter().map(|(t0, t1)| (t1 - t0, o + d * (0.5 * (t0 + t1)))).collect();
             stretches.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.x.total_cmp(&b.1.x)).then(a.1.y.total_cmp(&b.1.y)));
-            stretches.into_iter().map(|(_, q)| q).find(|q| self.clear(*q, r, footprints))
+            stretches.into_iter().map(|(_, q)| q).find(|q| self.clear(*q, r, footprints, at))
         })
     }
 
@@ -371,18 +395,24 @@ impl Outline {
         out
     }
 
-    /// Stretches (parameters along `o + t·d`) of the line inside the polygon, at least `r` from
-    /// its boundary and from every footprint.
-    fn clear_stretches(&self, o: DVec2, d: DVec2, r: f64, footprints: &[Footprint]) -> Vec<(f64, f64)> {
-        let side = |p: DVec2| d.perp_dot(p - o);
+    /// Stretches (parameters along `o + t·d`, on the aperture's plane) of the line inside the
+    /// polygon moved onto it, at least `r` from its boundary and from every footprint.
+    fn clear_stretches(&self, o: DVec2, d: DVec2, r: f64, footprints: &[Footprint], at: &Aperture) -> Vec<(f64, f64)> {
+        // Crossings with the polygon where it lies on this plane: the line moved back onto it.
+        let below = o - at.shift;
+        let side = |p: DVec2| d.perp_dot(p - below);
         let mut crossings: Vec<f64> = self
             .edges
             .iter()
             .filter(|(a, b)| (side(*a) > 0.0) != (side(*b) > 0.0))
-            .map(|(a, b)| (*a + (*b - *a) * (side(*a) / (side(*a) - side(*b))) - o).dot(d))
+            .map(|(a, b)| (*a + (*b - *a) * (side(*a) / (side(*a) - side(*b))) - below).dot(d))
             .collect();
         crossings.sort_by(f64::total_cmp);
-        let mut blocked: Vec<(f64, f64)> = self.edges.iter().filter_map(|(a, b)| capsule_interval(o, d, *a, *b, r)).collect();
+        let mut blocked: Vec<(f64, f64)> = if at.walls.is_empty() {
+            self.edges.iter().filter_map(|(a, b)| capsule_interval(o, d, *a, *b, r)).collect()
+        } else {
+            at.walls.iter().filter_map(|w| w.interval(o, d, r)).collect()
+        };
         blocked.extend(footprints.iter().filter_map(|f| f.interval(o, d, r)));
         blocked.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut out = Vec::new();
@@ -613,18 +643,52 @@ impl Certifier<'_> {
     }
 
     /// Whether some disc of `shape` holding [`MIN_LIT_SHARE`] of its area is lit at every
-    /// direction of `cone` (every one in front of the receiver and above the horizon). The
-    /// first candidate disc is the last one `hints` proved, then one looked for among the
-    /// casters near the receiver (found here along the cone where the hints have none). Neither
-    /// hint decides anything: every caster in the volume the candidate disc sweeps is checked.
+    /// direction of `cone` (every one in front of the receiver and above the horizon): one on
+    /// the receiver's plane, else one seen through an aperture in front of it ([`aperture`]);
+    /// the aperture first where it proved the receiver's last set.
     pub(super) fn not_dark_over(&self, shape: &Shape, cone: &DirectionCone, hints: &mut Hints) -> bool {
         let Some(outline) = &shape.outline else { return false };
         hints.proofs += 1;
+        let aperture_first = hints.aperture.is_some();
+        if !aperture_first && self.lit_disc(shape, outline, cone, 0.0, &mut hints.discs, &mut hints.near) {
+            return true;
+        }
+        let height = hints.aperture.or_else(|| self.aperture_height(outline, hints.near.as_deref().unwrap_or_default()));
+        if let Some(height) = height.filter(|h| *h > 0.0) {
+            if hints.aperture != Some(height) {
+                hints.aperture_discs.clear();
+            }
+            if self.lit_disc(shape, outline, cone, height, &mut hints.aperture_discs, &mut hints.near) {
+                hints.aperture = Some(height);
+                hints.apertures_proved += 1;
+                return true;
+            }
+            hints.aperture = None;
+        }
+        aperture_first && self.lit_disc(shape, outline, cone, 0.0, &mut hints.discs, &mut hints.near)
+    }
+
+    /// Whether a disc on the plane `height` in front of the receiver's (0: on it) is lit, moved
+    /// along every direction of `cone` onto the receiver. The first candidate disc is the last
+    /// one `discs` proved, then one looked for among the casters near the receiver (found here
+    /// along the cone where `near_hint` has none). Neither hint decides anything: every caster
+    /// in the volume the candidate disc's rays sweep is checked.
+    #[allow(clippy::too_many_arguments)]
+    fn lit_disc(
+        &self,
+        shape: &Shape,
+        outline: &Outline,
+        cone: &DirectionCone,
+        height: f64,
+        discs: &mut Vec<DVec2>,
+        near_hint: &mut Option<Vec<usize>>,
+    ) -> bool {
         let tolerance = PLANE_TOLERANCE * (1.0 + self.extent);
         // The GPU rounds in f32 about the scene's origin: the disc keeps this much clear too.
         let r = outline.radius + COVER_MARGIN * (1.0 + self.extent);
-        let reach = self.reach(cone);
-        let onto = outline.onto(cone);
+        let reach = self.reach(cone) + height;
+        let onto = outline.onto_at(cone, height);
+        let at = Aperture::of(outline, &onto);
         let mut footprints = Vec::new();
         // Footprints of the fresh casters among `positions` that may come near a disc, and
         // which casters those were (one position each).
@@ -668,8 +732,8 @@ impl Certifier<'_> {
         };
         // The last disc proved lit first, against only what its own volume reaches, each caster
         // stopping the check as soon as it comes near the disc (its footprint kept only near it).
-        let hinted = hints.discs.first().copied().filter(|q| outline.clear(*q, r, &[]));
-        if let Some(found) = hinted.and_then(|q| Some((q, self.reached(&outline.square(q, r), cone, reach)?))) {
+        let hinted = discs.first().copied().filter(|q| outline.clear(*q, r, &[], &at));
+        if let Some(found) = hinted.and_then(|q| Some((q, self.reached(&outline.aperture_square(q, r, &onto), cone, reach)?))) {
             let (q, found) = found;
             let (mut near_q, mut seen) = (Vec::new(), Seen::default());
             let blocked = found.chunks(1).any(|p| {
@@ -680,30 +744,30 @@ impl Certifier<'_> {
                 return true;
             }
             // Blocked by a caster of its own volume: not worth trying again over this cone.
-            hints.discs.remove(0);
+            discs.remove(0);
         }
         // The casters near the receiver (a scrim's rods, a reveal) first, for a good candidate;
         // what the candidate's own volume holds decides. Found once per set, and only those
         // whose footprint came near the receiver are handed to its halves.
-        let (listed, first) = match hints.near.take() {
+        let (listed, first) = match near_hint.take() {
             Some(listed) => (listed, false),
             None => (self.reached(&shape.points, cone, (NEAR_REACH * (1.0 + self.extent)).min(reach)).unwrap_or_default(), true),
         };
         let mut kept = Vec::new();
         let mut seen = Seen::default();
-        let whole = (outline.lo, outline.hi);
+        let whole = (outline.lo + at.shift, outline.hi + at.shift);
         add(&listed, &mut footprints, &mut kept, &mut seen, whole);
-        hints.near = Some(if first { kept } else { listed });
+        *near_hint = Some(if first { kept } else { listed });
         for _ in 0..ROUNDS {
             // A disc that proved a recent set, where it is still clear here; else a search.
-            let last = hints.discs.iter().copied().find(|q| outline.clear(*q, r, &footprints));
-            let Some(q) = last.or_else(|| outline.find(&footprints, r)) else { return false };
-            let Some(found) = self.reached(&outline.square(q, r), cone, reach) else { return false };
+            let last = discs.iter().copied().find(|q| outline.clear(*q, r, &footprints, &at));
+            let Some(q) = last.or_else(|| outline.find(&footprints, r, &at)) else { return false };
+            let Some(found) = self.reached(&outline.aperture_square(q, r, &onto), cone, reach) else { return false };
             let start = add(&found, &mut footprints, &mut Vec::new(), &mut seen, whole);
-            hints.discs.retain(|d| *d != q);
+            discs.retain(|d| *d != q);
             if footprints[start..].iter().all(|f| f.distance_at_least(q, r)) {
-                hints.discs.insert(0, q);
-                hints.discs.truncate(RECENT_DISCS);
+                discs.insert(0, q);
+                discs.truncate(RECENT_DISCS);
                 return true;
             }
             // Blocked: the next round searches again with what blocked it.
@@ -715,15 +779,43 @@ impl Certifier<'_> {
     /// cone within `reach`; None past [`MAX_SWEPT`].
     fn reached(&self, points: &[DVec3], cone: &DirectionCone, reach: f64) -> Option<Vec<usize>> {
         let corners = self.swept_corners(points, cone, reach);
-        let view = view::fit(&corners, cone.axis(), self.index.bounds, self.index.origin, 64);
+        let found = self.culled(&corners, cone);
+        if found.len() <= MAX_SWEPT {
+            return Some(found);
+        }
+        // The culling's box holds the volume's far cross-section all the way from the receiver,
+        // where a city's scrims and facades stand: culled again in sections along the cone,
+        // each box only as wide as its own part of the volume (and reaching on to the scene's
+        // end, so each holds what lies beyond its part too).
+        let mut found: Vec<usize> = SECTIONS
+            .windows(2)
+            .flat_map(|ends| {
+                let from: Vec<DVec3> =
+                    cone.generators().iter().flat_map(|g| points.iter().map(move |p| *p + *g * (ends[0] * reach))).collect();
+                let to: Vec<DVec3> =
+                    cone.generators().iter().flat_map(|g| points.iter().map(move |p| *p + *g * (ends[1] * reach))).collect();
+                let corners = [from, to].concat();
+                let view = view::fit_slab(&corners, cone.axis(), self.index.bounds, self.index.origin, 64);
+                let mut reached = Vec::new();
+                self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
+                reached.into_iter().flatten()
+            })
+            .collect();
+        found.sort_unstable();
+        found.dedup();
+        (found.len() <= MAX_SWEPT).then_some(found)
+    }
+
+    /// The positions of the triangles in the culling's box about `corners`, along the cone's
+    /// axis from them to the scene's end.
+    fn culled(&self, corners: &[DVec3], cone: &DirectionCone) -> Vec<usize> {
+        let view = view::fit(corners, cone.axis(), self.index.bounds, self.index.origin, 64);
         let mut reached = Vec::new();
         self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
-        if reached.iter().map(|r| r.len()).sum::<usize>() > MAX_SWEPT {
-            return None;
-        }
-        Some(reached.into_iter().flatten().collect())
+        reached.into_iter().flatten().collect()
     }
 }
 
+mod aperture;
 #[cfg(test)]
 mod tests;
