@@ -779,7 +779,7 @@ impl Certifier<'_> {
     /// cone within `reach`; None past [`MAX_SWEPT`].
     fn reached(&self, points: &[DVec3], cone: &DirectionCone, reach: f64) -> Option<Vec<usize>> {
         let corners = self.swept_corners(points, cone, reach);
-        let found = self.culled(&corners, cone);
+        let found = self.culled(&view::fit(&corners, cone.axis(), self.index.bounds, self.index.origin, 64));
         if found.len() <= MAX_SWEPT {
             return Some(found);
         }
@@ -790,15 +790,12 @@ impl Certifier<'_> {
         let mut found: Vec<usize> = SECTIONS
             .windows(2)
             .flat_map(|ends| {
-                let from: Vec<DVec3> =
-                    cone.generators().iter().flat_map(|g| points.iter().map(move |p| *p + *g * (ends[0] * reach))).collect();
-                let to: Vec<DVec3> =
-                    cone.generators().iter().flat_map(|g| points.iter().map(move |p| *p + *g * (ends[1] * reach))).collect();
-                let corners = [from, to].concat();
-                let view = view::fit_slab(&corners, cone.axis(), self.index.bounds, self.index.origin, 64);
-                let mut reached = Vec::new();
-                self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
-                reached.into_iter().flatten()
+                // The points moved along each generator to the slab's two ends.
+                let corners: Vec<DVec3> = ends
+                    .iter()
+                    .flat_map(|&end| cone.generators().iter().flat_map(move |g| points.iter().map(move |p| *p + *g * (end * reach))))
+                    .collect();
+                self.culled(&view::fit_slab(&corners, cone.axis(), self.index.bounds, self.index.origin, 64))
             })
             .collect();
         found.sort_unstable();
@@ -806,10 +803,8 @@ impl Certifier<'_> {
         (found.len() <= MAX_SWEPT).then_some(found)
     }
 
-    /// The positions of the triangles in the culling's box about `corners`, along the cone's
-    /// axis from them to the scene's end.
-    fn culled(&self, corners: &[DVec3], cone: &DirectionCone) -> Vec<usize> {
-        let view = view::fit(corners, cone.axis(), self.index.bounds, self.index.origin, 64);
+    /// The positions of the triangles in `view`'s box (what the culling visits).
+    fn culled(&self, view: &view::SunView) -> Vec<usize> {
         let mut reached = Vec::new();
         self.index.culling.visit_triangles(&view.view_proj, |r| reached.push(r));
         reached.into_iter().flatten().collect()
